@@ -1,0 +1,187 @@
+//! Adapter and device creation, and the device's error channel.
+
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use crate::error::GpuError;
+
+/// How long any single wait for the GPU may take before it is reported as a hang. Submissions are
+/// kept to a fraction of a second, so this is only reached when something is badly wrong.
+pub const DEFAULT_GPU_TIMEOUT: Duration = Duration::from_secs(120);
+
+/// A device and queue plus what illum needs to know about them.
+///
+/// `wgpu::Device` and `wgpu::Queue` are cheap handles, so renderers clone them; the viewer builds
+/// a `GpuContext` around eframe's own device with [`GpuContext::from_device`].
+#[derive(Clone)]
+pub struct GpuContext {
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub adapter_info: wgpu::AdapterInfo,
+    /// True when the device was created with `TIMESTAMP_QUERY`, so passes can be timed on the GPU.
+    pub timestamps: bool,
+    /// Errors raised outside any error scope (validation, out of memory) and device loss, drained
+    /// by [`GpuContext::check`] after each submission.
+    errors: Arc<Mutex<Vec<GpuError>>>,
+}
+
+impl GpuContext {
+    /// Creates a headless device.
+    ///
+    /// Backends come from `WGPU_BACKEND` (default: Vulkan, Metal and DX12; GL is left out because
+    /// the path tracer needs compute). `WGPU_ADAPTER_NAME` picks an adapter by case-insensitive
+    /// substring. Otherwise a hardware adapter is preferred, and under CI (`CI` set) lavapipe is
+    /// preferred so that reference images are compared on the driver that made them.
+    pub fn new() -> Result<Self, GpuError> {
+        pollster::block_on(Self::new_async())
+    }
+
+    async fn new_async() -> Result<Self, GpuError> {
+        let mut instance_desc = wgpu::InstanceDescriptor::new_without_display_handle();
+        instance_desc.backends = wgpu::Backends::VULKAN | wgpu::Backends::METAL | wgpu::Backends::DX12;
+        let instance_desc = instance_desc.with_env();
+        let backends = instance_desc.backends;
+        let instance = wgpu::Instance::new(instance_desc);
+
+        let adapters = instance.enumerate_adapters(backends).await;
+        let adapter = choose_adapter(adapters, backends)?;
+        let info = adapter.get_info();
+        log::info!("GPU adapter: {} ({:?}, {})", info.name, info.backend, info.driver);
+
+        let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        let mut required_features = wgpu::Features::empty();
+        if timestamps {
+            required_features |= wgpu::Features::TIMESTAMP_QUERY;
+        }
+        // Ask for everything the adapter offers: large storage buffers and textures are what let
+        // big renders proceed, and the resolution check reports against these same limits.
+        let required_limits = adapter.limits();
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("illum device"),
+                required_features,
+                required_limits,
+                experimental_features: wgpu::ExperimentalFeatures::disabled(),
+                memory_hints: wgpu::MemoryHints::Performance,
+                trace: wgpu::Trace::Off,
+            })
+            .await
+            .map_err(|e| GpuError::RequestDevice { adapter: info.name.clone(), message: e.to_string() })?;
+        Ok(Self::from_device(device, queue, info))
+    }
+
+    /// Wraps an existing device (for example eframe's), installing illum's error handlers.
+    pub fn from_device(device: wgpu::Device, queue: wgpu::Queue, adapter_info: wgpu::AdapterInfo) -> Self {
+        let timestamps = device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        let errors: Arc<Mutex<Vec<GpuError>>> = Arc::default();
+        {
+            let errors = errors.clone();
+            device.on_uncaptured_error(Arc::new(move |error: wgpu::Error| {
+                let converted = convert_error("an uncaptured GPU operation", error);
+                log::error!("{converted}");
+                errors.lock().unwrap_or_else(|p| p.into_inner()).push(converted);
+            }));
+        }
+        {
+            let errors = errors.clone();
+            device.set_device_lost_callback(move |reason, message| {
+                // Dropping the device on purpose also reports "lost"; that is not an error.
+                if reason != wgpu::DeviceLostReason::Destroyed {
+                    errors
+                        .lock()
+                        .unwrap_or_else(|p| p.into_inner())
+                        .push(GpuError::DeviceLost { message: format!("{reason:?}: {message}") });
+                }
+            });
+        }
+        Self { device, queue, adapter_info, timestamps, errors }
+    }
+
+    /// True for CPU implementations (lavapipe / llvmpipe, WARP, SwiftShader).
+    pub fn is_software(&self) -> bool {
+        self.adapter_info.device_type == wgpu::DeviceType::Cpu
+    }
+
+    /// Returns the first error the device reported since the last call, if any.
+    pub fn check(&self) -> Result<(), GpuError> {
+        let mut errors = self.errors.lock().unwrap_or_else(|p| p.into_inner());
+        if errors.is_empty() { Ok(()) } else { Err(errors.remove(0)) }
+    }
+
+    /// Blocks until all submitted work is done, turning a hang into [`GpuError::Timeout`].
+    pub fn wait_idle(&self, context: &str) -> Result<(), GpuError> {
+        self.device
+            .poll(wgpu::PollType::Wait { submission_index: None, timeout: Some(DEFAULT_GPU_TIMEOUT) })
+            .map_err(|e| match e {
+                wgpu::PollError::Timeout => GpuError::Timeout {
+                    context: context.to_owned(),
+                    seconds: DEFAULT_GPU_TIMEOUT.as_secs_f64(),
+                },
+                other => GpuError::DeviceLost { message: other.to_string() },
+            })?;
+        self.check()
+    }
+
+    /// Runs `f` inside validation and out-of-memory error scopes, returning the first error raised.
+    /// Used around pipeline and buffer creation, where wgpu reports errors asynchronously.
+    pub fn scoped<T>(&self, context: &str, f: impl FnOnce() -> T) -> Result<T, GpuError> {
+        let oom = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let validation = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let value = f();
+        let validation_error = pollster::block_on(validation.pop());
+        let oom_error = pollster::block_on(oom.pop());
+        if let Some(e) = validation_error.or(oom_error) {
+            return Err(convert_error(context, e));
+        }
+        self.check()?;
+        Ok(value)
+    }
+}
+
+fn convert_error(context: &str, error: wgpu::Error) -> GpuError {
+    match error {
+        wgpu::Error::OutOfMemory { source } => {
+            GpuError::OutOfMemory { context: context.to_owned(), message: source.to_string() }
+        }
+        wgpu::Error::Validation { description, .. } | wgpu::Error::Internal { description, .. } => {
+            GpuError::Validation { context: context.to_owned(), message: description }
+        }
+    }
+}
+
+fn choose_adapter(adapters: Vec<wgpu::Adapter>, backends: wgpu::Backends) -> Result<wgpu::Adapter, GpuError> {
+    if adapters.is_empty() {
+        return Err(GpuError::NoAdapter { backends: format!("{backends:?}") });
+    }
+    let describe = |adapters: &[wgpu::Adapter]| {
+        adapters
+            .iter()
+            .map(|a| {
+                let info = a.get_info();
+                format!("{:?} ({:?})", info.name, info.backend)
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    if let Ok(wanted) = std::env::var("WGPU_ADAPTER_NAME") {
+        let needle = wanted.to_lowercase();
+        let available = describe(&adapters);
+        return adapters
+            .into_iter()
+            .find(|a| a.get_info().name.to_lowercase().contains(&needle))
+            .ok_or(GpuError::AdapterNotFound { wanted, available });
+    }
+    let under_ci = std::env::var_os("CI").is_some();
+    let rank = |a: &wgpu::Adapter| {
+        let t = a.get_info().device_type;
+        let software = t == wgpu::DeviceType::Cpu;
+        match (under_ci, software, t) {
+            (true, true, _) => 0,
+            (_, false, wgpu::DeviceType::DiscreteGpu) => 1,
+            (_, false, wgpu::DeviceType::IntegratedGpu) => 2,
+            (_, false, _) => 3,
+            (false, true, _) => 4,
+        }
+    };
+    Ok(adapters.into_iter().min_by_key(rank).expect("checked non-empty above"))
+}

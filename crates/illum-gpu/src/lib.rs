@@ -1,0 +1,18 @@
+//! illum-gpu: the GPU core shared by both renderers.
+//!
+//! - [`GpuContext`]: instance, adapter and device creation that works headless on Mesa lavapipe,
+//!   honours `WGPU_BACKEND` / `WGPU_ADAPTER_NAME`, and turns "no adapter", device loss and
+//!   validation errors into [`GpuError`]s instead of panics or hangs.
+//! - [`readback`]: copy a GPU buffer back to the CPU.
+//! - [`timing`]: GPU pass timing with timestamp queries, where the adapter has them.
+//! - [`shader`]: WGSL composition (naga_oil) and validation.
+
+mod context;
+mod error;
+pub mod readback;
+pub mod shader;
+pub mod timing;
+
+pub use context::{DEFAULT_GPU_TIMEOUT, GpuContext};
+pub use error::GpuError;
+pub use wgpu;

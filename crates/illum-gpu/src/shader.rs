@@ -1,0 +1,106 @@
+//! WGSL composition and validation.
+//!
+//! Shaders live in the workspace's `shaders/` folder and are embedded at compile time. Shared
+//! modules declare `#define_import_path illum::NAME` and are pulled in with `#import` by the
+//! naga_oil composer; `#ifdef` shader defs select code per pipeline. The result is a validated
+//! `naga::Module` handed to wgpu directly, so wgpu never re-parses WGSL.
+
+use std::borrow::Cow;
+use std::collections::HashMap;
+
+use naga_oil::compose::{
+    ComposableModuleDescriptor, Composer, NagaModuleDescriptor, ShaderDefValue, ShaderLanguage, ShaderType,
+};
+
+use crate::{GpuContext, GpuError};
+
+/// One WGSL file: its path relative to the workspace (for error messages) and its text.
+#[derive(Clone, Copy, Debug)]
+pub struct ShaderFile {
+    pub path: &'static str,
+    pub source: &'static str,
+}
+
+macro_rules! shader_file {
+    ($path:literal) => {
+        ShaderFile { path: $path, source: include_str!(concat!("../../../", $path)) }
+    };
+}
+
+/// Shared modules, in dependency order (a module may import only those before it).
+pub const COMMON_MODULES: &[ShaderFile] = &[
+    shader_file!("shaders/common/constants.wgsl"),
+    shader_file!("shaders/common/rng.wgsl"),
+    shader_file!("shaders/common/sampling.wgsl"),
+];
+
+/// A shader def: `#ifdef NAME` / `#if NAME == value` in WGSL.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Def {
+    Bool(bool),
+    UInt(u32),
+}
+
+/// Composes `entry` with `modules` into one validated naga module.
+pub fn compose(
+    modules: &[ShaderFile],
+    entry: &ShaderFile,
+    defs: &[(&str, Def)],
+) -> Result<naga::Module, GpuError> {
+    let shader_defs: HashMap<String, ShaderDefValue> = defs
+        .iter()
+        .map(|(name, value)| {
+            let value = match value {
+                Def::Bool(b) => ShaderDefValue::Bool(*b),
+                Def::UInt(u) => ShaderDefValue::UInt(*u),
+            };
+            ((*name).to_owned(), value)
+        })
+        .collect();
+    let mut composer = Composer::default();
+    for module in modules {
+        let added = composer
+            .add_composable_module(ComposableModuleDescriptor {
+                source: module.source,
+                file_path: module.path,
+                language: ShaderLanguage::Wgsl,
+                shader_defs: shader_defs.clone(),
+                ..Default::default()
+            })
+            .map(|_| ());
+        added.map_err(|e| GpuError::Shader {
+            file: module.path.to_owned(),
+            message: e.emit_to_string(&composer),
+        })?;
+    }
+    composer
+        .make_naga_module(NagaModuleDescriptor {
+            source: entry.source,
+            file_path: entry.path,
+            shader_type: ShaderType::Wgsl,
+            shader_defs,
+            ..Default::default()
+        })
+        .map_err(|e| GpuError::Shader { file: entry.path.to_owned(), message: e.emit_to_string(&composer) })
+}
+
+/// Validates a composed module with naga's validator (all capabilities wgpu's core needs).
+pub fn validate(module: &naga::Module, file: &str) -> Result<naga::valid::ModuleInfo, GpuError> {
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default())
+        .validate(module)
+        .map_err(|e| GpuError::Shader { file: file.to_owned(), message: format!("{e:?}") })
+}
+
+/// Creates a wgpu shader module from a composed naga module, reporting validation errors.
+pub fn create_module(
+    gpu: &GpuContext,
+    module: naga::Module,
+    label: &str,
+) -> Result<wgpu::ShaderModule, GpuError> {
+    gpu.scoped(label, || {
+        gpu.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(label),
+            source: wgpu::ShaderSource::Naga(Cow::Owned(module)),
+        })
+    })
+}

@@ -1,0 +1,152 @@
+//! Atomic file output: a reader of the target path sees either the old file or the complete
+//! new one, never a half-written image, even if the program is interrupted or the encoder
+//! fails midway.
+//!
+//! The data go to a temporary file in the *same directory* as the target (a rename is only
+//! atomic within one file system), which is flushed and fsynced before it is renamed over
+//! the target. On any error the temporary file is deleted and the target is left untouched.
+
+use std::fs::File;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use crate::ImageError;
+
+/// Writes `path` atomically. `write` receives the temporary file (seekable, as some encoders
+/// need); it should write the whole content and may return any [`ImageError`], which is
+/// passed on after the temporary file has been removed. The parent directory is created if
+/// it is missing.
+pub fn write_atomically<F>(path: impl AsRef<Path>, write: F) -> Result<(), ImageError>
+where
+    F: FnOnce(&mut File) -> Result<(), ImageError>,
+{
+    let path = path.as_ref();
+    let file_name = path
+        .file_name()
+        .ok_or_else(|| ImageError::invalid(path, "the path names no file (it is empty or ends in '..')"))?;
+    let dir: PathBuf = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    std::fs::create_dir_all(&dir).map_err(|e| ImageError::io(&dir, "creating the output directory", e))?;
+
+    // A dot-prefixed name that shows what it will become, e.g. ".render.png.a1B2c3.tmp".
+    let mut prefix = std::ffi::OsString::from(".");
+    prefix.push(file_name);
+    prefix.push(".");
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(&prefix).suffix(".tmp");
+    // tempfile creates files readable by the owner only; output images should get the usual
+    // permissions (0o666 less the umask), as a plain `File::create` would give them.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    // From here on, dropping `tmp` (on any early return) deletes the temporary file.
+    let mut tmp = builder
+        .tempfile_in(&dir)
+        .map_err(|e| ImageError::io(path, "creating a temporary file next to the output", e))?;
+
+    write(tmp.as_file_mut())?;
+
+    let file = tmp.as_file_mut();
+    file.flush().map_err(|e| ImageError::io(path, "flushing the temporary file", e))?;
+    // fsync before the rename: otherwise a crash shortly after could leave the *renamed*
+    // file with missing data on some file systems.
+    file.sync_all().map_err(|e| ImageError::io(path, "syncing the temporary file to disk", e))?;
+
+    tmp.persist(path).map_err(|e| {
+        // `e.file` is the temporary file; dropping it with `e` deletes it.
+        ImageError::io(path, "renaming the temporary file onto the output", e.error)
+    })?;
+
+    // Make the rename itself durable. Best effort: some file systems refuse to fsync a
+    // directory, and the image is already complete and in place.
+    #[cfg(unix)]
+    if let Ok(d) = File::open(&dir) {
+        let _ = d.sync_all();
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn entries(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn writes_new_file_and_creates_parent() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("a/b/out.bin");
+        write_atomically(&target, |f| f.write_all(b"hello").map_err(|e| ImageError::io("x", "writing", e)))
+            .unwrap();
+        assert_eq!(std::fs::read(&target).unwrap(), b"hello");
+        assert_eq!(entries(&dir.path().join("a/b")), vec!["out.bin".to_string()]);
+    }
+
+    #[test]
+    fn replaces_existing_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("out.bin");
+        std::fs::write(&target, b"old content").unwrap();
+        write_atomically(&target, |f| f.write_all(b"new").map_err(|e| ImageError::io("x", "writing", e)))
+            .unwrap();
+        assert_eq!(std::fs::read(&target).unwrap(), b"new");
+    }
+
+    #[test]
+    fn failing_writer_leaves_old_file_and_no_temporary() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("out.bin");
+        std::fs::write(&target, b"old content").unwrap();
+        let err = write_atomically(&target, |f| {
+            // Write part of the content, then fail, as an encoder might.
+            f.write_all(b"half").unwrap();
+            Err(ImageError::invalid(&target, "simulated encoder failure"))
+        })
+        .unwrap_err();
+        assert!(err.to_string().contains("simulated encoder failure"), "{err}");
+        assert_eq!(std::fs::read(&target).unwrap(), b"old content");
+        assert_eq!(entries(dir.path()), vec!["out.bin".to_string()], "temporary file left");
+    }
+
+    #[test]
+    fn failing_writer_creates_no_target() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("never.bin");
+        write_atomically(&target, |_| Err(ImageError::invalid("never.bin", "no"))).unwrap_err();
+        assert!(!target.exists());
+        assert!(entries(dir.path()).is_empty());
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn output_is_not_owner_only() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("perm.bin");
+        write_atomically(&target, |_| Ok(())).unwrap();
+        let mode = std::fs::metadata(&target).unwrap().permissions().mode() & 0o777;
+        // A plain File::create gets 0o666 less the umask; the atomic writer must match it
+        // rather than keep tempfile's owner-only 0o600.
+        let plain = dir.path().join("plain.bin");
+        std::fs::File::create(&plain).unwrap();
+        let plain_mode = std::fs::metadata(&plain).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode, plain_mode, "atomic {mode:o} vs plain {plain_mode:o}");
+    }
+
+    #[test]
+    fn path_without_file_name_is_an_error() {
+        let err = write_atomically("..", |_| Ok(())).unwrap_err();
+        assert!(matches!(err, ImageError::Invalid { .. }), "{err}");
+    }
+}

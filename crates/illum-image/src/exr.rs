@@ -1,0 +1,372 @@
+//! OpenEXR output and input: linear f32 RGB plus the render settings as text attributes.
+//!
+//! EXR is the lossless record of a render: channels R, G, B stored as 32-bit floats (not
+//! half floats, whose 11-bit mantissa would add quantisation error larger than the noise of a
+//! converged render), compressed with ZIP, which is lossless. The settings that produced the
+//! image travel with it as custom text attributes named `illum.<field>`, so a reference image
+//! says how it was made.
+
+use std::collections::HashMap;
+use std::fs::File;
+use std::io::BufReader;
+use std::path::Path;
+
+use exr::meta::attribute::{AttributeValue, Text};
+use exr::meta::header::LayerAttributes;
+use exr::prelude::{Image, Layer, ReadChannels, ReadLayers, SpecificChannels, Vec2, WritableImage};
+
+use crate::ImageError;
+use crate::atomic::write_atomically;
+use crate::png::check_writable;
+use crate::rgb_image::RgbImage32;
+
+/// Prefix of every attribute illum writes.
+pub const ATTRIBUTE_PREFIX: &str = "illum.";
+
+/// Names (without [`ATTRIBUTE_PREFIX`]) of the fixed fields of [`ExrMetadata`].
+const FIELD_NAMES: [&str; 6] = ["scene", "spp", "bounces", "seed", "sampling", "render_seconds"];
+
+/// The settings a render was made with, stored in its EXR file.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ExrMetadata {
+    /// The scene file or scene name.
+    pub scene: String,
+    /// Samples per pixel accumulated in the image.
+    pub spp: u64,
+    /// The path-length setting, as the user gave it (e.g. "5" or "0..=5").
+    pub bounces: String,
+    /// The seed of the random number streams.
+    pub seed: u32,
+    /// The sampling strategy (e.g. "nee", "bsdf", "mis").
+    pub sampling: String,
+    /// Wall-clock render time in seconds (a record, never asserted on).
+    pub render_seconds: f64,
+    /// Further settings, each stored as `illum.<key>`. Read back sorted by key.
+    pub extra: Vec<(String, String)>,
+}
+
+impl ExrMetadata {
+    /// The attributes this metadata is stored as: full names (with [`ATTRIBUTE_PREFIX`]) and
+    /// text values. Numbers are written in Rust's shortest round-trip form, so they parse
+    /// back to the same value.
+    pub fn to_attributes(&self) -> Vec<(String, String)> {
+        let fixed = [
+            self.scene.clone(),
+            self.spp.to_string(),
+            self.bounces.clone(),
+            self.seed.to_string(),
+            self.sampling.clone(),
+            self.render_seconds.to_string(),
+        ];
+        FIELD_NAMES
+            .iter()
+            .zip(fixed)
+            .map(|(name, value)| (format!("{ATTRIBUTE_PREFIX}{name}"), value))
+            .chain(self.extra.iter().map(|(k, v)| (format!("{ATTRIBUTE_PREFIX}{k}"), v.clone())))
+            .collect()
+    }
+
+    /// Rebuilds the metadata from the text attributes [`load_exr`] returns. `Ok(None)` when
+    /// the file carries none of illum's fixed fields (an EXR from another program); an error
+    /// when some are present but one is missing or does not parse. `path` is only used in
+    /// error messages. Attributes without the `illum.` prefix are ignored.
+    pub fn from_attributes(
+        path: impl AsRef<Path>,
+        attributes: &[(String, String)],
+    ) -> Result<Option<ExrMetadata>, ImageError> {
+        let path = path.as_ref();
+        let ours: HashMap<&str, &str> = attributes
+            .iter()
+            .filter_map(|(k, v)| k.strip_prefix(ATTRIBUTE_PREFIX).map(|k| (k, v.as_str())))
+            .collect();
+        if !FIELD_NAMES.iter().any(|f| ours.contains_key(f)) {
+            return Ok(None);
+        }
+        let get = |field: &str| {
+            ours.get(field).copied().ok_or_else(|| ImageError::BadContent {
+                path: path.to_path_buf(),
+                reason: format!(
+                    "attribute '{ATTRIBUTE_PREFIX}{field}' is missing (illum writes all of {})",
+                    FIELD_NAMES.join(", ")
+                ),
+            })
+        };
+        fn parse<T: std::str::FromStr>(
+            path: &Path,
+            field: &str,
+            value: &str,
+            allowed: &str,
+        ) -> Result<T, ImageError> {
+            value.trim().parse().map_err(|_| ImageError::BadContent {
+                path: path.to_path_buf(),
+                reason: format!("attribute '{ATTRIBUTE_PREFIX}{field}' is '{value}'; expected {allowed}"),
+            })
+        }
+        let mut extra: Vec<(String, String)> = ours
+            .iter()
+            .filter(|(k, _)| !FIELD_NAMES.contains(k))
+            .map(|(k, v)| ((*k).to_owned(), (*v).to_owned()))
+            .collect();
+        extra.sort();
+        Ok(Some(ExrMetadata {
+            scene: get("scene")?.to_owned(),
+            spp: parse(path, "spp", get("spp")?, "a whole number >= 0")?,
+            bounces: get("bounces")?.to_owned(),
+            seed: parse(path, "seed", get("seed")?, "a whole number in 0..=4294967295")?,
+            sampling: get("sampling")?.to_owned(),
+            render_seconds: parse(path, "render_seconds", get("render_seconds")?, "a number of seconds")?,
+            extra,
+        }))
+    }
+}
+
+/// Checks the attribute names the writer would produce: unique, no NUL byte (names are
+/// NUL-terminated in the file), and shorter than 256 bytes (the format's limit).
+fn check_attribute_names(path: &Path, attributes: &[(String, String)]) -> Result<(), ImageError> {
+    let mut seen = std::collections::HashSet::new();
+    for (name, _) in attributes {
+        if !seen.insert(name.as_str()) {
+            let hint = match name.strip_prefix(ATTRIBUTE_PREFIX) {
+                Some(f) if FIELD_NAMES.contains(&f) => " (a fixed field of ExrMetadata)",
+                _ => "",
+            };
+            return Err(ImageError::invalid(
+                path,
+                format!("metadata key '{name}' is given twice{hint}; each key must be unique"),
+            ));
+        }
+        if name.contains('\0') {
+            return Err(ImageError::invalid(
+                path,
+                format!("metadata key {name:?} contains a NUL character, which EXR does not allow"),
+            ));
+        }
+        if name.len() >= 256 {
+            return Err(ImageError::invalid(
+                path,
+                format!("metadata key '{name}' is {} bytes long; EXR allows at most 255", name.len()),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// EXR text attributes are byte strings; illum stores UTF-8 (which is what OpenEXR itself
+/// assumes), so any Rust string survives the round trip.
+fn text(s: &str) -> Text {
+    Text::from_slice_unchecked(s.as_bytes())
+}
+
+fn string(t: &Text) -> String {
+    String::from_utf8_lossy(t.as_slice()).into_owned()
+}
+
+/// Writes `image` as a linear EXR with channels R, G, B in f32 (ZIP, lossless), with
+/// `metadata` as `illum.*` text attributes, atomically.
+pub fn save_exr(
+    path: impl AsRef<Path>,
+    image: &RgbImage32,
+    metadata: &ExrMetadata,
+) -> Result<(), ImageError> {
+    let path = path.as_ref();
+    check_writable(path, image)?;
+    let attributes = metadata.to_attributes();
+    check_attribute_names(path, &attributes)?;
+
+    let mut layer_attributes =
+        LayerAttributes { software_name: Some(text("illum")), ..LayerAttributes::default() };
+    for (name, value) in &attributes {
+        layer_attributes.other.insert(text(name), AttributeValue::Text(text(value)));
+    }
+    let width = image.width as usize;
+    let channels = SpecificChannels::rgb(|pos: Vec2<usize>| {
+        let [r, g, b] = image.pixels[pos.y() * width + pos.x()];
+        (r, g, b)
+    });
+    let layer = Layer::new(
+        (width, image.height as usize),
+        layer_attributes,
+        exr::image::Encoding::SMALL_LOSSLESS,
+        channels,
+    );
+    let exr_image = Image::from_layer(layer);
+    write_atomically(path, |file| {
+        exr_image.write().to_unbuffered(file).map_err(|e| ImageError::Encode {
+            path: path.to_path_buf(),
+            format: "EXR",
+            source: Box::new(e),
+        })
+    })
+}
+
+/// Pixels as the reader delivers them, before the size is known to fit in `u32`.
+struct ReadPixels {
+    width: usize,
+    height: usize,
+    data: Vec<[f32; 3]>,
+}
+
+/// Reads the first layer with R, G and B channels of an EXR file (f16, f32 or u32 samples,
+/// converted to f32; other channels such as A are ignored), plus every text attribute of the
+/// file as (name, value), sorted by name. Use [`ExrMetadata::from_attributes`] to recover
+/// illum's settings.
+pub fn load_exr(path: impl AsRef<Path>) -> Result<(RgbImage32, Vec<(String, String)>), ImageError> {
+    let path = path.as_ref();
+    let file = File::open(path).map_err(|e| ImageError::io(path, "opening the EXR file", e))?;
+    let decode_err = |e: exr::error::Error| ImageError::Decode {
+        path: path.to_path_buf(),
+        format: "EXR",
+        source: Box::new(e),
+    };
+    let image = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .rgb_channels(
+            |resolution: Vec2<usize>, _| ReadPixels {
+                width: resolution.width(),
+                height: resolution.height(),
+                data: vec![[0.0; 3]; resolution.area()],
+            },
+            |pixels: &mut ReadPixels, pos: Vec2<usize>, (r, g, b): (f32, f32, f32)| {
+                pixels.data[pos.y() * pixels.width + pos.x()] = [r, g, b];
+            },
+        )
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(BufReader::new(file))
+        .map_err(decode_err)?;
+
+    let pixels = image.layer_data.channel_data.pixels;
+    let (Ok(width), Ok(height)) = (u32::try_from(pixels.width), u32::try_from(pixels.height)) else {
+        return Err(ImageError::BadContent {
+            path: path.to_path_buf(),
+            reason: format!(
+                "the image is {}x{}; illum handles at most {} pixels per side",
+                pixels.width,
+                pixels.height,
+                u32::MAX
+            ),
+        });
+    };
+    let rgb = RgbImage32 { width, height, pixels: pixels.data };
+
+    let mut attributes: Vec<(String, String)> = image
+        .attributes
+        .other
+        .iter()
+        .chain(image.layer_data.attributes.other.iter())
+        .filter_map(|(name, value)| match value {
+            AttributeValue::Text(t) => Some((string(name), string(t))),
+            _ => None,
+        })
+        .collect();
+    attributes.sort();
+    Ok((rgb, attributes))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn metadata() -> ExrMetadata {
+        ExrMetadata {
+            scene: "scenes/cornell.toml — Ünïcode".into(),
+            spp: 1 << 40,
+            bounces: "0..=5".into(),
+            seed: u32::MAX,
+            sampling: "nee".into(),
+            render_seconds: 12.345_678_901_234_5,
+            extra: vec![("adapter".into(), "llvmpipe (LLVM 19)".into()), ("a".into(), String::new())],
+        }
+    }
+
+    #[test]
+    fn round_trip_exact_floats_and_metadata() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("sub/render.exr");
+        let special = [
+            0.0,
+            -0.0,
+            1.0e-40, // subnormal: f16 would flush it
+            std::f32::consts::PI,
+            -7.25,
+            65_519.99, // above f16's range
+            f32::MAX,
+            f32::INFINITY,
+        ];
+        let img = RgbImage32::from_fn(5, 3, |x, y| {
+            let i = (y * 5 + x) as usize;
+            [special[i % special.len()], 0.1 * i as f32, 1.0 / (1.0 + i as f32)]
+        });
+        let meta = metadata();
+        save_exr(&path, &img, &meta).unwrap();
+
+        let (back, attrs) = load_exr(&path).unwrap();
+        assert_eq!((back.width, back.height), (5, 3));
+        let bits =
+            |im: &RgbImage32| -> Vec<u32> { im.pixels.iter().flatten().map(|v| v.to_bits()).collect() };
+        assert_eq!(bits(&back), bits(&img), "pixels are not bit-exact");
+
+        assert!(attrs.contains(&("illum.spp".to_string(), "1099511627776".to_string())), "{attrs:?}");
+        let parsed = ExrMetadata::from_attributes(&path, &attrs).unwrap().unwrap();
+        let mut expected = meta;
+        expected.extra.sort();
+        assert_eq!(parsed, expected);
+    }
+
+    #[test]
+    fn reads_half_float_rgba_from_other_programs() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("half.exr");
+        exr::prelude::write_rgba_file(&path, 2, 2, |x, y| {
+            let v = exr::prelude::f16::from_f32((x + 2 * y) as f32 * 0.5);
+            (v, v, v, exr::prelude::f16::ONE)
+        })
+        .unwrap();
+        let (img, attrs) = load_exr(&path).unwrap();
+        assert_eq!(img.pixels, vec![[0.0; 3], [0.5; 3], [1.0; 3], [1.5; 3]]);
+        assert_eq!(ExrMetadata::from_attributes(&path, &attrs).unwrap(), None);
+    }
+
+    #[test]
+    fn errors_name_the_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let missing = dir.path().join("missing.exr");
+        let err = load_exr(&missing).unwrap_err();
+        assert!(matches!(err, ImageError::Io { .. }) && err.to_string().contains("missing.exr"), "{err}");
+
+        let garbage = dir.path().join("garbage.exr");
+        std::fs::write(&garbage, b"this is not an EXR file").unwrap();
+        let err = load_exr(&garbage).unwrap_err();
+        assert!(matches!(err, ImageError::Decode { .. }) && err.to_string().contains("garbage.exr"), "{err}");
+    }
+
+    #[test]
+    fn bad_metadata_is_rejected_before_writing() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("dup.exr");
+        let mut meta = metadata();
+        meta.extra.push(("spp".into(), "3".into()));
+        let err = save_exr(&path, &RgbImage32::new(1, 1), &meta).unwrap_err().to_string();
+        assert!(err.contains("dup.exr") && err.contains("'illum.spp' is given twice"), "{err}");
+        assert!(!path.exists());
+
+        let mut meta = metadata();
+        meta.extra.push(("k".repeat(300), "v".into()));
+        let err = save_exr(&path, &RgbImage32::new(1, 1), &meta).unwrap_err().to_string();
+        assert!(err.contains("at most 255"), "{err}");
+    }
+
+    #[test]
+    fn unparsable_or_missing_fields_are_reported() {
+        let attrs = ExrMetadata::default().to_attributes();
+        let mut bad = attrs.clone();
+        bad.iter_mut().find(|(k, _)| k == "illum.spp").unwrap().1 = "many".into();
+        let err = ExrMetadata::from_attributes("x.exr", &bad).unwrap_err().to_string();
+        assert!(err.contains("x.exr") && err.contains("'illum.spp' is 'many'"), "{err}");
+
+        let partial: Vec<_> = attrs.into_iter().filter(|(k, _)| k != "illum.seed").collect();
+        let err = ExrMetadata::from_attributes("x.exr", &partial).unwrap_err().to_string();
+        assert!(err.contains("'illum.seed' is missing"), "{err}");
+    }
+}

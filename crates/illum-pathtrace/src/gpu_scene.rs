@@ -1,0 +1,212 @@
+//! The scene as the shader sees it: plain-old-data structs laid out like the WGSL ones.
+
+use bytemuck::{Pod, Zeroable};
+use illum_scene::{Bounces, Sampling, Scene, Shape};
+
+use crate::PathTraceError;
+
+pub const KIND_BOX: u32 = 0;
+pub const KIND_QUAD: u32 = 1;
+pub const KIND_SPHERE: u32 = 2;
+/// `Params::bounces` value meaning "unbounded, with Russian roulette".
+pub const UNBOUNDED: u32 = u32::MAX;
+
+/// Mirrors `struct Object` in pathtrace.wgsl (see there for what a..d hold per kind).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct GpuObject {
+    pub kind: u32,
+    pub material: u32,
+    pub emitter: u32,
+    pub _pad: u32,
+    pub a: [f32; 4],
+    pub b: [f32; 4],
+    pub c: [f32; 4],
+    pub d: [f32; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct GpuMaterial {
+    pub albedo: [f32; 4],
+    pub emission: [f32; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct GpuLight {
+    /// xyz = corner, w = running sum of light areas up to and including this one.
+    pub corner: [f32; 4],
+    /// xyz = edge_u, w = this light's area.
+    pub edge_u: [f32; 4],
+    pub edge_v: [f32; 4],
+    pub normal: [f32; 4],
+    pub emission: [f32; 4],
+}
+
+/// Mirrors `struct Params` in pathtrace.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct GpuParams {
+    pub eye: [f32; 3],
+    pub tan_half_fov: f32,
+    pub right: [f32; 3],
+    pub aspect: f32,
+    pub up: [f32; 3],
+    pub light_area: f32,
+    pub forward: [f32; 3],
+    pub num_objects: u32,
+    pub width: u32,
+    pub height: u32,
+    pub row_offset: u32,
+    pub rows: u32,
+    pub sample_base: u32,
+    pub sample_count: u32,
+    pub seed: u32,
+    pub bounces: u32,
+    pub sampling: u32,
+    pub num_lights: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+}
+
+/// The uploaded form of a scene.
+#[derive(Clone, Debug)]
+pub struct GpuScene {
+    /// Non-emitters first, then emitters: the shader relies on this order to let a light win a
+    /// tie with the surface it is set into.
+    pub objects: Vec<GpuObject>,
+    pub materials: Vec<GpuMaterial>,
+    pub lights: Vec<GpuLight>,
+    /// Sum of all light areas (the light-sampling pdf is its inverse).
+    pub light_area: f32,
+}
+
+fn v4(v: glam::Vec3, w: f32) -> [f32; 4] {
+    [v.x, v.y, v.z, w]
+}
+
+impl GpuScene {
+    pub fn new(scene: &Scene) -> Result<Self, PathTraceError> {
+        let materials = scene
+            .materials
+            .iter()
+            .map(|m| GpuMaterial { albedo: v4(m.albedo, 0.0), emission: v4(m.emission, 0.0) })
+            .collect();
+        let mut objects = Vec::with_capacity(scene.objects.len());
+        let mut emitters = Vec::new();
+        let mut lights = Vec::new();
+        let mut light_area = 0.0f32;
+        for object in &scene.objects {
+            let material = &scene.materials[object.material];
+            let emitter = material.is_emitter();
+            let gpu = match object.shape {
+                Shape::Box(b) => {
+                    let (rotation, offset) = b.local_to_world();
+                    // rotation is R_y(angle): its first column is (cos, 0, -sin).
+                    let (cos, sin) = (rotation.x_axis.x, -rotation.x_axis.z);
+                    GpuObject {
+                        kind: KIND_BOX,
+                        material: object.material as u32,
+                        emitter: emitter as u32,
+                        _pad: 0,
+                        a: v4(b.min, cos),
+                        b: v4(b.max, sin),
+                        c: v4(offset, 0.0),
+                        d: [0.0; 4],
+                    }
+                }
+                Shape::Quad(q) => {
+                    if emitter {
+                        let area = q.area();
+                        light_area += area;
+                        lights.push(GpuLight {
+                            corner: v4(q.corner, light_area),
+                            edge_u: v4(q.edge_u, area),
+                            edge_v: v4(q.edge_v, 0.0),
+                            normal: v4(q.normal(), 0.0),
+                            emission: v4(material.emission, 0.0),
+                        });
+                    }
+                    GpuObject {
+                        kind: KIND_QUAD,
+                        material: object.material as u32,
+                        emitter: emitter as u32,
+                        _pad: 0,
+                        a: v4(q.corner, 0.0),
+                        b: v4(q.edge_u, 0.0),
+                        c: v4(q.edge_v, 0.0),
+                        d: v4(q.edge_u.cross(q.edge_v), 0.0),
+                    }
+                }
+                Shape::Sphere(s) => GpuObject {
+                    kind: KIND_SPHERE,
+                    material: object.material as u32,
+                    emitter: emitter as u32,
+                    _pad: 0,
+                    a: v4(s.center, s.radius),
+                    b: [0.0; 4],
+                    c: [0.0; 4],
+                    d: [0.0; 4],
+                },
+            };
+            if emitter {
+                if !matches!(object.shape, Shape::Quad(_)) {
+                    return Err(PathTraceError::Unsupported {
+                        scene: scene.name.clone(),
+                        message: format!(
+                            "object {:?} emits light but is not a quad; only rectangular lights can be sampled",
+                            object.name
+                        ),
+                    });
+                }
+                emitters.push(gpu);
+            } else {
+                objects.push(gpu);
+            }
+        }
+        if lights.is_empty() {
+            return Err(PathTraceError::Unsupported {
+                scene: scene.name.clone(),
+                message: "the scene has no light (a quad whose material has emission > 0); \
+                          the path tracer would render black"
+                    .to_owned(),
+            });
+        }
+        objects.extend(emitters);
+        Ok(Self { objects, materials, lights, light_area })
+    }
+}
+
+/// The per-dispatch parameters for `scene` with its current render settings.
+pub fn params(scene: &Scene, gpu_scene: &GpuScene) -> GpuParams {
+    let basis = scene.camera.basis();
+    GpuParams {
+        eye: scene.camera.eye.to_array(),
+        tan_half_fov: basis.tan_half_fov,
+        right: basis.right.to_array(),
+        aspect: basis.aspect,
+        up: basis.up.to_array(),
+        light_area: gpu_scene.light_area,
+        forward: basis.forward.to_array(),
+        num_objects: gpu_scene.objects.len() as u32,
+        width: scene.camera.width,
+        height: scene.camera.height,
+        row_offset: 0,
+        rows: scene.camera.height,
+        sample_base: 0,
+        sample_count: 0,
+        seed: scene.render.seed,
+        bounces: match scene.render.bounces {
+            Bounces::Fixed(n) => n,
+            Bounces::Unbounded => UNBOUNDED,
+        },
+        sampling: match scene.render.sampling {
+            Sampling::Cosine => 0,
+            Sampling::Uniform => 1,
+        },
+        num_lights: gpu_scene.lights.len() as u32,
+        _pad0: 0,
+        _pad1: 0,
+    }
+}

@@ -1,0 +1,18 @@
+//! illum-pathtrace: the Cornell box path tracer (the assignment's task 2).
+//!
+//! A WGSL compute shader (`shaders/pathtrace/pathtrace.wgsl`) traces paths over the scene's
+//! analytic boxes, quads and spheres with next-event estimation on rectangular lights. The host
+//! side here uploads the scene ([`gpu_scene`]), plans short GPU submissions ([`planner`]),
+//! and folds each batch's f32 sums into f64 per-pixel statistics ([`accumulator`]).
+
+pub mod accumulator;
+mod error;
+pub mod gpu_scene;
+pub mod planner;
+pub mod progressive;
+mod tracer;
+
+pub use accumulator::Accumulator;
+pub use error::PathTraceError;
+pub use progressive::{StopReason, StopRules, render_progressive};
+pub use tracer::{PathTracer, StepReport};

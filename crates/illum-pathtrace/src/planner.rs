@@ -1,0 +1,102 @@
+//! Sizing GPU submissions.
+//!
+//! Every submission should take about `target_seconds` (default 0.15 s, well under the quarter
+//! second a UI frame and a GPU watchdog tolerate). The planner learns the cost of one sample from
+//! the submissions so far and chooses, for a new pass over the image, how many samples per pixel
+//! it carries and into how many bands of rows it is split.
+
+/// Default wall time aimed at per submission.
+pub const DEFAULT_TARGET_SECONDS: f64 = 0.15;
+
+/// Pixels in the first, measuring submission (before any cost is known).
+const PROBE_PIXELS: u64 = 16 * 1024;
+
+#[derive(Clone, Debug)]
+pub struct BatchPlanner {
+    target_seconds: f64,
+    /// Smoothed wall seconds per sample (one path), once measured.
+    seconds_per_sample: Option<f64>,
+}
+
+/// What the next pass does: `spp` samples for every pixel, in bands of `rows` rows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PassPlan {
+    pub spp: u32,
+    pub rows: u32,
+}
+
+impl BatchPlanner {
+    pub fn new(target_seconds: f64) -> Self {
+        Self { target_seconds, seconds_per_sample: None }
+    }
+
+    pub fn target_seconds(&self) -> f64 {
+        self.target_seconds
+    }
+
+    /// Plans a pass over a `width` x `height` image with at most `max_spp` samples per pixel.
+    pub fn plan(&self, width: u32, height: u32, max_spp: u32) -> PassPlan {
+        let max_spp = max_spp.max(1);
+        let pixels = width as u64 * height as u64;
+        let budget = match self.seconds_per_sample {
+            None => PROBE_PIXELS,
+            Some(cost) => (self.target_seconds / cost).max(1.0) as u64,
+        };
+        if pixels <= budget {
+            let spp = (budget / pixels).clamp(1, max_spp as u64) as u32;
+            PassPlan { spp, rows: height }
+        } else {
+            let rows = (budget / width as u64).clamp(1, height as u64) as u32;
+            PassPlan { spp: 1, rows }
+        }
+    }
+
+    /// Records that `samples` paths took `seconds` of wall time.
+    pub fn record(&mut self, samples: u64, seconds: f64) {
+        if samples == 0 || seconds.is_nan() || seconds <= 0.0 {
+            return;
+        }
+        let cost = seconds / samples as f64;
+        // Exponential smoothing: quick to follow a change of settings, steady under noise.
+        self.seconds_per_sample = Some(match self.seconds_per_sample {
+            None => cost,
+            Some(old) => 0.5 * old + 0.5 * cost,
+        });
+    }
+
+    /// Forget the measured cost (the scene or settings changed).
+    pub fn reset(&mut self) {
+        self.seconds_per_sample = None;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn first_pass_is_a_small_probe() {
+        let p = BatchPlanner::new(0.15).plan(1024, 1024, 64);
+        assert_eq!(p.spp, 1);
+        assert_eq!(p.rows as u64 * 1024, PROBE_PIXELS);
+    }
+
+    #[test]
+    fn cheap_samples_pack_many_spp_per_pass_and_respect_the_cap() {
+        let mut planner = BatchPlanner::new(0.1);
+        planner.record(1_000_000, 0.1); // 1e-7 s per sample: 1e6 samples per submission
+        let p = planner.plan(100, 100, 1000);
+        assert_eq!(p, PassPlan { spp: 100, rows: 100 });
+        assert_eq!(planner.plan(100, 100, 7).spp, 7);
+    }
+
+    #[test]
+    fn expensive_images_are_split_into_bands_of_at_least_one_row() {
+        let mut planner = BatchPlanner::new(0.1);
+        planner.record(1000, 1.0); // 1 ms per sample: 100 samples per submission
+        let p = planner.plan(50, 40, 16);
+        assert_eq!(p, PassPlan { spp: 1, rows: 2 });
+        planner.record(1, 10.0);
+        assert_eq!(planner.plan(50, 40, 16).rows, 1);
+    }
+}

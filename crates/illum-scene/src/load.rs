@@ -1,0 +1,107 @@
+//! The public entry points on [`Scene`]: loading, command-line overrides, device-limit checks,
+//! and the list of emitters.
+
+use std::path::Path;
+
+use crate::error::SceneError;
+use crate::file::RawScene;
+use crate::settings::bounces_allowed;
+use crate::types::{Bounces, DeviceLimits, MAX_BOUNCES, Object, Overrides, Quad, Scene, Shape};
+use crate::validate::scene_from_raw;
+
+impl Scene {
+    /// Reads and validates a scene file. Errors name the file as `path` was given.
+    pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        let label = path.display().to_string();
+        let text =
+            std::fs::read_to_string(path).map_err(|source| SceneError::Io { file: label.clone(), source })?;
+        Self::from_toml_str(&text, &label)
+    }
+
+    /// Parses and validates scene text. `file_label` names the source in errors, and its file
+    /// stem is the scene's name when the text has no `name`.
+    pub fn from_toml_str(text: &str, file_label: &str) -> Result<Scene, SceneError> {
+        let raw: RawScene = toml::from_str(text).map_err(|e| SceneError::from_toml(&e, text, file_label))?;
+        let default_name = Path::new(file_label)
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .filter(|s| !s.is_empty())
+            .unwrap_or_else(|| "scene".to_owned());
+        scene_from_raw(raw, file_label, &default_name)
+    }
+
+    /// Replaces the file's settings with the given overrides, after checking them by the same
+    /// rules as the file. `origin` labels the errors (e.g. "command line"), whose fields are the
+    /// flag names (`--spp`, `--bounces`, `--width`, `--height`). On error nothing is changed.
+    pub fn apply_overrides(&mut self, o: &Overrides, origin: &str) -> Result<(), SceneError> {
+        let at_least_one = |field: &str, v: Option<u32>| match v {
+            Some(0) => Err(SceneError::invalid(origin, field, "0", "must be at least 1")),
+            _ => Ok(()),
+        };
+        at_least_one("--spp", o.spp)?;
+        at_least_one("--width", o.width)?;
+        at_least_one("--height", o.height)?;
+        if let Some(Bounces::Fixed(n)) = o.bounces
+            && n > MAX_BOUNCES
+        {
+            return Err(SceneError::invalid(origin, "--bounces", n.to_string(), bounces_allowed()));
+        }
+
+        let r = &mut self.render;
+        r.spp = o.spp.unwrap_or(r.spp);
+        r.bounces = o.bounces.unwrap_or(r.bounces);
+        r.seed = o.seed.unwrap_or(r.seed);
+        r.sampling = o.sampling.unwrap_or(r.sampling);
+        let c = &mut self.camera;
+        c.width = o.width.unwrap_or(c.width);
+        c.height = o.height.unwrap_or(c.height);
+        Ok(())
+    }
+
+    /// Checks that the output fits the device: each side within `max_texture_dimension_2d`, and
+    /// width x height x `bytes_per_pixel` (the caller's per-pixel storage, e.g. an accumulation
+    /// buffer) within `max_storage_buffer_binding_size`. Errors are labelled `scene "NAME"`,
+    /// since the resolution may come from the file or from overrides.
+    pub fn check_device_limits(&self, limits: &DeviceLimits, bytes_per_pixel: u64) -> Result<(), SceneError> {
+        let label = format!("scene {:?}", self.name);
+        let (w, h) = (self.camera.width, self.camera.height);
+        for (field, side) in [("camera.width", w), ("camera.height", h)] {
+            if side > limits.max_texture_dimension_2d {
+                return Err(SceneError::invalid(
+                    &label,
+                    field,
+                    side.to_string(),
+                    format!(
+                        "must be at most {}, the device's max_texture_dimension_2d",
+                        limits.max_texture_dimension_2d
+                    ),
+                ));
+            }
+        }
+        // u64 holds 2^32 * 2^32 pixels only without the factor; saturate rather than wrap.
+        let bytes = u64::from(w).saturating_mul(u64::from(h)).saturating_mul(bytes_per_pixel);
+        if bytes > limits.max_storage_buffer_binding_size {
+            return Err(SceneError::invalid(
+                &label,
+                "camera.width x camera.height",
+                format!("{w} x {h} (x {bytes_per_pixel} bytes per pixel = {bytes} bytes)"),
+                format!(
+                    "must fit in {} bytes, the device's max_storage_buffer_binding_size",
+                    limits.max_storage_buffer_binding_size
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The light sources: (object index, object, its quad) for every object whose material
+    /// emits. Validation guarantees emitters are quads; anything else is skipped.
+    pub fn emitters(&self) -> impl Iterator<Item = (usize, &Object, &Quad)> {
+        self.objects.iter().enumerate().filter_map(move |(i, object)| match &object.shape {
+            Shape::Quad(quad) if self.materials.get(object.material).is_some_and(|m| m.is_emitter()) => {
+                Some((i, object, quad))
+            }
+            _ => None,
+        })
+    }
+}

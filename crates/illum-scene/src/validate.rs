@@ -1,0 +1,456 @@
+//! From the raw file structs to a validated [`Scene`].
+//!
+//! Checks run in file order (camera, render, materials, objects) and stop at the first problem.
+//! Every number is checked for finiteness *after* conversion to f32 — TOML happily accepts
+//! `nan` and `inf`, and a finite f64 such as 1e39 becomes infinite in f32 — before any check
+//! that compares it, because NaN fails every comparison silently.
+
+use std::collections::BTreeMap;
+
+use glam::Vec3;
+
+use crate::camera::robust_normalize;
+use crate::error::SceneError;
+use crate::file::{Int, Num, RawBox, RawCamera, RawMaterial, RawObject, RawRender, RawScene, RawVec3};
+use crate::settings::{UNBOUNDED, bounces_allowed};
+use crate::types::{
+    Bounces, BoxShape, Camera, MAX_BOUNCES, Material, Object, Quad, RenderSettings, Sampling, Scene, Shape,
+    Sphere,
+};
+
+const FINITE_ALLOWED: &str =
+    "must be a finite number within f32 range (|x| <= 3.4e38); nan and inf are not allowed";
+
+/// The relative size of |edge_u x edge_v| below which a quad counts as degenerate:
+/// |u x v| = |u| |v| sin(angle), so this is sin(angle) < 1e-12 between the edges.
+const QUAD_DEGENERATE_SIN: f64 = 1e-12;
+
+/// Below this, |normalize(forward) x normalize(up)| counts as parallel: the camera's right
+/// vector would be dominated by rounding.
+const CAMERA_PARALLEL_SIN: f32 = 1e-6;
+
+/// Validates `raw` (read from `file`) into a scene named `raw.name` or else `default_name`.
+pub(crate) fn scene_from_raw(raw: RawScene, file: &str, default_name: &str) -> Result<Scene, SceneError> {
+    let check = Check { file };
+    let camera = check.camera(&raw.camera)?;
+    let render = check.render(&raw.render)?;
+    let (materials, index_of) = check.materials(&raw.materials)?;
+    if raw.objects.is_empty() {
+        return Err(check.invalid(
+            "objects",
+            "[]",
+            "a scene needs at least one object (an [[objects]] table with a box, quad or sphere)",
+        ));
+    }
+    let objects = raw
+        .objects
+        .iter()
+        .enumerate()
+        .map(|(i, o)| check.object(i, o, &materials, &index_of))
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(Scene {
+        name: raw.name.unwrap_or_else(|| default_name.to_owned()),
+        camera,
+        render,
+        materials,
+        objects,
+    })
+}
+
+/// Validation context: the file label every error carries.
+struct Check<'a> {
+    file: &'a str,
+}
+
+impl Check<'_> {
+    fn invalid(
+        &self,
+        field: impl Into<String>,
+        value: impl Into<String>,
+        allowed: impl Into<String>,
+    ) -> SceneError {
+        SceneError::invalid(self.file, field, value, allowed)
+    }
+
+    fn number(&self, field: &str, x: Num) -> Result<f32, SceneError> {
+        let y = x.0 as f32;
+        if y.is_finite() { Ok(y) } else { Err(self.invalid(field, fmt_num(x.0), FINITE_ALLOWED)) }
+    }
+
+    fn vec3(&self, field: &str, v: RawVec3) -> Result<Vec3, SceneError> {
+        let y = Vec3::from_array(v.0.map(|x| x as f32));
+        if y.is_finite() {
+            Ok(y)
+        } else {
+            Err(self.invalid(field, fmt_vec(v.0), format!("every component {FINITE_ALLOWED}")))
+        }
+    }
+
+    /// An integer in `min..=u32::MAX`.
+    fn u32_at_least(&self, field: &str, x: Int, min: u32) -> Result<u32, SceneError> {
+        let allowed = if x.0 < i64::from(min) {
+            format!("must be at least {min}")
+        } else {
+            match u32::try_from(x.0) {
+                Ok(v) => return Ok(v),
+                Err(_) => format!("must be at most {}", u32::MAX),
+            }
+        };
+        Err(self.invalid(field, x.0.to_string(), allowed))
+    }
+
+    fn camera(&self, raw: &RawCamera) -> Result<Camera, SceneError> {
+        let eye = self.vec3("camera.eye", raw.eye)?;
+        let target = self.vec3("camera.target", raw.target)?;
+        let up = self.vec3("camera.up", raw.up)?;
+        let vfov_deg = self.number("camera.vfov", raw.vfov)?;
+        // tan(vfov / 2) must be finite and positive: 0 and 180 degrees are excluded.
+        if !(vfov_deg > 0.0 && vfov_deg < 180.0) {
+            return Err(self.invalid(
+                "camera.vfov",
+                fmt_num(raw.vfov.0),
+                "must be in the open interval (0, 180) degrees (full vertical field of view)",
+            ));
+        }
+        let width = self.u32_at_least("camera.width", raw.width, 1)?;
+        let height = self.u32_at_least("camera.height", raw.height, 1)?;
+        self.view(eye, target, up)?;
+        Ok(Camera { eye, target, up, vfov_deg, width, height })
+    }
+
+    /// The view must define a frame: target - eye non-zero (and finite in f32), up non-zero
+    /// and not parallel to it, else right = forward x up is undefined.
+    fn view(&self, eye: Vec3, target: Vec3, up: Vec3) -> Result<(), SceneError> {
+        let Some(forward) = robust_normalize(target - eye) else {
+            return Err(self.invalid(
+                "camera.target",
+                fmt_vec32(target),
+                format!(
+                    "must differ from camera.eye = {} (the view direction target - eye must be \
+                     non-zero and finite)",
+                    fmt_vec32(eye)
+                ),
+            ));
+        };
+        let parallel = match robust_normalize(up) {
+            None => true,
+            Some(up) => forward.cross(up).length() < CAMERA_PARALLEL_SIN,
+        };
+        if parallel {
+            return Err(self.invalid(
+                "camera.up",
+                fmt_vec32(up),
+                format!(
+                    "must be non-zero and not parallel to the view direction target - eye = {}",
+                    fmt_vec32(target - eye)
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    fn render(&self, raw: &RawRender) -> Result<RenderSettings, SceneError> {
+        let spp = self.u32_at_least("render.spp", raw.spp, 1)?;
+        let bounces = self.bounces(&raw.bounces)?;
+        let seed = self.u32_at_least("render.seed", raw.seed, 0)?;
+        let sampling: Sampling = raw.sampling.parse().map_err(|e: crate::ParseValueError| {
+            self.invalid("render.sampling", format!("{:?}", raw.sampling), e.allowed)
+        })?;
+        Ok(RenderSettings { spp, bounces, seed, sampling })
+    }
+
+    /// `bounces` is an integer in 0..=MAX_BOUNCES or exactly the string "unbounded".
+    fn bounces(&self, value: &toml::Value) -> Result<Bounces, SceneError> {
+        match value {
+            toml::Value::Integer(n) => {
+                if let Ok(n) = u32::try_from(*n)
+                    && n <= MAX_BOUNCES
+                {
+                    return Ok(Bounces::Fixed(n));
+                }
+            }
+            toml::Value::String(s) if s == UNBOUNDED => return Ok(Bounces::Unbounded),
+            _ => {}
+        }
+        let shown = match value {
+            toml::Value::String(s) => format!("{s:?}"),
+            other => other.to_string(),
+        };
+        Err(self.invalid("render.bounces", shown, bounces_allowed()))
+    }
+
+    /// Materials in sorted-name order, plus the name -> index map objects resolve against.
+    fn materials(
+        &self,
+        raw: &BTreeMap<String, RawMaterial>,
+    ) -> Result<(Vec<Material>, BTreeMap<String, usize>), SceneError> {
+        let mut materials = Vec::with_capacity(raw.len());
+        let mut index_of = BTreeMap::new();
+        for (name, m) in raw {
+            let path = format!("materials.{}", toml_key(name));
+            let albedo_path = format!("{path}.albedo");
+            let albedo = self.vec3(&albedo_path, m.albedo)?;
+            // A Lambertian surface reflects at most what it receives: albedo in [0, 1].
+            if !(albedo.cmpge(Vec3::ZERO).all() && albedo.cmple(Vec3::ONE).all()) {
+                return Err(self.invalid(
+                    albedo_path,
+                    fmt_vec(m.albedo.0),
+                    "every channel must be in [0, 1] (the fraction of light reflected)",
+                ));
+            }
+            let emission_path = format!("{path}.emission");
+            let emission = self.vec3(&emission_path, m.emission)?;
+            if !emission.cmpge(Vec3::ZERO).all() {
+                return Err(self.invalid(
+                    emission_path,
+                    fmt_vec(m.emission.0),
+                    "every channel must be >= 0 (emitted radiance)",
+                ));
+            }
+            index_of.insert(name.clone(), materials.len());
+            materials.push(Material { name: name.clone(), albedo, emission });
+        }
+        Ok((materials, index_of))
+    }
+
+    fn object(
+        &self,
+        i: usize,
+        raw: &RawObject,
+        materials: &[Material],
+        index_of: &BTreeMap<String, usize>,
+    ) -> Result<Object, SceneError> {
+        let label = match &raw.name {
+            Some(name) => format!("objects[{i}] ({name:?})"),
+            None => format!("objects[{i}]"),
+        };
+        let shape = match (&raw.box_, &raw.quad, &raw.sphere) {
+            (Some(b), None, None) => Shape::Box(self.box_shape(&format!("{label}.box"), b)?),
+            (None, Some(q), None) => {
+                let path = format!("{label}.quad");
+                let quad = Quad {
+                    corner: self.vec3(&format!("{path}.corner"), q.corner)?,
+                    edge_u: self.vec3(&format!("{path}.edge_u"), q.edge_u)?,
+                    edge_v: self.vec3(&format!("{path}.edge_v"), q.edge_v)?,
+                };
+                self.quad_area(&path, q.edge_u.0, q.edge_v.0, &quad)?;
+                Shape::Quad(quad)
+            }
+            (None, None, Some(s)) => {
+                let path = format!("{label}.sphere");
+                let center = self.vec3(&format!("{path}.center"), s.center)?;
+                let radius_path = format!("{path}.radius");
+                let radius = self.number(&radius_path, s.radius)?;
+                if radius <= 0.0 {
+                    return Err(self.invalid(radius_path, fmt_num(s.radius.0), "must be > 0"));
+                }
+                Shape::Sphere(Sphere { center, radius })
+            }
+            (b, q, s) => {
+                let given: Vec<&str> = [(b.is_some(), "box"), (q.is_some(), "quad")]
+                    .into_iter()
+                    .chain([(s.is_some(), "sphere")])
+                    .filter_map(|(present, key)| present.then_some(key))
+                    .collect();
+                let value = if given.is_empty() {
+                    "(no shape)".to_owned()
+                } else {
+                    format!("(both {})", given.join(" and "))
+                };
+                return Err(self.invalid(label, value, "each object needs exactly one of box, quad, sphere"));
+            }
+        };
+
+        let material_path = format!("{label}.material");
+        let Some(&material) = index_of.get(&raw.material) else {
+            let allowed = if materials.is_empty() {
+                "must name a material, but none are defined; add a [materials.NAME] table".to_owned()
+            } else {
+                let known: Vec<&str> = materials.iter().map(|m| m.name.as_str()).collect();
+                format!("must name a material defined under [materials]; known: {}", known.join(", "))
+            };
+            return Err(self.invalid(material_path, format!("{:?}", raw.material), allowed));
+        };
+        // The path tracer's next-event estimation samples points on rectangles only, so an
+        // emitting box or sphere would be lit by nothing and light nothing directly.
+        let kind = match shape {
+            Shape::Box(_) => Some("box"),
+            Shape::Sphere(_) => Some("sphere"),
+            Shape::Quad(_) => None,
+        };
+        if let Some(kind) = kind
+            && materials[material].is_emitter()
+        {
+            return Err(self.invalid(
+                material_path,
+                format!("{:?}", raw.material),
+                format!(
+                    "emission is supported on quad objects only (this object is a {kind} and \
+                     material {:?} emits {}; the path tracer samples only rectangular lights)",
+                    raw.material,
+                    fmt_vec32(materials[material].emission)
+                ),
+            ));
+        }
+
+        Ok(Object { name: raw.name.clone().unwrap_or_else(|| format!("objects[{i}]")), material, shape })
+    }
+
+    fn box_shape(&self, path: &str, raw: &RawBox) -> Result<BoxShape, SceneError> {
+        let (min, max) = match (raw.center, raw.half_extent, raw.min, raw.max) {
+            (Some(c), Some(h), None, None) => {
+                let center = self.vec3(&format!("{path}.center"), c)?;
+                let half_path = format!("{path}.half_extent");
+                let half = self.vec3(&half_path, h)?;
+                if !half.cmpgt(Vec3::ZERO).all() {
+                    return Err(self.invalid(
+                        half_path,
+                        fmt_vec(h.0),
+                        "every component must be > 0 (a box needs positive size on each axis)",
+                    ));
+                }
+                let (min, max) = (center - half, center + half);
+                // A half-extent tiny next to the centre can vanish in f32 rounding.
+                if !(min.is_finite() && max.is_finite() && max.cmpgt(min).all()) {
+                    return Err(self.invalid(
+                        half_path,
+                        fmt_vec(h.0),
+                        format!(
+                            "must keep center - half_extent < center + half_extent finite and \
+                             distinct in f32 on every axis (center = {})",
+                            fmt_vec(c.0)
+                        ),
+                    ));
+                }
+                (min, max)
+            }
+            (None, None, Some(lo), Some(hi)) => {
+                let min = self.vec3(&format!("{path}.min"), lo)?;
+                let max_path = format!("{path}.max");
+                let max = self.vec3(&max_path, hi)?;
+                if !max.cmpgt(min).all() {
+                    return Err(self.invalid(
+                        max_path,
+                        fmt_vec(hi.0),
+                        format!(
+                            "must be greater than {path}.min = {} on every axis (a box needs \
+                             positive size on each axis)",
+                            fmt_vec(lo.0)
+                        ),
+                    ));
+                }
+                (min, max)
+            }
+            (c, h, lo, hi) => {
+                let given: Vec<&str> = [
+                    (c.is_some(), "center"),
+                    (h.is_some(), "half_extent"),
+                    (lo.is_some(), "min"),
+                    (hi.is_some(), "max"),
+                ]
+                .into_iter()
+                .filter_map(|(present, key)| present.then_some(key))
+                .collect();
+                return Err(self.invalid(
+                    path,
+                    format!("{{ {} }}", given.join(", ")),
+                    "give either center + half_extent or min + max (not both, not a mix)",
+                ));
+            }
+        };
+        Ok(BoxShape {
+            min,
+            max,
+            rotate_y_deg: self.number(&format!("{path}.rotate_y"), raw.rotate_y)?,
+            pivot: self.vec3(&format!("{path}.pivot"), raw.pivot)?,
+            translate: self.vec3(&format!("{path}.translate"), raw.translate)?,
+        })
+    }
+
+    /// |u x v| = |u| |v| sin(angle) is the quad's area. It must be clearly non-zero relative to
+    /// the edge lengths (in f64, from the file's numbers), and the f32 quad the renderer gets
+    /// must still have a finite, non-zero area and a finite normal.
+    fn quad_area(&self, path: &str, u: [f64; 3], v: [f64; 3], quad: &Quad) -> Result<(), SceneError> {
+        let (du, dv) = (glam::DVec3::from_array(u), glam::DVec3::from_array(v));
+        let area64 = du.cross(dv).length();
+        let scale = du.length() * dv.length();
+        let ok64 = scale > 0.0 && area64 >= QUAD_DEGENERATE_SIN * scale;
+        let area32 = quad.area();
+        let ok32 = area32 > 0.0 && area32.is_finite() && quad.normal().is_finite();
+        if ok64 && ok32 {
+            return Ok(());
+        }
+        Err(self.invalid(
+            path,
+            format!("{{ edge_u = {}, edge_v = {} }}", fmt_vec(u), fmt_vec(v)),
+            "edge_u and edge_v must be non-zero and not parallel (|edge_u x edge_v| is the \
+             quad's area, which must be > 0 and finite)",
+        ))
+    }
+}
+
+/// A number as TOML would spell it: `nan`, `inf`, exponent form for very large or small
+/// magnitudes, else Rust's shortest round-trip decimal.
+fn fmt_num(x: f64) -> String {
+    if x.is_nan() {
+        "nan".to_owned()
+    } else if x.is_infinite() {
+        if x > 0.0 { "inf" } else { "-inf" }.to_owned()
+    } else if x != 0.0 && !(1e-5..1e16).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        x.to_string()
+    }
+}
+
+fn fmt_vec(v: [f64; 3]) -> String {
+    format!("[{}, {}, {}]", fmt_num(v[0]), fmt_num(v[1]), fmt_num(v[2]))
+}
+
+/// f32 values print in their own shortest form (0.5608, not 0.5608000159263611), by the same
+/// rules as `fmt_num`.
+fn fmt_vec32(v: Vec3) -> String {
+    let f = |x: f32| {
+        if x.is_finite() && (x == 0.0 || (1e-5..1e16).contains(&x.abs())) {
+            x.to_string()
+        } else if x.is_finite() {
+            format!("{x:e}")
+        } else {
+            fmt_num(f64::from(x))
+        }
+    };
+    format!("[{}, {}, {}]", f(v.x), f(v.y), f(v.z))
+}
+
+/// A TOML key as it would be written in a dotted path: bare if it can be, quoted otherwise.
+fn toml_key(name: &str) -> String {
+    let bare = !name.is_empty() && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
+    if bare { name.to_owned() } else { format!("{name:?}") }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn number_formatting_uses_toml_spellings() {
+        assert_eq!(fmt_num(f64::NAN), "nan");
+        assert_eq!(fmt_num(f64::INFINITY), "inf");
+        assert_eq!(fmt_num(f64::NEG_INFINITY), "-inf");
+        assert_eq!(fmt_num(278.0), "278");
+        assert_eq!(fmt_num(0.0), "0");
+        assert_eq!(fmt_num(1e39), "1e39");
+        assert_eq!(fmt_num(-2.5e-7), "-2.5e-7");
+        assert_eq!(fmt_vec([1.0, -724.26, 0.5]), "[1, -724.26, 0.5]");
+        assert_eq!(fmt_vec32(Vec3::new(0.5608, 1.0, f32::NAN)), "[0.5608, 1, nan]");
+    }
+
+    #[test]
+    fn keys_are_quoted_only_when_needed() {
+        assert_eq!(toml_key("red"), "red");
+        assert_eq!(toml_key("light-2_b"), "light-2_b");
+        assert_eq!(toml_key("my red"), "\"my red\"");
+        assert_eq!(toml_key("a.b"), "\"a.b\"");
+        assert_eq!(toml_key(""), "\"\"");
+    }
+}

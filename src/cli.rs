@@ -1,0 +1,73 @@
+//! Command-line pieces shared by the examples: the scene flags and device setup.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use clap::Args;
+use illum_scene::{Bounces, Overrides, Sampling, Scene};
+
+/// The default scene: the assignment's Cornell box.
+pub const DEFAULT_SCENE: &str = "scenes/cornell.toml";
+
+/// Flags that override the scene file's settings (same names in every example).
+#[derive(Args, Clone, Debug, Default)]
+pub struct SceneArgs {
+    /// Samples per pixel (>= 1).
+    #[arg(long)]
+    pub spp: Option<u32>,
+    /// Bounces of indirect light: 0 = direct only, up to 256, or `unbounded` (Russian roulette).
+    #[arg(long)]
+    pub bounces: Option<Bounces>,
+    /// Random seed.
+    #[arg(long)]
+    pub seed: Option<u32>,
+    /// Image width in pixels.
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Image height in pixels.
+    #[arg(long)]
+    pub height: Option<u32>,
+    /// Hemisphere sampling for bounces: `cosine` or `uniform`.
+    #[arg(long)]
+    pub sampling: Option<Sampling>,
+}
+
+impl SceneArgs {
+    pub fn overrides(&self) -> Overrides {
+        Overrides {
+            spp: self.spp,
+            bounces: self.bounces,
+            seed: self.seed,
+            sampling: self.sampling,
+            width: self.width,
+            height: self.height,
+        }
+    }
+}
+
+/// Resolves a scene path given on the command line. A relative path that does not exist from
+/// the current directory is also looked up from the workspace root, so examples work from any
+/// directory inside the checkout.
+pub fn resolve_scene_path(path: &Path) -> PathBuf {
+    if path.is_relative() && !path.exists() {
+        let from_root = Path::new(env!("CARGO_MANIFEST_DIR")).join(path);
+        if from_root.exists() {
+            return from_root;
+        }
+    }
+    path.to_path_buf()
+}
+
+/// Loads a scene file and applies the command-line overrides.
+pub fn load_scene(path: &Path, args: &SceneArgs) -> anyhow::Result<Scene> {
+    let mut scene = Scene::load(&resolve_scene_path(path))?;
+    scene.apply_overrides(&args.overrides(), "command line")?;
+    Ok(scene)
+}
+
+/// Creates the GPU context, adding what to do when it fails.
+pub fn gpu() -> anyhow::Result<illum_gpu::GpuContext> {
+    let gpu = illum_gpu::GpuContext::new().context("setting up the GPU")?;
+    log::info!("adapter: {} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend);
+    Ok(gpu)
+}

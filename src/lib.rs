@@ -1,0 +1,10 @@
+//! illum: a Rust + wgpu renderer for the two scenes of an illumination assignment.
+//!
+//! This facade re-exports the workspace crates so that `examples/` and `tests/` can use one name,
+//! and holds the command-line pieces the examples share ([`cli`]).
+pub mod cli;
+
+pub use illum_gpu as gpu;
+pub use illum_image as image;
+pub use illum_pathtrace as pathtrace;
+pub use illum_scene as scene;
