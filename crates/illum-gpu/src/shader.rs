@@ -14,24 +14,41 @@ use naga_oil::compose::{
 
 use crate::{GpuContext, GpuError};
 
-/// One WGSL file: its path relative to the workspace (for error messages) and its text.
-#[derive(Clone, Copy, Debug)]
+/// One WGSL file: its path relative to the workspace (for error messages) and its text. Files
+/// from `shaders/` are embedded ([`shader_file!`]); generated modules own their text.
+#[derive(Clone, Debug)]
 pub struct ShaderFile {
-    pub path: &'static str,
-    pub source: &'static str,
+    pub path: Cow<'static, str>,
+    pub source: Cow<'static, str>,
 }
 
+impl ShaderFile {
+    /// A module generated at run time; `name` stands in for a path in error messages.
+    pub fn generated(name: String, source: String) -> Self {
+        Self { path: Cow::Owned(name), source: Cow::Owned(source) }
+    }
+}
+
+/// Embeds `shaders/...` (a path relative to the workspace root) as a [`ShaderFile`].
+#[macro_export]
 macro_rules! shader_file {
     ($path:literal) => {
-        ShaderFile { path: $path, source: include_str!(concat!("../../../", $path)) }
+        $crate::shader::ShaderFile {
+            path: ::std::borrow::Cow::Borrowed($path),
+            source: ::std::borrow::Cow::Borrowed(include_str!(concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/../../",
+                $path
+            ))),
+        }
     };
 }
 
 /// Shared modules, in dependency order (a module may import only those before it).
 pub const COMMON_MODULES: &[ShaderFile] = &[
-    shader_file!("shaders/common/constants.wgsl"),
-    shader_file!("shaders/common/rng.wgsl"),
-    shader_file!("shaders/common/sampling.wgsl"),
+    crate::shader_file!("shaders/common/constants.wgsl"),
+    crate::shader_file!("shaders/common/rng.wgsl"),
+    crate::shader_file!("shaders/common/sampling.wgsl"),
 ];
 
 /// A shader def: `#ifdef NAME` / `#if NAME == value` in WGSL.
@@ -61,27 +78,27 @@ pub fn compose(
     for module in modules {
         let added = composer
             .add_composable_module(ComposableModuleDescriptor {
-                source: module.source,
-                file_path: module.path,
+                source: &module.source,
+                file_path: &module.path,
                 language: ShaderLanguage::Wgsl,
                 shader_defs: shader_defs.clone(),
                 ..Default::default()
             })
             .map(|_| ());
         added.map_err(|e| GpuError::Shader {
-            file: module.path.to_owned(),
+            file: module.path.to_string(),
             message: e.emit_to_string(&composer),
         })?;
     }
     composer
         .make_naga_module(NagaModuleDescriptor {
-            source: entry.source,
-            file_path: entry.path,
+            source: &entry.source,
+            file_path: &entry.path,
             shader_type: ShaderType::Wgsl,
             shader_defs,
             ..Default::default()
         })
-        .map_err(|e| GpuError::Shader { file: entry.path.to_owned(), message: e.emit_to_string(&composer) })
+        .map_err(|e| GpuError::Shader { file: entry.path.to_string(), message: e.emit_to_string(&composer) })
 }
 
 /// Validates a composed module with naga's validator (all capabilities wgpu's core needs).

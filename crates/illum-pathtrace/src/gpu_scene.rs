@@ -8,6 +8,8 @@ use crate::PathTraceError;
 pub const KIND_BOX: u32 = 0;
 pub const KIND_QUAD: u32 = 1;
 pub const KIND_SPHERE: u32 = 2;
+/// A box without rotation, stored by its world bounds: the shader skips the frame change.
+pub const KIND_AABB: u32 = 3;
 /// `Params::bounces` value meaning "unbounded, with Russian roulette".
 pub const UNBOUNDED: u32 = u32::MAX;
 
@@ -18,7 +20,7 @@ pub struct GpuObject {
     pub kind: u32,
     pub material: u32,
     pub emitter: u32,
-    pub _pad: u32,
+    pub padding: u32,
     pub a: [f32; 4],
     pub b: [f32; 4],
     pub c: [f32; 4],
@@ -66,8 +68,8 @@ pub struct GpuParams {
     pub bounces: u32,
     pub sampling: u32,
     pub num_lights: u32,
-    pub _pad0: u32,
-    pub _pad1: u32,
+    pub first_emitter: u32,
+    pub padding: u32,
 }
 
 /// The uploaded form of a scene.
@@ -80,6 +82,8 @@ pub struct GpuScene {
     pub lights: Vec<GpuLight>,
     /// Sum of all light areas (the light-sampling pdf is its inverse).
     pub light_area: f32,
+    /// Index of the first emitter in `objects`.
+    pub first_emitter: u32,
 }
 
 fn v4(v: glam::Vec3, w: f32) -> [f32; 4] {
@@ -101,6 +105,19 @@ impl GpuScene {
             let material = &scene.materials[object.material];
             let emitter = material.is_emitter();
             let gpu = match object.shape {
+                Shape::Box(b) if b.rotate_y_deg == 0.0 => {
+                    let offset = b.translate;
+                    GpuObject {
+                        kind: KIND_AABB,
+                        material: object.material as u32,
+                        emitter: emitter as u32,
+                        padding: 0,
+                        a: v4(b.min + offset, 0.0),
+                        b: v4(b.max + offset, 0.0),
+                        c: [0.0; 4],
+                        d: [0.0; 4],
+                    }
+                }
                 Shape::Box(b) => {
                     let (rotation, offset) = b.local_to_world();
                     // rotation is R_y(angle): its first column is (cos, 0, -sin).
@@ -109,7 +126,7 @@ impl GpuScene {
                         kind: KIND_BOX,
                         material: object.material as u32,
                         emitter: emitter as u32,
-                        _pad: 0,
+                        padding: 0,
                         a: v4(b.min, cos),
                         b: v4(b.max, sin),
                         c: v4(offset, 0.0),
@@ -132,7 +149,7 @@ impl GpuScene {
                         kind: KIND_QUAD,
                         material: object.material as u32,
                         emitter: emitter as u32,
-                        _pad: 0,
+                        padding: 0,
                         a: v4(q.corner, 0.0),
                         b: v4(q.edge_u, 0.0),
                         c: v4(q.edge_v, 0.0),
@@ -143,7 +160,7 @@ impl GpuScene {
                     kind: KIND_SPHERE,
                     material: object.material as u32,
                     emitter: emitter as u32,
-                    _pad: 0,
+                    padding: 0,
                     a: v4(s.center, s.radius),
                     b: [0.0; 4],
                     c: [0.0; 4],
@@ -173,8 +190,9 @@ impl GpuScene {
                     .to_owned(),
             });
         }
+        let first_emitter = objects.len() as u32;
         objects.extend(emitters);
-        Ok(Self { objects, materials, lights, light_area })
+        Ok(Self { objects, materials, lights, light_area, first_emitter })
     }
 }
 
@@ -206,7 +224,7 @@ pub fn params(scene: &Scene, gpu_scene: &GpuScene) -> GpuParams {
             Sampling::Uniform => 1,
         },
         num_lights: gpu_scene.lights.len() as u32,
-        _pad0: 0,
-        _pad1: 0,
+        first_emitter: gpu_scene.first_emitter,
+        padding: 0,
     }
 }

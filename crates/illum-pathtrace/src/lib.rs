@@ -10,9 +10,12 @@ mod error;
 pub mod gpu_scene;
 pub mod planner;
 pub mod progressive;
+mod specialise;
 mod tracer;
 
 pub use accumulator::Accumulator;
 pub use error::PathTraceError;
 pub use progressive::{StopReason, StopRules, render_progressive};
-pub use tracer::{PathTracer, StepReport};
+pub use tracer::{
+    GENERIC_TRAVERSAL, PATHTRACE_SHADER, PathTracer, SCENE_MODULE, StepReport, Traversal, shader_modules,
+};

@@ -3,6 +3,7 @@
 use std::time::Instant;
 
 use illum_gpu::shader::{self, COMMON_MODULES, ShaderFile};
+use illum_gpu::shader_file;
 use illum_gpu::timing::PassTimer;
 use illum_gpu::{GpuContext, readback, wgpu};
 use illum_scene::{DeviceLimits, Scene};
@@ -10,12 +11,36 @@ use wgpu::util::DeviceExt;
 
 use crate::gpu_scene::{self, GpuParams, GpuScene};
 use crate::planner::{BatchPlanner, DEFAULT_TARGET_SECONDS, PassPlan};
-use crate::{Accumulator, PathTraceError};
+use crate::{Accumulator, PathTraceError, specialise};
 
-pub const PATHTRACE_SHADER: ShaderFile = ShaderFile {
-    path: "shaders/pathtrace/pathtrace.wgsl",
-    source: include_str!("../../../shaders/pathtrace/pathtrace.wgsl"),
-};
+/// The integrator (entry point `main`).
+pub const PATHTRACE_SHADER: ShaderFile = shader_file!("shaders/pathtrace/pathtrace.wgsl");
+/// Scene layout, bindings and ray-shape tests.
+pub const SCENE_MODULE: ShaderFile = shader_file!("shaders/pathtrace/scene.wgsl");
+/// The generic traversal (a loop over the object buffer).
+pub const GENERIC_TRAVERSAL: ShaderFile = shader_file!("shaders/pathtrace/traversal.wgsl");
+
+/// How rays find what they hit.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Traversal {
+    /// Traversal code generated from the scene: every object's test unrolled with its numbers as
+    /// constants (see `specialise.rs`). The default.
+    #[default]
+    Specialised,
+    /// One loop over the object buffer, the same pipeline for every scene.
+    Generic,
+}
+
+/// The shader modules, in import order, for `scene` with `traversal`.
+pub fn shader_modules(scene: &Scene, gpu_scene: &GpuScene, traversal: Traversal) -> Vec<ShaderFile> {
+    let mut modules = COMMON_MODULES.to_vec();
+    modules.push(SCENE_MODULE);
+    modules.push(match traversal {
+        Traversal::Generic => GENERIC_TRAVERSAL,
+        Traversal::Specialised => specialise::traversal_module(scene, gpu_scene),
+    });
+    modules
+}
 
 /// Bytes per pixel of the batch buffers: vec4 sum plus vec4 sum of squares.
 pub const BYTES_PER_PIXEL: u64 = 32;
@@ -63,8 +88,18 @@ pub struct PathTracer {
 }
 
 impl PathTracer {
-    /// Validates `scene` against the device, compiles the pipeline and allocates the buffers.
+    /// Validates `scene` against the device, compiles the (specialised) pipeline and allocates
+    /// the buffers.
     pub fn new(gpu: &GpuContext, scene: &Scene) -> Result<Self, PathTraceError> {
+        Self::with_traversal(gpu, scene, Traversal::default())
+    }
+
+    /// As [`Self::new`], choosing the traversal (the bench compares the two).
+    pub fn with_traversal(
+        gpu: &GpuContext,
+        scene: &Scene,
+        traversal: Traversal,
+    ) -> Result<Self, PathTraceError> {
         let limits = gpu.device.limits();
         scene.check_device_limits(
             &DeviceLimits {
@@ -78,8 +113,9 @@ impl PathTracer {
         let gpu_scene = GpuScene::new(scene)?;
         let base_params = gpu_scene::params(scene, &gpu_scene);
 
-        let module = shader::compose(COMMON_MODULES, &PATHTRACE_SHADER, &[])?;
-        let module = shader::create_module(gpu, module, PATHTRACE_SHADER.path)?;
+        let modules = shader_modules(scene, &gpu_scene, traversal);
+        let module = shader::compose(&modules, &PATHTRACE_SHADER, &[])?;
+        let module = shader::create_module(gpu, module, &PATHTRACE_SHADER.path)?;
         let pipeline = gpu.scoped("creating the path-tracing pipeline", || {
             gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some("pathtrace"),

@@ -57,13 +57,14 @@ pub(crate) fn scene_from_raw(raw: RawScene, file: &str, default_name: &str) -> R
     })
 }
 
-/// Validation context: the file label every error carries.
-struct Check<'a> {
-    file: &'a str,
+/// Validation context: the file label every error carries. Shared with the Whitted scene's
+/// validation (`whitted_validate.rs`), so both formats word their errors the same way.
+pub(crate) struct Check<'a> {
+    pub(crate) file: &'a str,
 }
 
 impl Check<'_> {
-    fn invalid(
+    pub(crate) fn invalid(
         &self,
         field: impl Into<String>,
         value: impl Into<String>,
@@ -72,12 +73,12 @@ impl Check<'_> {
         SceneError::invalid(self.file, field, value, allowed)
     }
 
-    fn number(&self, field: &str, x: Num) -> Result<f32, SceneError> {
+    pub(crate) fn number(&self, field: &str, x: Num) -> Result<f32, SceneError> {
         let y = x.0 as f32;
         if y.is_finite() { Ok(y) } else { Err(self.invalid(field, fmt_num(x.0), FINITE_ALLOWED)) }
     }
 
-    fn vec3(&self, field: &str, v: RawVec3) -> Result<Vec3, SceneError> {
+    pub(crate) fn vec3(&self, field: &str, v: RawVec3) -> Result<Vec3, SceneError> {
         let y = Vec3::from_array(v.0.map(|x| x as f32));
         if y.is_finite() {
             Ok(y)
@@ -87,7 +88,7 @@ impl Check<'_> {
     }
 
     /// An integer in `min..=u32::MAX`.
-    fn u32_at_least(&self, field: &str, x: Int, min: u32) -> Result<u32, SceneError> {
+    pub(crate) fn u32_at_least(&self, field: &str, x: Int, min: u32) -> Result<u32, SceneError> {
         let allowed = if x.0 < i64::from(min) {
             format!("must be at least {min}")
         } else {
@@ -99,7 +100,7 @@ impl Check<'_> {
         Err(self.invalid(field, x.0.to_string(), allowed))
     }
 
-    fn camera(&self, raw: &RawCamera) -> Result<Camera, SceneError> {
+    pub(crate) fn camera(&self, raw: &RawCamera) -> Result<Camera, SceneError> {
         let eye = self.vec3("camera.eye", raw.eye)?;
         let target = self.vec3("camera.target", raw.target)?;
         let up = self.vec3("camera.up", raw.up)?;
@@ -120,7 +121,7 @@ impl Check<'_> {
 
     /// The view must define a frame: target - eye non-zero (and finite in f32), up non-zero
     /// and not parallel to it, else right = forward x up is undefined.
-    fn view(&self, eye: Vec3, target: Vec3, up: Vec3) -> Result<(), SceneError> {
+    pub(crate) fn view(&self, eye: Vec3, target: Vec3, up: Vec3) -> Result<(), SceneError> {
         let Some(forward) = robust_normalize(target - eye) else {
             return Err(self.invalid(
                 "camera.target",
@@ -391,7 +392,7 @@ impl Check<'_> {
 
 /// A number as TOML would spell it: `nan`, `inf`, exponent form for very large or small
 /// magnitudes, else Rust's shortest round-trip decimal.
-fn fmt_num(x: f64) -> String {
+pub(crate) fn fmt_num(x: f64) -> String {
     if x.is_nan() {
         "nan".to_owned()
     } else if x.is_infinite() {
@@ -403,13 +404,13 @@ fn fmt_num(x: f64) -> String {
     }
 }
 
-fn fmt_vec(v: [f64; 3]) -> String {
+pub(crate) fn fmt_vec(v: [f64; 3]) -> String {
     format!("[{}, {}, {}]", fmt_num(v[0]), fmt_num(v[1]), fmt_num(v[2]))
 }
 
 /// f32 values print in their own shortest form (0.5608, not 0.5608000159263611), by the same
 /// rules as `fmt_num`.
-fn fmt_vec32(v: Vec3) -> String {
+pub(crate) fn fmt_vec32(v: Vec3) -> String {
     let f = |x: f32| {
         if x.is_finite() && (x == 0.0 || (1e-5..1e16).contains(&x.abs())) {
             x.to_string()

@@ -1,0 +1,120 @@
+//! Throughput benchmark of the path tracer (and, where built, the raster scene).
+//!
+//! ```text
+//! cargo run --release --example bench -- [--runs N] [--quick]
+//! ```
+//! For `scenes/cornell.toml` at each size and bounce count it renders a fixed number of samples
+//! per pixel `runs` times and prints the median of:
+//! - samples/s: width x height x spp / wall time of the GPU submissions (readback and f64 fold
+//!   included, as a user experiences it);
+//! - GPU samples/s: the same over the compute passes' timestamp-query time;
+//! - rays/s: rays traced (camera, bounce and shadow rays) per second of wall time; the count
+//!   comes from the bounce structure (see `rays_per_sample`).
+//! Timings are never asserted in tests; the figures go to docs/performance.md.
+
+use std::path::PathBuf;
+
+use clap::Parser;
+use illum::cli::{self, SceneArgs};
+use illum::pathtrace::PathTracer;
+use illum::scene::{Bounces, Scene};
+
+#[derive(Parser, Debug)]
+struct Args {
+    /// Scene to benchmark.
+    #[arg(default_value = cli::DEFAULT_SCENE)]
+    scene: PathBuf,
+    /// Repetitions per configuration (the median is reported).
+    #[arg(long, default_value_t = 5)]
+    runs: usize,
+    /// Only the issue's headline configuration (256 x 256, 64 spp, bounces 2 and 8).
+    #[arg(long)]
+    quick: bool,
+}
+
+struct Config {
+    size: u32,
+    spp: u32,
+    bounces: u32,
+}
+
+fn main() {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    if let Err(error) = run(Args::parse()) {
+        eprintln!("error: {error:#}");
+        std::process::exit(1);
+    }
+}
+
+fn median(values: &mut [f64]) -> f64 {
+    values.sort_by(f64::total_cmp);
+    values[values.len() / 2]
+}
+
+/// Upper bound on rays per path for a fixed bounce count: one camera ray, then at each of the
+/// `bounces + 1` surface hits one shadow ray, plus one bounce ray per bounce. Paths that escape
+/// or reach the light early trace fewer, so rays/s computed from this is an upper estimate.
+fn rays_per_sample(bounces: u32) -> u64 {
+    1 + (bounces as u64 + 1) + bounces as u64
+}
+
+fn run(args: Args) -> anyhow::Result<()> {
+    let gpu = cli::gpu()?;
+    println!(
+        "adapter: {} ({:?}, driver {})",
+        gpu.adapter_info.name, gpu.adapter_info.backend, gpu.adapter_info.driver_info
+    );
+    let mut configs =
+        vec![Config { size: 256, spp: 64, bounces: 2 }, Config { size: 256, spp: 64, bounces: 8 }];
+    if !args.quick {
+        for (size, spp) in [(256, 64), (1024, 4)] {
+            for bounces in [0, 1, 2, 8] {
+                if !(size == 256 && (bounces == 2 || bounces == 8)) {
+                    configs.push(Config { size, spp, bounces });
+                }
+            }
+        }
+    }
+    println!(
+        "| size | spp | bounces | Msamples/s (wall) | Msamples/s (GPU) | Mrays/s (wall, upper) | GPU ms per submission |"
+    );
+    println!("|---|---|---|---|---|---|---|");
+    for config in configs {
+        let settings = SceneArgs {
+            spp: Some(config.spp),
+            bounces: Some(Bounces::Fixed(config.bounces)),
+            width: Some(config.size),
+            height: Some(config.size),
+            ..Default::default()
+        };
+        let scene: Scene = cli::load_scene(&args.scene, &settings)?;
+        let mut tracer = PathTracer::new(&gpu, &scene)?;
+        // Warm-up: compiles the pipeline on the driver and teaches the planner the cost.
+        tracer.render(1)?;
+        let (mut wall, mut gpu_rate, mut per_submission) = (Vec::new(), Vec::new(), Vec::new());
+        for _ in 0..args.runs.max(1) {
+            tracer.reset();
+            let mut submissions = 0u32;
+            while tracer.spp_done() < config.spp {
+                tracer.step(Some(config.spp))?;
+                submissions += 1;
+            }
+            let samples = (config.size as f64).powi(2) * config.spp as f64;
+            wall.push(samples / tracer.wall_seconds());
+            gpu_rate.push(samples / tracer.gpu_seconds());
+            per_submission.push(tracer.gpu_seconds() * 1e3 / submissions as f64);
+        }
+        let wall = median(&mut wall);
+        println!(
+            "| {0}x{0} | {1} | {2} | {3:.2} | {4:.2} | {5:.1} | {6:.0} |",
+            config.size,
+            config.spp,
+            config.bounces,
+            wall * 1e-6,
+            median(&mut gpu_rate) * 1e-6,
+            wall * rays_per_sample(config.bounces) as f64 * 1e-6,
+            median(&mut per_submission),
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,191 @@
+#define_import_path illum::pathtrace::scene
+
+// The path tracer's scene as the GPU sees it (mirrored by gpu_scene.rs), and ray-shape tests.
+
+const KIND_BOX: u32 = 0u;
+const KIND_QUAD: u32 = 1u;
+const KIND_SPHERE: u32 = 2u;
+const KIND_AABB: u32 = 3u;
+const NO_HIT: u32 = 0xffffffffu;
+const FAR: f32 = 3.0e38;
+// A ray that hits an emitter within this relative distance of a coplanar surface sees the
+// emitter: the light's face lies exactly in the ceiling's plane and must win that tie.
+const EMITTER_TIE: f32 = 1.0e-5;
+
+struct Params {
+    eye: vec3<f32>,
+    tan_half_fov: f32,
+    right: vec3<f32>,
+    aspect: f32,
+    up: vec3<f32>,
+    light_area: f32,
+    forward: vec3<f32>,
+    num_objects: u32,
+    width: u32,
+    height: u32,
+    row_offset: u32,
+    rows: u32,
+    sample_base: u32,
+    sample_count: u32,
+    seed: u32,
+    bounces: u32,
+    sampling: u32,
+    num_lights: u32,
+    // Objects [first_emitter, num_objects) are the emitters.
+    first_emitter: u32,
+    padding: u32,
+}
+
+// Box: a = (local min, cos), b = (local max, sin), c = (offset, 0): world = R_y local + offset.
+// Axis-aligned box (a box without rotation): a = world min, b = world max.
+// Quad: a = corner, b = edge_u, c = edge_v, d = (edge_u x edge_v, 0).
+// Sphere: a = (centre, radius).
+struct Object {
+    kind: u32,
+    material: u32,
+    emitter: u32,
+    padding: u32,
+    a: vec4<f32>,
+    b: vec4<f32>,
+    c: vec4<f32>,
+    d: vec4<f32>,
+}
+
+struct Material {
+    albedo: vec4<f32>,
+    emission: vec4<f32>,
+}
+
+// corner.w = running sum of light areas up to and including this light (for selection).
+struct Light {
+    corner: vec4<f32>,
+    edge_u: vec4<f32>,
+    edge_v: vec4<f32>,
+    normal: vec4<f32>,
+    emission: vec4<f32>,
+}
+
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var<storage, read> objects: array<Object>;
+@group(0) @binding(2) var<storage, read> materials: array<Material>;
+@group(0) @binding(3) var<storage, read> lights: array<Light>;
+// Per pixel: (sum of radiance, number of finite samples) and (sum of squares, dropped samples).
+@group(0) @binding(4) var<storage, read_write> batch_sum: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read_write> batch_sum_sq: array<vec4<f32>>;
+
+struct Hit {
+    t: f32,
+    index: u32,
+}
+
+// Ray direction with zero components replaced by a tiny value of the same slab behaviour, so the
+// slab test divides by it without producing 0 * inf = NaN.
+fn safe_inverse(d: vec3<f32>) -> vec3<f32> {
+    let tiny = vec3<f32>(1.0e-30);
+    return 1.0 / select(d, tiny, abs(d) < tiny);
+}
+
+// Inverse of R_y(angle): world-to-local for a direction. R_y maps (x, y, z) to
+// (c x + s z, y, -s x + c z), so its transpose maps (x, y, z) to (c x - s z, y, s x + c z).
+fn rotate_y_inverse(v: vec3<f32>, c: f32, s: f32) -> vec3<f32> {
+    return vec3<f32>(c * v.x - s * v.z, v.y, s * v.x + c * v.z);
+}
+
+fn rotate_y(v: vec3<f32>, c: f32, s: f32) -> vec3<f32> {
+    return vec3<f32>(c * v.x + s * v.z, v.y, -s * v.x + c * v.z);
+}
+
+// Nearest t > 0 at which the ray o + t d meets the surface of the box [lo, hi], or FAR, given
+// inv = 1 / d. Slab method (Kay and Kajiya): the ray is inside the box between the largest
+// entering and the smallest leaving slab distance.
+fn hit_slabs(o: vec3<f32>, inv: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>) -> f32 {
+    let t0 = (lo - o) * inv;
+    let t1 = (hi - o) * inv;
+    let near = min(t0, t1);
+    let far = max(t0, t1);
+    let t_enter = max(max(near.x, near.y), near.z);
+    let t_exit = min(min(far.x, far.y), far.z);
+    if (t_exit < t_enter || t_exit <= 0.0) {
+        return FAR;
+    }
+    return select(t_exit, t_enter, t_enter > 0.0);
+}
+
+// A box [lo, hi] rotated by R_y (cos c, sin s) and moved by offset: the slab test in its frame.
+fn hit_box(o: vec3<f32>, d: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>, c: f32, s: f32, offset: vec3<f32>) -> f32 {
+    let ol = rotate_y_inverse(o - offset, c, s);
+    let inv = safe_inverse(rotate_y_inverse(d, c, s));
+    return hit_slabs(ol, inv, lo, hi);
+}
+
+// The parallelogram corner + s u + t v, s, t in [0, 1]; n = u x v (not normalised).
+fn hit_quad(o: vec3<f32>, d: vec3<f32>, corner: vec3<f32>, u: vec3<f32>, v: vec3<f32>, n: vec3<f32>) -> f32 {
+    let denom = dot(n, d);
+    if (denom == 0.0) {
+        return FAR;
+    }
+    let t = dot(corner - o, n) / denom;
+    if (!(t > 0.0)) {
+        return FAR;
+    }
+    // Barycentric-like coordinates of the hit in the (edge_u, edge_v) basis: with w = n / |n|^2,
+    // alpha = w . (h x v) and beta = w . (u x h) (h = hit - corner).
+    let w = n / dot(n, n);
+    let h = o + t * d - corner;
+    let alpha = dot(w, cross(h, v));
+    let beta = dot(w, cross(u, h));
+    if (alpha < 0.0 || alpha > 1.0 || beta < 0.0 || beta > 1.0) {
+        return FAR;
+    }
+    return t;
+}
+
+// d must be unit length (the quadratic's leading coefficient is taken as 1).
+fn hit_sphere(o: vec3<f32>, d: vec3<f32>, centre: vec3<f32>, radius: f32) -> f32 {
+    let oc = o - centre;
+    let b = dot(oc, d);
+    let c = dot(oc, oc) - radius * radius;
+    let disc = b * b - c;
+    if (disc < 0.0) {
+        return FAR;
+    }
+    let s = sqrt(disc);
+    let t_near = -b - s;
+    let t_far = -b + s;
+    if (t_near > 0.0) {
+        return t_near;
+    }
+    return select(FAR, t_far, t_far > 0.0);
+}
+
+// Outward normal of the face of the cube [-1, 1]^3 nearest to q (q on the cube's surface): the
+// axis on which q sits farthest out.
+fn box_face_normal(q: vec3<f32>) -> vec3<f32> {
+    let aq = abs(q);
+    if (aq.x >= aq.y && aq.x >= aq.z) {
+        return vec3<f32>(sign(q.x), 0.0, 0.0);
+    } else if (aq.y >= aq.z) {
+        return vec3<f32>(0.0, sign(q.y), 0.0);
+    }
+    return vec3<f32>(0.0, 0.0, sign(q.z));
+}
+
+// Geometric normal at p on the object (not yet oriented toward the ray).
+fn surface_normal(obj: Object, p: vec3<f32>) -> vec3<f32> {
+    switch obj.kind {
+        case KIND_AABB: {
+            let centre = 0.5 * (obj.a.xyz + obj.b.xyz);
+            return box_face_normal((p - centre) / (0.5 * (obj.b.xyz - obj.a.xyz)));
+        }
+        case KIND_BOX: {
+            // The face is the axis on which p sits farthest out, relative to the half-extent.
+            let pl = rotate_y_inverse(p - obj.c.xyz, obj.a.w, obj.b.w);
+            let centre = 0.5 * (obj.a.xyz + obj.b.xyz);
+            let nl = box_face_normal((pl - centre) / (0.5 * (obj.b.xyz - obj.a.xyz)));
+            return rotate_y(nl, obj.a.w, obj.b.w);
+        }
+        case KIND_QUAD: { return normalize(obj.d.xyz); }
+        default: { return (p - obj.a.xyz) / obj.a.w; }
+    }
+}
+

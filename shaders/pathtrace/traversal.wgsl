@@ -1,0 +1,49 @@
+#define_import_path illum::pathtrace::traversal
+
+// Generic traversal: loops over the object buffer, so one pipeline serves every scene.
+// (The specialised pipeline replaces this module with code generated from the scene.)
+
+#import illum::pathtrace::scene::{Hit, FAR, NO_HIT, EMITTER_TIE, KIND_AABB, KIND_BOX, KIND_QUAD, params, objects, safe_inverse, hit_slabs, hit_box, hit_quad, hit_sphere}
+
+// Closest hit over all objects. `d` must be unit length. Only the fields a shape's test needs are
+// loaded: on a CPU driver each storage-buffer read is a per-lane memory access.
+fn closest_hit(o: vec3<f32>, d: vec3<f32>) -> Hit {
+    var best = Hit(FAR, NO_HIT);
+    let inv_d = safe_inverse(d);
+    for (var i = 0u; i < params.num_objects; i++) {
+        let t = hit_object_at(o, d, inv_d, i);
+        // Emitters are stored last; they win ties with the surface they are set into.
+        let limit = select(best.t, best.t * (1.0 + EMITTER_TIE), i >= params.first_emitter);
+        if (t < limit) {
+            best = Hit(t, i);
+        }
+    }
+    return best;
+}
+
+fn hit_object_at(o: vec3<f32>, d: vec3<f32>, inv_d: vec3<f32>, i: u32) -> f32 {
+    switch objects[i].kind {
+        case KIND_AABB: { return hit_slabs(o, inv_d, objects[i].a.xyz, objects[i].b.xyz); }
+        case KIND_BOX: {
+            let obj = objects[i];
+            return hit_box(o, d, obj.a.xyz, obj.b.xyz, obj.a.w, obj.b.w, obj.c.xyz);
+        }
+        case KIND_QUAD: {
+            let obj = objects[i];
+            return hit_quad(o, d, obj.a.xyz, obj.b.xyz, obj.c.xyz, obj.d.xyz);
+        }
+        default: { return hit_sphere(o, d, objects[i].a.xyz, objects[i].a.w); }
+    }
+}
+
+// True when a non-emitting object lies on the ray strictly between 0 and t_max.
+fn occluded(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> bool {
+    let inv_d = safe_inverse(d);
+    for (var i = 0u; i < params.first_emitter; i++) {
+        if (hit_object_at(o, d, inv_d, i) < t_max) {
+            return true;
+        }
+    }
+    return false;
+}
+
