@@ -10,6 +10,7 @@
 //! - GPU samples/s: the same over the compute passes' timestamp-query time;
 //! - rays/s: rays traced (camera, bounce and shadow rays) per second of wall time; the count
 //!   comes from the bounce structure (see `rays_per_sample`).
+//!
 //! Timings are never asserted in tests; the figures go to docs/performance.md.
 
 use std::path::PathBuf;

@@ -1,6 +1,6 @@
 //! Copying GPU buffers back to the CPU.
 
-use crate::{GpuContext, GpuError};
+use crate::{DEFAULT_GPU_TIMEOUT, GpuContext, GpuError};
 
 /// Reads `size` bytes at `offset` of `source` (which needs `COPY_SRC`). Blocks until done.
 /// `offset` and `size` must be multiples of 4 (`wgpu::COPY_BUFFER_ALIGNMENT`).
@@ -36,19 +36,24 @@ pub fn read_mapped(
         // The receiver outlives this callback unless we already returned with an error.
         let _ = sender.send(result);
     });
-    gpu.wait_idle(context)?;
-    match receiver.try_recv() {
-        Ok(Ok(())) => {}
-        Ok(Err(e)) => {
-            return Err(GpuError::Map { context: context.to_owned(), message: e.to_string() });
+    // Another thread polling the same device may be the one that runs this callback, and may
+    // still be running it when our own wait returns; so wait on the channel, polling again
+    // meanwhile, until the callback reports or the overall timeout passes.
+    let started = std::time::Instant::now();
+    let result = loop {
+        gpu.wait_idle(context)?;
+        match receiver.recv_timeout(std::time::Duration::from_millis(20)) {
+            Ok(result) => break result,
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) if started.elapsed() < DEFAULT_GPU_TIMEOUT => {}
+            Err(_) => {
+                return Err(GpuError::Timeout {
+                    context: format!("{context} (waiting for the buffer to map)"),
+                    seconds: DEFAULT_GPU_TIMEOUT.as_secs_f64(),
+                });
+            }
         }
-        Err(_) => {
-            return Err(GpuError::Map {
-                context: context.to_owned(),
-                message: "the map callback did not run after the device went idle".to_owned(),
-            });
-        }
-    }
+    };
+    result.map_err(|e| GpuError::Map { context: context.to_owned(), message: e.to_string() })?;
     let bytes = {
         let view = buffer
             .get_mapped_range(0..size)

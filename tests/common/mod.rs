@@ -1,0 +1,67 @@
+//! Shared by the GPU integration tests: one device per test binary, scene helpers, and the
+//! failure artefacts (actual and diff images under target/).
+#![allow(dead_code)] // each test binary uses a different subset
+
+use std::path::PathBuf;
+use std::sync::OnceLock;
+
+use illum::gpu::GpuContext;
+use illum::image::RgbImage32;
+use illum::pathtrace::PathTracer;
+use illum::scene::{Overrides, Scene};
+
+/// The device every test in this binary shares. Without a Vulkan adapter this panics with the
+/// error, which names the fix (`apt-get install mesa-vulkan-drivers`): a missing driver fails
+/// the tests, it never skips them.
+pub fn gpu() -> &'static GpuContext {
+    static GPU: OnceLock<GpuContext> = OnceLock::new();
+    GPU.get_or_init(|| match GpuContext::new() {
+        Ok(gpu) => gpu,
+        Err(e) => panic!("GPU tests need a Vulkan adapter: {e}"),
+    })
+}
+
+pub fn workspace_path(relative: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(relative)
+}
+
+/// Loads `scenes/NAME.toml` with overrides.
+pub fn scene(name: &str, overrides: Overrides) -> Scene {
+    let mut scene = Scene::load(&workspace_path(&format!("scenes/{name}.toml"))).expect("scene loads");
+    scene.apply_overrides(&overrides, "test").expect("valid overrides");
+    scene
+}
+
+pub fn small(width: u32, height: u32, spp: u32) -> Overrides {
+    Overrides { width: Some(width), height: Some(height), spp: Some(spp), ..Default::default() }
+}
+
+/// Renders `scene` to its own spp and returns the tracer (for the accumulator's statistics).
+pub fn render(scene: &Scene) -> PathTracer {
+    let mut tracer = PathTracer::new(gpu(), scene).expect("path tracer builds");
+    tracer.render(scene.render.spp).expect("render succeeds");
+    tracer
+}
+
+/// Where failing image tests write `*-actual.png` and `*-diff.png`.
+pub fn failure_dir() -> PathBuf {
+    workspace_path("target/test-failures")
+}
+
+/// Mean over all pixels of the per-pixel means, and the variance of that mean (the pixels are
+/// independent, so the variances of their means add, divided by N^2).
+pub fn image_mean_and_variance(tracer: &PathTracer, channel: usize) -> (f64, f64) {
+    let acc = tracer.accumulator();
+    let n = (acc.width * acc.height) as usize;
+    let mut mean = 0.0;
+    let mut variance = 0.0;
+    for p in 0..n {
+        mean += acc.pixel_mean(p)[channel];
+        variance += acc.pixel_variance_of_mean(p)[channel];
+    }
+    (mean / n as f64, variance / (n * n) as f64)
+}
+
+pub fn assert_all_finite(image: &RgbImage32, what: &str) {
+    assert!(!image.has_non_finite(), "{what}: the image contains NaN or Inf");
+}
