@@ -13,7 +13,8 @@ fn closest_hit(o: vec3<f32>, d: vec3<f32>) -> Hit {
     for (var i = 0u; i < params.num_objects; i++) {
         let t = hit_object_at(o, d, inv_d, i);
         // Emitters are stored last; they win ties with the surface they are set into.
-        let limit = select(best.t, best.t * (1.0 + EMITTER_TIE), i >= params.first_emitter);
+        // (Capped at FAR: a missed emitter reports FAR, which must not count as a hit.)
+        let limit = select(best.t, min(best.t * (1.0 + EMITTER_TIE), FAR), i >= params.first_emitter);
         if (t < limit) {
             best = Hit(t, i);
         }

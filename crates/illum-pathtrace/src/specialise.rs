@@ -64,9 +64,10 @@ pub fn traversal_module(scene: &Scene, gpu_scene: &GpuScene) -> ShaderFile {
         let hit = hit_expression(object);
         closest.push_str(&format!("    // {i}: {name}\n    t = {hit};\n"));
         if object.emitter != 0 {
-            // The emitter wins a tie with the surface it is set into (see scene.wgsl).
+            // The emitter wins a tie with the surface it is set into (see scene.wgsl); the cap at
+            // FAR keeps a missed emitter (which reports FAR) from counting as a hit.
             closest.push_str(&format!(
-                "    if (t < best.t * (1.0 + EMITTER_TIE)) {{\n        best = Hit(t, {i}u);\n    }}\n"
+                "    if (t < min(best.t * (1.0 + EMITTER_TIE), FAR)) {{\n        best = Hit(t, {i}u);\n    }}\n"
             ));
         } else {
             closest.push_str(&format!("    if (t < best.t) {{\n        best = Hit(t, {i}u);\n    }}\n"));

@@ -10,7 +10,7 @@ use std::ops::Range;
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     /// The file could not be read.
-    #[error("{file}: cannot read the scene file: {source}")]
+    #[error("{file}: cannot read the scene file")]
     Io {
         file: String,
         #[source]

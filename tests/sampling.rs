@@ -1,0 +1,262 @@
+//! Chi-square tests of the WGSL sampling routines, run on the GPU through a small compute
+//! harness so that the shader code itself is what is tested (as Mitsuba tests its samplers).
+//!
+//! Each routine draws N = 2^20 samples from `illum::rng`. The samples are binned on a grid whose
+//! cell probabilities are integrated from the routine's pdf in closed form here, in f64,
+//! independently of the shader; Pearson's statistic is compared with the chi-square critical
+//! value at alpha = 0.01 (Wilson-Hilferty approximation, accurate to <1% at these degrees of
+//! freedom). Cells expecting fewer than 5 samples are pooled, as the test requires.
+
+use std::f64::consts::PI;
+
+use glam::DVec3;
+use illum::gpu::readback::read_buffer;
+use illum::gpu::shader::{self, COMMON_MODULES, ShaderFile};
+use illum::gpu::wgpu;
+use illum::image::inverse_normal_cdf;
+
+mod common;
+
+const N: u32 = 1 << 20;
+const ALPHA: f64 = 0.01;
+
+/// Runs `expression` (WGSL, may use u1, u2 in [0, 1) and must give a vec3<f32>) for N samples.
+fn run_on_gpu(expression: &str, seed: u32) -> Vec<DVec3> {
+    let gpu = common::gpu();
+    let source = format!(
+        "#import illum::rng::{{rng_seed, rng_f32}}
+#import illum::sampling::{{sample_cosine_hemisphere, sample_uniform_hemisphere, to_world, sample_parallelogram}}
+@group(0) @binding(0) var<storage, read_write> samples: array<vec4<f32>>;
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {{
+    let i = gid.x + 65536u * gid.y;
+    if (i >= arrayLength(&samples)) {{ return; }}
+    var rng = rng_seed({seed}u, i, 0u);
+    let u1 = rng_f32(&rng);
+    let u2 = rng_f32(&rng);
+    samples[i] = vec4<f32>({expression}, 0.0);
+}}
+"
+    );
+    let entry = ShaderFile::generated("sampling harness".into(), source);
+    let module = shader::compose(COMMON_MODULES, &entry, &[]).expect("harness composes");
+    let module = shader::create_module(gpu, module, "sampling harness").expect("harness compiles");
+    let pipeline = gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("sampling harness"),
+        layout: None,
+        module: &module,
+        entry_point: Some("main"),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+    let size = N as u64 * 16;
+    let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("samples"),
+        size,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }],
+    });
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    {
+        let mut pass = encoder.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        let groups = N / 64;
+        pass.dispatch_workgroups(groups.min(1024), groups.div_ceil(1024), 1);
+    }
+    gpu.queue.submit([encoder.finish()]);
+    let bytes = read_buffer(gpu, &buffer, 0, size, "sampling harness").expect("readback");
+    bytes
+        .chunks_exact(16)
+        .map(|c| {
+            let f = |i: usize| f32::from_le_bytes(c[4 * i..4 * i + 4].try_into().expect("4 bytes")) as f64;
+            DVec3::new(f(0), f(1), f(2))
+        })
+        .collect()
+}
+
+/// Chi-square critical value for `dof` degrees of freedom at upper-tail probability `alpha`.
+fn chi_square_critical(dof: usize, alpha: f64) -> f64 {
+    let k = dof as f64;
+    let z = inverse_normal_cdf(1.0 - alpha);
+    k * (1.0 - 2.0 / (9.0 * k) + z * (2.0 / (9.0 * k)).sqrt()).powi(3)
+}
+
+/// Pearson's test of observed counts against cell probabilities (pooling cells expecting < 5).
+fn chi_square_test(name: &str, observed: &[u64], probability: &[f64]) {
+    let total: u64 = observed.iter().sum();
+    let p_sum: f64 = probability.iter().sum();
+    assert!((p_sum - 1.0).abs() < 1e-9, "{name}: cell probabilities sum to {p_sum}");
+    let mut cells: Vec<(f64, f64)> = Vec::new();
+    let (mut pool_o, mut pool_e) = (0.0, 0.0);
+    for (&o, &p) in observed.iter().zip(probability) {
+        let e = p * total as f64;
+        if e < 5.0 {
+            pool_o += o as f64;
+            pool_e += e;
+        } else {
+            cells.push((o as f64, e));
+        }
+    }
+    if pool_e > 0.0 {
+        cells.push((pool_o, pool_e));
+    }
+    let statistic: f64 = cells.iter().map(|(o, e)| (o - e) * (o - e) / e).sum();
+    let critical = chi_square_critical(cells.len() - 1, ALPHA);
+    println!("{name}: chi2 = {statistic:.1}, critical {critical:.1} ({} cells)", cells.len());
+    assert!(statistic < critical, "{name}: chi-square {statistic:.1} exceeds {critical:.1} at alpha {ALPHA}");
+}
+
+/// An orthonormal frame (t, b) around n, built independently of the shader's.
+fn frame(n: DVec3) -> (DVec3, DVec3) {
+    let helper = if n.x.abs() < 0.9 { DVec3::X } else { DVec3::Y };
+    let t = n.cross(helper).normalize();
+    (t, n.cross(t))
+}
+
+const THETA_BINS: usize = 16;
+const PHI_BINS: usize = 16;
+
+/// Bins directions by (theta, phi) around n; also checks they are unit and in the hemisphere.
+fn bin_directions(name: &str, samples: &[DVec3], n: DVec3) -> Vec<u64> {
+    let (t, b) = frame(n);
+    let mut counts = vec![0u64; THETA_BINS * PHI_BINS];
+    for d in samples {
+        assert!((d.length() - 1.0).abs() < 1e-5, "{name}: direction {d} is not unit length");
+        let cos_theta = d.dot(n);
+        assert!(cos_theta >= -1e-6, "{name}: direction {d} is below the hemisphere");
+        let theta = cos_theta.clamp(0.0, 1.0).acos();
+        let phi = d.dot(b).atan2(d.dot(t)).rem_euclid(2.0 * PI);
+        let i = ((theta / (PI / 2.0) * THETA_BINS as f64) as usize).min(THETA_BINS - 1);
+        let j = ((phi / (2.0 * PI) * PHI_BINS as f64) as usize).min(PHI_BINS - 1);
+        counts[i * PHI_BINS + j] += 1;
+    }
+    counts
+}
+
+/// Cell probabilities from a pdf that depends on theta only, through its integral over theta:
+/// P(cell) = (dphi / 2pi) * (F(theta1) - F(theta0)), F = CDF of theta.
+fn theta_cells(theta_cdf: impl Fn(f64) -> f64) -> Vec<f64> {
+    let mut p = Vec::new();
+    for i in 0..THETA_BINS {
+        let (t0, t1) = (i as f64, (i + 1) as f64);
+        let (t0, t1) = (t0 * PI / 2.0 / THETA_BINS as f64, t1 * PI / 2.0 / THETA_BINS as f64);
+        for _ in 0..PHI_BINS {
+            p.push((theta_cdf(t1) - theta_cdf(t0)) / PHI_BINS as f64);
+        }
+    }
+    p
+}
+
+/// A tilted normal, so the test also covers the shader's frame construction (to_world).
+fn tilted_normal() -> (DVec3, &'static str) {
+    (DVec3::new(0.3, -0.5, 0.8).normalize(), "normalize(vec3<f32>(0.3, -0.5, 0.8))")
+}
+
+#[test]
+fn cosine_hemisphere_sampling_follows_cos_theta_over_pi() {
+    let (n, n_wgsl) = tilted_normal();
+    let samples = run_on_gpu(&format!("to_world({n_wgsl}, sample_cosine_hemisphere(u1, u2))"), 1);
+    let counts = bin_directions("cosine", &samples, n);
+    // pdf = cos(theta)/pi over solid angle: the theta CDF is sin^2(theta).
+    chi_square_test("cosine hemisphere", &counts, &theta_cells(|t| t.sin().powi(2)));
+}
+
+#[test]
+fn uniform_hemisphere_sampling_follows_one_over_two_pi() {
+    let (n, n_wgsl) = tilted_normal();
+    let samples = run_on_gpu(&format!("to_world({n_wgsl}, sample_uniform_hemisphere(u1, u2))"), 2);
+    let counts = bin_directions("uniform", &samples, n);
+    // pdf = 1/(2 pi): the theta CDF is 1 - cos(theta).
+    chi_square_test("uniform hemisphere", &counts, &theta_cells(|t| 1.0 - t.cos()));
+}
+
+#[test]
+fn a_wrong_pdf_is_rejected() {
+    // The test has power: cosine-distributed samples fail against the uniform pdf.
+    let (n, n_wgsl) = tilted_normal();
+    let samples = run_on_gpu(&format!("to_world({n_wgsl}, sample_cosine_hemisphere(u1, u2))"), 3);
+    let counts = bin_directions("cosine as uniform", &samples, n);
+    let result = std::panic::catch_unwind(|| {
+        chi_square_test("cosine tested as uniform", &counts, &theta_cells(|t| 1.0 - t.cos()))
+    });
+    assert!(result.is_err(), "the chi-square test accepted the wrong pdf");
+}
+
+#[test]
+fn rectangular_light_sampling_is_uniform_over_area() {
+    // A parallelogram with non-axis-aligned, non-orthogonal edges.
+    let (corner, u, v) =
+        (DVec3::new(1.0, 2.0, 3.0), DVec3::new(130.0, 5.0, 0.0), DVec3::new(10.0, 0.0, 105.0));
+    let samples = run_on_gpu(
+        "sample_parallelogram(vec3<f32>(1.0, 2.0, 3.0), vec3<f32>(130.0, 5.0, 0.0), vec3<f32>(10.0, 0.0, 105.0), u1, u2)",
+        4,
+    );
+    // Recover (s, t) from p = corner + s u + t v with the dual basis of (u, v) in their plane.
+    let normal = u.cross(v);
+    let (du, dv) = (v.cross(normal) / u.dot(v.cross(normal)), normal.cross(u) / v.dot(normal.cross(u)));
+    const BINS: usize = 16;
+    let mut counts = vec![0u64; BINS * BINS];
+    for p in &samples {
+        let h = *p - corner;
+        let (s, t) = (h.dot(du), h.dot(dv));
+        assert!(h.dot(normal).abs() < 1e-3 * normal.length(), "sample {p} is off the light's plane");
+        assert!((-1e-5..=1.0 + 1e-5).contains(&s) && (-1e-5..=1.0 + 1e-5).contains(&t), "({s}, {t}) outside");
+        let i = ((s * BINS as f64) as usize).min(BINS - 1);
+        let j = ((t * BINS as f64) as usize).min(BINS - 1);
+        counts[i * BINS + j] += 1;
+    }
+    // pdf = 1/A over area: every cell of the (s, t) grid has the same area, so p = 1/256.
+    chi_square_test("rectangle", &counts, &vec![1.0 / (BINS * BINS) as f64; BINS * BINS]);
+}
+
+#[test]
+fn random_numbers_are_uniform_in_the_half_open_unit_interval() {
+    let samples = run_on_gpu("vec3<f32>(u1, u2, 0.0)", 5);
+    const BINS: usize = 64;
+    let mut counts = vec![0u64; BINS * BINS];
+    for s in &samples {
+        assert!((0.0..1.0).contains(&s.x) && (0.0..1.0).contains(&s.y), "{s} outside [0, 1)");
+        counts[(s.x * BINS as f64) as usize * BINS + (s.y * BINS as f64) as usize] += 1;
+    }
+    // Pairs binned in 2D also test that consecutive numbers are independent.
+    chi_square_test("rng pairs", &counts, &vec![1.0 / (BINS * BINS) as f64; BINS * BINS]);
+}
+
+/// Question 2b: with uniform sampling, pdf = 1/(2 pi), the Monte Carlo estimate of
+/// the integral of cos(theta) over the hemisphere converges to its value, pi; with cosine
+/// sampling every sample gives exactly pi (zero variance, the reason it is the default).
+#[test]
+fn the_estimators_of_the_cosine_integral_converge_to_pi() {
+    let (n, n_wgsl) = tilted_normal();
+    let uniform = run_on_gpu(&format!("to_world({n_wgsl}, sample_uniform_hemisphere(u1, u2))"), 6);
+    let values: Vec<f64> = uniform.iter().map(|d| d.dot(n).max(0.0) * 2.0 * PI).collect();
+    let mean = values.iter().sum::<f64>() / values.len() as f64;
+    let variance = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (values.len() - 1) as f64;
+    let standard_error = (variance / values.len() as f64).sqrt();
+    assert!((mean - PI).abs() < 4.0 * standard_error, "uniform estimate {mean} vs pi (se {standard_error})");
+
+    let cosine = run_on_gpu(&format!("to_world({n_wgsl}, sample_cosine_hemisphere(u1, u2))"), 7);
+    for d in cosine.iter().take(1000) {
+        let cos_theta = d.dot(n);
+        if cos_theta > 1e-3 {
+            let estimate = cos_theta / (cos_theta / PI);
+            assert!((estimate - PI).abs() < 1e-9);
+        }
+    }
+    // The pdfs integrate to 1 (midpoint rule over theta, with the solid-angle element).
+    let steps = 100_000;
+    let (mut uniform_total, mut cosine_total) = (0.0, 0.0);
+    for i in 0..steps {
+        let theta = (i as f64 + 0.5) / steps as f64 * PI / 2.0;
+        let d_omega = 2.0 * PI * theta.sin() * (PI / 2.0 / steps as f64);
+        uniform_total += 1.0 / (2.0 * PI) * d_omega;
+        cosine_total += theta.cos() / PI * d_omega;
+    }
+    assert!((uniform_total - 1.0).abs() < 1e-6 && (cosine_total - 1.0).abs() < 1e-6);
+}
