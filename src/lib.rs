@@ -3,8 +3,10 @@
 //! This facade re-exports the workspace crates so that `examples/` and `tests/` can use one name,
 //! and holds the command-line pieces the examples share ([`cli`]).
 pub mod cli;
+pub mod raster_cli;
 
 pub use illum_gpu as gpu;
 pub use illum_image as image;
 pub use illum_pathtrace as pathtrace;
+pub use illum_raster as raster;
 pub use illum_scene as scene;

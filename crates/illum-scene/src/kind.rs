@@ -58,7 +58,8 @@ impl SceneKind {
 /// Reads `path` and tells which renderer it is for (see [`SceneKind::from_toml_str`]).
 pub fn scene_kind(path: &Path) -> Result<SceneKind, SceneError> {
     let label = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io { file: label.clone(), source })?;
+    let text =
+        std::fs::read_to_string(path).map_err(|source| SceneError::Io { file: label.clone(), source })?;
     SceneKind::from_toml_str(&text, &label)
 }
 

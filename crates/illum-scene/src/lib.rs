@@ -24,14 +24,27 @@
 //! assert_eq!(scene.name, "example");
 //! assert_eq!(scene.render.spp, 16);
 //! ```
+//!
+//! The same folder holds scenes for the Whitted look-alike rasterizer, marked with a top-level
+//! `renderer = "raster"`: [`scene_kind`] tells the two formats apart, and [`WhittedScene`] loads
+//! the rasterizer's (format in `whitted_file.rs`).
 
 mod camera;
 mod error;
 mod file;
+mod kind;
 mod load;
 mod settings;
 mod types;
 mod validate;
+mod whitted;
+mod whitted_file;
+mod whitted_validate;
 
 pub use error::{ParseValueError, SceneError};
+pub use kind::{SceneKind, scene_kind};
 pub use types::*;
+pub use whitted::{
+    AmbientLight, CheckerFloor, ClipPlanes, DirectionalLight, Effects, GlassSphere, Look, MetalSphere,
+    RasterLimits, RasterQuality, WhittedScene,
+};

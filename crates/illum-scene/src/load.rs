@@ -5,6 +5,7 @@ use std::path::Path;
 
 use crate::error::SceneError;
 use crate::file::RawScene;
+use crate::kind::SceneKind;
 use crate::settings::bounces_allowed;
 use crate::types::{Bounces, DeviceLimits, MAX_BOUNCES, Object, Overrides, Quad, Scene, Shape};
 use crate::validate::scene_from_raw;
@@ -21,6 +22,17 @@ impl Scene {
     /// Parses and validates scene text. `file_label` names the source in errors, and its file
     /// stem is the scene's name when the text has no `name`.
     pub fn from_toml_str(text: &str, file_label: &str) -> Result<Scene, SceneError> {
+        // A rasterizer scene would otherwise fail on its first unknown key; say what it is.
+        if SceneKind::from_toml_str(text, file_label)? == SceneKind::Raster {
+            return Err(SceneError::invalid(
+                file_label,
+                crate::kind::RENDERER_KEY,
+                format!("{:?}", crate::kind::RASTER),
+                "this is a Whitted look-alike scene for the rasterizer, not a path-tracer scene; \
+                 load it with illum_scene::WhittedScene::load (the render example picks the \
+                 renderer from the file by itself)",
+            ));
+        }
         let raw: RawScene = toml::from_str(text).map_err(|e| SceneError::from_toml(&e, text, file_label))?;
         let default_name = Path::new(file_label)
             .file_stem()

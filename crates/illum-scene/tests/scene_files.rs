@@ -1,11 +1,13 @@
-//! The shipped scene files: every one loads, and the two Cornell boxes hold the numbers of
-//! /work/shared/scene-facts.md (sections 2 and 3). Expected values are typed in from that
+//! The shipped scene files: every one loads, the two Cornell boxes hold the numbers of
+//! /work/shared/scene-facts.md (sections 2 and 3) and the Whitted scene those of section 1. Expected values are typed in from that
 //! document, not computed by the crate.
 
 use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
-use illum_scene::{Bounces, BoxShape, Sampling, Scene, SceneError, Shape};
+use illum_scene::{
+    Bounces, BoxShape, Look, Sampling, Scene, SceneError, SceneKind, Shape, WhittedScene, scene_kind,
+};
 
 fn scenes_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
@@ -72,16 +74,28 @@ fn assert_footprint(b: &BoxShape, expected: [(f32, f32); 4], what: &str) {
 
 #[test]
 fn every_scene_file_loads() {
+    // Each file is loaded by the loader its `renderer` key names, and refused by the other one.
     let mut loaded = Vec::new();
     for entry in std::fs::read_dir(scenes_dir()).expect("scenes/ exists") {
         let path = entry.unwrap().path();
         if path.extension().is_some_and(|e| e == "toml") {
-            let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
-            assert!(!scene.objects.is_empty());
+            match scene_kind(&path).unwrap_or_else(|e| panic!("{e}")) {
+                SceneKind::PathTrace => {
+                    let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+                    assert!(!scene.objects.is_empty());
+                    let err = WhittedScene::load(&path).unwrap_err().to_string();
+                    assert!(err.contains("renderer = (missing)"), "{err}");
+                }
+                SceneKind::Raster => {
+                    WhittedScene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+                    let err = Scene::load(&path).unwrap_err().to_string();
+                    assert!(err.contains("renderer = \"raster\"") && err.contains("WhittedScene"), "{err}");
+                }
+            }
             loaded.push(path.file_name().unwrap().to_string_lossy().into_owned());
         }
     }
-    for required in ["cornell.toml", "cornell-classic.toml"] {
+    for required in ["cornell.toml", "cornell-classic.toml", "whitted.toml"] {
         assert!(loaded.iter().any(|n| n == required), "{required} missing: {loaded:?}");
     }
 }
@@ -263,4 +277,47 @@ fn load_names_the_scene_after_the_file_stem_and_labels_errors_with_the_path() {
     let err = Scene::load(&broken).unwrap_err().to_string();
     let label = broken.display().to_string();
     assert_eq!(err, format!("{label}: render.spp = 0: must be at least 1"));
+}
+
+#[test]
+fn whitted_matches_section_1() {
+    let s = WhittedScene::load(&scenes_dir().join("whitted.toml")).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(s.name, "whitted");
+    assert_eq!(s.look, Look::Figure);
+    let c = s.camera;
+    assert_eq!(c.eye, Vec3::new(7.5, 2.3, -4.2));
+    assert_eq!(c.target, Vec3::new(4.2, 2.3, -4.2));
+    assert_eq!(c.up, Vec3::Y);
+    assert_eq!(c.vfov_deg, 60.0);
+    assert_eq!((s.clip.near, s.clip.far), (0.1, 3000.0));
+    // The camera looks along -X and screen-right is world -Z.
+    let basis = c.basis();
+    assert!(close3(basis.forward, Vec3::NEG_X, 1e-6), "{:?}", basis.forward);
+    assert!(close3(basis.right, Vec3::NEG_Z, 1e-6), "{:?}", basis.right);
+
+    assert_eq!(s.background, Vec3::new(0.3, 0.5, 0.9));
+    assert_eq!(s.light.position, Vec3::new(10.0, 13.0, -2.0));
+    assert_eq!(s.light.target, Vec3::ZERO);
+    assert_eq!(s.light.radiance(), Vec3::ONE);
+    let expected = -Vec3::new(10.0, 13.0, -2.0) / 273f32.sqrt();
+    assert!(close3(s.light.direction(), expected, 1e-6), "{:?}", s.light.direction());
+    assert_eq!(s.ambient.radiance(), Vec3::splat(0.23));
+
+    // x in [-23, 7], z in [-7.5, 7.5], 1 x 1 tiles: 30 x 15 squares.
+    assert_eq!(s.floor.min_corner(), glam::Vec2::new(-23.0, -7.5));
+    assert_eq!(s.floor.max_corner(), glam::Vec2::new(7.0, 7.5));
+    assert_eq!(s.floor.height(), 0.0);
+    assert_eq!(s.floor.tile, 1.0);
+    // 0xcccc00 and 0xcc0000 as linear 0xcc / 255 = 0.8.
+    assert_eq!(s.floor.colors, [Vec3::new(0.8, 0.8, 0.0), Vec3::new(0.8, 0.0, 0.0)]);
+
+    assert_eq!((s.glass.center, s.glass.radius), (Vec3::new(4.2, 2.6, -4.2), 1.0));
+    assert_eq!(s.glass.color, Vec3::ONE);
+    assert_eq!(s.glass.refraction_ratio, 0.7);
+    assert_eq!(s.glass.reflectivity, 0.9);
+    assert_eq!((s.metal.center, s.metal.radius), (Vec3::new(2.0, 1.9, -2.5), 1.0));
+    // 0xcadcd9 = (202, 220, 217) / 255.
+    assert!(close3(s.metal.color, Vec3::new(202.0, 220.0, 217.0) / 255.0, 1e-3), "{:?}", s.metal.color);
+    assert_eq!(s.metal.specular, Vec3::ONE);
+    assert_eq!(s.effects, illum_scene::Effects::ALL_ON);
 }

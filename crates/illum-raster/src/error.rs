@@ -1,0 +1,10 @@
+use thiserror::Error;
+
+/// Why the rasterizer could not render.
+#[derive(Debug, Error)]
+pub enum RasterError {
+    #[error(transparent)]
+    Gpu(#[from] illum_gpu::GpuError),
+    #[error(transparent)]
+    Scene(#[from] illum_scene::SceneError),
+}

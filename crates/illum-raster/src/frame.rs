@@ -1,0 +1,262 @@
+//! Recording one frame: the shadow pass, the cube-map captures and the main pass.
+//!
+//! Order matters because each pass reads what the previous ones wrote:
+//! 1. shadow: the spheres' depth from the light;
+//! 2. glass cube: six faces from the glass sphere's centre showing everything but the glass
+//!    (the floor with its shadows, the metal sphere Phong-lit, the sky), then the same six at
+//!    an eighth of the side, the prefiltered level for lookups with a wide footprint;
+//! 3. metal cube (whitted look with reflection only): six faces from the metal sphere's centre
+//!    showing everything but the metal, the glass refracting the glass cube just made;
+//! 4. main: floor and both spheres, the glass reading the glass cube and (whitted) the metal
+//!    reading the metal cube, multisampled and resolved into the output.
+//!
+//! So the metal seen inside the glass lacks its own reflection, and the glass seen in the
+//! metal's mirror has one cube level less: a rasterizer's stand-in for recursion depth.
+
+use illum_gpu::timing::PassTimer;
+use illum_gpu::wgpu;
+
+use crate::views::CUBE_FACE_NAMES;
+
+/// Slots of the view uniform buffer.
+pub const MAIN_VIEW: usize = 0;
+pub const GLASS_FACE_VIEWS: usize = 1;
+pub const METAL_FACE_VIEWS: usize = 7;
+pub const SHADOW_VIEW: usize = 13;
+pub const VIEW_COUNT: usize = 14;
+
+/// Both spheres, as instances of the shadow pass (0 glass, 1 metal, as in scene.wgsl).
+const BOTH: std::ops::Range<u32> = 0..2;
+/// Six vertices: the two triangles of a quad.
+const QUAD: std::ops::Range<u32> = 0..6;
+
+/// Names of the timed passes: "shadow", eighteen cube faces, "main".
+pub fn pass_names() -> Vec<String> {
+    let mut names = vec!["shadow".to_owned()];
+    for cube in ["glass", "metal"] {
+        names.extend(CUBE_FACE_NAMES.iter().map(|face| format!("cube {cube} {face}")));
+    }
+    names.extend(CUBE_FACE_NAMES.iter().map(|face| format!("cube glass coarse {face}")));
+    names.push("main".to_owned());
+    names
+}
+
+/// Everything a frame's passes bind or render into.
+pub struct FrameResources<'a> {
+    pub timer: &'a PassTimer,
+    pub uniforms: &'a wgpu::BindGroup,
+    pub view_stride: u64,
+    pub shadow_pipeline: &'a wgpu::RenderPipeline,
+    pub shadow_map: &'a wgpu::TextureView,
+    pub cube_floor: &'a wgpu::RenderPipeline,
+    /// The floor's shadow receiver (`None`: shadows off), for the cube faces and the main view.
+    pub cube_floor_receiver: Option<&'a wgpu::RenderPipeline>,
+    pub main_floor_receiver: Option<&'a wgpu::RenderPipeline>,
+    /// The metal sphere as the glass capture draws it.
+    pub cube_metal: &'a wgpu::RenderPipeline,
+    /// The glass sphere as the metal capture draws it (`None`: no metal cube this frame).
+    pub cube_glass: Option<&'a wgpu::RenderPipeline>,
+    pub cube_depth: &'a wgpu::TextureView,
+    pub coarse_depth: &'a wgpu::TextureView,
+    pub glass_faces: &'a [wgpu::TextureView],
+    pub glass_coarse_faces: &'a [wgpu::TextureView],
+    pub metal_faces: &'a [wgpu::TextureView],
+    /// Group 1 for the glass capture (no cube map readable), the metal capture (glass cube
+    /// readable) and the main pass (both).
+    pub glass_capture_textures: &'a wgpu::BindGroup,
+    pub metal_capture_textures: &'a wgpu::BindGroup,
+    pub main_textures: &'a wgpu::BindGroup,
+    pub main_floor: &'a wgpu::RenderPipeline,
+    pub main_glass: &'a wgpu::RenderPipeline,
+    pub main_metal: &'a wgpu::RenderPipeline,
+    /// The multisampled colour buffer, when MSAA is on.
+    pub main_multisampled: Option<&'a wgpu::TextureView>,
+    pub main_output: &'a wgpu::TextureView,
+    pub main_depth: &'a wgpu::TextureView,
+    pub background: [f32; 3],
+}
+
+/// One cube map's capture.
+#[derive(Clone, Copy)]
+struct Capture<'a> {
+    /// For the pass names: "cube NAME +X" and so on.
+    name: &'a str,
+    /// The six layers to render, in CUBE_FACE_NAMES order.
+    faces: &'a [wgpu::TextureView],
+    depth: &'a wgpu::TextureView,
+    /// View-uniform slot of the +X face; the others follow.
+    first_view: usize,
+    textures: &'a wgpu::BindGroup,
+    /// The other sphere, as seen from this one (`None`: the cube map is not needed this frame).
+    sphere: Option<&'a wgpu::RenderPipeline>,
+}
+
+impl FrameResources<'_> {
+    fn view_offset(&self, slot: usize) -> u32 {
+        (slot as u64 * self.view_stride) as u32
+    }
+
+    fn clear_colour(&self) -> wgpu::Color {
+        let [r, g, b] = self.background.map(f64::from);
+        wgpu::Color { r, g, b, a: 1.0 }
+    }
+
+    fn clear_depth<'t>(
+        &self,
+        view: &'t wgpu::TextureView,
+    ) -> Option<wgpu::RenderPassDepthStencilAttachment<'t>> {
+        Some(wgpu::RenderPassDepthStencilAttachment {
+            view,
+            depth_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Clear(1.0),
+                store: wgpu::StoreOp::Discard,
+            }),
+            stencil_ops: None,
+        })
+    }
+
+    /// Records every pass of one frame. Every timed pass is recorded even when it draws nothing
+    /// (no shadows, no metal cube), so that every timestamp query is written each frame.
+    /// `shadows`: draw the casters into the shadow map (else it stays cleared: all lit).
+    pub fn record(&self, encoder: &mut wgpu::CommandEncoder, shadows: bool) {
+        self.shadow_pass(encoder, shadows);
+        // Seen from the glass sphere's centre: everything but the glass; then the same views at
+        // an eighth of the side, the glass's prefiltered level.
+        let glass = Capture {
+            name: "glass",
+            faces: self.glass_faces,
+            depth: self.cube_depth,
+            first_view: GLASS_FACE_VIEWS,
+            textures: self.glass_capture_textures,
+            sphere: Some(self.cube_metal),
+        };
+        self.capture(encoder, &glass);
+        self.capture(
+            encoder,
+            &Capture {
+                name: "glass coarse",
+                faces: self.glass_coarse_faces,
+                depth: self.coarse_depth,
+                ..glass
+            },
+        );
+        // Seen from the metal sphere's centre: everything but the metal.
+        let metal = Capture {
+            name: "metal",
+            faces: self.metal_faces,
+            depth: self.cube_depth,
+            first_view: METAL_FACE_VIEWS,
+            textures: self.metal_capture_textures,
+            sphere: self.cube_glass,
+        };
+        self.capture(encoder, &metal);
+        self.main_pass(encoder);
+    }
+
+    /// The six faces of one cube map.
+    fn capture(&self, encoder: &mut wgpu::CommandEncoder, capture: &Capture) {
+        for (face, face_name) in CUBE_FACE_NAMES.iter().enumerate() {
+            let name = format!("cube {} {face_name}", capture.name);
+            self.cube_face(encoder, &name, capture, face);
+        }
+    }
+
+    fn shadow_pass(&self, encoder: &mut wgpu::CommandEncoder, draw: bool) {
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("raster shadow"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: self.shadow_map,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: self.timer.render_writes("shadow"),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        if draw {
+            pass.set_pipeline(self.shadow_pipeline);
+            pass.set_bind_group(0, self.uniforms, &[self.view_offset(SHADOW_VIEW)]);
+            pass.draw(QUAD, BOTH);
+        }
+    }
+
+    /// One cube face: the floor and the capture's sphere, or, without a sphere, an empty pass
+    /// that leaves the face as it is (a cube map the frame does not use).
+    fn cube_face(&self, encoder: &mut wgpu::CommandEncoder, name: &str, capture: &Capture, face: usize) {
+        let sphere = capture.sphere;
+        let load =
+            if sphere.is_some() { wgpu::LoadOp::Clear(self.clear_colour()) } else { wgpu::LoadOp::Load };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(name),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &capture.faces[face],
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations { load, store: wgpu::StoreOp::Store },
+            })],
+            depth_stencil_attachment: sphere.and_then(|_| self.clear_depth(capture.depth)),
+            timestamp_writes: self.timer.render_writes(name),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        let Some(sphere) = sphere else { return };
+        pass.set_bind_group(0, self.uniforms, &[self.view_offset(capture.first_view + face)]);
+        pass.set_bind_group(1, capture.textures, &[]);
+        // Sphere first: it hides part of the floor, whose fragments then fail the early depth
+        // test before shading (the sphere writes its depth from the fragment shader, so it gets
+        // no early test itself). On lavapipe this order also avoids a fixed cost of about a
+        // millisecond per pass that a floor-first pass pays (measured, see docs/performance-raster.md).
+        // The floor's shadow receiver goes before the rest of the floor (floor.wgsl).
+        for pipeline in [Some(sphere), self.cube_floor_receiver, Some(self.cube_floor)].into_iter().flatten()
+        {
+            pass.set_pipeline(pipeline);
+            pass.draw(QUAD, 0..1);
+        }
+    }
+
+    fn main_pass(&self, encoder: &mut wgpu::CommandEncoder) {
+        // With MSAA the samples are resolved into the output at the end of the pass (the box
+        // filter over each pixel's samples) and need not be stored.
+        let colour = match self.main_multisampled {
+            Some(samples) => wgpu::RenderPassColorAttachment {
+                view: samples,
+                depth_slice: None,
+                resolve_target: Some(self.main_output),
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(self.clear_colour()),
+                    store: wgpu::StoreOp::Discard,
+                },
+            },
+            None => wgpu::RenderPassColorAttachment {
+                view: self.main_output,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(self.clear_colour()),
+                    store: wgpu::StoreOp::Store,
+                },
+            },
+        };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("raster main"),
+            color_attachments: &[Some(colour)],
+            depth_stencil_attachment: self.clear_depth(self.main_depth),
+            timestamp_writes: self.timer.render_writes("main"),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_bind_group(0, self.uniforms, &[self.view_offset(MAIN_VIEW)]);
+        pass.set_bind_group(1, self.main_textures, &[]);
+        // Spheres first, for the reasons given in cube_face.
+        let pipelines =
+            [Some(self.main_glass), Some(self.main_metal), self.main_floor_receiver, Some(self.main_floor)];
+        for pipeline in pipelines.into_iter().flatten() {
+            pass.set_pipeline(pipeline);
+            pass.draw(QUAD, 0..1);
+        }
+    }
+}

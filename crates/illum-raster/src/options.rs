@@ -1,0 +1,50 @@
+//! What a frame should look like: the look and the effect toggles.
+
+use illum_scene::{Effects, Look, WhittedScene};
+
+/// The choices a caller makes per frame. The scene file supplies defaults
+/// ([`Options::from_scene`]); code, the command line or a viewer may change any of them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Options {
+    pub look: Look,
+    pub effects: Effects,
+}
+
+impl Options {
+    /// The look and effects written in the scene file.
+    pub fn from_scene(scene: &WhittedScene) -> Self {
+        Options { look: scene.look, effects: scene.effects }
+    }
+
+    /// `look` with every effect on.
+    pub fn all_on(look: Look) -> Self {
+        Options { look, effects: Effects::ALL_ON }
+    }
+
+    /// Whether the frame needs the metal sphere's cube map: only the whitted look mirrors.
+    pub fn needs_metal_cube(&self) -> bool {
+        self.look == Look::Whitted && self.effects.reflection
+    }
+
+    /// Samples per pixel of the main pass.
+    pub fn samples(&self) -> u32 {
+        if self.effects.msaa { crate::MSAA_SAMPLES } else { 1 }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn metal_cube_only_for_whitted_reflections() {
+        assert!(!Options::all_on(Look::Figure).needs_metal_cube());
+        assert!(Options::all_on(Look::Whitted).needs_metal_cube());
+        let mut o = Options::all_on(Look::Whitted);
+        o.effects.reflection = false;
+        assert!(!o.needs_metal_cube());
+        assert_eq!(o.samples(), 4);
+        o.effects.msaa = false;
+        assert_eq!(o.samples(), 1);
+    }
+}

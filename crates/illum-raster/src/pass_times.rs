@@ -1,0 +1,55 @@
+//! GPU time per part of a frame, from the timestamp queries of `frame::pass_names`.
+
+use illum_image::RgbImage32;
+
+/// GPU time of each part of a frame, in milliseconds, from timestamp queries.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PassTimes {
+    /// The shadow map.
+    pub shadow_ms: f64,
+    /// All eighteen cube-map faces: the glass's, its coarse copy's and the metal's (empty passes
+    /// in the figure look).
+    pub cube_ms: f64,
+    /// The main view, including the MSAA resolve.
+    pub main_ms: f64,
+}
+
+impl PassTimes {
+    /// Sums per-pass timings named as in `frame::pass_names`.
+    pub(crate) fn from_named(named: &[(String, f64)]) -> Self {
+        let mut t = PassTimes::default();
+        for (name, ms) in named {
+            match name.as_str() {
+                "shadow" => t.shadow_ms += ms,
+                "main" => t.main_ms += ms,
+                _ => t.cube_ms += ms,
+            }
+        }
+        t
+    }
+
+    pub fn total_ms(&self) -> f64 {
+        self.shadow_ms + self.cube_ms + self.main_ms
+    }
+}
+
+/// A rendered image with the GPU times of its passes (`None` without timestamp queries).
+#[derive(Clone, Debug)]
+pub struct Frame {
+    pub image: RgbImage32,
+    pub pass_times: Option<PassTimes>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frame::pass_names;
+
+    #[test]
+    fn pass_times_sum_the_cube_faces() {
+        let named: Vec<(String, f64)> = pass_names().into_iter().map(|n| (n, 0.5)).collect();
+        let t = PassTimes::from_named(&named);
+        assert_eq!((t.shadow_ms, t.cube_ms, t.main_ms), (0.5, 9.0, 0.5));
+        assert_eq!(t.total_ms(), 10.0);
+    }
+}

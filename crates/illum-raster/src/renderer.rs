@@ -1,0 +1,331 @@
+//! [`WhittedRenderer`]: owns the GPU resources and turns a scene plus [`Options`] into frames.
+
+use glam::Vec3;
+use illum_gpu::timing::PassTimer;
+use illum_gpu::{GpuContext, readback, wgpu};
+use illum_image::RgbImage32;
+use illum_scene::{RasterLimits, WhittedScene};
+
+use crate::RasterError;
+use crate::bindings::{Samplers, TextureGroups, Uniforms};
+use crate::frame::{
+    FrameResources, GLASS_FACE_VIEWS, MAIN_VIEW, METAL_FACE_VIEWS, SHADOW_VIEW, VIEW_COUNT, pass_names,
+};
+use crate::options::Options;
+use crate::pass_times::{Frame, PassTimes};
+use crate::pipelines::Pipelines;
+use crate::shadow_fit::{MAX_SHADOW_MAP, ShadowFit, fit_shadow};
+use crate::targets::{CubeSet, MainTargets, ShadowMap};
+use crate::uniforms::{self, ViewUniform};
+use crate::variants::{PipelineKey, Surface, Target};
+use crate::views::{cube_face_view_proj, main_view_proj};
+
+/// The pipelines of one frame.
+struct Keys {
+    cube_floor: PipelineKey,
+    cube_receiver: PipelineKey,
+    cube_metal: PipelineKey,
+    cube_glass: PipelineKey,
+    main_floor: PipelineKey,
+    main_receiver: PipelineKey,
+    main_glass: PipelineKey,
+    main_metal: PipelineKey,
+}
+
+/// Bytes per output pixel (RGBA8) and the row alignment of texture-to-buffer copies.
+const BYTES_PER_PIXEL: u32 = 4;
+
+/// The Whitted look-alike renderer: a scene, a fixed output size and the GPU resources for them.
+pub struct WhittedRenderer {
+    gpu: GpuContext,
+    scene: WhittedScene,
+    width: u32,
+    height: u32,
+    pipelines: Pipelines,
+    uniforms: Uniforms,
+    samplers: Samplers,
+    shadow_fit: ShadowFit,
+    shadow_map: ShadowMap,
+    cubes: CubeSet,
+    texture_groups: TextureGroups,
+    main: Option<MainTargets>,
+    timer: PassTimer,
+    staging: Option<wgpu::Buffer>,
+}
+
+impl WhittedRenderer {
+    /// Compiles the pipelines and allocates everything for `width` x `height` output, after
+    /// checking the size (and the scene's cube maps) against the device's limits.
+    pub fn new(gpu: &GpuContext, scene: &WhittedScene, width: u32, height: u32) -> Result<Self, RasterError> {
+        let scene = Self::sized(gpu, scene, width, height)?;
+        let pipelines = Pipelines::new(gpu)?;
+        let uniforms = Uniforms::new(gpu, &pipelines.uniforms_layout)?;
+        let samplers = Samplers::new(gpu)?;
+        let shadow_fit = fit_shadow(&scene, Self::max_shadow_map(gpu));
+        let shadow_map = ShadowMap::new(gpu, shadow_fit.size)?;
+        let cubes = CubeSet::new(gpu, scene.quality.cube_size)?;
+        let texture_groups =
+            TextureGroups::new(gpu, &pipelines.textures_layout, &samplers, &shadow_map, &cubes)?;
+        let names = pass_names();
+        let name_refs: Vec<&str> = names.iter().map(String::as_str).collect();
+        Ok(WhittedRenderer {
+            gpu: gpu.clone(),
+            scene,
+            width,
+            height,
+            pipelines,
+            uniforms,
+            samplers,
+            shadow_fit,
+            shadow_map,
+            cubes,
+            texture_groups,
+            main: None,
+            timer: PassTimer::new(gpu, &name_refs),
+            staging: None,
+        })
+    }
+
+    /// `scene` with the output size set to `width` x `height`, checked against the device.
+    fn sized(
+        gpu: &GpuContext,
+        scene: &WhittedScene,
+        width: u32,
+        height: u32,
+    ) -> Result<WhittedScene, RasterError> {
+        let mut scene = scene.clone();
+        scene.set_resolution(Some(width), Some(height), "WhittedRenderer")?;
+        let limits = gpu.device.limits();
+        scene.check_device_limits(&RasterLimits {
+            max_texture_dimension_2d: limits.max_texture_dimension_2d,
+            max_buffer_size: limits.max_buffer_size,
+        })?;
+        Ok(scene)
+    }
+
+    fn max_shadow_map(gpu: &GpuContext) -> u32 {
+        gpu.device.limits().max_texture_dimension_2d.min(MAX_SHADOW_MAP)
+    }
+
+    pub fn scene(&self) -> &WhittedScene {
+        &self.scene
+    }
+
+    pub fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    /// The shadow map's side in texels and one texel's size in scene units.
+    pub fn shadow_map_resolution(&self) -> (u32, f32) {
+        (self.shadow_fit.size, self.shadow_fit.texel)
+    }
+
+    /// Replaces the scene (a moved sphere or light, other colours): refits the shadow map and,
+    /// if the cube size changed, reallocates the cube maps. The output size stays.
+    pub fn set_scene(&mut self, scene: &WhittedScene) -> Result<(), RasterError> {
+        let scene = Self::sized(&self.gpu, scene, self.width, self.height)?;
+        let fit = fit_shadow(&scene, Self::max_shadow_map(&self.gpu));
+        let cube_size = scene.quality.cube_size;
+        if fit.size != self.shadow_map.size {
+            self.shadow_map = ShadowMap::new(&self.gpu, fit.size)?;
+        }
+        if cube_size != self.cubes.glass.size {
+            self.cubes = CubeSet::new(&self.gpu, cube_size)?;
+        }
+        self.texture_groups = TextureGroups::new(
+            &self.gpu,
+            &self.pipelines.textures_layout,
+            &self.samplers,
+            &self.shadow_map,
+            &self.cubes,
+        )?;
+        self.shadow_fit = fit;
+        self.scene = scene;
+        Ok(())
+    }
+
+    /// Changes the output size (checked against the device's limits).
+    pub fn resize(&mut self, width: u32, height: u32) -> Result<(), RasterError> {
+        self.scene = Self::sized(&self.gpu, &self.scene, width, height)?;
+        self.width = width;
+        self.height = height;
+        self.main = None;
+        Ok(())
+    }
+
+    /// Renders one frame and reads it back: linear RGB, row 0 at the top, each value one of the
+    /// 256 levels k / 255 of the 8-bit output.
+    pub fn render(&mut self, options: &Options) -> Result<RgbImage32, RasterError> {
+        Ok(self.render_timed(options)?.image)
+    }
+
+    /// [`Self::render`] plus the GPU time of each pass.
+    pub fn render_timed(&mut self, options: &Options) -> Result<Frame, RasterError> {
+        let mut encoder = self.record(options)?;
+        let row = (self.width * BYTES_PER_PIXEL).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+        let image_bytes = u64::from(row) * u64::from(self.height);
+        let staging = self.staging(image_bytes + self.timer.result_size());
+        let main = self.main.as_ref().expect("record() made the main targets");
+        encoder.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture: &main.output,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &staging,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(row),
+                    rows_per_image: None,
+                },
+            },
+            wgpu::Extent3d { width: self.width, height: self.height, depth_or_array_layers: 1 },
+        );
+        self.timer.copy_results(&mut encoder, &staging, image_bytes);
+        self.gpu.queue.submit([encoder.finish()]);
+        let bytes =
+            readback::read_mapped(&self.gpu, &staging, staging.size(), "reading back a raster frame")?;
+        let (pixels, timestamps) = bytes.split_at(image_bytes as usize);
+        let image = RgbImage32::from_fn(self.width, self.height, |x, y| {
+            let i = (y * row + x * BYTES_PER_PIXEL) as usize;
+            [0, 1, 2].map(|c| f32::from(pixels[i + c]) / 255.0)
+        });
+        let pass_times = self.timer.decode(timestamps).map(|named| PassTimes::from_named(&named));
+        Ok(Frame { image, pass_times })
+    }
+
+    /// Renders one frame into [`Self::output_view`] without reading it back, waits for the GPU
+    /// and returns the pass times (what a benchmark or a viewer needs).
+    pub fn draw(&mut self, options: &Options) -> Result<Option<PassTimes>, RasterError> {
+        let mut encoder = self.record(options)?;
+        if !self.timer.enabled() {
+            self.gpu.queue.submit([encoder.finish()]);
+            self.gpu.wait_idle("drawing a raster frame")?;
+            return Ok(None);
+        }
+        let size = self.timer.result_size();
+        let staging = self.staging(size);
+        self.timer.copy_results(&mut encoder, &staging, 0);
+        self.gpu.queue.submit([encoder.finish()]);
+        let bytes = readback::read_mapped(&self.gpu, &staging, size, "reading raster pass times")?;
+        Ok(self.timer.decode(&bytes).map(|named| PassTimes::from_named(&named)))
+    }
+
+    /// The last frame (RGBA8, linear values), after [`Self::draw`] or [`Self::render`].
+    pub fn output_view(&self) -> Option<&wgpu::TextureView> {
+        self.main.as_ref().map(|m| &m.output_view)
+    }
+
+    /// A mappable staging buffer of at least `size` bytes (reused between frames).
+    fn staging(&mut self, size: u64) -> wgpu::Buffer {
+        if self.staging.as_ref().is_none_or(|s| s.size() != size) {
+            self.staging = Some(self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("raster staging"),
+                size,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }));
+        }
+        self.staging.clone().expect("allocated above")
+    }
+
+    /// Writes the frame's uniforms and records its passes.
+    fn record(&mut self, options: &Options) -> Result<wgpu::CommandEncoder, RasterError> {
+        let samples = options.samples();
+        if self.main.as_ref().is_none_or(|m| m.samples != samples) {
+            self.main = Some(MainTargets::new(&self.gpu, self.width, self.height, samples)?);
+        }
+        let main = Target::Main { samples };
+        let (glass_shadowed, metal_shadowed) =
+            (self.shadow_fit.glass_shadowed, self.shadow_fit.metal_shadowed);
+        let key = |surface, target| {
+            let shadowed = match surface {
+                Surface::Glass => glass_shadowed,
+                Surface::Metal => metal_shadowed,
+                Surface::Floor | Surface::FloorReceiver => true,
+            };
+            PipelineKey::new(surface, target, options, shadowed)
+        };
+        let keys = Keys {
+            cube_floor: key(Surface::Floor, Target::Cube),
+            cube_receiver: key(Surface::FloorReceiver, Target::Cube),
+            cube_metal: key(Surface::Metal, Target::Cube),
+            cube_glass: key(Surface::Glass, Target::Cube),
+            main_floor: key(Surface::Floor, main),
+            main_receiver: key(Surface::FloorReceiver, main),
+            main_glass: key(Surface::Glass, main),
+            main_metal: key(Surface::Metal, main),
+        };
+        let shadows = options.effects.shadows;
+        let metal_cube = options.needs_metal_cube();
+        for (key, needed) in [
+            (keys.cube_floor, true),
+            (keys.cube_receiver, shadows),
+            (keys.cube_metal, true),
+            // The glass as the metal's cube map sees it.
+            (keys.cube_glass, metal_cube),
+            (keys.main_floor, true),
+            (keys.main_receiver, shadows),
+            (keys.main_glass, true),
+            (keys.main_metal, true),
+        ] {
+            if needed {
+                self.pipelines.ensure(&self.gpu, key)?;
+            }
+        }
+        self.write_uniforms();
+
+        let mut encoder = self
+            .gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("raster frame") });
+        let main = self.main.as_ref().expect("made above");
+        let resources = FrameResources {
+            timer: &self.timer,
+            uniforms: &self.uniforms.group,
+            view_stride: self.uniforms.view_stride,
+            shadow_pipeline: &self.pipelines.shadow,
+            shadow_map: &self.shadow_map.view,
+            cube_floor: self.pipelines.get(&keys.cube_floor),
+            cube_floor_receiver: shadows.then(|| self.pipelines.get(&keys.cube_receiver)),
+            main_floor_receiver: shadows.then(|| self.pipelines.get(&keys.main_receiver)),
+            cube_metal: self.pipelines.get(&keys.cube_metal),
+            cube_glass: metal_cube.then(|| self.pipelines.get(&keys.cube_glass)),
+            cube_depth: &self.cubes.depth,
+            coarse_depth: &self.cubes.coarse_depth,
+            glass_faces: &self.cubes.glass.face_views,
+            glass_coarse_faces: &self.cubes.glass_coarse.face_views,
+            metal_faces: &self.cubes.metal.face_views,
+            glass_capture_textures: &self.texture_groups.glass_capture,
+            metal_capture_textures: &self.texture_groups.metal_capture,
+            main_textures: &self.texture_groups.main,
+            main_floor: self.pipelines.get(&keys.main_floor),
+            main_glass: self.pipelines.get(&keys.main_glass),
+            main_metal: self.pipelines.get(&keys.main_metal),
+            main_multisampled: main.multisampled.as_ref(),
+            main_output: &main.output_view,
+            main_depth: &main.depth,
+            background: self.scene.background.to_array(),
+        };
+        resources.record(&mut encoder, shadows);
+        Ok(encoder)
+    }
+
+    fn write_uniforms(&self) {
+        let scene = &self.scene;
+        let mut views: [ViewUniform; VIEW_COUNT] = bytemuck::Zeroable::zeroed();
+        views[MAIN_VIEW] =
+            uniforms::perspective_view(main_view_proj(scene, self.width, self.height), scene.camera.eye);
+        let cube_view = |center: Vec3, face: usize| {
+            uniforms::perspective_view(cube_face_view_proj(center, face, scene.clip), center)
+        };
+        for face in 0..6 {
+            views[GLASS_FACE_VIEWS + face] = cube_view(scene.glass.center, face);
+            views[METAL_FACE_VIEWS + face] = cube_view(scene.metal.center, face);
+        }
+        views[SHADOW_VIEW] = uniforms::shadow_view(&self.shadow_fit);
+        self.uniforms.write(&self.gpu, &uniforms::scene_uniform(scene, &self.shadow_fit), &views);
+    }
+}

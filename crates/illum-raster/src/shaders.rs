@@ -1,0 +1,53 @@
+//! The rasterizer's WGSL: three composable modules and three entry files in `shaders/raster/`.
+//!
+//! Every entry file is composed with illum-gpu's [`COMMON_MODULES`] followed by [`MODULES`]
+//! (see [`compose`]); the naga validation test walks [`SHADERS`] the same way.
+
+use illum_gpu::GpuError;
+use illum_gpu::shader::{self, COMMON_MODULES, ShaderFile};
+
+/// Uniform layout and helpers shared by every raster pass (`illum::raster::scene`).
+pub const SCENE_MODULE: ShaderFile = illum_gpu::shader_file!("shaders/raster/scene.wgsl");
+/// Sphere impostors: billboards, ray-sphere tests, MSAA coverage (`illum::raster::sphere`).
+pub const SPHERE_MODULE: ShaderFile = illum_gpu::shader_file!("shaders/raster/sphere.wgsl");
+/// Shadows, the filtered checker, cube-map lookups and the two looks (`illum::raster::lighting`).
+pub const LIGHTING_MODULE: ShaderFile = illum_gpu::shader_file!("shaders/raster/lighting.wgsl");
+
+/// The raster modules, in dependency order (each imports only those before it).
+pub const MODULES: &[ShaderFile] = &[SCENE_MODULE, SPHERE_MODULE, LIGHTING_MODULE];
+
+/// The modules every entry file is composed with: `COMMON_MODULES` then [`MODULES`].
+pub fn modules() -> Vec<ShaderFile> {
+    COMMON_MODULES.iter().chain(MODULES).cloned().collect()
+}
+
+/// The shadow pass: sphere depth from the light (`vs_main`, `fs_main`).
+pub const SHADOW_SHADER: ShaderFile = illum_gpu::shader_file!("shaders/raster/shadow.wgsl");
+/// The checkerboard floor (`vs_main`, `fs_main`).
+pub const FLOOR_SHADER: ShaderFile = illum_gpu::shader_file!("shaders/raster/floor.wgsl");
+/// The glass and metal spheres (`vs_main`, `fs_main`).
+pub const SPHERES_SHADER: ShaderFile = illum_gpu::shader_file!("shaders/raster/spheres.wgsl");
+
+/// The entry files, each composed with `COMMON_MODULES` + [`MODULES`].
+pub const SHADERS: &[ShaderFile] = &[SHADOW_SHADER, FLOOR_SHADER, SPHERES_SHADER];
+
+/// Composes one of [`SHADERS`] into a naga module (validated by naga_oil's composer).
+pub fn compose(entry: &ShaderFile) -> Result<naga::Module, GpuError> {
+    shader::compose(&modules(), entry, &[])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_entry_composes_and_validates() {
+        for entry in SHADERS {
+            let module = compose(entry).unwrap_or_else(|e| panic!("{e}"));
+            shader::validate(&module, &entry.path).unwrap_or_else(|e| panic!("{e}"));
+            for stage in ["vs_main", "fs_main"] {
+                assert!(module.entry_points.iter().any(|e| e.name == stage), "{}: no {stage}", entry.path);
+            }
+        }
+    }
+}

@@ -1,0 +1,191 @@
+//! Which pipeline variant draws each surface of a frame.
+//!
+//! The entry shaders declare override constants (WHITTED, SHADOWS, ...; see `Switches` in
+//! scene.wgsl) that fix the effects when a pipeline is created, so the driver compiles out the
+//! paths not taken. On lavapipe, which runs both sides of a branch under a lane mask, this made
+//! the sphere shading several times faster than branching on uniform flags. Keys leave out the
+//! switches a surface ignores, so toggling an effect builds only the pipelines it changes.
+
+use illum_scene::Look;
+
+use crate::options::Options;
+
+/// A surface drawn by the floor and sphere pipelines.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Surface {
+    /// The whole floor without shadow lookups, depth-biased so that it fills in only where the
+    /// receiver did not draw (floor.wgsl).
+    Floor,
+    /// The floor under the shadow map, with shadow lookups (only drawn with shadows on).
+    FloorReceiver,
+    Glass,
+    Metal,
+}
+
+/// The kind of target: a cube-map face (half float, one sample) or the main view.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Target {
+    Cube,
+    Main { samples: u32 },
+}
+
+impl Target {
+    pub fn samples(self) -> u32 {
+        match self {
+            Target::Cube => 1,
+            Target::Main { samples } => samples,
+        }
+    }
+}
+
+/// The override constants of one pipeline (names as in the entry shaders).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Switches {
+    pub whitted: bool,
+    pub shadows: bool,
+    pub pcf: bool,
+    pub refraction: bool,
+    pub reflection: bool,
+    pub fresnel: bool,
+    pub metal_env: bool,
+}
+
+/// A pipeline: what it draws, where, and with which switches.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct PipelineKey {
+    pub surface: Surface,
+    pub target: Target,
+    pub switches: Switches,
+}
+
+impl PipelineKey {
+    /// The pipeline that draws `surface` into `target` for `options`, with only the switches
+    /// that surface reads. The metal's cube map exists only in the main pass of a frame that
+    /// captured it. `shadowed`: whether this sphere can receive a shadow at all (from the other
+    /// sphere; see `shadow_fit::can_shadow`); where it cannot, its shadow lookup is compiled out.
+    pub fn new(surface: Surface, target: Target, options: &Options, shadowed: bool) -> Self {
+        let e = &options.effects;
+        let sphere_shadows = e.shadows && shadowed;
+        let whitted = options.look == Look::Whitted;
+        let switches = match surface {
+            Surface::Floor => Switches::default(),
+            Surface::FloorReceiver => Switches { shadows: true, pcf: e.pcf, ..Default::default() },
+            // The figure's glass is unlit: only refraction matters.
+            Surface::Glass if !whitted => Switches { refraction: e.refraction, ..Default::default() },
+            Surface::Glass => Switches {
+                whitted,
+                shadows: sphere_shadows,
+                pcf: e.pcf,
+                refraction: e.refraction,
+                reflection: e.reflection,
+                fresnel: e.fresnel && e.reflection,
+                metal_env: false,
+            },
+            Surface::Metal => {
+                let mirror = whitted && e.reflection && matches!(target, Target::Main { .. });
+                Switches {
+                    whitted: mirror,
+                    shadows: sphere_shadows,
+                    pcf: e.pcf,
+                    reflection: mirror,
+                    metal_env: mirror,
+                    ..Default::default()
+                }
+            }
+        };
+        let switches = Switches { pcf: switches.pcf && switches.shadows, ..switches };
+        PipelineKey { surface, target, switches }
+    }
+
+    /// The pipeline-overridable constants for the entry shader of this key.
+    pub fn constants(&self) -> Vec<(&'static str, f64)> {
+        let s = &self.switches;
+        let flag = |b: bool| if b { 1.0 } else { 0.0 };
+        if matches!(self.surface, Surface::Floor | Surface::FloorReceiver) {
+            return vec![("RECEIVER", flag(s.shadows)), ("PCF", flag(s.pcf))];
+        }
+        let mut constants = vec![("SHADOWS", flag(s.shadows)), ("PCF", flag(s.pcf))];
+        {
+            let sphere = if self.surface == Surface::Glass { 0.0 } else { 1.0 };
+            constants.extend([
+                ("SPHERE", sphere),
+                ("SAMPLES", f64::from(self.target.samples())),
+                ("WHITTED", flag(s.whitted)),
+                ("REFRACTION", flag(s.refraction)),
+                ("REFLECTION", flag(s.reflection)),
+                ("FRESNEL", flag(s.fresnel)),
+                ("METAL_ENV", flag(s.metal_env)),
+            ]);
+        }
+        constants
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use illum_scene::Effects;
+
+    #[test]
+    fn keys_ignore_switches_a_surface_does_not_read() {
+        let figure = Options::all_on(Look::Figure);
+        let mut no_fresnel = figure;
+        no_fresnel.effects.fresnel = false;
+        no_fresnel.effects.reflection = false;
+        for surface in [Surface::Floor, Surface::FloorReceiver, Surface::Glass, Surface::Metal] {
+            let target = Target::Main { samples: 4 };
+            assert_eq!(
+                PipelineKey::new(surface, target, &figure, true),
+                PipelineKey::new(surface, target, &no_fresnel, true)
+            );
+        }
+        let no_shadows = Options { effects: Effects { shadows: false, ..Effects::ALL_ON }, ..figure };
+        let key = PipelineKey::new(Surface::Metal, Target::Cube, &no_shadows, true);
+        assert!(!key.switches.shadows && !key.switches.pcf, "PCF means nothing without shadows");
+        let plain = PipelineKey::new(Surface::Floor, Target::Cube, &figure, true);
+        assert_eq!(plain, PipelineKey::new(Surface::Floor, Target::Cube, &no_shadows, true));
+    }
+
+    #[test]
+    fn the_metal_mirrors_only_in_the_whitted_main_pass() {
+        let whitted = Options::all_on(Look::Whitted);
+        assert!(
+            PipelineKey::new(Surface::Metal, Target::Main { samples: 1 }, &whitted, true).switches.metal_env
+        );
+        assert!(!PipelineKey::new(Surface::Metal, Target::Cube, &whitted, true).switches.metal_env);
+        let figure = Options::all_on(Look::Figure);
+        assert!(
+            !PipelineKey::new(Surface::Metal, Target::Main { samples: 1 }, &figure, true).switches.metal_env
+        );
+    }
+
+    #[test]
+    fn a_sphere_out_of_reach_of_the_other_has_no_shadow_lookup() {
+        let options = Options::all_on(Look::Whitted);
+        for surface in [Surface::Glass, Surface::Metal] {
+            let target = Target::Main { samples: 4 };
+            assert!(PipelineKey::new(surface, target, &options, true).switches.shadows);
+            let key = PipelineKey::new(surface, target, &options, false);
+            assert!(!key.switches.shadows && !key.switches.pcf);
+        }
+    }
+
+    #[test]
+    fn constants_name_the_overrides_of_each_entry() {
+        let key = PipelineKey::new(
+            Surface::Glass,
+            Target::Main { samples: 4 },
+            &Options::all_on(Look::Whitted),
+            true,
+        );
+        let c = key.constants();
+        assert!(
+            c.contains(&("SPHERE", 0.0)) && c.contains(&("SAMPLES", 4.0)) && c.contains(&("WHITTED", 1.0))
+        );
+        let whitted = Options::all_on(Look::Whitted);
+        let receiver = PipelineKey::new(Surface::FloorReceiver, Target::Cube, &whitted, true).constants();
+        assert_eq!(receiver, vec![("RECEIVER", 1.0), ("PCF", 1.0)]);
+        let floor = PipelineKey::new(Surface::Floor, Target::Cube, &whitted, true).constants();
+        assert_eq!(floor, vec![("RECEIVER", 0.0), ("PCF", 0.0)]);
+    }
+}

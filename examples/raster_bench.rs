@@ -1,0 +1,92 @@
+//! Frame-rate benchmark of the Whitted look-alike rasterizer.
+//!
+//! ```text
+//! cargo run --release --example raster_bench -- [SCENE] [--width 1280 --height 720]
+//!     [--frames 60] [--warmup 5] [--look figure|whitted] [--cube-size N] [--no-msaa] ...
+//! ```
+//! Renders `frames` frames (after `warmup` untimed ones) without reading them back and prints the
+//! median frame time, frames per second, and the median GPU time of each pass (shadow map, the
+//! twelve cube-map faces together, main pass with MSAA resolve) from timestamp queries. With no
+//! flags: `scenes/whitted.toml` at 1280 x 720, whitted look, every effect on. Timings are never
+//! asserted in tests; the figures are in docs/performance-raster.md.
+
+use std::path::PathBuf;
+
+use anyhow::Context;
+use clap::Parser;
+use illum::cli;
+use illum::raster::{Look, bench_frames};
+use illum::raster_cli::RasterArgs;
+use illum::scene::WhittedScene;
+
+#[derive(Parser, Debug)]
+struct Args {
+    /// Rasterizer scene file.
+    #[arg(default_value = "scenes/whitted.toml")]
+    scene: PathBuf,
+    #[arg(long, default_value_t = 1280)]
+    width: u32,
+    #[arg(long, default_value_t = 720)]
+    height: u32,
+    /// Timed frames (the median is reported).
+    #[arg(long, default_value_t = 60)]
+    frames: u32,
+    /// Untimed frames first (pipeline compilation, allocation).
+    #[arg(long, default_value_t = 5)]
+    warmup: u32,
+    /// Overrides the scene's cube-map face size.
+    #[arg(long)]
+    cube_size: Option<u32>,
+    #[command(flatten)]
+    raster: RasterArgs,
+}
+
+fn main() {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    if let Err(error) = run(Args::parse()) {
+        eprintln!("error: {error:#}");
+        std::process::exit(1);
+    }
+}
+
+fn run(args: Args) -> anyhow::Result<()> {
+    let path = cli::resolve_scene_path(&args.scene);
+    let mut scene = WhittedScene::load(&path)?;
+    if let Some(size) = args.cube_size {
+        anyhow::ensure!(size >= 1, "--cube-size = 0: must be at least 1");
+        scene.quality.cube_size = size;
+    }
+    let mut options = args.raster.options(&scene);
+    if args.raster.look.is_none() {
+        options.look = Look::Whitted;
+    }
+    anyhow::ensure!(args.frames >= 1, "--frames = 0: must be at least 1");
+    let gpu = cli::gpu()?;
+    let report = bench_frames(&gpu, &scene, args.width, args.height, &options, args.warmup, args.frames)
+        .context("benchmarking the rasterizer")?;
+    println!(
+        "{} {}x{} look {} (shadow map {}^2, cube faces {}^2, {} frames): median frame {:.2} ms = {:.1} fps (min {:.2}, max {:.2})",
+        scene.name,
+        report.width,
+        report.height,
+        report.options.look,
+        report.shadow_map_size,
+        report.cube_size,
+        report.frame_ms.len(),
+        report.median_frame_ms(),
+        report.fps(),
+        report.frame_ms.iter().copied().fold(f64::INFINITY, f64::min),
+        report.frame_ms.iter().copied().fold(0.0, f64::max),
+    );
+    match report.median_pass_ms() {
+        Some(t) => println!(
+            "  median GPU ms per pass: shadow {:.2}, cube {:.2}, main {:.2} (sum {:.2})",
+            t.shadow_ms,
+            t.cube_ms,
+            t.main_ms,
+            t.total_ms()
+        ),
+        None => println!("  (no timestamp queries on {}: no per-pass GPU times)", gpu.adapter_info.name),
+    }
+    Ok(())
+}

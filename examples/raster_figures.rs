@@ -1,0 +1,71 @@
+//! Renders the pictures of docs/theory-whitted.md: both looks of the Whitted look-alike, and a
+//! contact sheet of the effect toggles.
+//!
+//! ```text
+//! cargo run --release --example raster_figures -- [--out docs/images]
+//! ```
+//! Writes `whitted-figure.png` and `whitted-whitted.png` (640 x 360) and `whitted-effects.png`
+//! (eight labelled 400 x 225 panels). PNGs are linear, as the assignment's figure 1.
+
+use std::path::PathBuf;
+
+use anyhow::Context;
+use clap::Parser;
+use illum::cli;
+use illum::image::{Encoding, contact_sheet, save_png, save_rgba8_png, to_rgba8};
+use illum::raster::{Effects, Look, Options, WhittedRenderer};
+use illum::scene::WhittedScene;
+
+#[derive(Parser, Debug)]
+struct Args {
+    /// Output folder.
+    #[arg(long, default_value = "docs/images")]
+    out: PathBuf,
+}
+
+fn main() {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    if let Err(error) = run(Args::parse()) {
+        eprintln!("error: {error:#}");
+        std::process::exit(1);
+    }
+}
+
+fn with(look: Look, change: impl FnOnce(&mut Effects)) -> Options {
+    let mut options = Options::all_on(look);
+    change(&mut options.effects);
+    options
+}
+
+fn run(args: Args) -> anyhow::Result<()> {
+    let scene = WhittedScene::load(&cli::resolve_scene_path("scenes/whitted.toml".as_ref()))?;
+    let gpu = cli::gpu()?;
+
+    let mut large = WhittedRenderer::new(&gpu, &scene, 640, 360)?;
+    for look in Look::ALL {
+        let path = args.out.join(format!("whitted-{look}.png"));
+        save_png(&path, &large.render(&Options::all_on(look))?, 0.0, Encoding::Linear)?;
+        println!("wrote {}", path.display());
+    }
+
+    let panels = [
+        ("figure (the fake)", Options::all_on(Look::Figure)),
+        ("whitted look", Options::all_on(Look::Whitted)),
+        ("figure, no refraction", with(Look::Figure, |e| e.refraction = false)),
+        ("whitted, no reflection", with(Look::Whitted, |e| e.reflection = false)),
+        ("whitted, no Fresnel", with(Look::Whitted, |e| e.fresnel = false)),
+        ("figure, no shadows", with(Look::Figure, |e| e.shadows = false)),
+        ("figure, no PCF", with(Look::Figure, |e| e.pcf = false)),
+        ("figure, no MSAA", with(Look::Figure, |e| e.msaa = false)),
+    ];
+    let mut small = WhittedRenderer::new(&gpu, &scene, 400, 225)?;
+    let mut images = Vec::new();
+    for (label, options) in panels {
+        let image = small.render(&options).with_context(|| format!("rendering {label}"))?;
+        images.push((label.to_owned(), to_rgba8(&image, 0.0, Encoding::Linear)));
+    }
+    let path = args.out.join("whitted-effects.png");
+    save_rgba8_png(&path, &contact_sheet(&images, 4))?;
+    println!("wrote {}", path.display());
+    Ok(())
+}

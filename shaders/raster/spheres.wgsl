@@ -1,0 +1,78 @@
+// A sphere as an analytic impostor (sphere.wgsl), shaded by lighting.wgsl. Used by the main pass
+// and by the cube-map captures; each pipeline draws one sphere, so a capture leaves out the
+// sphere it is taken from by drawing only the other.
+
+#import illum::raster::scene::{view, sphere_of, view_depth, quad_corner, Switches, SPHERE_GLASS}
+#import illum::raster::sphere::{billboard_perspective, coverage_mask, visible_point}
+#import illum::raster::lighting::{shade_glass, shade_metal}
+
+// Set per pipeline (see Switches in scene.wgsl).
+override SPHERE: u32 = 0u;
+override SAMPLES: u32 = 1u;
+override WHITTED: bool = false;
+override SHADOWS: bool = true;
+override PCF: bool = true;
+override REFRACTION: bool = true;
+override REFLECTION: bool = true;
+override FRESNEL: bool = true;
+override METAL_ENV: bool = false;
+
+struct VertexOut {
+    @builtin(position) position: vec4<f32>,
+    @location(0) world: vec3<f32>,
+}
+
+@vertex
+fn vs_main(@builtin(vertex_index) vertex: u32) -> VertexOut {
+    let world = billboard_perspective(sphere_of(SPHERE), view.eye.xyz, quad_corner(vertex));
+    var out: VertexOut;
+    out.position = view.view_proj * vec4<f32>(world, 1.0);
+    out.world = world;
+    return out;
+}
+
+struct FragmentOut {
+    @location(0) color: vec4<f32>,
+    // The sphere's true depth, so it intersects the floor and the other sphere correctly.
+    @builtin(frag_depth) depth: f32,
+    // Which MSAA samples the sphere covers: the silhouette is anti-aliased analytically, although
+    // the fragment is shaded once per pixel.
+    @builtin(sample_mask) coverage: u32,
+}
+
+@fragment
+fn fs_main(in: VertexOut) -> FragmentOut {
+    let dx = dpdx(in.world);
+    let dy = dpdy(in.world);
+    let sphere = sphere_of(SPHERE);
+    let eye = view.eye.xyz;
+    let coverage = coverage_mask(eye, in.world, dx, dy, sphere, SAMPLES);
+    if coverage == 0u {
+        discard;
+    }
+    // The visible point of this pixel and of its right and lower neighbours (the impostor is a
+    // plane, so a neighbour's point on it is one derivative away): the glass's environment
+    // lookups measure their footprint between them.
+    let p = array<vec3<f32>, 3>(
+        visible_point(eye, normalize(in.world - eye), sphere),
+        visible_point(eye, normalize(in.world + dx - eye), sphere),
+        visible_point(eye, normalize(in.world + dy - eye), sphere),
+    );
+    let n = array<vec3<f32>, 3>(
+        normalize(p[0] - sphere.xyz),
+        normalize(p[1] - sphere.xyz),
+        normalize(p[2] - sphere.xyz),
+    );
+    let sw = Switches(WHITTED, SHADOWS, PCF, REFRACTION, REFLECTION, FRESNEL, METAL_ENV);
+    var color: vec3<f32>;
+    if SPHERE == SPHERE_GLASS {
+        color = shade_glass(sw, p, n, eye);
+    } else {
+        color = shade_metal(sw, p[0], n[0], eye);
+    }
+    var out: FragmentOut;
+    out.color = vec4<f32>(color, 1.0);
+    out.depth = view_depth(p[0]);
+    out.coverage = coverage;
+    return out;
+}

@@ -1,0 +1,251 @@
+//! The `render` example's path for rasterizer scenes (`renderer = "raster"`, the Whitted
+//! look-alike): its flags, and rendering to PNG / EXR with the same error quality as the path
+//! tracer's path.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::bail;
+use clap::Args;
+use illum_gpu::GpuContext;
+use illum_image::{Encoding, ExrMetadata, save_exr, save_png};
+use illum_raster::{Look, Options, PassTimes, WhittedRenderer};
+use illum_scene::WhittedScene;
+
+use crate::cli::{self, SceneArgs};
+
+/// Flags that apply to rasterizer scenes only. Each effect is on unless the scene file or one of
+/// these flags turns it off.
+#[derive(Args, Clone, Debug, Default)]
+pub struct RasterArgs {
+    /// Rasterizer scenes: `figure` (the assignment's figure 1) or `whitted` (mirror reflections,
+    /// Fresnel, refraction through both faces). Default: the scene file's `look`.
+    #[arg(long)]
+    pub look: Option<Look>,
+    /// Rasterizer scenes: no shadow map.
+    #[arg(long)]
+    pub no_shadows: bool,
+    /// Rasterizer scenes: hard shadow edges (one depth comparison instead of PCF).
+    #[arg(long)]
+    pub no_pcf: bool,
+    /// Rasterizer scenes: the glass shows what is straight behind it, unbent.
+    #[arg(long)]
+    pub no_refraction: bool,
+    /// Rasterizer scenes (whitted look): no mirror reflections.
+    #[arg(long)]
+    pub no_reflection: bool,
+    /// Rasterizer scenes (whitted look): the glass reflects its normal-incidence fraction everywhere.
+    #[arg(long)]
+    pub no_fresnel: bool,
+    /// Rasterizer scenes: one sample per pixel instead of 4x MSAA.
+    #[arg(long)]
+    pub no_msaa: bool,
+}
+
+impl RasterArgs {
+    /// The flags given, as typed.
+    fn given(&self) -> Vec<&'static str> {
+        [
+            (self.look.is_some(), "--look"),
+            (self.no_shadows, "--no-shadows"),
+            (self.no_pcf, "--no-pcf"),
+            (self.no_refraction, "--no-refraction"),
+            (self.no_reflection, "--no-reflection"),
+            (self.no_fresnel, "--no-fresnel"),
+            (self.no_msaa, "--no-msaa"),
+        ]
+        .into_iter()
+        .filter_map(|(given, flag)| given.then_some(flag))
+        .collect()
+    }
+
+    /// The scene file's look and effects, changed by the flags.
+    pub fn options(&self, scene: &WhittedScene) -> Options {
+        let mut options = Options::from_scene(scene);
+        if let Some(look) = self.look {
+            options.look = look;
+        }
+        let e = &mut options.effects;
+        e.shadows &= !self.no_shadows;
+        e.pcf &= !self.no_pcf;
+        e.refraction &= !self.no_refraction;
+        e.reflection &= !self.no_reflection;
+        e.fresnel &= !self.no_fresnel;
+        e.msaa &= !self.no_msaa;
+        options
+    }
+
+    /// An error when rasterizer flags are given for a path-tracer scene.
+    pub fn reject_for_path_tracer(&self, scene: &Path) -> anyhow::Result<()> {
+        let given = self.given();
+        if !given.is_empty() {
+            bail!(
+                "{}: {} {} only to rasterizer scenes (renderer = \"raster\", such as scenes/whitted.toml); \
+                 this is a path-tracer scene",
+                scene.display(),
+                given.join(", "),
+                verb(given.len())
+            );
+        }
+        Ok(())
+    }
+}
+
+/// "applies" for one flag, "apply" for several.
+fn verb(flags: usize) -> &'static str {
+    if flags == 1 { "applies" } else { "apply" }
+}
+
+/// Everything the `render` example passes for a rasterizer scene.
+pub struct RasterRequest<'a> {
+    pub scene: &'a Path,
+    pub settings: &'a SceneArgs,
+    pub raster: &'a RasterArgs,
+    /// Output files; empty: `out/NAME-LOOK.png`.
+    pub outputs: &'a [PathBuf],
+    /// PNG encoding; `None`: linear, as the assignment's figure was written.
+    pub encoding: Option<Encoding>,
+    pub exposure: f32,
+    /// Path-tracer-only flags of the example that were given (e.g. "--target-error"): an error.
+    pub path_tracer_flags: Vec<&'static str>,
+}
+
+/// The path tracer's flags in [`SceneArgs`] that were given.
+fn path_tracer_settings(settings: &SceneArgs) -> Vec<&'static str> {
+    [
+        (settings.spp.is_some(), "--spp"),
+        (settings.bounces.is_some(), "--bounces"),
+        (settings.seed.is_some(), "--seed"),
+        (settings.sampling.is_some(), "--sampling"),
+    ]
+    .into_iter()
+    .filter_map(|(given, flag)| given.then_some(flag))
+    .collect()
+}
+
+enum Format {
+    Png,
+    Exr,
+}
+
+fn output_format(path: &Path) -> anyhow::Result<Format> {
+    match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+        Some("png") => Ok(Format::Png),
+        Some("exr") => Ok(Format::Exr),
+        _ => bail!("output {}: unknown extension; allowed: .png or .exr", path.display()),
+    }
+}
+
+/// Loads the scene, applies `--width` / `--height`, and checks every flag and output name,
+/// before any GPU work.
+fn prepare(request: &RasterRequest) -> anyhow::Result<(WhittedScene, Options, Vec<PathBuf>)> {
+    let path = cli::resolve_scene_path(request.scene);
+    let mut flags = path_tracer_settings(request.settings);
+    flags.extend(&request.path_tracer_flags);
+    if !flags.is_empty() {
+        bail!(
+            "{}: {} {} only to path-tracer scenes; this is a rasterizer scene (renderer = \"raster\"), \
+             whose flags are --look, --no-shadows, --no-pcf, --no-refraction, --no-reflection, \
+             --no-fresnel, --no-msaa, --width, --height",
+            request.scene.display(),
+            flags.join(", "),
+            verb(flags.len())
+        );
+    }
+    let mut scene = WhittedScene::load(&path)?;
+    scene.set_resolution(request.settings.width, request.settings.height, "command line")?;
+    let options = request.raster.options(&scene);
+    let outputs = if request.outputs.is_empty() {
+        vec![PathBuf::from(format!("out/{}-{}.png", scene.name, options.look))]
+    } else {
+        request.outputs.to_vec()
+    };
+    for output in &outputs {
+        output_format(output)?;
+    }
+    Ok((scene, options, outputs))
+}
+
+/// Renders a rasterizer scene as `request` says, creating the GPU context.
+pub fn render_raster(request: &RasterRequest) -> anyhow::Result<()> {
+    let (scene, options, outputs) = prepare(request)?;
+    let gpu = cli::gpu()?;
+    render_prepared(&gpu, &scene, &options, &outputs, request)
+}
+
+/// [`render_raster`] on an existing GPU context (tests share one device).
+pub fn render_raster_with(gpu: &GpuContext, request: &RasterRequest) -> anyhow::Result<()> {
+    let (scene, options, outputs) = prepare(request)?;
+    render_prepared(gpu, &scene, &options, &outputs, request)
+}
+
+fn describe(options: &Options) -> String {
+    let e = &options.effects;
+    let effects: Vec<&str> = [
+        (e.shadows, "shadows"),
+        (e.pcf, "pcf"),
+        (e.refraction, "refraction"),
+        (e.reflection && options.look == Look::Whitted, "reflection"),
+        (e.fresnel && options.look == Look::Whitted, "fresnel"),
+        (e.msaa, "msaa"),
+    ]
+    .into_iter()
+    .filter_map(|(on, name)| on.then_some(name))
+    .collect();
+    format!(
+        "look {}, effects: {}",
+        options.look,
+        if effects.is_empty() { "none".into() } else { effects.join(" ") }
+    )
+}
+
+fn render_prepared(
+    gpu: &GpuContext,
+    scene: &WhittedScene,
+    options: &Options,
+    outputs: &[PathBuf],
+    request: &RasterRequest,
+) -> anyhow::Result<()> {
+    let (width, height) = (scene.camera.width, scene.camera.height);
+    let started = Instant::now();
+    let mut renderer = WhittedRenderer::new(gpu, scene, width, height)?;
+    let frame = renderer.render_timed(options)?;
+    let seconds = started.elapsed().as_secs_f64();
+    let encoding = request.encoding.unwrap_or(Encoding::Linear);
+    let times = frame.pass_times.map(|t: PassTimes| {
+        format!(
+            "GPU ms of this first (cold) frame: shadow {:.2}, cube {:.2}, main {:.2} (warm figures: raster_bench)",
+            t.shadow_ms, t.cube_ms, t.main_ms
+        )
+    });
+    let metadata = ExrMetadata {
+        scene: scene.name.clone(),
+        spp: u64::from(options.samples()),
+        bounces: "rasterized".to_owned(),
+        seed: 0,
+        sampling: format!("raster {}", options.look),
+        render_seconds: seconds,
+        extra: vec![
+            ("renderer".into(), "raster".into()),
+            ("options".into(), describe(options)),
+            ("adapter".into(), gpu.adapter_info.name.clone()),
+        ],
+    };
+    for output in outputs {
+        match output_format(output)? {
+            Format::Png => save_png(output, &frame.image, request.exposure, encoding)?,
+            Format::Exr => save_exr(output, &frame.image, &metadata)?,
+        }
+    }
+    println!(
+        "{}: {width}x{height}, {}, {:.2} s including setup{}",
+        scene.name,
+        describe(options),
+        seconds,
+        times.map(|t| format!(", {t}")).unwrap_or_default()
+    );
+    for output in outputs {
+        println!("wrote {}", output.display());
+    }
+    Ok(())
+}

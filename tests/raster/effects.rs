@@ -1,0 +1,149 @@
+//! Every effect toggle changes the picture where it should and nowhere else; shadows leave the
+//! lit spheres untouched (no acne); MSAA changes only pixels on an edge.
+
+use illum::image::RgbImage32;
+use illum::raster::{Look, Options};
+use illum::scene::{Effects, WhittedScene};
+
+use crate::{HEIGHT, WIDTH, camera, level, ray_sphere, render, scene};
+
+/// Pixels whose largest channel differs by more than 2 levels.
+fn changed(a: &RgbImage32, b: &RgbImage32) -> Vec<(u32, u32)> {
+    let mut out = Vec::new();
+    for y in 0..a.height {
+        for x in 0..a.width {
+            let (p, q) = (a.get(x, y), b.get(x, y));
+            if (0..3).any(|c| (level(p[c]) - level(q[c])).abs() > 2) {
+                out.push((x, y));
+            }
+        }
+    }
+    out
+}
+
+/// Turns one effect off.
+type Toggle = fn(&mut Effects);
+
+fn with(look: Look, change: impl FnOnce(&mut Effects)) -> Options {
+    let mut options = Options::all_on(look);
+    change(&mut options.effects);
+    options
+}
+
+#[test]
+fn each_toggle_changes_the_picture_or_is_documented_not_to() {
+    let s = scene();
+    for look in Look::ALL {
+        let all = render(&s, &Options::all_on(look));
+        let toggles: [(&str, Toggle); 6] = [
+            ("shadows", |e| e.shadows = false),
+            ("pcf", |e| e.pcf = false),
+            ("refraction", |e| e.refraction = false),
+            ("reflection", |e| e.reflection = false),
+            ("fresnel", |e| e.fresnel = false),
+            ("msaa", |e| e.msaa = false),
+        ];
+        for (name, off) in toggles {
+            let n = changed(&all, &render(&s, &with(look, off))).len();
+            // The figure has no reflections and no Fresnel: those toggles belong to the whitted look.
+            let inert = look == Look::Figure && (name == "reflection" || name == "fresnel");
+            if inert {
+                assert_eq!(n, 0, "look {look}: turning {name} off changed {n} pixels");
+            } else {
+                assert!(n > 40, "look {look}: turning {name} off changed only {n} pixels");
+            }
+        }
+    }
+}
+
+/// Which surface the camera ray through (x, y) meets first: 0 sky, 1 floor, 2 glass, 3 metal.
+fn surface(s: &WhittedScene, x: f32, y: f32) -> u8 {
+    let cam = camera(s, WIDTH, HEIGHT);
+    let dir = cam.ray_direction(x, y);
+    let glass = ray_sphere(cam.eye, dir, s.glass.center, s.glass.radius);
+    let metal = ray_sphere(cam.eye, dir, s.metal.center, s.metal.radius);
+    match (glass, metal) {
+        (Some(g), Some(m)) => return if g < m { 2 } else { 3 },
+        (Some(_), None) => return 2,
+        (None, Some(_)) => return 3,
+        (None, None) => {}
+    }
+    if crate::floor_hit(s, &cam, x, y).is_some() { 1 } else { 0 }
+}
+
+/// True when every point of the pixel (probed at its corners and centre, slightly enlarged)
+/// sees the same surface.
+fn interior(s: &WhittedScene, x: u32, y: u32) -> Option<u8> {
+    let (cx, cy) = (x as f32 + 0.5, y as f32 + 0.5);
+    let centre = surface(s, cx, cy);
+    let corners = [(-0.6, -0.6), (0.6, -0.6), (-0.6, 0.6), (0.6, 0.6)];
+    corners.iter().all(|(dx, dy)| surface(s, cx + dx, cy + dy) == centre).then_some(centre)
+}
+
+/// For a pixel inside a sphere's disc (`which`: 2 glass, 3 metal): whether the light reaches
+/// the visible point without passing within `margin` of the other sphere (so no shadow, not even
+/// a soft edge, belongs there).
+fn clear_of_the_other_sphere(s: &WhittedScene, x: u32, y: u32, which: u8, margin: f32) -> bool {
+    let cam = camera(s, WIDTH, HEIGHT);
+    let dir = cam.ray_direction(x as f32 + 0.5, y as f32 + 0.5);
+    let [(c, r), (other, other_r)] = if which == 2 {
+        [(s.glass.center, s.glass.radius), (s.metal.center, s.metal.radius)]
+    } else {
+        [(s.metal.center, s.metal.radius), (s.glass.center, s.glass.radius)]
+    };
+    let Some(t) = ray_sphere(cam.eye, dir, c, r) else { return false };
+    let p = cam.eye + t * dir;
+    crate::ray_distance(p, s.light.to_light(), other) > other_r + margin
+}
+
+#[test]
+fn shadows_leave_the_lit_metal_untouched() {
+    // A sphere casts no shadow on itself, so wherever the light reaches the metal sphere clear
+    // of the glass, the shadow map must not change a pixel: the metal is tested against its own
+    // depth in the map, and acne would show here. (Where the light grazes the glass, the glass's
+    // soft shadow edge legitimately reaches across.) The figure look's metal is plain Phong, so
+    // nothing else changes with the shadows; the glass shows the floor's shadows through its
+    // cube map and cannot be checked this way. A low light makes grazing angles on the metal.
+    let margin = 3.0 * scene().quality.pcf_radius + 0.05;
+    for light in [scene().light.position, glam::Vec3::new(10.0, 2.5, -2.0)] {
+        let mut s = scene();
+        s.light.position = light;
+        let options = Options::all_on(Look::Figure);
+        let on = render(&s, &options);
+        let off = render(&s, &with(Look::Figure, |e| e.shadows = false));
+        let changed_pixels = changed(&on, &off);
+        let mut checked = 0;
+        for y in 0..HEIGHT {
+            for x in 0..WIDTH {
+                if interior(&s, x, y) != Some(3) || !clear_of_the_other_sphere(&s, x, y, 3, margin) {
+                    continue;
+                }
+                checked += 1;
+                assert!(
+                    !changed_pixels.contains(&(x, y)),
+                    "light at {light}: shadows changed metal pixel ({x}, {y})"
+                );
+            }
+        }
+        assert!(checked > 1000, "light at {light}: only {checked} metal pixels checked");
+    }
+}
+
+#[test]
+fn msaa_changes_only_pixels_on_an_edge() {
+    let s = scene();
+    for look in Look::ALL {
+        let on = render(&s, &Options::all_on(look));
+        let off = render(&s, &with(look, |e| e.msaa = false));
+        let differing = changed(&on, &off);
+        let inside: Vec<_> = differing.iter().filter(|(x, y)| interior(&s, *x, *y).is_some()).collect();
+        assert!(
+            inside.is_empty(),
+            "look {look}: MSAA changed {} pixels away from any edge, e.g. {:?}",
+            inside.len(),
+            &inside[..inside.len().min(5)]
+        );
+        // Silhouettes of both spheres and the floor's far edge: a few hundred pixels at this size.
+        assert!(differing.len() > 150, "look {look}: MSAA changed only {} edge pixels", differing.len());
+    }
+}
