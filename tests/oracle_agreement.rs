@@ -72,7 +72,8 @@ fn compare(bounces: u32) {
         let v = variances.iter().zip(&lit).filter(|(_, k)| **k).map(|(p, _)| p[c]).sum::<f64>() / (n * n);
         (m, v)
     };
-    let gpu_pixels: Vec<[f64; 3]> = (0..(SIZE * SIZE) as usize).map(|p| gpu.accumulator().pixel_mean(p)).collect();
+    let gpu_pixels: Vec<[f64; 3]> =
+        (0..(SIZE * SIZE) as usize).map(|p| gpu.accumulator().pixel_mean(p)).collect();
     let gpu_variances: Vec<[f64; 3]> =
         (0..(SIZE * SIZE) as usize).map(|p| gpu.accumulator().pixel_variance_of_mean(p)).collect();
     for c in 0..3 {
@@ -82,7 +83,10 @@ fn compare(bounces: u32) {
         println!("bounces {bounces}, channel {c}: GPU {a:.6}, oracle {b:.6}, z = {z:.2}");
         assert!(z.abs() < 4.0, "bounces {bounces}, channel {c}: whole-image means differ by {z:.2} sigma");
         let z_biased = (1.02 * a - b) / (va + vb).sqrt();
-        assert!(z_biased.abs() > 4.0, "bounces {bounces}: a 2% bias would pass (z = {z_biased:.2}): no power");
+        assert!(
+            z_biased.abs() > 4.0,
+            "bounces {bounces}: a 2% bias would pass (z = {z_biased:.2}): no power"
+        );
     }
 
     // Per-pixel power: an image 25% too bright must fail most pixels.
@@ -90,8 +94,9 @@ fn compare(bounces: u32) {
     for p in &mut brighter.pixels {
         *p = p.map(|v| v * 1.25);
     }
-    let biased_pass = z_test_pass_fraction(&brighter, &variance, &oracle_mean, &oracle_variance, 3.0 * per_test)
-        .expect("same size");
+    let biased_pass =
+        z_test_pass_fraction(&brighter, &variance, &oracle_mean, &oracle_variance, 3.0 * per_test)
+            .expect("same size");
     assert!(biased_pass < 0.5, "bounces {bounces}: a 25% bias still passes {biased_pass:.3} of pixels");
 }
 

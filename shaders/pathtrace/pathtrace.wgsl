@@ -9,7 +9,7 @@
 // A camera ray that hits a light sees its emitted radiance.
 
 #import illum::constants::INV_PI
-#import illum::rng::{rng_seed, rng_f32}
+#import illum::sampler::{Sampler, sampler_new, sample_1d}
 #import illum::sampling::{sample_cosine_hemisphere, sample_uniform_hemisphere, to_world, sample_parallelogram}
 #import illum::pathtrace::scene::{NO_HIT, params, objects, materials, lights, batch_sum, batch_sum_sq, surface_normal}
 #import illum::pathtrace::traversal::{closest_hit, occluded}
@@ -37,10 +37,10 @@ fn spawn_offset(p: vec3<f32>) -> f32 {
 // Next-event estimation: radiance arriving at p from one point sampled uniformly on the lights,
 // already divided by its pdf (1 / A_total) and multiplied by cos(theta_x); the caller multiplies
 // by albedo / pi.
-fn direct_light(p: vec3<f32>, n: vec3<f32>, rng: ptr<function, u32>) -> vec3<f32> {
-    let pick = rng_f32(rng) * params.light_area;
-    let u1 = rng_f32(rng);
-    let u2 = rng_f32(rng);
+fn direct_light(p: vec3<f32>, n: vec3<f32>, sampler: ptr<function, Sampler>) -> vec3<f32> {
+    let pick = sample_1d(sampler) * params.light_area;
+    let u1 = sample_1d(sampler);
+    let u2 = sample_1d(sampler);
     var li = 0u;
     for (; li + 1u < params.num_lights; li++) {
         if (pick < lights[li].corner.w) {
@@ -69,7 +69,7 @@ fn max3(v: vec3<f32>) -> f32 {
 }
 
 // One path's radiance estimate along the camera ray (o, d).
-fn radiance(origin: vec3<f32>, direction: vec3<f32>, rng: ptr<function, u32>) -> vec3<f32> {
+fn radiance(origin: vec3<f32>, direction: vec3<f32>, sampler: ptr<function, Sampler>) -> vec3<f32> {
     var o = origin;
     var d = direction;
     var hit = closest_hit(o, d);
@@ -93,7 +93,7 @@ fn radiance(origin: vec3<f32>, direction: vec3<f32>, rng: ptr<function, u32>) ->
         }
         let albedo = materials[obj.material].albedo.xyz;
         let p_spawn = p + n * spawn_offset(p);
-        radiance += throughput * albedo * INV_PI * direct_light(p_spawn, n, rng);
+        radiance += throughput * albedo * INV_PI * direct_light(p_spawn, n, sampler);
 
         if (params.bounces != UNBOUNDED && depth >= params.bounces) {
             break;
@@ -101,8 +101,8 @@ fn radiance(origin: vec3<f32>, direction: vec3<f32>, rng: ptr<function, u32>) ->
         if (depth >= UNBOUNDED_DEPTH_CAP) {
             break;
         }
-        let u1 = rng_f32(rng);
-        let u2 = rng_f32(rng);
+        let u1 = sample_1d(sampler);
+        let u2 = sample_1d(sampler);
         // Lambertian f = albedo / pi. Cosine pdf cos/pi: f cos / pdf = albedo.
         // Uniform pdf 1/(2 pi): f cos / pdf = 2 albedo cos.
         if (params.sampling == SAMPLING_COSINE) {
@@ -116,7 +116,7 @@ fn radiance(origin: vec3<f32>, direction: vec3<f32>, rng: ptr<function, u32>) ->
         if (params.bounces == UNBOUNDED && depth >= RR_START) {
             // Survive with probability q and divide by q: E[throughput] is unchanged.
             let q = min(max3(throughput), RR_MAX_SURVIVAL);
-            if (rng_f32(rng) >= q) {
+            if (sample_1d(sampler) >= q) {
                 break;
             }
             throughput /= q;
@@ -160,12 +160,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let inv_width = 1.0 / f32(params.width);
     let inv_height = 1.0 / f32(params.height);
     for (var i = 0u; i < params.sample_count; i++) {
-        var rng = rng_seed(params.seed, pixel, params.sample_base + i);
+        var sampler = sampler_new(params.seed, pixel, params.sample_base + i);
         // Jitter uniformly inside the pixel; row 0 is the top of the image.
-        let sx = (2.0 * (f32(x) + rng_f32(&rng)) * inv_width - 1.0) * params.aspect * params.tan_half_fov;
-        let sy = (1.0 - 2.0 * (f32(y) + rng_f32(&rng)) * inv_height) * params.tan_half_fov;
+        let sx = (2.0 * (f32(x) + sample_1d(&sampler)) * inv_width - 1.0) * params.aspect * params.tan_half_fov;
+        let sy = (1.0 - 2.0 * (f32(y) + sample_1d(&sampler)) * inv_height) * params.tan_half_fov;
         let d = normalize(params.forward + sx * params.right + sy * params.up);
-        let l = radiance(params.eye, d, &rng);
+        let l = radiance(params.eye, d, &sampler);
         if (is_finite3(l)) {
             sum += l;
             sum_sq += l * l;

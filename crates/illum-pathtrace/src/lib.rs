@@ -17,5 +17,6 @@ pub use accumulator::Accumulator;
 pub use error::PathTraceError;
 pub use progressive::{StopReason, StopRules, render_progressive};
 pub use tracer::{
-    GENERIC_TRAVERSAL, PATHTRACE_SHADER, PathTracer, SCENE_MODULE, StepReport, Traversal, shader_modules,
+    GENERIC_TRAVERSAL, PATHTRACE_SHADER, PathTracer, SCENE_MODULE, Sequence, StepReport, TracerOptions,
+    Traversal, shader_modules,
 };

@@ -2,7 +2,7 @@
 
 use std::time::Instant;
 
-use illum_gpu::shader::{self, COMMON_MODULES, ShaderFile};
+use illum_gpu::shader::{self, COMMON_MODULES, Def, ShaderFile};
 use illum_gpu::shader_file;
 use illum_gpu::timing::PassTimer;
 use illum_gpu::{GpuContext, readback, wgpu};
@@ -29,6 +29,53 @@ pub enum Traversal {
     Specialised,
     /// One loop over the object buffer, the same pipeline for every scene.
     Generic,
+}
+
+/// Where a path's random sample values come from (see shaders/common/sampler.wgsl).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Sequence {
+    /// Independent uniform numbers from a PCG stream per (seed, pixel, sample index).
+    #[default]
+    Independent,
+    /// A randomly shifted Kronecker (R_d) low-discrepancy sequence for the first 16 dimensions.
+    LowDiscrepancy,
+}
+
+impl std::str::FromStr for Sequence {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "independent" => Ok(Self::Independent),
+            "low-discrepancy" => Ok(Self::LowDiscrepancy),
+            other => Err(format!("unknown sequence {other:?}; allowed: independent, low-discrepancy")),
+        }
+    }
+}
+
+impl std::fmt::Display for Sequence {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::Independent => "independent",
+            Self::LowDiscrepancy => "low-discrepancy",
+        })
+    }
+}
+
+/// Pipeline choices that do not change the expected image, only speed or noise.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct TracerOptions {
+    pub traversal: Traversal,
+    pub sequence: Sequence,
+}
+
+impl TracerOptions {
+    /// naga_oil shader defs for these options.
+    pub fn shader_defs(&self) -> Vec<(&'static str, Def)> {
+        match self.sequence {
+            Sequence::Independent => Vec::new(),
+            Sequence::LowDiscrepancy => vec![("LOW_DISCREPANCY", Def::Bool(true))],
+        }
+    }
 }
 
 /// The shader modules, in import order, for `scene` with `traversal`.
@@ -91,14 +138,14 @@ impl PathTracer {
     /// Validates `scene` against the device, compiles the (specialised) pipeline and allocates
     /// the buffers.
     pub fn new(gpu: &GpuContext, scene: &Scene) -> Result<Self, PathTraceError> {
-        Self::with_traversal(gpu, scene, Traversal::default())
+        Self::with_options(gpu, scene, TracerOptions::default())
     }
 
-    /// As [`Self::new`], choosing the traversal (the bench compares the two).
-    pub fn with_traversal(
+    /// As [`Self::new`], choosing the traversal and the sample sequence.
+    pub fn with_options(
         gpu: &GpuContext,
         scene: &Scene,
-        traversal: Traversal,
+        options: TracerOptions,
     ) -> Result<Self, PathTraceError> {
         let limits = gpu.device.limits();
         scene.check_device_limits(
@@ -113,8 +160,8 @@ impl PathTracer {
         let gpu_scene = GpuScene::new(scene)?;
         let base_params = gpu_scene::params(scene, &gpu_scene);
 
-        let modules = shader_modules(scene, &gpu_scene, traversal);
-        let module = shader::compose(&modules, &PATHTRACE_SHADER, &[])?;
+        let modules = shader_modules(scene, &gpu_scene, options.traversal);
+        let module = shader::compose(&modules, &PATHTRACE_SHADER, &options.shader_defs())?;
         let module = shader::create_module(gpu, module, &PATHTRACE_SHADER.path)?;
         let pipeline = gpu.scoped("creating the path-tracing pipeline", || {
             gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -351,5 +398,35 @@ impl PathTracer {
             gpu_seconds,
             pass_completed,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// The WGSL table LD_ALPHA holds floor(alpha_j 2^32) with alpha_j = (1/phi_16)^(j+1) and
+    /// phi_16 the positive root of x^17 = x + 1 (Roberts' generalised golden ratio).
+    #[test]
+    fn ld_alphas_match_roberts_definition() {
+        let source = include_str!("../../../shaders/common/sampler.wgsl");
+        let table = source.split("array<u32, 16>(").nth(1).expect("table present");
+        let table = table.split(')').next().expect("closed");
+        let values: Vec<u64> = table
+            .split(',')
+            .map(str::trim)
+            .filter(|v| !v.is_empty())
+            .map(|v| v.trim_end_matches('u').parse().expect("integer"))
+            .collect();
+        assert_eq!(values.len(), 16);
+        // Fixed-point iteration x <- (1 + x)^(1/17) converges to phi_16.
+        let mut phi = 2.0f64;
+        for _ in 0..200 {
+            phi = (1.0 + phi).powf(1.0 / 17.0);
+        }
+        assert!((phi.powi(17) - phi - 1.0).abs() < 1e-12);
+        for (j, &value) in values.iter().enumerate() {
+            let alpha = (1.0 / phi).powi(j as i32 + 1).fract();
+            let expected = (alpha * 4294967296.0).floor() as u64;
+            assert!(value.abs_diff(expected) <= 1, "alpha_{j}: {value} vs {expected}");
+        }
     }
 }
