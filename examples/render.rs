@@ -18,7 +18,7 @@ use anyhow::{Context, bail};
 use clap::Parser;
 use illum::cli::{self, DEFAULT_SCENE, SceneArgs};
 use illum::image::{Encoding, ExrMetadata, save_exr, save_png};
-use illum::pathtrace::{PathTracer, StopReason, StopRules, render_progressive};
+use illum::pathtrace::{PathTracer, Sequence, StopReason, StopRules, TracerOptions, render_progressive};
 use indicatif::{ProgressBar, ProgressStyle};
 
 #[derive(Parser, Debug)]
@@ -42,6 +42,10 @@ struct Args {
     /// PNG encoding: gamma2.2 (the assignment's), srgb or linear.
     #[arg(long, default_value = "gamma2.2")]
     encoding: Encoding,
+    /// Sample values: `independent` or `low-discrepancy` (lower error for the same spp; see
+    /// docs/accuracy.md).
+    #[arg(long, default_value = "independent")]
+    sequence: Sequence,
     /// PNG exposure in stops (EXR output is never scaled).
     #[arg(long, default_value_t = 0.0)]
     exposure: f32,
@@ -80,7 +84,11 @@ fn run(args: Args) -> anyhow::Result<()> {
     };
 
     let gpu = cli::gpu()?;
-    let mut tracer = PathTracer::new(&gpu, &scene)?;
+    let mut tracer = PathTracer::with_options(
+        &gpu,
+        &scene,
+        TracerOptions { sequence: args.sequence, ..Default::default() },
+    )?;
     let cancel = Arc::new(AtomicBool::new(false));
     {
         let cancel = cancel.clone();
@@ -121,6 +129,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         render_seconds: seconds,
         extra: vec![
             ("stopped_by".into(), format!("{reason:?}")),
+            ("sequence".into(), args.sequence.to_string()),
             ("dropped_samples".into(), accumulator.dropped_samples().to_string()),
             ("estimated_relative_error".into(), format!("{:.6}", accumulator.estimated_relative_error())),
             ("adapter".into(), gpu.adapter_info.name.clone()),

@@ -17,13 +17,11 @@
 #import illum::rng::{pcg_hash, rng_seed, rng_f32}
 
 const LD_DIMENSIONS: u32 = 16u;
-// floor(alpha_j * 2^32) for d = 16 (phi_16 = 1.0429177323017866); checked by the Rust test
-// `ld_alphas_match_roberts_definition` in crates/illum-pathtrace/src/tracer.rs.
-const LD_ALPHA = array<u32, 16>(
-    4118222524u, 3948751082u, 3786253661u, 3630443268u, 3481044723u, 3337794166u, 3200438599u,
-    3068735433u, 2942452063u, 2821365456u, 2705261756u, 2593935909u, 2487191299u, 2384839400u,
-    2286699445u, 2192598107u,
-);
+// 1 / phi_16, phi_16 = 1.0429177323017866 the positive root of x^17 = x + 1; checked by the
+// Rust test `ld_alpha_matches_roberts_definition` in crates/illum-pathtrace/src/tracer.rs.
+// alpha_j = (1/phi)^(j+1) is formed by repeated multiplication as dimensions are drawn (a
+// constant table indexed at run time is copied to local memory on every call by some drivers).
+const LD_INV_PHI: f32 = 0.958848401;
 
 struct Sampler {
     // PCG state for the independent stream (and the fallback dimensions).
@@ -32,10 +30,12 @@ struct Sampler {
     pixel_key: u32,
     sample_index: u32,
     dimension: u32,
+    // alpha of the next low-discrepancy dimension.
+    alpha: f32,
 }
 
 fn sampler_new(seed: u32, pixel: u32, sample_index: u32) -> Sampler {
-    return Sampler(rng_seed(seed, pixel, sample_index), pcg_hash(seed ^ pcg_hash(pixel)), sample_index, 0u);
+    return Sampler(rng_seed(seed, pixel, sample_index), pcg_hash(seed ^ pcg_hash(pixel)), sample_index, 0u, LD_INV_PHI);
 }
 
 // The next dimension's value, in [0, 1).
@@ -44,8 +44,13 @@ fn sample_1d(s: ptr<function, Sampler>) -> f32 {
     let d = (*s).dimension;
     (*s).dimension = d + 1u;
     if (d < LD_DIMENSIONS) {
-        let shift = pcg_hash((*s).pixel_key ^ pcg_hash(d + 0x9e3779b9u));
-        let x = shift + (*s).sample_index * LD_ALPHA[d];
+        // One hash per (pixel, dimension): the key times an odd constant spreads the
+        // dimensions apart before the permutation mixes them.
+        let shift = pcg_hash((*s).pixel_key + d * 0x9e3779b9u);
+        // alpha in 32-bit fixed point: an f32 in (0, 1) times 2^32 is an exact integer.
+        let alpha = u32((*s).alpha * 4294967296.0);
+        (*s).alpha *= LD_INV_PHI;
+        let x = shift + (*s).sample_index * alpha;
         return f32(x >> 8u) * 5.9604644775390625e-8;
     }
 #endif

@@ -403,30 +403,31 @@ impl PathTracer {
 
 #[cfg(test)]
 mod tests {
-    /// The WGSL table LD_ALPHA holds floor(alpha_j 2^32) with alpha_j = (1/phi_16)^(j+1) and
-    /// phi_16 the positive root of x^17 = x + 1 (Roberts' generalised golden ratio).
+    /// The WGSL constant LD_INV_PHI is 1/phi_16, phi_16 the positive root of x^17 = x + 1
+    /// (Roberts' generalised golden ratio), and its powers are the R_16 sequence's alphas.
     #[test]
-    fn ld_alphas_match_roberts_definition() {
+    fn ld_alpha_matches_roberts_definition() {
         let source = include_str!("../../../shaders/common/sampler.wgsl");
-        let table = source.split("array<u32, 16>(").nth(1).expect("table present");
-        let table = table.split(')').next().expect("closed");
-        let values: Vec<u64> = table
-            .split(',')
-            .map(str::trim)
-            .filter(|v| !v.is_empty())
-            .map(|v| v.trim_end_matches('u').parse().expect("integer"))
-            .collect();
-        assert_eq!(values.len(), 16);
+        let constant: f64 = source
+            .split("const LD_INV_PHI: f32 = ")
+            .nth(1)
+            .and_then(|rest| rest.split(';').next())
+            .expect("LD_INV_PHI present")
+            .parse()
+            .expect("a number");
         // Fixed-point iteration x <- (1 + x)^(1/17) converges to phi_16.
         let mut phi = 2.0f64;
         for _ in 0..200 {
             phi = (1.0 + phi).powf(1.0 / 17.0);
         }
         assert!((phi.powi(17) - phi - 1.0).abs() < 1e-12);
-        for (j, &value) in values.iter().enumerate() {
-            let alpha = (1.0 / phi).powi(j as i32 + 1).fract();
-            let expected = (alpha * 4294967296.0).floor() as u64;
-            assert!(value.abs_diff(expected) <= 1, "alpha_{j}: {value} vs {expected}");
+        assert!(((constant as f32) as f64 - 1.0 / phi).abs() < 1e-7, "{constant} vs {}", 1.0 / phi);
+        // The shader's f32 recurrence stays within 1e-6 of (1/phi)^(j+1) over the 16 dimensions.
+        let mut alpha = constant as f32;
+        for j in 0..16 {
+            let exact = (1.0 / phi).powi(j + 1);
+            assert!((alpha as f64 - exact).abs() < 1e-6, "alpha_{j}: {alpha} vs {exact}");
+            alpha *= constant as f32;
         }
     }
 }
