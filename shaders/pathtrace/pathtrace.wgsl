@@ -11,8 +11,8 @@
 #import illum::constants::INV_PI
 #import illum::sampler::{Sampler, sampler_new, sample_1d}
 #import illum::sampling::{sample_cosine_hemisphere, sample_uniform_hemisphere, to_world, sample_parallelogram}
-#import illum::pathtrace::scene::{NO_HIT, params, objects, materials, lights, batch_sum, batch_sum_sq, surface_normal}
-#import illum::pathtrace::traversal::{closest_hit, occluded}
+#import illum::pathtrace::scene::{NO_HIT, params, objects, materials, lights, batch_sum, batch_sum_sq}
+#import illum::pathtrace::traversal::{closest_hit, occluded, surface_normal, choose_light}
 
 const SAMPLING_COSINE: u32 = 0u;
 const UNBOUNDED: u32 = 0xffffffffu;
@@ -41,13 +41,7 @@ fn direct_light(p: vec3<f32>, n: vec3<f32>, sampler: ptr<function, Sampler>) -> 
     let pick = sample_1d(sampler) * params.light_area;
     let u1 = sample_1d(sampler);
     let u2 = sample_1d(sampler);
-    var li = 0u;
-    for (; li + 1u < params.num_lights; li++) {
-        if (pick < lights[li].corner.w) {
-            break;
-        }
-    }
-    let light = lights[li];
+    let light = lights[choose_light(pick)];
     let y = sample_parallelogram(light.corner.xyz, light.edge_u.xyz, light.edge_v.xyz, u1, u2);
     let to_light = y - p;
     let dist2 = dot(to_light, to_light);

@@ -170,22 +170,27 @@ fn box_face_normal(q: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(0.0, 0.0, sign(q.z));
 }
 
-// Geometric normal at p on the object (not yet oriented toward the ray).
-fn surface_normal(obj: Object, p: vec3<f32>) -> vec3<f32> {
-    switch obj.kind {
-        case KIND_AABB: {
-            let centre = 0.5 * (obj.a.xyz + obj.b.xyz);
-            return box_face_normal((p - centre) / (0.5 * (obj.b.xyz - obj.a.xyz)));
-        }
-        case KIND_BOX: {
-            // The face is the axis on which p sits farthest out, relative to the half-extent.
-            let pl = rotate_y_inverse(p - obj.c.xyz, obj.a.w, obj.b.w);
-            let centre = 0.5 * (obj.a.xyz + obj.b.xyz);
-            let nl = box_face_normal((pl - centre) / (0.5 * (obj.b.xyz - obj.a.xyz)));
-            return rotate_y(nl, obj.a.w, obj.b.w);
-        }
-        case KIND_QUAD: { return normalize(obj.d.xyz); }
-        default: { return (p - obj.a.xyz) / obj.a.w; }
-    }
+// Geometric normals at a point p on each kind of object (not yet oriented toward the ray). The
+// traversal module dispatches on the kinds its scene contains (surface_normal).
+fn normal_aabb(obj: Object, p: vec3<f32>) -> vec3<f32> {
+    let centre = 0.5 * (obj.a.xyz + obj.b.xyz);
+    return box_face_normal((p - centre) / (0.5 * (obj.b.xyz - obj.a.xyz)));
+}
+
+fn normal_box(obj: Object, p: vec3<f32>) -> vec3<f32> {
+    // The face is the axis on which p sits farthest out, relative to the half-extent, found in
+    // the box's own frame.
+    let pl = rotate_y_inverse(p - obj.c.xyz, obj.a.w, obj.b.w);
+    let centre = 0.5 * (obj.a.xyz + obj.b.xyz);
+    let nl = box_face_normal((pl - centre) / (0.5 * (obj.b.xyz - obj.a.xyz)));
+    return rotate_y(nl, obj.a.w, obj.b.w);
+}
+
+fn normal_quad(obj: Object) -> vec3<f32> {
+    return normalize(obj.d.xyz);
+}
+
+fn normal_sphere(obj: Object, p: vec3<f32>) -> vec3<f32> {
+    return (p - obj.a.xyz) / obj.a.w;
 }
 

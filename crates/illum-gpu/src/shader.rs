@@ -53,7 +53,7 @@ pub const COMMON_MODULES: &[ShaderFile] = &[
 ];
 
 /// A shader def: `#ifdef NAME` / `#if NAME == value` in WGSL.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Def {
     Bool(bool),
     UInt(u32),

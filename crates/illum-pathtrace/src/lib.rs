@@ -10,7 +10,7 @@ mod error;
 pub mod gpu_scene;
 pub mod planner;
 pub mod progressive;
-mod specialise;
+pub mod specialise;
 mod tracer;
 
 pub use accumulator::Accumulator;
@@ -18,5 +18,5 @@ pub use error::PathTraceError;
 pub use progressive::{StopReason, StopRules, render_progressive};
 pub use tracer::{
     GENERIC_TRAVERSAL, PATHTRACE_SHADER, PathTracer, SCENE_MODULE, Sequence, StepReport, TracerOptions,
-    Traversal, shader_modules,
+    Traversal, pipelines_compiled, shader_modules,
 };

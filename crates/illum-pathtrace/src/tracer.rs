@@ -1,5 +1,7 @@
 //! The path tracer's GPU side: pipeline, buffers, and the submit-readback-fold loop.
 
+use std::collections::HashMap;
+use std::sync::{Mutex, OnceLock};
 use std::time::Instant;
 
 use illum_gpu::shader::{self, COMMON_MODULES, Def, ShaderFile};
@@ -78,6 +80,20 @@ impl TracerOptions {
     }
 }
 
+/// Compiled pipelines by (device, traversal source, shader defs): two scenes with the same
+/// specialisation share one pipeline, so switching back to a scene does not recompile.
+type PipelineKey = (wgpu::Device, String, Vec<(&'static str, Def)>);
+
+fn pipeline_cache() -> &'static Mutex<HashMap<PipelineKey, wgpu::ComputePipeline>> {
+    static CACHE: OnceLock<Mutex<HashMap<PipelineKey, wgpu::ComputePipeline>>> = OnceLock::new();
+    CACHE.get_or_init(Mutex::default)
+}
+
+/// Number of pipelines compiled so far in this process (the cache's misses).
+pub fn pipelines_compiled() -> usize {
+    pipeline_cache().lock().unwrap_or_else(|p| p.into_inner()).len()
+}
+
 /// The shader modules, in import order, for `scene` with `traversal`.
 pub fn shader_modules(scene: &Scene, gpu_scene: &GpuScene, traversal: Traversal) -> Vec<ShaderFile> {
     let mut modules = COMMON_MODULES.to_vec();
@@ -116,6 +132,9 @@ struct ActivePass {
 pub struct PathTracer {
     gpu: GpuContext,
     scene: Scene,
+    options: TracerOptions,
+    /// The traversal module's source: the specialisation this pipeline was built for.
+    traversal_source: String,
     base_params: GpuParams,
     pipeline: wgpu::ComputePipeline,
     bind_group: wgpu::BindGroup,
@@ -161,18 +180,32 @@ impl PathTracer {
         let base_params = gpu_scene::params(scene, &gpu_scene);
 
         let modules = shader_modules(scene, &gpu_scene, options.traversal);
-        let module = shader::compose(&modules, &PATHTRACE_SHADER, &options.shader_defs())?;
-        let module = shader::create_module(gpu, module, &PATHTRACE_SHADER.path)?;
-        let pipeline = gpu.scoped("creating the path-tracing pipeline", || {
-            gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("pathtrace"),
-                layout: None,
-                module: &module,
-                entry_point: Some("main"),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        })?;
+        let defs = options.shader_defs();
+        let key: PipelineKey =
+            (gpu.device.clone(), modules.last().expect("traversal").source.to_string(), defs.clone());
+        let cached = pipeline_cache().lock().unwrap_or_else(|p| p.into_inner()).get(&key).cloned();
+        let pipeline = match cached {
+            Some(pipeline) => pipeline,
+            None => {
+                let module = shader::compose(&modules, &PATHTRACE_SHADER, &defs)?;
+                let module = shader::create_module(gpu, module, &PATHTRACE_SHADER.path)?;
+                let pipeline = gpu.scoped("creating the path-tracing pipeline", || {
+                    gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                        label: Some("pathtrace"),
+                        layout: None,
+                        module: &module,
+                        entry_point: Some("main"),
+                        compilation_options: Default::default(),
+                        cache: None,
+                    })
+                })?;
+                pipeline_cache()
+                    .lock()
+                    .unwrap_or_else(|p| p.into_inner())
+                    .insert(key.clone(), pipeline.clone());
+                pipeline
+            }
+        };
 
         let device = &gpu.device;
         let storage = |label: &str, contents: &[u8]| {
@@ -225,6 +258,8 @@ impl PathTracer {
         Ok(Self {
             gpu: gpu.clone(),
             scene: scene.clone(),
+            options,
+            traversal_source: key.1,
             base_params,
             pipeline,
             bind_group,
@@ -268,6 +303,46 @@ impl PathTracer {
     /// Sets the wall time aimed at per submission (default 0.15 s).
     pub fn set_target_seconds(&mut self, seconds: f64) {
         self.planner = BatchPlanner::new(seconds);
+    }
+
+    /// Takes a new camera and render settings (spp, bounces, seed, sampling) without rebuilding
+    /// the pipeline, and restarts the accumulation. The geometry and materials must be the ones
+    /// the pipeline was built for: a scene that differs in them (another specialisation, or
+    /// other object data) is refused with an error naming what changed; build a new
+    /// `PathTracer` for it. The resolution may change (the buffers are reallocated).
+    pub fn update_scene(&mut self, scene: &Scene) -> Result<(), PathTraceError> {
+        if scene.objects != self.scene.objects || scene.materials != self.scene.materials {
+            let gpu_scene = GpuScene::new(scene)?;
+            let needed = specialise::specialise(scene, &gpu_scene);
+            let what = if self.options.traversal == Traversal::Specialised
+                && needed.source != self.traversal_source
+            {
+                format!(
+                    "its geometry needs a pipeline specialised for shapes {:?}, {} light(s) and shadow-ray occluders {:?}",
+                    needed.kinds, needed.lights, needed.occluders
+                )
+            } else {
+                "its objects or materials differ from the uploaded ones".to_owned()
+            };
+            return Err(PathTraceError::Unsupported {
+                scene: scene.name.clone(),
+                message: format!(
+                    "this path tracer was built for scene {:?} and cannot render it: {what}; create a new PathTracer",
+                    self.scene.name
+                ),
+            });
+        }
+        let resized =
+            (scene.camera.width, scene.camera.height) != (self.scene.camera.width, self.scene.camera.height);
+        if resized {
+            *self = Self::with_options(&self.gpu, scene, self.options)?;
+            return Ok(());
+        }
+        let gpu_scene = GpuScene::new(scene)?;
+        self.base_params = gpu_scene::params(scene, &gpu_scene);
+        self.scene = scene.clone();
+        self.reset();
+        Ok(())
     }
 
     /// Discards everything accumulated; the next step starts again at sample 0.
