@@ -118,9 +118,9 @@ impl Bounds {
         };
         let mut bounds = Bounds { lo: [f32::MAX; 3], hi: [f32::MIN; 3] };
         for p in points {
-            for a in 0..3 {
-                bounds.lo[a] = bounds.lo[a].min(p[a]);
-                bounds.hi[a] = bounds.hi[a].max(p[a]);
+            for (a, value) in p.into_iter().enumerate() {
+                bounds.lo[a] = bounds.lo[a].min(value);
+                bounds.hi[a] = bounds.hi[a].max(value);
             }
         }
         bounds
