@@ -41,7 +41,7 @@ fn each_scene_file_picks_the_specialisation_it_should() {
         // A wall cannot shadow a light inside the room; only the blocks can.
         assert_eq!(occluders, expected_occluders, "{file}");
         assert!(!key.source.contains("hit_sphere("), "{file}: a scene without spheres has sphere code");
-        assert!(!key.source.contains("normal_sphere("), "{file}: a scene without spheres has sphere code");
+        assert!(!key.source.contains("surface_sphere("), "{file}: a scene without spheres has sphere code");
         assert!(
             key.source.contains("return 0u;") && !key.source.contains("pick <"),
             "{file}: one light needs no selection"

@@ -50,6 +50,7 @@ pub const COMMON_MODULES: &[ShaderFile] = &[
     crate::shader_file!("shaders/common/rng.wgsl"),
     crate::shader_file!("shaders/common/sampling.wgsl"),
     crate::shader_file!("shaders/common/sampler.wgsl"),
+    crate::shader_file!("shaders/common/spawn.wgsl"),
 ];
 
 /// A shader def: `#ifdef NAME` / `#if NAME == value` in WGSL.
