@@ -17,7 +17,7 @@ use std::path::PathBuf;
 
 use clap::Parser;
 use illum::cli::{self, SceneArgs};
-use illum::pathtrace::PathTracer;
+use illum::pathtrace::{PathTracer, TracerOptions, Traversal};
 use illum::scene::{Bounces, Scene};
 
 #[derive(Parser, Debug)]
@@ -37,6 +37,7 @@ struct Config {
     size: u32,
     spp: u32,
     bounces: u32,
+    traversal: Traversal,
 }
 
 fn main() {
@@ -65,21 +66,26 @@ fn run(args: Args) -> anyhow::Result<()> {
         "adapter: {} ({:?}, driver {})",
         gpu.adapter_info.name, gpu.adapter_info.backend, gpu.adapter_info.driver_info
     );
-    let mut configs =
-        vec![Config { size: 256, spp: 64, bounces: 2 }, Config { size: 256, spp: 64, bounces: 8 }];
+    // The headline configurations, each with the specialised (default) and generic traversal.
+    let mut configs = Vec::new();
+    for bounces in [2, 8] {
+        for traversal in [Traversal::Specialised, Traversal::Generic] {
+            configs.push(Config { size: 256, spp: 64, bounces, traversal });
+        }
+    }
     if !args.quick {
         for (size, spp) in [(256, 64), (1024, 4)] {
             for bounces in [0, 1, 2, 8] {
                 if !(size == 256 && (bounces == 2 || bounces == 8)) {
-                    configs.push(Config { size, spp, bounces });
+                    configs.push(Config { size, spp, bounces, traversal: Traversal::Specialised });
                 }
             }
         }
     }
     println!(
-        "| size | spp | bounces | Msamples/s (wall) | Msamples/s (GPU) | Mrays/s (wall, upper) | GPU ms per submission |"
+        "| size | spp | bounces | traversal | Msamples/s (wall) | Msamples/s (GPU) | Mrays/s (wall, upper) | GPU ms per submission |"
     );
-    println!("|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|");
     for config in configs {
         let settings = SceneArgs {
             spp: Some(config.spp),
@@ -89,7 +95,8 @@ fn run(args: Args) -> anyhow::Result<()> {
             ..Default::default()
         };
         let scene: Scene = cli::load_scene(&args.scene, &settings)?;
-        let mut tracer = PathTracer::new(&gpu, &scene)?;
+        let options = TracerOptions { traversal: config.traversal, ..Default::default() };
+        let mut tracer = PathTracer::with_options(&gpu, &scene, options)?;
         // Warm-up: compiles the pipeline on the driver and teaches the planner the cost.
         tracer.render(1)?;
         let (mut wall, mut gpu_rate, mut per_submission) = (Vec::new(), Vec::new(), Vec::new());
@@ -107,7 +114,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         }
         let wall = median(&mut wall);
         println!(
-            "| {0}x{0} | {1} | {2} | {3:.2} | {4:.2} | {5:.1} | {6:.0} |",
+            "| {0}x{0} | {1} | {2} | {7:?} | {3:.2} | {4:.2} | {5:.1} | {6:.0} |",
             config.size,
             config.spp,
             config.bounces,
@@ -115,6 +122,7 @@ fn run(args: Args) -> anyhow::Result<()> {
             median(&mut gpu_rate) * 1e-6,
             wall * rays_per_sample(config.bounces) as f64 * 1e-6,
             median(&mut per_submission),
+            config.traversal,
         );
     }
     Ok(())

@@ -21,7 +21,7 @@ use anyhow::{Context, bail};
 use clap::Parser;
 use illum::cli::{self, DEFAULT_SCENE, SceneArgs};
 use illum::image::{Encoding, ExrMetadata, save_exr, save_png};
-use illum::pathtrace::{PathTracer, StopReason, StopRules, render_progressive};
+use illum::pathtrace::{PathTracer, Sequence, StopReason, StopRules, TracerOptions, render_progressive};
 use illum::raster_cli::{RasterArgs, RasterRequest, render_raster};
 use illum::scene::{SceneKind, scene_kind};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -50,6 +50,10 @@ struct Args {
     /// path-traced scenes, linear for rasterizer scenes (the assignment's figure 1 is linear).
     #[arg(long)]
     encoding: Option<Encoding>,
+    /// Sample values: `independent` or `low-discrepancy` (lower error for the same spp; see
+    /// docs/accuracy.md).
+    #[arg(long, default_value = "independent")]
+    sequence: Sequence,
     /// PNG exposure in stops (EXR output is never scaled).
     #[arg(long, default_value_t = 0.0)]
     exposure: f32,
@@ -103,7 +107,11 @@ fn run(args: Args) -> anyhow::Result<()> {
     };
 
     let gpu = cli::gpu()?;
-    let mut tracer = PathTracer::new(&gpu, &scene)?;
+    let mut tracer = PathTracer::with_options(
+        &gpu,
+        &scene,
+        TracerOptions { sequence: args.sequence, ..Default::default() },
+    )?;
     let cancel = Arc::new(AtomicBool::new(false));
     {
         let cancel = cancel.clone();
@@ -144,6 +152,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         render_seconds: seconds,
         extra: vec![
             ("stopped_by".into(), format!("{reason:?}")),
+            ("sequence".into(), args.sequence.to_string()),
             ("dropped_samples".into(), accumulator.dropped_samples().to_string()),
             ("estimated_relative_error".into(), format!("{:.6}", accumulator.estimated_relative_error())),
             ("adapter".into(), gpu.adapter_info.name.clone()),

@@ -5,14 +5,17 @@
 //! and the irradiance from a uniformly emitting polygon of radiance Le is Lambert's formula
 //!     E(x) = Le / 2 * | sum_i theta_i (n . g_i) |,
 //! where theta_i is the angle subtended at x by the edge (v_i, v_{i+1}) and g_i is the unit
-//! normal of the plane through x and that edge. The formula is evaluated here in f64,
-//! independently of the shader, and compared with the GPU estimate within 4 standard errors.
+//! normal of the plane through x and that edge. The formula (tests/common/closed_form.rs) is
+//! evaluated in f64, independently of the shader, and compared with the GPU estimate within 4
+//! standard errors.
 
 use glam::DVec3;
 use illum::pathtrace::PathTracer;
 use illum::scene::Scene;
 
 mod common;
+
+use common::closed_form::lambert_irradiance_factor;
 
 /// The assignment's box without the two blocks, so nothing but the geometry of the light
 /// decides the direct light on the floor. Camera placeholders are replaced per point.
@@ -53,22 +56,14 @@ material = "light"
 quad = { corner = [213.0, 555.0, 225.5], edge_u = [130.0, 0.0, 0.0], edge_v = [0.0, 0.0, 105.0] }
 "#;
 
-const LIGHT: [[f64; 3]; 4] =
-    [[213.0, 555.0, 225.5], [343.0, 555.0, 225.5], [343.0, 555.0, 330.5], [213.0, 555.0, 330.5]];
+const LIGHT: [DVec3; 4] = [
+    DVec3::new(213.0, 555.0, 225.5),
+    DVec3::new(343.0, 555.0, 225.5),
+    DVec3::new(343.0, 555.0, 330.5),
+    DVec3::new(213.0, 555.0, 330.5),
+];
 const RADIANCE: f64 = 30.0;
 const ALBEDO: f64 = 0.5;
-
-/// Lambert's irradiance at x (normal n) from the polygon, per unit emitted radiance.
-fn lambert_irradiance_factor(x: DVec3, n: DVec3, polygon: &[[f64; 3]]) -> f64 {
-    let mut sum = 0.0;
-    for i in 0..polygon.len() {
-        let a = (DVec3::from(polygon[i]) - x).normalize();
-        let b = (DVec3::from(polygon[(i + 1) % polygon.len()]) - x).normalize();
-        let theta = a.dot(b).clamp(-1.0, 1.0).acos();
-        sum += theta * n.dot(a.cross(b).normalize());
-    }
-    0.5 * sum.abs()
-}
 
 /// Renders a tiny image of the floor around `x` (camera 1 unit above, looking straight down
 /// with a 0.01 degree field of view, so every pixel sees x to within 1e-4 units) and returns the
@@ -128,7 +123,12 @@ fn floor_at_grazing_incidence() {
 fn lambert_formula_matches_the_small_source_limit() {
     // Independent check of the formula itself: far away, a source of area A looks like a point,
     // E = Le * A * cos(theta_x) cos(theta_y) / r^2.
-    let small = [[0.0, 1000.0, 0.0], [0.0, 1000.0, 1.0], [1.0, 1000.0, 1.0], [1.0, 1000.0, 0.0]];
+    let small = [
+        DVec3::new(0.0, 1000.0, 0.0),
+        DVec3::new(0.0, 1000.0, 1.0),
+        DVec3::new(1.0, 1000.0, 1.0),
+        DVec3::new(1.0, 1000.0, 0.0),
+    ];
     let x = DVec3::new(0.5, 0.0, 0.5);
     let expected = 1.0 / (1000.0f64 * 1000.0);
     let factor = lambert_irradiance_factor(x, DVec3::Y, &small);

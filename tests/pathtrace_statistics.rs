@@ -2,7 +2,7 @@
 //! has lower variance, seeds and batching behave, and nothing is NaN.
 
 use illum::image::z_test_pass_fraction;
-use illum::pathtrace::{PathTracer, Traversal};
+use illum::pathtrace::{PathTracer, Sequence, TracerOptions, Traversal};
 use illum::scene::{Bounces, Overrides, Sampling};
 
 mod common;
@@ -61,6 +61,41 @@ fn cosine_and_uniform_sampling_converge_to_the_same_image_and_cosine_is_less_noi
 }
 
 #[test]
+fn the_low_discrepancy_sequence_is_unbiased_and_less_noisy() {
+    // Same scene; independent numbers vs the shifted Kronecker sequence. Both must agree per
+    // pixel (Z-test; each estimate's variance comes from its own samples), and the
+    // low-discrepancy image must be closer to a high-spp reference.
+    let scene = cornell(32, 256, 2, Sampling::Cosine, 21);
+    let render = |sequence| {
+        let mut t =
+            PathTracer::with_options(common::gpu(), &scene, TracerOptions { sequence, ..Default::default() })
+                .expect("builds");
+        t.render(256).expect("renders");
+        t
+    };
+    let independent = render(Sequence::Independent);
+    let low_discrepancy = render(Sequence::LowDiscrepancy);
+    let mut reference_scene = scene.clone();
+    reference_scene.render.seed = 99;
+    reference_scene.render.spp = 8192;
+    let reference = common::render(&reference_scene).accumulator().mean_image();
+    let pass = z_test_pass_fraction(
+        &low_discrepancy.accumulator().mean_image(),
+        &low_discrepancy.accumulator().variance_image(),
+        &reference,
+        &common::render(&reference_scene).accumulator().variance_image(),
+        0.01,
+    )
+    .expect("same size");
+    assert!(pass > 0.97, "low-discrepancy image disagrees with the reference on {:.3} of pixels", 1.0 - pass);
+    let error =
+        |t: &PathTracer| illum::image::rmse(&t.accumulator().mean_image(), &reference).expect("same size");
+    let (e_ind, e_ld) = (error(&independent), error(&low_discrepancy));
+    println!("RMSE at 256 spp: independent {e_ind:.5}, low-discrepancy {e_ld:.5}");
+    assert!(e_ld < e_ind, "low-discrepancy RMSE {e_ld} is not below independent {e_ind}");
+}
+
+#[test]
 fn the_same_seed_gives_the_same_image_and_another_seed_does_not() {
     let a = common::render(&cornell(24, 8, 2, Sampling::Cosine, 7)).accumulator().mean_image();
     let b = common::render(&cornell(24, 8, 2, Sampling::Cosine, 7)).accumulator().mean_image();
@@ -95,7 +130,12 @@ fn batching_does_not_change_the_image() {
 fn generic_and_specialised_traversal_give_the_same_image() {
     let scene = cornell(24, 16, 2, Sampling::Cosine, 5);
     let render = |traversal| {
-        let mut tracer = PathTracer::with_traversal(common::gpu(), &scene, traversal).expect("builds");
+        let mut tracer = PathTracer::with_options(
+            common::gpu(),
+            &scene,
+            TracerOptions { traversal, ..Default::default() },
+        )
+        .expect("builds");
         tracer.render(16).expect("renders");
         tracer.accumulator().mean_image()
     };
@@ -117,7 +157,12 @@ fn the_background_outside_the_box_is_black_and_the_light_is_its_radiance() {
     // so the image's corners look past the walls (x in [-1, 557], y in [0, 556]) into nothing.
     for traversal in [Traversal::Generic, Traversal::Specialised] {
         let scene = cornell(64, 4, 2, Sampling::Cosine, 1);
-        let mut tracer = PathTracer::with_traversal(common::gpu(), &scene, traversal).expect("builds");
+        let mut tracer = PathTracer::with_options(
+            common::gpu(),
+            &scene,
+            TracerOptions { traversal, ..Default::default() },
+        )
+        .expect("builds");
         tracer.render(4).expect("renders");
         let image = tracer.accumulator().mean_image();
         for (x, y) in [(0, 0), (63, 0), (0, 63), (63, 63)] {

@@ -3,15 +3,17 @@
 
 use std::collections::BTreeSet;
 
-use illum::gpu::shader::{self, COMMON_MODULES, ShaderFile};
-use illum::pathtrace::{self, PATHTRACE_SHADER, Traversal, gpu_scene::GpuScene, shader_modules};
+use illum::gpu::shader::{self, COMMON_MODULES, Def, ShaderFile};
+use illum::pathtrace::{
+    self, PATHTRACE_SHADER, Sequence, TracerOptions, Traversal, gpu_scene::GpuScene, shader_modules,
+};
 use illum::scene::Scene;
 
 mod common;
 
 /// Composes `entry` with `modules` and validates the result with naga.
-fn check(modules: &[ShaderFile], entry: &ShaderFile, covered: &mut BTreeSet<String>) {
-    let module = shader::compose(modules, entry, &[]).unwrap_or_else(|e| panic!("{e}"));
+fn check(modules: &[ShaderFile], entry: &ShaderFile, defs: &[(&str, Def)], covered: &mut BTreeSet<String>) {
+    let module = shader::compose(modules, entry, defs).unwrap_or_else(|e| panic!("{e}"));
     shader::validate(&module, &entry.path).unwrap_or_else(|e| panic!("{e}"));
     covered.insert(entry.path.to_string());
     covered.extend(modules.iter().map(|m| m.path.to_string()));
@@ -49,18 +51,21 @@ fn every_wgsl_file_composes_and_validates() {
             format!("entry importing {import_path}"),
             format!("#import {import_path} as m\n@compute @workgroup_size(1)\nfn main() {{}}\n"),
         );
-        check(&COMMON_MODULES[..=i], &entry, &mut covered);
+        check(&COMMON_MODULES[..=i], &entry, &[], &mut covered);
     }
     // The path tracer, generic and specialised for every scene file.
     for scene in path_tracer_scenes() {
         let gpu_scene = GpuScene::new(&scene).unwrap_or_else(|e| panic!("{e}"));
         for traversal in [Traversal::Generic, Traversal::Specialised] {
-            check(&shader_modules(&scene, &gpu_scene, traversal), &PATHTRACE_SHADER, &mut covered);
+            for sequence in [Sequence::Independent, Sequence::LowDiscrepancy] {
+                let defs = TracerOptions { traversal, sequence }.shader_defs();
+                check(&shader_modules(&scene, &gpu_scene, traversal), &PATHTRACE_SHADER, &defs, &mut covered);
+            }
         }
     }
     for shaders in extra_shader_sets() {
         for (modules, entry) in shaders {
-            check(&modules, &entry, &mut covered);
+            check(&modules, &entry, &[], &mut covered);
         }
     }
 
@@ -84,7 +89,11 @@ fn every_wgsl_file_composes_and_validates() {
 
 /// Shader sets of the other renderers: (modules, entry) pairs.
 fn extra_shader_sets() -> Vec<Vec<(Vec<ShaderFile>, ShaderFile)>> {
-    Vec::new()
+    let raster = illum::raster::shaders::SHADERS
+        .iter()
+        .map(|entry| (illum::raster::shaders::modules(), entry.clone()))
+        .collect();
+    vec![raster]
 }
 
 #[test]

@@ -1,4 +1,5 @@
-// The Cornell box path tracer: one invocation per pixel, `sample_count` samples per dispatch.
+// The Cornell box path tracer: one invocation per pixel and chunk of samples (see main);
+// `sample_count` samples per pixel per dispatch.
 //
 // Estimator (docs/theory.md): at every diffuse hit x the direct light is estimated by next-event
 // estimation on the rectangular lights,
@@ -9,10 +10,11 @@
 // A camera ray that hits a light sees its emitted radiance.
 
 #import illum::constants::INV_PI
-#import illum::rng::{rng_seed, rng_f32}
+#import illum::sampler::{Sampler, sampler_new, sample_1d}
 #import illum::sampling::{sample_cosine_hemisphere, sample_uniform_hemisphere, to_world, sample_parallelogram}
-#import illum::pathtrace::scene::{NO_HIT, params, objects, materials, lights, batch_sum, batch_sum_sq, surface_normal}
-#import illum::pathtrace::traversal::{closest_hit, occluded}
+#import illum::spawn::{spawn_point, spawn_error, max_abs}
+#import illum::pathtrace::scene::{NO_HIT, Surface, params, objects, materials, lights, batch_sum, batch_sum_sq}
+#import illum::pathtrace::traversal::{closest_hit, occluded, surface_at, choose_light}
 
 const SAMPLING_COSINE: u32 = 0u;
 const UNBOUNDED: u32 = 0xffffffffu;
@@ -23,45 +25,46 @@ const RR_MAX_SURVIVAL: f32 = 0.95;
 // A safety net for `unbounded`: reaching it needs 0.95^1000 ~ 5e-23 survival odds, so the bias it
 // introduces is far below f32 resolution.
 const UNBOUNDED_DEPTH_CAP: u32 = 1024u;
-// Shadow rays stop this fraction short of the sampled light point, so the light's own plane
-// (and a ceiling coplanar with it) never shadows it.
-const SHADOW_SHORTEN: f32 = 1.0e-4;
+// Shadow rays end this fraction of their length short of the light (on top of the light's own
+// error band, see direct_light). It covers rounding only: the computed length of the segment and
+// the distance at which the slab or quad test finds a surface lying in the light's plane each
+// carry a few units of roundoff (u = 2^-24) relative to the true distance, about 7 u together;
+// 2^-20 = 16 u. Relative, so it scales with the scene; a blocker under the light is found
+// whenever its gap to the light's plane exceeds the light's error band plus 2^-20 of the distance.
+const SHADOW_SHORTEN: f32 = 9.5367431640625e-7;
 
-// Distance to move a new ray's origin off the surface at p: relative to p's magnitude, because
-// the rounding error of a computed hit point grows with it (about 2^-23 |p| per operation).
-fn spawn_offset(p: vec3<f32>) -> f32 {
-    let m = max(max(abs(p.x), abs(p.y)), abs(p.z));
-    return 3.0e-5 * max(m, 1.0e-3);
-}
-
-// Next-event estimation: radiance arriving at p from one point sampled uniformly on the lights,
-// already divided by its pdf (1 / A_total) and multiplied by cos(theta_x); the caller multiplies
-// by albedo / pi.
-fn direct_light(p: vec3<f32>, n: vec3<f32>, rng: ptr<function, u32>) -> vec3<f32> {
-    let pick = rng_f32(rng) * params.light_area;
-    let u1 = rng_f32(rng);
-    let u2 = rng_f32(rng);
-    var li = 0u;
-    for (; li + 1u < params.num_lights; li++) {
-        if (pick < lights[li].corner.w) {
-            break;
+// Next-event estimation at the surface point s (normal s.n facing the incoming ray): radiance
+// arriving from one point sampled uniformly on the lights, already divided by its pdf
+// (1 / A_total) and multiplied by cos(theta_x); the caller multiplies by albedo / pi. The
+// geometry uses the surface point itself; only visibility is tested from the spawned origin.
+fn direct_light(s: Surface, origin: vec3<f32>, sampler: ptr<function, Sampler>) -> vec3<f32> {
+    let pick = sample_1d(sampler) * params.light_area;
+    let u1 = sample_1d(sampler);
+    let u2 = sample_1d(sampler);
+    let light = lights[choose_light(pick)];
+    let y = sample_parallelogram(light.corner.xyz, light.edge_u.xyz, light.edge_v.xyz, u1, u2);
+    let to_light = y - s.p;
+    let dist2 = dot(to_light, to_light);
+    let wi = to_light / sqrt(dist2);
+    let cos_x = dot(s.n, wi);
+    let cos_y = -dot(light.normal.xyz, wi);
+    // Only a point in front of the light, facing it, receives light. Written as a positive test
+    // so that a NaN cosine (a point on the light itself: dist2 = 0) fails it as well, whatever a
+    // compiler does with negated comparisons.
+    if (cos_x > 0.0 && cos_y > 0.0) {
+        // The light's plane, and any surface lying in it such as the ceiling around the light,
+        // is known only to within the light's error bound err_l; along a ray arriving at angle
+        // theta_y that band is err_l / cos(theta_y) long, so the shadow ray stops that much short
+        // of y, and SHADOW_SHORTEN more for rounding.
+        let err_l = spawn_error(max_abs(light.corner.xyz) + max_abs(light.edge_u.xyz) + max_abs(light.edge_v.xyz));
+        let segment = y - origin;
+        let length_to_light = length(segment);
+        let t_max = length_to_light * (1.0 - SHADOW_SHORTEN) - err_l / cos_y;
+        if (!occluded(origin, segment / length_to_light, t_max)) {
+            return light.emission.xyz * (cos_x * cos_y / dist2 * params.light_area);
         }
     }
-    let light = lights[li];
-    let y = sample_parallelogram(light.corner.xyz, light.edge_u.xyz, light.edge_v.xyz, u1, u2);
-    let to_light = y - p;
-    let dist2 = dot(to_light, to_light);
-    let dist = sqrt(dist2);
-    let wi = to_light / dist;
-    let cos_x = dot(n, wi);
-    let cos_y = -dot(light.normal.xyz, wi);
-    if (cos_x <= 0.0 || cos_y <= 0.0) {
-        return vec3<f32>(0.0);
-    }
-    if (occluded(p, wi, dist * (1.0 - SHADOW_SHORTEN))) {
-        return vec3<f32>(0.0);
-    }
-    return light.emission.xyz * (cos_x * cos_y / dist2 * params.light_area);
+    return vec3<f32>(0.0);
 }
 
 fn max3(v: vec3<f32>) -> f32 {
@@ -69,7 +72,7 @@ fn max3(v: vec3<f32>) -> f32 {
 }
 
 // One path's radiance estimate along the camera ray (o, d).
-fn radiance(origin: vec3<f32>, direction: vec3<f32>, rng: ptr<function, u32>) -> vec3<f32> {
+fn radiance(origin: vec3<f32>, direction: vec3<f32>, sampler: ptr<function, Sampler>) -> vec3<f32> {
     var o = origin;
     var d = direction;
     var hit = closest_hit(o, d);
@@ -79,21 +82,21 @@ fn radiance(origin: vec3<f32>, direction: vec3<f32>, rng: ptr<function, u32>) ->
     var obj = objects[hit.index];
     if (obj.emitter != 0u) {
         // One-sided emitter: visible only from its front.
-        let facing = dot(surface_normal(obj, o + hit.t * d), d) < 0.0;
+        let facing = dot(surface_at(obj, o + hit.t * d).n, d) < 0.0;
         return select(vec3<f32>(0.0), materials[obj.material].emission.xyz, facing);
     }
     var radiance = vec3<f32>(0.0);
     var throughput = vec3<f32>(1.0);
     var depth = 0u;
     loop {
-        let p = o + hit.t * d;
-        var n = surface_normal(obj, p);
-        if (dot(n, d) > 0.0) {
-            n = -n;
+        var s = surface_at(obj, o + hit.t * d);
+        if (dot(s.n, d) > 0.0) {
+            s.n = -s.n;
         }
         let albedo = materials[obj.material].albedo.xyz;
-        let p_spawn = p + n * spawn_offset(p);
-        radiance += throughput * albedo * INV_PI * direct_light(p_spawn, n, rng);
+        // Every ray leaving this point (shadow and bounce) starts here, off the surface.
+        let spawned = spawn_point(s.p, s.n, s.err);
+        radiance += throughput * albedo * INV_PI * direct_light(s, spawned, sampler);
 
         if (params.bounces != UNBOUNDED && depth >= params.bounces) {
             break;
@@ -101,22 +104,22 @@ fn radiance(origin: vec3<f32>, direction: vec3<f32>, rng: ptr<function, u32>) ->
         if (depth >= UNBOUNDED_DEPTH_CAP) {
             break;
         }
-        let u1 = rng_f32(rng);
-        let u2 = rng_f32(rng);
+        let u1 = sample_1d(sampler);
+        let u2 = sample_1d(sampler);
         // Lambertian f = albedo / pi. Cosine pdf cos/pi: f cos / pdf = albedo.
         // Uniform pdf 1/(2 pi): f cos / pdf = 2 albedo cos.
         if (params.sampling == SAMPLING_COSINE) {
-            d = to_world(n, sample_cosine_hemisphere(u1, u2));
+            d = to_world(s.n, sample_cosine_hemisphere(u1, u2));
             throughput *= albedo;
         } else {
             let local = sample_uniform_hemisphere(u1, u2);
-            d = to_world(n, local);
+            d = to_world(s.n, local);
             throughput *= albedo * (2.0 * local.z);
         }
         if (params.bounces == UNBOUNDED && depth >= RR_START) {
             // Survive with probability q and divide by q: E[throughput] is unchanged.
             let q = min(max3(throughput), RR_MAX_SURVIVAL);
-            if (rng_f32(rng) >= q) {
+            if (sample_1d(sampler) >= q) {
                 break;
             }
             throughput /= q;
@@ -124,7 +127,7 @@ fn radiance(origin: vec3<f32>, direction: vec3<f32>, rng: ptr<function, u32>) ->
         if (max3(throughput) <= 0.0) {
             break;
         }
-        o = p_spawn;
+        o = spawned;
         hit = closest_hit(o, d);
         if (hit.index == NO_HIT) {
             break;
@@ -145,11 +148,19 @@ fn is_finite3(v: vec3<f32>) -> bool {
     return all(exponent != vec3<u32>(0x7f800000u));
 }
 
+// One invocation traces one chunk of at most `chunk_samples` samples of one pixel and writes
+// their f32 sums to its own slot; the CPU folds the slots in f64. Chunks keep two things small:
+// the rounding of an f32 sum of n terms, at most (n - 1) u of the sum of their magnitudes
+// (with n = 16: 15 x 2^-24 < 1e-6 relative), and the work of one invocation (lavapipe stops an
+// invocation's loops after 65535 iterations; GPUs have watchdogs). Slot index: chunk-major, then
+// the band's rows, then columns.
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    if (gid.x >= params.width || gid.y >= params.rows) {
+    let first = gid.z * params.chunk_samples;
+    if (gid.x >= params.width || gid.y >= params.rows || first >= params.sample_count) {
         return;
     }
+    let count = min(params.chunk_samples, params.sample_count - first);
     let x = gid.x;
     let y = gid.y + params.row_offset;
     let pixel = y * params.width + x;
@@ -159,13 +170,13 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var dropped = 0u;
     let inv_width = 1.0 / f32(params.width);
     let inv_height = 1.0 / f32(params.height);
-    for (var i = 0u; i < params.sample_count; i++) {
-        var rng = rng_seed(params.seed, pixel, params.sample_base + i);
+    for (var i = 0u; i < count; i++) {
+        var sampler = sampler_new(params.seed, pixel, params.sample_base + first + i);
         // Jitter uniformly inside the pixel; row 0 is the top of the image.
-        let sx = (2.0 * (f32(x) + rng_f32(&rng)) * inv_width - 1.0) * params.aspect * params.tan_half_fov;
-        let sy = (1.0 - 2.0 * (f32(y) + rng_f32(&rng)) * inv_height) * params.tan_half_fov;
+        let sx = (2.0 * (f32(x) + sample_1d(&sampler)) * inv_width - 1.0) * params.aspect * params.tan_half_fov;
+        let sy = (1.0 - 2.0 * (f32(y) + sample_1d(&sampler)) * inv_height) * params.tan_half_fov;
         let d = normalize(params.forward + sx * params.right + sy * params.up);
-        let l = radiance(params.eye, d, &rng);
+        let l = radiance(params.eye, d, &sampler);
         if (is_finite3(l)) {
             sum += l;
             sum_sq += l * l;
@@ -174,6 +185,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             dropped += 1u;
         }
     }
-    batch_sum[pixel] = vec4<f32>(sum, f32(finite));
-    batch_sum_sq[pixel] = vec4<f32>(sum_sq, f32(dropped));
+    let slot = (gid.z * params.rows + gid.y) * params.width + x;
+    batch_sum[slot] = vec4<f32>(sum, f32(finite));
+    batch_sum_sq[slot] = vec4<f32>(sum_sq, f32(dropped));
 }

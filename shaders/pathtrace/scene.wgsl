@@ -1,5 +1,7 @@
 #define_import_path illum::pathtrace::scene
 
+#import illum::spawn::{spawn_error, max_abs}
+
 // The path tracer's scene as the GPU sees it (mirrored by gpu_scene.rs), and ray-shape tests.
 
 const KIND_BOX: u32 = 0u;
@@ -9,7 +11,11 @@ const KIND_AABB: u32 = 3u;
 const NO_HIT: u32 = 0xffffffffu;
 const FAR: f32 = 3.0e38;
 // A ray that hits an emitter within this relative distance of a coplanar surface sees the
-// emitter: the light's face lies exactly in the ceiling's plane and must win that tie.
+// emitter: the light's face lies exactly in the ceiling's plane and must win that tie. The two
+// distances come from different tests of the same plane (slab and quad), each within about 10
+// units of roundoff (u = 2^-24) of the exact distance, so they agree to ~20 u = 1.2e-6 relative;
+// 1e-5 (~170 u) leaves a wide margin and is still far below any gap between distinct surfaces
+// that the image could resolve.
 const EMITTER_TIE: f32 = 1.0e-5;
 
 struct Params {
@@ -33,7 +39,8 @@ struct Params {
     num_lights: u32,
     // Objects [first_emitter, num_objects) are the emitters.
     first_emitter: u32,
-    padding: u32,
+    // Samples per invocation (one chunk); the dispatch's z dimension counts chunks.
+    chunk_samples: u32,
 }
 
 // Box: a = (local min, cos), b = (local max, sin), c = (offset, 0): world = R_y local + offset.
@@ -69,7 +76,8 @@ struct Light {
 @group(0) @binding(1) var<storage, read> objects: array<Object>;
 @group(0) @binding(2) var<storage, read> materials: array<Material>;
 @group(0) @binding(3) var<storage, read> lights: array<Light>;
-// Per pixel: (sum of radiance, number of finite samples) and (sum of squares, dropped samples).
+// Per slot (one chunk of samples of one pixel, see pathtrace.wgsl's main): (sum of radiance,
+// number of finite samples) and (sum of squares, number of dropped samples).
 @group(0) @binding(4) var<storage, read_write> batch_sum: array<vec4<f32>>;
 @group(0) @binding(5) var<storage, read_write> batch_sum_sq: array<vec4<f32>>;
 
@@ -79,7 +87,9 @@ struct Hit {
 }
 
 // Ray direction with zero components replaced by a tiny value of the same slab behaviour, so the
-// slab test divides by it without producing 0 * inf = NaN.
+// slab test divides by it without producing 0 * inf = NaN. Directions are unit vectors, so
+// 1e-30 is far below their resolution (6e-8); (lo - o) * 1e30 stays finite while coordinates
+// differ by less than 3e8, beyond any scene f32 can hold with useful precision.
 fn safe_inverse(d: vec3<f32>) -> vec3<f32> {
     let tiny = vec3<f32>(1.0e-30);
     return 1.0 / select(d, tiny, abs(d) < tiny);
@@ -170,22 +180,76 @@ fn box_face_normal(q: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(0.0, 0.0, sign(q.z));
 }
 
-// Geometric normal at p on the object (not yet oriented toward the ray).
-fn surface_normal(obj: Object, p: vec3<f32>) -> vec3<f32> {
-    switch obj.kind {
-        case KIND_AABB: {
-            let centre = 0.5 * (obj.a.xyz + obj.b.xyz);
-            return box_face_normal((p - centre) / (0.5 * (obj.b.xyz - obj.a.xyz)));
-        }
-        case KIND_BOX: {
-            // The face is the axis on which p sits farthest out, relative to the half-extent.
-            let pl = rotate_y_inverse(p - obj.c.xyz, obj.a.w, obj.b.w);
-            let centre = 0.5 * (obj.a.xyz + obj.b.xyz);
-            let nl = box_face_normal((pl - centre) / (0.5 * (obj.b.xyz - obj.a.xyz)));
-            return rotate_y(nl, obj.a.w, obj.b.w);
-        }
-        case KIND_QUAD: { return normalize(obj.d.xyz); }
-        default: { return (p - obj.a.xyz) / obj.a.w; }
-    }
+// A hit point made precise: the point moved onto the surface it belongs to, the unit geometric
+// normal there (not yet oriented toward the ray), and `err`, a bound on the point's remaining
+// distance from the surface along that normal, for spawn_point (spawn.wgsl).
+struct Surface {
+    p: vec3<f32>,
+    n: vec3<f32>,
+    err: f32,
 }
 
+// q with its coordinate on the axis of the unit axis vector n replaced by the box face's: hi on
+// a + face, lo on a - face. Those are the slab planes the intersection test uses, as exact floats.
+fn snap_to_face(q: vec3<f32>, n: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>) -> vec3<f32> {
+    return select(q, select(lo, hi, n > vec3<f32>(0.0)), n != vec3<f32>(0.0));
+}
+
+// The surface of `obj` at the computed hit point p = o + t d.
+//
+// p itself carries the rounding of o + t d, which grows with |o| and t (a camera 1e5 units from
+// the origin puts errors of ~0.01 in it), not with the surface. Each shape therefore rebuilds the
+// point from its own numbers, so that the error left depends only on the shape's magnitude M.
+// The bounds below are in units of u = 2^-24 (the unit roundoff) and cover both the rebuilt
+// point and the same shape's intersection test run again from the spawned origin, whose answer
+// decides whether the new ray "hits its own surface":
+// - axis-aligned box: the coordinate across the face is set to the face's plane (lo or hi), the
+//   very float the slab test subtracts from; the test's (plane - origin) then has the exact sign,
+//   so err = 0 and the one-float step of spawn_point is enough.
+// - rotated box: the local point is snapped to the local face and rotated back: <= 5.3 u M for
+//   the rotation, the added offset and R^T R != I in floats, <= 3 u M for the test's own
+//   world-to-local transform; M = |offset| + 2 |local corner| bounds every intermediate.
+// - quad: the point is rebuilt as corner + alpha u + beta v: <= 7.2 u M, including the tilt of
+//   the rounded normal u x v; the test's dot(corner - o, n) <= 8.7 u M. M = |corner|+|u|+|v|.
+// - sphere: the point is projected back onto the sphere (pbrt's reprojection): <= 4 u M; the
+//   test's |o - c|^2 - r^2 <= 7.5 u M in distance. M = |centre| + r.
+// All are under 17 u = 8.5 epsilons of M; spawn_error allows 32 epsilons (SPAWN_REL_ERROR).
+// (The traversal module's surface_at dispatches to these on the kinds its scene contains.)
+fn surface_aabb(obj: Object, p: vec3<f32>) -> Surface {
+    let lo = obj.a.xyz;
+    let hi = obj.b.xyz;
+    let n = box_face_normal((p - 0.5 * (lo + hi)) / (0.5 * (hi - lo)));
+    return Surface(snap_to_face(p, n, lo, hi), n, 0.0);
+}
+
+fn surface_box(obj: Object, p: vec3<f32>) -> Surface {
+    // Local frame: the face is the axis on which p sits farthest out, relative to the
+    // half-extent.
+    let lo = obj.a.xyz;
+    let hi = obj.b.xyz;
+    let c = obj.a.w;
+    let s = obj.b.w;
+    let pl = rotate_y_inverse(p - obj.c.xyz, c, s);
+    let nl = box_face_normal((pl - 0.5 * (lo + hi)) / (0.5 * (hi - lo)));
+    let q = rotate_y(snap_to_face(pl, nl, lo, hi), c, s) + obj.c.xyz;
+    let magnitude = max_abs(obj.c.xyz) + 2.0 * max(max_abs(lo), max_abs(hi));
+    return Surface(q, rotate_y(nl, c, s), spawn_error(magnitude));
+}
+
+fn surface_quad(obj: Object, p: vec3<f32>) -> Surface {
+    let corner = obj.a.xyz;
+    let u = obj.b.xyz;
+    let v = obj.c.xyz;
+    let w = obj.d.xyz / dot(obj.d.xyz, obj.d.xyz);
+    let h = p - corner;
+    let q = corner + dot(w, cross(h, v)) * u + dot(w, cross(u, h)) * v;
+    let magnitude = max_abs(corner) + max_abs(u) + max_abs(v);
+    return Surface(q, normalize(obj.d.xyz), spawn_error(magnitude));
+}
+
+fn surface_sphere(obj: Object, p: vec3<f32>) -> Surface {
+    let centre = obj.a.xyz;
+    let radius = obj.a.w;
+    let n = normalize(p - centre);
+    return Surface(centre + radius * n, n, spawn_error(max_abs(centre) + radius));
+}

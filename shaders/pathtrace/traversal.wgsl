@@ -3,7 +3,7 @@
 // Generic traversal: loops over the object buffer, so one pipeline serves every scene.
 // (The specialised pipeline replaces this module with code generated from the scene.)
 
-#import illum::pathtrace::scene::{Hit, FAR, NO_HIT, EMITTER_TIE, KIND_AABB, KIND_BOX, KIND_QUAD, params, objects, safe_inverse, hit_slabs, hit_box, hit_quad, hit_sphere}
+#import illum::pathtrace::scene::{Hit, Object, FAR, NO_HIT, EMITTER_TIE, KIND_AABB, KIND_BOX, KIND_QUAD, params, objects, lights, safe_inverse, hit_slabs, hit_box, hit_quad, hit_sphere, Surface, surface_aabb, surface_box, surface_quad, surface_sphere}
 
 // Closest hit over all objects. `d` must be unit length. Only the fields a shape's test needs are
 // loaded: on a CPU driver each storage-buffer read is a per-lane memory access.
@@ -48,3 +48,25 @@ fn occluded(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> bool {
     return false;
 }
 
+
+// The surface at the computed hit point p on the object (see scene.wgsl's surface functions).
+fn surface_at(obj: Object, p: vec3<f32>) -> Surface {
+    switch obj.kind {
+        case KIND_AABB: { return surface_aabb(obj, p); }
+        case KIND_BOX: { return surface_box(obj, p); }
+        case KIND_QUAD: { return surface_quad(obj, p); }
+        default: { return surface_sphere(obj, p); }
+    }
+}
+
+// The light whose share of the total light area contains `pick` (in [0, total area)): lights
+// are chosen with probability proportional to their area.
+fn choose_light(pick: f32) -> u32 {
+    var li = 0u;
+    for (; li + 1u < params.num_lights; li++) {
+        if (pick < lights[li].corner.w) {
+            break;
+        }
+    }
+    return li;
+}

@@ -10,6 +10,9 @@ use illum::image::RgbImage32;
 use illum::pathtrace::PathTracer;
 use illum::scene::{Overrides, Scene};
 
+pub mod closed_form;
+pub mod edit;
+
 /// The device every test in this binary shares. Without a Vulkan adapter this panics with the
 /// error, which names the fix (`apt-get install mesa-vulkan-drivers`): a missing driver fails
 /// the tests, it never skips them.

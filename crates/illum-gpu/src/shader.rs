@@ -49,10 +49,12 @@ pub const COMMON_MODULES: &[ShaderFile] = &[
     crate::shader_file!("shaders/common/constants.wgsl"),
     crate::shader_file!("shaders/common/rng.wgsl"),
     crate::shader_file!("shaders/common/sampling.wgsl"),
+    crate::shader_file!("shaders/common/sampler.wgsl"),
+    crate::shader_file!("shaders/common/spawn.wgsl"),
 ];
 
 /// A shader def: `#ifdef NAME` / `#if NAME == value` in WGSL.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Def {
     Bool(bool),
     UInt(u32),

@@ -33,6 +33,23 @@ impl Accumulator {
         }
     }
 
+    /// As [`Self::new`], but reports the bytes it needed instead of aborting when the host cannot
+    /// allocate them (a very large image: 56 bytes per pixel).
+    pub fn try_new(width: u32, height: u32) -> Result<Self, u64> {
+        let n = width as usize * height as usize;
+        let bytes = n as u64 * (2 * std::mem::size_of::<[f64; 3]>() + std::mem::size_of::<u64>()) as u64;
+        let mut sum = Vec::new();
+        let mut sum_sq = Vec::new();
+        let mut count = Vec::new();
+        sum.try_reserve_exact(n).map_err(|_| bytes)?;
+        sum_sq.try_reserve_exact(n).map_err(|_| bytes)?;
+        count.try_reserve_exact(n).map_err(|_| bytes)?;
+        sum.resize(n, [0.0; 3]);
+        sum_sq.resize(n, [0.0; 3]);
+        count.resize(n, 0);
+        Ok(Self { width, height, sum, sum_sq, count, dropped: 0 })
+    }
+
     /// Folds one batch for consecutive pixels starting at `first_pixel`. `sums[i]` is (sum, finite
     /// count), `sums_sq[i]` is (sum of squares, dropped count), as the shader writes them.
     pub fn fold(&mut self, first_pixel: usize, sums: &[[f32; 4]], sums_sq: &[[f32; 4]]) {

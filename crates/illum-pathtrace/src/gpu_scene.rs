@@ -69,7 +69,9 @@ pub struct GpuParams {
     pub sampling: u32,
     pub num_lights: u32,
     pub first_emitter: u32,
-    pub padding: u32,
+    /// Samples per invocation: each invocation traces one chunk of a pixel's samples and writes
+    /// its own slot (see the tracer).
+    pub chunk_samples: u32,
 }
 
 /// The uploaded form of a scene.
@@ -225,6 +227,6 @@ pub fn params(scene: &Scene, gpu_scene: &GpuScene) -> GpuParams {
         },
         num_lights: gpu_scene.lights.len() as u32,
         first_emitter: gpu_scene.first_emitter,
-        padding: 0,
+        chunk_samples: crate::tracer::CHUNK_SAMPLES,
     }
 }

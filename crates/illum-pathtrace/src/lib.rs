@@ -10,12 +10,14 @@ mod error;
 pub mod gpu_scene;
 pub mod planner;
 pub mod progressive;
-mod specialise;
+pub mod spawn;
+pub mod specialise;
 mod tracer;
 
 pub use accumulator::Accumulator;
 pub use error::PathTraceError;
 pub use progressive::{StopReason, StopRules, render_progressive};
 pub use tracer::{
-    GENERIC_TRAVERSAL, PATHTRACE_SHADER, PathTracer, SCENE_MODULE, StepReport, Traversal, shader_modules,
+    CHUNK_SAMPLES, GENERIC_TRAVERSAL, PATHTRACE_SHADER, PathTracer, SCENE_MODULE, SLOT_BYTES, Sequence,
+    StepReport, TracerOptions, Traversal, pipelines_compiled, shader_modules,
 };

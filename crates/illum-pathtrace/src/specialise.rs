@@ -1,16 +1,44 @@
-//! Traversal code generated for one scene.
+//! Traversal code generated for one scene ("model only what a scene requires").
 //!
 //! The generic traversal loops over a storage buffer of objects and switches on each one's kind.
 //! On a CPU Vulkan driver such as lavapipe every one of those reads is a per-lane memory access
 //! and the loop cannot be unrolled. For a scene of a handful of analytic shapes it is cheaper to
 //! emit one straight-line test per object with its numbers as literals: the compiler then folds
-//! the constants (an axis-aligned box needs no frame change, a wall's zero extents vanish) and
-//! no object data is read at all. Only the shapes the scene contains appear in the code.
+//! the constants (an axis-aligned box needs no frame change) and no object data is read while
+//! tracing. The generated module also contains only what the scene uses:
+//! - surface reconstruction only for the kinds of shape present;
+//! - no light-selection code when there is one light;
+//! - shadow rays test only the objects that can block a light (see [`can_block_light`]).
+
+use std::collections::BTreeSet;
 
 use illum_gpu::shader::ShaderFile;
 use illum_scene::Scene;
 
 use crate::gpu_scene::{GpuObject, GpuScene, KIND_AABB, KIND_BOX, KIND_QUAD, KIND_SPHERE};
+
+/// What a specialised pipeline was built for. Two scenes with equal keys share a pipeline.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct Specialisation {
+    /// Kinds of shape with code in the pipeline ("aabb", "box", "quad", "sphere").
+    pub kinds: BTreeSet<&'static str>,
+    /// Number of lights (1 means no light-selection code).
+    pub lights: usize,
+    /// Indices (into the uploaded objects) of the objects shadow rays test.
+    pub occluders: Vec<usize>,
+    /// The generated WGSL (the scene's numbers are literals in it).
+    pub source: String,
+}
+
+fn kind_name(kind: u32) -> &'static str {
+    match kind {
+        KIND_AABB => "aabb",
+        KIND_BOX => "box",
+        KIND_QUAD => "quad",
+        KIND_SPHERE => "sphere",
+        other => unreachable!("gpu_scene produced an unknown object kind {other}"),
+    }
+}
 
 /// WGSL for an f32 literal that reads back as exactly the same f32 (Rust's `{:?}` prints the
 /// shortest string that round-trips, always with a `.` or an exponent).
@@ -34,20 +62,174 @@ fn hit_expression(object: &GpuObject) -> String {
             lit(object.b[3]),
             vec3(object.c)
         ),
-        KIND_QUAD => format!(
-            "hit_quad(o, d, {}, {}, {}, {})",
-            vec3(object.a),
-            vec3(object.b),
-            vec3(object.c),
-            vec3(object.d)
-        ),
-        KIND_SPHERE => format!("hit_sphere(o, d, {}, {})", vec3(object.a), lit(object.a[3])),
-        other => unreachable!("gpu_scene produced an unknown object kind {other}"),
+        KIND_QUAD => {
+            format!(
+                "hit_quad(o, d, {}, {}, {}, {})",
+                vec3(object.a),
+                vec3(object.b),
+                vec3(object.c),
+                vec3(object.d)
+            )
+        }
+        _ => format!("hit_sphere(o, d, {}, {})", vec3(object.a), lit(object.a[3])),
     }
 }
 
-/// The `illum::pathtrace::traversal` module for `scene`: `closest_hit` and `occluded`.
-pub fn traversal_module(scene: &Scene, gpu_scene: &GpuScene) -> ShaderFile {
+/// An axis-aligned box [lo, hi] (lo <= hi; a flat box for a quad).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Bounds {
+    lo: [f32; 3],
+    hi: [f32; 3],
+}
+
+impl Bounds {
+    fn of(object: &GpuObject) -> Self {
+        let points: Vec<[f32; 3]> = match object.kind {
+            KIND_AABB => vec![xyz(object.a), xyz(object.b)],
+            KIND_BOX => {
+                // The eight corners of the rotated box.
+                let (c, s) = (object.a[3], object.b[3]);
+                let mut corners = Vec::new();
+                for i in 0..8 {
+                    let l = [
+                        if i & 1 == 0 { object.a[0] } else { object.b[0] },
+                        if i & 2 == 0 { object.a[1] } else { object.b[1] },
+                        if i & 4 == 0 { object.a[2] } else { object.b[2] },
+                    ];
+                    corners.push([
+                        c * l[0] + s * l[2] + object.c[0],
+                        l[1] + object.c[1],
+                        -s * l[0] + c * l[2] + object.c[2],
+                    ]);
+                }
+                corners
+            }
+            KIND_QUAD => {
+                let (p, u, v) = (xyz(object.a), xyz(object.b), xyz(object.c));
+                vec![p, add(p, u), add(p, v), add(add(p, u), v)]
+            }
+            _ => {
+                let r = object.a[3];
+                vec![
+                    [object.a[0] - r, object.a[1] - r, object.a[2] - r],
+                    [object.a[0] + r, object.a[1] + r, object.a[2] + r],
+                ]
+            }
+        };
+        let mut bounds = Bounds { lo: [f32::MAX; 3], hi: [f32::MIN; 3] };
+        for p in points {
+            for (a, value) in p.into_iter().enumerate() {
+                bounds.lo[a] = bounds.lo[a].min(value);
+                bounds.hi[a] = bounds.hi[a].max(value);
+            }
+        }
+        bounds
+    }
+
+    fn contains(&self, other: &Bounds) -> bool {
+        (0..3).all(|a| self.lo[a] <= other.lo[a] && other.hi[a] <= self.hi[a])
+    }
+}
+
+fn xyz(v: [f32; 4]) -> [f32; 3] {
+    [v[0], v[1], v[2]]
+}
+
+fn add(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+/// Corners of every light.
+fn light_corners(scene: &GpuScene) -> Vec<[f32; 3]> {
+    scene
+        .lights
+        .iter()
+        .flat_map(|l| {
+            let (p, u, v) = (xyz(l.corner), xyz(l.edge_u), xyz(l.edge_v));
+            [p, add(p, u), add(p, v), add(add(p, u), v)]
+        })
+        .collect()
+}
+
+/// Whether the object at `index` can lie on a shadow ray between a lit surface point and a light.
+///
+/// Only axis-aligned boxes are ever excluded (every other shape is kept, conservatively). A box
+/// O is excluded when one of its faces lies in a plane P with:
+/// 1. every light point on the far side of P from O (or on P), and
+/// 2. every surface point that can receive light and is not inside O, also on that far side:
+///    for each other object B, the part of B beyond P is inside O, except on faces of B that
+///    face away from every light point (they never send shadow rays: cos theta <= 0).
+///
+/// Then a shadow ray runs from a point on the far side to a light point on the far side: the
+/// segment stays in that closed half-space, which meets O at most in its face on P, so O
+/// cannot block it. Points on O itself need no test either: O is convex, and next-event
+/// estimation only traces rays leaving a surface on its outer side.
+pub fn can_block_light(scene: &GpuScene, index: usize) -> bool {
+    let object = &scene.objects[index];
+    if object.kind != KIND_AABB || object.emitter != 0 {
+        return true;
+    }
+    let o = Bounds::of(object);
+    let lights = light_corners(scene);
+    for axis in 0..3 {
+        // side = +1: the plane x_axis = o.hi with O below it; -1: x_axis = o.lo with O above.
+        for side in [1.0f32, -1.0] {
+            let plane = if side > 0.0 { o.hi[axis] } else { o.lo[axis] };
+            // Signed distance beyond the plane (positive on the far side from O).
+            let beyond = |value: f32| side * (value - plane);
+            if lights.iter().any(|c| beyond(c[axis]) < 0.0) {
+                continue;
+            }
+            let others_clear = scene.objects.iter().enumerate().all(|(j, b)| {
+                if j == index || b.emitter != 0 {
+                    return true; // paths end at emitters: no shading points there
+                }
+                let bounds = Bounds::of(b);
+                // The part of B on O's side of the plane (strictly): B clipped to that half-space.
+                let mut clipped = bounds;
+                if side > 0.0 {
+                    clipped.hi[axis] = clipped.hi[axis].min(plane);
+                } else {
+                    clipped.lo[axis] = clipped.lo[axis].max(plane);
+                }
+                let reaches_past = if side > 0.0 { bounds.lo[axis] < plane } else { bounds.hi[axis] > plane };
+                if !reaches_past || o.contains(&clipped) {
+                    return true;
+                }
+                if b.kind != KIND_AABB {
+                    return false;
+                }
+                // An axis-aligned B: each of its faces that some light point is in front of
+                // must, within the clipped part, lie inside O.
+                (0..3).all(|face_axis| {
+                    [1.0f32, -1.0].iter().all(|&face_side| {
+                        let face_plane =
+                            if face_side > 0.0 { bounds.hi[face_axis] } else { bounds.lo[face_axis] };
+                        let lit = lights.iter().any(|c| face_side * (c[face_axis] - face_plane) > 0.0);
+                        if !lit {
+                            return true;
+                        }
+                        let mut face = clipped;
+                        face.lo[face_axis] = face_plane;
+                        face.hi[face_axis] = face_plane;
+                        let empty = (0..3).any(|a| face.lo[a] > face.hi[a])
+                            || face_plane < clipped.lo[face_axis]
+                            || face_plane > clipped.hi[face_axis];
+                        empty || o.contains(&face)
+                    })
+                })
+            });
+            if others_clear {
+                return false;
+            }
+        }
+    }
+    true
+}
+
+/// Builds the `illum::pathtrace::traversal` module for `scene`: `closest_hit`, `occluded`,
+/// `surface_at` and `choose_light`.
+pub fn specialise(scene: &Scene, gpu_scene: &GpuScene) -> Specialisation {
     // gpu_scene orders non-emitters before emitters; recover each object's name for comments.
     let mut names: Vec<&str> = Vec::new();
     for emitters in [false, true] {
@@ -57,8 +239,10 @@ pub fn traversal_module(scene: &Scene, gpu_scene: &GpuScene) -> ShaderFile {
             }
         }
     }
+    let kinds: BTreeSet<&'static str> = gpu_scene.objects.iter().map(|o| kind_name(o.kind)).collect();
     let mut closest = String::new();
     let mut occluded = String::new();
+    let mut occluders = Vec::new();
     for (i, object) in gpu_scene.objects.iter().enumerate() {
         let name = names.get(i).copied().unwrap_or("?").replace(['\n', '\r'], " ");
         let hit = hit_expression(object);
@@ -71,18 +255,60 @@ pub fn traversal_module(scene: &Scene, gpu_scene: &GpuScene) -> ShaderFile {
             ));
         } else {
             closest.push_str(&format!("    if (t < best.t) {{\n        best = Hit(t, {i}u);\n    }}\n"));
-            occluded.push_str(&format!(
-                "    // {name}\n    if ({hit} < t_max) {{\n        return true;\n    }}\n"
-            ));
+            if can_block_light(gpu_scene, i) {
+                occluders.push(i);
+                occluded.push_str(&format!(
+                    "    // {name}\n    if ({hit} < t_max) {{\n        return true;\n    }}\n"
+                ));
+            } else {
+                occluded.push_str(&format!(
+                    "    // {name}: cannot block a light (specialise.rs, can_block_light)\n"
+                ));
+            }
         }
     }
+    // Every kind but the last gets a case; the last is the default (WGSL requires one).
+    let mut normal_cases = String::new();
+    let last_kind = kinds.iter().next_back().copied();
+    for kind in &kinds {
+        let call = match *kind {
+            "aabb" => "surface_aabb(obj, p)",
+            "box" => "surface_box(obj, p)",
+            "quad" => "surface_quad(obj, p)",
+            _ => "surface_sphere(obj, p)",
+        };
+        let constant = match *kind {
+            "aabb" => "KIND_AABB",
+            "box" => "KIND_BOX",
+            "quad" => "KIND_QUAD",
+            _ => "KIND_SPHERE",
+        };
+        if Some(*kind) == last_kind {
+            normal_cases.push_str(&format!("        default: {{ return {call}; }}\n"));
+        } else {
+            normal_cases.push_str(&format!("        case {constant}: {{ return {call}; }}\n"));
+        }
+    }
+    let choose_light = if gpu_scene.lights.len() == 1 {
+        "    // One light: nothing to choose.\n    return 0u;\n".to_owned()
+    } else {
+        let mut code = String::new();
+        for (i, light) in gpu_scene.lights.iter().enumerate().take(gpu_scene.lights.len() - 1) {
+            code.push_str(&format!(
+                "    if (pick < {}) {{\n        return {i}u;\n    }}\n",
+                lit(light.corner[3])
+            ));
+        }
+        code.push_str(&format!("    return {}u;\n", gpu_scene.lights.len() - 1));
+        code
+    };
     let source = format!(
         "#define_import_path illum::pathtrace::traversal
 
 // Generated by illum-pathtrace (specialise.rs) for scene {scene_name:?}: {count} objects, each
 // test unrolled with its numbers as constants. Emitters come last.
 
-#import illum::pathtrace::scene::{{Hit, FAR, NO_HIT, EMITTER_TIE, safe_inverse, hit_slabs, hit_box, hit_quad, hit_sphere}}
+#import illum::pathtrace::scene::{{Hit, Object, FAR, NO_HIT, EMITTER_TIE, KIND_AABB, KIND_BOX, KIND_QUAD, KIND_SPHERE, safe_inverse, hit_slabs, hit_box, hit_quad, hit_sphere, Surface, surface_aabb, surface_box, surface_quad, surface_sphere}}
 
 fn closest_hit(o: vec3<f32>, d: vec3<f32>) -> Hit {{
     let inv_d = safe_inverse(d);
@@ -91,14 +317,32 @@ fn closest_hit(o: vec3<f32>, d: vec3<f32>) -> Hit {{
 {closest}    return best;
 }}
 
-// True when a non-emitting object lies on the ray strictly between 0 and t_max.
+// True when an object that can block a light lies on the ray strictly between 0 and t_max.
 fn occluded(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> bool {{
     let inv_d = safe_inverse(d);
 {occluded}    return false;
 }}
+
+// Surfaces for the kinds of shape in this scene ({kind_list}).
+fn surface_at(obj: Object, p: vec3<f32>) -> Surface {{
+    switch obj.kind {{
+{normal_cases}    }}
+}}
+
+fn choose_light(pick: f32) -> u32 {{
+{choose_light}}}
 ",
         scene_name = scene.name,
         count = gpu_scene.objects.len(),
+        kind_list = kinds.iter().copied().collect::<Vec<_>>().join(", "),
     );
-    ShaderFile::generated(format!("generated traversal for scene {:?}", scene.name), source)
+    Specialisation { kinds, lights: gpu_scene.lights.len(), occluders, source }
+}
+
+/// The generated traversal as a shader module.
+pub fn traversal_module(scene: &Scene, gpu_scene: &GpuScene) -> ShaderFile {
+    ShaderFile::generated(
+        format!("generated traversal for scene {:?}", scene.name),
+        specialise(scene, gpu_scene).source,
+    )
 }

@@ -1,8 +1,10 @@
 //! The path tracer's GPU side: pipeline, buffers, and the submit-readback-fold loop.
 
+use std::collections::HashMap;
+use std::sync::{Mutex, OnceLock};
 use std::time::Instant;
 
-use illum_gpu::shader::{self, COMMON_MODULES, ShaderFile};
+use illum_gpu::shader::{self, COMMON_MODULES, Def, ShaderFile};
 use illum_gpu::shader_file;
 use illum_gpu::timing::PassTimer;
 use illum_gpu::{GpuContext, readback, wgpu};
@@ -31,6 +33,67 @@ pub enum Traversal {
     Generic,
 }
 
+/// Where a path's random sample values come from (see shaders/common/sampler.wgsl).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Sequence {
+    /// Independent uniform numbers from a PCG stream per (seed, pixel, sample index).
+    #[default]
+    Independent,
+    /// A randomly shifted Kronecker (R_d) low-discrepancy sequence for the first 16 dimensions.
+    LowDiscrepancy,
+}
+
+impl std::str::FromStr for Sequence {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "independent" => Ok(Self::Independent),
+            "low-discrepancy" => Ok(Self::LowDiscrepancy),
+            other => Err(format!("unknown sequence {other:?}; allowed: independent, low-discrepancy")),
+        }
+    }
+}
+
+impl std::fmt::Display for Sequence {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::Independent => "independent",
+            Self::LowDiscrepancy => "low-discrepancy",
+        })
+    }
+}
+
+/// Pipeline choices that do not change the expected image, only speed or noise.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct TracerOptions {
+    pub traversal: Traversal,
+    pub sequence: Sequence,
+}
+
+impl TracerOptions {
+    /// naga_oil shader defs for these options.
+    pub fn shader_defs(&self) -> Vec<(&'static str, Def)> {
+        match self.sequence {
+            Sequence::Independent => Vec::new(),
+            Sequence::LowDiscrepancy => vec![("LOW_DISCREPANCY", Def::Bool(true))],
+        }
+    }
+}
+
+/// Compiled pipelines by (device, traversal source, shader defs): two scenes with the same
+/// specialisation share one pipeline, so switching back to a scene does not recompile.
+type PipelineKey = (wgpu::Device, String, Vec<(&'static str, Def)>);
+
+fn pipeline_cache() -> &'static Mutex<HashMap<PipelineKey, wgpu::ComputePipeline>> {
+    static CACHE: OnceLock<Mutex<HashMap<PipelineKey, wgpu::ComputePipeline>>> = OnceLock::new();
+    CACHE.get_or_init(Mutex::default)
+}
+
+/// Number of pipelines compiled so far in this process (the cache's misses).
+pub fn pipelines_compiled() -> usize {
+    pipeline_cache().lock().unwrap_or_else(|p| p.into_inner()).len()
+}
+
 /// The shader modules, in import order, for `scene` with `traversal`.
 pub fn shader_modules(scene: &Scene, gpu_scene: &GpuScene, traversal: Traversal) -> Vec<ShaderFile> {
     let mut modules = COMMON_MODULES.to_vec();
@@ -42,8 +105,15 @@ pub fn shader_modules(scene: &Scene, gpu_scene: &GpuScene, traversal: Traversal)
     modules
 }
 
-/// Bytes per pixel of the batch buffers: vec4 sum plus vec4 sum of squares.
-pub const BYTES_PER_PIXEL: u64 = 32;
+/// Bytes of one slot of a batch buffer: a vec4 of f32 (the sum buffer and the sum-of-squares
+/// buffer each hold one per slot).
+pub const SLOT_BYTES: u64 = 16;
+/// Default samples per invocation (one chunk, one slot). An f32 sum of n positive terms is within
+/// (n - 1) u of the exact sum, relatively (u = 2^-24): with 16, 15 u < 1e-6, so every batch the
+/// CPU folds in f64 is within 1e-6 of the f64 fold of the very same samples. It also bounds one
+/// invocation's work: lavapipe silently ends an invocation's loops after 65535 iterations (in
+/// total), which a single invocation looping over thousands of samples used to hit, losing them.
+pub const CHUNK_SAMPLES: u32 = 16;
 const WORKGROUP: u32 = 8;
 const TIMED_PASS: &str = "pathtrace";
 
@@ -60,6 +130,13 @@ pub struct StepReport {
     pub pass_completed: bool,
 }
 
+struct BatchBuffers {
+    slots: u64,
+    sum: wgpu::Buffer,
+    sum_sq: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+}
+
 struct ActivePass {
     plan: PassPlan,
     sample_base: u32,
@@ -69,13 +146,26 @@ struct ActivePass {
 pub struct PathTracer {
     gpu: GpuContext,
     scene: Scene,
+    options: TracerOptions,
+    /// The traversal module's source: the specialisation this pipeline was built for.
+    traversal_source: String,
     base_params: GpuParams,
     pipeline: wgpu::ComputePipeline,
-    bind_group: wgpu::BindGroup,
     params_buffer: wgpu::Buffer,
-    sum_buffer: wgpu::Buffer,
-    sum_sq_buffer: wgpu::Buffer,
+    objects_buffer: wgpu::Buffer,
+    materials_buffer: wgpu::Buffer,
+    lights_buffer: wgpu::Buffer,
+    /// The batch buffers (sum, sum of squares) and the bind group that uses them; grown on demand
+    /// up to `max_slots`.
+    batch: Option<BatchBuffers>,
     staging: Option<wgpu::Buffer>,
+    /// Samples per invocation.
+    chunk_samples: u32,
+    /// Most slots one batch buffer may hold: the device's storage binding limit (or a lower cap
+    /// set by [`PathTracer::limit_batch_bytes`]) over [`SLOT_BYTES`].
+    max_slots: u64,
+    /// Most chunks one dispatch may carry (its z dimension).
+    max_chunks: u32,
     timer: PassTimer,
     planner: BatchPlanner,
     accumulator: Accumulator,
@@ -91,16 +181,20 @@ impl PathTracer {
     /// Validates `scene` against the device, compiles the (specialised) pipeline and allocates
     /// the buffers.
     pub fn new(gpu: &GpuContext, scene: &Scene) -> Result<Self, PathTraceError> {
-        Self::with_traversal(gpu, scene, Traversal::default())
+        Self::with_options(gpu, scene, TracerOptions::default())
     }
 
-    /// As [`Self::new`], choosing the traversal (the bench compares the two).
-    pub fn with_traversal(
+    /// As [`Self::new`], choosing the traversal and the sample sequence.
+    pub fn with_options(
         gpu: &GpuContext,
         scene: &Scene,
-        traversal: Traversal,
+        options: TracerOptions,
     ) -> Result<Self, PathTraceError> {
         let limits = gpu.device.limits();
+        // The batch buffers hold one band of rows at a time (the image is tiled into bands that
+        // fit one storage binding, see `fit`), so the storage limit applies to a band, not to the
+        // whole image: only the texture-size limit is checked against the full resolution here,
+        // and one row of one chunk must fit (below).
         scene.check_device_limits(
             &DeviceLimits {
                 max_texture_dimension_2d: limits.max_texture_dimension_2d,
@@ -108,24 +202,52 @@ impl PathTracer {
                     .max_storage_buffer_binding_size
                     .min(limits.max_buffer_size),
             },
-            BYTES_PER_PIXEL / 2,
+            0,
         )?;
+        let max_slots = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size) / SLOT_BYTES;
+        check_row_fits(scene, max_slots)?;
+        let accumulator = Accumulator::try_new(scene.camera.width, scene.camera.height).map_err(|bytes| {
+            PathTraceError::Unsupported {
+                scene: scene.name.clone(),
+                message: format!(
+                    "camera.width x camera.height = {} x {}: its f64 statistics need {:.1} GiB of host memory, \
+                     which could not be allocated",
+                    scene.camera.width,
+                    scene.camera.height,
+                    bytes as f64 / (1u64 << 30) as f64
+                ),
+            }
+        })?;
         let gpu_scene = GpuScene::new(scene)?;
         let base_params = gpu_scene::params(scene, &gpu_scene);
 
-        let modules = shader_modules(scene, &gpu_scene, traversal);
-        let module = shader::compose(&modules, &PATHTRACE_SHADER, &[])?;
-        let module = shader::create_module(gpu, module, &PATHTRACE_SHADER.path)?;
-        let pipeline = gpu.scoped("creating the path-tracing pipeline", || {
-            gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("pathtrace"),
-                layout: None,
-                module: &module,
-                entry_point: Some("main"),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        })?;
+        let modules = shader_modules(scene, &gpu_scene, options.traversal);
+        let defs = options.shader_defs();
+        let key: PipelineKey =
+            (gpu.device.clone(), modules.last().expect("traversal").source.to_string(), defs.clone());
+        let cached = pipeline_cache().lock().unwrap_or_else(|p| p.into_inner()).get(&key).cloned();
+        let pipeline = match cached {
+            Some(pipeline) => pipeline,
+            None => {
+                let module = shader::compose(&modules, &PATHTRACE_SHADER, &defs)?;
+                let module = shader::create_module(gpu, module, &PATHTRACE_SHADER.path)?;
+                let pipeline = gpu.scoped("creating the path-tracing pipeline", || {
+                    gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                        label: Some("pathtrace"),
+                        layout: None,
+                        module: &module,
+                        entry_point: Some("main"),
+                        compilation_options: Default::default(),
+                        cache: None,
+                    })
+                })?;
+                pipeline_cache()
+                    .lock()
+                    .unwrap_or_else(|p| p.into_inner())
+                    .insert(key.clone(), pipeline.clone());
+                pipeline
+            }
+        };
 
         let device = &gpu.device;
         let storage = |label: &str, contents: &[u8]| {
@@ -135,59 +257,40 @@ impl PathTracer {
                 usage: wgpu::BufferUsages::STORAGE,
             })
         };
-        let pixels = scene.camera.width as u64 * scene.camera.height as u64;
-        let (params_buffer, objects, materials, lights, sum_buffer, sum_sq_buffer) =
+        let (params_buffer, objects_buffer, materials_buffer, lights_buffer) =
             gpu.scoped("allocating path-tracer buffers", || {
                 let params_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some("pathtrace params"),
                     contents: bytemuck::bytes_of(&base_params),
                     usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                 });
-                let batch = |label: &str| {
-                    device.create_buffer(&wgpu::BufferDescriptor {
-                        label: Some(label),
-                        size: pixels * BYTES_PER_PIXEL / 2,
-                        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-                        mapped_at_creation: false,
-                    })
-                };
                 (
                     params_buffer,
                     storage("pathtrace objects", bytemuck::cast_slice(&gpu_scene.objects)),
                     storage("pathtrace materials", bytemuck::cast_slice(&gpu_scene.materials)),
                     storage("pathtrace lights", bytemuck::cast_slice(&gpu_scene.lights)),
-                    batch("pathtrace batch sum"),
-                    batch("pathtrace batch sum of squares"),
                 )
             })?;
-        let bind_group = gpu.scoped("binding path-tracer buffers", || {
-            device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("pathtrace"),
-                layout: &pipeline.get_bind_group_layout(0),
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: params_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: objects.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 2, resource: materials.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 3, resource: lights.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 4, resource: sum_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 5, resource: sum_sq_buffer.as_entire_binding() },
-                ],
-            })
-        })?;
 
         Ok(Self {
             gpu: gpu.clone(),
             scene: scene.clone(),
+            options,
+            traversal_source: key.1,
             base_params,
             pipeline,
-            bind_group,
             params_buffer,
-            sum_buffer,
-            sum_sq_buffer,
+            objects_buffer,
+            materials_buffer,
+            lights_buffer,
+            batch: None,
             staging: None,
+            chunk_samples: CHUNK_SAMPLES,
+            max_slots,
+            max_chunks: limits.max_compute_workgroups_per_dimension,
             timer: PassTimer::new(gpu, &[TIMED_PASS]),
             planner: BatchPlanner::new(DEFAULT_TARGET_SECONDS),
-            accumulator: Accumulator::new(scene.camera.width, scene.camera.height),
+            accumulator,
             pass: None,
             spp_done: 0,
             wall_seconds: 0.0,
@@ -223,6 +326,66 @@ impl PathTracer {
         self.planner = BatchPlanner::new(seconds);
     }
 
+    /// Takes a new camera and render settings (spp, bounces, seed, sampling) without rebuilding
+    /// the pipeline, and restarts the accumulation. The geometry and materials must be the ones
+    /// the pipeline was built for: a scene that differs in them (another specialisation, or
+    /// other object data) is refused with an error naming what changed; build a new
+    /// `PathTracer` for it. The resolution may change (the buffers are reallocated).
+    pub fn update_scene(&mut self, scene: &Scene) -> Result<(), PathTraceError> {
+        if scene.objects != self.scene.objects || scene.materials != self.scene.materials {
+            let gpu_scene = GpuScene::new(scene)?;
+            let needed = specialise::specialise(scene, &gpu_scene);
+            let what = if self.options.traversal == Traversal::Specialised
+                && needed.source != self.traversal_source
+            {
+                format!(
+                    "its geometry needs a pipeline specialised for shapes {:?}, {} light(s) and shadow-ray occluders {:?}",
+                    needed.kinds, needed.lights, needed.occluders
+                )
+            } else {
+                "its objects or materials differ from the uploaded ones".to_owned()
+            };
+            return Err(PathTraceError::Unsupported {
+                scene: scene.name.clone(),
+                message: format!(
+                    "this path tracer was built for scene {:?} and cannot render it: {what}; create a new PathTracer",
+                    self.scene.name
+                ),
+            });
+        }
+        let resized =
+            (scene.camera.width, scene.camera.height) != (self.scene.camera.width, self.scene.camera.height);
+        if resized {
+            *self = Self::with_options(&self.gpu, scene, self.options)?;
+            return Ok(());
+        }
+        let gpu_scene = GpuScene::new(scene)?;
+        self.base_params = gpu_scene::params(scene, &gpu_scene);
+        self.scene = scene.clone();
+        self.reset();
+        Ok(())
+    }
+
+    /// Sets the samples per invocation (default [`CHUNK_SAMPLES`]; values below 1 count as 1),
+    /// from the next pass on. With 1 every sample reaches the f64 fold as its own f32 value, which
+    /// makes the result the exact f64 fold of the samples (tests use it as the reference); larger
+    /// chunks round each chunk's f32 sum by up to (n - 1) x 2^-24 relative.
+    pub fn set_chunk_samples(&mut self, samples: u32) {
+        self.chunk_samples = samples.max(1);
+    }
+
+    /// Caps each batch buffer at `bytes` (at most the device's storage binding limit, which is the
+    /// default; at least one row of one chunk), from the next pass on. The image is then rendered
+    /// in bands of rows that fit; tests use it to force that tiling on small images.
+    pub fn limit_batch_bytes(&mut self, bytes: u64) -> Result<(), PathTraceError> {
+        let limits = self.gpu.device.limits();
+        let device_slots = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size) / SLOT_BYTES;
+        let slots = (bytes / SLOT_BYTES).min(device_slots);
+        check_row_fits(&self.scene, slots)?;
+        self.max_slots = slots;
+        Ok(())
+    }
+
     /// Discards everything accumulated; the next step starts again at sample 0.
     pub fn reset(&mut self) {
         self.accumulator.reset();
@@ -242,7 +405,7 @@ impl PathTracer {
                 Some(t) => t - self.spp_done,
                 None => u32::MAX - self.spp_done,
             };
-            let plan = self.planner.plan(camera.width, camera.height, remaining);
+            let plan = self.fit(self.planner.plan(camera.width, camera.height, remaining));
             self.pass = Some(ActivePass { plan, sample_base: self.spp_done, next_row: 0 });
         }
         let report = self.submit_band()?;
@@ -250,20 +413,41 @@ impl PathTracer {
         Ok(report)
     }
 
-    /// Renders exactly `spp` more samples per pixel as one pass (split into bands only if the
-    /// image is too large for one short submission). Tests use it to control batching.
+    /// Renders exactly `spp` more samples per pixel, as one pass when the device allows (split
+    /// into bands only if the image is too large for one short submission or one storage binding,
+    /// and into several passes only if one dispatch cannot carry `spp` chunks). Tests use it to
+    /// control batching.
     pub fn render_pass(&mut self, spp: u32) -> Result<(), PathTraceError> {
         assert!(self.pass.is_none(), "render_pass called in the middle of a pass");
         let camera = self.scene.camera;
-        let planned = self.planner.plan(camera.width, camera.height, spp);
-        let rows = if planned.spp >= spp { camera.height } else { planned.rows.max(1) };
-        self.pass =
-            Some(ActivePass { plan: PassPlan { spp, rows }, sample_base: self.spp_done, next_row: 0 });
-        while self.pass.is_some() {
-            let report = self.submit_band()?;
-            self.planner.record(report.samples, report.wall_seconds);
+        let mut remaining = spp;
+        while remaining > 0 {
+            let planned = self.planner.plan(camera.width, camera.height, remaining);
+            let rows = if planned.spp >= remaining { camera.height } else { planned.rows.max(1) };
+            let plan = self.fit(PassPlan { spp: remaining, rows });
+            self.pass = Some(ActivePass { plan, sample_base: self.spp_done, next_row: 0 });
+            while self.pass.is_some() {
+                let report = self.submit_band()?;
+                self.planner.record(report.samples, report.wall_seconds);
+            }
+            remaining -= plan.spp;
         }
         Ok(())
+    }
+
+    /// Shrinks a pass plan to what the device can take: at most `max_chunks` chunks per dispatch
+    /// (the z dimension), and a band of at most `max_slots` slots (rows x width x chunks) per
+    /// batch buffer, so an image of any size is rendered band by band.
+    fn fit(&self, plan: PassPlan) -> PassPlan {
+        let width = u64::from(self.scene.camera.width);
+        let chunk = u64::from(self.chunk_samples);
+        // check_row_fits guarantees max_slots >= width, so at least one chunk fits.
+        let max_chunks = u64::from(self.max_chunks).min(self.max_slots / width).max(1);
+        let spp = u64::from(plan.spp.max(1)).min(max_chunks * chunk);
+        let chunks = spp.div_ceil(chunk);
+        let max_rows = (self.max_slots / (width * chunks)).max(1);
+        let rows = u64::from(plan.rows).clamp(1, max_rows);
+        PassPlan { spp: spp as u32, rows: rows as u32 }
     }
 
     /// Steps until every pixel has `spp` samples.
@@ -271,6 +455,47 @@ impl PathTracer {
         while self.spp_done < spp {
             self.step(Some(spp))?;
         }
+        Ok(())
+    }
+
+    /// Makes sure the batch buffers hold at least `slots` slots (growing them, within
+    /// `max_slots`, and rebinding).
+    fn ensure_batch_capacity(&mut self, slots: u64) -> Result<(), PathTraceError> {
+        if self.batch.as_ref().is_some_and(|b| b.slots >= slots) {
+            return Ok(());
+        }
+        // Grow geometrically (within max_slots) so that passes of slowly rising spp do not
+        // reallocate every time; never below what this band needs (a pass planned before a
+        // lower cap was set still needs its own size).
+        let doubled = self.batch.as_ref().map_or(0, |b| 2 * b.slots).min(self.max_slots);
+        let slots = slots.max(doubled);
+        let device = &self.gpu.device;
+        let batch = self.gpu.scoped("allocating path-tracer batch buffers", || {
+            let buffer = |label: &str| {
+                device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(label),
+                    size: slots * SLOT_BYTES,
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                    mapped_at_creation: false,
+                })
+            };
+            let sum = buffer("pathtrace batch sum");
+            let sum_sq = buffer("pathtrace batch sum of squares");
+            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("pathtrace"),
+                layout: &self.pipeline.get_bind_group_layout(0),
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: self.params_buffer.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: self.objects_buffer.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 2, resource: self.materials_buffer.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 3, resource: self.lights_buffer.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 4, resource: sum.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 5, resource: sum_sq.as_entire_binding() },
+                ],
+            });
+            BatchBuffers { slots, sum, sum_sq, bind_group }
+        })?;
+        self.batch = Some(batch);
         Ok(())
     }
 
@@ -282,17 +507,23 @@ impl PathTracer {
         let row_offset = pass.next_row;
         let rows = pass.plan.rows.min(height - row_offset);
         let spp = pass.plan.spp;
+        let sample_base = pass.sample_base;
+        let chunk = self.chunk_samples;
+        let chunks = spp.div_ceil(chunk);
+        let band_pixels = rows as usize * width as usize;
+        let slots = band_pixels as u64 * u64::from(chunks);
+        self.ensure_batch_capacity(slots)?;
 
         let mut params = self.base_params;
         params.row_offset = row_offset;
         params.rows = rows;
-        params.sample_base = pass.sample_base;
+        params.sample_base = sample_base;
         params.sample_count = spp;
+        params.chunk_samples = chunk;
         self.gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&params));
 
-        let band_bytes = rows as u64 * width as u64 * BYTES_PER_PIXEL / 2;
-        let band_offset = row_offset as u64 * width as u64 * BYTES_PER_PIXEL / 2;
-        let staging_size = 2 * band_bytes + self.timer.result_size();
+        let bytes = slots * SLOT_BYTES;
+        let staging_size = 2 * bytes + self.timer.result_size();
         if self.staging.as_ref().is_none_or(|s| s.size() < staging_size) {
             self.staging = Some(self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("pathtrace staging"),
@@ -302,6 +533,7 @@ impl PathTracer {
             }));
         }
         let staging = self.staging.as_ref().expect("allocated above");
+        let batch = self.batch.as_ref().expect("allocated above");
 
         let mut encoder = self
             .gpu
@@ -313,17 +545,17 @@ impl PathTracer {
                 timestamp_writes: self.timer.compute_writes(TIMED_PASS),
             });
             compute.set_pipeline(&self.pipeline);
-            compute.set_bind_group(0, &self.bind_group, &[]);
-            compute.dispatch_workgroups(width.div_ceil(WORKGROUP), rows.div_ceil(WORKGROUP), 1);
+            compute.set_bind_group(0, &batch.bind_group, &[]);
+            compute.dispatch_workgroups(width.div_ceil(WORKGROUP), rows.div_ceil(WORKGROUP), chunks);
         }
-        encoder.copy_buffer_to_buffer(&self.sum_buffer, band_offset, staging, 0, band_bytes);
-        encoder.copy_buffer_to_buffer(&self.sum_sq_buffer, band_offset, staging, band_bytes, band_bytes);
-        self.timer.copy_results(&mut encoder, staging, 2 * band_bytes);
+        encoder.copy_buffer_to_buffer(&batch.sum, 0, staging, 0, bytes);
+        encoder.copy_buffer_to_buffer(&batch.sum_sq, 0, staging, bytes, bytes);
+        self.timer.copy_results(&mut encoder, staging, 2 * bytes);
         self.gpu.queue.submit([encoder.finish()]);
 
-        let bytes =
+        let data =
             readback::read_mapped(&self.gpu, staging, staging_size, "reading back a path-tracing batch")?;
-        let floats: Vec<[f32; 4]> = bytes[..(2 * band_bytes) as usize]
+        let floats: Vec<[f32; 4]> = data[..(2 * bytes) as usize]
             .chunks_exact(16)
             .map(|c| {
                 let f = |i: usize| f32::from_le_bytes(c[4 * i..4 * i + 4].try_into().expect("4 bytes"));
@@ -331,9 +563,27 @@ impl PathTracer {
             })
             .collect();
         let (sums, sums_sq) = floats.split_at(floats.len() / 2);
-        self.accumulator.fold(row_offset as usize * width as usize, sums, sums_sq);
-        let gpu_seconds =
-            self.timer.decode(&bytes[(2 * band_bytes) as usize..]).map(|timings| timings[0].1 * 1e-3);
+        // Every slot must account for all of its chunk's samples (finite + dropped). A shortfall
+        // means the driver ended the invocation early; its statistics would silently be short.
+        for k in 0..chunks {
+            let expected = chunk.min(spp - k * chunk);
+            let range = k as usize * band_pixels..(k as usize + 1) * band_pixels;
+            for (s, q) in sums[range.clone()].iter().zip(&sums_sq[range]) {
+                let found = s[3] as u64 + q[3] as u64;
+                if found != u64::from(expected) {
+                    return Err(PathTraceError::IncompleteBatch { expected, found });
+                }
+            }
+        }
+        for k in 0..chunks as usize {
+            let range = k * band_pixels..(k + 1) * band_pixels;
+            self.accumulator.fold(
+                row_offset as usize * width as usize,
+                &sums[range.clone()],
+                &sums_sq[range],
+            );
+        }
+        let gpu_seconds = self.timer.decode(&data[(2 * bytes) as usize..]).map(|timings| timings[0].1 * 1e-3);
 
         let pass = self.pass.as_mut().expect("still active");
         pass.next_row += rows;
@@ -351,5 +601,53 @@ impl PathTracer {
             gpu_seconds,
             pass_completed,
         })
+    }
+}
+
+/// One row of one chunk is the smallest band; it must fit in one batch buffer.
+fn check_row_fits(scene: &Scene, max_slots: u64) -> Result<(), PathTraceError> {
+    let width = u64::from(scene.camera.width);
+    if width > max_slots {
+        return Err(PathTraceError::Unsupported {
+            scene: scene.name.clone(),
+            message: format!(
+                "camera.width = {width}: one row needs {} bytes per batch buffer, more than the {} \
+                 bytes allowed (the device's max_storage_buffer_binding_size, or a lower cap)",
+                width * SLOT_BYTES,
+                max_slots * SLOT_BYTES
+            ),
+        });
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    /// The WGSL constant LD_INV_PHI is 1/phi_16, phi_16 the positive root of x^17 = x + 1
+    /// (Roberts' generalised golden ratio), and its powers are the R_16 sequence's alphas.
+    #[test]
+    fn ld_alpha_matches_roberts_definition() {
+        let source = include_str!("../../../shaders/common/sampler.wgsl");
+        let constant: f64 = source
+            .split("const LD_INV_PHI: f32 = ")
+            .nth(1)
+            .and_then(|rest| rest.split(';').next())
+            .expect("LD_INV_PHI present")
+            .parse()
+            .expect("a number");
+        // Fixed-point iteration x <- (1 + x)^(1/17) converges to phi_16.
+        let mut phi = 2.0f64;
+        for _ in 0..200 {
+            phi = (1.0 + phi).powf(1.0 / 17.0);
+        }
+        assert!((phi.powi(17) - phi - 1.0).abs() < 1e-12);
+        assert!(((constant as f32) as f64 - 1.0 / phi).abs() < 1e-7, "{constant} vs {}", 1.0 / phi);
+        // The shader's f32 recurrence stays within 1e-6 of (1/phi)^(j+1) over the 16 dimensions.
+        let mut alpha = constant as f32;
+        for j in 0..16 {
+            let exact = (1.0 / phi).powi(j + 1);
+            assert!((alpha as f64 - exact).abs() < 1e-6, "alpha_{j}: {alpha} vs {exact}");
+            alpha *= constant as f32;
+        }
     }
 }

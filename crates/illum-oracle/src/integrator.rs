@@ -1,0 +1,218 @@
+//! The path estimator, written from the rendering equation for Lambertian surfaces.
+//!
+//! At a diffuse point x with albedo rho and normal n (turned to face the arriving ray),
+//!     L(x) = int_lights rho/pi Le cos_x cos_y / |x - y|^2 V(x, y) dA_y
+//!          + int_hemisphere rho/pi L_indirect(x, w) cos(w) dw.
+//! The first integral is estimated with one point y uniform on the union of the emitting
+//! parallelograms (pdf 1 / A_total): rho/pi Le cos_x cos_y / r^2 A_total, zero when y is behind x,
+//! x is behind the (one-sided) light, or a non-emitting surface blocks the segment. The second
+//! is estimated by one direction w drawn from the hemisphere (cosine: weight rho; uniform:
+//! weight 2 rho cos) and recursion at the next surface. Because emitted light was already
+//! counted by the light integral, a continuation ray that reaches an emitter (or nothing) ends
+//! the path with nothing added; only the camera ray itself may see an emitter directly.
+//!
+//! Path length: `Bounces::Fixed(n)` allows n continuation rays (0 = direct light only).
+//! `Bounces::Unbounded` continues forever in principle; from the fourth continuation on, a
+//! path survives each step with probability q (the largest channel of throughput x albedo, at
+//! most 0.95) and its throughput is divided by q, which keeps the expectation unchanged
+//! (Russian roulette).
+
+use std::f64::consts::FRAC_1_PI;
+
+use glam::DVec3;
+use illum_scene::{Bounces, Sampling, Scene};
+
+use crate::camera::PinholeCamera;
+use crate::rng::Rng;
+use crate::sampling::{cosine_hemisphere, local_to_world, uniform_hemisphere};
+use crate::scene::{Primitive, TraceScene};
+
+/// Relative distance by which an emitter may lie behind the nearest other surface and still
+/// be the one that is hit: lights set into a coplanar ceiling win the tie.
+const EMITTER_TIE: f64 = 1e-9;
+/// A new ray starts this far (relative to the point's largest coordinate, at least 1e-9) off
+/// the surface along the facing normal. f64 hit points carry errors ~1e-16 |p|.
+const SPAWN_OFFSET: f64 = 1e-9;
+/// Shadow rays end this fraction short of the light point, so the light's own plane (and a
+/// surface coplanar with it) does not shadow it.
+const SHADOW_SHORTEN: f64 = 1e-8;
+/// Continuation rays taken without Russian roulette in unbounded mode.
+const ROULETTE_AFTER: u32 = 3;
+const ROULETTE_MAX_SURVIVAL: f64 = 0.95;
+/// A safety limit for unbounded paths; reaching it has probability below 0.95^100000.
+const UNBOUNDED_LIMIT: u32 = 100_000;
+
+/// What a ray hit: the primitive, distance and geometric normal.
+#[derive(Clone, Copy, Debug)]
+struct Hit<'a> {
+    primitive: &'a Primitive,
+    t: f64,
+    normal: DVec3,
+}
+
+/// Nearest hit with t in (0, inf) among `list`.
+fn nearest_in(list: &[Primitive], o: DVec3, d: DVec3) -> Option<Hit<'_>> {
+    let mut best: Option<Hit<'_>> = None;
+    for primitive in list {
+        let limit = best.map_or(f64::INFINITY, |h| h.t);
+        if let Some(h) = primitive.surface.intersect(o, d, limit) {
+            best = Some(Hit { primitive, t: h.t, normal: h.normal });
+        }
+    }
+    best
+}
+
+/// A scene prepared for tracing with the settings of one estimate.
+#[derive(Clone, Debug)]
+pub struct Oracle {
+    scene: TraceScene,
+    pub camera: PinholeCamera,
+    pub bounces: Bounces,
+    pub sampling: Sampling,
+}
+
+impl Oracle {
+    /// Prepares `scene` with its own render settings (`scene.render.bounces` and `.sampling`).
+    pub fn new(scene: &Scene) -> Oracle {
+        Oracle {
+            scene: TraceScene::new(scene),
+            camera: PinholeCamera::new(&scene.camera),
+            bounces: scene.render.bounces,
+            sampling: scene.render.sampling,
+        }
+    }
+
+    pub fn with_bounces(mut self, bounces: Bounces) -> Oracle {
+        self.bounces = bounces;
+        self
+    }
+
+    pub fn with_sampling(mut self, sampling: Sampling) -> Oracle {
+        self.sampling = sampling;
+        self
+    }
+
+    /// Total area of the emitting parallelograms.
+    pub fn light_area(&self) -> f64 {
+        self.scene.light_area
+    }
+
+    /// Nearest hit along o + t d (d unit) with t in (0, inf); an emitter wins a tie with a
+    /// surface up to the relative distance EMITTER_TIE behind it.
+    fn closest_hit(&self, o: DVec3, d: DVec3) -> Option<Hit<'_>> {
+        let surface = nearest_in(&self.scene.surfaces, o, d);
+        let emitter = nearest_in(&self.scene.emitters, o, d);
+        match (surface, emitter) {
+            (Some(s), Some(e)) => Some(if e.t <= s.t * (1.0 + EMITTER_TIE) { e } else { s }),
+            (s, e) => s.or(e),
+        }
+    }
+
+    /// True when a non-emitting surface crosses o + t d for some t in (0, t_max).
+    fn blocked(&self, o: DVec3, d: DVec3, t_max: f64) -> bool {
+        self.scene.surfaces.iter().any(|p| p.surface.intersect(o, d, t_max).is_some())
+    }
+
+    /// One-sample estimate of the light arriving at x (already offset off the surface) with
+    /// facing normal n, weighted by cos_x: Le cos_x cos_y / r^2 A_total, or zero.
+    fn light_sample(&self, x: DVec3, n: DVec3, rng: &mut Rng) -> DVec3 {
+        let lights = &self.scene.lights;
+        if lights.is_empty() {
+            return DVec3::ZERO;
+        }
+        let (s, r) = (rng.uniform(), rng.uniform());
+        let pick = rng.uniform() * self.scene.light_area;
+        let index = lights.partition_point(|l| l.cumulative_area <= pick).min(lights.len() - 1);
+        let light = &lights[index];
+        let y = light.shape.point(s, r);
+        let to_light = y - x;
+        let dist_sq = to_light.length_squared();
+        let dist = dist_sq.sqrt();
+        let w = to_light / dist;
+        let cos_x = n.dot(w);
+        let cos_y = -light.shape.normal.dot(w);
+        if !(cos_x > 0.0 && cos_y > 0.0) || self.blocked(x, w, dist * (1.0 - SHADOW_SHORTEN)) {
+            return DVec3::ZERO;
+        }
+        light.emission * (cos_x * cos_y / dist_sq * self.scene.light_area)
+    }
+
+    /// Whether the path may take continuation ray number `taken + 1`, given `taken` so far.
+    fn may_continue(&self, taken: u32) -> bool {
+        match self.bounces {
+            Bounces::Fixed(n) => taken < n,
+            Bounces::Unbounded => taken < UNBOUNDED_LIMIT,
+        }
+    }
+
+    /// One sample of the radiance arriving at `origin` from direction -`dir` (the quantity a
+    /// camera ray from `origin` along `dir` measures). `dir` need not be normalised.
+    pub fn radiance(&self, origin: DVec3, dir: DVec3, rng: &mut Rng) -> DVec3 {
+        let mut d = dir.normalize();
+        let Some(mut hit) = self.closest_hit(origin, d) else {
+            return DVec3::ZERO;
+        };
+        if hit.primitive.emitter {
+            // One-sided: only the front (normal against the ray) emits.
+            return if hit.normal.dot(d) < 0.0 { hit.primitive.emission } else { DVec3::ZERO };
+        }
+        let mut o = origin;
+        let mut sum = DVec3::ZERO;
+        let mut throughput = DVec3::ONE;
+        let mut taken = 0u32;
+        loop {
+            let x = o + hit.t * d;
+            let n = if hit.normal.dot(d) > 0.0 { -hit.normal } else { hit.normal };
+            let albedo = hit.primitive.albedo;
+            let x_off = x + n * (SPAWN_OFFSET * x.abs().max_element().max(1.0));
+            sum += throughput * albedo * FRAC_1_PI * self.light_sample(x_off, n, rng);
+
+            if !self.may_continue(taken) {
+                break;
+            }
+            if self.bounces == Bounces::Unbounded && taken >= ROULETTE_AFTER {
+                let q = (throughput * albedo).max_element().min(ROULETTE_MAX_SURVIVAL);
+                let survives = q > 0.0 && rng.uniform() < q;
+                if !survives {
+                    break;
+                }
+                throughput /= q;
+            }
+            let (u1, u2) = (rng.uniform(), rng.uniform());
+            let local = match self.sampling {
+                Sampling::Cosine => {
+                    // (rho/pi) cos / (cos/pi) = rho
+                    throughput *= albedo;
+                    cosine_hemisphere(u1, u2)
+                }
+                Sampling::Uniform => {
+                    let local = uniform_hemisphere(u1, u2);
+                    // (rho/pi) cos / (1/(2 pi)) = 2 rho cos
+                    throughput *= albedo * (2.0 * local.z);
+                    local
+                }
+            };
+            // Nothing more can be added once every channel is zero (or not a number).
+            if !throughput.cmpgt(DVec3::ZERO).any() {
+                break;
+            }
+            d = local_to_world(n, local).normalize();
+            o = x_off;
+            match self.closest_hit(o, d) {
+                Some(next) if !next.primitive.emitter => hit = next,
+                _ => break,
+            }
+            taken += 1;
+        }
+        sum
+    }
+
+    /// Sample `sample` of pixel (x, y) under `seed`: jittered camera ray, then [`Self::radiance`].
+    pub fn pixel_sample(&self, x: u32, y: u32, seed: u64, sample: u32) -> DVec3 {
+        let pixel = u64::from(y) * u64::from(self.camera.width) + u64::from(x);
+        let mut rng = Rng::for_sample(seed, pixel, u64::from(sample));
+        let (jx, jy) = (rng.uniform(), rng.uniform());
+        let d = self.camera.direction(x, y, jx, jy);
+        self.radiance(self.camera.eye, d, &mut rng)
+    }
+}

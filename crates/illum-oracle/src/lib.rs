@@ -1,0 +1,65 @@
+//! illum-oracle: an independent, scalar CPU reference for the Cornell box path tracer, in f64.
+//!
+//! It estimates the same per-pixel quantity as the GPU path tracer (`shaders/pathtrace/`) —
+//! equal in expectation, not sample for sample — from its own mathematics and its own random
+//! numbers, so that tests and the convergence tool can compare the two statistically. It is
+//! slow and simple on purpose: no acceleration structure, no SIMD, one ray at a time.
+//!
+//! What is estimated (see `integrator.rs` for the derivation):
+//! - pinhole camera, rays jittered uniformly inside each pixel (`camera.rs`);
+//! - boxes (rotated about +Y), parallelograms and spheres, all Lambertian and two-sided;
+//! - emitting parallelograms, one-sided (front = edge_u x edge_v), seen directly only by camera
+//!   rays, winning ties against a coplanar surface; black background;
+//! - next-event estimation at every diffuse hit with a point uniform on the union of the lights
+//!   by area; `Bounces::Fixed(n)` continuation rays or unbounded with Russian roulette; cosine
+//!   or uniform hemisphere sampling (`Sampling`).
+//!
+//! Random numbers: SplitMix64 (`rng.rs`) keyed by (seed, pixel, sample), so results do not
+//! depend on threading or on how samples are grouped.
+//!
+//! ```
+//! let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/cornell.toml");
+//! let mut scene = illum_scene::Scene::load(std::path::Path::new(path)).unwrap();
+//! scene.camera.width = 4;
+//! scene.camera.height = 4;
+//! let image = illum_oracle::render(&scene, 2, 0);
+//! assert_eq!(image.mean.len(), 16);
+//! ```
+
+mod camera;
+mod geometry;
+mod integrator;
+mod render;
+mod rng;
+mod sampling;
+mod scene;
+
+pub use camera::PinholeCamera;
+pub use integrator::Oracle;
+pub use render::{OracleImage, PixelEstimate};
+pub use rng::Rng;
+
+use illum_scene::Scene;
+
+/// Renders `scene` at its camera's resolution with `spp` samples per pixel under `seed`, using
+/// `scene.render.bounces` and `scene.render.sampling`, on all available cores.
+///
+/// # Panics
+/// If `spp` is 0.
+pub fn render(scene: &Scene, spp: u32, seed: u64) -> OracleImage {
+    Oracle::new(scene).render(spp, seed, default_threads())
+}
+
+/// The estimate of one pixel: exactly the value [`render`] produces for it with the same
+/// `spp` and `seed`.
+///
+/// # Panics
+/// If `spp` is 0.
+pub fn radiance_at_pixel(scene: &Scene, x: u32, y: u32, spp: u32, seed: u64) -> PixelEstimate {
+    Oracle::new(scene).pixel(x, y, spp, seed)
+}
+
+/// The number of threads [`render`] uses: `std::thread::available_parallelism`, or 1.
+pub fn default_threads() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}

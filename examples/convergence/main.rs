@@ -1,0 +1,410 @@
+//! The speed/accuracy trade, measured: error against time and samples per pixel.
+//!
+//! ```text
+//! cargo run --release --example convergence -- [SCENE] [--width W --height H] [--bounces B]
+//!     [--spp 1,2,4,...,4096] [--time-budgets 0.5,1,2] [--reference FILE.exr]
+//!     [--reference-factor 64] [--bounces-spp 1024] [--out DIR]
+//! ```
+//! For each option (cosine or uniform hemisphere sampling; independent or low-discrepancy
+//! numbers) and each spp count or time budget it records: spp, wall time, samples/s, RMSE,
+//! relMSE and mean-luminance bias against a reference, the relMSE *estimated without the
+//! reference* from the per-pixel variance, and efficiency 1 / (relMSE x time).
+//!
+//! The reference is the given EXR, or a render with `reference-factor` times the largest spp
+//! (default 64x), made once and kept in the output folder for later runs. A second table gives
+//! the mean radiance per bounce count (0 to 8 and unbounded): how the series converges.
+//!
+//! Outputs in DIR: convergence.csv, convergence.md, bounces.csv, and the plots
+//! error-vs-time-sampling.png, error-vs-time-sequence.png, error-vs-spp.png, bounces.png.
+
+mod plot;
+
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+use std::time::Duration;
+
+use anyhow::{Context, bail};
+use clap::Parser;
+use illum::cli::{self, SceneArgs};
+use illum::gpu::GpuContext;
+use illum::image::{ExrMetadata, RgbImage32, load_exr, mean_luminance_bias, rel_mse, rmse, save_exr};
+use illum::pathtrace::{PathTracer, Sequence, StopRules, TracerOptions, render_progressive};
+use illum::scene::{Bounces, Sampling, Scene};
+use plot::Line;
+
+#[derive(Parser, Debug)]
+#[command(about = "Measure error against time and spp for the path tracer's options")]
+struct Args {
+    #[arg(default_value = cli::DEFAULT_SCENE)]
+    scene: PathBuf,
+    #[command(flatten)]
+    settings: SceneArgs,
+    /// Samples per pixel at which to record a row (comma-separated).
+    #[arg(
+        long = "spp-list",
+        value_delimiter = ',',
+        default_value = "1,2,4,8,16,32,64,128,256,512,1024,2048,4096"
+    )]
+    spp_list: Vec<u32>,
+    /// Time budgets in seconds at which to record a row (comma-separated).
+    #[arg(long, value_delimiter = ',')]
+    time_budgets: Vec<f64>,
+    /// A reference EXR (linear, same size); by default one is rendered and cached.
+    #[arg(long)]
+    reference: Option<PathBuf>,
+    /// The rendered reference has this many times the largest spp.
+    #[arg(long, default_value_t = 64)]
+    reference_factor: u32,
+    /// Samples per pixel for the bounce-count table (0 skips it).
+    #[arg(long, default_value_t = 1024)]
+    bounces_spp: u32,
+    #[arg(long, default_value = "out/convergence")]
+    out: PathBuf,
+}
+
+/// One option of the comparison.
+#[derive(Clone, Copy)]
+struct Variant {
+    name: &'static str,
+    sampling: Sampling,
+    sequence: Sequence,
+}
+
+const VARIANTS: [Variant; 3] = [
+    Variant { name: "cosine, independent", sampling: Sampling::Cosine, sequence: Sequence::Independent },
+    Variant { name: "uniform, independent", sampling: Sampling::Uniform, sequence: Sequence::Independent },
+    Variant {
+        name: "cosine, low-discrepancy",
+        sampling: Sampling::Cosine,
+        sequence: Sequence::LowDiscrepancy,
+    },
+];
+
+struct Row {
+    variant: &'static str,
+    spp: u64,
+    seconds: f64,
+    samples_per_second: f64,
+    rmse: f64,
+    rel_mse: f64,
+    bias: f64,
+    estimated_rel_mse: f64,
+}
+
+impl Row {
+    fn efficiency(&self) -> f64 {
+        1.0 / (self.rel_mse * self.seconds)
+    }
+}
+
+fn main() {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    if let Err(error) = run(Args::parse()) {
+        eprintln!("error: {error:#}");
+        std::process::exit(1);
+    }
+}
+
+fn run(mut args: Args) -> anyhow::Result<()> {
+    args.settings.width.get_or_insert(64);
+    args.settings.height.get_or_insert(64);
+    if args.spp_list.is_empty() || args.spp_list.contains(&0) {
+        bail!("--spp-list = {:?}: give one or more counts, each at least 1", args.spp_list);
+    }
+    args.spp_list.sort_unstable();
+    args.spp_list.dedup();
+    if let Some(bad) = args.time_budgets.iter().find(|t| !(t.is_finite() && **t > 0.0)) {
+        bail!("--time-budgets: {bad} is not a positive number of seconds");
+    }
+    if args.reference_factor < 1 {
+        bail!("--reference-factor = 0: must be at least 1");
+    }
+    let scene = cli::load_scene(&args.scene, &args.settings)?;
+    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
+    let gpu = cli::gpu()?;
+    let max_spp = *args.spp_list.last().expect("checked non-empty");
+    let reference = reference_image(&gpu, &scene, &args, max_spp)?;
+    println!(
+        "scene {} at {}x{}, bounces {}; reference mean luminance {:.5}",
+        scene.name,
+        scene.camera.width,
+        scene.camera.height,
+        scene.render.bounces,
+        reference.mean_luminance()
+    );
+
+    let mut rows = Vec::new();
+    for variant in VARIANTS {
+        let mut variant_scene = scene.clone();
+        variant_scene.render.sampling = variant.sampling;
+        let options = TracerOptions { sequence: variant.sequence, ..Default::default() };
+        let mut tracer = PathTracer::with_options(&gpu, &variant_scene, options)?;
+        // The driver compiles a pipeline on its first dispatch: keep that out of the timings.
+        tracer.render(1)?;
+        tracer.reset();
+        for &spp in &args.spp_list {
+            tracer.render(spp)?;
+            rows.push(measure(variant.name, &tracer, &reference)?);
+            print_row(rows.last().expect("just pushed"));
+        }
+        for &budget in &args.time_budgets {
+            let mut tracer = PathTracer::with_options(&gpu, &variant_scene, options)?;
+            tracer.render(1)?;
+            tracer.reset();
+            let rules =
+                StopRules { time_budget: Some(Duration::from_secs_f64(budget)), ..Default::default() };
+            render_progressive(&mut tracer, &rules, &AtomicBool::new(false), |_| {})?;
+            rows.push(measure(variant.name, &tracer, &reference)?);
+            print_row(rows.last().expect("just pushed"));
+        }
+    }
+    write_tables(&args.out, &rows)?;
+    plot_rows(&args.out, &rows)?;
+    if args.bounces_spp > 0 {
+        bounce_table(&gpu, &scene, args.bounces_spp, &args.out)?;
+    }
+    println!("wrote {}", args.out.display());
+    Ok(())
+}
+
+/// Loads the user's reference, or renders one (and caches it, keyed by the settings).
+fn reference_image(gpu: &GpuContext, scene: &Scene, args: &Args, max_spp: u32) -> anyhow::Result<RgbImage32> {
+    if let Some(path) = &args.reference {
+        let (image, _) = load_exr(path)?;
+        if (image.width, image.height) != (scene.camera.width, scene.camera.height) {
+            bail!(
+                "reference {} is {}x{} but the render is {}x{}: give --width/--height to match",
+                path.display(),
+                image.width,
+                image.height,
+                scene.camera.width,
+                scene.camera.height
+            );
+        }
+        return Ok(image);
+    }
+    let spp = max_spp.saturating_mul(args.reference_factor);
+    let path = args.out.join(format!(
+        "reference-{}-{}x{}-b{}-{}spp.exr",
+        scene.name, scene.camera.width, scene.camera.height, scene.render.bounces, spp
+    ));
+    if path.exists() {
+        let (image, _) = load_exr(&path)?;
+        println!("reusing reference {}", path.display());
+        return Ok(image);
+    }
+    println!("rendering the reference: {spp} spp (cached as {})", path.display());
+    let mut reference_scene = scene.clone();
+    reference_scene.render.sampling = Sampling::Cosine;
+    // A seed the measured runs do not use, so reference and test noise are independent.
+    reference_scene.render.seed = scene.render.seed.wrapping_add(0x5eed);
+    let mut tracer = PathTracer::new(gpu, &reference_scene)?;
+    tracer.render(spp)?;
+    let image = tracer.accumulator().mean_image();
+    let metadata = ExrMetadata {
+        scene: scene.name.clone(),
+        spp: spp as u64,
+        bounces: scene.render.bounces.to_string(),
+        seed: reference_scene.render.seed,
+        sampling: "cosine".into(),
+        render_seconds: tracer.wall_seconds(),
+        extra: vec![("role".into(), "convergence reference".into())],
+    };
+    save_exr(&path, &image, &metadata)?;
+    Ok(image)
+}
+
+fn measure(variant: &'static str, tracer: &PathTracer, reference: &RgbImage32) -> anyhow::Result<Row> {
+    let acc = tracer.accumulator();
+    let image = acc.mean_image();
+    let seconds = tracer.wall_seconds();
+    Ok(Row {
+        variant,
+        spp: acc.min_samples(),
+        seconds,
+        samples_per_second: acc.total_samples() as f64 / seconds,
+        rmse: rmse(&image, reference)?,
+        rel_mse: rel_mse(&image, reference)?,
+        bias: mean_luminance_bias(&image, reference)?,
+        estimated_rel_mse: acc.estimated_rel_mse(),
+    })
+}
+
+fn print_row(r: &Row) {
+    println!(
+        "{:26} {:6} spp {:8.3} s  relMSE {:.3e} (estimated {:.3e})  efficiency {:.3e}",
+        r.variant,
+        r.spp,
+        r.seconds,
+        r.rel_mse,
+        r.estimated_rel_mse,
+        r.efficiency()
+    );
+}
+
+fn write_text(path: &Path, text: &str) -> anyhow::Result<()> {
+    illum::image::write_atomically(path, |file| {
+        file.write_all(text.as_bytes()).map_err(|e| illum::image::ImageError::Io {
+            path: path.to_path_buf(),
+            action: "writing",
+            source: e,
+        })
+    })?;
+    Ok(())
+}
+
+fn write_tables(out: &Path, rows: &[Row]) -> anyhow::Result<()> {
+    let mut csv = String::from(
+        "variant,spp,seconds,samples_per_second,rmse,rel_mse,mean_luminance_bias,estimated_rel_mse,estimated_over_true,efficiency\n",
+    );
+    let mut md = String::from(
+        "| option | spp | time (s) | Msamples/s | RMSE | relMSE | bias | estimated relMSE | est./true | efficiency |\n|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in rows {
+        let ratio = r.estimated_rel_mse / r.rel_mse;
+        writeln!(
+            csv,
+            "{},{},{},{},{},{},{},{},{},{}",
+            r.variant,
+            r.spp,
+            r.seconds,
+            r.samples_per_second,
+            r.rmse,
+            r.rel_mse,
+            r.bias,
+            r.estimated_rel_mse,
+            ratio,
+            r.efficiency()
+        )?;
+        writeln!(
+            md,
+            "| {} | {} | {:.3} | {:.2} | {:.4} | {:.3e} | {:+.4} | {:.3e} | {:.2} | {:.3e} |",
+            r.variant,
+            r.spp,
+            r.seconds,
+            r.samples_per_second * 1e-6,
+            r.rmse,
+            r.rel_mse,
+            r.bias,
+            r.estimated_rel_mse,
+            ratio,
+            r.efficiency()
+        )?;
+    }
+    write_text(&out.join("convergence.csv"), &csv)?;
+    write_text(&out.join("convergence.md"), &md)
+}
+
+fn series(rows: &[Row], variant: &str, x: impl Fn(&Row) -> f64, y: impl Fn(&Row) -> f64) -> Vec<(f64, f64)> {
+    let mut points: Vec<(f64, f64)> =
+        rows.iter().filter(|r| r.variant == variant).map(|r| (x(r), y(r))).collect();
+    points.sort_by(|a, b| a.0.total_cmp(&b.0));
+    points
+}
+
+fn plot_rows(out: &Path, rows: &[Row]) -> anyhow::Result<()> {
+    let time = |r: &Row| r.seconds;
+    let measured = |r: &Row| r.rel_mse;
+    let estimated = |r: &Row| r.estimated_rel_mse;
+    let pair = |names: [&str; 2]| -> Vec<Line> {
+        names
+            .iter()
+            .flat_map(|name| {
+                [
+                    Line {
+                        label: format!("{name}: relMSE"),
+                        points: series(rows, name, time, measured),
+                        markers_only: false,
+                    },
+                    Line {
+                        label: format!("{name}: estimated"),
+                        points: series(rows, name, time, estimated),
+                        markers_only: true,
+                    },
+                ]
+            })
+            .collect()
+    };
+    plot::log_log(
+        &out.join("error-vs-time-sampling.png"),
+        "Cosine vs uniform hemisphere sampling",
+        "wall time (s)",
+        "relMSE",
+        &pair([VARIANTS[0].name, VARIANTS[1].name]),
+    )?;
+    plot::log_log(
+        &out.join("error-vs-time-sequence.png"),
+        "Independent vs low-discrepancy numbers",
+        "wall time (s)",
+        "relMSE",
+        &pair([VARIANTS[0].name, VARIANTS[2].name]),
+    )?;
+    let spp = |r: &Row| r.spp as f64;
+    let mut lines: Vec<Line> = VARIANTS
+        .iter()
+        .map(|v| Line {
+            label: v.name.to_owned(),
+            points: series(rows, v.name, spp, measured),
+            markers_only: false,
+        })
+        .collect();
+    // The 1/N line through the first baseline point: Monte Carlo's convergence rate.
+    if let Some(&(n0, e0)) = lines[0].points.first() {
+        let last = lines[0].points.last().map_or(n0, |p| p.0);
+        lines.push(Line {
+            label: "1/N (relMSE of an O(1/sqrt N) error)".into(),
+            points: vec![(n0, e0), (last, e0 * n0 / last)],
+            markers_only: false,
+        });
+    }
+    plot::log_log(&out.join("error-vs-spp.png"), "Error against samples per pixel", "spp", "relMSE", &lines)
+}
+
+/// Mean radiance of the image per bounce count: each bounce adds a term of the Neumann series.
+fn bounce_table(gpu: &GpuContext, scene: &Scene, spp: u32, out: &Path) -> anyhow::Result<()> {
+    let mut csv = String::from("bounces,mean_luminance,standard_error,increment\n");
+    let mut md = String::from(
+        "| bounces | mean luminance | standard error | added by this bounce |\n|---|---|---|---|\n",
+    );
+    let mut previous = 0.0;
+    let mut points = Vec::new();
+    let settings: Vec<Bounces> = (0..=8).map(Bounces::Fixed).chain([Bounces::Unbounded]).collect();
+    for bounces in settings {
+        let mut s = scene.clone();
+        s.render.bounces = bounces;
+        let mut tracer = PathTracer::new(gpu, &s)?;
+        tracer.render(spp)?;
+        let acc = tracer.accumulator();
+        let n = (acc.width * acc.height) as usize;
+        let weights = [0.2126, 0.7152, 0.0722];
+        let (mut mean, mut variance) = (0.0, 0.0);
+        for p in 0..n {
+            let (m, v) = (acc.pixel_mean(p), acc.pixel_variance_of_mean(p));
+            for c in 0..3 {
+                mean += weights[c] * m[c];
+                variance += weights[c] * weights[c] * v[c];
+            }
+        }
+        mean /= n as f64;
+        let standard_error = variance.sqrt() / n as f64;
+        let increment = mean - previous;
+        writeln!(csv, "{bounces},{mean},{standard_error},{increment}")?;
+        writeln!(md, "| {bounces} | {mean:.5} | {standard_error:.5} | {increment:+.5} |")?;
+        if let Bounces::Fixed(b) = bounces {
+            points.push(((b + 1) as f64, increment.max(1e-12)));
+        }
+        previous = mean;
+        println!("bounces {bounces:>9}: mean luminance {mean:.5} +- {standard_error:.5}");
+    }
+    write_text(&out.join("bounces.csv"), &csv)?;
+    write_text(&out.join("bounces.md"), &md)?;
+    plot::log_log(
+        &out.join("bounces.png"),
+        "Light added by each bounce",
+        "bounce index + 1",
+        "added mean luminance",
+        &[Line { label: "increment".into(), points, markers_only: false }],
+    )
+}

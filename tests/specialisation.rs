@@ -1,0 +1,134 @@
+//! "Model only what a scene requires": each scene's specialised pipeline contains what it uses
+//! and nothing else, renders the same image as the generic one (tested in
+//! pathtrace_statistics.rs), is cached, and refuses a scene it was not built for.
+
+use illum::pathtrace::gpu_scene::GpuScene;
+use illum::pathtrace::specialise::specialise;
+use illum::pathtrace::{PathTracer, pipelines_compiled};
+use illum::scene::{Overrides, Scene};
+
+mod common;
+
+fn names_of(scene: &Scene, indices: &[usize]) -> Vec<String> {
+    // gpu_scene uploads non-emitters first, in file order.
+    let non_emitters: Vec<&str> = scene
+        .objects
+        .iter()
+        .filter(|o| !scene.materials[o.material].is_emitter())
+        .map(|o| o.name.as_str())
+        .collect();
+    indices.iter().map(|&i| non_emitters[i].to_owned()).collect()
+}
+
+#[test]
+fn each_scene_file_picks_the_specialisation_it_should() {
+    // cornell-classic's ceiling and back wall overhang the side walls by 2 units; the overhang's
+    // lit face is hidden only by the union of two boxes, which the (conservative) rule does not
+    // prove, so its side walls stay in the shadow test. That costs speed, never correctness.
+    let cases: [(&str, &[&str]); 2] = [
+        ("cornell", &["short block", "tall block"]),
+        ("cornell-classic", &["left wall", "right wall", "short block", "tall block"]),
+    ];
+    for (file, expected_occluders) in cases {
+        let scene = common::scene(file, Overrides::default());
+        let gpu_scene = GpuScene::new(&scene).expect("uploads");
+        let key = specialise(&scene, &gpu_scene);
+        // Walls, floor, ceiling are axis-aligned boxes, the blocks rotated boxes, the light a quad.
+        assert_eq!(key.kinds.iter().copied().collect::<Vec<_>>(), ["aabb", "box", "quad"], "{file}");
+        assert_eq!(key.lights, 1, "{file}");
+        let mut occluders = names_of(&scene, &key.occluders);
+        occluders.sort();
+        // A wall cannot shadow a light inside the room; only the blocks can.
+        assert_eq!(occluders, expected_occluders, "{file}");
+        assert!(!key.source.contains("hit_sphere("), "{file}: a scene without spheres has sphere code");
+        assert!(!key.source.contains("surface_sphere("), "{file}: a scene without spheres has sphere code");
+        assert!(
+            key.source.contains("return 0u;") && !key.source.contains("pick <"),
+            "{file}: one light needs no selection"
+        );
+    }
+}
+
+/// The Cornell box with a sphere in it and the light split in two.
+fn cornell_with_sphere_and_two_lights() -> Scene {
+    let text = std::fs::read_to_string(common::workspace_path("scenes/cornell.toml")).expect("readable");
+    let light =
+        "quad = { corner = [213.0, 555.0, 225.5], edge_u = [130.0, 0.0, 0.0], edge_v = [0.0, 0.0, 105.0] }";
+    assert!(text.contains(light), "scenes/cornell.toml's light changed; update this test");
+    let text = text.replace(
+        light,
+        "quad = { corner = [213.0, 555.0, 225.5], edge_u = [65.0, 0.0, 0.0], edge_v = [0.0, 0.0, 105.0] }\n\
+         [[objects]]\nname = \"light 2\"\nmaterial = \"light\"\n\
+         quad = { corner = [278.0, 555.0, 225.5], edge_u = [65.0, 0.0, 0.0], edge_v = [0.0, 0.0, 105.0] }\n\
+         [[objects]]\nname = \"ball\"\nmaterial = \"white\"\nsphere = { center = [150.0, 300.0, 400.0], radius = 60.0 }",
+    );
+    Scene::from_toml_str(&text, "cornell with a ball and two lights").expect("parses")
+}
+
+#[test]
+fn a_sphere_and_a_second_light_bring_their_code_and_nothing_else() {
+    let scene = cornell_with_sphere_and_two_lights();
+    let gpu_scene = GpuScene::new(&scene).expect("uploads");
+    let key = specialise(&scene, &gpu_scene);
+    assert!(key.kinds.contains("sphere"));
+    assert_eq!(key.lights, 2);
+    assert!(key.source.contains("hit_sphere(") && key.source.contains("pick <"));
+    let occluders = names_of(&scene, &key.occluders);
+    assert!(occluders.contains(&"ball".to_owned()), "the ball can shadow the floor: {occluders:?}");
+
+    // The two half lights together give the same image as the one whole light.
+    let small = Overrides { width: Some(24), height: Some(24), spp: Some(256), ..Default::default() };
+    let mut split = scene.clone();
+    split.apply_overrides(&small, "test").expect("valid");
+    let mut whole = common::scene("cornell", small);
+    // Put the ball into the one-light scene too, so the two differ only in the light's split.
+    whole.objects.push(split.objects.iter().find(|o| o.name == "ball").expect("ball").clone());
+    let (a, b) = (common::render(&split), common::render(&whole));
+    for c in 0..3 {
+        let (ma, va) = common::image_mean_and_variance(&a, c);
+        let (mb, vb) = common::image_mean_and_variance(&b, c);
+        let z = (ma - mb) / (va + vb).sqrt();
+        assert!(z.abs() < 4.0, "channel {c}: split lights {ma} vs one light {mb} (z = {z:.2})");
+    }
+}
+
+#[test]
+fn pipelines_are_cached_by_specialisation() {
+    let scene = common::scene("cornell", Overrides { width: Some(8), height: Some(8), ..Default::default() });
+    let _first = PathTracer::new(common::gpu(), &scene).expect("builds");
+    let compiled = pipelines_compiled();
+    // Another seed and resolution: same geometry, same pipeline.
+    let other = common::scene(
+        "cornell",
+        Overrides { width: Some(16), height: Some(4), seed: Some(3), ..Default::default() },
+    );
+    let _second = PathTracer::new(common::gpu(), &other).expect("builds");
+    assert_eq!(pipelines_compiled(), compiled, "an equal specialisation was compiled again");
+}
+
+#[test]
+fn a_scene_the_pipeline_was_not_built_for_is_refused() {
+    let scene = common::scene(
+        "cornell",
+        Overrides { width: Some(8), height: Some(8), spp: Some(2), ..Default::default() },
+    );
+    let mut tracer = PathTracer::new(common::gpu(), &scene).expect("builds");
+    tracer.render(2).expect("renders");
+
+    // A new camera and settings are fine and restart the accumulation.
+    let mut moved = scene.clone();
+    moved.camera.eye.x += 10.0;
+    moved.render.seed = 9;
+    tracer.update_scene(&moved).expect("camera changes need no new pipeline");
+    assert_eq!(tracer.spp_done(), 0);
+
+    // A sphere is a feature this pipeline lacks: an error, never a wrong image.
+    let with_ball = cornell_with_sphere_and_two_lights();
+    let mut with_ball_small = with_ball.clone();
+    with_ball_small.camera = scene.camera;
+    let message = match tracer.update_scene(&with_ball_small) {
+        Ok(()) => panic!("a scene with a sphere must be refused by a box-only pipeline"),
+        Err(e) => e.to_string(),
+    };
+    assert!(message.contains("sphere") && message.contains("new PathTracer"), "{message}");
+}
