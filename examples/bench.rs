@@ -41,11 +41,7 @@ struct Config {
 }
 
 fn main() {
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
-    if let Err(error) = run(Args::parse()) {
-        eprintln!("error: {error:#}");
-        std::process::exit(1);
-    }
+    illum::cli::main_with(run);
 }
 
 fn median(values: &mut [f64]) -> f64 {

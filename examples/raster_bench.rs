@@ -42,11 +42,7 @@ struct Args {
 }
 
 fn main() {
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
-    if let Err(error) = run(Args::parse()) {
-        eprintln!("error: {error:#}");
-        std::process::exit(1);
-    }
+    illum::cli::main_with(run);
 }
 
 fn run(args: Args) -> anyhow::Result<()> {

@@ -12,14 +12,14 @@
 //! Ctrl-C stops the render early and still writes what has accumulated; the EXR's metadata
 //! records the samples per pixel actually reached.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, bail};
 use clap::Parser;
-use illum::cli::{self, DEFAULT_SCENE, SceneArgs};
+use illum::cli::{self, DEFAULT_SCENE, OutputFormat, SceneArgs, output_format};
 use illum::image::{Encoding, ExrMetadata, save_exr, save_png};
 use illum::pathtrace::{PathTracer, Sequence, StopReason, StopRules, TracerOptions, render_progressive};
 use illum::raster_cli::{RasterArgs, RasterRequest, render_raster};
@@ -60,11 +60,7 @@ struct Args {
 }
 
 fn main() {
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
-    if let Err(error) = run(Args::parse()) {
-        eprintln!("error: {error:#}");
-        std::process::exit(1);
-    }
+    illum::cli::main_with(run);
 }
 
 fn run(args: Args) -> anyhow::Result<()> {
@@ -160,8 +156,8 @@ fn run(args: Args) -> anyhow::Result<()> {
     };
     for output in &outputs {
         match output_format(output)? {
-            Format::Png => save_png(output, &image, args.exposure, args.encoding.unwrap_or_default())?,
-            Format::Exr => save_exr(output, &image, &metadata)?,
+            OutputFormat::Png => save_png(output, &image, args.exposure, args.encoding.unwrap_or_default())?,
+            OutputFormat::Exr => save_exr(output, &image, &metadata)?,
         }
     }
     let samples = accumulator.total_samples() as f64;
@@ -188,17 +184,4 @@ fn run(args: Args) -> anyhow::Result<()> {
         println!("wrote {}", output.display());
     }
     Ok(())
-}
-
-enum Format {
-    Png,
-    Exr,
-}
-
-fn output_format(path: &Path) -> anyhow::Result<Format> {
-    match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
-        Some("png") => Ok(Format::Png),
-        Some("exr") => Ok(Format::Exr),
-        _ => bail!("output {}: unknown extension; allowed: .png or .exr", path.display()),
-    }
 }

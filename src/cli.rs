@@ -71,3 +71,29 @@ pub fn gpu() -> anyhow::Result<illum_gpu::GpuContext> {
     log::info!("adapter: {} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend);
     Ok(gpu)
 }
+
+/// Runs an example's `run` with logging set up, printing any error with its causes and exiting
+/// with status 1 (never a panic's backtrace for a user mistake).
+pub fn main_with<A: clap::Parser>(run: impl FnOnce(A) -> anyhow::Result<()>) {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    if let Err(error) = run(A::parse()) {
+        eprintln!("error: {error:#}");
+        std::process::exit(1);
+    }
+}
+
+/// An output file's format, from its extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OutputFormat {
+    Png,
+    Exr,
+}
+
+/// The format of `path` (.png or .exr, any case), or an error naming what is allowed.
+pub fn output_format(path: &Path) -> anyhow::Result<OutputFormat> {
+    match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+        Some("png") => Ok(OutputFormat::Png),
+        Some("exr") => Ok(OutputFormat::Exr),
+        _ => anyhow::bail!("output {}: unknown extension; allowed: .png or .exr", path.display()),
+    }
+}

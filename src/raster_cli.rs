@@ -8,6 +8,8 @@ use std::time::Instant;
 use anyhow::bail;
 use clap::Args;
 use illum_gpu::GpuContext;
+
+use crate::cli::{OutputFormat, output_format};
 use illum_image::{Encoding, ExrMetadata, save_exr, save_png};
 use illum_raster::{Look, Options, PassTimes, WhittedRenderer};
 use illum_scene::WhittedScene;
@@ -123,19 +125,6 @@ fn path_tracer_settings(settings: &SceneArgs) -> Vec<&'static str> {
     .collect()
 }
 
-enum Format {
-    Png,
-    Exr,
-}
-
-fn output_format(path: &Path) -> anyhow::Result<Format> {
-    match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
-        Some("png") => Ok(Format::Png),
-        Some("exr") => Ok(Format::Exr),
-        _ => bail!("output {}: unknown extension; allowed: .png or .exr", path.display()),
-    }
-}
-
 /// Loads the scene, applies `--width` / `--height`, and checks every flag and output name,
 /// before any GPU work.
 fn prepare(request: &RasterRequest) -> anyhow::Result<(WhittedScene, Options, Vec<PathBuf>)> {
@@ -233,8 +222,8 @@ fn render_prepared(
     };
     for output in outputs {
         match output_format(output)? {
-            Format::Png => save_png(output, &frame.image, request.exposure, encoding)?,
-            Format::Exr => save_exr(output, &frame.image, &metadata)?,
+            OutputFormat::Png => save_png(output, &frame.image, request.exposure, encoding)?,
+            OutputFormat::Exr => save_exr(output, &frame.image, &metadata)?,
         }
     }
     println!(
