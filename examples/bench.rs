@@ -18,6 +18,8 @@ use std::path::PathBuf;
 use clap::Parser;
 use illum::cli::{self, SceneArgs};
 use illum::pathtrace::{PathTracer, TracerOptions, Traversal};
+use illum::raster::{Look, Options, bench_frames};
+use illum::scene::WhittedScene;
 use illum::scene::{Bounces, Scene};
 
 #[derive(Parser, Debug)]
@@ -121,5 +123,32 @@ fn run(args: Args) -> anyhow::Result<()> {
             config.traversal,
         );
     }
+    bench_raster(&gpu, args.runs)
+}
+
+/// The Whitted look-alike at 1280 x 720, whitted look, every effect on: frames per second and
+/// the GPU time of each pass (more options: `--example raster_bench`).
+fn bench_raster(gpu: &illum::gpu::GpuContext, runs: usize) -> anyhow::Result<()> {
+    let path = cli::resolve_scene_path(std::path::Path::new("scenes/whitted.toml"));
+    let scene = WhittedScene::load(&path)?;
+    let options = Options::all_on(Look::Whitted);
+    let report = bench_frames(gpu, &scene, 1280, 720, &options, 5, (12 * runs.max(1)) as u32)?;
+    println!();
+    println!(
+        "| Whitted look-alike, 1280x720, every effect on | median frame (ms) | fps | shadow (ms) | cube maps (ms) | main (ms) |"
+    );
+    println!("|---|---|---|---|---|---|");
+    let passes = report.median_pass_ms();
+    let pass = |f: fn(&illum::raster::PassTimes) -> f64| {
+        passes.as_ref().map_or("n/a".to_owned(), |p| format!("{:.2}", f(p)))
+    };
+    println!(
+        "| whitted look | {:.2} | {:.1} | {} | {} | {} |",
+        report.median_frame_ms(),
+        report.fps(),
+        pass(|p| p.shadow_ms),
+        pass(|p| p.cube_ms),
+        pass(|p| p.main_ms),
+    );
     Ok(())
 }
