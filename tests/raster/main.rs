@@ -21,6 +21,7 @@ mod common;
 
 mod cli;
 mod effects;
+mod extremes;
 mod figure;
 mod reference;
 

@@ -1,0 +1,272 @@
+//! Issue 6, section 3: the raster scene at the extremes. Every case checks that the image is
+//! finite and measures a physical property against a value computed here (ray casts in f64, or a
+//! second render that must agree). Each prints what it measured; docs/accuracy.md's table
+//! "Raster extremes" quotes these numbers.
+
+use glam::{DVec3, Vec3};
+use illum::image::RgbImage32;
+use illum::raster::{Look, Options};
+use illum::scene::{Camera, WhittedScene};
+
+use crate::{HEIGHT, WIDTH, camera, level, ray_sphere, render, scene};
+
+fn finite(image: &RgbImage32, what: &str) {
+    assert!(!image.has_non_finite(), "{what}: the image holds NaN or Inf");
+}
+
+fn spheres(s: &WhittedScene) -> [(Vec3, f32); 2] {
+    [(s.glass.center, s.glass.radius), (s.metal.center, s.metal.radius)]
+}
+
+/// The scene with its light moved to `degrees` of elevation above the floor, same azimuth and
+/// distance from its target, seen from above: from the file's camera the long shadows of a low
+/// light fall on the far floor straight behind the glass sphere.
+fn light_at_elevation(degrees: f32) -> WhittedScene {
+    let mut s = scene();
+    s.camera.eye = Vec3::new(10.0, 18.0, 6.0);
+    s.camera.target = Vec3::new(-7.0, 0.0, -1.0);
+    let offset = s.light.position - s.light.target;
+    let horizontal = Vec3::new(offset.x, 0.0, offset.z).normalize();
+    let e = degrees.to_radians();
+    s.light.position = s.light.target + offset.length() * (e.cos() * horizontal + e.sin() * Vec3::Y);
+    s
+}
+
+/// How far the ray from floor point p toward the light passes outside sphere (c, r), in f64
+/// (negative: it goes through the sphere, so p is in that sphere's exact shadow).
+fn exact_margin(s: &WhittedScene, p: DVec3, (c, r): (Vec3, f32)) -> f64 {
+    let l = (s.light.position.as_dvec3() - s.light.target.as_dvec3()).normalize();
+    let oc = c.as_dvec3() - p;
+    let t = oc.dot(l).max(0.0);
+    (oc - t * l).length() - f64::from(r)
+}
+
+/// What the camera ray through pixel point (x, y) meets first.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Hit {
+    Sky,
+    Floor(Vec3),
+    Glass,
+    Metal,
+}
+
+/// The first surface along origin + t dir (t > 0), from either side of the floor. `with_glass`
+/// false leaves the glass out (what its cube map sees).
+fn trace(s: &WhittedScene, origin: Vec3, dir: Vec3, with_glass: bool) -> Hit {
+    let glass = if with_glass { ray_sphere(origin, dir, s.glass.center, s.glass.radius) } else { None };
+    let metal = ray_sphere(origin, dir, s.metal.center, s.metal.radius);
+    let floor = (dir.y != 0.0)
+        .then(|| (s.floor.height() - origin.y) / dir.y)
+        .filter(|t| *t > 0.0)
+        .map(|t| (t, origin + t * dir))
+        .filter(|(_, p)| {
+            let (lo, hi) = (s.floor.min_corner(), s.floor.max_corner());
+            p.x > lo.x && p.x < hi.x && p.z > lo.y && p.z < hi.y
+        });
+    let mut best = (f32::INFINITY, Hit::Sky);
+    for (t, hit) in [(glass, Hit::Glass), (metal, Hit::Metal)] {
+        if let Some(t) = t.filter(|t| *t < best.0) {
+            best = (t, hit);
+        }
+    }
+    if let Some((t, p)) = floor.filter(|(t, _)| *t < best.0) {
+        best = (t, Hit::Floor(p));
+    }
+    best.1
+}
+
+/// What pixel (x, y) sees, if its centre and four points 0.6 px away see the same kind of
+/// surface (no silhouette or floor edge within the pixel). Floor hits return the centre's point.
+fn interior(s: &WhittedScene, cam: &Camera, x: u32, y: u32) -> Option<Hit> {
+    let (cx, cy) = (x as f32 + 0.5, y as f32 + 0.5);
+    let centre = trace(s, cam.eye, cam.ray_direction(cx, cy), true);
+    let kind = |h: Hit| std::mem::discriminant(&h);
+    [(-0.6, -0.6), (0.6, -0.6), (-0.6, 0.6), (0.6, 0.6)]
+        .iter()
+        .all(|(dx, dy)| kind(trace(s, cam.eye, cam.ray_direction(cx + dx, cy + dy), true)) == kind(centre))
+        .then_some(centre)
+}
+
+/// Floor points seen at the pixel's centre and its four corners, when all five are floor.
+fn floor_corners(s: &WhittedScene, cam: &Camera, x: u32, y: u32) -> Option<[Vec3; 5]> {
+    let (cx, cy) = (x as f32 + 0.5, y as f32 + 0.5);
+    let mut out = [Vec3::ZERO; 5];
+    for (k, (dx, dy)) in [(0.0, 0.0), (-0.5, -0.5), (0.5, -0.5), (-0.5, 0.5), (0.5, 0.5)].iter().enumerate() {
+        match trace(s, cam.eye, cam.ray_direction(cx + dx, cy + dy), true) {
+            Hit::Floor(p) => out[k] = p,
+            _ => return None,
+        }
+    }
+    Some(out)
+}
+
+// ---------------------------------------------------------------------------------------------
+// 1. Shadow-map bias at light elevations of 5 and 85 degrees.
+
+struct ShadowMeasure {
+    lit: usize,
+    umbra: usize,
+    acne: usize,
+    missing: usize,
+    extra: usize,
+    /// Distance between the rendered and the exact shadow's centroids (scene units): of all the
+    /// shadow on screen, then of each sphere's own (None when the other sphere's shadow covers
+    /// all of it on the floor, as at 5 degrees, where both fall on the same far band).
+    centroid_offset: [Option<f64>; 3],
+    metal_checked: usize,
+    metal_changed: usize,
+    /// The farthest checked umbra pixel from the nearer sphere's centre, horizontally.
+    umbra_reach: f32,
+}
+
+fn measure_shadows(s: &WhittedScene) -> ShadowMeasure {
+    let options = Options::all_on(Look::Figure);
+    let image = render(s, &options);
+    finite(&image, "shadows on");
+    let mut off = options;
+    off.effects.shadows = false;
+    let unshadowed = render(s, &off);
+    finite(&unshadowed, "shadows off");
+    let cam = camera(s, WIDTH, HEIGHT);
+    let [a, b] = s.floor.colors;
+    assert_eq!(a.x, b.x, "the visibility is read off the red channel, equal on both tiles");
+    let red = a.x;
+    let ambient = s.ambient.radiance().x;
+    let direct = s.light.radiance().x * s.light.to_light().y;
+    let lit_level = level(red * (ambient + direct));
+    // The soft edge: the PCF kernel's reach (1.5 pcf_radius, measured across the light, which
+    // is what exact_margin measures) plus a shadow-map texel and rounding.
+    let pen = f64::from(1.5 * s.quality.pcf_radius + 0.02);
+    let forward = cam.basis().forward;
+    let mut m = ShadowMeasure {
+        lit: 0,
+        umbra: 0,
+        acne: 0,
+        missing: 0,
+        extra: 0,
+        centroid_offset: [None; 3],
+        metal_checked: 0,
+        metal_changed: 0,
+        umbra_reach: 0.0,
+    };
+    // All shadow, then per sphere: (weight, weighted position) of the rendered and exact shadow.
+    let mut rendered = [(0.0f64, DVec3::ZERO); 3];
+    let mut exact = [(0.0f64, DVec3::ZERO); 3];
+    for y in 0..HEIGHT {
+        for x in 0..WIDTH {
+            let Some(points) = floor_corners(s, &cam, x, y) else { continue };
+            let margins: Vec<[f64; 2]> =
+                points.iter().map(|p| spheres(s).map(|sp| exact_margin(s, p.as_dvec3(), sp))).collect();
+            let got = image.get(x, y)[0];
+            let visibility = (got / red - ambient) / direct;
+            let in_umbra = margins.iter().all(|m| m[0] < -pen || m[1] < -pen);
+            let in_light = margins.iter().all(|m| m[0] > pen && m[1] > pen);
+            if in_light {
+                m.lit += 1;
+                if level(got) < lit_level - 2 {
+                    m.acne += 1;
+                }
+                if visibility < 0.5 {
+                    m.extra += 1;
+                }
+            } else if in_umbra {
+                m.umbra += 1;
+                let p = points[0];
+                let reach = spheres(s).map(|(c, _)| Vec3::new(p.x - c.x, 0.0, p.z - c.z).length());
+                m.umbra_reach = m.umbra_reach.max(reach[0].min(reach[1]));
+                if visibility > 0.5 {
+                    m.missing += 1;
+                }
+            }
+            // Centroids over the floor within 0.5 (across the light) of an exact shadow, penumbra
+            // included, weighted by the floor area the pixel covers; a pixel belongs to the
+            // sphere whose shadow it is nearer. (Farther out, the 8-bit rounding of lit pixels
+            // would add a faint uniform "shadow" that pulls the centroid.)
+            if margins[0][0].min(margins[0][1]) > 0.5 {
+                continue;
+            }
+            let p = points[0];
+            let k = if margins[0][0] <= margins[0][1] { 1 } else { 2 };
+            let dir = cam.ray_direction(x as f32 + 0.5, y as f32 + 0.5);
+            let t = p.distance(cam.eye);
+            let area = f64::from(dir.dot(forward).powi(3) * t * t / dir.y.abs());
+            let shadow = f64::from((1.0 - visibility).clamp(0.0, 1.0));
+            let inside = if margins[0][k - 1] < 0.0 { 1.0 } else { 0.0 };
+            let p = p.as_dvec3();
+            for k in [0, k] {
+                rendered[k] = (rendered[k].0 + area * shadow, rendered[k].1 + area * shadow * p);
+                exact[k] = (exact[k].0 + area * inside, exact[k].1 + area * inside * p);
+            }
+        }
+    }
+    assert!(exact[0].0 > 0.0, "no shadow on screen");
+    for k in 0..3 {
+        if exact[k].0 > 0.0 {
+            m.centroid_offset[k] = Some((rendered[k].1 / rendered[k].0).distance(exact[k].1 / exact[k].0));
+        }
+    }
+    // The metal sphere against its own depth in the map: where the light reaches it clear of the
+    // glass (and of the glass's soft edge), shadows must not change a pixel.
+    let clear = f64::from(3.0 * s.quality.pcf_radius + 0.05);
+    for y in 0..HEIGHT {
+        for x in 0..WIDTH {
+            if interior(s, &cam, x, y) != Some(Hit::Metal) {
+                continue;
+            }
+            let dir = cam.ray_direction(x as f32 + 0.5, y as f32 + 0.5);
+            let Some(t) = ray_sphere(cam.eye, dir, s.metal.center, s.metal.radius) else { continue };
+            let p = (cam.eye + t * dir).as_dvec3();
+            if exact_margin(s, p, (s.glass.center, s.glass.radius)) <= clear {
+                continue;
+            }
+            m.metal_checked += 1;
+            let (u, v) = (image.get(x, y), unshadowed.get(x, y));
+            if (0..3).any(|c| (level(u[c]) - level(v[c])).abs() > 2) {
+                m.metal_changed += 1;
+            }
+        }
+    }
+    m
+}
+
+#[test]
+fn shadow_bias_at_light_elevations_of_5_and_85_degrees() {
+    for degrees in [5.0, 85.0] {
+        let s = light_at_elevation(degrees);
+        let m = measure_shadows(&s);
+        let mismatch = (m.missing + m.extra) as f64 / (m.lit + m.umbra) as f64;
+        println!(
+            "elevation {degrees}: lit {} (acne {}), umbra {} (missing {}), extra {}, mismatch {:.5}, \
+             umbra reaches {:.1} from a sphere, centroid offsets (all, glass, metal) {:?}, metal pixels {} (changed by shadows {})",
+            m.lit,
+            m.acne,
+            m.umbra,
+            m.missing,
+            m.extra,
+            mismatch,
+            m.umbra_reach,
+            m.centroid_offset,
+            m.metal_checked,
+            m.metal_changed
+        );
+        assert!(m.lit > 5000 && m.umbra > 100, "{degrees} deg: too few pixels checked");
+        assert_eq!(m.acne, 0, "{degrees} deg: lit floor pixels darker than lit (acne)");
+        assert_eq!(m.missing + m.extra, 0, "{degrees} deg: shadow mask differs from the exact one");
+        if degrees < 10.0 {
+            // The shadow map is fitted to the casters along the light, so a shadow ten sphere
+            // heights long is covered to the floor's far end (x = -23, ~27 from the spheres).
+            assert!(
+                m.umbra_reach > 20.0,
+                "5 deg: the checked umbra ends {:.1} from the spheres",
+                m.umbra_reach
+            );
+        }
+        assert!(m.centroid_offset[0].is_some(), "{degrees} deg: no shadow on screen");
+        for (k, offset) in m.centroid_offset.iter().enumerate() {
+            let offset = offset.unwrap_or(0.0);
+            assert!(offset < 0.05, "{degrees} deg: centroid {k} is {offset:.3} from the exact one");
+        }
+        assert!(m.metal_checked > 100, "{degrees} deg: only {} metal pixels", m.metal_checked);
+        assert_eq!(m.metal_changed, 0, "{degrees} deg: shadows changed lit metal pixels (acne)");
+    }
+}
