@@ -47,5 +47,7 @@ fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
         discard;
     }
     let sw = Switches(false, RECEIVER, PCF, false, false, false, false);
-    return vec4<f32>(shade_floor(sw, in.world, tile_coord, footprint), 1.0);
+    // The side of the floor the view sees: its top from above, its underside from below.
+    let n = vec3<f32>(0.0, select(-1.0, 1.0, view.eye.y >= scene.floor_params.x), 0.0);
+    return vec4<f32>(shade_floor(sw, in.world, n, tile_coord, footprint), 1.0);
 }

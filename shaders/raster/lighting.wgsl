@@ -20,8 +20,6 @@
 // whose directions spread over many texels within one pixel (see glass_environment).
 @group(1) @binding(6) var glass_env_coarse: texture_cube<f32>;
 
-const UP: vec3<f32> = vec3<f32>(0.0, 1.0, 0.0);
-
 // PCF: four bilinear comparison taps at (+-1/2, +-1/2) texel. A bilinear tap weighs the depth
 // tests of its 2 x 2 texels with a tent of half-width one texel, so the four together form a
 // smooth kernel reaching 1.5 texels either side (PCF_REACH_TEXELS in shadow_fit.rs). The renderer
@@ -98,16 +96,18 @@ fn filtered_checker(t: vec2<f32>, width: vec2<f32>) -> f32 {
     return average.x + average.y - 2.0 * average.x * average.y;
 }
 
-// The floor at world point p: tile colour x (ambient + light x N.L x visibility), N = +Y.
+// The floor at world point p: tile colour x (ambient + light x N.L x visibility). `n` is the
+// normal of the side being seen: +Y from above; from below (an eye under the floor) -Y, which
+// faces away from any light above, so the underside is ambient-only.
 // `tile_coord` is p's position in tiles from the floor's minimum corner and `footprint` the
 // pixel's extent in the same units (from screen-space derivatives, taken by the caller).
-fn shade_floor(sw: Switches, p: vec3<f32>, tile_coord: vec2<f32>, footprint: vec2<f32>) -> vec3<f32> {
+fn shade_floor(sw: Switches, p: vec3<f32>, n: vec3<f32>, tile_coord: vec2<f32>, footprint: vec2<f32>) -> vec3<f32> {
     let odd = filtered_checker(tile_coord, footprint);
     let albedo = mix(scene.floor_color_a.rgb, scene.floor_color_b.rgb, odd);
-    let n_dot_l = max(dot(UP, scene.to_light.xyz), 0.0);
+    let n_dot_l = max(dot(n, scene.to_light.xyz), 0.0);
     var direct = 0.0;
     if n_dot_l > 0.0 {
-        direct = n_dot_l * shadow_visibility(sw, p, UP, 0.0);
+        direct = n_dot_l * shadow_visibility(sw, p, n, 0.0);
     }
     return albedo * (scene.ambient.rgb + scene.light_radiance.rgb * direct);
 }

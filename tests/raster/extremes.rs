@@ -50,6 +50,23 @@ enum Hit {
     Metal,
 }
 
+/// The first surface the camera ray along `dir` meets, from either side of the floor. The floor
+/// is clipped by the near plane like any polygon (where it is nearer, the ray sees what lies
+/// beyond); a sphere is not: its impostor keeps it closed (near_plane_cutting_the_glass_sphere).
+fn trace_camera(s: &WhittedScene, cam: &Camera, dir: Vec3) -> Hit {
+    let hit = trace(s, cam.eye, dir, true);
+    match hit {
+        Hit::Floor(p) if (p - cam.eye).dot(cam.basis().forward) < s.clip.near => {
+            let beyond = p + 1e-4 * dir;
+            match trace(s, beyond, dir, true) {
+                Hit::Floor(_) => Hit::Sky,
+                other => other,
+            }
+        }
+        other => other,
+    }
+}
+
 /// The first surface along origin + t dir (t > 0), from either side of the floor. `with_glass`
 /// false leaves the glass out (what its cube map sees).
 fn trace(s: &WhittedScene, origin: Vec3, dir: Vec3, with_glass: bool) -> Hit {
@@ -79,11 +96,11 @@ fn trace(s: &WhittedScene, origin: Vec3, dir: Vec3, with_glass: bool) -> Hit {
 /// surface (no silhouette or floor edge within the pixel). Floor hits return the centre's point.
 fn interior(s: &WhittedScene, cam: &Camera, x: u32, y: u32) -> Option<Hit> {
     let (cx, cy) = (x as f32 + 0.5, y as f32 + 0.5);
-    let centre = trace(s, cam.eye, cam.ray_direction(cx, cy), true);
+    let centre = trace_camera(s, cam, cam.ray_direction(cx, cy));
     let kind = |h: Hit| std::mem::discriminant(&h);
     [(-0.6, -0.6), (0.6, -0.6), (-0.6, 0.6), (0.6, 0.6)]
         .iter()
-        .all(|(dx, dy)| kind(trace(s, cam.eye, cam.ray_direction(cx + dx, cy + dy), true)) == kind(centre))
+        .all(|(dx, dy)| kind(trace_camera(s, cam, cam.ray_direction(cx + dx, cy + dy))) == kind(centre))
         .then_some(centre)
 }
 
@@ -92,7 +109,7 @@ fn floor_corners(s: &WhittedScene, cam: &Camera, x: u32, y: u32) -> Option<[Vec3
     let (cx, cy) = (x as f32 + 0.5, y as f32 + 0.5);
     let mut out = [Vec3::ZERO; 5];
     for (k, (dx, dy)) in [(0.0, 0.0), (-0.5, -0.5), (0.5, -0.5), (-0.5, 0.5), (0.5, 0.5)].iter().enumerate() {
-        match trace(s, cam.eye, cam.ray_direction(cx + dx, cy + dy), true) {
+        match trace_camera(s, cam, cam.ray_direction(cx + dx, cy + dy)) {
             Hit::Floor(p) => out[k] = p,
             _ => return None,
         }
@@ -268,5 +285,271 @@ fn shadow_bias_at_light_elevations_of_5_and_85_degrees() {
         }
         assert!(m.metal_checked > 100, "{degrees} deg: only {} metal pixels", m.metal_checked);
         assert_eq!(m.metal_changed, 0, "{degrees} deg: shadows changed lit metal pixels (acne)");
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// 2. The camera at the near and far planes, and orbiting down to the horizon.
+
+/// Pixels whose largest channel differs by more than `tolerance` levels between a and b.
+fn count_changed(a: &RgbImage32, b: &RgbImage32, keep: impl Fn(u32, u32) -> bool, tolerance: i32) -> usize {
+    let mut n = 0;
+    for y in 0..a.height {
+        for x in 0..a.width {
+            let (p, q) = (a.get(x, y), b.get(x, y));
+            if keep(x, y) && (0..3).any(|c| (level(p[c]) - level(q[c])).abs() > tolerance) {
+                n += 1;
+            }
+        }
+    }
+    n
+}
+
+/// The largest channel of `rgb` in levels.
+fn max_level(rgb: [f32; 3]) -> i32 {
+    rgb.into_iter().map(level).max().unwrap_or(0)
+}
+
+/// Glass pixel checks shared by several cases: the environment the pixel shows, E (figure look:
+/// pixel = 0.1 white + 0.9 E; whitted look: the pixel itself, a mix of environment lookups plus
+/// a highlight), must be a colour in [0, 1] whose brightest channel is at least `floor` levels:
+/// no black holes. Returns (glass pixels, darkest max channel of E in levels).
+fn check_glass_pixels(
+    s: &WhittedScene,
+    image: &RgbImage32,
+    look: Look,
+    floor: i32,
+    what: &str,
+) -> (usize, i32) {
+    let cam = camera(s, image.width, image.height);
+    let mix = s.glass.reflectivity;
+    let base = (1.0 - mix) * s.glass.color;
+    let (mut n, mut darkest) = (0, i32::MAX);
+    for y in 0..image.height {
+        for x in 0..image.width {
+            if interior(s, &cam, x, y) != Some(Hit::Glass) {
+                continue;
+            }
+            n += 1;
+            let p = image.get(x, y);
+            let e = match look {
+                Look::Figure => [0, 1, 2].map(|c| (p[c] - base[c]) / mix),
+                Look::Whitted => p,
+            };
+            let slack = 2.5 / 255.0 / mix;
+            assert!(
+                e.iter().all(|v| (-slack..=1.0 + slack).contains(v)),
+                "{what}: glass pixel ({x}, {y}) = {:?} is not a 0.1 white + 0.9 E mix",
+                p.map(level)
+            );
+            darkest = darkest.min(max_level(e));
+        }
+    }
+    assert!(
+        darkest >= floor,
+        "{what}: a glass pixel shows an environment of {darkest} levels, below {floor}"
+    );
+    (n, darkest)
+}
+
+#[test]
+fn near_plane_cutting_the_glass_sphere() {
+    // The eye 0.5 from the glass's surface with the near plane at 0.6: the plane cuts a cap off
+    // the sphere. The impostor computes the surface point per pixel, so what the near plane
+    // removes must not open a hole: every pixel whose ray meets the glass shows glass (a 0.1 + 0.9 E
+    // mix, no black), every pixel whose ray meets nothing shows the background exactly.
+    let mut s = scene();
+    s.camera.eye = s.glass.center + Vec3::new(1.5, 0.0, 0.0);
+    s.camera.target = s.glass.center;
+    s.clip.near = 0.6;
+    let image = render(&s, &Options::all_on(Look::Figure));
+    finite(&image, "near plane");
+    let cam = camera(&s, WIDTH, HEIGHT);
+    let background = s.background.to_array().map(level);
+    let (mut sky, mut sky_wrong, mut cut) = (0, 0, 0);
+    for y in 0..HEIGHT {
+        for x in 0..WIDTH {
+            match interior(&s, &cam, x, y) {
+                Some(Hit::Sky) => {
+                    sky += 1;
+                    if image.get(x, y).map(level) != background {
+                        sky_wrong += 1;
+                    }
+                }
+                Some(Hit::Glass) => {
+                    let dir = cam.ray_direction(x as f32 + 0.5, y as f32 + 0.5);
+                    let t = ray_sphere(cam.eye, dir, s.glass.center, s.glass.radius).unwrap_or(0.0);
+                    if t * dir.dot(cam.basis().forward) < s.clip.near {
+                        cut += 1;
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+    let (glass, darkest) = check_glass_pixels(&s, &image, Look::Figure, 40, "near plane");
+    println!(
+        "near plane 0.6, eye 0.5 from the glass: {glass} glass pixels ({cut} of them nearer than the near plane), \
+         darkest E {darkest}, {sky} sky pixels, {sky_wrong} not background"
+    );
+    assert!(cut > 1000, "the near plane cuts only {cut} pixels of the sphere");
+    assert!(sky > 1000 && sky_wrong == 0);
+}
+
+#[test]
+fn far_plane_just_beyond_and_before_the_floor_end() {
+    // A camera looking down the floor's length (from the file's camera the far floor hides
+    // behind the glass). `end` is the depth of the floor's farthest corner along the view axis.
+    let mut s = scene();
+    s.camera.eye = Vec3::new(7.5, 6.0, 0.0);
+    s.camera.target = Vec3::new(-8.0, 0.0, 0.0);
+    let options = Options::all_on(Look::Figure);
+    let reference = render(&s, &options);
+    let cam = camera(&s, WIDTH, HEIGHT);
+    let forward = cam.basis().forward;
+    let (lo, hi) = (s.floor.min_corner(), s.floor.max_corner());
+    let end = [(lo.x, lo.y), (lo.x, hi.y), (hi.x, lo.y), (hi.x, hi.y)]
+        .map(|(x, z)| (Vec3::new(x, s.floor.height(), z) - cam.eye).dot(forward))
+        .into_iter()
+        .fold(0.0f32, f32::max);
+    let cut = end - 8.0;
+    let background = s.background.to_array().map(level);
+    let mut beyond = s.clone();
+    beyond.clip.far = end + 0.5;
+    let image = render(&beyond, &options);
+    finite(&image, "far 31");
+    let changed = count_changed(&image, &reference, |_, _| true, 2);
+    println!(
+        "far plane {:.2} (0.5 beyond the floor's end): {changed} pixels differ from far 3000 by > 2 levels",
+        end + 0.5
+    );
+    assert_eq!(changed, 0);
+
+    let mut before = s.clone();
+    before.clip.far = cut;
+    let image = render(&before, &options);
+    finite(&image, "far before the end");
+    let (mut clipped, mut clipped_wrong, mut kept, mut kept_wrong) = (0, 0, 0, 0);
+    for y in 0..HEIGHT {
+        for x in 0..WIDTH {
+            let Some(points) = floor_corners(&s, &cam, x, y) else { continue };
+            let depths = points.map(|p| (p - cam.eye).dot(forward));
+            let got = image.get(x, y);
+            if depths.iter().all(|d| *d > cut + 0.05) {
+                clipped += 1;
+                if got.map(level) != background {
+                    clipped_wrong += 1;
+                }
+            } else if depths.iter().all(|d| *d < cut - 0.05) {
+                kept += 1;
+                let want = reference.get(x, y);
+                if (0..3).any(|c| (level(got[c]) - level(want[c])).abs() > 2) {
+                    kept_wrong += 1;
+                }
+            }
+        }
+    }
+    println!(
+        "far plane {cut:.2} (8 before the floor's end): {clipped} floor pixels beyond it ({clipped_wrong} not background), {kept} before it \
+         ({kept_wrong} differ from far 3000)"
+    );
+    assert!(clipped > 500 && kept > 5000);
+    assert_eq!((clipped_wrong, kept_wrong), (0, 0));
+}
+
+/// The file's camera orbited in its vertical plane around the target down to eye height `y`
+/// (it then looks up at the target), or, `level`, moved to height `y` looking level along -X,
+/// so that the horizon crosses the middle of the view.
+fn camera_at_height(y: f32, level: bool) -> WhittedScene {
+    let mut s = scene();
+    let t = s.camera.target;
+    if level {
+        s.camera.eye.y = y;
+        s.camera.target = Vec3::new(-8.0, y, t.z);
+        return s;
+    }
+    let radius = s.camera.eye.distance(t);
+    let horizontal = (s.camera.eye - t).with_y(0.0).normalize();
+    let sin = (y - t.y) / radius;
+    s.camera.eye = t + radius * ((1.0 - sin * sin).sqrt() * horizontal) + Vec3::new(0.0, y - t.y, 0.0);
+    s
+}
+
+#[test]
+fn orbiting_down_to_the_horizon() {
+    for (height, level_view) in
+        [(0.25, false), (0.0, false), (-0.01, false), (0.25, true), (0.0, true), (-0.01, true)]
+    {
+        let s = camera_at_height(height, level_view);
+        let what = format!("eye height {height} ({})", if level_view { "level" } else { "orbit" });
+        let image = render(&s, &Options::all_on(Look::Figure));
+        finite(&image, &what);
+        let cam = camera(&s, WIDTH, HEIGHT);
+        let background = s.background.to_array().map(level);
+        let (mut sky, mut sky_wrong, mut under, mut under_wrong) = (0, 0, 0, 0);
+        let underside = level(s.floor.colors[0].x * s.ambient.radiance().x);
+        // The far floor band: pixels whose footprint spans more than two tiles along X, clear of
+        // any shadow. The filtered checker must give the even blend of the two tiles there.
+        let mut band = Vec::new();
+        for y in 0..HEIGHT {
+            for x in 0..WIDTH {
+                match interior(&s, &cam, x, y) {
+                    Some(Hit::Sky) => {
+                        sky += 1;
+                        if image.get(x, y).map(level) != background {
+                            sky_wrong += 1;
+                        }
+                    }
+                    Some(Hit::Floor(_)) if cam.eye.y < s.floor.height() => {
+                        // The floor's underside faces away from the light: ambient only.
+                        under += 1;
+                        if (level(image.get(x, y)[0]) - underside).abs() > 1 {
+                            under_wrong += 1;
+                        }
+                    }
+                    Some(Hit::Floor(_)) => {
+                        let Some(points) = floor_corners(&s, &cam, x, y) else { continue };
+                        let xs = points.map(|p| p.x);
+                        let extent = xs.iter().fold(f32::MIN, |a, b| a.max(*b))
+                            - xs.iter().fold(f32::MAX, |a, b| a.min(*b));
+                        let clear = points
+                            .iter()
+                            .all(|p| spheres(&s).iter().all(|sp| exact_margin(&s, p.as_dvec3(), *sp) > 0.2));
+                        if extent > 2.0 * s.floor.tile && clear {
+                            band.push(f64::from(image.get(x, y)[1]) * 255.0);
+                        }
+                    }
+                    _ => {}
+                }
+            }
+        }
+        let blend = 0.5
+            * (s.floor.colors[0].y + s.floor.colors[1].y)
+            * (s.ambient.radiance().y + s.light.radiance().y * s.light.to_light().y);
+        let (mean, sd) = if band.is_empty() {
+            (f64::NAN, f64::NAN)
+        } else {
+            let n = band.len() as f64;
+            let mean = band.iter().sum::<f64>() / n;
+            (mean, (band.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n).sqrt())
+        };
+        println!(
+            "{what}: {sky} sky pixels ({sky_wrong} not background), {under} underside pixels ({under_wrong} not \
+             ambient-only), far band {} pixels: green mean {mean:.2} (even blend {:.2}), sd {sd:.2} levels",
+            band.len(),
+            blend * 255.0
+        );
+        assert!(sky > 1000 && sky_wrong == 0, "{what}");
+        assert_eq!(under_wrong, 0, "{what}");
+        if level_view && height < 0.0 {
+            assert!(under > 300, "{what}: only {under} underside pixels");
+        }
+        if level_view && height > 0.0 {
+            assert!(band.len() > 100, "{what}: only {} far-band pixels", band.len());
+            assert!(
+                (mean - f64::from(blend) * 255.0).abs() < 3.0 && sd < 3.0,
+                "{what}: the far band aliases"
+            );
+        }
     }
 }

@@ -94,13 +94,19 @@ fn surface_pipeline(
                 buffers: &[],
             },
             primitive: primitive(),
-            depth_stencil: Some(wgpu::DepthStencilState {
-                bias: if key.surface == Surface::Floor {
-                    FLOOR_AFTER_RECEIVER_BIAS
-                } else {
-                    Default::default()
-                },
-                ..depth_state(wgpu::CompareFunction::Less)
+            depth_stencil: Some(if key.surface == Surface::Floor {
+                // The biased floor compares LessEqual: near the far plane its bias pushes the
+                // depth past 1, where it is clamped to 1, the cleared value; with Less the floor's
+                // far end then vanished (a band of background before the far plane, found by
+                // tests/raster/extremes.rs). Where the receiver drew, the floor's biased depth is
+                // still greater and fails; only within one bias of the far plane (both clamped to
+                // 1) may it draw over the receiver, losing a shadow there.
+                wgpu::DepthStencilState {
+                    bias: FLOOR_AFTER_RECEIVER_BIAS,
+                    ..depth_state(wgpu::CompareFunction::LessEqual)
+                }
+            } else {
+                depth_state(wgpu::CompareFunction::Less)
             }),
             multisample: wgpu::MultisampleState { count: key.target.samples(), ..Default::default() },
             fragment: Some(wgpu::FragmentState {

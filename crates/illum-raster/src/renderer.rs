@@ -18,7 +18,7 @@ use crate::shadow_fit::{MAX_SHADOW_MAP, ShadowFit, fit_shadow};
 use crate::targets::{CubeSet, MainTargets, ShadowMap};
 use crate::uniforms::{self, ViewUniform};
 use crate::variants::{PipelineKey, Surface, Target};
-use crate::views::{cube_face_view_proj, main_view_proj};
+use crate::views::{capture_clip, cube_face_view_proj, main_view_proj};
 
 /// The pipelines of one frame.
 struct Keys {
@@ -319,7 +319,7 @@ impl WhittedRenderer {
         views[MAIN_VIEW] =
             uniforms::perspective_view(main_view_proj(scene, self.width, self.height), scene.camera.eye);
         let cube_view = |center: Vec3, face: usize| {
-            uniforms::perspective_view(cube_face_view_proj(center, face, scene.clip), center)
+            uniforms::perspective_view(cube_face_view_proj(center, face, capture_clip(scene, center)), center)
         };
         for face in 0..6 {
             views[GLASS_FACE_VIEWS + face] = cube_view(scene.glass.center, face);

@@ -53,6 +53,31 @@ pub fn cube_face_view_proj(center: Vec3, face: usize, clip: ClipPlanes) -> Mat4 
     pinhole(center, CUBE_AXES[face], 1.0, 1.0, clip)
 }
 
+/// The clip planes of the cube maps captured at `center` (a sphere's centre). They are not the
+/// camera's: a far plane set just beyond the floor's end as the camera sees it would, from the
+/// sphere, cut the floor's far corners out of the environment the glass refracts and the metal
+/// mirrors. Far reaches the farthest floor corner and the far side of the other sphere (with
+/// 1% slack); near is the camera's, but at most half the distance to the nearest surface (the
+/// floor's plane or the other sphere), so nothing the capture should see is clipped.
+pub fn capture_clip(scene: &WhittedScene, center: Vec3) -> ClipPlanes {
+    let floor = &scene.floor;
+    let (lo, hi) = (floor.min_corner(), floor.max_corner());
+    let y = floor.height();
+    let corners = [(lo.x, lo.y), (lo.x, hi.y), (hi.x, lo.y), (hi.x, hi.y)];
+    let mut far = corners.iter().map(|&(x, z)| center.distance(Vec3::new(x, y, z))).fold(0.0f32, f32::max);
+    let mut nearest = (center.y - y).abs();
+    for (c, r) in [(scene.glass.center, scene.glass.radius), (scene.metal.center, scene.metal.radius)] {
+        let d = center.distance(c);
+        if d > r {
+            far = far.max(d + r);
+            nearest = nearest.min(d - r);
+        }
+    }
+    let far = 1.01 * far.max(1e-3);
+    let near = scene.clip.near.min(0.5 * nearest).max(1e-6 * far);
+    ClipPlanes { near, far }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -105,6 +130,31 @@ mod tests {
         assert!(depth(0.5).abs() < 1e-6);
         assert!((depth(100.0) - 1.0).abs() < 1e-6);
         assert!(depth(2.0) < depth(3.0));
+    }
+
+    #[test]
+    fn captures_see_the_whole_floor_whatever_the_camera_clips() {
+        let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/whitted.toml"))
+            .unwrap();
+        let mut scene = WhittedScene::from_toml_str(&text, "whitted.toml").unwrap();
+        scene.clip = ClipPlanes { near: 0.6, far: 5.0 };
+        let clip = capture_clip(&scene, scene.glass.center);
+        // The floor's farthest corner from the glass (4.2, 2.6, -4.2) is (-23, 0, 7.5): 29.7 away.
+        let corner = scene.glass.center.distance(Vec3::new(-23.0, 0.0, 7.5));
+        assert!(clip.far > corner && clip.far < 1.02 * corner, "{clip:?}");
+        // The metal's surface is 1.87 from the glass's centre: near stays below half of that.
+        assert!(clip.near > 0.0 && clip.near <= 0.5 * 1.87, "{clip:?}");
+        assert_eq!(
+            capture_clip(
+                &{
+                    scene.clip.near = 0.1;
+                    scene
+                },
+                Vec3::new(4.2, 2.6, -4.2)
+            )
+            .near,
+            0.1
+        );
     }
 
     #[test]
