@@ -167,10 +167,36 @@ fn shade_metal(sw: Switches, p: vec3<f32>, n: vec3<f32>, eye: vec3<f32>) -> vec3
     return diffuse + specular;
 }
 
+// The refracted direction of unit `incident` at a surface with unit normal `n` (against the
+// ray) and ratio eta = n_from / n_to; on total internal reflection, where refract() returns the
+// zero vector (sin of the refracted angle would exceed 1, possible only for eta > 1), the mirror
+// direction, as a real dielectric reflects everything there. A zero vector must never reach a
+// cube-map lookup: its face and texel are undefined.
+fn refract_or_reflect(incident: vec3<f32>, n: vec3<f32>, eta: f32) -> vec3<f32> {
+    let out = refract(incident, n, eta);
+    if dot(out, out) == 0.0 {
+        return reflect(incident, n);
+    }
+    return out;
+}
+
+// Whether light along unit `incident` is totally reflected at normal n (against the ray) with
+// ratio eta: 1 - eta^2 (1 - cos^2) < 0.
+fn total_internal_reflection(incident: vec3<f32>, n: vec3<f32>, eta: f32) -> bool {
+    let c = dot(n, incident);
+    return 1.0 - eta * eta * (1.0 - c * c) < 0.0;
+}
+
 // Direction in which a ray entering the glass sphere at p1 (outward normal n1) along `incident`
-// leaves it: refraction into the glass, the chord to the far side, refraction out.
+// leaves it: refraction into the glass, the chord to the far side, refraction out. A ratio
+// above 1 (a sphere less dense than its surroundings, allowed only through the API) reflects
+// totally at the front face beyond the critical angle: then the ray never enters and the mirror
+// direction is returned.
 fn refract_through_sphere(p1: vec3<f32>, n1: vec3<f32>, incident: vec3<f32>, eta: f32) -> vec3<f32> {
     let sphere = scene.glass_sphere;
+    if total_internal_reflection(incident, n1, eta) {
+        return reflect(incident, n1);
+    }
     let inside = refract(incident, n1, eta);
     // The refracted ray p1 + s inside meets the sphere again where |p1 + s inside - c|^2 = r^2.
     // With |p1 - c| = r this is s^2 + 2 s (p1 - c).inside = 0, so the chord is
@@ -208,7 +234,7 @@ fn shade_glass(sw: Switches, p: array<vec3<f32>, 3>, n: array<vec3<f32>, 3>, eye
             if sw.whitted {
                 through[i] = refract_through_sphere(p[i], n[i], incident, eta);
             } else {
-                through[i] = refract(incident, n[i], eta);
+                through[i] = refract_or_reflect(incident, n[i], eta);
             }
         }
         mirrored[i] = reflect(incident, n[i]);
@@ -225,7 +251,14 @@ fn shade_glass(sw: Switches, p: array<vec3<f32>, 3>, n: array<vec3<f32>, 3>, eye
         let f0 = scene.glass_params.z;
         fresnel = f0;
         if sw.fresnel {
-            fresnel = f0 + (1.0 - f0) * pow(1.0 - clamp(dot(n[0], v), 0.0, 1.0), 5.0);
+            // Schlick's approximation takes the cosine on the less dense side: for eta > 1 the
+            // refracted angle's, and under total internal reflection everything is reflected.
+            var c = clamp(dot(n[0], v), 0.0, 1.0);
+            if eta > 1.0 {
+                let k = 1.0 - eta * eta * (1.0 - c * c);
+                c = sqrt(max(k, 0.0));
+            }
+            fresnel = f0 + (1.0 - f0) * pow(1.0 - c, 5.0);
         }
     }
     let transmitted = scene.glass_color.rgb * glass_environment(through);

@@ -553,3 +553,233 @@ fn orbiting_down_to_the_horizon() {
         }
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// 3. Refraction ratio 1: the glass must vanish into its background.
+
+/// Whether pixel (x, y)'s rays (centre and four points 0.6 px away) see the sky both from the
+/// eye (past the glass) and from the glass's centre (where its cube map is captured): there the
+/// cube-map lookup and the true background agree exactly.
+fn sky_behind_glass(s: &WhittedScene, cam: &Camera, x: u32, y: u32) -> bool {
+    let (cx, cy) = (x as f32 + 0.5, y as f32 + 0.5);
+    [(0.0, 0.0), (-0.6, -0.6), (0.6, -0.6), (-0.6, 0.6), (0.6, 0.6)].iter().all(|(dx, dy)| {
+        let d = cam.ray_direction(cx + dx, cy + dy);
+        trace(s, cam.eye, d, false) == Hit::Sky && trace(s, s.glass.center, d, false) == Hit::Sky
+    })
+}
+
+/// The glass moved under the floor, where the floor hides it and it shadows nothing visible.
+fn without_glass(s: &WhittedScene) -> WhittedScene {
+    let mut gone = s.clone();
+    gone.glass.center.y = s.floor.height() - 3.0 * s.glass.radius;
+    gone
+}
+
+/// The Blinn-Phong highlight of the glass at pixel (x, y), in levels (0 off the glass).
+fn glass_highlight_levels(s: &WhittedScene, cam: &Camera, x: u32, y: u32) -> f32 {
+    let dir = cam.ray_direction(x as f32 + 0.5, y as f32 + 0.5);
+    let Some(t) = ray_sphere(cam.eye, dir, s.glass.center, s.glass.radius) else { return 0.0 };
+    let n = (cam.eye + t * dir - s.glass.center).normalize();
+    let l = s.light.to_light();
+    if n.dot(l) <= 0.0 {
+        return 0.0;
+    }
+    255.0 * n.dot((l - dir).normalize()).max(0.0).powf(s.glass.shininess)
+}
+
+#[test]
+fn refraction_ratio_one_makes_the_glass_vanish() {
+    let mut s = scene();
+    s.glass.refraction_ratio = 1.0;
+    let cam = camera(&s, WIDTH, HEIGHT);
+    let white = s.glass.color;
+    let mix = s.glass.reflectivity;
+    for look in Look::ALL {
+        let mut on = Options::all_on(look);
+        on.effects.fresnel = false;
+        let mut off = on;
+        off.effects.refraction = false;
+        let bent = render(&s, &on);
+        let straight = render(&s, &off);
+        let behind = render(&without_glass(&s), &on);
+        for (image, what) in [(&bent, "refraction on"), (&straight, "refraction off"), (&behind, "no glass")]
+        {
+            finite(image, what);
+        }
+        let (
+            mut glass,
+            mut bent_vs_straight,
+            mut sky,
+            mut sky_wrong,
+            mut highlight,
+            mut all_close,
+            mut worst,
+        ) = (0, 0, 0, 0, 0, 0, 0);
+        for y in 0..HEIGHT {
+            for x in 0..WIDTH {
+                if interior(&s, &cam, x, y) != Some(Hit::Glass) {
+                    continue;
+                }
+                glass += 1;
+                let (p, q) = (bent.get(x, y), straight.get(x, y));
+                if (0..3).any(|c| (level(p[c]) - level(q[c])).abs() > 1) {
+                    bent_vs_straight += 1;
+                }
+                // What the pixel should be: figure look 0.1 white + 0.9 behind; whitted look
+                // (F0 = 0 at ratio 1, white tint) what is behind.
+                let b = behind.get(x, y);
+                let want = match look {
+                    Look::Figure => [0, 1, 2].map(|c| (1.0 - mix) * white[c] + mix * b[c]),
+                    Look::Whitted => b,
+                };
+                let diff = (0..3).map(|c| (level(p[c]) - level(want[c])).abs()).max().unwrap_or(0);
+                if look == Look::Whitted && glass_highlight_levels(&s, &cam, x, y) > 0.5 {
+                    highlight += 1;
+                    continue;
+                }
+                worst = worst.max(diff);
+                if diff <= 2 {
+                    all_close += 1;
+                }
+                if sky_behind_glass(&s, &cam, x, y) {
+                    sky += 1;
+                    if diff > 1 {
+                        sky_wrong += 1;
+                    }
+                }
+            }
+        }
+        println!(
+            "ratio 1, look {look}: {glass} glass pixels; refraction on vs off: {bent_vs_straight} differ by > 1 \
+             level; sky behind: {sky} pixels, {sky_wrong} off the expected by > 1 level; highlight pixels \
+             left out: {highlight}; all glass pixels within 2 levels of the expected: {all_close} of {} \
+             (the rest: the cube map looks from the centre, not the surface; worst {worst} levels)",
+            glass - highlight
+        );
+        assert!(glass > 5000 && sky > 1000, "look {look}: too few pixels checked");
+        assert_eq!(bent_vs_straight, 0, "look {look}: ratio 1 still bends the view");
+        assert_eq!(sky_wrong, 0, "look {look}: the sky through the glass differs from the sky behind it");
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// 4. Total internal reflection and extreme ratios: no NaN, no black holes.
+
+#[test]
+fn extreme_refraction_ratios_leave_no_black_holes() {
+    // The validator allows ratios in (0, 1] (glass denser than air); 2.0 (a bubble: the sphere
+    // less dense than its surroundings, with total internal reflection at the front face beyond
+    // 30 degrees of incidence) can only be set through the API, and is tested so the shader stays
+    // robust. The floor: the darkest environment colour anywhere else in the frame (its largest
+    // channel), less 3 levels of filtering slack.
+    for ratio in [0.3, 0.7, 1.0, 2.0] {
+        for look in Look::ALL {
+            let mut s = scene();
+            s.glass.refraction_ratio = ratio;
+            let image = render(&s, &Options::all_on(look));
+            let what = format!("ratio {ratio}, look {look}");
+            finite(&image, &what);
+            let cam = camera(&s, WIDTH, HEIGHT);
+            let mut darkest_elsewhere = i32::MAX;
+            for y in 0..HEIGHT {
+                for x in 0..WIDTH {
+                    if matches!(interior(&s, &cam, x, y), Some(Hit::Sky | Hit::Floor(_) | Hit::Metal)) {
+                        darkest_elsewhere = darkest_elsewhere.min(max_level(image.get(x, y)));
+                    }
+                }
+            }
+            let (n, darkest) = check_glass_pixels(&s, &image, look, darkest_elsewhere - 3, &what);
+            println!(
+                "{what}: {n} glass pixels, darkest environment seen through it {darkest} levels (elsewhere {darkest_elsewhere})"
+            );
+        }
+    }
+}
+
+/// For a pixel of the glass whose rays (centre and four points 0.6 px away) all meet the glass
+/// beyond the critical angle of ratio `eta` (with a margin), what the mirror directions see from
+/// the glass's centre (where the cube map is captured), if the same for all five: the sky, or the
+/// floor with the red channel it has there (equal on both tiles: colour x (ambient + light N.L) or,
+/// in shadow, colour x ambient), at least 0.15 from any shadow edge.
+fn totally_reflected_red(s: &WhittedScene, cam: &Camera, x: u32, y: u32, eta: f32) -> Option<f32> {
+    let (cx, cy) = (x as f32 + 0.5, y as f32 + 0.5);
+    let red = s.floor.colors[0].x;
+    let (ambient, direct) = (s.ambient.radiance().x, s.light.radiance().x * s.light.to_light().y);
+    let mut seen = Vec::new();
+    for (dx, dy) in [(0.0, 0.0), (-0.6, -0.6), (0.6, -0.6), (-0.6, 0.6), (0.6, 0.6)] {
+        let d = cam.ray_direction(cx + dx, cy + dy);
+        let t = ray_sphere(cam.eye, d, s.glass.center, s.glass.radius)?;
+        let n = (cam.eye + t * d - s.glass.center).normalize();
+        let cos = -n.dot(d);
+        if eta * eta * (1.0 - cos * cos) < 1.05 {
+            return None;
+        }
+        let m = d + 2.0 * cos * n;
+        seen.push(match trace(s, s.glass.center, m, false) {
+            Hit::Sky => s.background.x,
+            Hit::Floor(q) => {
+                let margin = spheres(s)
+                    .map(|sp| exact_margin(s, q.as_dvec3(), sp))
+                    .into_iter()
+                    .fold(f64::MAX, f64::min);
+                if margin.abs() < 0.15 {
+                    return None;
+                }
+                red * (ambient + if margin > 0.0 { direct } else { 0.0 })
+            }
+            _ => return None,
+        });
+    }
+    seen.iter().all(|v| (v - seen[0]).abs() < 1e-6).then_some(seen[0])
+}
+
+#[test]
+fn total_internal_reflection_mirrors_the_environment() {
+    // Ratio 2 (set through the API; see above): beyond 30 degrees of incidence nothing enters
+    // the sphere. Where the mirror direction sees the sky or the floor (away from shadow edges),
+    // the red channel must be the figure's 0.1 white + 0.9 E or, in the whitted look (Fresnel 1
+    // under total reflection), E itself, E the red of what the mirror direction sees.
+    let mut s = scene();
+    s.glass.refraction_ratio = 2.0;
+    let cam = camera(&s, WIDTH, HEIGHT);
+    for look in Look::ALL {
+        let image = render(&s, &Options::all_on(look));
+        finite(&image, "ratio 2");
+        let (mut sky, mut floor, mut wrong, mut worst) = (0, 0, 0, 0);
+        for y in 0..HEIGHT {
+            for x in 0..WIDTH {
+                if interior(&s, &cam, x, y) != Some(Hit::Glass)
+                    || glass_highlight_levels(&s, &cam, x, y) > 0.5
+                {
+                    continue;
+                }
+                let Some(e) = totally_reflected_red(&s, &cam, x, y, 2.0) else { continue };
+                if e == s.background.x {
+                    sky += 1;
+                } else {
+                    floor += 1;
+                }
+                let want = match look {
+                    Look::Figure => {
+                        level((1.0 - s.glass.reflectivity) * s.glass.color.x + s.glass.reflectivity * e)
+                    }
+                    Look::Whitted => level(e),
+                };
+                let diff = (level(image.get(x, y)[0]) - want).abs();
+                worst = worst.max(diff);
+                if diff > 3 {
+                    wrong += 1;
+                }
+            }
+        }
+        println!(
+            "ratio 2, look {look}: totally reflecting pixels mirroring the sky {sky}, the floor {floor}; \
+             {wrong} off by > 3 levels in red (worst {worst})"
+        );
+        assert!(sky > 300 && floor > 100, "look {look}: too few pixels checked");
+        assert!(
+            (wrong as f64) < 0.01 * (sky + floor) as f64,
+            "look {look}: total internal reflection does not mirror the environment"
+        );
+    }
+}
