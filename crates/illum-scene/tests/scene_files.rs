@@ -295,7 +295,10 @@ fn whitted_matches_section_1() {
     assert!(close3(basis.forward, Vec3::NEG_X, 1e-6), "{:?}", basis.forward);
     assert!(close3(basis.right, Vec3::NEG_Z, 1e-6), "{:?}", basis.right);
 
-    assert_eq!(s.background, Vec3::new(0.3, 0.5, 0.9));
+    // The figure's 8-bit levels (76, 128, 229) / 255, within 0.002 of the skeleton's (0.3, 0.5, 0.9)
+    // (scenes/whitted.toml says why).
+    assert_eq!(s.background, Vec3::new(0.298039, 0.501961, 0.898039));
+    assert!(close3(s.background, Vec3::new(0.3, 0.5, 0.9), 0.002));
     assert_eq!(s.light.position, Vec3::new(10.0, 13.0, -2.0));
     assert_eq!(s.light.target, Vec3::ZERO);
     assert_eq!(s.light.radiance(), Vec3::ONE);
