@@ -4,6 +4,9 @@
 //! - `figure`: checks of the figure look that need no reference: the floor's Lambert shading,
 //!   the background value, where the shadows fall, and the glass's 0.1 white + 0.9 environment;
 //! - `effects`: every toggle does what it says (and only that), no shadow acne, MSAA on edges;
+//! - `extremes`: issue 6 section 3, the scene at its extremes (low and high light, near and far
+//!   planes, the horizon, refraction ratio 1, total internal reflection), tabulated in
+//!   docs/accuracy.md;
 //! - `cli`: the render example's raster path, its errors and its output file.
 //!
 //! The expected values are computed here from the scene file and illum-scene's camera, never
