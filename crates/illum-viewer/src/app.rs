@@ -8,6 +8,7 @@ use std::str::FromStr;
 
 use illum_gpu::GpuContext;
 
+use crate::frame_rate::FrameRate;
 use crate::pathtrace_panel::PathTraceMode;
 use crate::raster_panel::RasterMode;
 use crate::scene_file::{self, DEFAULT_PATHTRACE_SCENE, DEFAULT_RASTER_SCENE, LoadedScene};
@@ -63,6 +64,8 @@ pub struct ViewerApp {
     /// The last open attempt's error (the current scenes stay).
     pub open_error: Option<String>,
     screenshot: Option<ScreenshotJob>,
+    /// How often the window repaints (shown in the top bar, printed after a screenshot run).
+    frame_rate: FrameRate,
 }
 
 impl ViewerApp {
@@ -83,6 +86,7 @@ impl ViewerApp {
             scene_field: options.scene.display().to_string(),
             open_error: None,
             screenshot: options.screenshot,
+            frame_rate: FrameRate::default(),
         };
         // Each mode starts on its default scene; the given file then replaces its mode's.
         app.pathtrace = load_pathtrace(Path::new(DEFAULT_PATHTRACE_SCENE));
@@ -99,6 +103,11 @@ impl ViewerApp {
 
     pub fn mode(&self) -> Mode {
         self.mode
+    }
+
+    /// The window's repaint rate over the last frames.
+    pub fn window_fps(&self) -> Option<f64> {
+        self.frame_rate.fps()
     }
 
     pub fn set_mode(&mut self, mode: Mode) {
@@ -124,19 +133,20 @@ impl ViewerApp {
     /// Opens a scene file into the mode of its kind and returns that mode. On error nothing
     /// changes and the loader's message is returned.
     pub fn open(&mut self, path: &Path) -> Result<Mode, String> {
-        let resolved = scene_file::resolve(path);
+        // The path as given names the scene in the UI and in saved metadata.
+        let given = path.to_path_buf();
         match scene_file::load(path)? {
             LoadedScene::PathTrace(scene) => {
                 match &mut self.pathtrace {
-                    Ok(mode) => mode.set_scene(resolved, scene),
-                    Err(_) => self.pathtrace = Ok(PathTraceMode::new(resolved, scene)),
+                    Ok(mode) => mode.set_scene(given, scene),
+                    Err(_) => self.pathtrace = Ok(PathTraceMode::new(given, scene)),
                 }
                 Ok(Mode::PathTrace)
             }
             LoadedScene::Raster(scene) => {
                 match &mut self.raster {
-                    Ok(mode) => mode.set_scene(resolved, scene),
-                    Err(_) => self.raster = Ok(RasterMode::new(resolved, scene)),
+                    Ok(mode) => mode.set_scene(given, scene),
+                    Err(_) => self.raster = Ok(RasterMode::new(given, scene)),
                 }
                 Ok(Mode::Raster)
             }
@@ -148,8 +158,10 @@ impl ViewerApp {
             ui.selectable_value(&mut self.mode, Mode::Raster, "Whitted raster");
             ui.selectable_value(&mut self.mode, Mode::PathTrace, "Path tracer");
             ui.separator();
-            ui.label("Scene");
-            let field = ui.add(egui::TextEdit::singleline(&mut self.scene_field).desired_width(280.0));
+            let label = ui.label("Scene");
+            let field = ui
+                .add(egui::TextEdit::singleline(&mut self.scene_field).desired_width(280.0))
+                .labelled_by(label.id);
             let entered = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
             if ui.button("Open").clicked() || entered {
                 let path = PathBuf::from(self.scene_field.trim());
@@ -167,6 +179,9 @@ impl ViewerApp {
             };
             if let Some(current) = current {
                 ui.weak(format!("showing {current}"));
+            }
+            if let Some(fps) = self.frame_rate.fps() {
+                ui.weak(format!("window {fps:.0} fps"));
             }
         });
         if let Some(error) = &self.open_error {
@@ -236,25 +251,26 @@ impl ViewerApp {
 
 fn load_pathtrace(path: &Path) -> Result<PathTraceMode, String> {
     match scene_file::load(path)? {
-        LoadedScene::PathTrace(scene) => Ok(PathTraceMode::new(scene_file::resolve(path), scene)),
+        LoadedScene::PathTrace(scene) => Ok(PathTraceMode::new(path.to_path_buf(), scene)),
         LoadedScene::Raster(_) => Err(format!("{} is a raster scene", path.display())),
     }
 }
 
 fn load_raster(path: &Path) -> Result<RasterMode, String> {
     match scene_file::load(path)? {
-        LoadedScene::Raster(scene) => Ok(RasterMode::new(scene_file::resolve(path), scene)),
+        LoadedScene::Raster(scene) => Ok(RasterMode::new(path.to_path_buf(), scene)),
         LoadedScene::PathTrace(_) => Err(format!("{} is a path-tracer scene", path.display())),
     }
 }
 
 impl eframe::App for ViewerApp {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        self.frame_rate.tick();
         egui::Panel::top("top bar").show(ui, |ui| self.top_bar(ui));
         egui::Panel::left("settings").resizable(true).default_size(320.0).show(ui, |ui| self.side_panel(ui));
         egui::CentralPanel::default().show(ui, |ui| self.view(ui));
         if let Some(job) = &mut self.screenshot {
-            job.tick(ui.ctx());
+            job.tick(ui.ctx(), self.frame_rate.fps());
         }
     }
 }

@@ -12,6 +12,7 @@ pub mod app;
 pub mod camera;
 pub mod cli;
 pub mod display;
+pub mod frame_rate;
 pub mod gpu_setup;
 pub mod pathtrace_panel;
 pub mod raster_panel;

@@ -323,8 +323,9 @@ impl PathTraceMode {
         ui.horizontal(|ui| {
             let mut unlimited = s.spp_target.is_none();
             let mut spp = s.spp_target.unwrap_or(self.scene.render.spp.max(1));
-            ui.add_enabled(!unlimited, egui::DragValue::new(&mut spp).range(1..=1_000_000).speed(1.0));
-            ui.label("spp target");
+            let label = ui.label("spp target");
+            ui.add_enabled(!unlimited, egui::DragValue::new(&mut spp).range(1..=1_000_000).speed(1.0))
+                .labelled_by(label.id);
             ui.checkbox(&mut unlimited, "Unlimited");
             s.spp_target = if unlimited { None } else { Some(spp) };
         });
@@ -334,8 +335,8 @@ impl PathTraceMode {
             ui.radio_value(&mut s.sampling, Sampling::Uniform, "Uniform");
         });
         ui.horizontal(|ui| {
-            ui.add(egui::DragValue::new(&mut s.seed).speed(1.0));
-            ui.label("Seed");
+            let label = ui.label("Seed");
+            ui.add(egui::DragValue::new(&mut s.seed).speed(1.0)).labelled_by(label.id);
         });
         ui.add(egui::Slider::new(&mut s.resolution_scale, 0.1..=1.0).text("Resolution scale"));
         ui.add(egui::Slider::new(&mut s.exposure, -8.0..=8.0).text("Exposure (display)").suffix(" stops"));
@@ -345,15 +346,17 @@ impl PathTraceMode {
         ui.horizontal(|ui| {
             let mut on = s.target_error.is_some();
             let mut value = s.target_error.unwrap_or(0.01);
-            ui.checkbox(&mut on, "At relative error");
-            ui.add_enabled(on, egui::DragValue::new(&mut value).range(0.0001..=1.0).speed(0.001));
+            let check = ui.checkbox(&mut on, "At relative error");
+            ui.add_enabled(on, egui::DragValue::new(&mut value).range(0.0001..=1.0).speed(0.001))
+                .labelled_by(check.id);
             s.target_error = on.then_some(value);
         });
         ui.horizontal(|ui| {
             let mut on = s.time_budget.is_some();
             let mut value = s.time_budget.unwrap_or(10.0);
-            ui.checkbox(&mut on, "After time budget");
-            ui.add_enabled(on, egui::DragValue::new(&mut value).range(0.1..=86_400.0).speed(0.5).suffix(" s"));
+            let check = ui.checkbox(&mut on, "After time budget");
+            ui.add_enabled(on, egui::DragValue::new(&mut value).range(0.1..=86_400.0).speed(0.5).suffix(" s"))
+                .labelled_by(check.id);
             s.time_budget = on.then_some(value);
         });
 
@@ -374,8 +377,8 @@ impl PathTraceMode {
 
         ui.separator();
         ui.horizontal(|ui| {
-            ui.label("Save to");
-            ui.text_edit_singleline(&mut self.save_path);
+            let label = ui.label("Save to");
+            ui.text_edit_singleline(&mut self.save_path).labelled_by(label.id);
         });
         ui.horizontal(|ui| {
             for (button, extension) in [("Save PNG", "png"), ("Save EXR", "exr")] {

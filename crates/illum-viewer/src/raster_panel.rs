@@ -6,18 +6,14 @@
 //! bits, exactly the bytes of the raster's PNG output (whose default encoding is linear, as the
 //! assignment's figure 1), so the window shows what a saved PNG would contain.
 
-use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 use illum_gpu::GpuContext;
 use illum_raster::{Look, Options, PassTimes, WhittedRenderer};
 use illum_scene::WhittedScene;
 
 use crate::camera::OrbitCamera;
-
-/// Frames averaged for the frame-rate display.
-const FPS_WINDOW: usize = 30;
+use crate::frame_rate::FrameRate;
 
 /// The raster mode.
 pub struct RasterMode {
@@ -28,8 +24,8 @@ pub struct RasterMode {
     renderer: Option<RasterRenderer>,
     /// The (scene, size) the renderer last failed to be created for, not retried every frame.
     failed: Option<(WhittedScene, u32, u32)>,
-    /// Start times of the last frames, for the frame rate.
-    frame_starts: VecDeque<Instant>,
+    /// Frames drawn by the renderer, for its frame rate.
+    frame_rate: FrameRate,
     pass_times: Option<PassTimes>,
     /// The renderer's last error, shown in the panel.
     pub message: Option<String>,
@@ -50,7 +46,7 @@ impl RasterMode {
             scene,
             renderer: None,
             failed: None,
-            frame_starts: VecDeque::new(),
+            frame_rate: FrameRate::default(),
             pass_times: None,
             message: None,
         }
@@ -75,9 +71,7 @@ impl RasterMode {
 
     /// Frames per second over the last frames drawn.
     pub fn fps(&self) -> Option<f64> {
-        let (first, last) = (self.frame_starts.front()?, self.frame_starts.back()?);
-        let seconds = last.duration_since(*first).as_secs_f64();
-        (self.frame_starts.len() > 1 && seconds > 0.0).then(|| (self.frame_starts.len() - 1) as f64 / seconds)
+        self.frame_rate.fps()
     }
 
     pub fn pass_times(&self) -> Option<PassTimes> {
@@ -109,10 +103,7 @@ impl RasterMode {
                 return None;
             }
         }
-        self.frame_starts.push_back(Instant::now());
-        while self.frame_starts.len() > FPS_WINDOW {
-            self.frame_starts.pop_front();
-        }
+        self.frame_rate.tick();
         let view = state.renderer.output_view()?;
         let mut renderer = render_state.renderer.write();
         // The output texture is recreated on resize and when MSAA is toggled, so the egui

@@ -3,6 +3,13 @@
 //!
 //! Both renderers repaint continuously while they work, so the tests step a fixed number of
 //! frames (`run_steps`) instead of waiting for the UI to settle.
+//!
+//! All harnesses share one device, as the real window has one: wgpu compares devices by their
+//! id within their own instance, so devices of separate instances (one per harness by default)
+//! can compare equal, and the path tracer's process-wide pipeline cache, keyed by device, would
+//! hand one device's pipeline to another.
+
+use std::sync::OnceLock;
 
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
@@ -10,10 +17,24 @@ use illum_scene::Bounces;
 use illum_viewer::gpu_setup::wgpu_setup;
 use illum_viewer::{Mode, StartOptions, ViewerApp};
 
+/// The one device of this test process (lavapipe when present), created with the viewer's setup.
+fn shared_device() -> egui_wgpu::WgpuSetupExisting {
+    static STATE: OnceLock<egui_wgpu::RenderState> = OnceLock::new();
+    let state = STATE.get_or_init(|| {
+        egui_kittest::wgpu::create_render_state(wgpu_setup(true), egui_wgpu::RendererOptions::PREDICTABLE)
+    });
+    egui_wgpu::WgpuSetupExisting {
+        instance: state.instance.clone(),
+        adapter: state.adapter.clone(),
+        device: state.device.clone(),
+        queue: state.queue.clone(),
+    }
+}
+
 fn harness(mode: Mode) -> Harness<'static, ViewerApp> {
     Harness::builder()
         .with_size(egui::vec2(900.0, 560.0))
-        .wgpu_setup(wgpu_setup(true))
+        .wgpu_setup(egui_wgpu::WgpuSetup::Existing(shared_device()))
         .build_eframe(move |cc| {
             ViewerApp::new(cc, StartOptions { scene: "scenes/cornell.toml".into(), mode: Some(mode), screenshot: None })
         })
@@ -56,7 +77,7 @@ fn changing_bounces_restarts_the_accumulation() {
     harness.run_steps(6);
     let before = spp(&harness);
     assert!(before > 0, "the path tracer rendered nothing in 6 frames");
-    harness.get_by_label("Bounces").set_value_accesskit(5.0);
+    harness.get_by_role_and_label(egui::accesskit::Role::Slider, "Bounces").set_value_accesskit(5.0);
     harness.run_steps(1);
     assert_eq!(harness.state().pathtrace().unwrap().settings.bounces, Bounces::Fixed(5));
     harness.get_by_label("Unbounded").click();
