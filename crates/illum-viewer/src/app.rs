@@ -199,9 +199,7 @@ impl ViewerApp {
                 ui.colored_label(ui.visuals().error_fg_color, error.as_str());
             }
             ui.separator();
-            ui.weak(
-                "Mouse on the image: left drag orbits, right or middle drag pans, the wheel zooms.",
-            );
+            ui.weak("Mouse on the image: left drag orbits, right or middle drag pans, the wheel zooms.");
         });
     }
 
@@ -215,7 +213,8 @@ impl ViewerApp {
         };
         let size = ui.available_size().max(egui::vec2(1.0, 1.0));
         let pixels_per_point = ui.ctx().pixels_per_point();
-        let view_pixels = [(size.x * pixels_per_point).round() as u32, (size.y * pixels_per_point).round() as u32];
+        let view_pixels =
+            [(size.x * pixels_per_point).round() as u32, (size.y * pixels_per_point).round() as u32];
         let texture = match self.mode {
             Mode::Raster => self.raster.as_mut().ok().and_then(|m| m.frame(gpu, render_state, view_pixels)),
             Mode::PathTrace => self.pathtrace.as_mut().ok().and_then(|m| {

@@ -40,9 +40,16 @@ mod tests {
 
     #[test]
     fn parses_screenshot_options() {
-        let args =
-            Args::try_parse_from(["illum-viewer", "--mode", "raster", "--screenshot", "a.png", "--frames", "3"])
-                .unwrap();
+        let args = Args::try_parse_from([
+            "illum-viewer",
+            "--mode",
+            "raster",
+            "--screenshot",
+            "a.png",
+            "--frames",
+            "3",
+        ])
+        .unwrap();
         assert_eq!(args.mode, Some(Mode::Raster));
         assert_eq!(args.frames, 3);
         assert_eq!(args.screenshot, Some(PathBuf::from("a.png")));

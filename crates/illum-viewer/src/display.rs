@@ -114,7 +114,8 @@ impl Display {
         if image.width == 0 || image.height == 0 || !image.is_consistent() {
             return self.texture_id;
         }
-        let resized = self.textures.as_ref().is_none_or(|t| (t.width, t.height) != (image.width, image.height));
+        let resized =
+            self.textures.as_ref().is_none_or(|t| (t.width, t.height) != (image.width, image.height));
         if resized {
             self.textures = Some(self.create_textures(gpu, image.width, image.height));
         }
@@ -156,8 +157,9 @@ impl Display {
         let Some(textures) = &self.textures else { return };
         let scale = 2f32.powf(exposure);
         gpu.queue.write_buffer(&self.params, 0, bytemuck::cast_slice(&[scale, 0.0, 0.0, 0.0]));
-        let mut encoder =
-            gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("viewer display") });
+        let mut encoder = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("viewer display") });
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("viewer display"),
@@ -217,7 +219,10 @@ impl Display {
             label: Some("viewer display"),
             layout: &self.layout,
             entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&source_view) },
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(&source_view),
+                },
                 wgpu::BindGroupEntry { binding: 1, resource: self.params.as_entire_binding() },
             ],
         });
@@ -232,7 +237,8 @@ mod tests {
     /// The shader parses and validates without a GPU.
     #[test]
     fn display_shader_validates() {
-        let module = wgpu::naga::front::wgsl::parse_str(SHADER).unwrap_or_else(|e| panic!("{}", e.emit_to_string(SHADER)));
+        let module = wgpu::naga::front::wgsl::parse_str(SHADER)
+            .unwrap_or_else(|e| panic!("{}", e.emit_to_string(SHADER)));
         wgpu::naga::valid::Validator::new(
             wgpu::naga::valid::ValidationFlags::all(),
             wgpu::naga::valid::Capabilities::empty(),

@@ -13,7 +13,8 @@ fn main() {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let args = Args::parse();
     let outcome: Outcome = Arc::default();
-    let screenshot = args.screenshot.clone().map(|path| ScreenshotJob::new(path, args.frames, outcome.clone()));
+    let screenshot =
+        args.screenshot.clone().map(|path| ScreenshotJob::new(path, args.frames, outcome.clone()));
     let start = StartOptions { scene: args.scene.clone(), mode: args.mode, screenshot };
 
     let mut native = eframe::NativeOptions {
@@ -25,7 +26,8 @@ fn main() {
     // Under CI (as in the tests) prefer lavapipe, as illum_gpu::GpuContext::new does.
     native.wgpu_options.wgpu_setup = wgpu_setup(std::env::var_os("CI").is_some());
 
-    let result = eframe::run_native("illum viewer", native, Box::new(|cc| Ok(Box::new(ViewerApp::new(cc, start)))));
+    let result =
+        eframe::run_native("illum viewer", native, Box::new(|cc| Ok(Box::new(ViewerApp::new(cc, start)))));
     if let Err(e) = result {
         eprintln!("error: the window could not run: {e}");
         std::process::exit(1);

@@ -355,8 +355,11 @@ impl PathTraceMode {
             let mut on = s.time_budget.is_some();
             let mut value = s.time_budget.unwrap_or(10.0);
             let check = ui.checkbox(&mut on, "After time budget");
-            ui.add_enabled(on, egui::DragValue::new(&mut value).range(0.1..=86_400.0).speed(0.5).suffix(" s"))
-                .labelled_by(check.id);
+            ui.add_enabled(
+                on,
+                egui::DragValue::new(&mut value).range(0.1..=86_400.0).speed(0.5).suffix(" s"),
+            )
+            .labelled_by(check.id);
             s.time_budget = on.then_some(value);
         });
 

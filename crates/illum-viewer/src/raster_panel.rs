@@ -110,7 +110,12 @@ impl RasterMode {
         // texture is pointed at the current view every frame (this only rebuilds a bind group).
         let id = match state.texture {
             Some(id) => {
-                renderer.update_egui_texture_from_wgpu_texture(&gpu.device, view, egui_wgpu::wgpu::FilterMode::Linear, id);
+                renderer.update_egui_texture_from_wgpu_texture(
+                    &gpu.device,
+                    view,
+                    egui_wgpu::wgpu::FilterMode::Linear,
+                    id,
+                );
                 id
             }
             None => renderer.register_native_texture(&gpu.device, view, egui_wgpu::wgpu::FilterMode::Linear),

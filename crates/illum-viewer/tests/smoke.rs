@@ -10,7 +10,8 @@ const WIDTH: &str = "640";
 const HEIGHT: &str = "420";
 
 fn xvfb_run() -> &'static str {
-    let found = Command::new("sh").args(["-c", "command -v xvfb-run"]).output().is_ok_and(|o| o.status.success());
+    let found =
+        Command::new("sh").args(["-c", "command -v xvfb-run"]).output().is_ok_and(|o| o.status.success());
     assert!(
         found,
         "xvfb-run is missing: the viewer's smoke test needs a virtual X display. \

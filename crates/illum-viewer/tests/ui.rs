@@ -36,7 +36,10 @@ fn harness(mode: Mode) -> Harness<'static, ViewerApp> {
         .with_size(egui::vec2(900.0, 560.0))
         .wgpu_setup(egui_wgpu::WgpuSetup::Existing(shared_device()))
         .build_eframe(move |cc| {
-            ViewerApp::new(cc, StartOptions { scene: "scenes/cornell.toml".into(), mode: Some(mode), screenshot: None })
+            ViewerApp::new(
+                cc,
+                StartOptions { scene: "scenes/cornell.toml".into(), mode: Some(mode), screenshot: None },
+            )
         })
 }
 
@@ -119,7 +122,8 @@ fn saves_png_and_exr_into_a_directory() {
     let (w, h) = (png.width(), png.height());
     assert!(w > 0 && h > 0);
     let exr = target.with_extension("exr");
-    let (image, attributes) = illum_image::load_exr(&exr).unwrap_or_else(|e| panic!("{}: {e}", exr.display()));
+    let (image, attributes) =
+        illum_image::load_exr(&exr).unwrap_or_else(|e| panic!("{}: {e}", exr.display()));
     assert_eq!((image.width, image.height), (w, h));
     assert!(attributes.iter().any(|(k, _)| k.contains("spp")), "{attributes:?}");
     let message = harness.state().pathtrace().unwrap().message.clone().unwrap_or_default();
