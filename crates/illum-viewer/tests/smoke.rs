@@ -3,7 +3,8 @@
 //! draw different pictures.
 
 use std::path::Path;
-use std::process::Command;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
 
 /// Window size of the smoke runs (small: lavapipe draws every pixel on the CPU).
 const WIDTH: &str = "640";
@@ -20,20 +21,37 @@ fn xvfb_run() -> &'static str {
     "xvfb-run"
 }
 
+/// Longest a screenshot run may take before it counts as hung (it takes seconds on lavapipe).
+const RUN_TIMEOUT: Duration = Duration::from_secs(180);
+
 fn screenshot(mode: &str, path: &Path) -> image::RgbaImage {
-    let output = Command::new(xvfb_run())
+    let (log_out, log_err) = (path.with_extension("stdout.txt"), path.with_extension("stderr.txt"));
+    let mut child = Command::new(xvfb_run())
         .args(["-a", "-s", "-screen 0 1024x768x24"])
         .arg(env!("CARGO_BIN_EXE_illum-viewer"))
         .args(["--mode", mode, "--frames", "8", "--width", WIDTH, "--height", HEIGHT, "--screenshot"])
         .arg(path)
-        .output()
-        .expect("running xvfb-run");
+        // Files, not pipes: a full pipe would block the child while the test polls it.
+        .stdout(Stdio::from(std::fs::File::create(&log_out).expect("creating the stdout log")))
+        .stderr(Stdio::from(std::fs::File::create(&log_err).expect("creating the stderr log")))
+        .spawn()
+        .expect("starting xvfb-run");
+    let started = Instant::now();
+    // Poll rather than wait, so a hung window fails the test instead of hanging it.
+    while child.try_wait().expect("polling the viewer").is_none() {
+        if started.elapsed() > RUN_TIMEOUT {
+            let _ = child.kill();
+            panic!("the viewer did not exit within {RUN_TIMEOUT:?} in {mode} mode");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let status = child.wait().expect("collecting the viewer's exit status");
+    let read = |p: &Path| std::fs::read_to_string(p).unwrap_or_default();
     assert!(
-        output.status.success(),
-        "the viewer failed in {mode} mode ({}):\nstdout:\n{}\nstderr:\n{}",
-        output.status,
-        String::from_utf8_lossy(&output.stdout),
-        String::from_utf8_lossy(&output.stderr)
+        status.success(),
+        "the viewer failed in {mode} mode ({status}):\nstdout:\n{}\nstderr:\n{}",
+        read(&log_out),
+        read(&log_err)
     );
     image::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())).to_rgba8()
 }
