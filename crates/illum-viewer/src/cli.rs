@@ -23,10 +23,10 @@ pub struct Args {
     #[arg(long, default_value_t = 30)]
     pub frames: u32,
     /// Initial window width in points.
-    #[arg(long, default_value_t = 1100.0)]
+    #[arg(long, default_value_t = 960.0)]
     pub width: f32,
     /// Initial window height in points.
-    #[arg(long, default_value_t = 720.0)]
+    #[arg(long, default_value_t = 600.0)]
     pub height: f32,
 }
 

@@ -25,6 +25,9 @@ fn main() {
     };
     // Under CI (as in the tests) prefer lavapipe, as illum_gpu::GpuContext::new does.
     native.wgpu_options.wgpu_setup = wgpu_setup(std::env::var_os("CI").is_some());
+    // No vsync: the frame rate is bounded by the work (path-tracing slices, raster frames), and
+    // on software drivers FIFO presentation adds a wait to every frame.
+    native.wgpu_options.surface.present_mode = egui_wgpu::wgpu::PresentMode::AutoNoVsync;
 
     let result =
         eframe::run_native("illum viewer", native, Box::new(|cc| Ok(Box::new(ViewerApp::new(cc, start)))));

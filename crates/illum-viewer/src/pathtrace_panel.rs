@@ -18,7 +18,7 @@ use crate::display::Display;
 
 /// Wall time aimed at per submission: short enough that a frame (submission, fold, upload,
 /// egui) stays well under the 50 ms of 20 fps on lavapipe.
-pub const FRAME_BUDGET: f64 = 0.025;
+pub const FRAME_BUDGET: f64 = 0.015;
 /// Highest fixed bounce count offered by the slider (the scene format allows more).
 pub const MAX_UI_BOUNCES: u32 = 64;
 /// Default resolution scale: half the view's pixels in each direction keeps lavapipe
