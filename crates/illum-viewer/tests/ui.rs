@@ -177,3 +177,55 @@ fn snapshot_raster() {
     harness.run_steps(4);
     harness.snapshot("viewer_raster");
 }
+
+#[test]
+fn dragging_orbits_the_camera_and_reset_camera_restores_it() {
+    let mut harness = harness(Mode::PathTrace);
+    harness.run_steps(4);
+    assert!(spp(&harness) > 0);
+    // Paused, so that the restart caused by the camera change stays visible as 0 spp.
+    harness.get_by_label("Pause").click();
+    harness.run_steps(1);
+    // The image fills the central panel, right of the settings panel.
+    let start = egui::pos2(600.0, 300.0);
+    harness.event(egui::Event::PointerMoved(start));
+    harness.event(egui::Event::PointerButton {
+        pos: start,
+        button: egui::PointerButton::Primary,
+        pressed: true,
+        modifiers: egui::Modifiers::NONE,
+    });
+    harness.run_steps(1);
+    for step in 1..=5 {
+        harness.event(egui::Event::PointerMoved(start + egui::vec2(12.0 * step as f32, 4.0 * step as f32)));
+        harness.run_steps(1);
+    }
+    let end = start + egui::vec2(60.0, 20.0);
+    harness.event(egui::Event::PointerButton {
+        pos: end,
+        button: egui::PointerButton::Primary,
+        pressed: false,
+        modifiers: egui::Modifiers::NONE,
+    });
+    harness.run_steps(2);
+    assert!(!harness.state().pathtrace().unwrap().camera.is_home(), "the drag did not move the camera");
+    assert_eq!(spp(&harness), 0, "a camera change restarts the accumulation");
+    harness.get_by_label("Reset camera").click();
+    harness.run_steps(2);
+    assert!(harness.state().pathtrace().unwrap().camera.is_home());
+}
+
+#[test]
+fn the_path_tracer_follows_the_window_size() {
+    let mut harness = harness(Mode::PathTrace);
+    harness.run_steps(3);
+    let small = harness.state().pathtrace().unwrap().stats();
+    harness.set_size(egui::vec2(1000.0, 700.0));
+    harness.run_steps(3);
+    let large = harness.state().pathtrace().unwrap().stats();
+    assert!(large.width > small.width && large.height > small.height, "{small:?} -> {large:?}");
+    harness.state_mut().pathtrace_mut().unwrap().settings.resolution_scale = 0.25;
+    harness.run_steps(3);
+    let scaled = harness.state().pathtrace().unwrap().stats();
+    assert!(scaled.width * 2 <= large.width + 1, "{large:?} -> {scaled:?}");
+}
