@@ -93,7 +93,12 @@ fn extra_shader_sets() -> Vec<Vec<(Vec<ShaderFile>, ShaderFile)>> {
         .iter()
         .map(|entry| (illum::raster::shaders::modules(), entry.clone()))
         .collect();
-    vec![raster]
+    // The viewer's display pass: one self-contained file.
+    let display = ShaderFile {
+        path: "shaders/viewer/display.wgsl".into(),
+        source: include_str!("../shaders/viewer/display.wgsl").into(),
+    };
+    vec![raster, vec![(Vec::new(), display)]]
 }
 
 #[test]

@@ -20,6 +20,9 @@ pub struct GpuContext {
     pub adapter_info: wgpu::AdapterInfo,
     /// True when the device was created with `TIMESTAMP_QUERY`, so passes can be timed on the GPU.
     pub timestamps: bool,
+    /// Unique within the process: caches of device objects key on it (wgpu's own device ids
+    /// repeat across instances).
+    id: u64,
     /// Errors raised outside any error scope (validation, out of memory) and device loss, drained
     /// by [`GpuContext::check`] after each submission.
     errors: Arc<Mutex<Vec<GpuError>>>,
@@ -94,7 +97,14 @@ impl GpuContext {
                 }
             });
         }
-        Self { device, queue, adapter_info, timestamps, errors }
+        static NEXT_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+        let id = NEXT_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        Self { device, queue, adapter_info, timestamps, id, errors }
+    }
+
+    /// This context's process-unique id (clones share it).
+    pub fn id(&self) -> u64 {
+        self.id
     }
 
     /// True for CPU implementations (lavapipe / llvmpipe, WARP, SwiftShader).

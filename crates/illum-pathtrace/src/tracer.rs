@@ -80,9 +80,10 @@ impl TracerOptions {
     }
 }
 
-/// Compiled pipelines by (device, traversal source, shader defs): two scenes with the same
-/// specialisation share one pipeline, so switching back to a scene does not recompile.
-type PipelineKey = (wgpu::Device, String, Vec<(&'static str, Def)>);
+/// Compiled pipelines by (GPU context id, traversal source, shader defs): two scenes with the
+/// same specialisation share one pipeline, so switching back to a scene does not recompile.
+/// (Keyed by illum's context id, not `wgpu::Device`, whose ids repeat across wgpu instances.)
+type PipelineKey = (u64, String, Vec<(&'static str, Def)>);
 
 fn pipeline_cache() -> &'static Mutex<HashMap<PipelineKey, wgpu::ComputePipeline>> {
     static CACHE: OnceLock<Mutex<HashMap<PipelineKey, wgpu::ComputePipeline>>> = OnceLock::new();
@@ -224,7 +225,7 @@ impl PathTracer {
         let modules = shader_modules(scene, &gpu_scene, options.traversal);
         let defs = options.shader_defs();
         let key: PipelineKey =
-            (gpu.device.clone(), modules.last().expect("traversal").source.to_string(), defs.clone());
+            (gpu.id(), modules.last().expect("traversal").source.to_string(), defs.clone());
         let cached = pipeline_cache().lock().unwrap_or_else(|p| p.into_inner()).get(&key).cloned();
         let pipeline = match cached {
             Some(pipeline) => pipeline,

@@ -1,0 +1,275 @@
+//! The application: the mode switch, opening scene files, and the layout (top bar, the mode's
+//! panel on the left, the image filling the rest). Each mode keeps its own settings, camera
+//! and renderer, so switching away and back finds them as they were.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+
+use illum_gpu::GpuContext;
+
+use crate::frame_rate::FrameRate;
+use crate::pathtrace_panel::PathTraceMode;
+use crate::raster_panel::RasterMode;
+use crate::scene_file::{self, DEFAULT_PATHTRACE_SCENE, DEFAULT_RASTER_SCENE, LoadedScene};
+use crate::screenshot::ScreenshotJob;
+
+/// Which renderer the window shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mode {
+    Raster,
+    PathTrace,
+}
+
+impl FromStr for Mode {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "raster" => Ok(Mode::Raster),
+            "pathtrace" => Ok(Mode::PathTrace),
+            _ => Err(format!("unknown mode {s:?}: must be \"raster\" or \"pathtrace\"")),
+        }
+    }
+}
+
+impl fmt::Display for Mode {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Mode::Raster => "raster",
+            Mode::PathTrace => "pathtrace",
+        })
+    }
+}
+
+/// How the window starts.
+pub struct StartOptions {
+    /// A scene file of either kind; it opens in its own mode.
+    pub scene: PathBuf,
+    /// The mode shown first (default: the scene's).
+    pub mode: Option<Mode>,
+    pub screenshot: Option<ScreenshotJob>,
+}
+
+/// The viewer.
+pub struct ViewerApp {
+    mode: Mode,
+    /// eframe's device wrapped for the renderers, or why there is none.
+    gpu: Result<(GpuContext, egui_wgpu::RenderState), String>,
+    /// Each mode, or why its scene could not be loaded.
+    pathtrace: Result<PathTraceMode, String>,
+    raster: Result<RasterMode, String>,
+    /// The "open scene" text field.
+    pub scene_field: String,
+    /// The last open attempt's error (the current scenes stay).
+    pub open_error: Option<String>,
+    screenshot: Option<ScreenshotJob>,
+    /// How often the window repaints (shown in the top bar, printed after a screenshot run).
+    frame_rate: FrameRate,
+}
+
+impl ViewerApp {
+    pub fn new(cc: &eframe::CreationContext<'_>, options: StartOptions) -> Self {
+        let gpu = match &cc.wgpu_render_state {
+            Some(rs) => {
+                let gpu = GpuContext::from_device(rs.device.clone(), rs.queue.clone(), rs.adapter.get_info());
+                log::info!("viewer adapter: {} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend);
+                Ok((gpu, rs.clone()))
+            }
+            None => Err("eframe started without its wgpu renderer; the viewer needs wgpu".to_owned()),
+        };
+        let mut app = ViewerApp {
+            mode: Mode::PathTrace,
+            gpu,
+            pathtrace: Err("no path-tracer scene loaded".to_owned()),
+            raster: Err("no raster scene loaded".to_owned()),
+            scene_field: options.scene.display().to_string(),
+            open_error: None,
+            screenshot: options.screenshot,
+            frame_rate: FrameRate::default(),
+        };
+        // Each mode starts on its default scene; the given file then replaces its mode's.
+        app.pathtrace = load_pathtrace(Path::new(DEFAULT_PATHTRACE_SCENE));
+        app.raster = load_raster(Path::new(DEFAULT_RASTER_SCENE));
+        match app.open(&options.scene) {
+            Ok(mode) => app.mode = mode,
+            Err(e) => app.open_error = Some(e),
+        }
+        if let Some(mode) = options.mode {
+            app.mode = mode;
+        }
+        app
+    }
+
+    pub fn mode(&self) -> Mode {
+        self.mode
+    }
+
+    /// The window's repaint rate over the last frames.
+    pub fn window_fps(&self) -> Option<f64> {
+        self.frame_rate.fps()
+    }
+
+    pub fn set_mode(&mut self, mode: Mode) {
+        self.mode = mode;
+    }
+
+    pub fn pathtrace(&self) -> Option<&PathTraceMode> {
+        self.pathtrace.as_ref().ok()
+    }
+
+    pub fn pathtrace_mut(&mut self) -> Option<&mut PathTraceMode> {
+        self.pathtrace.as_mut().ok()
+    }
+
+    pub fn raster(&self) -> Option<&RasterMode> {
+        self.raster.as_ref().ok()
+    }
+
+    pub fn raster_mut(&mut self) -> Option<&mut RasterMode> {
+        self.raster.as_mut().ok()
+    }
+
+    /// Opens a scene file into the mode of its kind and returns that mode. On error nothing
+    /// changes and the loader's message is returned.
+    pub fn open(&mut self, path: &Path) -> Result<Mode, String> {
+        // The path as given names the scene in the UI and in saved metadata.
+        let given = path.to_path_buf();
+        match scene_file::load(path)? {
+            LoadedScene::PathTrace(scene) => {
+                match &mut self.pathtrace {
+                    Ok(mode) => mode.set_scene(given, scene),
+                    Err(_) => self.pathtrace = Ok(PathTraceMode::new(given, scene)),
+                }
+                Ok(Mode::PathTrace)
+            }
+            LoadedScene::Raster(scene) => {
+                match &mut self.raster {
+                    Ok(mode) => mode.set_scene(given, scene),
+                    Err(_) => self.raster = Ok(RasterMode::new(given, scene)),
+                }
+                Ok(Mode::Raster)
+            }
+        }
+    }
+
+    fn top_bar(&mut self, ui: &mut egui::Ui) {
+        ui.horizontal(|ui| {
+            ui.selectable_value(&mut self.mode, Mode::Raster, "Whitted raster");
+            ui.selectable_value(&mut self.mode, Mode::PathTrace, "Path tracer");
+            ui.separator();
+            let label = ui.label("Scene");
+            let field = ui
+                .add(egui::TextEdit::singleline(&mut self.scene_field).desired_width(280.0))
+                .labelled_by(label.id);
+            let entered = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+            if ui.button("Open").clicked() || entered {
+                let path = PathBuf::from(self.scene_field.trim());
+                match self.open(&path) {
+                    Ok(mode) => {
+                        self.mode = mode;
+                        self.open_error = None;
+                    }
+                    Err(e) => self.open_error = Some(e),
+                }
+            }
+            let current = match self.mode {
+                Mode::Raster => self.raster.as_ref().ok().map(|m| m.scene_path().display().to_string()),
+                Mode::PathTrace => self.pathtrace.as_ref().ok().map(|m| m.scene_path().display().to_string()),
+            };
+            if let Some(current) = current {
+                ui.weak(format!("showing {current}"));
+            }
+            if let Some(fps) = self.frame_rate.fps() {
+                ui.weak(format!("window {fps:.0} fps"));
+            }
+        });
+        if let Some(error) = &self.open_error {
+            ui.colored_label(ui.visuals().error_fg_color, format!("Could not open the scene: {error}"));
+        }
+    }
+
+    fn side_panel(&mut self, ui: &mut egui::Ui) {
+        egui::ScrollArea::vertical().show(ui, |ui| {
+            let result = match self.mode {
+                Mode::Raster => self.raster.as_mut().map(|m| m.panel(ui)),
+                Mode::PathTrace => self.pathtrace.as_mut().map(|m| m.panel(ui)),
+            };
+            if let Err(error) = result {
+                ui.colored_label(ui.visuals().error_fg_color, error.as_str());
+            }
+            ui.separator();
+            ui.weak("Mouse on the image: left drag orbits, right or middle drag pans, the wheel zooms.");
+        });
+    }
+
+    fn view(&mut self, ui: &mut egui::Ui) {
+        let (gpu, render_state) = match &self.gpu {
+            Ok(pair) => pair,
+            Err(error) => {
+                ui.colored_label(ui.visuals().error_fg_color, error.as_str());
+                return;
+            }
+        };
+        let size = ui.available_size().max(egui::vec2(1.0, 1.0));
+        let pixels_per_point = ui.ctx().pixels_per_point();
+        let view_pixels =
+            [(size.x * pixels_per_point).round() as u32, (size.y * pixels_per_point).round() as u32];
+        let texture = match self.mode {
+            Mode::Raster => self.raster.as_mut().ok().and_then(|m| m.frame(gpu, render_state, view_pixels)),
+            Mode::PathTrace => self.pathtrace.as_mut().ok().and_then(|m| {
+                m.frame(gpu, render_state, view_pixels);
+                m.texture()
+            }),
+        };
+        let sense = egui::Sense::click_and_drag();
+        let response = match texture {
+            Some(id) => ui.add(egui::Image::new(egui::load::SizedTexture::new(id, size)).sense(sense)),
+            None => ui.allocate_response(size, sense),
+        };
+        let camera = match self.mode {
+            Mode::Raster => self.raster.as_mut().ok().map(|m| &mut m.camera),
+            Mode::PathTrace => self.pathtrace.as_mut().ok().map(|m| &mut m.camera),
+        };
+        if let Some(camera) = camera
+            && camera.handle(ui, &response)
+        {
+            ui.ctx().request_repaint();
+        }
+        // The raster redraws every frame (it is a real-time renderer and its frame rate is
+        // measured); the path tracer while it still has samples to take.
+        let busy = match self.mode {
+            Mode::Raster => self.raster.is_ok(),
+            Mode::PathTrace => self.pathtrace.as_ref().is_ok_and(PathTraceMode::is_rendering),
+        };
+        if busy {
+            ui.ctx().request_repaint();
+        }
+    }
+}
+
+fn load_pathtrace(path: &Path) -> Result<PathTraceMode, String> {
+    match scene_file::load(path)? {
+        LoadedScene::PathTrace(scene) => Ok(PathTraceMode::new(path.to_path_buf(), scene)),
+        LoadedScene::Raster(_) => Err(format!("{} is a raster scene", path.display())),
+    }
+}
+
+fn load_raster(path: &Path) -> Result<RasterMode, String> {
+    match scene_file::load(path)? {
+        LoadedScene::Raster(scene) => Ok(RasterMode::new(path.to_path_buf(), scene)),
+        LoadedScene::PathTrace(_) => Err(format!("{} is a path-tracer scene", path.display())),
+    }
+}
+
+impl eframe::App for ViewerApp {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        self.frame_rate.tick();
+        egui::Panel::top("top bar").show(ui, |ui| self.top_bar(ui));
+        egui::Panel::left("settings").resizable(true).default_size(320.0).show(ui, |ui| self.side_panel(ui));
+        egui::CentralPanel::default().show(ui, |ui| self.view(ui));
+        if let Some(job) = &mut self.screenshot {
+            job.tick(ui.ctx(), self.frame_rate.fps());
+        }
+    }
+}

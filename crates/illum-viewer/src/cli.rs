@@ -1,0 +1,59 @@
+//! The command line: `illum-viewer [SCENE] [--mode raster|pathtrace] [--screenshot FILE --frames N]`.
+
+use std::path::PathBuf;
+
+use clap::Parser;
+
+use crate::app::Mode;
+
+#[derive(Parser, Debug, Clone)]
+#[command(name = "illum-viewer", about = "Interactive viewer for illum's Whitted raster and path tracer")]
+pub struct Args {
+    /// Scene file (TOML) of either kind: a path-tracer scene or a `renderer = "raster"` scene.
+    /// It opens in its own mode; the other mode keeps its default scene.
+    #[arg(default_value = crate::scene_file::DEFAULT_PATHTRACE_SCENE)]
+    pub scene: PathBuf,
+    /// The mode shown first. Default: the mode of SCENE.
+    #[arg(long, value_parser = parse_mode)]
+    pub mode: Option<Mode>,
+    /// Render `--frames` frames, save a screenshot of the window to this PNG file and exit.
+    #[arg(long)]
+    pub screenshot: Option<PathBuf>,
+    /// Frames drawn before the screenshot is taken (with `--screenshot`).
+    #[arg(long, default_value_t = 30)]
+    pub frames: u32,
+    /// Initial window width in points.
+    #[arg(long, default_value_t = 960.0)]
+    pub width: f32,
+    /// Initial window height in points.
+    #[arg(long, default_value_t = 600.0)]
+    pub height: f32,
+}
+
+fn parse_mode(text: &str) -> Result<Mode, String> {
+    text.parse()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_screenshot_options() {
+        let args = Args::try_parse_from([
+            "illum-viewer",
+            "--mode",
+            "raster",
+            "--screenshot",
+            "a.png",
+            "--frames",
+            "3",
+        ])
+        .unwrap();
+        assert_eq!(args.mode, Some(Mode::Raster));
+        assert_eq!(args.frames, 3);
+        assert_eq!(args.screenshot, Some(PathBuf::from("a.png")));
+        let err = Args::try_parse_from(["illum-viewer", "--mode", "xyz"]).unwrap_err().to_string();
+        assert!(err.contains("raster") && err.contains("pathtrace"), "{err}");
+    }
+}

@@ -1,0 +1,24 @@
+//! illum-viewer: one eframe window that shows either renderer of illum on eframe's own wgpu
+//! device.
+//!
+//! - [`app`]: the application state, the mode switch and the scene field;
+//! - [`pathtrace_panel`] / [`raster_panel`]: each mode's settings, renderer and panel;
+//! - [`camera`]: orbit / pan / zoom with the mouse, shared by both modes;
+//! - [`display`]: the path tracer's GPU tone-mapping pass into the texture egui shows;
+//! - [`gpu_setup`]: how eframe creates the device the renderers share;
+//! - [`frame_rate`]: frames per second over recent frames;
+//! - [`scene_file`]: opening scene files of either kind, with errors as text;
+//! - [`cli`] and [`screenshot`]: the command line, and `--screenshot FILE --frames N`.
+
+pub mod app;
+pub mod camera;
+pub mod cli;
+pub mod display;
+pub mod frame_rate;
+pub mod gpu_setup;
+pub mod pathtrace_panel;
+pub mod raster_panel;
+pub mod scene_file;
+pub mod screenshot;
+
+pub use app::{Mode, StartOptions, ViewerApp};

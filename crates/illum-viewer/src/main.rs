@@ -1,0 +1,51 @@
+//! `cargo run --release -p illum-viewer -- [SCENE] [--mode raster|pathtrace]
+//! [--screenshot FILE --frames N]`
+
+use std::sync::Arc;
+
+use clap::Parser;
+use illum_viewer::cli::Args;
+use illum_viewer::gpu_setup::wgpu_setup;
+use illum_viewer::screenshot::{Outcome, ScreenshotJob};
+use illum_viewer::{StartOptions, ViewerApp};
+
+fn main() {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    let args = Args::parse();
+    let outcome: Outcome = Arc::default();
+    let screenshot =
+        args.screenshot.clone().map(|path| ScreenshotJob::new(path, args.frames, outcome.clone()));
+    let start = StartOptions { scene: args.scene.clone(), mode: args.mode, screenshot };
+
+    let mut native = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default()
+            .with_title("illum viewer")
+            .with_inner_size([args.width, args.height]),
+        ..Default::default()
+    };
+    // Under CI (as in the tests) prefer lavapipe, as illum_gpu::GpuContext::new does.
+    native.wgpu_options.wgpu_setup = wgpu_setup(std::env::var_os("CI").is_some());
+    // No vsync: the frame rate is bounded by the work (path-tracing slices, raster frames), and
+    // on software drivers FIFO presentation adds a wait to every frame.
+    native.wgpu_options.surface.present_mode = egui_wgpu::wgpu::PresentMode::AutoNoVsync;
+
+    let result =
+        eframe::run_native("illum viewer", native, Box::new(|cc| Ok(Box::new(ViewerApp::new(cc, start)))));
+    if let Err(e) = result {
+        eprintln!("error: the window could not run: {e}");
+        std::process::exit(1);
+    }
+    if args.screenshot.is_some() {
+        match outcome.lock().unwrap_or_else(|p| p.into_inner()).take() {
+            Some(Ok(path)) => println!("screenshot saved to {}", path.display()),
+            Some(Err(e)) => {
+                eprintln!("error: {e}");
+                std::process::exit(1);
+            }
+            None => {
+                eprintln!("error: the window closed before the screenshot was taken");
+                std::process::exit(1);
+            }
+        }
+    }
+}

@@ -1,0 +1,441 @@
+//! The path-tracer mode: its settings, its `PathTracer` on the shared device, the per-frame
+//! slice of rendering work, live statistics, stop rules and saving.
+//!
+//! Responsiveness: each frame runs one short submission (`set_target_seconds(FRAME_BUDGET)`),
+//! so the window keeps repainting while samples accumulate. A change of camera, window size or
+//! setting goes through `PathTracer::update_scene`, which restarts the accumulation without
+//! recompiling the pipeline.
+
+use std::path::{Path, PathBuf};
+
+use illum_gpu::GpuContext;
+use illum_image::{Encoding, ExrMetadata, RgbImage32, save_exr, save_png};
+use illum_pathtrace::{PathTracer, StopReason};
+use illum_scene::{Bounces, Sampling, Scene};
+
+use crate::camera::OrbitCamera;
+use crate::display::Display;
+
+/// Wall time aimed at per submission: short enough that a frame (submission, fold, upload,
+/// egui) stays well under the 50 ms of 20 fps on lavapipe.
+pub const FRAME_BUDGET: f64 = 0.015;
+/// Highest fixed bounce count offered by the slider (the scene format allows more).
+pub const MAX_UI_BOUNCES: u32 = 64;
+/// Default resolution scale: half the view's pixels in each direction keeps lavapipe
+/// interactive; raise it for a sharper image.
+pub const DEFAULT_SCALE: f32 = 0.5;
+
+/// Everything the user sets in the path-tracer panel.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PathTraceSettings {
+    pub bounces: Bounces,
+    /// Samples per pixel to stop at; `None`: keep going.
+    pub spp_target: Option<u32>,
+    pub sampling: Sampling,
+    pub seed: u32,
+    /// Render resolution = view size in pixels x this.
+    pub resolution_scale: f32,
+    /// Display-only exposure in stops (the saved files are not scaled).
+    pub exposure: f32,
+    /// Stop once the estimated relative error falls to this.
+    pub target_error: Option<f64>,
+    /// Stop after this many seconds of rendering.
+    pub time_budget: Option<f64>,
+}
+
+impl PathTraceSettings {
+    /// The scene file's render settings, with no stop rule beyond its spp.
+    pub fn from_scene(scene: &Scene) -> Self {
+        PathTraceSettings {
+            bounces: scene.render.bounces,
+            spp_target: None,
+            sampling: scene.render.sampling,
+            seed: scene.render.seed,
+            resolution_scale: DEFAULT_SCALE,
+            exposure: 0.0,
+            target_error: None,
+            time_budget: None,
+        }
+    }
+}
+
+/// The statistics shown in the panel, refreshed as samples arrive.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Stats {
+    pub spp: u32,
+    pub samples_per_second: f64,
+    pub elapsed_seconds: f64,
+    /// Estimated relative standard error; `None` before two samples per pixel.
+    pub relative_error: Option<f64>,
+    pub dropped_samples: u64,
+    pub width: u32,
+    pub height: u32,
+}
+
+/// The path-tracer mode.
+pub struct PathTraceMode {
+    scene_path: PathBuf,
+    scene: Scene,
+    pub settings: PathTraceSettings,
+    pub camera: OrbitCamera,
+    tracer: Option<PathTracer>,
+    /// The scene the tracer last failed on, so a failure is not retried every frame.
+    failed: Option<Scene>,
+    display: Option<Display>,
+    paused: bool,
+    stopped: Option<StopReason>,
+    stats: Stats,
+    /// Total samples at the last statistics update, to tell when new samples arrived.
+    shown_samples: u64,
+    shown_exposure: f32,
+    pub save_path: String,
+    /// The last save's outcome or the renderer's last error, shown under the controls.
+    pub message: Option<String>,
+}
+
+impl PathTraceMode {
+    pub fn new(scene_path: PathBuf, scene: Scene) -> Self {
+        let stem = scene.name.clone();
+        PathTraceMode {
+            settings: PathTraceSettings::from_scene(&scene),
+            camera: OrbitCamera::new(scene.camera),
+            scene_path,
+            scene,
+            tracer: None,
+            failed: None,
+            display: None,
+            paused: false,
+            stopped: None,
+            stats: Stats::default(),
+            shown_samples: 0,
+            shown_exposure: 0.0,
+            save_path: format!("out/viewer-{stem}.png"),
+            message: None,
+        }
+    }
+
+    /// Replaces the scene (opened from the UI); settings and camera start from its own.
+    pub fn set_scene(&mut self, scene_path: PathBuf, scene: Scene) {
+        let keep = self.settings;
+        *self = PathTraceMode { display: self.display.take(), ..PathTraceMode::new(scene_path, scene) };
+        self.settings.resolution_scale = keep.resolution_scale;
+        self.settings.exposure = keep.exposure;
+    }
+
+    pub fn scene_path(&self) -> &Path {
+        &self.scene_path
+    }
+
+    pub fn stats(&self) -> Stats {
+        self.stats
+    }
+
+    pub fn paused(&self) -> bool {
+        self.paused
+    }
+
+    pub fn stop_reason(&self) -> Option<StopReason> {
+        self.stopped
+    }
+
+    /// Still has work to do this frame (so the window should keep repainting).
+    pub fn is_rendering(&self) -> bool {
+        !self.paused && self.stopped.is_none()
+    }
+
+    /// Discards the accumulated samples and starts again.
+    pub fn reset(&mut self) {
+        if let Some(tracer) = &mut self.tracer {
+            tracer.reset();
+        }
+        self.stopped = None;
+        self.stats = Stats { width: self.stats.width, height: self.stats.height, ..Stats::default() };
+        self.shown_samples = u64::MAX;
+    }
+
+    /// The scene to render at `width` x `height`: the file's geometry with the panel's settings
+    /// and the interactive camera.
+    fn desired_scene(&self, width: u32, height: u32) -> Scene {
+        let mut scene = self.scene.clone();
+        scene.camera = self.camera.camera(width, height);
+        scene.render.bounces = self.settings.bounces;
+        scene.render.sampling = self.settings.sampling;
+        scene.render.seed = self.settings.seed;
+        if let Some(spp) = self.settings.spp_target {
+            scene.render.spp = spp.max(1);
+        }
+        scene
+    }
+
+    /// Brings the tracer in line with the settings, camera and `view_pixels` size, runs this
+    /// frame's slice of work and refreshes the displayed texture.
+    pub fn frame(&mut self, gpu: &GpuContext, render_state: &egui_wgpu::RenderState, view_pixels: [u32; 2]) {
+        let scale = self.settings.resolution_scale.clamp(0.05, 2.0);
+        let width = ((view_pixels[0] as f32 * scale).round() as u32).max(1);
+        let height = ((view_pixels[1] as f32 * scale).round() as u32).max(1);
+        let wanted = self.desired_scene(width, height);
+        if self.failed.as_ref() == Some(&wanted) {
+            return;
+        }
+        if let Err(message) = self.sync_tracer(gpu, &wanted) {
+            self.message = Some(format!("path tracer: {message}"));
+            self.tracer = None;
+            self.failed = Some(wanted);
+            return;
+        }
+        self.failed = None;
+        let Some(tracer) = self.tracer.as_mut() else { return };
+        // Fields, not `is_rendering()`: `tracer` borrows `self.tracer` mutably.
+        if !self.paused && self.stopped.is_none() {
+            self.stopped = Self::stop_rule(tracer, &self.settings);
+        }
+        if !self.paused && self.stopped.is_none() {
+            match tracer.step(self.settings.spp_target) {
+                Ok(report) => {
+                    if report.pass_completed {
+                        self.stopped = Self::stop_rule(tracer, &self.settings);
+                    }
+                }
+                Err(e) => {
+                    self.message = Some(format!("path tracer: {e}"));
+                    self.paused = true;
+                }
+            }
+        }
+        let total = tracer.accumulator().total_samples();
+        let display = self.display.get_or_insert_with(|| Display::new(gpu));
+        if total != self.shown_samples {
+            self.shown_samples = total;
+            self.stats = Self::measure(tracer);
+            let image = tracer.accumulator().mean_image();
+            let mut renderer = render_state.renderer.write();
+            display.show(gpu, &mut renderer, &image, self.settings.exposure);
+            self.shown_exposure = self.settings.exposure;
+        } else if self.shown_exposure != self.settings.exposure {
+            display.redraw(gpu, self.settings.exposure);
+            self.shown_exposure = self.settings.exposure;
+        }
+    }
+
+    /// The texture to show, once something was rendered.
+    pub fn texture(&self) -> Option<egui::TextureId> {
+        self.display.as_ref().and_then(Display::texture_id)
+    }
+
+    /// Creates the tracer, or hands it the new scene when anything changed (which restarts the
+    /// accumulation). Errors are the renderer's messages.
+    fn sync_tracer(&mut self, gpu: &GpuContext, wanted: &Scene) -> Result<(), String> {
+        match &mut self.tracer {
+            Some(tracer) if tracer.scene() == wanted => return Ok(()),
+            Some(tracer) => tracer.update_scene(wanted).map_err(|e| e.to_string())?,
+            None => {
+                let mut tracer = PathTracer::new(gpu, wanted).map_err(|e| e.to_string())?;
+                tracer.set_target_seconds(FRAME_BUDGET);
+                self.tracer = Some(tracer);
+            }
+        }
+        // A fresh accumulation: the stop rules start over too.
+        self.stopped = None;
+        self.shown_samples = u64::MAX;
+        Ok(())
+    }
+
+    /// The first stop rule that holds, checked between submissions.
+    fn stop_rule(tracer: &PathTracer, settings: &PathTraceSettings) -> Option<StopReason> {
+        if settings.spp_target.is_some_and(|spp| tracer.spp_done() >= spp) {
+            return Some(StopReason::SppReached);
+        }
+        if settings.time_budget.is_some_and(|budget| tracer.wall_seconds() >= budget) {
+            return Some(StopReason::TimeBudget);
+        }
+        if tracer.spp_done() >= 2
+            && settings
+                .target_error
+                .is_some_and(|target| tracer.accumulator().estimated_relative_error() <= target)
+        {
+            return Some(StopReason::ErrorReached);
+        }
+        None
+    }
+
+    fn measure(tracer: &PathTracer) -> Stats {
+        let accumulator = tracer.accumulator();
+        let elapsed = tracer.wall_seconds();
+        let total = accumulator.total_samples();
+        Stats {
+            spp: tracer.spp_done(),
+            samples_per_second: if elapsed > 0.0 { total as f64 / elapsed } else { 0.0 },
+            elapsed_seconds: elapsed,
+            relative_error: (tracer.spp_done() >= 2).then(|| accumulator.estimated_relative_error()),
+            dropped_samples: accumulator.dropped_samples(),
+            width: accumulator.width,
+            height: accumulator.height,
+        }
+    }
+
+    /// Writes the mean image to `save_path` with the given extension ("png" or "exr"),
+    /// atomically (illum-image writes a temporary file and renames it). Returns the path.
+    pub fn save(&mut self, extension: &str) -> Result<PathBuf, String> {
+        let tracer = self.tracer.as_ref().ok_or("nothing rendered yet")?;
+        if tracer.accumulator().total_samples() == 0 {
+            return Err("nothing rendered yet".to_owned());
+        }
+        let path = Path::new(self.save_path.trim()).with_extension(extension);
+        if path.as_os_str().is_empty() || path.file_stem().is_none() {
+            return Err(format!("{:?} is not a file name", self.save_path));
+        }
+        let image: RgbImage32 = tracer.accumulator().mean_image();
+        let result = if extension == "exr" {
+            let metadata = ExrMetadata {
+                scene: self.scene_path.display().to_string(),
+                spp: u64::from(tracer.spp_done()),
+                bounces: self.settings.bounces.to_string(),
+                seed: self.settings.seed,
+                sampling: self.settings.sampling.to_string(),
+                render_seconds: tracer.wall_seconds(),
+                extra: vec![
+                    ("source".to_owned(), "illum-viewer".to_owned()),
+                    ("dropped_samples".to_owned(), tracer.accumulator().dropped_samples().to_string()),
+                ],
+            };
+            save_exr(&path, &image, &metadata)
+        } else {
+            // The PNG is the image as rendered: gamma 2.2, no display exposure.
+            save_png(&path, &image, 0.0, Encoding::Gamma22)
+        };
+        result.map(|()| path.clone()).map_err(|e| error_chain(&e))
+    }
+
+    /// The panel's controls.
+    pub fn panel(&mut self, ui: &mut egui::Ui) {
+        ui.heading("Path tracer");
+        let s = &mut self.settings;
+        ui.horizontal(|ui| {
+            let mut unbounded = s.bounces == Bounces::Unbounded;
+            let mut fixed = match s.bounces {
+                Bounces::Fixed(n) => n.min(MAX_UI_BOUNCES),
+                Bounces::Unbounded => 2,
+            };
+            ui.add_enabled(!unbounded, egui::Slider::new(&mut fixed, 0..=MAX_UI_BOUNCES).text("Bounces"));
+            ui.checkbox(&mut unbounded, "Unbounded");
+            s.bounces = if unbounded { Bounces::Unbounded } else { Bounces::Fixed(fixed) };
+        });
+        ui.horizontal(|ui| {
+            let mut unlimited = s.spp_target.is_none();
+            let mut spp = s.spp_target.unwrap_or(self.scene.render.spp.max(1));
+            let label = ui.label("spp target");
+            ui.add_enabled(!unlimited, egui::DragValue::new(&mut spp).range(1..=1_000_000).speed(1.0))
+                .labelled_by(label.id);
+            ui.checkbox(&mut unlimited, "Unlimited");
+            s.spp_target = if unlimited { None } else { Some(spp) };
+        });
+        ui.horizontal(|ui| {
+            ui.label("Sampling");
+            ui.radio_value(&mut s.sampling, Sampling::Cosine, "Cosine");
+            ui.radio_value(&mut s.sampling, Sampling::Uniform, "Uniform");
+        });
+        ui.horizontal(|ui| {
+            let label = ui.label("Seed");
+            ui.add(egui::DragValue::new(&mut s.seed).speed(1.0)).labelled_by(label.id);
+        });
+        ui.add(egui::Slider::new(&mut s.resolution_scale, 0.1..=1.0).text("Resolution scale"));
+        ui.add(egui::Slider::new(&mut s.exposure, -8.0..=8.0).text("Exposure (display)").suffix(" stops"));
+
+        ui.separator();
+        ui.label("Stop rules");
+        ui.horizontal(|ui| {
+            let mut on = s.target_error.is_some();
+            let mut value = s.target_error.unwrap_or(0.01);
+            let check = ui.checkbox(&mut on, "At relative error");
+            ui.add_enabled(on, egui::DragValue::new(&mut value).range(0.0001..=1.0).speed(0.001))
+                .labelled_by(check.id);
+            s.target_error = on.then_some(value);
+        });
+        ui.horizontal(|ui| {
+            let mut on = s.time_budget.is_some();
+            let mut value = s.time_budget.unwrap_or(10.0);
+            let check = ui.checkbox(&mut on, "After time budget");
+            ui.add_enabled(
+                on,
+                egui::DragValue::new(&mut value).range(0.1..=86_400.0).speed(0.5).suffix(" s"),
+            )
+            .labelled_by(check.id);
+            s.time_budget = on.then_some(value);
+        });
+
+        ui.separator();
+        ui.horizontal(|ui| {
+            let label = if self.paused { "Resume" } else { "Pause" };
+            if ui.button(label).clicked() {
+                self.paused = !self.paused;
+            }
+            if ui.button("Reset").clicked() {
+                self.reset();
+            }
+            if ui.add_enabled(!self.camera.is_home(), egui::Button::new("Reset camera")).clicked() {
+                self.camera.reset();
+            }
+        });
+        self.stats_ui(ui);
+
+        ui.separator();
+        ui.horizontal(|ui| {
+            let label = ui.label("Save to");
+            ui.text_edit_singleline(&mut self.save_path).labelled_by(label.id);
+        });
+        ui.horizontal(|ui| {
+            for (button, extension) in [("Save PNG", "png"), ("Save EXR", "exr")] {
+                if ui.button(button).clicked() {
+                    self.message = Some(match self.save(extension) {
+                        Ok(path) => format!("saved {}", path.display()),
+                        Err(e) => format!("not saved: {e}"),
+                    });
+                }
+            }
+        });
+        if let Some(message) = &self.message {
+            ui.label(message);
+        }
+    }
+
+    fn stats_ui(&self, ui: &mut egui::Ui) {
+        let st = &self.stats;
+        egui::Grid::new("pathtrace stats").num_columns(2).show(ui, |ui| {
+            let mut row = |name: &str, value: String| {
+                ui.label(name);
+                ui.label(value);
+                ui.end_row();
+            };
+            row("Resolution", format!("{} x {}", st.width, st.height));
+            row("spp done", st.spp.to_string());
+            row("Samples/s", format!("{:.3} M", st.samples_per_second / 1e6));
+            row("Elapsed", format!("{:.1} s", st.elapsed_seconds));
+            row(
+                "Rel. error",
+                st.relative_error.map_or("(needs 2 spp)".to_owned(), |e| format!("{:.2} %", e * 100.0)),
+            );
+            row("Dropped NaN/Inf", st.dropped_samples.to_string());
+            let state = match (self.paused, self.stopped) {
+                (true, _) => "paused".to_owned(),
+                (false, Some(StopReason::SppReached)) => "done: spp target reached".to_owned(),
+                (false, Some(StopReason::ErrorReached)) => "done: error target reached".to_owned(),
+                (false, Some(StopReason::TimeBudget)) => "done: time budget spent".to_owned(),
+                (false, Some(StopReason::Cancelled)) => "stopped".to_owned(),
+                (false, None) => "rendering".to_owned(),
+            };
+            row("State", state);
+        });
+    }
+}
+
+/// An error with its causes, "outer: inner: ...", so a failed save says why.
+fn error_chain(error: &dyn std::error::Error) -> String {
+    let mut text = error.to_string();
+    let mut source = error.source();
+    while let Some(cause) = source {
+        text.push_str(": ");
+        text.push_str(&cause.to_string());
+        source = cause.source();
+    }
+    text
+}

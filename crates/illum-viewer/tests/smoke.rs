@@ -1,0 +1,86 @@
+//! Starts the real viewer binary under Xvfb in each mode with `--screenshot FILE --frames N`,
+//! and checks that each screenshot shows a picture (not one flat colour) and that the two modes
+//! draw different pictures.
+
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// Window size of the smoke runs (small: lavapipe draws every pixel on the CPU).
+const WIDTH: &str = "640";
+const HEIGHT: &str = "420";
+
+fn xvfb_run() -> &'static str {
+    let found =
+        Command::new("sh").args(["-c", "command -v xvfb-run"]).output().is_ok_and(|o| o.status.success());
+    assert!(
+        found,
+        "xvfb-run is missing: the viewer's smoke test needs a virtual X display. \
+         Install it with `apt-get install xvfb xauth` (Debian/Ubuntu)."
+    );
+    "xvfb-run"
+}
+
+/// Longest a screenshot run may take before it counts as hung (it takes seconds on lavapipe).
+const RUN_TIMEOUT: Duration = Duration::from_secs(180);
+
+fn screenshot(mode: &str, path: &Path) -> image::RgbaImage {
+    let (log_out, log_err) = (path.with_extension("stdout.txt"), path.with_extension("stderr.txt"));
+    let mut child = Command::new(xvfb_run())
+        .args(["-a", "-s", "-screen 0 1024x768x24"])
+        .arg(env!("CARGO_BIN_EXE_illum-viewer"))
+        .args(["--mode", mode, "--frames", "8", "--width", WIDTH, "--height", HEIGHT, "--screenshot"])
+        .arg(path)
+        // Files, not pipes: a full pipe would block the child while the test polls it.
+        .stdout(Stdio::from(std::fs::File::create(&log_out).expect("creating the stdout log")))
+        .stderr(Stdio::from(std::fs::File::create(&log_err).expect("creating the stderr log")))
+        .spawn()
+        .expect("starting xvfb-run");
+    let started = Instant::now();
+    // Poll rather than wait, so a hung window fails the test instead of hanging it.
+    while child.try_wait().expect("polling the viewer").is_none() {
+        if started.elapsed() > RUN_TIMEOUT {
+            let _ = child.kill();
+            panic!("the viewer did not exit within {RUN_TIMEOUT:?} in {mode} mode");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let status = child.wait().expect("collecting the viewer's exit status");
+    let read = |p: &Path| std::fs::read_to_string(p).unwrap_or_default();
+    assert!(
+        status.success(),
+        "the viewer failed in {mode} mode ({status}):\nstdout:\n{}\nstderr:\n{}",
+        read(&log_out),
+        read(&log_err)
+    );
+    image::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())).to_rgba8()
+}
+
+/// Standard deviation of the pixels' grey level, 0..255.
+fn spread(image: &image::RgbaImage) -> f64 {
+    let grey: Vec<f64> =
+        image.pixels().map(|p| (f64::from(p[0]) + f64::from(p[1]) + f64::from(p[2])) / 3.0).collect();
+    let mean = grey.iter().sum::<f64>() / grey.len() as f64;
+    (grey.iter().map(|g| (g - mean).powi(2)).sum::<f64>() / grey.len() as f64).sqrt()
+}
+
+/// Mean absolute difference per channel, 0..255.
+fn difference(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
+    assert_eq!(a.dimensions(), b.dimensions());
+    let total: u64 = a.as_raw().iter().zip(b.as_raw()).map(|(x, y)| u64::from(x.abs_diff(*y))).sum();
+    total as f64 / a.as_raw().len() as f64
+}
+
+#[test]
+fn both_modes_draw_under_xvfb() {
+    let dir = tempfile::tempdir().unwrap();
+    let raster = screenshot("raster", &dir.path().join("raster.png"));
+    let pathtrace = screenshot("pathtrace", &dir.path().join("pathtrace.png"));
+    for (name, image) in [("raster", &raster), ("pathtrace", &pathtrace)] {
+        assert!(image.width() >= 200 && image.height() >= 200, "{name}: {:?}", image.dimensions());
+        let s = spread(image);
+        assert!(s > 10.0, "{name} screenshot looks blank (grey-level spread {s:.1})");
+    }
+    let d = difference(&raster, &pathtrace);
+    assert!(d > 5.0, "the two modes' screenshots barely differ (mean difference {d:.2})");
+}

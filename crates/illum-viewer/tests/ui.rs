@@ -1,0 +1,231 @@
+//! egui_kittest tests that drive the real viewer UI on lavapipe: the mode switch, the path
+//! tracer's controls, saving, opening a bad file, and snapshots of both modes.
+//!
+//! Both renderers repaint continuously while they work, so the tests step a fixed number of
+//! frames (`run_steps`) instead of waiting for the UI to settle.
+//!
+//! All harnesses share one device, as the real window has one: wgpu compares devices by their
+//! id within their own instance, so devices of separate instances (one per harness by default)
+//! can compare equal, and the path tracer's process-wide pipeline cache, keyed by device, would
+//! hand one device's pipeline to another.
+
+use std::sync::OnceLock;
+
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use illum_scene::Bounces;
+use illum_viewer::gpu_setup::wgpu_setup;
+use illum_viewer::{Mode, StartOptions, ViewerApp};
+
+/// The one device of this test process (lavapipe when present), created with the viewer's setup.
+fn shared_device() -> egui_wgpu::WgpuSetupExisting {
+    static STATE: OnceLock<egui_wgpu::RenderState> = OnceLock::new();
+    let state = STATE.get_or_init(|| {
+        egui_kittest::wgpu::create_render_state(wgpu_setup(true), egui_wgpu::RendererOptions::PREDICTABLE)
+    });
+    egui_wgpu::WgpuSetupExisting {
+        instance: state.instance.clone(),
+        adapter: state.adapter.clone(),
+        device: state.device.clone(),
+        queue: state.queue.clone(),
+    }
+}
+
+fn harness(mode: Mode) -> Harness<'static, ViewerApp> {
+    Harness::builder()
+        .with_size(egui::vec2(900.0, 560.0))
+        .wgpu_setup(egui_wgpu::WgpuSetup::Existing(shared_device()))
+        .build_eframe(move |cc| {
+            ViewerApp::new(
+                cc,
+                StartOptions { scene: "scenes/cornell.toml".into(), mode: Some(mode), screenshot: None },
+            )
+        })
+}
+
+fn spp(harness: &Harness<'_, ViewerApp>) -> u32 {
+    harness.state().pathtrace().expect("path tracer loaded").stats().spp
+}
+
+#[test]
+fn switching_modes_keeps_each_modes_settings() {
+    let mut harness = harness(Mode::PathTrace);
+    harness.run_steps(2);
+    harness.get_by_label("Uniform").click();
+    harness.run_steps(1);
+
+    harness.get_by_label("Whitted raster").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().mode(), Mode::Raster);
+    harness.get_by_label("whitted").click();
+    harness.get_by_label("MSAA 4x").click();
+    harness.run_steps(2);
+
+    harness.get_by_label("Path tracer").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().mode(), Mode::PathTrace);
+    let settings = harness.state().pathtrace().unwrap().settings;
+    assert_eq!(settings.sampling, illum_scene::Sampling::Uniform);
+
+    harness.get_by_label("Whitted raster").click();
+    harness.run_steps(2);
+    let options = harness.state().raster().unwrap().options;
+    assert_eq!(options.look, illum_raster::Look::Whitted);
+    assert!(!options.effects.msaa);
+}
+
+#[test]
+fn changing_bounces_restarts_the_accumulation() {
+    let mut harness = harness(Mode::PathTrace);
+    harness.run_steps(6);
+    let before = spp(&harness);
+    assert!(before > 0, "the path tracer rendered nothing in 6 frames");
+    harness.get_by_role_and_label(egui::accesskit::Role::Slider, "Bounces").set_value_accesskit(5.0);
+    harness.run_steps(1);
+    assert_eq!(harness.state().pathtrace().unwrap().settings.bounces, Bounces::Fixed(5));
+    harness.get_by_label("Unbounded").click();
+    harness.run_steps(1);
+    assert_eq!(harness.state().pathtrace().unwrap().settings.bounces, Bounces::Unbounded);
+    assert!(spp(&harness) < before.max(2), "a bounce change must restart: {} >= {before}", spp(&harness));
+}
+
+#[test]
+fn pause_and_reset() {
+    let mut harness = harness(Mode::PathTrace);
+    harness.run_steps(6);
+    harness.get_by_label("Pause").click();
+    harness.run_steps(1);
+    assert!(harness.state().pathtrace().unwrap().paused());
+    harness.get_by_label("Reset").click();
+    harness.run_steps(2);
+    assert_eq!(spp(&harness), 0, "reset while paused leaves no samples");
+    harness.get_by_label("Resume").click();
+    harness.run_steps(4);
+    assert!(!harness.state().pathtrace().unwrap().paused());
+    assert!(harness.state().pathtrace().unwrap().stats().elapsed_seconds > 0.0);
+}
+
+#[test]
+fn saves_png_and_exr_into_a_directory() {
+    let dir = tempfile::tempdir().unwrap();
+    let target = dir.path().join("nested").join("render.png");
+    let mut harness = harness(Mode::PathTrace);
+    harness.run_steps(4);
+    harness.state_mut().pathtrace_mut().unwrap().save_path = target.display().to_string();
+    harness.run_steps(1);
+    harness.get_by_label("Save PNG").click();
+    harness.run_steps(1);
+    harness.get_by_label("Save EXR").click();
+    harness.run_steps(1);
+
+    let png = image::open(&target).unwrap_or_else(|e| panic!("{}: {e}", target.display()));
+    let (w, h) = (png.width(), png.height());
+    assert!(w > 0 && h > 0);
+    let exr = target.with_extension("exr");
+    let (image, attributes) =
+        illum_image::load_exr(&exr).unwrap_or_else(|e| panic!("{}: {e}", exr.display()));
+    assert_eq!((image.width, image.height), (w, h));
+    assert!(attributes.iter().any(|(k, _)| k.contains("spp")), "{attributes:?}");
+    let message = harness.state().pathtrace().unwrap().message.clone().unwrap_or_default();
+    assert!(message.starts_with("saved"), "{message}");
+}
+
+#[test]
+fn a_bad_scene_file_shows_its_error_and_keeps_the_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("broken.toml");
+    std::fs::write(&bad, "[camera]\nvfov = \"wide\"\n").unwrap();
+    let mut harness = harness(Mode::PathTrace);
+    harness.run_steps(2);
+    harness.state_mut().scene_field = bad.display().to_string();
+    harness.run_steps(1);
+    harness.get_by_label("Open").click();
+    harness.run_steps(2);
+    let error = harness.state().open_error.clone().expect("an error is shown");
+    assert!(error.contains("broken.toml"), "{error}");
+    harness.get_by_label_contains("Could not open the scene");
+    assert_eq!(harness.state().mode(), Mode::PathTrace);
+    assert!(harness.state().pathtrace().unwrap().scene_path().ends_with("scenes/cornell.toml"));
+    // A good file of the other kind then opens in its own mode.
+    harness.state_mut().scene_field = "scenes/whitted.toml".to_owned();
+    harness.run_steps(1);
+    harness.get_by_label("Open").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().mode(), Mode::Raster);
+    assert!(harness.state().open_error.is_none());
+}
+
+#[test]
+fn snapshot_path_tracer() {
+    let mut harness = harness(Mode::PathTrace);
+    // A fixed spp target makes the image deterministic; the run stops there.
+    harness.state_mut().pathtrace_mut().unwrap().settings.spp_target = Some(4);
+    for _ in 0..200 {
+        harness.run_steps(1);
+        if harness.state().pathtrace().unwrap().stop_reason().is_some() {
+            break;
+        }
+    }
+    assert_eq!(spp(&harness), 4);
+    harness.run_steps(2);
+    harness.snapshot("viewer_pathtrace");
+}
+
+#[test]
+fn snapshot_raster() {
+    let mut harness = harness(Mode::Raster);
+    harness.run_steps(4);
+    harness.snapshot("viewer_raster");
+}
+
+#[test]
+fn dragging_orbits_the_camera_and_reset_camera_restores_it() {
+    let mut harness = harness(Mode::PathTrace);
+    harness.run_steps(4);
+    assert!(spp(&harness) > 0);
+    // Paused, so that the restart caused by the camera change stays visible as 0 spp.
+    harness.get_by_label("Pause").click();
+    harness.run_steps(1);
+    // The image fills the central panel, right of the settings panel.
+    let start = egui::pos2(600.0, 300.0);
+    harness.event(egui::Event::PointerMoved(start));
+    harness.event(egui::Event::PointerButton {
+        pos: start,
+        button: egui::PointerButton::Primary,
+        pressed: true,
+        modifiers: egui::Modifiers::NONE,
+    });
+    harness.run_steps(1);
+    for step in 1..=5 {
+        harness.event(egui::Event::PointerMoved(start + egui::vec2(12.0 * step as f32, 4.0 * step as f32)));
+        harness.run_steps(1);
+    }
+    let end = start + egui::vec2(60.0, 20.0);
+    harness.event(egui::Event::PointerButton {
+        pos: end,
+        button: egui::PointerButton::Primary,
+        pressed: false,
+        modifiers: egui::Modifiers::NONE,
+    });
+    harness.run_steps(2);
+    assert!(!harness.state().pathtrace().unwrap().camera.is_home(), "the drag did not move the camera");
+    assert_eq!(spp(&harness), 0, "a camera change restarts the accumulation");
+    harness.get_by_label("Reset camera").click();
+    harness.run_steps(2);
+    assert!(harness.state().pathtrace().unwrap().camera.is_home());
+}
+
+#[test]
+fn the_path_tracer_follows_the_window_size() {
+    let mut harness = harness(Mode::PathTrace);
+    harness.run_steps(3);
+    let small = harness.state().pathtrace().unwrap().stats();
+    harness.set_size(egui::vec2(1000.0, 700.0));
+    harness.run_steps(3);
+    let large = harness.state().pathtrace().unwrap().stats();
+    assert!(large.width > small.width && large.height > small.height, "{small:?} -> {large:?}");
+    harness.state_mut().pathtrace_mut().unwrap().settings.resolution_scale = 0.25;
+    harness.run_steps(3);
+    let scaled = harness.state().pathtrace().unwrap().stats();
+    assert!(scaled.width * 2 <= large.width + 1, "{large:?} -> {scaled:?}");
+}
