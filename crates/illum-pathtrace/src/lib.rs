@@ -19,5 +19,5 @@ pub use error::PathTraceError;
 pub use progressive::{StopReason, StopRules, render_progressive};
 pub use tracer::{
     CHUNK_SAMPLES, GENERIC_TRAVERSAL, PATHTRACE_SHADER, PathTracer, SCENE_MODULE, SLOT_BYTES, Sequence,
-    StepReport, TracerOptions, Traversal, pipelines_compiled, shader_modules,
+    StepReport, TracerOptions, Traversal, shader_modules,
 };

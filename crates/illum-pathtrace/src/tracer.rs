@@ -90,11 +90,6 @@ fn pipeline_cache() -> &'static Mutex<HashMap<PipelineKey, wgpu::ComputePipeline
     CACHE.get_or_init(Mutex::default)
 }
 
-/// Number of pipelines compiled so far in this process (the cache's misses).
-pub fn pipelines_compiled() -> usize {
-    pipeline_cache().lock().unwrap_or_else(|p| p.into_inner()).len()
-}
-
 /// The shader modules, in import order, for `scene` with `traversal`.
 pub fn shader_modules(scene: &Scene, gpu_scene: &GpuScene, traversal: Traversal) -> Vec<ShaderFile> {
     let mut modules = COMMON_MODULES.to_vec();
@@ -301,6 +296,12 @@ impl PathTracer {
 
     pub fn scene(&self) -> &Scene {
         &self.scene
+    }
+
+    /// Whether `self` and `other` run the very same compiled pipeline: the cache found an equal
+    /// specialisation instead of compiling again.
+    pub fn shares_pipeline_with(&self, other: &PathTracer) -> bool {
+        self.pipeline == other.pipeline
     }
 
     pub fn accumulator(&self) -> &Accumulator {

@@ -5,7 +5,7 @@ use illum::image::z_test_pass_fraction;
 use illum::pathtrace::{PathTracer, Sequence, TracerOptions, Traversal};
 use illum::scene::{Bounces, Overrides, Sampling};
 
-mod common;
+use crate::common;
 
 fn cornell(size: u32, spp: u32, bounces: u32, sampling: Sampling, seed: u32) -> illum::scene::Scene {
     common::scene(

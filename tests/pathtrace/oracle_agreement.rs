@@ -11,7 +11,7 @@
 use illum::image::{RgbImage32, z_test_pass_fraction};
 use illum::scene::{Bounces, Overrides};
 
-mod common;
+use crate::common;
 
 const SIZE: u32 = 24;
 const GPU_SPP: u32 = 4096;

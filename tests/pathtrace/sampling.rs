@@ -15,7 +15,7 @@ use illum::gpu::shader::{self, COMMON_MODULES, ShaderFile};
 use illum::gpu::wgpu;
 use illum::image::inverse_normal_cdf;
 
-mod common;
+use crate::common;
 
 const N: u32 = 1 << 20;
 const ALPHA: f64 = 0.01;

@@ -10,7 +10,7 @@ use illum::image::{load_exr, rel_mse};
 use illum::pathtrace::PathTracer;
 use illum::scene::{Bounces, Overrides};
 
-mod common;
+use crate::common;
 
 #[test]
 fn estimated_relative_error_tracks_the_true_error_within_a_factor_of_1_5() {

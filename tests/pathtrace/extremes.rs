@@ -6,7 +6,7 @@
 //! the baseline scene or a closed form. Statistical bounds are 4 standard errors for a single
 //! mean (a false alarm once in about 16 000 runs) and, per pixel, a two-sample Z-test at
 //! alpha = 0.01 that at least 97% of pixels must pass. Every measured number is printed
-//! (`cargo test --test extremes -- --nocapture`); docs/accuracy.md records them.
+//! (`cargo test --test pathtrace extremes -- --nocapture`); docs/accuracy.md records them.
 
 use std::sync::OnceLock;
 
@@ -15,7 +15,7 @@ use illum::image::{RgbImage32, z_test_pass_fraction};
 use illum::pathtrace::PathTracer;
 use illum::scene::{Bounces, Camera, Overrides, Sampling, Scene, Shape};
 
-mod common;
+use crate::common;
 
 use common::closed_form::{Room, expected_pixel};
 use common::edit::{set_albedo, transformed};

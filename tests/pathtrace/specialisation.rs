@@ -1,13 +1,13 @@
 //! "Model only what a scene requires": each scene's specialised pipeline contains what it uses
 //! and nothing else, renders the same image as the generic one (tested in
-//! pathtrace_statistics.rs), is cached, and refuses a scene it was not built for.
+//! statistics.rs), is cached, and refuses a scene it was not built for.
 
+use illum::pathtrace::PathTracer;
 use illum::pathtrace::gpu_scene::GpuScene;
 use illum::pathtrace::specialise::specialise;
-use illum::pathtrace::{PathTracer, pipelines_compiled};
 use illum::scene::{Overrides, Scene};
 
-mod common;
+use crate::common;
 
 fn names_of(scene: &Scene, indices: &[usize]) -> Vec<String> {
     // gpu_scene uploads non-emitters first, in file order.
@@ -95,15 +95,19 @@ fn a_sphere_and_a_second_light_bring_their_code_and_nothing_else() {
 #[test]
 fn pipelines_are_cached_by_specialisation() {
     let scene = common::scene("cornell", Overrides { width: Some(8), height: Some(8), ..Default::default() });
-    let _first = PathTracer::new(common::gpu(), &scene).expect("builds");
-    let compiled = pipelines_compiled();
+    let first = PathTracer::new(common::gpu(), &scene).expect("builds");
     // Another seed and resolution: same geometry, same pipeline.
     let other = common::scene(
         "cornell",
         Overrides { width: Some(16), height: Some(4), seed: Some(3), ..Default::default() },
     );
-    let _second = PathTracer::new(common::gpu(), &other).expect("builds");
-    assert_eq!(pipelines_compiled(), compiled, "an equal specialisation was compiled again");
+    let second = PathTracer::new(common::gpu(), &other).expect("builds");
+    assert!(first.shares_pipeline_with(&second), "an equal specialisation was compiled again");
+    // Other geometry: its own pipeline (so the check above can fail).
+    let classic =
+        common::scene("cornell-classic", Overrides { width: Some(8), height: Some(8), ..Default::default() });
+    let third = PathTracer::new(common::gpu(), &classic).expect("builds");
+    assert!(!first.shares_pipeline_with(&third), "different geometry reused a pipeline");
 }
 
 #[test]

@@ -9,7 +9,7 @@ use illum::pathtrace::{
 };
 use illum::scene::Scene;
 
-mod common;
+use crate::common;
 
 /// Composes `entry` with `modules` and validates the result with naga.
 fn check(modules: &[ShaderFile], entry: &ShaderFile, defs: &[(&str, Def)], covered: &mut BTreeSet<String>) {
@@ -96,7 +96,7 @@ fn extra_shader_sets() -> Vec<Vec<(Vec<ShaderFile>, ShaderFile)>> {
     // The viewer's display pass: one self-contained file.
     let display = ShaderFile {
         path: "shaders/viewer/display.wgsl".into(),
-        source: include_str!("../shaders/viewer/display.wgsl").into(),
+        source: include_str!("../../shaders/viewer/display.wgsl").into(),
     };
     vec![raster, vec![(Vec::new(), display)]]
 }

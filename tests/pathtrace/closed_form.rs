@@ -13,7 +13,7 @@ use glam::DVec3;
 use illum::pathtrace::PathTracer;
 use illum::scene::Scene;
 
-mod common;
+use crate::common;
 
 use common::closed_form::lambert_irradiance_factor;
 

@@ -7,12 +7,12 @@
 //! reference's variance of the mean, on at least 97% of pixels; a correct renderer passes about
 //! 99%. Correctness itself is covered independently by the closed-form and oracle tests.
 //!
-//! Regenerate with `ILLUM_BLESS=1 cargo test --test pathtrace_reference` after an intended change.
+//! Regenerate with `ILLUM_BLESS=1 cargo test --test pathtrace reference` after an intended change.
 
 use illum::image::{ExrMetadata, load_exr, save_diff_images, save_exr, z_test_pass_fraction};
 use illum::scene::{Bounces, Overrides};
 
-mod common;
+use crate::common;
 
 const SIZE: u32 = 64;
 const REFERENCE_SPP: u32 = 16384;

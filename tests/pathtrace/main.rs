@@ -1,0 +1,26 @@
+//! GPU tests of the Cornell box path tracer, in one test binary that shares one device on
+//! lavapipe. (One binary, not one per file: each test binary links wgpu, and a dozen of them
+//! filled the CI machine's disk.)
+//!
+//! - `closed_form`: direct light at floor points against Lambert's polygon formula;
+//! - `statistics`: the samplers agree, cosine sampling is less noisy, seeds, batching, no NaN;
+//! - `reference`: a small Cornell box against checked-in converged references, per pixel;
+//! - `oracle_agreement`: the GPU against the independent f64 CPU oracle (crates/illum-oracle);
+//! - `error_estimate`: the error shown to users tracks the true error; the 1/sqrt(N) rate;
+//! - `sampling`: chi-square tests of the WGSL sampling routines, run on the GPU;
+//! - `extremes`: issue 6, the path tracer where floats run out;
+//! - `specialisation`: each scene's pipeline holds what it uses, is cached, refuses others;
+//! - `shaders`: naga validates every WGSL file in shaders/ (the raster's and viewer's too).
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod closed_form;
+mod error_estimate;
+mod extremes;
+mod oracle_agreement;
+mod reference;
+mod sampling;
+mod shaders;
+mod specialisation;
+mod statistics;
