@@ -817,6 +817,10 @@ fn a_one_by_one_image_is_the_mean_of_the_view() {
 /// returns the tracer and the number of submissions.
 fn render_capped(scene: &Scene, bytes: Option<u64>) -> (PathTracer, usize) {
     let mut tracer = PathTracer::new(common::gpu(), scene).expect("builds");
+    // Passes are otherwise sized by measured speed, which other tests running in parallel change;
+    // with no time limit per submission both renders plan the same passes (the probe pass, then
+    // the rest), so their samples fall into the same chunks whatever the machine's load.
+    tracer.set_target_seconds(f64::INFINITY);
     if let Some(bytes) = bytes {
         tracer.limit_batch_bytes(bytes).expect("one row fits");
     }

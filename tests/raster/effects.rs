@@ -60,8 +60,8 @@ fn each_toggle_changes_the_picture_or_is_documented_not_to() {
 fn surface(s: &WhittedScene, x: f32, y: f32) -> u8 {
     let cam = camera(s, WIDTH, HEIGHT);
     let dir = cam.ray_direction(x, y);
-    let glass = ray_sphere(cam.eye, dir, s.glass.center, s.glass.radius);
-    let metal = ray_sphere(cam.eye, dir, s.metal.center, s.metal.radius);
+    let glass = ray_sphere(cam.eye, dir, s.glass.unwrap().center, s.glass.unwrap().radius);
+    let metal = ray_sphere(cam.eye, dir, s.metal.unwrap().center, s.metal.unwrap().radius);
     match (glass, metal) {
         (Some(g), Some(m)) => return if g < m { 2 } else { 3 },
         (Some(_), None) => return 2,
@@ -87,9 +87,15 @@ fn clear_of_the_other_sphere(s: &WhittedScene, x: u32, y: u32, which: u8, margin
     let cam = camera(s, WIDTH, HEIGHT);
     let dir = cam.ray_direction(x as f32 + 0.5, y as f32 + 0.5);
     let [(c, r), (other, other_r)] = if which == 2 {
-        [(s.glass.center, s.glass.radius), (s.metal.center, s.metal.radius)]
+        [
+            (s.glass.unwrap().center, s.glass.unwrap().radius),
+            (s.metal.unwrap().center, s.metal.unwrap().radius),
+        ]
     } else {
-        [(s.metal.center, s.metal.radius), (s.glass.center, s.glass.radius)]
+        [
+            (s.metal.unwrap().center, s.metal.unwrap().radius),
+            (s.glass.unwrap().center, s.glass.unwrap().radius),
+        ]
     };
     let Some(t) = ray_sphere(cam.eye, dir, c, r) else { return false };
     let p = cam.eye + t * dir;

@@ -15,7 +15,7 @@ fn finite(image: &RgbImage32, what: &str) {
 }
 
 fn spheres(s: &WhittedScene) -> [(Vec3, f32); 2] {
-    [(s.glass.center, s.glass.radius), (s.metal.center, s.metal.radius)]
+    [(s.glass.unwrap().center, s.glass.unwrap().radius), (s.metal.unwrap().center, s.metal.unwrap().radius)]
 }
 
 /// The scene with its light moved to `degrees` of elevation above the floor, same azimuth and
@@ -70,8 +70,12 @@ fn trace_camera(s: &WhittedScene, cam: &Camera, dir: Vec3) -> Hit {
 /// The first surface along origin + t dir (t > 0), from either side of the floor. `with_glass`
 /// false leaves the glass out (what its cube map sees).
 fn trace(s: &WhittedScene, origin: Vec3, dir: Vec3, with_glass: bool) -> Hit {
-    let glass = if with_glass { ray_sphere(origin, dir, s.glass.center, s.glass.radius) } else { None };
-    let metal = ray_sphere(origin, dir, s.metal.center, s.metal.radius);
+    let glass = if with_glass {
+        ray_sphere(origin, dir, s.glass.unwrap().center, s.glass.unwrap().radius)
+    } else {
+        None
+    };
+    let metal = ray_sphere(origin, dir, s.metal.unwrap().center, s.metal.unwrap().radius);
     let floor = (dir.y != 0.0)
         .then(|| (s.floor.height() - origin.y) / dir.y)
         .filter(|t| *t > 0.0)
@@ -231,9 +235,11 @@ fn measure_shadows(s: &WhittedScene) -> ShadowMeasure {
                 continue;
             }
             let dir = cam.ray_direction(x as f32 + 0.5, y as f32 + 0.5);
-            let Some(t) = ray_sphere(cam.eye, dir, s.metal.center, s.metal.radius) else { continue };
+            let Some(t) = ray_sphere(cam.eye, dir, s.metal.unwrap().center, s.metal.unwrap().radius) else {
+                continue;
+            };
             let p = (cam.eye + t * dir).as_dvec3();
-            if exact_margin(s, p, (s.glass.center, s.glass.radius)) <= clear {
+            if exact_margin(s, p, (s.glass.unwrap().center, s.glass.unwrap().radius)) <= clear {
                 continue;
             }
             m.metal_checked += 1;
@@ -322,8 +328,8 @@ fn check_glass_pixels(
     what: &str,
 ) -> (usize, i32) {
     let cam = camera(s, image.width, image.height);
-    let mix = s.glass.reflectivity;
-    let base = (1.0 - mix) * s.glass.color;
+    let mix = s.glass.unwrap().reflectivity;
+    let base = (1.0 - mix) * s.glass.unwrap().color;
     let (mut n, mut darkest) = (0, i32::MAX);
     for y in 0..image.height {
         for x in 0..image.width {
@@ -359,8 +365,8 @@ fn near_plane_cutting_the_glass_sphere() {
     // removes must not open a hole: every pixel whose ray meets the glass shows glass (a 0.1 + 0.9 E
     // mix, no black), every pixel whose ray meets nothing shows the background exactly.
     let mut s = scene();
-    s.camera.eye = s.glass.center + Vec3::new(1.5, 0.0, 0.0);
-    s.camera.target = s.glass.center;
+    s.camera.eye = s.glass.unwrap().center + Vec3::new(1.5, 0.0, 0.0);
+    s.camera.target = s.glass.unwrap().center;
     s.clip.near = 0.6;
     let image = render(&s, &Options::all_on(Look::Figure));
     finite(&image, "near plane");
@@ -378,7 +384,8 @@ fn near_plane_cutting_the_glass_sphere() {
                 }
                 Some(Hit::Glass) => {
                     let dir = cam.ray_direction(x as f32 + 0.5, y as f32 + 0.5);
-                    let t = ray_sphere(cam.eye, dir, s.glass.center, s.glass.radius).unwrap_or(0.0);
+                    let t = ray_sphere(cam.eye, dir, s.glass.unwrap().center, s.glass.unwrap().radius)
+                        .unwrap_or(0.0);
                     if t * dir.dot(cam.basis().forward) < s.clip.near {
                         cut += 1;
                     }
@@ -564,36 +571,36 @@ fn sky_behind_glass(s: &WhittedScene, cam: &Camera, x: u32, y: u32) -> bool {
     let (cx, cy) = (x as f32 + 0.5, y as f32 + 0.5);
     [(0.0, 0.0), (-0.6, -0.6), (0.6, -0.6), (-0.6, 0.6), (0.6, 0.6)].iter().all(|(dx, dy)| {
         let d = cam.ray_direction(cx + dx, cy + dy);
-        trace(s, cam.eye, d, false) == Hit::Sky && trace(s, s.glass.center, d, false) == Hit::Sky
+        trace(s, cam.eye, d, false) == Hit::Sky && trace(s, s.glass.unwrap().center, d, false) == Hit::Sky
     })
 }
 
-/// The glass moved under the floor, where the floor hides it and it shadows nothing visible.
+/// The scene without its glass sphere.
 fn without_glass(s: &WhittedScene) -> WhittedScene {
-    let mut gone = s.clone();
-    gone.glass.center.y = s.floor.height() - 3.0 * s.glass.radius;
-    gone
+    WhittedScene { glass: None, ..s.clone() }
 }
 
 /// The Blinn-Phong highlight of the glass at pixel (x, y), in levels (0 off the glass).
 fn glass_highlight_levels(s: &WhittedScene, cam: &Camera, x: u32, y: u32) -> f32 {
     let dir = cam.ray_direction(x as f32 + 0.5, y as f32 + 0.5);
-    let Some(t) = ray_sphere(cam.eye, dir, s.glass.center, s.glass.radius) else { return 0.0 };
-    let n = (cam.eye + t * dir - s.glass.center).normalize();
+    let Some(t) = ray_sphere(cam.eye, dir, s.glass.unwrap().center, s.glass.unwrap().radius) else {
+        return 0.0;
+    };
+    let n = (cam.eye + t * dir - s.glass.unwrap().center).normalize();
     let l = s.light.to_light();
     if n.dot(l) <= 0.0 {
         return 0.0;
     }
-    255.0 * n.dot((l - dir).normalize()).max(0.0).powf(s.glass.shininess)
+    255.0 * n.dot((l - dir).normalize()).max(0.0).powf(s.glass.unwrap().shininess)
 }
 
 #[test]
 fn refraction_ratio_one_makes_the_glass_vanish() {
     let mut s = scene();
-    s.glass.refraction_ratio = 1.0;
+    s.glass.as_mut().unwrap().refraction_ratio = 1.0;
     let cam = camera(&s, WIDTH, HEIGHT);
-    let white = s.glass.color;
-    let mix = s.glass.reflectivity;
+    let white = s.glass.unwrap().color;
+    let mix = s.glass.unwrap().reflectivity;
     for look in Look::ALL {
         let mut on = Options::all_on(look);
         on.effects.fresnel = false;
@@ -675,7 +682,7 @@ fn extreme_refraction_ratios_leave_no_black_holes() {
     for ratio in [0.3, 0.7, 1.0, 2.0] {
         for look in Look::ALL {
             let mut s = scene();
-            s.glass.refraction_ratio = ratio;
+            s.glass.as_mut().unwrap().refraction_ratio = ratio;
             let image = render(&s, &Options::all_on(look));
             let what = format!("ratio {ratio}, look {look}");
             finite(&image, &what);
@@ -708,14 +715,14 @@ fn totally_reflected_red(s: &WhittedScene, cam: &Camera, x: u32, y: u32, eta: f3
     let mut seen = Vec::new();
     for (dx, dy) in [(0.0, 0.0), (-0.6, -0.6), (0.6, -0.6), (-0.6, 0.6), (0.6, 0.6)] {
         let d = cam.ray_direction(cx + dx, cy + dy);
-        let t = ray_sphere(cam.eye, d, s.glass.center, s.glass.radius)?;
-        let n = (cam.eye + t * d - s.glass.center).normalize();
+        let t = ray_sphere(cam.eye, d, s.glass.unwrap().center, s.glass.unwrap().radius)?;
+        let n = (cam.eye + t * d - s.glass.unwrap().center).normalize();
         let cos = -n.dot(d);
         if eta * eta * (1.0 - cos * cos) < 1.05 {
             return None;
         }
         let m = d + 2.0 * cos * n;
-        seen.push(match trace(s, s.glass.center, m, false) {
+        seen.push(match trace(s, s.glass.unwrap().center, m, false) {
             Hit::Sky => s.background.x,
             Hit::Floor(q) => {
                 let margin = spheres(s)
@@ -740,7 +747,7 @@ fn total_internal_reflection_mirrors_the_environment() {
     // the red channel must be the figure's 0.1 white + 0.9 E or, in the whitted look (Fresnel 1
     // under total reflection), E itself, E the red of what the mirror direction sees.
     let mut s = scene();
-    s.glass.refraction_ratio = 2.0;
+    s.glass.as_mut().unwrap().refraction_ratio = 2.0;
     let cam = camera(&s, WIDTH, HEIGHT);
     for look in Look::ALL {
         let image = render(&s, &Options::all_on(look));
@@ -760,9 +767,10 @@ fn total_internal_reflection_mirrors_the_environment() {
                     floor += 1;
                 }
                 let want = match look {
-                    Look::Figure => {
-                        level((1.0 - s.glass.reflectivity) * s.glass.color.x + s.glass.reflectivity * e)
-                    }
+                    Look::Figure => level(
+                        (1.0 - s.glass.unwrap().reflectivity) * s.glass.unwrap().color.x
+                            + s.glass.unwrap().reflectivity * e,
+                    ),
                     Look::Whitted => level(e),
                 };
                 let diff = (level(image.get(x, y)[0]) - want).abs();

@@ -19,7 +19,8 @@ fn penumbra(scene: &WhittedScene) -> f32 {
 }
 
 fn spheres(scene: &WhittedScene) -> [(Vec3, f32); 2] {
-    [(scene.glass.center, scene.glass.radius), (scene.metal.center, scene.metal.radius)]
+    let pair: [(Vec3, f32); 2] = scene.spheres().try_into().expect("the assignment's two spheres");
+    pair
 }
 
 /// How far the ray from p toward the light passes outside sphere (c, r) (negative: through it).
@@ -45,34 +46,34 @@ fn tile_coord(scene: &WhittedScene, p: Vec3) -> glam::Vec2 {
     (glam::Vec2::new(p.x, p.z) - scene.floor.min_corner()) / scene.floor.tile
 }
 
-#[test]
-fn floor_pixels_are_colour_times_ambient_plus_n_dot_l() {
-    let s = scene();
-    let image = render(&s, &figure());
-    let cam = camera(&s, WIDTH, HEIGHT);
-    // The floor's normal is +Y, so N.L is the y component of the unit vector toward the light:
-    // 13 / sqrt(10^2 + 13^2 + 2^2) = 0.7868 for the light at (10, 13, -2).
+/// Checks every floor pixel of `image` (the figure look of `s`) whose footprint lies inside one
+/// tile and clear of a penumbra: colour x (ambient + light x N.L) in light, colour x ambient in
+/// shadow, within 2 levels. A sphere shadows a point when the ray toward the light passes through
+/// it, and only under a light that casts shadows. Returns the counts of lit and shadowed pixels
+/// checked.
+pub(crate) fn check_floor_shading(s: &WhittedScene, image: &RgbImage32) -> (usize, usize) {
+    let cam = camera(s, image.width, image.height);
     let n_dot_l = s.light.to_light().y.max(0.0);
-    assert!((n_dot_l - 13.0 / 273f32.sqrt()).abs() < 1e-6);
     let ambient = s.ambient.radiance();
     let light = s.light.radiance();
+    let casters = if s.light.casts_shadows { s.spheres() } else { Vec::new() };
     let (mut lit, mut shadowed, mut wrong) = (0, 0, Vec::new());
-    for py in 0..HEIGHT {
-        for px in 0..WIDTH {
-            let Some(p) = floor_interior(&s, &cam, px, py) else { continue };
+    for py in 0..image.height {
+        for px in 0..image.width {
+            let Some(p) = floor_interior(s, &cam, px, py) else { continue };
             // The checker is box-filtered over the pixel's footprint: keep to pixels whose
             // footprint lies inside one tile. The footprint is measured from the neighbours' hits.
-            let here = tile_coord(&s, p);
-            let right = floor_hit(&s, &cam, px as f32 + 1.5, py as f32 + 0.5).map(|q| tile_coord(&s, q));
-            let below = floor_hit(&s, &cam, px as f32 + 0.5, py as f32 + 1.5).map(|q| tile_coord(&s, q));
+            let here = tile_coord(s, p);
+            let right = floor_hit(s, &cam, px as f32 + 1.5, py as f32 + 0.5).map(|q| tile_coord(s, q));
+            let below = floor_hit(s, &cam, px as f32 + 0.5, py as f32 + 1.5).map(|q| tile_coord(s, q));
             let (Some(right), Some(below)) = (right, below) else { continue };
             let footprint = (right - here).abs() + (below - here).abs();
             let to_edge = (here - here.round()).abs();
             if to_edge.x <= footprint.x + 0.01 || to_edge.y <= footprint.y + 0.01 {
                 continue;
             }
-            let margins = spheres(&s).map(|sphere| shadow_margin(&s, p, sphere));
-            let m = penumbra(&s);
+            let margins: Vec<f32> = casters.iter().map(|&sphere| shadow_margin(s, p, sphere)).collect();
+            let m = penumbra(s);
             let in_umbra = margins.iter().any(|&d| d < -m);
             let in_light = margins.iter().all(|&d| d > m);
             if !in_umbra && !in_light {
@@ -100,9 +101,21 @@ fn floor_pixels_are_colour_times_ambient_plus_n_dot_l() {
         lit + shadowed,
         &wrong[..wrong.len().min(5)]
     );
+    (lit, shadowed)
+}
+
+#[test]
+fn floor_pixels_are_colour_times_ambient_plus_n_dot_l() {
+    let s = scene();
+    // The floor's normal is +Y, so N.L is the y component of the unit vector toward the light:
+    // 13 / sqrt(10^2 + 13^2 + 2^2) = 0.7868 for the light at (10, 13, -2).
+    let n_dot_l = s.light.to_light().y.max(0.0);
+    assert!((n_dot_l - 13.0 / 273f32.sqrt()).abs() < 1e-6);
+    let (lit, shadowed) = check_floor_shading(&s, &render(&s, &figure()));
     // The check must not pass by checking nothing.
     assert!(lit > 5000 && shadowed > 500, "only {lit} lit and {shadowed} shadowed pixels checked");
     // scene-facts: lit tiles (207, 207, 0) / (207, 0, 0), shadowed (47, 47, 0) / (47, 0, 0).
+    let (ambient, light) = (s.ambient.radiance(), s.light.radiance());
     let yellow = s.floor.colors[0];
     assert_eq!((yellow * (ambient + light * n_dot_l)).to_array().map(level), [207, 207, 0]);
     assert_eq!((yellow * ambient).to_array().map(level), [47, 47, 0]);
@@ -202,7 +215,7 @@ fn shadows_fall_where_the_light_projects_the_sphere_centres() {
     // As a user would edit the file: another light direction and a moved metal sphere.
     let mut moved = scene();
     moved.light.position = Vec3::new(8.0, 14.0, 3.0);
-    moved.metal.center = Vec3::new(1.5, 1.5, -1.0);
+    moved.metal.as_mut().unwrap().center = Vec3::new(1.5, 1.5, -1.0);
     check_shadow_placement(&moved, "moved light and sphere");
 }
 
@@ -213,11 +226,11 @@ fn the_glass_is_a_tenth_white_plus_nine_tenths_environment() {
     let s = scene();
     let image = render_at(&s, &figure(), width, height);
     let cam = camera(&s, width, height);
-    let mix = s.glass.reflectivity;
-    let base = (1.0 - mix) * s.glass.color;
+    let mix = s.glass.unwrap().reflectivity;
+    let base = (1.0 - mix) * s.glass.unwrap().color;
     let inside_glass = |x: f32, y: f32| {
         let dir = cam.ray_direction(x, y);
-        ray_sphere(cam.eye, dir, s.glass.center, s.glass.radius).is_some()
+        ray_sphere(cam.eye, dir, s.glass.unwrap().center, s.glass.unwrap().radius).is_some()
     };
     let (mut glass, mut sky, mut floor) = (0, 0, 0);
     let sky_level = (base + mix * s.background).to_array().map(level);

@@ -7,6 +7,7 @@
 //! - `extremes`: issue 6 section 3, the scene at its extremes (low and high light, near and far
 //!   planes, the horizon, refraction ratio 1, total internal reflection), tabulated in
 //!   docs/accuracy.md;
+//! - `passes`: a frame records only the passes its scene needs, and skipping one changes nothing;
 //! - `cli`: the render example's raster path, its errors and its output file.
 //!
 //! The expected values are computed here from the scene file and illum-scene's camera, never
@@ -26,6 +27,7 @@ mod cli;
 mod effects;
 mod extremes;
 mod figure;
+mod passes;
 mod reference;
 
 /// The size of the reference images and of most checks.
@@ -102,8 +104,7 @@ pub fn floor_hit(scene: &WhittedScene, camera: &Camera, px: f32, py: f32) -> Opt
     let p = eye + t * dir;
     let (lo, hi) = (scene.floor.min_corner(), scene.floor.max_corner());
     let inside = p.x > lo.x && p.x < hi.x && p.z > lo.y && p.z < hi.y;
-    let hidden = [(scene.glass.center, scene.glass.radius), (scene.metal.center, scene.metal.radius)]
-        .iter()
-        .any(|&(c, r)| ray_sphere(eye, dir, c, r).is_some_and(|ts| ts < t));
+    let hidden =
+        scene.spheres().into_iter().any(|(c, r)| ray_sphere(eye, dir, c, r).is_some_and(|ts| ts < t));
     (inside && !hidden).then_some(p)
 }

@@ -21,7 +21,8 @@ struct Queries {
 impl PassTimer {
     pub fn new(gpu: &GpuContext, pass_names: &[&str]) -> Self {
         let names: Vec<String> = pass_names.iter().map(|s| (*s).to_owned()).collect();
-        let queries = gpu.timestamps.then(|| {
+        // A query set cannot be empty: with no passes to time the timer is inert.
+        let queries = (gpu.timestamps && !names.is_empty()).then(|| {
             let count = 2 * names.len() as u32;
             Queries {
                 set: gpu.device.create_query_set(&wgpu::QuerySetDescriptor {

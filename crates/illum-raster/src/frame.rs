@@ -5,10 +5,12 @@
 //! 2. glass cube: six faces from the glass sphere's centre showing everything but the glass
 //!    (the floor with its shadows, the metal sphere Phong-lit, the sky), then the same six at
 //!    an eighth of the side, the prefiltered level for lookups with a wide footprint;
-//! 3. metal cube (whitted look with reflection only): six faces from the metal sphere's centre
-//!    showing everything but the metal, the glass refracting the glass cube just made;
-//! 4. main: floor and both spheres, the glass reading the glass cube and (whitted) the metal
+//! 3. metal cube: six faces from the metal sphere's centre showing everything but the metal,
+//!    the glass refracting the glass cube just made;
+//! 4. main: floor and spheres, the glass reading the glass cube and (whitted) the metal
 //!    reading the metal cube, multisampled and resolved into the output.
+//!
+//! A pass the frame's [`FramePlan`] leaves out is not recorded at all (plan.rs says when).
 //!
 //! So the metal seen inside the glass lacks its own reflection, and the glass seen in the
 //! metal's mirror has one cube level less: a rasterizer's stand-in for recursion depth.
@@ -16,6 +18,7 @@
 use illum_gpu::timing::PassTimer;
 use illum_gpu::wgpu;
 
+use crate::plan::FramePlan;
 use crate::views::CUBE_FACE_NAMES;
 
 /// Slots of the view uniform buffer.
@@ -25,36 +28,25 @@ pub const METAL_FACE_VIEWS: usize = 7;
 pub const SHADOW_VIEW: usize = 13;
 pub const VIEW_COUNT: usize = 14;
 
-/// Both spheres, as instances of the shadow pass (0 glass, 1 metal, as in scene.wgsl).
-const BOTH: std::ops::Range<u32> = 0..2;
 /// Six vertices: the two triangles of a quad.
 const QUAD: std::ops::Range<u32> = 0..6;
 
-/// Names of the timed passes: "shadow", eighteen cube faces, "main".
-pub fn pass_names() -> Vec<String> {
-    let mut names = vec!["shadow".to_owned()];
-    for cube in ["glass", "metal"] {
-        names.extend(CUBE_FACE_NAMES.iter().map(|face| format!("cube {cube} {face}")));
-    }
-    names.extend(CUBE_FACE_NAMES.iter().map(|face| format!("cube glass coarse {face}")));
-    names.push("main".to_owned());
-    names
-}
-
 /// Everything a frame's passes bind or render into.
 pub struct FrameResources<'a> {
+    pub plan: FramePlan,
     pub timer: &'a PassTimer,
     pub uniforms: &'a wgpu::BindGroup,
     pub view_stride: u64,
     pub shadow_pipeline: &'a wgpu::RenderPipeline,
     pub shadow_map: &'a wgpu::TextureView,
-    pub cube_floor: &'a wgpu::RenderPipeline,
+    /// The floor in cube faces (`None`: the frame captures no cube map).
+    pub cube_floor: Option<&'a wgpu::RenderPipeline>,
     /// The floor's shadow receiver (`None`: shadows off), for the cube faces and the main view.
     pub cube_floor_receiver: Option<&'a wgpu::RenderPipeline>,
     pub main_floor_receiver: Option<&'a wgpu::RenderPipeline>,
-    /// The metal sphere as the glass capture draws it.
-    pub cube_metal: &'a wgpu::RenderPipeline,
-    /// The glass sphere as the metal capture draws it (`None`: no metal cube this frame).
+    /// The metal sphere as the glass capture draws it (`None`: no metal sphere).
+    pub cube_metal: Option<&'a wgpu::RenderPipeline>,
+    /// The glass sphere as the metal capture draws it (`None`: no glass sphere, or no metal cube).
     pub cube_glass: Option<&'a wgpu::RenderPipeline>,
     pub cube_depth: &'a wgpu::TextureView,
     pub coarse_depth: &'a wgpu::TextureView,
@@ -67,8 +59,9 @@ pub struct FrameResources<'a> {
     pub metal_capture_textures: &'a wgpu::BindGroup,
     pub main_textures: &'a wgpu::BindGroup,
     pub main_floor: &'a wgpu::RenderPipeline,
-    pub main_glass: &'a wgpu::RenderPipeline,
-    pub main_metal: &'a wgpu::RenderPipeline,
+    /// The spheres in the main view (`None`: the scene lacks that sphere).
+    pub main_glass: Option<&'a wgpu::RenderPipeline>,
+    pub main_metal: Option<&'a wgpu::RenderPipeline>,
     /// The multisampled colour buffer, when MSAA is on.
     pub main_multisampled: Option<&'a wgpu::TextureView>,
     pub main_output: &'a wgpu::TextureView,
@@ -87,7 +80,7 @@ struct Capture<'a> {
     /// View-uniform slot of the +X face; the others follow.
     first_view: usize,
     textures: &'a wgpu::BindGroup,
-    /// The other sphere, as seen from this one (`None`: the cube map is not needed this frame).
+    /// The other sphere, as seen from this one (`None`: the scene has no other sphere).
     sphere: Option<&'a wgpu::RenderPipeline>,
 }
 
@@ -115,41 +108,45 @@ impl FrameResources<'_> {
         })
     }
 
-    /// Records every pass of one frame. Every timed pass is recorded even when it draws nothing
-    /// (no shadows, no metal cube), so that every timestamp query is written each frame.
-    /// `shadows`: draw the casters into the shadow map (else it stays cleared: all lit).
-    pub fn record(&self, encoder: &mut wgpu::CommandEncoder, shadows: bool) {
-        self.shadow_pass(encoder, shadows);
-        // Seen from the glass sphere's centre: everything but the glass; then the same views at
-        // an eighth of the side, the glass's prefiltered level.
-        let glass = Capture {
-            name: "glass",
-            faces: self.glass_faces,
-            depth: self.cube_depth,
-            first_view: GLASS_FACE_VIEWS,
-            textures: self.glass_capture_textures,
-            sphere: Some(self.cube_metal),
-        };
-        self.capture(encoder, &glass);
-        self.capture(
-            encoder,
-            &Capture {
-                name: "glass coarse",
-                faces: self.glass_coarse_faces,
-                depth: self.coarse_depth,
-                ..glass
-            },
-        );
-        // Seen from the metal sphere's centre: everything but the metal.
-        let metal = Capture {
-            name: "metal",
-            faces: self.metal_faces,
-            depth: self.cube_depth,
-            first_view: METAL_FACE_VIEWS,
-            textures: self.metal_capture_textures,
-            sphere: self.cube_glass,
-        };
-        self.capture(encoder, &metal);
+    /// Records the passes of one frame that its plan includes.
+    pub fn record(&self, encoder: &mut wgpu::CommandEncoder) {
+        if self.plan.shadow_pass {
+            self.shadow_pass(encoder);
+        }
+        if self.plan.glass {
+            // Seen from the glass sphere's centre: everything but the glass; then the same views
+            // at an eighth of the side, the glass's prefiltered level.
+            let glass = Capture {
+                name: "glass",
+                faces: self.glass_faces,
+                depth: self.cube_depth,
+                first_view: GLASS_FACE_VIEWS,
+                textures: self.glass_capture_textures,
+                sphere: self.cube_metal,
+            };
+            self.capture(encoder, &glass);
+            self.capture(
+                encoder,
+                &Capture {
+                    name: "glass coarse",
+                    faces: self.glass_coarse_faces,
+                    depth: self.coarse_depth,
+                    ..glass
+                },
+            );
+        }
+        if self.plan.metal_cube {
+            // Seen from the metal sphere's centre: everything but the metal.
+            let metal = Capture {
+                name: "metal",
+                faces: self.metal_faces,
+                depth: self.cube_depth,
+                first_view: METAL_FACE_VIEWS,
+                textures: self.metal_capture_textures,
+                sphere: self.cube_glass,
+            };
+            self.capture(encoder, &metal);
+        }
         self.main_pass(encoder);
     }
 
@@ -161,7 +158,7 @@ impl FrameResources<'_> {
         }
     }
 
-    fn shadow_pass(&self, encoder: &mut wgpu::CommandEncoder, draw: bool) {
+    fn shadow_pass(&self, encoder: &mut wgpu::CommandEncoder) {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("raster shadow"),
             color_attachments: &[],
@@ -177,33 +174,29 @@ impl FrameResources<'_> {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        if draw {
-            pass.set_pipeline(self.shadow_pipeline);
-            pass.set_bind_group(0, self.uniforms, &[self.view_offset(SHADOW_VIEW)]);
-            pass.draw(QUAD, BOTH);
-        }
+        pass.set_pipeline(self.shadow_pipeline);
+        pass.set_bind_group(0, self.uniforms, &[self.view_offset(SHADOW_VIEW)]);
+        pass.draw(QUAD, self.plan.shadow_casters());
     }
 
-    /// One cube face: the floor and the capture's sphere, or, without a sphere, an empty pass
-    /// that leaves the face as it is (a cube map the frame does not use).
+    /// One cube face: the other sphere, if any, and the floor.
     fn cube_face(&self, encoder: &mut wgpu::CommandEncoder, name: &str, capture: &Capture, face: usize) {
-        let sphere = capture.sphere;
-        let load =
-            if sphere.is_some() { wgpu::LoadOp::Clear(self.clear_colour()) } else { wgpu::LoadOp::Load };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(name),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
                 view: &capture.faces[face],
                 depth_slice: None,
                 resolve_target: None,
-                ops: wgpu::Operations { load, store: wgpu::StoreOp::Store },
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(self.clear_colour()),
+                    store: wgpu::StoreOp::Store,
+                },
             })],
-            depth_stencil_attachment: sphere.and_then(|_| self.clear_depth(capture.depth)),
+            depth_stencil_attachment: self.clear_depth(capture.depth),
             timestamp_writes: self.timer.render_writes(name),
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        let Some(sphere) = sphere else { return };
         pass.set_bind_group(0, self.uniforms, &[self.view_offset(capture.first_view + face)]);
         pass.set_bind_group(1, capture.textures, &[]);
         // Sphere first: it hides part of the floor, whose fragments then fail the early depth
@@ -211,8 +204,7 @@ impl FrameResources<'_> {
         // no early test itself). On lavapipe this order also avoids a fixed cost of about a
         // millisecond per pass that a floor-first pass pays (measured, see docs/performance-raster.md).
         // The floor's shadow receiver goes before the rest of the floor (floor.wgsl).
-        for pipeline in [Some(sphere), self.cube_floor_receiver, Some(self.cube_floor)].into_iter().flatten()
-        {
+        for pipeline in [capture.sphere, self.cube_floor_receiver, self.cube_floor].into_iter().flatten() {
             pass.set_pipeline(pipeline);
             pass.draw(QUAD, 0..1);
         }
@@ -252,8 +244,7 @@ impl FrameResources<'_> {
         pass.set_bind_group(0, self.uniforms, &[self.view_offset(MAIN_VIEW)]);
         pass.set_bind_group(1, self.main_textures, &[]);
         // Spheres first, for the reasons given in cube_face.
-        let pipelines =
-            [Some(self.main_glass), Some(self.main_metal), self.main_floor_receiver, Some(self.main_floor)];
+        let pipelines = [self.main_glass, self.main_metal, self.main_floor_receiver, Some(self.main_floor)];
         for pipeline in pipelines.into_iter().flatten() {
             pass.set_pipeline(pipeline);
             pass.draw(QUAD, 0..1);

@@ -2,11 +2,13 @@
 //! pipelines only.
 //!
 //! Each frame ([`frame`] has the order and why):
-//! - a **shadow map** from the directional light, fitted to the two spheres ([`shadow_fit`]),
-//!   read with percentage-closer filtering for soft edges;
+//! - a **shadow map** from the directional light, fitted to the spheres ([`shadow_fit`]), read
+//!   with percentage-closer filtering for soft edges;
 //! - a **cube map** captured at the glass sphere's centre (six faces, without the glass), which
 //!   the glass refracts; in the `whitted` look a second one at the metal sphere's centre, which
 //!   the metal mirrors ([`views`] has the face conventions);
+//! - only the passes the scene needs: no shadow map for a light that casts no shadows, no cube
+//!   map for a sphere the scene lacks or that mirrors nothing ([`plan`]);
 //! - the **main pass** with 4x MSAA: the procedural checkerboard floor, anti-aliased by an exact
 //!   box filter over each pixel's footprint, and the spheres as analytic impostors that write
 //!   their true depth and an analytic MSAA coverage mask, so silhouettes are round at any size.
@@ -34,6 +36,7 @@ pub mod frame;
 mod options;
 mod pass_times;
 mod pipelines;
+pub mod plan;
 mod renderer;
 pub mod shaders;
 pub mod shadow_fit;
@@ -47,6 +50,7 @@ pub use error::RasterError;
 pub use illum_scene::{Effects, Look, WhittedScene};
 pub use options::Options;
 pub use pass_times::{Frame, PassTimes};
+pub use plan::FramePlan;
 pub use renderer::WhittedRenderer;
 pub use shaders::{MODULES, SHADERS};
 

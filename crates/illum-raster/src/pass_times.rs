@@ -1,21 +1,21 @@
-//! GPU time per part of a frame, from the timestamp queries of `frame::pass_names`.
+//! GPU time per part of a frame, from the timestamp queries of `FramePlan::pass_names`.
 
 use illum_image::RgbImage32;
 
 /// GPU time of each part of a frame, in milliseconds, from timestamp queries.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PassTimes {
-    /// The shadow map.
+    /// The shadow map (0 when the frame has no shadow pass).
     pub shadow_ms: f64,
-    /// All eighteen cube-map faces: the glass's, its coarse copy's and the metal's (empty passes
-    /// in the figure look).
+    /// The cube-map faces the frame captured: the glass's and its coarse copy's (twelve), and
+    /// the metal's (six more, in the whitted look with reflection).
     pub cube_ms: f64,
     /// The main view, including the MSAA resolve.
     pub main_ms: f64,
 }
 
 impl PassTimes {
-    /// Sums per-pass timings named as in `frame::pass_names`.
+    /// Sums per-pass timings named as in `FramePlan::pass_names`.
     pub(crate) fn from_named(named: &[(String, f64)]) -> Self {
         let mut t = PassTimes::default();
         for (name, ms) in named {
@@ -43,11 +43,19 @@ pub struct Frame {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::frame::pass_names;
+    use crate::plan::FramePlan;
 
     #[test]
     fn pass_times_sum_the_cube_faces() {
-        let named: Vec<(String, f64)> = pass_names().into_iter().map(|n| (n, 0.5)).collect();
+        let plan = FramePlan {
+            glass: true,
+            metal: true,
+            shadow_pass: true,
+            glass_shadowed: false,
+            metal_shadowed: true,
+            metal_cube: true,
+        };
+        let named: Vec<(String, f64)> = plan.pass_names().into_iter().map(|n| (n, 0.5)).collect();
         let t = PassTimes::from_named(&named);
         assert_eq!((t.shadow_ms, t.cube_ms, t.main_ms), (0.5, 9.0, 0.5));
         assert_eq!(t.total_ms(), 10.0);

@@ -8,12 +8,11 @@ use illum_scene::{RasterLimits, WhittedScene};
 
 use crate::RasterError;
 use crate::bindings::{Samplers, TextureGroups, Uniforms};
-use crate::frame::{
-    FrameResources, GLASS_FACE_VIEWS, MAIN_VIEW, METAL_FACE_VIEWS, SHADOW_VIEW, VIEW_COUNT, pass_names,
-};
+use crate::frame::{FrameResources, GLASS_FACE_VIEWS, MAIN_VIEW, METAL_FACE_VIEWS, SHADOW_VIEW, VIEW_COUNT};
 use crate::options::Options;
 use crate::pass_times::{Frame, PassTimes};
 use crate::pipelines::Pipelines;
+use crate::plan::FramePlan;
 use crate::shadow_fit::{MAX_SHADOW_MAP, ShadowFit, fit_shadow};
 use crate::targets::{CubeSet, MainTargets, ShadowMap};
 use crate::uniforms::{self, ViewUniform};
@@ -49,7 +48,10 @@ pub struct WhittedRenderer {
     cubes: CubeSet,
     texture_groups: TextureGroups,
     main: Option<MainTargets>,
+    /// Timestamp queries for exactly the passes of the last frame's plan (rebuilt when the plan
+    /// changes, so that every query resolved was written).
     timer: PassTimer,
+    timer_plan: Option<FramePlan>,
     staging: Option<wgpu::Buffer>,
 }
 
@@ -66,8 +68,6 @@ impl WhittedRenderer {
         let cubes = CubeSet::new(gpu, scene.quality.cube_size)?;
         let texture_groups =
             TextureGroups::new(gpu, &pipelines.textures_layout, &samplers, &shadow_map, &cubes)?;
-        let names = pass_names();
-        let name_refs: Vec<&str> = names.iter().map(String::as_str).collect();
         Ok(WhittedRenderer {
             gpu: gpu.clone(),
             scene,
@@ -81,7 +81,8 @@ impl WhittedRenderer {
             cubes,
             texture_groups,
             main: None,
-            timer: PassTimer::new(gpu, &name_refs),
+            timer: PassTimer::new(gpu, &[]),
+            timer_plan: None,
             staging: None,
         })
     }
@@ -142,6 +143,11 @@ impl WhittedRenderer {
         self.shadow_fit = fit;
         self.scene = scene;
         Ok(())
+    }
+
+    /// The passes a frame with `options` records (see [`FramePlan`]).
+    pub fn plan(&self, options: &Options) -> FramePlan {
+        FramePlan::new(&self.scene, options, &self.shadow_fit)
     }
 
     /// Changes the output size (checked against the device's limits).
@@ -238,16 +244,14 @@ impl WhittedRenderer {
             self.main = Some(MainTargets::new(&self.gpu, self.width, self.height, samples)?);
         }
         let main = Target::Main { samples };
-        let (glass_shadowed, metal_shadowed) =
-            (self.shadow_fit.glass_shadowed, self.shadow_fit.metal_shadowed);
-        let key = |surface, target| {
-            let shadowed = match surface {
-                Surface::Glass => glass_shadowed,
-                Surface::Metal => metal_shadowed,
-                Surface::Floor | Surface::FloorReceiver => true,
-            };
-            PipelineKey::new(surface, target, options, shadowed)
-        };
+        let plan = self.plan(options);
+        if self.timer_plan != Some(plan) {
+            let names = plan.pass_names();
+            let name_refs: Vec<&str> = names.iter().map(String::as_str).collect();
+            self.timer = PassTimer::new(&self.gpu, &name_refs);
+            self.timer_plan = Some(plan);
+        }
+        let key = |surface, target| PipelineKey::new(surface, target, options, &plan);
         let keys = Keys {
             cube_floor: key(Surface::Floor, Target::Cube),
             cube_receiver: key(Surface::FloorReceiver, Target::Cube),
@@ -258,18 +262,20 @@ impl WhittedRenderer {
             main_glass: key(Surface::Glass, main),
             main_metal: key(Surface::Metal, main),
         };
-        let shadows = options.effects.shadows;
-        let metal_cube = options.needs_metal_cube();
+        let shadows = plan.shadow_pass;
+        // The glass's cube faces draw the metal; the metal's cube faces draw the glass.
+        let cube_metal = plan.glass && plan.metal;
+        let cube_glass = plan.metal_cube && plan.glass;
+        let cubes = plan.glass || plan.metal_cube;
         for (key, needed) in [
-            (keys.cube_floor, true),
-            (keys.cube_receiver, shadows),
-            (keys.cube_metal, true),
-            // The glass as the metal's cube map sees it.
-            (keys.cube_glass, metal_cube),
+            (keys.cube_floor, cubes),
+            (keys.cube_receiver, cubes && shadows),
+            (keys.cube_metal, cube_metal),
+            (keys.cube_glass, cube_glass),
             (keys.main_floor, true),
             (keys.main_receiver, shadows),
-            (keys.main_glass, true),
-            (keys.main_metal, true),
+            (keys.main_glass, plan.glass),
+            (keys.main_metal, plan.metal),
         ] {
             if needed {
                 self.pipelines.ensure(&self.gpu, key)?;
@@ -283,16 +289,17 @@ impl WhittedRenderer {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("raster frame") });
         let main = self.main.as_ref().expect("made above");
         let resources = FrameResources {
+            plan,
             timer: &self.timer,
             uniforms: &self.uniforms.group,
             view_stride: self.uniforms.view_stride,
             shadow_pipeline: &self.pipelines.shadow,
             shadow_map: &self.shadow_map.view,
-            cube_floor: self.pipelines.get(&keys.cube_floor),
-            cube_floor_receiver: shadows.then(|| self.pipelines.get(&keys.cube_receiver)),
+            cube_floor: cubes.then(|| self.pipelines.get(&keys.cube_floor)),
+            cube_floor_receiver: (cubes && shadows).then(|| self.pipelines.get(&keys.cube_receiver)),
             main_floor_receiver: shadows.then(|| self.pipelines.get(&keys.main_receiver)),
-            cube_metal: self.pipelines.get(&keys.cube_metal),
-            cube_glass: metal_cube.then(|| self.pipelines.get(&keys.cube_glass)),
+            cube_metal: cube_metal.then(|| self.pipelines.get(&keys.cube_metal)),
+            cube_glass: cube_glass.then(|| self.pipelines.get(&keys.cube_glass)),
             cube_depth: &self.cubes.depth,
             coarse_depth: &self.cubes.coarse_depth,
             glass_faces: &self.cubes.glass.face_views,
@@ -302,14 +309,14 @@ impl WhittedRenderer {
             metal_capture_textures: &self.texture_groups.metal_capture,
             main_textures: &self.texture_groups.main,
             main_floor: self.pipelines.get(&keys.main_floor),
-            main_glass: self.pipelines.get(&keys.main_glass),
-            main_metal: self.pipelines.get(&keys.main_metal),
+            main_glass: plan.glass.then(|| self.pipelines.get(&keys.main_glass)),
+            main_metal: plan.metal.then(|| self.pipelines.get(&keys.main_metal)),
             main_multisampled: main.multisampled.as_ref(),
             main_output: &main.output_view,
             main_depth: &main.depth,
             background: self.scene.background.to_array(),
         };
-        resources.record(&mut encoder, shadows);
+        resources.record(&mut encoder);
         Ok(encoder)
     }
 
@@ -321,9 +328,14 @@ impl WhittedRenderer {
         let cube_view = |center: Vec3, face: usize| {
             uniforms::perspective_view(cube_face_view_proj(center, face, capture_clip(scene, center)), center)
         };
+        // An absent sphere's face views stay zero: no capture uses them.
         for face in 0..6 {
-            views[GLASS_FACE_VIEWS + face] = cube_view(scene.glass.center, face);
-            views[METAL_FACE_VIEWS + face] = cube_view(scene.metal.center, face);
+            if let Some(glass) = &scene.glass {
+                views[GLASS_FACE_VIEWS + face] = cube_view(glass.center, face);
+            }
+            if let Some(metal) = &scene.metal {
+                views[METAL_FACE_VIEWS + face] = cube_view(metal.center, face);
+            }
         }
         views[SHADOW_VIEW] = uniforms::shadow_view(&self.shadow_fit);
         self.uniforms.write(&self.gpu, &uniforms::scene_uniform(scene, &self.shadow_fit), &views);

@@ -40,7 +40,8 @@ pub struct ShadowFit {
     /// unbounded, and this is the whole floor rectangle instead.
     pub receiver: [Vec2; 3],
     /// Whether the glass (metal) sphere can receive any shadow, even a soft edge: only the
-    /// other sphere can cast one on it (a sphere never shadows its own lit half).
+    /// other sphere can cast one on it (a sphere never shadows its own lit half), so a scene
+    /// with one sphere has neither.
     pub glass_shadowed: bool,
     pub metal_shadowed: bool,
 }
@@ -74,12 +75,17 @@ fn perpendicular_frame(w: Vec3) -> (Vec3, Vec3) {
 pub fn fit_shadow(scene: &WhittedScene, max_size: u32) -> ShadowFit {
     let direction = scene.light.direction();
     let (u, v) = perpendicular_frame(direction);
-    let casters = [(scene.glass.center, scene.glass.radius), (scene.metal.center, scene.metal.radius)];
+    // Without a sphere nothing casts a shadow and no shadow pass runs (plan.rs); the map is then
+    // fitted around the floor's centre only so that every number stays finite.
+    let mut casters = scene.spheres();
+    if casters.is_empty() {
+        casters.push((scene.floor.center, scene.quality.pcf_radius));
+    }
 
     // The casters' discs in the light's (u, v) plane.
     let mut lo = glam::Vec2::splat(f32::INFINITY);
     let mut hi = glam::Vec2::splat(f32::NEG_INFINITY);
-    for (c, r) in casters {
+    for &(c, r) in &casters {
         let p = glam::Vec2::new(c.dot(u), c.dot(v));
         lo = lo.min(p - r);
         hi = hi.max(p + r);
@@ -114,7 +120,7 @@ pub fn fit_shadow(scene: &WhittedScene, max_size: u32) -> ShadowFit {
         near = near.min(z);
         far = far.max(z);
     }
-    for (c, r) in casters {
+    for &(c, r) in &casters {
         let z = c.dot(direction);
         near = near.min(z - r);
         far = far.max(z + r);
@@ -136,7 +142,7 @@ pub fn fit_shadow(scene: &WhittedScene, max_size: u32) -> ShadowFit {
     // The soft edge reaches pcf_radius beyond the sharp one, and a sphere's lookup point moves a
     // kernel and a texel along its normal: twice the kernel plus two texels covers both.
     let margin = 2.0 * (PCF_REACH_TEXELS + 1.0) * texel;
-    let [glass, metal] = casters;
+    let pair = scene.glass.zip(scene.metal).map(|(g, m)| ((g.center, g.radius), (m.center, m.radius)));
     ShadowFit {
         view_proj,
         size,
@@ -144,8 +150,8 @@ pub fn fit_shadow(scene: &WhittedScene, max_size: u32) -> ShadowFit {
         direction,
         depth_range,
         receiver,
-        glass_shadowed: can_shadow(metal, glass, direction, margin),
-        metal_shadowed: can_shadow(glass, metal, direction, margin),
+        glass_shadowed: pair.is_some_and(|(glass, metal)| can_shadow(metal, glass, direction, margin)),
+        metal_shadowed: pair.is_some_and(|(glass, metal)| can_shadow(glass, metal, direction, margin)),
     }
 }
 
@@ -186,6 +192,10 @@ mod tests {
         WhittedScene::from_toml_str(&text, "whitted.toml").unwrap()
     }
 
+    fn glass(s: &WhittedScene) -> illum_scene::GlassSphere {
+        s.glass.expect("whitted.toml has a glass sphere")
+    }
+
     fn clip(fit: &ShadowFit, p: Vec3) -> Vec3 {
         let c = fit.view_proj * p.extend(1.0);
         c.truncate() / c.w
@@ -198,7 +208,7 @@ mod tests {
         assert!((fit.texel - s.quality.pcf_radius / PCF_REACH_TEXELS).abs() < 1e-7);
         let margin_ndc = 2.0 * PCF_REACH_TEXELS / fit.size as f32;
         let (u, v) = perpendicular_frame(fit.direction);
-        for (c, r) in [(s.glass.center, s.glass.radius), (s.metal.center, s.metal.radius)] {
+        for (c, r) in s.spheres() {
             for edge in [u, -u, v, -v] {
                 let p = clip(&fit, c + r * edge);
                 assert!(p.x.abs() <= 1.0 - margin_ndc && p.y.abs() <= 1.0 - margin_ndc, "{p:?}");
@@ -208,19 +218,19 @@ mod tests {
             assert!(pole > 0.0 && pole < clip(&fit, c).z);
         }
         let under_glass = clip(&fit, Vec3::new(2.2, 0.0, -3.8)).z;
-        assert!(under_glass > clip(&fit, s.glass.center).z && under_glass < 1.0);
+        assert!(under_glass > clip(&fit, glass(&s).center).z && under_glass < 1.0);
     }
 
     #[test]
     fn points_along_the_light_share_a_texel() {
         let s = scene();
         let fit = fit_shadow(&s, 8192);
-        let a = clip(&fit, s.glass.center);
-        let b = clip(&fit, s.glass.center + 2.5 * fit.direction);
+        let a = clip(&fit, glass(&s).center);
+        let b = clip(&fit, glass(&s).center + 2.5 * fit.direction);
         assert!((a.x - b.x).abs() < 1e-5 && (a.y - b.y).abs() < 1e-5);
         // One scene unit across the light is size / (2 half) texels = 1 / texel.
         let (u, _) = perpendicular_frame(fit.direction);
-        let c = clip(&fit, s.glass.center + u);
+        let c = clip(&fit, glass(&s).center + u);
         let texels = 0.5 * (c.x - a.x) * fit.size as f32;
         assert!((texels - 1.0 / fit.texel).abs() < 1e-2, "{texels}");
     }
@@ -241,7 +251,7 @@ mod tests {
             assert!((p.x - expected.0).abs() < 1e-4 && (p.y - expected.1).abs() < 1e-4, "{p:?}");
         }
         // Both shadow centres (where the light projects the sphere centres) lie inside it.
-        for c in [s.glass.center, s.metal.center] {
+        for (c, _) in s.spheres() {
             let d = fit.direction;
             let on_floor = c + (s.floor.height() - c.y) / d.y * d;
             let p = clip(&fit, on_floor);
@@ -264,7 +274,7 @@ mod tests {
         assert!(!fit.glass_shadowed && fit.metal_shadowed);
         // Metal straight below the glass along the light: shadowed, and the glass not.
         let mut under = s.clone();
-        under.metal.center = s.glass.center + 2.5 * fit.direction;
+        under.metal.as_mut().unwrap().center = glass(&s).center + 2.5 * fit.direction;
         let fit = fit_shadow(&under, 8192);
         assert!(fit.metal_shadowed && !fit.glass_shadowed);
         // A light low enough to graze the metal past the glass.
@@ -278,6 +288,23 @@ mod tests {
             !can_shadow((Vec3::ZERO, 1.0), (Vec3::new(-5.0, 0.0, 0.0), 1.0), d, 0.0),
             "on the light's side"
         );
+    }
+
+    #[test]
+    fn one_sphere_shadows_nothing_but_the_floor_and_none_keeps_the_fit_finite() {
+        let s = scene();
+        let mut glass_only = s.clone();
+        glass_only.metal = None;
+        let fit = fit_shadow(&glass_only, 8192);
+        assert!(!fit.glass_shadowed && !fit.metal_shadowed);
+        let (c, r) = (glass(&s).center, glass(&s).radius);
+        assert!(clip(&fit, c + r * perpendicular_frame(fit.direction).0).x.abs() < 1.0);
+        let mut bare = s.clone();
+        bare.glass = None;
+        bare.metal = None;
+        let fit = fit_shadow(&bare, 8192);
+        assert!(fit.view_proj.is_finite() && fit.texel.is_finite() && fit.size >= MIN_SHADOW_MAP);
+        assert!(!fit.glass_shadowed && !fit.metal_shadowed);
     }
 
     #[test]

@@ -73,7 +73,24 @@ fn env_params(size: u32) -> [f32; 4] {
 pub fn scene_uniform(scene: &WhittedScene, shadow: &ShadowFit) -> SceneUniform {
     let floor = &scene.floor;
     let (lo, hi) = (floor.min_corner(), floor.max_corner());
-    let (glass, metal) = (&scene.glass, &scene.metal);
+    // An absent sphere's constants stay zero: nothing draws it or looks it up (plan.rs).
+    let zero = [0.0; 4];
+    let (glass_sphere, glass_color, glass_params) = match &scene.glass {
+        Some(glass) => (
+            v4(glass.center, glass.radius),
+            v4(glass.color, glass.reflectivity),
+            [glass.refraction_ratio, glass.shininess, schlick_f0(glass.refraction_ratio), 0.0],
+        ),
+        None => (zero, zero, zero),
+    };
+    let (metal_sphere, metal_color, metal_specular) = match &scene.metal {
+        Some(metal) => (
+            v4(metal.center, metal.radius),
+            v4(metal.color, metal.mirror),
+            v4(metal.specular, metal.shininess),
+        ),
+        None => (zero, zero, zero),
+    };
     // A sphere's shadow lookup moves outward along its normal by the kernel's reach plus a
     // texel: then every PCF tap samples from outside the sphere, on the light's side, so the
     // sphere never shadows its own lit half (see shadow_visibility in lighting.wgsl).
@@ -89,12 +106,12 @@ pub fn scene_uniform(scene: &WhittedScene, shadow: &ShadowFit) -> SceneUniform {
         receiver_v: [shadow.receiver[2].x, shadow.receiver[2].y, 0.0, 0.0],
         floor_color_a: v4(floor.colors[0], 1.0),
         floor_color_b: v4(floor.colors[1], 1.0),
-        glass_sphere: v4(glass.center, glass.radius),
-        glass_color: v4(glass.color, glass.reflectivity),
-        glass_params: [glass.refraction_ratio, glass.shininess, schlick_f0(glass.refraction_ratio), 0.0],
-        metal_sphere: v4(metal.center, metal.radius),
-        metal_color: v4(metal.color, metal.mirror),
-        metal_specular: v4(metal.specular, metal.shininess),
+        glass_sphere,
+        glass_color,
+        glass_params,
+        metal_sphere,
+        metal_color,
+        metal_specular,
         shadow_view_proj: shadow.view_proj.to_cols_array_2d(),
         shadow_params: [normal_offset, SHADOW_DEPTH_BIAS, 0.0, 0.0],
         env_params: env_params(scene.quality.cube_size),

@@ -9,6 +9,7 @@
 use illum_scene::Look;
 
 use crate::options::Options;
+use crate::plan::FramePlan;
 
 /// A surface drawn by the floor and sphere pipelines.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -60,12 +61,11 @@ pub struct PipelineKey {
 
 impl PipelineKey {
     /// The pipeline that draws `surface` into `target` for `options`, with only the switches
-    /// that surface reads. The metal's cube map exists only in the main pass of a frame that
-    /// captured it. `shadowed`: whether this sphere can receive a shadow at all (from the other
-    /// sphere; see `shadow_fit::can_shadow`); where it cannot, its shadow lookup is compiled out.
-    pub fn new(surface: Surface, target: Target, options: &Options, shadowed: bool) -> Self {
+    /// that surface reads and only what `plan` says the frame has: a sphere's shadow lookup only
+    /// where the other sphere can shade it (`shadow_fit::can_shadow`), the metal's mirror only in
+    /// the main pass of a frame that captured its cube map.
+    pub fn new(surface: Surface, target: Target, options: &Options, plan: &FramePlan) -> Self {
         let e = &options.effects;
-        let sphere_shadows = e.shadows && shadowed;
         let whitted = options.look == Look::Whitted;
         let switches = match surface {
             Surface::Floor => Switches::default(),
@@ -74,7 +74,7 @@ impl PipelineKey {
             Surface::Glass if !whitted => Switches { refraction: e.refraction, ..Default::default() },
             Surface::Glass => Switches {
                 whitted,
-                shadows: sphere_shadows,
+                shadows: plan.glass_shadowed,
                 pcf: e.pcf,
                 refraction: e.refraction,
                 reflection: e.reflection,
@@ -82,10 +82,10 @@ impl PipelineKey {
                 metal_env: false,
             },
             Surface::Metal => {
-                let mirror = whitted && e.reflection && matches!(target, Target::Main { .. });
+                let mirror = plan.metal_cube && matches!(target, Target::Main { .. });
                 Switches {
                     whitted: mirror,
-                    shadows: sphere_shadows,
+                    shadows: plan.metal_shadowed,
                     pcf: e.pcf,
                     reflection: mirror,
                     metal_env: mirror,
@@ -126,6 +126,20 @@ mod tests {
     use super::*;
     use illum_scene::Effects;
 
+    /// The plan of a frame of the assignment's scene (both spheres, a shadow-casting light, a
+    /// mirroring metal) under `options`; `shadowed`: whether the spheres can shade each other.
+    fn plan(options: &Options, shadowed: bool) -> FramePlan {
+        let shadow_pass = options.effects.shadows;
+        FramePlan {
+            glass: true,
+            metal: true,
+            shadow_pass,
+            glass_shadowed: shadow_pass && shadowed,
+            metal_shadowed: shadow_pass && shadowed,
+            metal_cube: options.look == Look::Whitted && options.effects.reflection,
+        }
+    }
+
     #[test]
     fn keys_ignore_switches_a_surface_does_not_read() {
         let figure = Options::all_on(Look::Figure);
@@ -135,27 +149,42 @@ mod tests {
         for surface in [Surface::Floor, Surface::FloorReceiver, Surface::Glass, Surface::Metal] {
             let target = Target::Main { samples: 4 };
             assert_eq!(
-                PipelineKey::new(surface, target, &figure, true),
-                PipelineKey::new(surface, target, &no_fresnel, true)
+                PipelineKey::new(surface, target, &figure, &plan(&figure, true)),
+                PipelineKey::new(surface, target, &no_fresnel, &plan(&no_fresnel, true))
             );
         }
         let no_shadows = Options { effects: Effects { shadows: false, ..Effects::ALL_ON }, ..figure };
-        let key = PipelineKey::new(Surface::Metal, Target::Cube, &no_shadows, true);
+        let key = PipelineKey::new(Surface::Metal, Target::Cube, &no_shadows, &plan(&no_shadows, true));
         assert!(!key.switches.shadows && !key.switches.pcf, "PCF means nothing without shadows");
-        let plain = PipelineKey::new(Surface::Floor, Target::Cube, &figure, true);
-        assert_eq!(plain, PipelineKey::new(Surface::Floor, Target::Cube, &no_shadows, true));
+        let plain = PipelineKey::new(Surface::Floor, Target::Cube, &figure, &plan(&figure, true));
+        assert_eq!(
+            plain,
+            PipelineKey::new(Surface::Floor, Target::Cube, &no_shadows, &plan(&no_shadows, true))
+        );
     }
 
     #[test]
     fn the_metal_mirrors_only_in_the_whitted_main_pass() {
         let whitted = Options::all_on(Look::Whitted);
         assert!(
-            PipelineKey::new(Surface::Metal, Target::Main { samples: 1 }, &whitted, true).switches.metal_env
+            PipelineKey::new(Surface::Metal, Target::Main { samples: 1 }, &whitted, &plan(&whitted, true))
+                .switches
+                .metal_env
         );
-        assert!(!PipelineKey::new(Surface::Metal, Target::Cube, &whitted, true).switches.metal_env);
+        assert!(
+            !PipelineKey::new(Surface::Metal, Target::Cube, &whitted, &plan(&whitted, true))
+                .switches
+                .metal_env
+        );
+        // A metal whose cube map the frame skips (mirror = 0) has no lookup into it.
+        let unmirrored = FramePlan { metal_cube: false, ..plan(&whitted, true) };
+        let key = PipelineKey::new(Surface::Metal, Target::Main { samples: 1 }, &whitted, &unmirrored);
+        assert!(!key.switches.metal_env && !key.switches.reflection);
         let figure = Options::all_on(Look::Figure);
         assert!(
-            !PipelineKey::new(Surface::Metal, Target::Main { samples: 1 }, &figure, true).switches.metal_env
+            !PipelineKey::new(Surface::Metal, Target::Main { samples: 1 }, &figure, &plan(&figure, true))
+                .switches
+                .metal_env
         );
     }
 
@@ -164,8 +193,8 @@ mod tests {
         let options = Options::all_on(Look::Whitted);
         for surface in [Surface::Glass, Surface::Metal] {
             let target = Target::Main { samples: 4 };
-            assert!(PipelineKey::new(surface, target, &options, true).switches.shadows);
-            let key = PipelineKey::new(surface, target, &options, false);
+            assert!(PipelineKey::new(surface, target, &options, &plan(&options, true)).switches.shadows);
+            let key = PipelineKey::new(surface, target, &options, &plan(&options, false));
             assert!(!key.switches.shadows && !key.switches.pcf);
         }
     }
@@ -176,16 +205,19 @@ mod tests {
             Surface::Glass,
             Target::Main { samples: 4 },
             &Options::all_on(Look::Whitted),
-            true,
+            &plan(&Options::all_on(Look::Whitted), true),
         );
         let c = key.constants();
         assert!(
             c.contains(&("SPHERE", 0.0)) && c.contains(&("SAMPLES", 4.0)) && c.contains(&("WHITTED", 1.0))
         );
         let whitted = Options::all_on(Look::Whitted);
-        let receiver = PipelineKey::new(Surface::FloorReceiver, Target::Cube, &whitted, true).constants();
+        let receiver =
+            PipelineKey::new(Surface::FloorReceiver, Target::Cube, &whitted, &plan(&whitted, true))
+                .constants();
         assert_eq!(receiver, vec![("RECEIVER", 1.0), ("PCF", 1.0)]);
-        let floor = PipelineKey::new(Surface::Floor, Target::Cube, &whitted, true).constants();
+        let floor =
+            PipelineKey::new(Surface::Floor, Target::Cube, &whitted, &plan(&whitted, true)).constants();
         assert_eq!(floor, vec![("RECEIVER", 0.0), ("PCF", 0.0)]);
     }
 }

@@ -66,7 +66,7 @@ pub fn capture_clip(scene: &WhittedScene, center: Vec3) -> ClipPlanes {
     let corners = [(lo.x, lo.y), (lo.x, hi.y), (hi.x, lo.y), (hi.x, hi.y)];
     let mut far = corners.iter().map(|&(x, z)| center.distance(Vec3::new(x, y, z))).fold(0.0f32, f32::max);
     let mut nearest = (center.y - y).abs();
-    for (c, r) in [(scene.glass.center, scene.glass.radius), (scene.metal.center, scene.metal.radius)] {
+    for (c, r) in scene.spheres() {
         let d = center.distance(c);
         if d > r {
             far = far.max(d + r);
@@ -138,9 +138,9 @@ mod tests {
             .unwrap();
         let mut scene = WhittedScene::from_toml_str(&text, "whitted.toml").unwrap();
         scene.clip = ClipPlanes { near: 0.6, far: 5.0 };
-        let clip = capture_clip(&scene, scene.glass.center);
+        let clip = capture_clip(&scene, scene.glass.expect("glass").center);
         // The floor's farthest corner from the glass (4.2, 2.6, -4.2) is (-23, 0, 7.5): 29.7 away.
-        let corner = scene.glass.center.distance(Vec3::new(-23.0, 0.0, 7.5));
+        let corner = scene.glass.expect("glass").center.distance(Vec3::new(-23.0, 0.0, 7.5));
         assert!(clip.far > corner && clip.far < 1.02 * corner, "{clip:?}");
         // The metal's surface is 1.87 from the glass's centre: near stays below half of that.
         assert!(clip.near > 0.0 && clip.near <= 0.5 * 1.87, "{clip:?}");

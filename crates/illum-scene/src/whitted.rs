@@ -31,8 +31,10 @@ pub struct WhittedScene {
     pub light: DirectionalLight,
     pub ambient: AmbientLight,
     pub floor: CheckerFloor,
-    pub glass: GlassSphere,
-    pub metal: MetalSphere,
+    /// The refracting sphere, if the scene has one (without it no glass cube map is captured).
+    pub glass: Option<GlassSphere>,
+    /// The Phong-lit (and, in the whitted look, mirroring) sphere, if the scene has one.
+    pub metal: Option<MetalSphere>,
     /// The look used when the caller does not choose one.
     pub look: Look,
     /// The effect toggles used when the caller does not choose them.
@@ -55,6 +57,8 @@ pub struct DirectionalLight {
     pub target: Vec3,
     pub color: Vec3,
     pub intensity: f32,
+    /// Whether the spheres cast shadows under this light (`false`: no shadow map is drawn).
+    pub casts_shadows: bool,
 }
 
 impl DirectionalLight {
@@ -270,6 +274,12 @@ impl WhittedScene {
             .filter(|s| !s.is_empty())
             .unwrap_or_else(|| "scene".to_owned());
         whitted_from_raw(raw, file_label, &default_name)
+    }
+
+    /// Centre and radius of each sphere the scene has: the glass's first, then the metal's.
+    pub fn spheres(&self) -> Vec<(Vec3, f32)> {
+        let glass = self.glass.map(|g| (g.center, g.radius));
+        glass.into_iter().chain(self.metal.map(|m| (m.center, m.radius))).collect()
     }
 
     /// Replaces the output resolution, after checking it by the same rules as the file.

@@ -25,6 +25,7 @@
 //! target = [0.0, 0.0, 0.0]         # optional, default the origin
 //! color = [1.0, 1.0, 1.0]          # optional, default white
 //! intensity = 1.0                  # optional, default 1
+//! casts_shadows = true             # optional, default true; false: no shadow pass at all
 //! [ambient]                        # optional table; uniform light from everywhere
 //! color = [1.0, 1.0, 1.0]          # optional, default white
 //! intensity = 0.23                 # optional, default 0
@@ -33,14 +34,14 @@
 //! size = [30.0, 15.0]              # extent along X and along Z, both > 0
 //! tile = 1.0                       # tile side, > 0
 //! colors = [[0.8, 0.8, 0.0], [0.8, 0.0, 0.0]]  # colors[0] on the tile at the minimum corner
-//! [glass]                          # the transparent sphere
+//! [glass]                          # optional: the transparent sphere (absent: no glass cube map)
 //! center = [4.2, 2.6, -4.2]
 //! radius = 1.0
 //! color = [1.0, 1.0, 1.0]          # optional: figure mix colour / whitted transmission tint
 //! refraction_ratio = 0.7           # n_outside / n_inside, in (0, 1]
 //! reflectivity = 0.9               # optional: figure look mixes (1 - r) color + r environment
 //! shininess = 200.0                # optional: whitted look highlight exponent
-//! [metal]                          # the Phong-lit sphere
+//! [metal]                          # optional: the Phong-lit sphere
 //! center = [2.0, 1.9, -2.5]
 //! radius = 1.0
 //! color = [0.792, 0.863, 0.851]
@@ -77,8 +78,8 @@ pub(crate) struct RawWhitted {
     #[serde(default)]
     pub ambient: RawAmbient,
     pub floor: RawFloor,
-    pub glass: RawGlass,
-    pub metal: RawMetal,
+    pub glass: Option<RawGlass>,
+    pub metal: Option<RawMetal>,
     #[serde(default)]
     pub effects: RawEffects,
     #[serde(default)]
@@ -122,6 +123,12 @@ pub(crate) struct RawLight {
     pub color: RawVec3,
     #[serde(default = "one")]
     pub intensity: Num,
+    #[serde(default = "yes")]
+    pub casts_shadows: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 #[derive(Debug, Deserialize)]

@@ -47,9 +47,9 @@ pub(crate) fn whitted_from_raw(
         intensity: at_least_zero(&check, "ambient.intensity", raw.ambient.intensity)?,
     };
     let floor = floor(&check, &raw.floor)?;
-    let glass = glass(&check, &raw.glass)?;
-    let metal = metal(&check, &raw.metal)?;
-    placement(&check, &camera, &glass, &metal)?;
+    let glass = raw.glass.as_ref().map(|g| glass(&check, g)).transpose()?;
+    let metal = raw.metal.as_ref().map(|m| metal(&check, m)).transpose()?;
+    placement(&check, &camera, glass.as_ref(), metal.as_ref())?;
     let RawEffects { shadows, pcf, refraction, reflection, fresnel, msaa } = raw.effects;
     let effects = Effects { shadows, pcf, refraction, reflection, fresnel, msaa };
     let pcf_radius = positive(&check, "quality.pcf_radius", raw.quality.pcf_radius)?;
@@ -101,6 +101,7 @@ fn light(check: &Check, raw: &RawLight) -> Result<DirectionalLight, SceneError> 
         target,
         color: non_negative(check, "light.color", raw.color)?,
         intensity: at_least_zero(check, "light.intensity", raw.intensity)?,
+        casts_shadows: raw.casts_shadows,
     })
 }
 
@@ -177,18 +178,20 @@ fn metal(check: &Check, raw: &RawMetal) -> Result<MetalSphere, SceneError> {
     })
 }
 
-/// The camera must be outside both spheres (a sphere around the eye would fill the view with its
-/// inside), and the spheres must not intersect: each cube map is captured from its sphere's
+/// The camera must be outside the spheres (a sphere around the eye would fill the view with its
+/// inside), and two spheres must not intersect: each cube map is captured from its sphere's
 /// centre and must see the other sphere from outside.
 fn placement(
     check: &Check,
     camera: &crate::Camera,
-    glass: &GlassSphere,
-    metal: &MetalSphere,
+    glass: Option<&GlassSphere>,
+    metal: Option<&MetalSphere>,
 ) -> Result<(), SceneError> {
-    for (name, center, radius) in
-        [("glass", glass.center, glass.radius), ("metal", metal.center, metal.radius)]
-    {
+    let spheres = glass
+        .map(|g| ("glass", g.center, g.radius))
+        .into_iter()
+        .chain(metal.map(|m| ("metal", m.center, m.radius)));
+    for (name, center, radius) in spheres {
         let distance = camera.eye.distance(center);
         if distance <= radius {
             return Err(check.invalid(
@@ -201,6 +204,7 @@ fn placement(
             ));
         }
     }
+    let (Some(glass), Some(metal)) = (glass, metal) else { return Ok(()) };
     let distance = glass.center.distance(metal.center);
     if distance <= glass.radius + metal.radius {
         return Err(check.invalid(

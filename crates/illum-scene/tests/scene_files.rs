@@ -314,13 +314,17 @@ fn whitted_matches_section_1() {
     // 0xcccc00 and 0xcc0000 as linear 0xcc / 255 = 0.8.
     assert_eq!(s.floor.colors, [Vec3::new(0.8, 0.8, 0.0), Vec3::new(0.8, 0.0, 0.0)]);
 
-    assert_eq!((s.glass.center, s.glass.radius), (Vec3::new(4.2, 2.6, -4.2), 1.0));
-    assert_eq!(s.glass.color, Vec3::ONE);
-    assert_eq!(s.glass.refraction_ratio, 0.7);
-    assert_eq!(s.glass.reflectivity, 0.9);
-    assert_eq!((s.metal.center, s.metal.radius), (Vec3::new(2.0, 1.9, -2.5), 1.0));
+    assert_eq!((s.glass.unwrap().center, s.glass.unwrap().radius), (Vec3::new(4.2, 2.6, -4.2), 1.0));
+    assert_eq!(s.glass.unwrap().color, Vec3::ONE);
+    assert_eq!(s.glass.unwrap().refraction_ratio, 0.7);
+    assert_eq!(s.glass.unwrap().reflectivity, 0.9);
+    assert_eq!((s.metal.unwrap().center, s.metal.unwrap().radius), (Vec3::new(2.0, 1.9, -2.5), 1.0));
     // 0xcadcd9 = (202, 220, 217) / 255.
-    assert!(close3(s.metal.color, Vec3::new(202.0, 220.0, 217.0) / 255.0, 1e-3), "{:?}", s.metal.color);
-    assert_eq!(s.metal.specular, Vec3::ONE);
+    assert!(
+        close3(s.metal.unwrap().color, Vec3::new(202.0, 220.0, 217.0) / 255.0, 1e-3),
+        "{:?}",
+        s.metal.unwrap().color
+    );
+    assert_eq!(s.metal.unwrap().specular, Vec3::ONE);
     assert_eq!(s.effects, illum_scene::Effects::ALL_ON);
 }

@@ -104,8 +104,8 @@ fn base_scene_loads_with_the_written_values() {
     assert_eq!(s.effects, Effects { pcf: false, msaa: false, ..Effects::ALL_ON });
     assert_eq!(s.quality.cube_size, 128);
     assert_eq!(s.quality.pcf_radius, 0.05);
-    assert_eq!(s.metal.mirror, 0.6);
-    assert_eq!(s.glass.shininess, 200.0);
+    assert_eq!(s.metal.unwrap().mirror, 0.6);
+    assert_eq!(s.glass.unwrap().shininess, 200.0);
 }
 
 #[test]
@@ -131,10 +131,14 @@ fn optional_parts_take_their_defaults() {
     assert_eq!(s.look, Look::Figure);
     assert_eq!(s.light.target, Vec3::ZERO);
     assert_eq!(s.light.radiance(), Vec3::ONE);
+    assert!(s.light.casts_shadows, "a light casts shadows unless the file says otherwise");
     assert_eq!(s.ambient.radiance(), Vec3::ZERO, "no ambient table, no ambient light");
-    assert_eq!(s.glass.color, Vec3::ONE);
-    assert_eq!((s.glass.reflectivity, s.glass.shininess), (0.9, 200.0));
-    assert_eq!((s.metal.specular, s.metal.shininess, s.metal.mirror), (Vec3::ONE, 30.0, 0.6));
+    assert_eq!(s.glass.unwrap().color, Vec3::ONE);
+    assert_eq!((s.glass.unwrap().reflectivity, s.glass.unwrap().shininess), (0.9, 200.0));
+    assert_eq!(
+        (s.metal.unwrap().specular, s.metal.unwrap().shininess, s.metal.unwrap().mirror),
+        (Vec3::ONE, 30.0, 0.6)
+    );
     assert_eq!(s.effects, Effects::ALL_ON);
     assert_eq!((s.quality.pcf_radius, s.quality.cube_size), (0.05, 256));
 }
@@ -281,6 +285,35 @@ fn the_camera_must_be_outside_the_spheres_and_the_spheres_apart() {
         "[3.5, 2.6, -4.2]",
         "must not touch or overlap",
     );
+}
+
+/// The `[glass]` section of BASE, whole.
+const GLASS_SECTION: &str = "[glass]\ncenter = [4.2, 2.6, -4.2]\nradius = 1.0\ncolor = [1.0, 1.0, 1.0]\n\
+                             refraction_ratio = 0.7\nreflectivity = 0.9\nshininess = 200.0\n";
+/// The `[metal]` section of BASE, whole.
+const METAL_SECTION: &str = "[metal]\ncenter = [2.0, 1.9, -2.5]\nradius = 1.0\ncolor = [0.792, 0.863, 0.851]\n\
+                             specular = [1.0, 1.0, 1.0]\nshininess = 30.0\nmirror = 0.6\n";
+
+#[test]
+fn spheres_are_optional_and_a_light_may_cast_no_shadows() {
+    let glassless = parse(&edit(GLASS_SECTION, "")).unwrap();
+    assert!(glassless.glass.is_none() && glassless.metal.is_some());
+    assert_eq!(glassless.spheres(), vec![(Vec3::new(2.0, 1.9, -2.5), 1.0)]);
+    let metalless = parse(&edit(METAL_SECTION, "")).unwrap();
+    assert!(metalless.glass.is_some() && metalless.metal.is_none());
+    let bare = parse(&edit(GLASS_SECTION, "").replacen(METAL_SECTION, "", 1)).unwrap();
+    assert!(bare.spheres().is_empty(), "a floor under a light is a scene too");
+
+    // The remaining sphere is still checked: the eye inside the metal, with no glass.
+    let eye_in_metal =
+        edit(GLASS_SECTION, "").replacen("eye = [7.5, 2.3, -4.2]", "eye = [2.0, 1.9, -2.4]", 1);
+    let err = parse(&eye_in_metal).unwrap_err();
+    check_invalid(&err, FILE, "camera.eye", "[2, 1.9, -2.4]", "outside the metal sphere");
+
+    let unshadowed = parse(&edit("intensity = 1.0\n", "intensity = 1.0\ncasts_shadows = false\n")).unwrap();
+    assert!(!unshadowed.light.casts_shadows);
+    let err = parse(&edit("intensity = 1.0\n", "intensity = 1.0\ncasts_shadows = 0\n")).unwrap_err();
+    assert!(err.to_string().contains("expected a boolean"), "{err}");
 }
 
 #[test]

@@ -1,0 +1,139 @@
+//! "Model only what a scene requires" in the rasterizer (issue 7, section 3): a frame records only
+//! the passes its scene and options need (no shadow pass without a shadow-casting light and a
+//! caster, no cube capture without a sphere that reads it), and leaving a pass out never changes
+//! the picture.
+
+use illum::image::RgbImage32;
+use illum::raster::{Look, Options, PassTimes};
+use illum::scene::WhittedScene;
+
+use crate::figure::check_floor_shading;
+use crate::{HEIGHT, WIDTH, common, level, renderer, scene};
+
+/// The planned pass names, the measured pass times and the image of one frame at the test size.
+fn frame(s: &WhittedScene, options: &Options) -> (Vec<String>, Option<PassTimes>, RgbImage32) {
+    let mut r = renderer();
+    if r.size() != (WIDTH, HEIGHT) {
+        r.resize(WIDTH, HEIGHT).unwrap_or_else(|e| panic!("{e}"));
+    }
+    r.set_scene(s).unwrap_or_else(|e| panic!("{e}"));
+    let names = r.plan(options).pass_names();
+    let frame = r.render_timed(options).unwrap_or_else(|e| panic!("{e}"));
+    assert!(!frame.image.has_non_finite());
+    (names, frame.pass_times, frame.image)
+}
+
+fn count(names: &[String], prefix: &str) -> usize {
+    names.iter().filter(|n| n.starts_with(prefix)).count()
+}
+
+/// Pixels whose 8-bit value differs in any channel.
+fn differing(a: &RgbImage32, b: &RgbImage32) -> usize {
+    let mut n = 0;
+    for y in 0..a.height {
+        for x in 0..a.width {
+            let (p, q) = (a.get(x, y), b.get(x, y));
+            n += usize::from((0..3).any(|c| level(p[c]) != level(q[c])));
+        }
+    }
+    n
+}
+
+fn with_effects(look: Look, change: impl FnOnce(&mut illum::scene::Effects)) -> Options {
+    let mut options = Options::all_on(look);
+    change(&mut options.effects);
+    options
+}
+
+#[test]
+fn each_scene_records_only_the_passes_it_needs() {
+    let s = scene();
+    let no_cast = {
+        let mut t = s.clone();
+        t.light.casts_shadows = false;
+        t
+    };
+    let no_mirror = {
+        let mut t = s.clone();
+        t.metal.as_mut().unwrap().mirror = 0.0;
+        t
+    };
+    let no_glass = WhittedScene { glass: None, ..s.clone() };
+    let no_spheres = WhittedScene { glass: None, metal: None, ..s.clone() };
+    let (figure, whitted) = (Options::all_on(Look::Figure), Options::all_on(Look::Whitted));
+    let shadows_off = with_effects(Look::Whitted, |e| e.shadows = false);
+    // (case, scene, options, shadow pass, glass faces (fine + coarse), metal faces)
+    let cases: [(&str, &WhittedScene, Options, bool, usize, usize); 8] = [
+        ("assignment, figure", &s, figure, true, 12, 0),
+        ("assignment, whitted", &s, whitted, true, 12, 6),
+        ("shadows switched off", &s, shadows_off, false, 12, 6),
+        ("light casts no shadows", &no_cast, whitted, false, 12, 6),
+        ("metal mirrors nothing", &no_mirror, whitted, true, 12, 0),
+        ("no glass, whitted", &no_glass, whitted, true, 0, 6),
+        ("no glass, figure", &no_glass, figure, true, 0, 0),
+        ("no spheres", &no_spheres, whitted, false, 0, 0),
+    ];
+    for (case, scene, options, shadow, glass_faces, metal_faces) in cases {
+        let (names, times, _) = frame(scene, &options);
+        assert_eq!(count(&names, "shadow"), usize::from(shadow), "{case}: {names:?}");
+        assert_eq!(count(&names, "cube glass"), glass_faces, "{case}: {names:?}");
+        assert_eq!(count(&names, "cube metal"), metal_faces, "{case}: {names:?}");
+        assert_eq!(names.last().map(String::as_str), Some("main"), "{case}: {names:?}");
+        assert_eq!(names.len(), usize::from(shadow) + glass_faces + metal_faces + 1, "{case}: {names:?}");
+        // The timestamps come from the passes actually recorded: a skipped pass takes no time.
+        if common::gpu().timestamps {
+            let t = times.unwrap_or_else(|| panic!("{case}: no pass times"));
+            assert_eq!(t.shadow_ms > 0.0, shadow, "{case}: shadow {} ms", t.shadow_ms);
+            assert_eq!(t.cube_ms > 0.0, glass_faces + metal_faces > 0, "{case}: cubes {} ms", t.cube_ms);
+            assert!(t.main_ms > 0.0, "{case}");
+        }
+    }
+}
+
+#[test]
+fn a_light_that_casts_no_shadows_draws_exactly_what_shadows_off_draws() {
+    let s = scene();
+    let mut no_cast = s.clone();
+    no_cast.light.casts_shadows = false;
+    for look in Look::ALL {
+        let (_, _, skipped) = frame(&no_cast, &Options::all_on(look));
+        let (_, _, switched_off) = frame(&s, &with_effects(look, |e| e.shadows = false));
+        assert_eq!(differing(&skipped, &switched_off), 0, "look {look}");
+        let (_, _, shadowed) = frame(&s, &Options::all_on(look));
+        assert!(differing(&skipped, &shadowed) > 40, "look {look}: the shadows were never there");
+    }
+    // And against the closed form: every floor pixel lit, colour x (ambient + N.L).
+    let (_, _, image) = frame(&no_cast, &Options::all_on(Look::Figure));
+    let (lit, shadowed) = check_floor_shading(&no_cast, &image);
+    assert!(lit > 5000 && shadowed == 0, "{lit} lit, {shadowed} shadowed");
+}
+
+#[test]
+fn a_floor_without_spheres_is_lit_everywhere_with_no_pass_but_the_main_one() {
+    let s = scene();
+    let bare = WhittedScene { glass: None, metal: None, ..s.clone() };
+    let (names, _, image) = frame(&bare, &Options::all_on(Look::Figure));
+    assert_eq!(names, vec!["main".to_owned()]);
+    let (lit, shadowed) = check_floor_shading(&bare, &image);
+    let (full_lit, _) = check_floor_shading(&s, &frame(&s, &Options::all_on(Look::Figure)).2);
+    // More floor is checked without the spheres hiding and shadowing it.
+    assert!(lit > full_lit && shadowed == 0, "{lit} lit ({full_lit} with the spheres), {shadowed} shadowed");
+}
+
+#[test]
+fn a_metal_that_mirrors_nothing_looks_as_without_reflection() {
+    // The metal alone (no glass, whose look also depends on the reflection toggle).
+    let metal_only = WhittedScene { glass: None, ..scene() };
+    let mut matte = metal_only.clone();
+    matte.metal.as_mut().unwrap().mirror = 0.0;
+    let whitted = Options::all_on(Look::Whitted);
+    let no_reflection = with_effects(Look::Whitted, |e| e.reflection = false);
+    let (names, _, skipped) = frame(&matte, &whitted);
+    assert_eq!(count(&names, "cube"), 0, "{names:?}");
+    let (_, _, switched_off) = frame(&matte, &no_reflection);
+    assert_eq!(differing(&skipped, &switched_off), 0);
+    // With its mirror the metal's cube map is captured and shows.
+    let (names, _, mirrored) = frame(&metal_only, &whitted);
+    assert_eq!(count(&names, "cube metal"), 6, "{names:?}");
+    assert!(differing(&mirrored, &switched_off) > 40, "the mirror shows nothing");
+}
