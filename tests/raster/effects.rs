@@ -24,7 +24,8 @@ fn changed(a: &RgbImage32, b: &RgbImage32) -> Vec<(u32, u32)> {
 /// Turns one effect off.
 type Toggle = fn(&mut Effects);
 
-fn with(look: Look, change: impl FnOnce(&mut Effects)) -> Options {
+/// `look` with every effect on but what `change` turns off.
+pub(crate) fn with(look: Look, change: impl FnOnce(&mut Effects)) -> Options {
     let mut options = Options::all_on(look);
     change(&mut options.effects);
     options

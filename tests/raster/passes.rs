@@ -7,6 +7,7 @@ use illum::image::RgbImage32;
 use illum::raster::{Look, Options, PassTimes};
 use illum::scene::WhittedScene;
 
+use crate::effects::with;
 use crate::figure::check_floor_shading;
 use crate::{HEIGHT, WIDTH, common, level, renderer, scene};
 
@@ -39,12 +40,6 @@ fn differing(a: &RgbImage32, b: &RgbImage32) -> usize {
     n
 }
 
-fn with_effects(look: Look, change: impl FnOnce(&mut illum::scene::Effects)) -> Options {
-    let mut options = Options::all_on(look);
-    change(&mut options.effects);
-    options
-}
-
 #[test]
 fn each_scene_records_only_the_passes_it_needs() {
     let s = scene();
@@ -61,7 +56,7 @@ fn each_scene_records_only_the_passes_it_needs() {
     let no_glass = WhittedScene { glass: None, ..s.clone() };
     let no_spheres = WhittedScene { glass: None, metal: None, ..s.clone() };
     let (figure, whitted) = (Options::all_on(Look::Figure), Options::all_on(Look::Whitted));
-    let shadows_off = with_effects(Look::Whitted, |e| e.shadows = false);
+    let shadows_off = with(Look::Whitted, |e| e.shadows = false);
     // (case, scene, options, shadow pass, glass faces (fine + coarse), metal faces)
     let cases: [(&str, &WhittedScene, Options, bool, usize, usize); 8] = [
         ("assignment, figure", &s, figure, true, 12, 0),
@@ -97,7 +92,7 @@ fn a_light_that_casts_no_shadows_draws_exactly_what_shadows_off_draws() {
     no_cast.light.casts_shadows = false;
     for look in Look::ALL {
         let (_, _, skipped) = frame(&no_cast, &Options::all_on(look));
-        let (_, _, switched_off) = frame(&s, &with_effects(look, |e| e.shadows = false));
+        let (_, _, switched_off) = frame(&s, &with(look, |e| e.shadows = false));
         assert_eq!(differing(&skipped, &switched_off), 0, "look {look}");
         let (_, _, shadowed) = frame(&s, &Options::all_on(look));
         assert!(differing(&skipped, &shadowed) > 40, "look {look}: the shadows were never there");
@@ -127,7 +122,7 @@ fn a_metal_that_mirrors_nothing_looks_as_without_reflection() {
     let mut matte = metal_only.clone();
     matte.metal.as_mut().unwrap().mirror = 0.0;
     let whitted = Options::all_on(Look::Whitted);
-    let no_reflection = with_effects(Look::Whitted, |e| e.reflection = false);
+    let no_reflection = with(Look::Whitted, |e| e.reflection = false);
     let (names, _, skipped) = frame(&matte, &whitted);
     assert_eq!(count(&names, "cube"), 0, "{names:?}");
     let (_, _, switched_off) = frame(&matte, &no_reflection);
