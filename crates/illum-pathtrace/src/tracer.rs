@@ -358,7 +358,12 @@ impl PathTracer {
         let resized =
             (scene.camera.width, scene.camera.height) != (self.scene.camera.width, self.scene.camera.height);
         if resized {
-            *self = Self::with_options(&self.gpu, scene, self.options)?;
+            let mut resized = Self::with_options(&self.gpu, scene, self.options)?;
+            // What the caller chose and the planner learnt (the cost of a sample) carry over:
+            // a viewer that set short submissions keeps them after the window is resized.
+            resized.planner = self.planner.clone();
+            resized.chunk_samples = self.chunk_samples;
+            *self = resized;
             return Ok(());
         }
         let gpu_scene = GpuScene::new(scene)?;
