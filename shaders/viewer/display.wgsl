@@ -1,16 +1,19 @@
-// The path tracer's display: the linear mean image (exposure-scaled) encoded with the PNG
-// output's pure gamma 2.2 into an 8-bit texture that egui shows as it is (egui takes native
-// Rgba8Unorm textures as already gamma-encoded).
+// The path tracer's display: the mean of the path tracer's display sum (a GPU buffer, see
+// shaders/pathtrace/display_sum.wgsl), exposure-scaled and encoded with the PNG output's pure
+// gamma 2.2 into an 8-bit texture that egui shows as it is (egui takes native Rgba8Unorm textures
+// as already gamma-encoded).
 
 struct Params {
+    // Image width in pixels: the display sum is row-major, pixel y * width + x.
+    width: u32,
     // 2^exposure: the display-only exposure slider, in stops.
     scale: f32,
-    pad0: f32,
-    pad1: f32,
-    pad2: f32,
+    pad0: u32,
+    pad1: u32,
 }
 
-@group(0) @binding(0) var source: texture_2d<f32>;
+// Per pixel: rgb = running sum of finite samples, w = their count.
+@group(0) @binding(0) var<storage, read> display_sum: array<vec4<f32>>;
 @group(0) @binding(1) var<uniform> params: Params;
 
 // One triangle covering the whole target: vertices (-1,-1), (3,-1), (-1,3).
@@ -22,8 +25,12 @@ fn vs_main(@builtin(vertex_index) index: u32) -> @builtin(position) vec4<f32> {
 
 @fragment
 fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
-    // Source and target have the same size, so each fragment reads its own texel.
-    let linear = textureLoad(source, vec2<i32>(position.xy), 0).rgb * params.scale;
-    let encoded = pow(clamp(linear, vec3<f32>(0.0), vec3<f32>(1.0)), vec3<f32>(1.0 / 2.2));
+    // The target has the image's size, so each fragment (at pixel centre x + 0.5, y + 0.5; row 0
+    // at the top, as in the image) reads its own pixel.
+    let pixel = vec2<u32>(position.xy);
+    let sum = display_sum[pixel.y * params.width + pixel.x];
+    // The mean of the finite samples; a pixel without any (w = 0, rgb = 0) shows black.
+    let mean = sum.rgb / max(sum.w, 1.0);
+    let encoded = pow(clamp(mean * params.scale, vec3<f32>(0.0), vec3<f32>(1.0)), vec3<f32>(1.0 / 2.2));
     return vec4<f32>(encoded, 1.0);
 }

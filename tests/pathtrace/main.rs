@@ -9,13 +9,16 @@
 //! - `error_estimate`: the error shown to users tracks the true error; the 1/sqrt(N) rate;
 //! - `sampling`: chi-square tests of the WGSL sampling routines, run on the GPU;
 //! - `extremes`: issue 6, the path tracer where floats run out;
-//! - `specialisation`: each scene's pipeline holds what it uses, is cached, refuses others;
+//! - `display_sum`: the viewer's GPU-resident running image agrees with the f64 statistics;
+//! - `specialisation`: each scene's pipeline holds what it uses, is cached, refuses others,
+//!   and keeps the caller's submission size across a resize;
 //! - `shaders`: naga validates every WGSL file in shaders/ (the raster's and viewer's too).
 
 #[path = "../common/mod.rs"]
 mod common;
 
 mod closed_form;
+mod display_sum;
 mod error_estimate;
 mod extremes;
 mod oracle_agreement;

@@ -63,6 +63,8 @@ fn every_wgsl_file_composes_and_validates() {
             }
         }
     }
+    // The display sum's pass: a self-contained entry shader.
+    check(&[], &pathtrace::DISPLAY_SUM_SHADER, &[], &mut covered);
     for shaders in extra_shader_sets() {
         for (modules, entry) in shaders {
             check(&modules, &entry, &[], &mut covered);

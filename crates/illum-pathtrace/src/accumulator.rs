@@ -78,6 +78,16 @@ impl Accumulator {
         self.count.iter().sum()
     }
 
+    /// Sum of the pixel's finite samples, per channel.
+    pub fn pixel_sum(&self, pixel: usize) -> [f64; 3] {
+        self.sum[pixel]
+    }
+
+    /// Finite samples in the pixel.
+    pub fn pixel_count(&self, pixel: usize) -> u64 {
+        self.count[pixel]
+    }
+
     pub fn pixel_mean(&self, pixel: usize) -> [f64; 3] {
         let n = self.count[pixel].max(1) as f64;
         self.sum[pixel].map(|s| s / n)

@@ -3,9 +3,12 @@
 //! A WGSL compute shader (`shaders/pathtrace/pathtrace.wgsl`) traces paths over the scene's
 //! analytic boxes, quads and spheres with next-event estimation on rectangular lights. The host
 //! side here uploads the scene ([`gpu_scene`]), plans short GPU submissions ([`planner`]),
-//! and folds each batch's f32 sums into f64 per-pixel statistics ([`accumulator`]).
+//! and folds each batch's f32 sums into f64 per-pixel statistics ([`accumulator`]). For viewers,
+//! an opt-in running image stays on the GPU ([`display_sum`]) so that showing it needs no copy
+//! through the CPU.
 
 pub mod accumulator;
+pub mod display_sum;
 mod error;
 pub mod gpu_scene;
 pub mod planner;
@@ -15,6 +18,7 @@ pub mod specialise;
 mod tracer;
 
 pub use accumulator::Accumulator;
+pub use display_sum::{DISPLAY_PIXEL_BYTES, DISPLAY_SUM_SHADER};
 pub use error::PathTraceError;
 pub use progressive::{StopReason, StopRules, render_progressive};
 pub use tracer::{

@@ -11,6 +11,7 @@ use illum_gpu::{GpuContext, readback, wgpu};
 use illum_scene::{DeviceLimits, Scene};
 use wgpu::util::DeviceExt;
 
+use crate::display_sum::DisplaySum;
 use crate::gpu_scene::{self, GpuParams, GpuScene};
 use crate::planner::{BatchPlanner, DEFAULT_TARGET_SECONDS, PassPlan};
 use crate::{Accumulator, PathTraceError, specialise};
@@ -165,6 +166,8 @@ pub struct PathTracer {
     timer: PassTimer,
     planner: BatchPlanner,
     accumulator: Accumulator,
+    /// The GPU-resident running image for viewers, when enabled (see `display_sum.rs`).
+    display_sum: Option<DisplaySum>,
     pass: Option<ActivePass>,
     /// Samples per pixel of all completed passes.
     spp_done: u32,
@@ -287,6 +290,7 @@ impl PathTracer {
             timer: PassTimer::new(gpu, &[TIMED_PASS]),
             planner: BatchPlanner::new(DEFAULT_TARGET_SECONDS),
             accumulator,
+            display_sum: None,
             pass: None,
             spp_done: 0,
             wall_seconds: 0.0,
@@ -306,6 +310,34 @@ impl PathTracer {
 
     pub fn accumulator(&self) -> &Accumulator {
         &self.accumulator
+    }
+
+    /// Keeps, from now on, a running sum of the image on the GPU for display: one storage buffer
+    /// of `width x height` `vec4<f32>` (rgb = sum of finite samples, w = their count; pixel
+    /// `y * width + x`), updated by every band's submission, cleared by [`Self::reset`] and by
+    /// [`Self::update_scene`], reallocated when the resolution changes. A viewer binds it
+    /// ([`Self::display_sum_buffer`]) and shows rgb / w without copying the image through the
+    /// CPU. Samples taken before the call are copied in once. Fails, naming the limit, when the
+    /// whole image does not fit one storage binding of the device (the statistics, which go band
+    /// by band, have no such limit). Enabling it twice does nothing.
+    pub fn enable_display_sum(&mut self) -> Result<(), PathTraceError> {
+        if self.display_sum.is_some() {
+            return Ok(());
+        }
+        let camera = self.scene.camera;
+        let display = DisplaySum::new(&self.gpu, &self.scene.name, camera.width, camera.height)?;
+        if self.accumulator.total_samples() > 0 {
+            display.seed(&self.gpu, &self.accumulator);
+        }
+        self.display_sum = Some(display);
+        Ok(())
+    }
+
+    /// The display sum's buffer (usage `STORAGE | COPY_SRC | COPY_DST`) once
+    /// [`Self::enable_display_sum`] was called. It is replaced by a new buffer when the
+    /// resolution changes, so bind it anew whenever this returns another buffer.
+    pub fn display_sum_buffer(&self) -> Option<&wgpu::Buffer> {
+        self.display_sum.as_ref().map(DisplaySum::buffer)
     }
 
     /// Samples per pixel in every pixel (completed passes).
@@ -358,7 +390,15 @@ impl PathTracer {
         let resized =
             (scene.camera.width, scene.camera.height) != (self.scene.camera.width, self.scene.camera.height);
         if resized {
-            *self = Self::with_options(&self.gpu, scene, self.options)?;
+            let mut resized = Self::with_options(&self.gpu, scene, self.options)?;
+            // What the caller chose and the planner learnt (the cost of a sample) carry over:
+            // a viewer that set short submissions keeps them after the window is resized.
+            resized.planner = self.planner.clone();
+            resized.chunk_samples = self.chunk_samples;
+            if self.display_sum.is_some() {
+                resized.enable_display_sum()?;
+            }
+            *self = resized;
             return Ok(());
         }
         let gpu_scene = GpuScene::new(scene)?;
@@ -391,6 +431,9 @@ impl PathTracer {
     /// Discards everything accumulated; the next step starts again at sample 0.
     pub fn reset(&mut self) {
         self.accumulator.reset();
+        if let Some(display) = &self.display_sum {
+            display.clear(&self.gpu);
+        }
         self.pass = None;
         self.spp_done = 0;
         self.wall_seconds = 0.0;
@@ -550,6 +593,11 @@ impl PathTracer {
             compute.set_bind_group(0, &batch.bind_group, &[]);
             compute.dispatch_workgroups(width.div_ceil(WORKGROUP), rows.div_ceil(WORKGROUP), chunks);
         }
+        // The display sum reads the slots on the GPU in the same submission (wgpu orders the two
+        // passes); the copies below for the f64 fold are unchanged.
+        if let Some(display) = &mut self.display_sum {
+            display.record(&self.gpu, &mut encoder, &batch.sum, rows, row_offset, chunks);
+        }
         encoder.copy_buffer_to_buffer(&batch.sum, 0, staging, 0, bytes);
         encoder.copy_buffer_to_buffer(&batch.sum_sq, 0, staging, bytes, bytes);
         self.timer.copy_results(&mut encoder, staging, 2 * bytes);
@@ -573,6 +621,11 @@ impl PathTracer {
             for (s, q) in sums[range.clone()].iter().zip(&sums_sq[range]) {
                 let found = s[3] as u64 + q[3] as u64;
                 if found != u64::from(expected) {
+                    // The accumulator drops this band, but the display pass already added it:
+                    // set the display sum back to the accumulator's samples.
+                    if let Some(display) = &self.display_sum {
+                        display.seed(&self.gpu, &self.accumulator);
+                    }
                     return Err(PathTraceError::IncompleteBatch { expected, found });
                 }
             }

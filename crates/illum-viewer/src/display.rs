@@ -1,35 +1,51 @@
 //! The path tracer's display on the GPU.
 //!
 //! The path tracer keeps its statistics on the CPU by design (batches of f32 sums folded into
-//! f64 per pixel), so its mean image is uploaded once per frame in which new samples arrived, as
-//! linear f32 RGBA. A render pass then applies the display exposure and the PNG output's gamma
-//! 2.2 into an 8-bit texture registered with egui_wgpu, on eframe's device. Changing the
-//! exposure re-runs only that pass; nothing is read back.
+//! f64 per pixel), but the viewer does not show those: it enables the tracer's display sum
+//! (`PathTracer::enable_display_sum`), a storage buffer on eframe's device to which every band's
+//! submission adds its samples on the GPU (rgb = sum of finite samples, w = their count). A
+//! render pass here reads that buffer directly in its fragment shader, divides rgb by w, applies
+//! the display exposure and the PNG output's gamma 2.2, and writes an 8-bit texture registered
+//! with egui_wgpu. The image never goes through the CPU on its way to the screen; nothing is
+//! uploaded or read back. The pass re-runs when new samples arrived or the exposure changed.
+//! Saving still uses the f64 mean (`Accumulator::mean_image`).
 
+use bytemuck::{Pod, Zeroable};
 use egui_wgpu::wgpu;
 use illum_gpu::GpuContext;
-use illum_image::RgbImage32;
+use illum_pathtrace::DISPLAY_PIXEL_BYTES;
 
 const SHADER: &str = include_str!("../../../shaders/viewer/display.wgsl");
 /// The texture egui shows: 8-bit, already gamma-encoded (egui's convention for native textures).
 const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
-/// The uploaded linear mean image.
-const SOURCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
-struct Textures {
+/// Mirrors `Params` in display.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct Params {
     width: u32,
-    height: u32,
-    source: wgpu::Texture,
-    target_view: wgpu::TextureView,
-    bind_group: wgpu::BindGroup,
+    /// 2^exposure.
+    scale: f32,
+    pad: [u32; 2],
 }
 
-/// Tone mapping from the uploaded mean image into the texture egui shows.
+/// The texture egui shows.
+struct Target {
+    width: u32,
+    height: u32,
+    texture: wgpu::Texture,
+    view: wgpu::TextureView,
+}
+
+/// Tone mapping from the path tracer's display sum into the texture egui shows.
 pub struct Display {
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
     params: wgpu::Buffer,
-    textures: Option<Textures>,
+    target: Option<Target>,
+    /// The display-sum buffer read and its bind group: a tracer rebuilt for a new resolution
+    /// brings a new buffer, and the bind group is made again for it.
+    source: Option<(wgpu::Buffer, wgpu::BindGroup)>,
     /// The egui texture id of the target, once registered.
     texture_id: Option<egui::TextureId>,
 }
@@ -47,11 +63,10 @@ impl Display {
                 wgpu::BindGroupLayoutEntry {
                     binding: 0,
                     visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        // f32 textures are not filterable everywhere; the shader only loads texels.
-                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: true },
+                        has_dynamic_offset: false,
+                        min_binding_size: wgpu::BufferSize::new(DISPLAY_PIXEL_BYTES),
                     },
                     count: None,
                 },
@@ -95,68 +110,73 @@ impl Display {
         });
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("viewer display params"),
-            size: 16,
+            size: std::mem::size_of::<Params>() as u64,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        Display { pipeline, layout, params, textures: None, texture_id: None }
+        Display { pipeline, layout, params, target: None, source: None, texture_id: None }
     }
 
-    /// Uploads `image` (linear RGB) and draws it with `exposure` stops into the shown texture,
-    /// (re)registering that texture with egui when its size changed. Returns its egui id.
+    /// Draws the `width` x `height` image held by `display_sum` (the path tracer's display-sum
+    /// buffer, on the same device) with `exposure` stops into the shown texture, (re)creating
+    /// and (re)registering that texture with egui when its size changed. Returns its egui id.
     pub fn show(
         &mut self,
         gpu: &GpuContext,
         renderer: &mut egui_wgpu::Renderer,
-        image: &RgbImage32,
+        display_sum: &wgpu::Buffer,
+        [width, height]: [u32; 2],
         exposure: f32,
     ) -> Option<egui::TextureId> {
-        if image.width == 0 || image.height == 0 || !image.is_consistent() {
+        let needed = u64::from(width) * u64::from(height) * DISPLAY_PIXEL_BYTES;
+        if width == 0 || height == 0 || display_sum.size() < needed {
+            log::warn!(
+                "display sum of {} bytes cannot hold a {width} x {height} image; not shown",
+                display_sum.size()
+            );
             return self.texture_id;
         }
-        let resized =
-            self.textures.as_ref().is_none_or(|t| (t.width, t.height) != (image.width, image.height));
+        let resized = self.target.as_ref().is_none_or(|t| (t.width, t.height) != (width, height));
         if resized {
-            self.textures = Some(self.create_textures(gpu, image.width, image.height));
+            self.target = Some(Self::create_target(gpu, width, height));
         }
-        let textures = self.textures.as_ref()?;
-        let texels: Vec<[f32; 4]> = image.pixels.iter().map(|&[r, g, b]| [r, g, b, 1.0]).collect();
-        gpu.queue.write_texture(
-            textures.source.as_image_copy(),
-            bytemuck::cast_slice(&texels),
-            wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(image.width * 16),
-                rows_per_image: Some(image.height),
-            },
-            wgpu::Extent3d { width: image.width, height: image.height, depth_or_array_layers: 1 },
-        );
+        if self.source.as_ref().is_none_or(|(bound, _)| bound != display_sum) {
+            let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("viewer display"),
+                layout: &self.layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: display_sum.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: self.params.as_entire_binding() },
+                ],
+            });
+            self.source = Some((display_sum.clone(), bind_group));
+        }
         self.redraw(gpu, exposure);
-        let textures = self.textures.as_ref()?;
+        let target = self.target.as_ref()?;
         let id = match (self.texture_id, resized) {
             (Some(id), false) => id,
             (Some(id), true) => {
                 renderer.update_egui_texture_from_wgpu_texture(
                     &gpu.device,
-                    &textures.target_view,
+                    &target.view,
                     wgpu::FilterMode::Linear,
                     id,
                 );
                 id
             }
             (None, _) => {
-                renderer.register_native_texture(&gpu.device, &textures.target_view, wgpu::FilterMode::Linear)
+                renderer.register_native_texture(&gpu.device, &target.view, wgpu::FilterMode::Linear)
             }
         };
         self.texture_id = Some(id);
         Some(id)
     }
 
-    /// Re-encodes the last uploaded image with another exposure (no upload).
+    /// Draws the display sum last shown again, with another exposure.
     pub fn redraw(&self, gpu: &GpuContext, exposure: f32) {
-        let Some(textures) = &self.textures else { return };
-        let scale = 2f32.powf(exposure);
-        gpu.queue.write_buffer(&self.params, 0, bytemuck::cast_slice(&[scale, 0.0, 0.0, 0.0]));
+        let (Some(target), Some((_, bind_group))) = (&self.target, &self.source) else { return };
+        let params = Params { width: target.width, scale: 2f32.powf(exposure), pad: [0; 2] };
+        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         let mut encoder = gpu
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("viewer display") });
@@ -164,7 +184,7 @@ impl Display {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("viewer display"),
                 color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &textures.target_view,
+                    view: &target.view,
                     depth_slice: None,
                     resolve_target: None,
                     ops: wgpu::Operations {
@@ -178,7 +198,7 @@ impl Display {
                 multiview_mask: None,
             });
             pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &textures.bind_group, &[]);
+            pass.set_bind_group(0, bind_group, &[]);
             pass.draw(0..3, 0..1);
         }
         gpu.queue.submit([encoder.finish()]);
@@ -189,44 +209,59 @@ impl Display {
         self.texture_id
     }
 
-    fn create_textures(&self, gpu: &GpuContext, width: u32, height: u32) -> Textures {
-        let size = wgpu::Extent3d { width, height, depth_or_array_layers: 1 };
-        let texture = |label, format, usage| {
-            gpu.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size,
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
-        };
-        let source = texture(
-            "viewer display source",
-            SOURCE_FORMAT,
-            wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        );
-        let target = texture(
-            "viewer display target",
-            TARGET_FORMAT,
-            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-        );
-        let source_view = source.create_view(&Default::default());
-        let target_view = target.create_view(&Default::default());
-        let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("viewer display"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(&source_view),
-                },
-                wgpu::BindGroupEntry { binding: 1, resource: self.params.as_entire_binding() },
-            ],
+    /// The shown texture read back (RGBA, gamma-encoded, top row first), once an image has been
+    /// shown; for tests, which compare it with the saved PNG. The window itself never reads it.
+    pub fn read_shown(&self, gpu: &GpuContext) -> Result<Option<image::RgbaImage>, illum_gpu::GpuError> {
+        let Some(target) = &self.target else { return Ok(None) };
+        let (width, height) = (target.width, target.height);
+        // Texture-to-buffer copies need rows padded to 256 bytes.
+        let row = u64::from(width) * 4;
+        let padded = row.next_multiple_of(u64::from(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT));
+        let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("viewer display readback"),
+            size: padded * u64::from(height),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
         });
-        Textures { width, height, source, target_view, bind_group }
+        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("viewer display readback"),
+        });
+        encoder.copy_texture_to_buffer(
+            target.texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &staging,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded as u32),
+                    rows_per_image: Some(height),
+                },
+            },
+            wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+        );
+        gpu.queue.submit([encoder.finish()]);
+        let bytes =
+            illum_gpu::readback::read_mapped(gpu, &staging, staging.size(), "reading the display back")?;
+        let pixels: Vec<u8> =
+            bytes.chunks_exact(padded as usize).flat_map(|r| r[..row as usize].iter().copied()).collect();
+        Ok(image::RgbaImage::from_raw(width, height, pixels))
+    }
+
+    fn create_target(gpu: &GpuContext, width: u32, height: u32) -> Target {
+        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("viewer display target"),
+            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: TARGET_FORMAT,
+            // COPY_SRC: tests read it back (`read_shown`).
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&Default::default());
+        Target { width, height, texture, view }
     }
 }
 

@@ -4,7 +4,8 @@
 //! - [`app`]: the application state, the mode switch and the scene field;
 //! - [`pathtrace_panel`] / [`raster_panel`]: each mode's settings, renderer and panel;
 //! - [`camera`]: orbit / pan / zoom with the mouse, shared by both modes;
-//! - [`display`]: the path tracer's GPU tone-mapping pass into the texture egui shows;
+//! - [`display`]: the path tracer's GPU tone-mapping pass from its display sum (a GPU buffer)
+//!   into the texture egui shows;
 //! - [`gpu_setup`]: how eframe creates the device the renderers share;
 //! - [`frame_rate`]: frames per second over recent frames;
 //! - [`scene_file`]: opening scene files of either kind, with errors as text;

@@ -5,6 +5,10 @@
 //! so the window keeps repainting while samples accumulate. A change of camera, window size or
 //! setting goes through `PathTracer::update_scene`, which restarts the accumulation without
 //! recompiling the pipeline.
+//!
+//! Display: the tracer's display sum (on the GPU) is drawn by [`Display`] whenever new samples
+//! arrived or the exposure changed; the f64 statistics are only read for the panel's numbers and
+//! for saving.
 
 use std::path::{Path, PathBuf};
 
@@ -16,8 +20,8 @@ use illum_scene::{Bounces, Sampling, Scene};
 use crate::camera::OrbitCamera;
 use crate::display::Display;
 
-/// Wall time aimed at per submission: short enough that a frame (submission, fold, upload,
-/// egui) stays well under the 50 ms of 20 fps on lavapipe.
+/// Wall time aimed at per submission: short enough that a frame (submission, readback and f64
+/// fold, display pass, egui) stays well under the 50 ms of 20 fps on lavapipe.
 pub const FRAME_BUDGET: f64 = 0.015;
 /// Highest fixed bounce count offered by the slider (the scene format allows more).
 pub const MAX_UI_BOUNCES: u32 = 64;
@@ -207,9 +211,17 @@ impl PathTraceMode {
         if total != self.shown_samples {
             self.shown_samples = total;
             self.stats = Self::measure(tracer);
-            let image = tracer.accumulator().mean_image();
-            let mut renderer = render_state.renderer.write();
-            display.show(gpu, &mut renderer, &image, self.settings.exposure);
+            let camera = tracer.scene().camera;
+            if let Some(display_sum) = tracer.display_sum_buffer() {
+                let mut renderer = render_state.renderer.write();
+                display.show(
+                    gpu,
+                    &mut renderer,
+                    display_sum,
+                    [camera.width, camera.height],
+                    self.settings.exposure,
+                );
+            }
             self.shown_exposure = self.settings.exposure;
         } else if self.shown_exposure != self.settings.exposure {
             display.redraw(gpu, self.settings.exposure);
@@ -222,6 +234,11 @@ impl PathTraceMode {
         self.display.as_ref().and_then(Display::texture_id)
     }
 
+    /// The display pass (tests read what it shows).
+    pub fn display(&self) -> Option<&Display> {
+        self.display.as_ref()
+    }
+
     /// Creates the tracer, or hands it the new scene when anything changed (which restarts the
     /// accumulation). Errors are the renderer's messages.
     fn sync_tracer(&mut self, gpu: &GpuContext, wanted: &Scene) -> Result<(), String> {
@@ -231,6 +248,8 @@ impl PathTraceMode {
             None => {
                 let mut tracer = PathTracer::new(gpu, wanted).map_err(|e| e.to_string())?;
                 tracer.set_target_seconds(FRAME_BUDGET);
+                // The window shows the GPU-resident sum; it follows resets and resizes itself.
+                tracer.enable_display_sum().map_err(|e| e.to_string())?;
                 self.tracer = Some(tracer);
             }
         }

@@ -1,5 +1,6 @@
 //! egui_kittest tests that drive the real viewer UI on lavapipe: the mode switch, the path
-//! tracer's controls, saving, opening a bad file, and snapshots of both modes.
+//! tracer's controls, saving, opening a bad file, that the path tracer's window shows what Save
+//! PNG writes, and snapshots of both modes.
 //!
 //! Both renderers repaint continuously while they work, so the tests step a fixed number of
 //! frames (`run_steps`) instead of waiting for the UI to settle.
@@ -169,6 +170,54 @@ fn snapshot_path_tracer() {
     assert_eq!(spp(&harness), 4);
     harness.run_steps(2);
     harness.snapshot("viewer_pathtrace");
+}
+
+/// The path tracer's image as the window shows it (read back from the display texture).
+fn shown(harness: &Harness<'_, ViewerApp>) -> image::RgbaImage {
+    let setup = shared_device();
+    let gpu = illum_gpu::GpuContext::from_device(setup.device, setup.queue, setup.adapter.get_info());
+    let display = harness.state().pathtrace().unwrap().display().expect("an image was shown");
+    display.read_shown(&gpu).unwrap_or_else(|e| panic!("{e}")).expect("an image was shown")
+}
+
+#[test]
+fn the_window_shows_what_save_png_writes() {
+    // The window draws the GPU display sum (f32); Save PNG writes the f64 mean. Both encode the
+    // same samples with gamma 2.2, so they may differ only where f32 rounding tips a value over
+    // a rounding boundary: by one level at most.
+    let dir = tempfile::tempdir().unwrap();
+    let mut harness = harness(Mode::PathTrace);
+    harness.state_mut().pathtrace_mut().unwrap().settings.spp_target = Some(3);
+    for _ in 0..200 {
+        harness.run_steps(1);
+        if harness.state().pathtrace().unwrap().stop_reason().is_some() {
+            break;
+        }
+    }
+    assert_eq!(spp(&harness), 3);
+    let mode = harness.state_mut().pathtrace_mut().unwrap();
+    mode.save_path = dir.path().join("shown.png").display().to_string();
+    let saved = mode.save("png").unwrap_or_else(|e| panic!("{e}"));
+    let png = image::open(&saved).unwrap_or_else(|e| panic!("{}: {e}", saved.display())).to_rgba8();
+    let window = shown(&harness);
+    assert_eq!(window.dimensions(), png.dimensions());
+    let differences: Vec<u8> =
+        window.as_raw().iter().zip(png.as_raw()).map(|(a, b)| a.abs_diff(*b)).filter(|&d| d > 0).collect();
+    println!("{} of {} channel values differ by one level", differences.len(), png.as_raw().len());
+    assert!(differences.iter().all(|&d| d <= 1), "the window differs from the PNG by more than one level");
+
+    // One stop of exposure redraws the same samples twice as bright: level v becomes about
+    // 255 (2 (v / 255)^2.2)^(1 / 2.2) = v 2^(1 / 2.2), clamped (the 8-bit v is itself within half
+    // a level of the exact value, so allow 2 levels).
+    harness.state_mut().pathtrace_mut().unwrap().settings.exposure = 1.0;
+    harness.run_steps(2);
+    let brighter = shown(&harness);
+    for (b, v) in brighter.pixels().zip(window.pixels()) {
+        for c in 0..3 {
+            let expected = (f64::from(v[c]) * 2f64.powf(1.0 / 2.2)).min(255.0);
+            assert!((f64::from(b[c]) - expected).abs() <= 2.0, "{v:?} at +1 stop became {b:?}");
+        }
+    }
 }
 
 #[test]
