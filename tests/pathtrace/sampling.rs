@@ -39,16 +39,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {{
 "
     );
     let entry = ShaderFile::generated("sampling harness".into(), source);
-    let module = shader::compose(COMMON_MODULES, &entry, &[]).expect("harness composes");
-    let module = shader::create_module(gpu, module, "sampling harness").expect("harness compiles");
-    let pipeline = gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some("sampling harness"),
-        layout: None,
-        module: &module,
-        entry_point: Some("main"),
-        compilation_options: Default::default(),
-        cache: None,
-    });
+    let pipeline = shader::compute_pipeline(gpu, COMMON_MODULES, &entry, &[], "sampling harness")
+        .unwrap_or_else(|e| panic!("the harness compiles: {e}"));
     let size = N as u64 * 16;
     let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("samples"),

@@ -123,3 +123,26 @@ pub fn create_module(
         })
     })
 }
+
+/// Composes `entry` with `modules` under `defs` and builds a compute pipeline of its `main`
+/// entry point, with the bind group layout derived from the shader. Composition, validation and
+/// out-of-memory errors come back as [`GpuError`]s that name `label`.
+pub fn compute_pipeline(
+    gpu: &GpuContext,
+    modules: &[ShaderFile],
+    entry: &ShaderFile,
+    defs: &[(&str, Def)],
+    label: &str,
+) -> Result<wgpu::ComputePipeline, GpuError> {
+    let module = create_module(gpu, compose(modules, entry, defs)?, &entry.path)?;
+    gpu.scoped(&format!("creating the {label} pipeline"), || {
+        gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(label),
+            layout: None,
+            module: &module,
+            entry_point: Some("main"),
+            compilation_options: Default::default(),
+            cache: None,
+        })
+    })
+}

@@ -50,18 +50,7 @@ fn pipeline(gpu: &GpuContext) -> Result<wgpu::ComputePipeline, PathTraceError> {
     if let Some(pipeline) = pipeline_cache().lock().unwrap_or_else(|p| p.into_inner()).get(&gpu.id()) {
         return Ok(pipeline.clone());
     }
-    let module = shader::compose(&[], &DISPLAY_SUM_SHADER, &[])?;
-    let module = shader::create_module(gpu, module, &DISPLAY_SUM_SHADER.path)?;
-    let pipeline = gpu.scoped("creating the display-sum pipeline", || {
-        gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("pathtrace display sum"),
-            layout: None,
-            module: &module,
-            entry_point: Some("main"),
-            compilation_options: Default::default(),
-            cache: None,
-        })
-    })?;
+    let pipeline = shader::compute_pipeline(gpu, &[], &DISPLAY_SUM_SHADER, &[], "display-sum")?;
     pipeline_cache().lock().unwrap_or_else(|p| p.into_inner()).insert(gpu.id(), pipeline.clone());
     Ok(pipeline)
 }

@@ -228,18 +228,8 @@ impl PathTracer {
         let pipeline = match cached {
             Some(pipeline) => pipeline,
             None => {
-                let module = shader::compose(&modules, &PATHTRACE_SHADER, &defs)?;
-                let module = shader::create_module(gpu, module, &PATHTRACE_SHADER.path)?;
-                let pipeline = gpu.scoped("creating the path-tracing pipeline", || {
-                    gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                        label: Some("pathtrace"),
-                        layout: None,
-                        module: &module,
-                        entry_point: Some("main"),
-                        compilation_options: Default::default(),
-                        cache: None,
-                    })
-                })?;
+                let pipeline =
+                    shader::compute_pipeline(gpu, &modules, &PATHTRACE_SHADER, &defs, "path-tracing")?;
                 pipeline_cache()
                     .lock()
                     .unwrap_or_else(|p| p.into_inner())
