@@ -21,11 +21,6 @@ impl Options {
         Options { look, effects: Effects::ALL_ON }
     }
 
-    /// Whether the frame needs the metal sphere's cube map: only the whitted look mirrors.
-    pub fn needs_metal_cube(&self) -> bool {
-        self.look == Look::Whitted && self.effects.reflection
-    }
-
     /// Samples per pixel of the main pass.
     pub fn samples(&self) -> u32 {
         if self.effects.msaa { crate::MSAA_SAMPLES } else { 1 }
@@ -37,12 +32,8 @@ mod tests {
     use super::*;
 
     #[test]
-    fn metal_cube_only_for_whitted_reflections() {
-        assert!(!Options::all_on(Look::Figure).needs_metal_cube());
-        assert!(Options::all_on(Look::Whitted).needs_metal_cube());
+    fn msaa_sets_the_main_pass_samples() {
         let mut o = Options::all_on(Look::Whitted);
-        o.effects.reflection = false;
-        assert!(!o.needs_metal_cube());
         assert_eq!(o.samples(), 4);
         o.effects.msaa = false;
         assert_eq!(o.samples(), 1);

@@ -72,3 +72,47 @@ impl FramePlan {
         first..end
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shadow_fit::fit_shadow;
+
+    fn scene() -> WhittedScene {
+        let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/whitted.toml"))
+            .expect("scenes/whitted.toml");
+        WhittedScene::from_toml_str(&text, "whitted.toml").expect("valid")
+    }
+
+    fn plan(scene: &WhittedScene, options: &Options) -> FramePlan {
+        FramePlan::new(scene, options, &fit_shadow(scene, 8192))
+    }
+
+    #[test]
+    fn metal_cube_only_for_whitted_reflections_of_a_mirror() {
+        let s = scene();
+        assert!(!plan(&s, &Options::all_on(Look::Figure)).metal_cube);
+        assert!(plan(&s, &Options::all_on(Look::Whitted)).metal_cube);
+        let mut o = Options::all_on(Look::Whitted);
+        o.effects.reflection = false;
+        assert!(!plan(&s, &o).metal_cube);
+        let mut matte = s.clone();
+        matte.metal.as_mut().expect("metal").mirror = 0.0;
+        assert!(!plan(&matte, &Options::all_on(Look::Whitted)).metal_cube);
+    }
+
+    #[test]
+    fn shadow_pass_needs_shadows_a_casting_light_and_a_caster() {
+        let s = scene();
+        assert!(plan(&s, &Options::all_on(Look::Figure)).shadow_pass);
+        let mut o = Options::all_on(Look::Figure);
+        o.effects.shadows = false;
+        assert!(!plan(&s, &o).shadow_pass);
+        let mut unlit = s.clone();
+        unlit.light.casts_shadows = false;
+        assert!(!plan(&unlit, &Options::all_on(Look::Figure)).shadow_pass);
+        let bare = WhittedScene { glass: None, metal: None, ..s };
+        let p = plan(&bare, &Options::all_on(Look::Figure));
+        assert!(!p.shadow_pass && p.shadow_casters().is_empty() && p.pass_names() == ["main"]);
+    }
+}
