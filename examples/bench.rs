@@ -18,8 +18,8 @@ use std::path::PathBuf;
 use clap::Parser;
 use illum::cli::{self, SceneArgs};
 use illum::pathtrace::{PathTracer, TracerOptions, Traversal};
+use illum::raster::RasterScene;
 use illum::raster::{Look, Options, bench_frames};
-use illum::scene::WhittedScene;
 use illum::scene::{Bounces, Scene};
 
 #[derive(Parser, Debug)]
@@ -130,8 +130,8 @@ fn run(args: Args) -> anyhow::Result<()> {
 /// the GPU time of each pass (more options: `--example raster_bench`).
 fn bench_raster(gpu: &illum::gpu::GpuContext, runs: usize) -> anyhow::Result<()> {
     let path = cli::resolve_scene_path(std::path::Path::new("scenes/whitted.toml"));
-    let scene = WhittedScene::load(&path)?;
-    let options = Options::all_on(Look::Whitted);
+    let scene = RasterScene::load(&path)?;
+    let options = Options::all_on(Look::Enhanced);
     let report = bench_frames(gpu, &scene, 1280, 720, &options, 5, (12 * runs.max(1)) as u32)?;
     println!();
     println!(

@@ -15,9 +15,9 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Parser;
 use illum::cli;
+use illum::raster::RasterScene;
 use illum::raster::{Look, bench_frames};
 use illum::raster_cli::RasterArgs;
-use illum::scene::WhittedScene;
 
 #[derive(Parser, Debug)]
 struct Args {
@@ -47,14 +47,14 @@ fn main() {
 
 fn run(args: Args) -> anyhow::Result<()> {
     let path = cli::resolve_scene_path(&args.scene);
-    let mut scene = WhittedScene::load(&path)?;
+    let mut scene = RasterScene::load(&path)?;
     if let Some(size) = args.cube_size {
         anyhow::ensure!(size >= 1, "--cube-size = 0: must be at least 1");
         scene.quality.cube_size = size;
     }
     let mut options = args.raster.options(&scene);
     if args.raster.look.is_none() {
-        options.look = Look::Whitted;
+        options.look = Look::Enhanced;
     }
     anyhow::ensure!(args.frames >= 1, "--frames = 0: must be at least 1");
     let gpu = cli::gpu()?;

@@ -4,7 +4,7 @@
 //! ```text
 //! cargo run --release --example raster_figures -- [--out docs/images]
 //! ```
-//! Writes `whitted-figure.png` and `whitted-whitted.png` (640 x 360) and `whitted-effects.png`
+//! Writes `whitted-figure.png` and `whitted-enhanced.png` (640 x 360) and `whitted-effects.png`
 //! (eight labelled 400 x 225 panels). PNGs are linear, as the assignment's figure 1.
 
 use std::path::PathBuf;
@@ -13,8 +13,7 @@ use anyhow::Context;
 use clap::Parser;
 use illum::cli;
 use illum::image::{Encoding, contact_sheet, save_png, save_rgba8_png, to_rgba8};
-use illum::raster::{Effects, Look, Options, WhittedRenderer};
-use illum::scene::WhittedScene;
+use illum::raster::{Effects, Look, Options, RasterRenderer, RasterScene};
 
 #[derive(Parser, Debug)]
 struct Args {
@@ -34,10 +33,10 @@ fn with(look: Look, change: impl FnOnce(&mut Effects)) -> Options {
 }
 
 fn run(args: Args) -> anyhow::Result<()> {
-    let scene = WhittedScene::load(&cli::resolve_scene_path("scenes/whitted.toml".as_ref()))?;
+    let scene = RasterScene::load(&cli::resolve_scene_path("scenes/whitted.toml".as_ref()))?;
     let gpu = cli::gpu()?;
 
-    let mut large = WhittedRenderer::new(&gpu, &scene, 640, 360)?;
+    let mut large = RasterRenderer::new(&gpu, &scene, 640, 360)?;
     for look in Look::ALL {
         let path = args.out.join(format!("whitted-{look}.png"));
         save_png(&path, &large.render(&Options::all_on(look))?, 0.0, Encoding::Linear)?;
@@ -46,15 +45,15 @@ fn run(args: Args) -> anyhow::Result<()> {
 
     let panels = [
         ("figure (the fake)", Options::all_on(Look::Figure)),
-        ("whitted look", Options::all_on(Look::Whitted)),
+        ("enhanced look", Options::all_on(Look::Enhanced)),
         ("figure, no refraction", with(Look::Figure, |e| e.refraction = false)),
-        ("whitted, no reflection", with(Look::Whitted, |e| e.reflection = false)),
-        ("whitted, no Fresnel", with(Look::Whitted, |e| e.fresnel = false)),
+        ("enhanced, no reflection", with(Look::Enhanced, |e| e.reflection = false)),
+        ("enhanced, no Fresnel", with(Look::Enhanced, |e| e.fresnel = false)),
         ("figure, no shadows", with(Look::Figure, |e| e.shadows = false)),
         ("figure, no PCF", with(Look::Figure, |e| e.pcf = false)),
         ("figure, no MSAA", with(Look::Figure, |e| e.msaa = false)),
     ];
-    let mut small = WhittedRenderer::new(&gpu, &scene, 400, 225)?;
+    let mut small = RasterRenderer::new(&gpu, &scene, 400, 225)?;
     let mut images = Vec::new();
     for (label, options) in panels {
         let image = small.render(&options).with_context(|| format!("rendering {label}"))?;

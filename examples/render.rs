@@ -6,9 +6,10 @@
 //!     [--target-error X] [--time-budget SECONDS] [--encoding gamma2.2|srgb] [--exposure STOPS]
 //! ```
 //! With no arguments it renders `scenes/cornell.toml` to `out/cornell.png` and `out/cornell.exr`.
-//! A rasterizer scene (`renderer = "raster"`, e.g. `scenes/whitted.toml`) is drawn by the Whitted
-//! look-alike instead, with `[--look figure|whitted] [--no-shadows] [--no-pcf] [--no-refraction]
-//! [--no-reflection] [--no-fresnel] [--no-msaa]` (see `illum::raster_cli`).
+//! `--renderer raster|pathtrace` picks the renderer; the default is the scene file's `renderer`
+//! (`scenes/whitted.toml` says `raster`). The rasterizer takes `[--look figure|enhanced]
+//! [--no-shadows] [--no-pcf] [--no-refraction] [--no-reflection] [--no-fresnel] [--no-msaa]`
+//! (see `illum::raster_cli`). A renderer given a scene it cannot render says what it lacks.
 //! Ctrl-C stops the render early and still writes what has accumulated; the EXR's metadata
 //! records the samples per pixel actually reached.
 
@@ -23,15 +24,18 @@ use illum::cli::{self, DEFAULT_SCENE, OutputFormat, SceneArgs, output_format};
 use illum::image::{Encoding, ExrMetadata, save_exr, save_png};
 use illum::pathtrace::{PathTracer, Sequence, StopReason, StopRules, TracerOptions, render_progressive};
 use illum::raster_cli::{RasterArgs, RasterRequest, render_raster};
-use illum::scene::{SceneKind, scene_kind};
+use illum::scene::{RendererKind, Scene};
 use indicatif::{ProgressBar, ProgressStyle};
 
 #[derive(Parser, Debug)]
-#[command(about = "Path-trace a scene file to PNG and/or EXR")]
+#[command(about = "Render a scene file to PNG and/or EXR with the path tracer or the rasterizer")]
 struct Args {
     /// Scene file (TOML).
     #[arg(default_value = DEFAULT_SCENE)]
     scene: PathBuf,
+    /// Renderer: `pathtrace` or `raster`. Default: the scene file's `renderer`.
+    #[arg(long)]
+    renderer: Option<RendererKind>,
     #[command(flatten)]
     settings: SceneArgs,
     #[command(flatten)]
@@ -51,9 +55,9 @@ struct Args {
     #[arg(long)]
     encoding: Option<Encoding>,
     /// Sample values: `independent` or `low-discrepancy` (lower error for the same spp; see
-    /// docs/accuracy.md).
-    #[arg(long, default_value = "independent")]
-    sequence: Sequence,
+    /// docs/accuracy.md). Default: the scene file's `[pathtrace] sequence`.
+    #[arg(long)]
+    sequence: Option<Sequence>,
     /// PNG exposure in stops (EXR output is never scaled).
     #[arg(long, default_value_t = 0.0)]
     exposure: f32,
@@ -64,10 +68,16 @@ fn main() {
 }
 
 fn run(args: Args) -> anyhow::Result<()> {
-    // A rasterizer scene (renderer = "raster", the Whitted look-alike) takes its own path.
-    if scene_kind(&cli::resolve_scene_path(&args.scene))? == SceneKind::Raster {
-        let given =
-            [(args.target_error.is_some(), "--target-error"), (args.time_budget.is_some(), "--time-budget")];
+    let renderer = match args.renderer {
+        Some(renderer) => renderer,
+        None => Scene::load(&cli::resolve_scene_path(&args.scene))?.renderer,
+    };
+    if renderer == RendererKind::Raster {
+        let given = [
+            (args.target_error.is_some(), "--target-error"),
+            (args.time_budget.is_some(), "--time-budget"),
+            (args.sequence.is_some(), "--sequence"),
+        ];
         return render_raster(&RasterRequest {
             scene: &args.scene,
             settings: &args.settings,
@@ -79,7 +89,10 @@ fn run(args: Args) -> anyhow::Result<()> {
         });
     }
     args.raster.reject_for_path_tracer(&args.scene)?;
-    let scene = cli::load_scene(&args.scene, &args.settings)?;
+    let mut scene = cli::load_scene(&args.scene, &args.settings)?;
+    if let Some(sequence) = args.sequence {
+        scene.pathtrace.sequence = sequence;
+    }
     let outputs = if args.outputs.is_empty() {
         vec![
             PathBuf::from(format!("out/{}.png", scene.name)),
@@ -106,7 +119,7 @@ fn run(args: Args) -> anyhow::Result<()> {
     let mut tracer = PathTracer::with_options(
         &gpu,
         &scene,
-        TracerOptions { sequence: args.sequence, ..Default::default() },
+        TracerOptions { sequence: scene.pathtrace.sequence, ..Default::default() },
     )?;
     let cancel = Arc::new(AtomicBool::new(false));
     {
@@ -120,7 +133,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         .context("installing the Ctrl-C handler")?;
     }
 
-    let spp = scene.render.spp;
+    let spp = scene.pathtrace.spp;
     let progress = ProgressBar::new(spp as u64);
     progress.set_style(
         ProgressStyle::with_template("{bar:40} {pos}/{len} spp  {msg}  [{elapsed_precise}, ETA {eta}]")
@@ -142,13 +155,13 @@ fn run(args: Args) -> anyhow::Result<()> {
     let metadata = ExrMetadata {
         scene: scene.name.clone(),
         spp: spp_reached,
-        bounces: scene.render.bounces.to_string(),
-        seed: scene.render.seed,
-        sampling: scene.render.sampling.to_string(),
+        bounces: scene.pathtrace.bounces.to_string(),
+        seed: scene.pathtrace.seed,
+        sampling: scene.pathtrace.sampling.to_string(),
         render_seconds: seconds,
         extra: vec![
             ("stopped_by".into(), format!("{reason:?}")),
-            ("sequence".into(), args.sequence.to_string()),
+            ("sequence".into(), scene.pathtrace.sequence.to_string()),
             ("dropped_samples".into(), accumulator.dropped_samples().to_string()),
             ("estimated_relative_error".into(), format!("{:.6}", accumulator.estimated_relative_error())),
             ("adapter".into(), gpu.adapter_info.name.clone()),
@@ -173,8 +186,8 @@ fn run(args: Args) -> anyhow::Result<()> {
             StopReason::TimeBudget => "stopped by the time budget",
             StopReason::Cancelled => "interrupted; kept what had accumulated",
         },
-        scene.render.bounces,
-        scene.render.sampling,
+        scene.pathtrace.bounces,
+        scene.pathtrace.sampling,
         seconds,
         samples / tracer.wall_seconds().max(1e-9) * 1e-6,
         accumulator.estimated_relative_error(),

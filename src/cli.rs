@@ -39,6 +39,7 @@ impl SceneArgs {
             bounces: self.bounces,
             seed: self.seed,
             sampling: self.sampling,
+            sequence: None,
             width: self.width,
             height: self.height,
         }

@@ -1,6 +1,6 @@
-//! The `render` example's path for rasterizer scenes (`renderer = "raster"`, the Whitted
-//! look-alike): its flags, and rendering to PNG / EXR with the same error quality as the path
-//! tracer's path.
+//! The `render` example's path for the rasterizer (`--renderer raster`, the default for a scene
+//! whose file says `renderer = "raster"`): its flags, and rendering to PNG / EXR with the same
+//! error quality as the path tracer's path.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -11,8 +11,7 @@ use illum_gpu::GpuContext;
 
 use crate::cli::{OutputFormat, output_format};
 use illum_image::{Encoding, ExrMetadata, save_exr, save_png};
-use illum_raster::{Look, Options, PassTimes, WhittedRenderer};
-use illum_scene::WhittedScene;
+use illum_raster::{Look, Options, PassTimes, RasterRenderer, RasterScene};
 
 use crate::cli::{self, SceneArgs};
 
@@ -20,8 +19,8 @@ use crate::cli::{self, SceneArgs};
 /// these flags turns it off.
 #[derive(Args, Clone, Debug, Default)]
 pub struct RasterArgs {
-    /// Rasterizer scenes: `figure` (the assignment's figure 1) or `whitted` (mirror reflections,
-    /// Fresnel, refraction through both faces). Default: the scene file's `look`.
+    /// Rasterizer: `figure` (the assignment's figure 1) or `enhanced` (mirror reflections,
+    /// Fresnel, refraction through both faces). Default: the scene file's `[raster] look`.
     #[arg(long)]
     pub look: Option<Look>,
     /// Rasterizer scenes: no shadow map.
@@ -33,10 +32,10 @@ pub struct RasterArgs {
     /// Rasterizer scenes: the glass shows what is straight behind it, unbent.
     #[arg(long)]
     pub no_refraction: bool,
-    /// Rasterizer scenes (whitted look): no mirror reflections.
+    /// Rasterizer scenes (enhanced look): no mirror reflections.
     #[arg(long)]
     pub no_reflection: bool,
-    /// Rasterizer scenes (whitted look): the glass reflects its normal-incidence fraction everywhere.
+    /// Rasterizer scenes (enhanced look): the glass reflects its normal-incidence fraction everywhere.
     #[arg(long)]
     pub no_fresnel: bool,
     /// Rasterizer scenes: one sample per pixel instead of 4x MSAA.
@@ -62,7 +61,7 @@ impl RasterArgs {
     }
 
     /// The scene file's look and effects, changed by the flags.
-    pub fn options(&self, scene: &WhittedScene) -> Options {
+    pub fn options(&self, scene: &RasterScene) -> Options {
         let mut options = Options::from_scene(scene);
         if let Some(look) = self.look {
             options.look = look;
@@ -82,8 +81,8 @@ impl RasterArgs {
         let given = self.given();
         if !given.is_empty() {
             bail!(
-                "{}: {} {} only to rasterizer scenes (renderer = \"raster\", such as scenes/whitted.toml); \
-                 this is a path-tracer scene",
+                "{}: {} {} only to the rasterizer (--renderer raster, the default for scenes such as \
+                 scenes/whitted.toml); this render uses the path tracer",
                 scene.display(),
                 given.join(", "),
                 verb(given.len())
@@ -127,13 +126,13 @@ fn path_tracer_settings(settings: &SceneArgs) -> Vec<&'static str> {
 
 /// Loads the scene, applies `--width` / `--height`, and checks every flag and output name,
 /// before any GPU work.
-fn prepare(request: &RasterRequest) -> anyhow::Result<(WhittedScene, Options, Vec<PathBuf>)> {
+fn prepare(request: &RasterRequest) -> anyhow::Result<(RasterScene, Options, Vec<PathBuf>)> {
     let path = cli::resolve_scene_path(request.scene);
     let mut flags = path_tracer_settings(request.settings);
     flags.extend(&request.path_tracer_flags);
     if !flags.is_empty() {
         bail!(
-            "{}: {} {} only to path-tracer scenes; this is a rasterizer scene (renderer = \"raster\"), \
+            "{}: {} {} only to the path tracer; this render uses the rasterizer (--renderer raster), \
              whose flags are --look, --no-shadows, --no-pcf, --no-refraction, --no-reflection, \
              --no-fresnel, --no-msaa, --width, --height",
             request.scene.display(),
@@ -141,7 +140,7 @@ fn prepare(request: &RasterRequest) -> anyhow::Result<(WhittedScene, Options, Ve
             verb(flags.len())
         );
     }
-    let mut scene = WhittedScene::load(&path)?;
+    let mut scene = RasterScene::load(&path)?;
     scene.set_resolution(request.settings.width, request.settings.height, "command line")?;
     let options = request.raster.options(&scene);
     let outputs = if request.outputs.is_empty() {
@@ -174,8 +173,8 @@ fn describe(options: &Options) -> String {
         (e.shadows, "shadows"),
         (e.pcf, "pcf"),
         (e.refraction, "refraction"),
-        (e.reflection && options.look == Look::Whitted, "reflection"),
-        (e.fresnel && options.look == Look::Whitted, "fresnel"),
+        (e.reflection && options.look == Look::Enhanced, "reflection"),
+        (e.fresnel && options.look == Look::Enhanced, "fresnel"),
         (e.msaa, "msaa"),
     ]
     .into_iter()
@@ -190,14 +189,14 @@ fn describe(options: &Options) -> String {
 
 fn render_prepared(
     gpu: &GpuContext,
-    scene: &WhittedScene,
+    scene: &RasterScene,
     options: &Options,
     outputs: &[PathBuf],
     request: &RasterRequest,
 ) -> anyhow::Result<()> {
     let (width, height) = (scene.camera.width, scene.camera.height);
     let started = Instant::now();
-    let mut renderer = WhittedRenderer::new(gpu, scene, width, height)?;
+    let mut renderer = RasterRenderer::new(gpu, scene, width, height)?;
     let frame = renderer.render_timed(options)?;
     let seconds = started.elapsed().as_secs_f64();
     let encoding = request.encoding.unwrap_or(Encoding::Linear);

@@ -127,14 +127,14 @@ fn run(mut args: Args) -> anyhow::Result<()> {
         scene.name,
         scene.camera.width,
         scene.camera.height,
-        scene.render.bounces,
+        scene.pathtrace.bounces,
         reference.mean_luminance()
     );
 
     let mut rows = Vec::new();
     for variant in VARIANTS {
         let mut variant_scene = scene.clone();
-        variant_scene.render.sampling = variant.sampling;
+        variant_scene.pathtrace.sampling = variant.sampling;
         let options = TracerOptions { sequence: variant.sequence, ..Default::default() };
         let mut tracer = PathTracer::with_options(&gpu, &variant_scene, options)?;
         // The driver compiles a pipeline on its first dispatch: keep that out of the timings.
@@ -184,7 +184,7 @@ fn reference_image(gpu: &GpuContext, scene: &Scene, args: &Args, max_spp: u32) -
     let spp = max_spp.saturating_mul(args.reference_factor);
     let path = args.out.join(format!(
         "reference-{}-{}x{}-b{}-{}spp.exr",
-        scene.name, scene.camera.width, scene.camera.height, scene.render.bounces, spp
+        scene.name, scene.camera.width, scene.camera.height, scene.pathtrace.bounces, spp
     ));
     if path.exists() {
         let (image, _) = load_exr(&path)?;
@@ -193,17 +193,17 @@ fn reference_image(gpu: &GpuContext, scene: &Scene, args: &Args, max_spp: u32) -
     }
     println!("rendering the reference: {spp} spp (cached as {})", path.display());
     let mut reference_scene = scene.clone();
-    reference_scene.render.sampling = Sampling::Cosine;
+    reference_scene.pathtrace.sampling = Sampling::Cosine;
     // A seed the measured runs do not use, so reference and test noise are independent.
-    reference_scene.render.seed = scene.render.seed.wrapping_add(0x5eed);
+    reference_scene.pathtrace.seed = scene.pathtrace.seed.wrapping_add(0x5eed);
     let mut tracer = PathTracer::new(gpu, &reference_scene)?;
     tracer.render(spp)?;
     let image = tracer.accumulator().mean_image();
     let metadata = ExrMetadata {
         scene: scene.name.clone(),
         spp: spp as u64,
-        bounces: scene.render.bounces.to_string(),
-        seed: reference_scene.render.seed,
+        bounces: scene.pathtrace.bounces.to_string(),
+        seed: reference_scene.pathtrace.seed,
         sampling: "cosine".into(),
         render_seconds: tracer.wall_seconds(),
         extra: vec![("role".into(), "convergence reference".into())],
@@ -369,7 +369,7 @@ fn bounce_table(gpu: &GpuContext, scene: &Scene, spp: u32, out: &Path) -> anyhow
     let settings: Vec<Bounces> = (0..=8).map(Bounces::Fixed).chain([Bounces::Unbounded]).collect();
     for bounces in settings {
         let mut s = scene.clone();
-        s.render.bounces = bounces;
+        s.pathtrace.bounces = bounces;
         let mut tracer = PathTracer::new(gpu, &s)?;
         tracer.render(spp)?;
         let acc = tracer.accumulator();

@@ -146,7 +146,7 @@ fn highlight(n: vec3<f32>, v: vec3<f32>, shininess: f32) -> f32 {
 }
 
 // The metal sphere at p (unit normal n) seen from `eye`. Both looks: Phong, colour x (ambient +
-// light x N.L x visibility) plus a specular highlight. The whitted look with reflection on also
+// light x N.L x visibility) plus a specular highlight. The enhanced look with reflection on also
 // mirrors the metal's cube map, tinted by the metal's colour (a metal's reflectance is coloured),
 // taking the fraction `mirror` from the diffuse part.
 fn shade_metal(sw: Switches, p: vec3<f32>, n: vec3<f32>, eye: vec3<f32>) -> vec3<f32> {
@@ -159,7 +159,7 @@ fn shade_metal(sw: Switches, p: vec3<f32>, n: vec3<f32>, eye: vec3<f32>) -> vec3
     let diffuse = scene.metal_color.rgb * (scene.ambient.rgb + scene.light_radiance.rgb * max(n_dot_l, 0.0) * visibility);
     let specular = scene.metal_specular.rgb * scene.light_radiance.rgb
         * (highlight(n, v, scene.metal_specular.w) * visibility);
-    if sw.whitted && sw.reflection && sw.metal_env {
+    if sw.enhanced && sw.reflection && sw.metal_env {
         let mirror = scene.metal_color.w;
         let reflected = metal_environment(reflect(-v, n));
         return (1.0 - mirror) * diffuse + mirror * scene.metal_color.rgb * reflected + specular;
@@ -220,7 +220,7 @@ fn refract_through_sphere(p1: vec3<f32>, n1: vec3<f32>, incident: vec3<f32>, eta
 // the environment along the view ray refracted once at the front face (refraction off: along
 // the unbent view ray).
 //
-// Whitted look: Schlick's Fresnel weight F = F0 + (1 - F0)(1 - cos)^5 between the mirror
+// Enhanced look: Schlick's Fresnel weight F = F0 + (1 - F0)(1 - cos)^5 between the mirror
 // reflection and the refraction through both faces of the sphere, plus a white highlight.
 // Without Fresnel F is F0 (normal incidence) everywhere; without reflection F is 0.
 fn shade_glass(sw: Switches, p: array<vec3<f32>, 3>, n: array<vec3<f32>, 3>, eye: vec3<f32>) -> vec3<f32> {
@@ -231,7 +231,7 @@ fn shade_glass(sw: Switches, p: array<vec3<f32>, 3>, n: array<vec3<f32>, 3>, eye
         let incident = normalize(p[i] - eye);
         through[i] = incident;
         if sw.refraction {
-            if sw.whitted {
+            if sw.enhanced {
                 through[i] = refract_through_sphere(p[i], n[i], incident, eta);
             } else {
                 through[i] = refract_or_reflect(incident, n[i], eta);
@@ -239,7 +239,7 @@ fn shade_glass(sw: Switches, p: array<vec3<f32>, 3>, n: array<vec3<f32>, 3>, eye
         }
         mirrored[i] = reflect(incident, n[i]);
     }
-    if !sw.whitted {
+    if !sw.enhanced {
         let r = scene.glass_color.w;
         return (1.0 - r) * scene.glass_color.rgb + r * glass_environment(through);
     }

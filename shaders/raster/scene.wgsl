@@ -9,15 +9,15 @@
 // matters: it runs both sides of a branch under a lane mask, so a uniform flag would cost every
 // path on every pixel.
 struct Switches {
-    // The whitted look (else the figure look).
-    whitted: bool,
+    // The enhanced look (else the figure look).
+    enhanced: bool,
     shadows: bool,
     pcf: bool,
     refraction: bool,
     reflection: bool,
     fresnel: bool,
     // The metal sphere's cube map may be read: only in the main pass, and only when it was
-    // captured (whitted look with reflection). The glass's cube map is readable wherever the
+    // captured (enhanced look with reflection). The glass's cube map is readable wherever the
     // glass is drawn, since no pass that renders it draws the glass.
     metal_env: bool,
 }
@@ -53,7 +53,7 @@ struct Scene {
     // x: refraction ratio n_outside / n_inside, y: highlight exponent, z: Schlick's F0.
     glass_params: vec4<f32>,
     metal_sphere: vec4<f32>,
-    // rgb: metal colour; w: whitted-look mirror fraction.
+    // rgb: metal colour; w: enhanced-look mirror fraction.
     metal_color: vec4<f32>,
     // rgb: specular colour; w: Phong exponent.
     metal_specular: vec4<f32>,

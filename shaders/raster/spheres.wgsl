@@ -9,7 +9,7 @@
 // Set per pipeline (see Switches in scene.wgsl).
 override SPHERE: u32 = 0u;
 override SAMPLES: u32 = 1u;
-override WHITTED: bool = false;
+override ENHANCED: bool = false;
 override SHADOWS: bool = true;
 override PCF: bool = true;
 override REFRACTION: bool = true;
@@ -63,7 +63,7 @@ fn fs_main(in: VertexOut) -> FragmentOut {
         normalize(p[1] - sphere.xyz),
         normalize(p[2] - sphere.xyz),
     );
-    let sw = Switches(WHITTED, SHADOWS, PCF, REFRACTION, REFLECTION, FRESNEL, METAL_ENV);
+    let sw = Switches(ENHANCED, SHADOWS, PCF, REFRACTION, REFLECTION, FRESNEL, METAL_ENV);
     var color: vec3<f32>;
     if SPHERE == SPHERE_GLASS {
         color = shade_glass(sw, p, n, eye);

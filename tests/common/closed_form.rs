@@ -122,7 +122,7 @@ up = {up}
 vfov = {vfov:?}
 width = {width}
 height = {height}
-[render]
+[pathtrace]
 spp = {spp}
 bounces = 0
 seed = {seed}

@@ -1,7 +1,7 @@
 //! Scene edits for the extremes tests: scaling and moving a whole scene, camera included.
 
 use glam::Vec3;
-use illum::scene::{Scene, Shape};
+use illum::scene::{MaterialKind, Scene, Shape};
 
 /// The scene with every position x replaced by `scale * x + offset` (camera included) and every
 /// length scaled by `scale`. Radiance is left alone, so a correct renderer draws the same image.
@@ -39,7 +39,7 @@ pub fn transformed(scene: &Scene, scale: f32, offset: Vec3) -> Scene {
 pub fn set_albedo(scene: &mut Scene, albedo: f32) {
     for material in &mut scene.materials {
         if !material.is_emitter() {
-            material.albedo = Vec3::splat(albedo);
+            material.kind = MaterialKind::Lambertian { albedo: Vec3::splat(albedo) };
         }
     }
 }

@@ -28,7 +28,7 @@ up = [0.0, 1.0, 0.0]
 vfov = 45.0
 width = 8
 height = 8
-[render]
+[pathtrace]
 spp = 1024
 bounces = 0
 [materials.white]
@@ -74,7 +74,7 @@ fn estimate_floor_radiance(x: DVec3, spp: u32) -> (f64, f64) {
     scene.camera.target = x.as_vec3();
     scene.camera.up = glam::Vec3::Z;
     scene.camera.vfov_deg = 0.01;
-    scene.render.spp = spp;
+    scene.pathtrace.spp = spp;
     let mut tracer = PathTracer::new(common::gpu(), &scene).expect("builds");
     tracer.render(spp).expect("renders");
     assert_eq!(tracer.accumulator().dropped_samples(), 0);

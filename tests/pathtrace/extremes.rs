@@ -1,4 +1,4 @@
-//! The path tracer at the extremes (issue 6): scale, translation, tiny and huge lights, grazing
+//! The path tracer at the extremes: scale, translation, tiny and huge lights, grazing
 //! geometry, albedo and bounce count, sample count, resolution, seeds and sampling modes.
 //!
 //! Every case checks three things: the output has no NaN or Inf, no sample was dropped as
@@ -13,7 +13,7 @@ use std::sync::OnceLock;
 use glam::{DVec3, Vec3};
 use illum::image::{RgbImage32, z_test_pass_fraction};
 use illum::pathtrace::PathTracer;
-use illum::scene::{Bounces, Camera, Overrides, Sampling, Scene, Shape};
+use illum::scene::{Bounces, Camera, MaterialKind, Overrides, Sampling, Scene, Shape};
 
 use crate::common;
 
@@ -58,10 +58,10 @@ fn render_checked(scene: &Scene, what: &str) -> Rendered {
     let tracer = common::render(scene);
     let acc = tracer.accumulator();
     assert_eq!(acc.dropped_samples(), 0, "{what}: samples were dropped as NaN/Inf");
-    assert_eq!(acc.min_samples(), scene.render.spp as u64, "{what}: a pixel is missing samples");
+    assert_eq!(acc.min_samples(), scene.pathtrace.spp as u64, "{what}: a pixel is missing samples");
     let mean = acc.mean_image();
     common::assert_all_finite(&mean, what);
-    Rendered { mean, variance: acc.variance_image(), spp: scene.render.spp }
+    Rendered { mean, variance: acc.variance_image(), spp: scene.pathtrace.spp }
 }
 
 /// z of the difference of two independent estimates.
@@ -96,6 +96,7 @@ fn cornell(size: u32, spp: u32, bounces: Bounces, seed: u32) -> Scene {
             bounces: Some(bounces),
             seed: Some(seed),
             sampling: Some(Sampling::Cosine),
+            sequence: None,
         },
     )
 }
@@ -312,7 +313,7 @@ fn cornell_with_square_light(side: f32, spp: u32) -> Scene {
     }
     for material in &mut scene.materials {
         if material.is_emitter() {
-            material.emission = Vec3::splat(room.radiance as f32);
+            material.kind = MaterialKind::Emitter { radiance: Vec3::splat(room.radiance as f32) };
         }
     }
     scene
@@ -634,7 +635,7 @@ fn seeds_0_and_max_in_both_sampling_modes_match_the_baseline() {
     for sampling in [Sampling::Cosine, Sampling::Uniform] {
         for seed in [0, u32::MAX] {
             let mut scene = cornell(BASE_SIZE, BASE_SPP, Bounces::Fixed(2), seed);
-            scene.render.sampling = sampling;
+            scene.pathtrace.sampling = sampling;
             let what = format!("seed {seed}, {sampling}");
             let rendered = render_checked(&scene, &what);
             assert_same_image(&rendered, baseline(), &what);
@@ -707,11 +708,11 @@ fn noisy_pixels(spp: u32) -> Scene {
 fn pixel_means(scene: &Scene, pass_spp: u32, chunk: u32) -> Vec<[f64; 3]> {
     let mut tracer = PathTracer::new(common::gpu(), scene).expect("builds");
     tracer.set_chunk_samples(chunk);
-    while tracer.spp_done() < scene.render.spp {
+    while tracer.spp_done() < scene.pathtrace.spp {
         tracer.render_pass(pass_spp).expect("renders");
     }
     let acc = tracer.accumulator();
-    assert_eq!(acc.min_samples(), scene.render.spp as u64);
+    assert_eq!(acc.min_samples(), scene.pathtrace.spp as u64);
     assert_eq!(acc.dropped_samples(), 0);
     (0..4).map(|p| acc.pixel_mean(p)).collect()
 }
@@ -825,8 +826,8 @@ fn render_capped(scene: &Scene, bytes: Option<u64>) -> (PathTracer, usize) {
         tracer.limit_batch_bytes(bytes).expect("one row fits");
     }
     let mut submissions = 0;
-    while tracer.spp_done() < scene.render.spp {
-        tracer.step(Some(scene.render.spp)).expect("renders");
+    while tracer.spp_done() < scene.pathtrace.spp {
+        tracer.step(Some(scene.pathtrace.spp)).expect("renders");
         submissions += 1;
     }
     (tracer, submissions)

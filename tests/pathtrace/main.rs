@@ -8,7 +8,7 @@
 //! - `oracle_agreement`: the GPU against the independent f64 CPU oracle (crates/illum-oracle);
 //! - `error_estimate`: the error shown to users tracks the true error; the 1/sqrt(N) rate;
 //! - `sampling`: chi-square tests of the WGSL sampling routines, run on the GPU;
-//! - `extremes`: issue 6, the path tracer where floats run out;
+//! - `extremes`: the path tracer where floats run out;
 //! - `display_sum`: the viewer's GPU-resident running image agrees with the f64 statistics;
 //! - `specialisation`: each scene's pipeline holds what it uses, is cached, refuses others,
 //!   and keeps the caller's submission size across a resize;

@@ -39,7 +39,7 @@ fn compare(bounces: u32) {
         },
     );
     let gpu = common::render(&scene);
-    let oracle = illum_oracle::render(&scene, ORACLE_SPP, 99);
+    let oracle = illum_oracle::render(&scene, ORACLE_SPP, 99).expect("the oracle renders this scene");
     assert_eq!(oracle.dropped, 0);
     let (mean, variance) = (gpu.accumulator().mean_image(), gpu.accumulator().variance_image());
     let oracle_mean = image_from(SIZE, SIZE, &oracle.mean);

@@ -122,7 +122,7 @@ fn a_scene_the_pipeline_was_not_built_for_is_refused() {
     // A new camera and settings are fine and restart the accumulation.
     let mut moved = scene.clone();
     moved.camera.eye.x += 10.0;
-    moved.render.seed = 9;
+    moved.pathtrace.seed = 9;
     tracer.update_scene(&moved).expect("camera changes need no new pipeline");
     assert_eq!(tracer.spp_done(), 0);
 

@@ -16,6 +16,7 @@ fn cornell(size: u32, spp: u32, bounces: u32, sampling: Sampling, seed: u32) -> 
             spp: Some(spp),
             bounces: Some(Bounces::Fixed(bounces)),
             sampling: Some(sampling),
+            sequence: None,
             seed: Some(seed),
         },
     )
@@ -76,8 +77,8 @@ fn the_low_discrepancy_sequence_is_unbiased_and_less_noisy() {
     let independent = render(Sequence::Independent);
     let low_discrepancy = render(Sequence::LowDiscrepancy);
     let mut reference_scene = scene.clone();
-    reference_scene.render.seed = 99;
-    reference_scene.render.spp = 8192;
+    reference_scene.pathtrace.seed = 99;
+    reference_scene.pathtrace.spp = 8192;
     let reference = common::render(&reference_scene).accumulator().mean_image();
     let pass = z_test_pass_fraction(
         &low_discrepancy.accumulator().mean_image(),
@@ -183,7 +184,7 @@ fn no_nan_or_inf_at_any_bounce_count_or_sampling() {
     for bounces in [Bounces::Fixed(0), Bounces::Fixed(1), Bounces::Fixed(8), Bounces::Unbounded] {
         for sampling in [Sampling::Cosine, Sampling::Uniform] {
             let mut scene = cornell(16, 16, 0, sampling, 11);
-            scene.render.bounces = bounces;
+            scene.pathtrace.bounces = bounces;
             let tracer = common::render(&scene);
             let image = tracer.accumulator().mean_image();
             common::assert_all_finite(&image, &format!("bounces {bounces}, {sampling}"));

@@ -31,7 +31,8 @@ fn a_raster_render_writes_a_linear_png() {
     let dir = tempfile::tempdir().expect("temp dir");
     let out = vec![dir.path().join("w.png")];
     let settings = SceneArgs { width: Some(96), height: Some(54), ..Default::default() };
-    let raster = RasterArgs { look: Some(illum::raster::Look::Whitted), no_msaa: true, ..Default::default() };
+    let raster =
+        RasterArgs { look: Some(illum::raster::Look::Enhanced), no_msaa: true, ..Default::default() };
     render_raster_with(common::gpu(), &request(&settings, &raster, &out)).unwrap_or_else(|e| panic!("{e:#}"));
     let png = image::open(&out[0]).expect("the PNG exists").to_rgb8();
     assert_eq!(png.dimensions(), (96, 54));
@@ -65,7 +66,7 @@ fn path_tracer_flags_and_bad_outputs_are_refused_before_rendering() {
     let out = vec![PathBuf::from("x.png")];
     let settings = SceneArgs { spp: Some(64), ..Default::default() };
     let error = error_of(&request(&settings, &raster, &out));
-    assert!(error.contains("--spp applies only to path-tracer scenes"), "{error}");
+    assert!(error.contains("--spp applies only to the path tracer"), "{error}");
     let settings = SceneArgs::default();
     let mut req = request(&settings, &raster, &out);
     req.path_tracer_flags = vec!["--target-error"];
@@ -79,6 +80,6 @@ fn path_tracer_flags_and_bad_outputs_are_refused_before_rendering() {
 fn raster_flags_are_refused_for_a_path_tracer_scene() {
     let raster = RasterArgs { no_msaa: true, look: Some(illum::raster::Look::Figure), ..Default::default() };
     let error = raster.reject_for_path_tracer(Path::new("scenes/cornell.toml")).unwrap_err().to_string();
-    assert!(error.contains("--look, --no-msaa apply only to rasterizer scenes"), "{error}");
+    assert!(error.contains("--look, --no-msaa apply only to the rasterizer"), "{error}");
     RasterArgs::default().reject_for_path_tracer(Path::new("scenes/cornell.toml")).unwrap();
 }

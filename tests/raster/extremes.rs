@@ -5,8 +5,9 @@
 
 use glam::{DVec3, Vec3};
 use illum::image::RgbImage32;
+use illum::raster::RasterScene;
 use illum::raster::{Look, Options};
-use illum::scene::{Camera, WhittedScene};
+use illum::scene::Camera;
 
 use crate::{HEIGHT, WIDTH, camera, level, ray_sphere, render, scene};
 
@@ -14,28 +15,28 @@ fn finite(image: &RgbImage32, what: &str) {
     assert!(!image.has_non_finite(), "{what}: the image holds NaN or Inf");
 }
 
-fn spheres(s: &WhittedScene) -> [(Vec3, f32); 2] {
+fn spheres(s: &RasterScene) -> [(Vec3, f32); 2] {
     [(s.glass.unwrap().center, s.glass.unwrap().radius), (s.metal.unwrap().center, s.metal.unwrap().radius)]
 }
 
-/// The scene with its light moved to `degrees` of elevation above the floor, same azimuth and
-/// distance from its target, seen from above: from the file's camera the long shadows of a low
+/// The scene with its light moved to `degrees` of elevation above the floor, same azimuth, seen
+/// from above: from the file's camera the long shadows of a low
 /// light fall on the far floor straight behind the glass sphere.
-fn light_at_elevation(degrees: f32) -> WhittedScene {
+fn light_at_elevation(degrees: f32) -> RasterScene {
     let mut s = scene();
     s.camera.eye = Vec3::new(10.0, 18.0, 6.0);
     s.camera.target = Vec3::new(-7.0, 0.0, -1.0);
-    let offset = s.light.position - s.light.target;
-    let horizontal = Vec3::new(offset.x, 0.0, offset.z).normalize();
+    let to_light = s.light.to_light();
+    let horizontal = Vec3::new(to_light.x, 0.0, to_light.z).normalize();
     let e = degrees.to_radians();
-    s.light.position = s.light.target + offset.length() * (e.cos() * horizontal + e.sin() * Vec3::Y);
+    s.light.direction = -(e.cos() * horizontal + e.sin() * Vec3::Y);
     s
 }
 
 /// How far the ray from floor point p toward the light passes outside sphere (c, r), in f64
 /// (negative: it goes through the sphere, so p is in that sphere's exact shadow).
-fn exact_margin(s: &WhittedScene, p: DVec3, (c, r): (Vec3, f32)) -> f64 {
-    let l = (s.light.position.as_dvec3() - s.light.target.as_dvec3()).normalize();
+fn exact_margin(s: &RasterScene, p: DVec3, (c, r): (Vec3, f32)) -> f64 {
+    let l = s.light.to_light().as_dvec3().normalize();
     let oc = c.as_dvec3() - p;
     let t = oc.dot(l).max(0.0);
     (oc - t * l).length() - f64::from(r)
@@ -53,7 +54,7 @@ enum Hit {
 /// The first surface the camera ray along `dir` meets, from either side of the floor. The floor
 /// is clipped by the near plane like any polygon (where it is nearer, the ray sees what lies
 /// beyond); a sphere is not: its impostor keeps it closed (near_plane_cutting_the_glass_sphere).
-fn trace_camera(s: &WhittedScene, cam: &Camera, dir: Vec3) -> Hit {
+fn trace_camera(s: &RasterScene, cam: &Camera, dir: Vec3) -> Hit {
     let hit = trace(s, cam.eye, dir, true);
     match hit {
         Hit::Floor(p) if (p - cam.eye).dot(cam.basis().forward) < s.clip.near => {
@@ -69,7 +70,7 @@ fn trace_camera(s: &WhittedScene, cam: &Camera, dir: Vec3) -> Hit {
 
 /// The first surface along origin + t dir (t > 0), from either side of the floor. `with_glass`
 /// false leaves the glass out (what its cube map sees).
-fn trace(s: &WhittedScene, origin: Vec3, dir: Vec3, with_glass: bool) -> Hit {
+fn trace(s: &RasterScene, origin: Vec3, dir: Vec3, with_glass: bool) -> Hit {
     let glass = if with_glass {
         ray_sphere(origin, dir, s.glass.unwrap().center, s.glass.unwrap().radius)
     } else {
@@ -98,7 +99,7 @@ fn trace(s: &WhittedScene, origin: Vec3, dir: Vec3, with_glass: bool) -> Hit {
 
 /// What pixel (x, y) sees, if its centre and four points 0.6 px away see the same kind of
 /// surface (no silhouette or floor edge within the pixel). Floor hits return the centre's point.
-fn interior(s: &WhittedScene, cam: &Camera, x: u32, y: u32) -> Option<Hit> {
+fn interior(s: &RasterScene, cam: &Camera, x: u32, y: u32) -> Option<Hit> {
     let (cx, cy) = (x as f32 + 0.5, y as f32 + 0.5);
     let centre = trace_camera(s, cam, cam.ray_direction(cx, cy));
     let kind = |h: Hit| std::mem::discriminant(&h);
@@ -109,7 +110,7 @@ fn interior(s: &WhittedScene, cam: &Camera, x: u32, y: u32) -> Option<Hit> {
 }
 
 /// Floor points seen at the pixel's centre and its four corners, when all five are floor.
-fn floor_corners(s: &WhittedScene, cam: &Camera, x: u32, y: u32) -> Option<[Vec3; 5]> {
+fn floor_corners(s: &RasterScene, cam: &Camera, x: u32, y: u32) -> Option<[Vec3; 5]> {
     let (cx, cy) = (x as f32 + 0.5, y as f32 + 0.5);
     let mut out = [Vec3::ZERO; 5];
     for (k, (dx, dy)) in [(0.0, 0.0), (-0.5, -0.5), (0.5, -0.5), (-0.5, 0.5), (0.5, 0.5)].iter().enumerate() {
@@ -140,7 +141,7 @@ struct ShadowMeasure {
     umbra_reach: f32,
 }
 
-fn measure_shadows(s: &WhittedScene) -> ShadowMeasure {
+fn measure_shadows(s: &RasterScene) -> ShadowMeasure {
     let options = Options::all_on(Look::Figure);
     let image = render(s, &options);
     finite(&image, "shadows on");
@@ -152,7 +153,7 @@ fn measure_shadows(s: &WhittedScene) -> ShadowMeasure {
     let [a, b] = s.floor.colors;
     assert_eq!(a.x, b.x, "the visibility is read off the red channel, equal on both tiles");
     let red = a.x;
-    let ambient = s.ambient.radiance().x;
+    let ambient = s.ambient.x;
     let direct = s.light.radiance().x * s.light.to_light().y;
     let lit_level = level(red * (ambient + direct));
     // The soft edge: the PCF kernel's reach (1.5 pcf_radius, measured across the light, which
@@ -321,7 +322,7 @@ fn max_level(rgb: [f32; 3]) -> i32 {
 /// a highlight), must be a colour in [0, 1] whose brightest channel is at least `floor` levels:
 /// no black holes. Returns (glass pixels, darkest max channel of E in levels).
 fn check_glass_pixels(
-    s: &WhittedScene,
+    s: &RasterScene,
     image: &RgbImage32,
     look: Look,
     floor: i32,
@@ -340,7 +341,7 @@ fn check_glass_pixels(
             let p = image.get(x, y);
             let e = match look {
                 Look::Figure => [0, 1, 2].map(|c| (p[c] - base[c]) / mix),
-                Look::Whitted => p,
+                Look::Enhanced => p,
             };
             let slack = 2.5 / 255.0 / mix;
             assert!(
@@ -467,7 +468,7 @@ fn far_plane_just_beyond_and_before_the_floor_end() {
 /// The file's camera orbited in its vertical plane around the target down to eye height `y`
 /// (it then looks up at the target), or, `level`, moved to height `y` looking level along -X,
 /// so that the horizon crosses the middle of the view.
-fn camera_at_height(y: f32, level: bool) -> WhittedScene {
+fn camera_at_height(y: f32, level: bool) -> RasterScene {
     let mut s = scene();
     let t = s.camera.target;
     if level {
@@ -494,7 +495,7 @@ fn orbiting_down_to_the_horizon() {
         let cam = camera(&s, WIDTH, HEIGHT);
         let background = s.background.to_array().map(level);
         let (mut sky, mut sky_wrong, mut under, mut under_wrong) = (0, 0, 0, 0);
-        let underside = level(s.floor.colors[0].x * s.ambient.radiance().x);
+        let underside = level(s.floor.colors[0].x * s.ambient.x);
         // The far floor band: pixels whose footprint spans more than two tiles along X, clear of
         // any shadow. The filtered checker must give the even blend of the two tiles there.
         let mut band = Vec::new();
@@ -532,7 +533,7 @@ fn orbiting_down_to_the_horizon() {
         }
         let blend = 0.5
             * (s.floor.colors[0].y + s.floor.colors[1].y)
-            * (s.ambient.radiance().y + s.light.radiance().y * s.light.to_light().y);
+            * (s.ambient.y + s.light.radiance().y * s.light.to_light().y);
         let (mean, sd) = if band.is_empty() {
             (f64::NAN, f64::NAN)
         } else {
@@ -567,7 +568,7 @@ fn orbiting_down_to_the_horizon() {
 /// Whether pixel (x, y)'s rays (centre and four points 0.6 px away) see the sky both from the
 /// eye (past the glass) and from the glass's centre (where its cube map is captured): there the
 /// cube-map lookup and the true background agree exactly.
-fn sky_behind_glass(s: &WhittedScene, cam: &Camera, x: u32, y: u32) -> bool {
+fn sky_behind_glass(s: &RasterScene, cam: &Camera, x: u32, y: u32) -> bool {
     let (cx, cy) = (x as f32 + 0.5, y as f32 + 0.5);
     [(0.0, 0.0), (-0.6, -0.6), (0.6, -0.6), (-0.6, 0.6), (0.6, 0.6)].iter().all(|(dx, dy)| {
         let d = cam.ray_direction(cx + dx, cy + dy);
@@ -576,12 +577,12 @@ fn sky_behind_glass(s: &WhittedScene, cam: &Camera, x: u32, y: u32) -> bool {
 }
 
 /// The scene without its glass sphere.
-fn without_glass(s: &WhittedScene) -> WhittedScene {
-    WhittedScene { glass: None, ..s.clone() }
+fn without_glass(s: &RasterScene) -> RasterScene {
+    RasterScene { glass: None, ..s.clone() }
 }
 
 /// The Blinn-Phong highlight of the glass at pixel (x, y), in levels (0 off the glass).
-fn glass_highlight_levels(s: &WhittedScene, cam: &Camera, x: u32, y: u32) -> f32 {
+fn glass_highlight_levels(s: &RasterScene, cam: &Camera, x: u32, y: u32) -> f32 {
     let dir = cam.ray_direction(x as f32 + 0.5, y as f32 + 0.5);
     let Some(t) = ray_sphere(cam.eye, dir, s.glass.unwrap().center, s.glass.unwrap().radius) else {
         return 0.0;
@@ -637,10 +638,10 @@ fn refraction_ratio_one_makes_the_glass_vanish() {
                 let b = behind.get(x, y);
                 let want = match look {
                     Look::Figure => [0, 1, 2].map(|c| (1.0 - mix) * white[c] + mix * b[c]),
-                    Look::Whitted => b,
+                    Look::Enhanced => b,
                 };
                 let diff = (0..3).map(|c| (level(p[c]) - level(want[c])).abs()).max().unwrap_or(0);
-                if look == Look::Whitted && glass_highlight_levels(&s, &cam, x, y) > 0.5 {
+                if look == Look::Enhanced && glass_highlight_levels(&s, &cam, x, y) > 0.5 {
                     highlight += 1;
                     continue;
                 }
@@ -708,10 +709,10 @@ fn extreme_refraction_ratios_leave_no_black_holes() {
 /// the glass's centre (where the cube map is captured), if the same for all five: the sky, or the
 /// floor with the red channel it has there (equal on both tiles: colour x (ambient + light N.L) or,
 /// in shadow, colour x ambient), at least 0.15 from any shadow edge.
-fn totally_reflected_red(s: &WhittedScene, cam: &Camera, x: u32, y: u32, eta: f32) -> Option<f32> {
+fn totally_reflected_red(s: &RasterScene, cam: &Camera, x: u32, y: u32, eta: f32) -> Option<f32> {
     let (cx, cy) = (x as f32 + 0.5, y as f32 + 0.5);
     let red = s.floor.colors[0].x;
-    let (ambient, direct) = (s.ambient.radiance().x, s.light.radiance().x * s.light.to_light().y);
+    let (ambient, direct) = (s.ambient.x, s.light.radiance().x * s.light.to_light().y);
     let mut seen = Vec::new();
     for (dx, dy) in [(0.0, 0.0), (-0.6, -0.6), (0.6, -0.6), (-0.6, 0.6), (0.6, 0.6)] {
         let d = cam.ray_direction(cx + dx, cy + dy);
@@ -771,7 +772,7 @@ fn total_internal_reflection_mirrors_the_environment() {
                         (1.0 - s.glass.unwrap().reflectivity) * s.glass.unwrap().color.x
                             + s.glass.unwrap().reflectivity * e,
                     ),
-                    Look::Whitted => level(e),
+                    Look::Enhanced => level(e),
                 };
                 let diff = (level(image.get(x, y)[0]) - want).abs();
                 worst = worst.max(diff);

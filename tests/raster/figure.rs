@@ -1,10 +1,11 @@
-//! Checks of the figure look that need no reference image: scene-facts section 1, number by
+//! Checks of the figure look that need no reference image: docs/scenes.md, number by
 //! number. Expected values come from the scene file and illum-scene's camera rays.
 
 use glam::Vec3;
 use illum::image::RgbImage32;
+use illum::raster::RasterScene;
 use illum::raster::{Look, Options};
-use illum::scene::{Camera, WhittedScene};
+use illum::scene::Camera;
 
 use crate::{HEIGHT, WIDTH, camera, floor_hit, level, ray_distance, ray_sphere, render, render_at, scene};
 
@@ -14,23 +15,23 @@ fn figure() -> Options {
 
 /// How far from a shadow's sharp edge a floor point must be to count as fully lit or fully
 /// shadowed: the PCF kernel's reach plus slack for the shadow map's texels.
-fn penumbra(scene: &WhittedScene) -> f32 {
+fn penumbra(scene: &RasterScene) -> f32 {
     1.5 * scene.quality.pcf_radius + 0.02
 }
 
-fn spheres(scene: &WhittedScene) -> [(Vec3, f32); 2] {
+fn spheres(scene: &RasterScene) -> [(Vec3, f32); 2] {
     let pair: [(Vec3, f32); 2] = scene.spheres().try_into().expect("the assignment's two spheres");
     pair
 }
 
 /// How far the ray from p toward the light passes outside sphere (c, r) (negative: through it).
-fn shadow_margin(scene: &WhittedScene, p: Vec3, (c, r): (Vec3, f32)) -> f32 {
+fn shadow_margin(scene: &RasterScene, p: Vec3, (c, r): (Vec3, f32)) -> f32 {
     ray_distance(p, scene.light.to_light(), c) - r
 }
 
 /// True when the floor is hit at pixel (px, py) and at its eight neighbours: no silhouette or
 /// floor edge (where MSAA blends) is within a pixel.
-fn floor_interior(scene: &WhittedScene, cam: &Camera, px: u32, py: u32) -> Option<Vec3> {
+fn floor_interior(scene: &RasterScene, cam: &Camera, px: u32, py: u32) -> Option<Vec3> {
     let at =
         |dx: i32, dy: i32| floor_hit(scene, cam, px as f32 + 0.5 + dx as f32, py as f32 + 0.5 + dy as f32);
     for dy in -1..=1 {
@@ -42,7 +43,7 @@ fn floor_interior(scene: &WhittedScene, cam: &Camera, px: u32, py: u32) -> Optio
 }
 
 /// Position in tiles from the floor's minimum corner.
-fn tile_coord(scene: &WhittedScene, p: Vec3) -> glam::Vec2 {
+fn tile_coord(scene: &RasterScene, p: Vec3) -> glam::Vec2 {
     (glam::Vec2::new(p.x, p.z) - scene.floor.min_corner()) / scene.floor.tile
 }
 
@@ -51,12 +52,12 @@ fn tile_coord(scene: &WhittedScene, p: Vec3) -> glam::Vec2 {
 /// shadow, within 2 levels. A sphere shadows a point when the ray toward the light passes through
 /// it, and only under a light that casts shadows. Returns the counts of lit and shadowed pixels
 /// checked.
-pub(crate) fn check_floor_shading(s: &WhittedScene, image: &RgbImage32) -> (usize, usize) {
+pub(crate) fn check_floor_shading(s: &RasterScene, image: &RgbImage32) -> (usize, usize) {
     let cam = camera(s, image.width, image.height);
     let n_dot_l = s.light.to_light().y.max(0.0);
-    let ambient = s.ambient.radiance();
+    let ambient = s.ambient;
     let light = s.light.radiance();
-    let casters = if s.light.casts_shadows { s.spheres() } else { Vec::new() };
+    let casters = if s.effects.shadows { s.spheres() } else { Vec::new() };
     let (mut lit, mut shadowed, mut wrong) = (0, 0, Vec::new());
     for py in 0..image.height {
         for px in 0..image.width {
@@ -114,14 +115,14 @@ fn floor_pixels_are_colour_times_ambient_plus_n_dot_l() {
     let (lit, shadowed) = check_floor_shading(&s, &render(&s, &figure()));
     // The check must not pass by checking nothing.
     assert!(lit > 5000 && shadowed > 500, "only {lit} lit and {shadowed} shadowed pixels checked");
-    // scene-facts: lit tiles (207, 207, 0) / (207, 0, 0), shadowed (47, 47, 0) / (47, 0, 0).
-    let (ambient, light) = (s.ambient.radiance(), s.light.radiance());
+    // docs/scenes.md: lit tiles (207, 207, 0) / (207, 0, 0), shadowed (47, 47, 0) / (47, 0, 0).
+    let (ambient, light) = (s.ambient, s.light.radiance());
     let yellow = s.floor.colors[0];
     assert_eq!((yellow * (ambient + light * n_dot_l)).to_array().map(level), [207, 207, 0]);
     assert_eq!((yellow * ambient).to_array().map(level), [47, 47, 0]);
 }
 
-/// scene-facts: the clear colour written to 8 bits shows as (76, 128, 229) in the figure.
+/// docs/scenes.md: the clear colour written to 8 bits shows as (76, 128, 229) in the figure.
 /// (scenes/whitted.toml gives it as those levels / 255: the skeleton's (0.3, 0.5, 0.9) is an exact
 /// tie between two levels in every channel, which no single rounding rule breaks the figure's way.)
 #[test]
@@ -146,7 +147,7 @@ fn project(cam: &Camera, p: Vec3) -> (f32, f32) {
 
 /// Where the light's ray through `center` meets the floor: the centre of that sphere's shadow
 /// (a sphere's shadow under parallel light is an ellipse centred there).
-fn shadow_centre(scene: &WhittedScene, center: Vec3) -> Vec3 {
+fn shadow_centre(scene: &RasterScene, center: Vec3) -> Vec3 {
     let d = scene.light.direction();
     center + (scene.floor.height() - center.y) / d.y * d
 }
@@ -156,13 +157,13 @@ fn shadow_centre(scene: &WhittedScene, center: Vec3) -> Vec3 {
 /// channel) has the centroid and area of the exact shadow, computed per pixel by casting the
 /// ray toward the light. A displaced or shrunken shadow (too much bias: a gap under the caster)
 /// moves the centroid or loses area.
-fn check_shadow_placement(s: &WhittedScene, label: &str) {
+fn check_shadow_placement(s: &RasterScene, label: &str) {
     let image: RgbImage32 = render(s, &figure());
     let cam = camera(s, WIDTH, HEIGHT);
     let [a, b] = s.floor.colors;
     assert_eq!(a.x, b.x, "the shadow fraction is read off the red channel, equal on both tiles");
     let red = a.x;
-    let ambient = s.ambient.radiance().x;
+    let ambient = s.ambient.x;
     let direct = s.light.radiance().x * s.light.to_light().y;
     let forward = cam.basis().forward;
     for (k, sphere) in spheres(s).into_iter().enumerate() {
@@ -214,7 +215,7 @@ fn shadows_fall_where_the_light_projects_the_sphere_centres() {
     check_shadow_placement(&scene(), "whitted.toml");
     // As a user would edit the file: another light direction and a moved metal sphere.
     let mut moved = scene();
-    moved.light.position = Vec3::new(8.0, 14.0, 3.0);
+    moved.light.direction = Vec3::new(-8.0, -14.0, -3.0).normalize();
     moved.metal.as_mut().unwrap().center = Vec3::new(1.5, 1.5, -1.0);
     check_shadow_placement(&moved, "moved light and sphere");
 }

@@ -4,7 +4,7 @@
 //! - `figure`: checks of the figure look that need no reference: the floor's Lambert shading,
 //!   the background value, where the shadows fall, and the glass's 0.1 white + 0.9 environment;
 //! - `effects`: every toggle does what it says (and only that), no shadow acne, MSAA on edges;
-//! - `extremes`: issue 6 section 3, the scene at its extremes (low and high light, near and far
+//! - `extremes`: the scene at its extremes (low and high light, near and far
 //!   planes, the horizon, refraction ratio 1, total internal reflection), tabulated in
 //!   docs/accuracy.md;
 //! - `passes`: a frame records only the passes its scene needs, and skipping one changes nothing;
@@ -17,8 +17,9 @@ use std::sync::{Mutex, MutexGuard, OnceLock};
 
 use glam::Vec3;
 use illum::image::RgbImage32;
-use illum::raster::{Options, WhittedRenderer};
-use illum::scene::{Camera, WhittedScene};
+use illum::raster::RasterScene;
+use illum::raster::{Options, RasterRenderer};
+use illum::scene::Camera;
 
 #[path = "../common/mod.rs"]
 mod common;
@@ -35,16 +36,16 @@ pub const WIDTH: u32 = 320;
 pub const HEIGHT: u32 = 180;
 
 /// scenes/whitted.toml as shipped.
-pub fn scene() -> WhittedScene {
-    WhittedScene::load(&common::workspace_path("scenes/whitted.toml")).unwrap_or_else(|e| panic!("{e}"))
+pub fn scene() -> RasterScene {
+    RasterScene::load(&common::workspace_path("scenes/whitted.toml")).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// One renderer for the whole binary (pipelines are compiled once); tests take turns.
-fn renderer() -> MutexGuard<'static, WhittedRenderer> {
-    static RENDERER: OnceLock<Mutex<WhittedRenderer>> = OnceLock::new();
+fn renderer() -> MutexGuard<'static, RasterRenderer> {
+    static RENDERER: OnceLock<Mutex<RasterRenderer>> = OnceLock::new();
     RENDERER
         .get_or_init(|| {
-            let renderer = WhittedRenderer::new(common::gpu(), &scene(), WIDTH, HEIGHT)
+            let renderer = RasterRenderer::new(common::gpu(), &scene(), WIDTH, HEIGHT)
                 .unwrap_or_else(|e| panic!("the rasterizer builds: {e}"));
             Mutex::new(renderer)
         })
@@ -53,7 +54,7 @@ fn renderer() -> MutexGuard<'static, WhittedRenderer> {
 }
 
 /// `scene` rendered with `options` at `width` x `height`.
-pub fn render_at(scene: &WhittedScene, options: &Options, width: u32, height: u32) -> RgbImage32 {
+pub fn render_at(scene: &RasterScene, options: &Options, width: u32, height: u32) -> RgbImage32 {
     let mut r = renderer();
     if r.size() != (width, height) {
         r.resize(width, height).unwrap_or_else(|e| panic!("{e}"));
@@ -64,7 +65,7 @@ pub fn render_at(scene: &WhittedScene, options: &Options, width: u32, height: u3
     image
 }
 
-pub fn render(scene: &WhittedScene, options: &Options) -> RgbImage32 {
+pub fn render(scene: &RasterScene, options: &Options) -> RgbImage32 {
     render_at(scene, options, WIDTH, HEIGHT)
 }
 
@@ -74,7 +75,7 @@ pub fn level(v: f32) -> i32 {
 }
 
 /// The scene's camera set to an image of `width` x `height`.
-pub fn camera(scene: &WhittedScene, width: u32, height: u32) -> Camera {
+pub fn camera(scene: &RasterScene, width: u32, height: u32) -> Camera {
     Camera { width, height, ..scene.camera }
 }
 
@@ -94,7 +95,7 @@ pub fn ray_sphere(origin: Vec3, dir: Vec3, center: Vec3, radius: f32) -> Option<
 
 /// Where the camera ray through pixel centre (px, py) meets the floor plane, if inside the
 /// floor's rectangle and not behind a sphere.
-pub fn floor_hit(scene: &WhittedScene, camera: &Camera, px: f32, py: f32) -> Option<Vec3> {
+pub fn floor_hit(scene: &RasterScene, camera: &Camera, px: f32, py: f32) -> Option<Vec3> {
     let dir = camera.ray_direction(px, py);
     let eye = camera.eye;
     if dir.y >= 0.0 {

@@ -1,18 +1,18 @@
-//! "Model only what a scene requires" in the rasterizer (issue 7, section 3): a frame records only
+//! "Model only what a scene requires" in the rasterizer: a frame records only
 //! the passes its scene and options need (no shadow pass without a shadow-casting light and a
 //! caster, no cube capture without a sphere that reads it), and leaving a pass out never changes
 //! the picture.
 
 use illum::image::RgbImage32;
+use illum::raster::RasterScene;
 use illum::raster::{Look, Options, PassTimes};
-use illum::scene::WhittedScene;
 
 use crate::effects::with;
 use crate::figure::check_floor_shading;
 use crate::{HEIGHT, WIDTH, common, level, renderer, scene};
 
 /// The planned pass names, the measured pass times and the image of one frame at the test size.
-fn frame(s: &WhittedScene, options: &Options) -> (Vec<String>, Option<PassTimes>, RgbImage32) {
+fn frame(s: &RasterScene, options: &Options) -> (Vec<String>, Option<PassTimes>, RgbImage32) {
     let mut r = renderer();
     if r.size() != (WIDTH, HEIGHT) {
         r.resize(WIDTH, HEIGHT).unwrap_or_else(|e| panic!("{e}"));
@@ -43,9 +43,12 @@ fn differing(a: &RgbImage32, b: &RgbImage32) -> usize {
 #[test]
 fn each_scene_records_only_the_passes_it_needs() {
     let s = scene();
+    // Shadows switched off in the scene file ([raster.effects] shadows = false) and read as
+    // the scene's default options.
     let no_cast = {
         let mut t = s.clone();
-        t.light.casts_shadows = false;
+        t.effects.shadows = false;
+        t.look = Look::Enhanced;
         t
     };
     let no_mirror = {
@@ -53,16 +56,16 @@ fn each_scene_records_only_the_passes_it_needs() {
         t.metal.as_mut().unwrap().mirror = 0.0;
         t
     };
-    let no_glass = WhittedScene { glass: None, ..s.clone() };
-    let no_spheres = WhittedScene { glass: None, metal: None, ..s.clone() };
-    let (figure, whitted) = (Options::all_on(Look::Figure), Options::all_on(Look::Whitted));
-    let shadows_off = with(Look::Whitted, |e| e.shadows = false);
+    let no_glass = RasterScene { glass: None, ..s.clone() };
+    let no_spheres = RasterScene { glass: None, metal: None, ..s.clone() };
+    let (figure, whitted) = (Options::all_on(Look::Figure), Options::all_on(Look::Enhanced));
+    let shadows_off = with(Look::Enhanced, |e| e.shadows = false);
     // (case, scene, options, shadow pass, glass faces (fine + coarse), metal faces)
-    let cases: [(&str, &WhittedScene, Options, bool, usize, usize); 8] = [
+    let cases: [(&str, &RasterScene, Options, bool, usize, usize); 8] = [
         ("assignment, figure", &s, figure, true, 12, 0),
         ("assignment, whitted", &s, whitted, true, 12, 6),
         ("shadows switched off", &s, shadows_off, false, 12, 6),
-        ("light casts no shadows", &no_cast, whitted, false, 12, 6),
+        ("shadows off in the file", &no_cast, Options::from_scene(&no_cast), false, 12, 6),
         ("metal mirrors nothing", &no_mirror, whitted, true, 12, 0),
         ("no glass, whitted", &no_glass, whitted, true, 0, 6),
         ("no glass, figure", &no_glass, figure, true, 0, 0),
@@ -86,19 +89,18 @@ fn each_scene_records_only_the_passes_it_needs() {
 }
 
 #[test]
-fn a_light_that_casts_no_shadows_draws_exactly_what_shadows_off_draws() {
+fn shadows_off_skips_the_shadow_pass_and_lights_the_whole_floor() {
     let s = scene();
     let mut no_cast = s.clone();
-    no_cast.light.casts_shadows = false;
+    no_cast.effects.shadows = false;
     for look in Look::ALL {
-        let (_, _, skipped) = frame(&no_cast, &Options::all_on(look));
-        let (_, _, switched_off) = frame(&s, &with(look, |e| e.shadows = false));
-        assert_eq!(differing(&skipped, &switched_off), 0, "look {look}");
+        let (names, _, skipped) = frame(&s, &with(look, |e| e.shadows = false));
+        assert_eq!(count(&names, "shadow"), 0, "look {look}: {names:?}");
         let (_, _, shadowed) = frame(&s, &Options::all_on(look));
         assert!(differing(&skipped, &shadowed) > 40, "look {look}: the shadows were never there");
     }
     // And against the closed form: every floor pixel lit, colour x (ambient + N.L).
-    let (_, _, image) = frame(&no_cast, &Options::all_on(Look::Figure));
+    let (_, _, image) = frame(&no_cast, &with(Look::Figure, |e| e.shadows = false));
     let (lit, shadowed) = check_floor_shading(&no_cast, &image);
     assert!(lit > 5000 && shadowed == 0, "{lit} lit, {shadowed} shadowed");
 }
@@ -106,7 +108,7 @@ fn a_light_that_casts_no_shadows_draws_exactly_what_shadows_off_draws() {
 #[test]
 fn a_floor_without_spheres_is_lit_everywhere_with_no_pass_but_the_main_one() {
     let s = scene();
-    let bare = WhittedScene { glass: None, metal: None, ..s.clone() };
+    let bare = RasterScene { glass: None, metal: None, ..s.clone() };
     let (names, _, image) = frame(&bare, &Options::all_on(Look::Figure));
     assert_eq!(names, vec!["main".to_owned()]);
     let (lit, shadowed) = check_floor_shading(&bare, &image);
@@ -118,11 +120,11 @@ fn a_floor_without_spheres_is_lit_everywhere_with_no_pass_but_the_main_one() {
 #[test]
 fn a_metal_that_mirrors_nothing_looks_as_without_reflection() {
     // The metal alone (no glass, whose look also depends on the reflection toggle).
-    let metal_only = WhittedScene { glass: None, ..scene() };
+    let metal_only = RasterScene { glass: None, ..scene() };
     let mut matte = metal_only.clone();
     matte.metal.as_mut().unwrap().mirror = 0.0;
-    let whitted = Options::all_on(Look::Whitted);
-    let no_reflection = with(Look::Whitted, |e| e.reflection = false);
+    let whitted = Options::all_on(Look::Enhanced);
+    let no_reflection = with(Look::Enhanced, |e| e.reflection = false);
     let (names, _, skipped) = frame(&matte, &whitted);
     assert_eq!(count(&names, "cube"), 0, "{names:?}");
     let (_, _, switched_off) = frame(&matte, &no_reflection);

@@ -1,5 +1,5 @@
 //! Image regression: both looks at 320 x 180 against tests/reference/whitted-figure.png and
-//! tests/reference/whitted-whitted.png.
+//! tests/reference/whitted-enhanced.png.
 //!
 //! Tolerance, in 8-bit levels of the (linear) PNG: the mean absolute difference over all pixels
 //! and channels at most [`MAX_MEAN_LEVELS`], and the 99th percentile of each pixel's largest
@@ -79,13 +79,13 @@ fn figure_matches_its_reference() {
 
 #[test]
 fn whitted_matches_its_reference() {
-    check(Look::Whitted);
+    check(Look::Enhanced);
 }
 
 #[test]
 fn the_tolerance_tells_the_looks_and_missing_effects_apart() {
     let figure = render(&scene(), &Options::all_on(Look::Figure));
-    let whitted_reference = load_reference(Look::Whitted);
+    let whitted_reference = load_reference(Look::Enhanced);
     assert!(!within_tolerance(difference(&figure, &whitted_reference)), "the looks are indistinguishable");
     let mut no_shadows = Options::all_on(Look::Figure);
     no_shadows.effects.shadows = false;

@@ -15,7 +15,10 @@ fn main() {
     let mut scene = Scene::load(std::path::Path::new(path)).expect("scenes/cornell.toml");
     scene.camera.width = 32;
     scene.camera.height = 32;
-    let oracle = Oracle::new(&scene).with_bounces(Bounces::Fixed(2)).with_sampling(Sampling::Cosine);
+    let oracle = Oracle::new(&scene)
+        .expect("the oracle renders this scene")
+        .with_bounces(Bounces::Fixed(2))
+        .with_sampling(Sampling::Cosine);
     let samples = f64::from(spp) * 32.0 * 32.0;
     for threads in [illum_oracle::default_threads(), 1] {
         let start = Instant::now();

@@ -251,7 +251,7 @@ mod tests {
         for (ours, theirs) in corners.iter().zip(shape.world_corners()) {
             assert!(close(*ours, crate::scene::dvec(theirs), 1e-3), "{ours:?} vs {theirs:?}");
         }
-        // scene-facts: the footprint corner with local (165, 0, 0) lands at (424.4, 0, 252.3).
+        // docs/scenes.md: the footprint corner with local (165, 0, 0) lands at (424.4, 0, 252.3).
         assert!(close(corners[1], DVec3::new(424.4, 0.0, 252.3), 0.06), "{:?}", corners[1]);
         // Each face's centre is hit head-on from outside with that face's normal.
         let faces = [

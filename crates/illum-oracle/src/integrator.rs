@@ -72,14 +72,15 @@ pub struct Oracle {
 }
 
 impl Oracle {
-    /// Prepares `scene` with its own render settings (`scene.render.bounces` and `.sampling`).
-    pub fn new(scene: &Scene) -> Oracle {
-        Oracle {
-            scene: TraceScene::new(scene),
+    /// Prepares `scene` with its own path-tracer settings (`scene.pathtrace.bounces` and
+    /// `.sampling`), or says which feature of the scene the oracle does not implement.
+    pub fn new(scene: &Scene) -> Result<Oracle, illum_scene::SceneError> {
+        Ok(Oracle {
+            scene: TraceScene::new(scene)?,
             camera: PinholeCamera::new(&scene.camera),
-            bounces: scene.render.bounces,
-            sampling: scene.render.sampling,
-        }
+            bounces: scene.pathtrace.bounces,
+            sampling: scene.pathtrace.sampling,
+        })
     }
 
     pub fn with_bounces(mut self, bounces: Bounces) -> Oracle {

@@ -39,15 +39,16 @@ pub use integrator::Oracle;
 pub use render::{OracleImage, PixelEstimate};
 pub use rng::Rng;
 
-use illum_scene::Scene;
+use illum_scene::{Scene, SceneError};
 
 /// Renders `scene` at its camera's resolution with `spp` samples per pixel under `seed`, using
-/// `scene.render.bounces` and `scene.render.sampling`, on all available cores.
+/// `scene.pathtrace.bounces` and `scene.pathtrace.sampling`, on all available cores. Errors
+/// name the feature of the scene the oracle does not implement.
 ///
 /// # Panics
 /// If `spp` is 0.
-pub fn render(scene: &Scene, spp: u32, seed: u64) -> OracleImage {
-    Oracle::new(scene).render(spp, seed, default_threads())
+pub fn render(scene: &Scene, spp: u32, seed: u64) -> Result<OracleImage, SceneError> {
+    Ok(Oracle::new(scene)?.render(spp, seed, default_threads()))
 }
 
 /// The estimate of one pixel: exactly the value [`render`] produces for it with the same
@@ -55,8 +56,14 @@ pub fn render(scene: &Scene, spp: u32, seed: u64) -> OracleImage {
 ///
 /// # Panics
 /// If `spp` is 0.
-pub fn radiance_at_pixel(scene: &Scene, x: u32, y: u32, spp: u32, seed: u64) -> PixelEstimate {
-    Oracle::new(scene).pixel(x, y, spp, seed)
+pub fn radiance_at_pixel(
+    scene: &Scene,
+    x: u32,
+    y: u32,
+    spp: u32,
+    seed: u64,
+) -> Result<PixelEstimate, SceneError> {
+    Ok(Oracle::new(scene)?.pixel(x, y, spp, seed))
 }
 
 /// The number of threads [`render`] uses: `std::thread::available_parallelism`, or 1.

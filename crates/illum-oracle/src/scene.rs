@@ -2,9 +2,14 @@
 //! emitting parallelograms for light sampling.
 
 use glam::{DVec3, Vec3};
-use illum_scene::{Scene, Shape};
+use illum_scene::{Feature, RendererKind, Scene, SceneError, Shape};
 
 use crate::geometry::{Ball, OrientedBox, Parallelogram, Surface};
+
+/// What the oracle implements: the same scenes as the GPU path tracer today, written
+/// independently (it shares no code with the WGSL).
+pub const FEATURES: &[Feature] =
+    &[Feature::BoxShape, Feature::QuadShape, Feature::SphereShape, Feature::Lambertian, Feature::AreaLight];
 
 pub(crate) fn dvec(v: Vec3) -> DVec3 {
     v.as_dvec3()
@@ -39,10 +44,11 @@ pub struct TraceScene {
 }
 
 impl TraceScene {
-    /// Converts a validated scene. Objects whose material emits are emitters; validation allows
-    /// emission on quads only, and an emitting box or sphere (not loadable) would be traced as
-    /// an emitter that is never sampled.
-    pub fn new(scene: &Scene) -> TraceScene {
+    /// Converts a validated scene of Lambertian surfaces and area lights (anything else is
+    /// refused by name). Objects whose material emits are emitters; validation allows emission
+    /// on quads only.
+    pub fn new(scene: &Scene) -> Result<TraceScene, SceneError> {
+        scene.require(RendererKind::PathTrace, FEATURES)?;
         let mut out =
             TraceScene { surfaces: Vec::new(), emitters: Vec::new(), lights: Vec::new(), light_area: 0.0 };
         for object in &scene.objects {
@@ -58,8 +64,8 @@ impl TraceScene {
             };
             let primitive = Primitive {
                 surface,
-                albedo: dvec(material.albedo),
-                emission: dvec(material.emission),
+                albedo: dvec(material.diffuse_albedo().unwrap_or_default()),
+                emission: dvec(material.emission()),
                 emitter: material.is_emitter(),
             };
             if !primitive.emitter {
@@ -76,6 +82,6 @@ impl TraceScene {
                 });
             }
         }
-        out
+        Ok(out)
     }
 }

@@ -98,7 +98,7 @@ fn direct_light_matches_lamberts_polygon_formula() {
             vfov = 0.05
             width = 1
             height = 1
-            [render]
+            [pathtrace]
             bounces = 0
             [materials.floor]
             albedo = {albedo:?}
@@ -114,7 +114,8 @@ fn direct_light_matches_lamberts_polygon_formula() {
             target.x, target.y, target.z
         );
         let scene = Scene::from_toml_str(&text, "lambert.toml").unwrap();
-        let est = illum_oracle::radiance_at_pixel(&scene, 0, 0, 20_000, 11);
+        let est =
+            illum_oracle::radiance_at_pixel(&scene, 0, 0, 20_000, 11).expect("the oracle renders this scene");
         let expected: [f64; 3] =
             std::array::from_fn(|c| albedo[c] / PI * polygon_irradiance(target, DVec3::Y, &lamp, le[c]));
         assert!(expected.iter().all(|&e| e > 1e-3), "the lamp must light {target:?}: {expected:?}");
@@ -184,7 +185,10 @@ fn sphere_enclosure_matches_the_closed_form_for_every_bounce_setting() {
     std::thread::scope(|scope| {
         for (i, bounces) in settings.into_iter().enumerate() {
             for (j, sampling) in samplings.into_iter().enumerate() {
-                let oracle = Oracle::new(&scene).with_bounces(bounces).with_sampling(sampling);
+                let oracle = Oracle::new(&scene)
+                    .expect("the oracle renders this scene")
+                    .with_bounces(bounces)
+                    .with_sampling(sampling);
                 scope.spawn(move || {
                     for (k, z) in [lit, unlit].into_iter().enumerate() {
                         let expected: [f64; 3] = std::array::from_fn(|c| {
@@ -229,7 +233,7 @@ fn emitters_are_one_sided_for_camera_rays() {
     // Front normal (0,2,0) x (2,0,0) = (0, 0, -4): toward -z, i.e. toward the camera. The
     // pixel sees 5 tan(5 deg) = 0.44 units either side of the centre: all lamp.
     let scene = Scene::from_toml_str(text, "lamp.toml").unwrap();
-    let oracle = Oracle::new(&scene);
+    let oracle = Oracle::new(&scene).expect("the oracle renders this scene");
     let mut rng = Rng::for_sample(0, 0, 0);
     let front = oracle.radiance(DVec3::new(0.2, 0.1, -5.0), DVec3::Z, &mut rng);
     assert_eq!(front, DVec3::new(3.0, 2.0, 1.0));
@@ -237,7 +241,7 @@ fn emitters_are_one_sided_for_camera_rays() {
     assert_eq!(back, DVec3::ZERO);
     let miss = oracle.radiance(DVec3::new(2.0, 0.1, -5.0), DVec3::Z, &mut rng);
     assert_eq!(miss, DVec3::ZERO);
-    let pixel = illum_oracle::radiance_at_pixel(&scene, 0, 0, 8, 3);
+    let pixel = illum_oracle::radiance_at_pixel(&scene, 0, 0, 8, 3).expect("the oracle renders this scene");
     assert_eq!(pixel.mean, [3.0, 2.0, 1.0]);
     assert_eq!(pixel.variance_of_mean, [0.0; 3]);
 }

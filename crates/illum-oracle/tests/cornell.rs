@@ -14,11 +14,11 @@ fn cornell(width: u32, height: u32) -> Scene {
 }
 
 fn render(scene: &Scene, bounces: Bounces, sampling: Sampling, spp: u32, seed: u64) -> OracleImage {
-    Oracle::new(scene).with_bounces(bounces).with_sampling(sampling).render(
-        spp,
-        seed,
-        illum_oracle::default_threads(),
-    )
+    Oracle::new(scene)
+        .expect("the oracle renders this scene")
+        .with_bounces(bounces)
+        .with_sampling(sampling)
+        .render(spp, seed, illum_oracle::default_threads())
 }
 
 /// Rows 4.. of a 16-row image: below the light (which the camera sees in row 2), whose pixels'
@@ -57,7 +57,7 @@ fn bright_cornell(width: u32, height: u32) -> Scene {
     let mut scene = cornell(width, height);
     for m in &mut scene.materials {
         if m.name == "white" {
-            m.albedo = glam::Vec3::splat(0.9);
+            m.kind = illum_scene::MaterialKind::Lambertian { albedo: glam::Vec3::splat(0.9) };
         }
     }
     scene
@@ -68,7 +68,7 @@ fn bright_cornell(width: u32, height: u32) -> Scene {
 /// radiance 30, exactly, for every sample — including rays aimed just inside its edges.
 #[test]
 fn light_wins_the_tie_with_the_coplanar_ceiling() {
-    let oracle = Oracle::new(&cornell(64, 64));
+    let oracle = Oracle::new(&cornell(64, 64)).expect("the oracle renders this scene");
     // The task's case: from the floor (the centre of the floor is clear of both blocks)
     // straight up at the light's centre.
     for s in 0..16 {
@@ -92,7 +92,7 @@ fn light_wins_the_tie_with_the_coplanar_ceiling() {
         }
     }
     // Just outside the rectangle the ray sees the ceiling, which is dimmer than the light.
-    let outside = Oracle::new(&cornell(64, 64));
+    let outside = Oracle::new(&cornell(64, 64)).expect("the oracle renders this scene");
     let mut sum = DVec3::ZERO;
     for s in 0..256 {
         sum += outside.radiance(DVec3::new(212.0, 2.0, 278.0), DVec3::Y, &mut Rng::for_sample(1, 2, s));
@@ -101,7 +101,8 @@ fn light_wins_the_tie_with_the_coplanar_ceiling() {
 
     // Through the camera: at 512 x 512 the light covers image rows ~76..93 and columns
     // ~219..293, so pixel (256, 85) sees only the light.
-    let est = illum_oracle::radiance_at_pixel(&cornell(512, 512), 256, 85, 32, 5);
+    let est = illum_oracle::radiance_at_pixel(&cornell(512, 512), 256, 85, 32, 5)
+        .expect("the oracle renders this scene");
     assert_eq!(est.mean, [30.0; 3]);
     assert_eq!(est.variance_of_mean, [0.0; 3]);
 }
@@ -177,13 +178,13 @@ fn uniform_and_cosine_sampling_agree() {
 #[test]
 fn results_do_not_depend_on_threads() {
     let scene = cornell(12, 10);
-    let oracle = Oracle::new(&scene);
+    let oracle = Oracle::new(&scene).expect("the oracle renders this scene");
     let one = oracle.render(4, 77, 1);
     for threads in [2, 3, 16] {
         assert_eq!(oracle.render(4, 77, threads), one, "{threads} threads");
     }
-    assert_eq!(illum_oracle::render(&scene, 4, 77), one);
-    let px = illum_oracle::radiance_at_pixel(&scene, 7, 3, 4, 77);
+    assert_eq!(illum_oracle::render(&scene, 4, 77).expect("the oracle renders this scene"), one);
+    let px = illum_oracle::radiance_at_pixel(&scene, 7, 3, 4, 77).expect("the oracle renders this scene");
     assert_eq!(px.mean, one.mean[one.index(7, 3)]);
     assert_eq!(px.variance_of_mean, one.variance_of_mean[one.index(7, 3)]);
     assert_ne!(oracle.render(4, 78, 2).mean, one.mean);

@@ -1,9 +1,14 @@
 //! The scene as the shader sees it: plain-old-data structs laid out like the WGSL ones.
 
 use bytemuck::{Pod, Zeroable};
-use illum_scene::{Bounces, Sampling, Scene, Shape};
+use illum_scene::{Bounces, Feature, RendererKind, Sampling, Scene, Shape};
 
 use crate::PathTraceError;
+
+/// What the path tracer implements today: Lambertian boxes, quads and spheres lit by area
+/// lights. Every other feature of the scene model is refused by name (see `Scene::require`).
+pub const FEATURES: &[Feature] =
+    &[Feature::BoxShape, Feature::QuadShape, Feature::SphereShape, Feature::Lambertian, Feature::AreaLight];
 
 pub const KIND_BOX: u32 = 0;
 pub const KIND_QUAD: u32 = 1;
@@ -94,10 +99,15 @@ fn v4(v: glam::Vec3, w: f32) -> [f32; 4] {
 
 impl GpuScene {
     pub fn new(scene: &Scene) -> Result<Self, PathTraceError> {
+        scene.require(RendererKind::PathTrace, FEATURES)?;
+        // Every material left is Lambertian or an emitter (which reflects nothing).
         let materials = scene
             .materials
             .iter()
-            .map(|m| GpuMaterial { albedo: v4(m.albedo, 0.0), emission: v4(m.emission, 0.0) })
+            .map(|m| GpuMaterial {
+                albedo: v4(m.diffuse_albedo().unwrap_or(glam::Vec3::ZERO), 0.0),
+                emission: v4(m.emission(), 0.0),
+            })
             .collect();
         let mut objects = Vec::with_capacity(scene.objects.len());
         let mut emitters = Vec::new();
@@ -144,7 +154,7 @@ impl GpuScene {
                             edge_u: v4(q.edge_u, area),
                             edge_v: v4(q.edge_v, 0.0),
                             normal: v4(q.normal(), 0.0),
-                            emission: v4(material.emission, 0.0),
+                            emission: v4(material.emission(), 0.0),
                         });
                     }
                     GpuObject {
@@ -216,12 +226,12 @@ pub fn params(scene: &Scene, gpu_scene: &GpuScene) -> GpuParams {
         rows: scene.camera.height,
         sample_base: 0,
         sample_count: 0,
-        seed: scene.render.seed,
-        bounces: match scene.render.bounces {
+        seed: scene.pathtrace.seed,
+        bounces: match scene.pathtrace.bounces {
             Bounces::Fixed(n) => n,
             Bounces::Unbounded => UNBOUNDED,
         },
-        sampling: match scene.render.sampling {
+        sampling: match scene.pathtrace.sampling {
             Sampling::Cosine => 0,
             Sampling::Uniform => 1,
         },

@@ -20,8 +20,10 @@ mod tracer;
 pub use accumulator::Accumulator;
 pub use display_sum::{DISPLAY_PIXEL_BYTES, DISPLAY_SUM_SHADER};
 pub use error::PathTraceError;
+pub use gpu_scene::FEATURES;
+pub use illum_scene::Sequence;
 pub use progressive::{StopReason, StopRules, render_progressive};
 pub use tracer::{
-    CHUNK_SAMPLES, GENERIC_TRAVERSAL, PATHTRACE_SHADER, PathTracer, SCENE_MODULE, SLOT_BYTES, Sequence,
-    StepReport, TracerOptions, Traversal, shader_modules,
+    CHUNK_SAMPLES, GENERIC_TRAVERSAL, PATHTRACE_SHADER, PathTracer, SCENE_MODULE, SLOT_BYTES, StepReport,
+    TracerOptions, Traversal, shader_modules,
 };

@@ -8,7 +8,7 @@ use illum_gpu::shader::{self, COMMON_MODULES, Def, ShaderFile};
 use illum_gpu::shader_file;
 use illum_gpu::timing::PassTimer;
 use illum_gpu::{GpuContext, readback, wgpu};
-use illum_scene::{DeviceLimits, Scene};
+use illum_scene::{DeviceLimits, Scene, Sequence};
 use wgpu::util::DeviceExt;
 
 use crate::display_sum::DisplaySum;
@@ -32,36 +32,6 @@ pub enum Traversal {
     Specialised,
     /// One loop over the object buffer, the same pipeline for every scene.
     Generic,
-}
-
-/// Where a path's random sample values come from (see shaders/common/sampler.wgsl).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum Sequence {
-    /// Independent uniform numbers from a PCG stream per (seed, pixel, sample index).
-    #[default]
-    Independent,
-    /// A randomly shifted Kronecker (R_d) low-discrepancy sequence for the first 16 dimensions.
-    LowDiscrepancy,
-}
-
-impl std::str::FromStr for Sequence {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "independent" => Ok(Self::Independent),
-            "low-discrepancy" => Ok(Self::LowDiscrepancy),
-            other => Err(format!("unknown sequence {other:?}; allowed: independent, low-discrepancy")),
-        }
-    }
-}
-
-impl std::fmt::Display for Sequence {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            Self::Independent => "independent",
-            Self::LowDiscrepancy => "low-discrepancy",
-        })
-    }
 }
 
 /// Pipeline choices that do not change the expected image, only speed or noise.

@@ -6,10 +6,10 @@
 
 use std::time::Instant;
 
+use crate::scene::RasterScene;
 use illum_gpu::GpuContext;
-use illum_scene::WhittedScene;
 
-use crate::{Options, PassTimes, RasterError, WhittedRenderer};
+use crate::{Options, PassTimes, RasterError, RasterRenderer};
 
 /// What [`bench_frames`] measured.
 #[derive(Clone, Debug)]
@@ -63,14 +63,14 @@ impl BenchReport {
 /// Renders `warmup` untimed frames, then `frames` timed ones, of `scene` at `width` x `height`.
 pub fn bench_frames(
     gpu: &GpuContext,
-    scene: &WhittedScene,
+    scene: &RasterScene,
     width: u32,
     height: u32,
     options: &Options,
     warmup: u32,
     frames: u32,
 ) -> Result<BenchReport, RasterError> {
-    let mut renderer = WhittedRenderer::new(gpu, scene, width, height)?;
+    let mut renderer = RasterRenderer::new(gpu, scene, width, height)?;
     for _ in 0..warmup {
         renderer.draw(options)?;
     }

@@ -7,7 +7,7 @@
 //!    an eighth of the side, the prefiltered level for lookups with a wide footprint;
 //! 3. metal cube: six faces from the metal sphere's centre showing everything but the metal,
 //!    the glass refracting the glass cube just made;
-//! 4. main: floor and spheres, the glass reading the glass cube and (whitted) the metal
+//! 4. main: floor and spheres, the glass reading the glass cube and (enhanced) the metal
 //!    reading the metal cube, multisampled and resolved into the output.
 //!
 //! A pass the frame's [`FramePlan`] leaves out is not recorded at all (plan.rs says when).

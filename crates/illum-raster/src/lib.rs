@@ -5,7 +5,7 @@
 //! - a **shadow map** from the directional light, fitted to the spheres ([`shadow_fit`]), read
 //!   with percentage-closer filtering for soft edges;
 //! - a **cube map** captured at the glass sphere's centre (six faces, without the glass), which
-//!   the glass refracts; in the `whitted` look a second one at the metal sphere's centre, which
+//!   the glass refracts; in the enhanced look a second one at the metal sphere's centre, which
 //!   the metal mirrors ([`views`] has the face conventions);
 //! - only the passes the scene needs: no shadow map for a light that casts no shadows, no cube
 //!   map for a sphere the scene lacks or that mirrors nothing ([`plan`]);
@@ -13,15 +13,15 @@
 //!   box filter over each pixel's footprint, and the spheres as analytic impostors that write
 //!   their true depth and an analytic MSAA coverage mask, so silhouettes are round at any size.
 //!
-//! Two looks ([`Look`]): `Figure` reproduces the assignment's figure 1, `Whitted` adds what a
-//! Whitted ray tracer would show. Every effect is a toggle ([`Effects`]).
+//! Two looks ([`Look`]): `Figure` reproduces the assignment's figure 1, `Enhanced` adds what a
+//! rasterizer can of a Whitted ray tracer's image. Every effect is a toggle ([`Effects`]).
 //!
 //! ```no_run
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
-//! use illum_raster::{Options, WhittedRenderer};
+//! use illum_raster::{Options, RasterRenderer};
 //! let gpu = illum_gpu::GpuContext::new()?;
-//! let scene = illum_scene::WhittedScene::load("scenes/whitted.toml".as_ref())?;
-//! let mut renderer = WhittedRenderer::new(&gpu, &scene, 640, 360)?;
+//! let scene = illum_raster::RasterScene::load("scenes/whitted.toml".as_ref())?;
+//! let mut renderer = RasterRenderer::new(&gpu, &scene, 640, 360)?;
 //! let image = renderer.render(&Options::from_scene(&scene))?;
 //! illum_image::save_png("whitted.png", &image, 0.0, illum_image::Encoding::Linear)?;
 //! # Ok(()) }
@@ -38,6 +38,7 @@ mod pass_times;
 mod pipelines;
 pub mod plan;
 mod renderer;
+pub mod scene;
 pub mod shaders;
 pub mod shadow_fit;
 mod targets;
@@ -47,11 +48,14 @@ pub mod views;
 
 pub use bench::{BenchReport, bench_frames};
 pub use error::RasterError;
-pub use illum_scene::{Effects, Look, WhittedScene};
+pub use illum_scene::{Effects, Look};
 pub use options::Options;
 pub use pass_times::{Frame, PassTimes};
 pub use plan::FramePlan;
-pub use renderer::WhittedRenderer;
+pub use renderer::RasterRenderer;
+pub use scene::{
+    CheckerFloor, GlassSphere, MetalSphere, RasterLight, RasterLimits, RasterQuality, RasterScene,
+};
 pub use shaders::{MODULES, SHADERS};
 
 /// Samples per pixel of the main pass with MSAA on.

@@ -1,6 +1,8 @@
 //! What a frame should look like: the look and the effect toggles.
 
-use illum_scene::{Effects, Look, WhittedScene};
+use illum_scene::{Effects, Look};
+
+use crate::scene::RasterScene;
 
 /// The choices a caller makes per frame. The scene file supplies defaults
 /// ([`Options::from_scene`]); code, the command line or a viewer may change any of them.
@@ -12,7 +14,7 @@ pub struct Options {
 
 impl Options {
     /// The look and effects written in the scene file.
-    pub fn from_scene(scene: &WhittedScene) -> Self {
+    pub fn from_scene(scene: &RasterScene) -> Self {
         Options { look: scene.look, effects: scene.effects }
     }
 
@@ -33,7 +35,7 @@ mod tests {
 
     #[test]
     fn msaa_sets_the_main_pass_samples() {
-        let mut o = Options::all_on(Look::Whitted);
+        let mut o = Options::all_on(Look::Enhanced);
         assert_eq!(o.samples(), 4);
         o.effects.msaa = false;
         assert_eq!(o.samples(), 1);

@@ -8,7 +8,7 @@ pub struct PassTimes {
     /// The shadow map (0 when the frame has no shadow pass).
     pub shadow_ms: f64,
     /// The cube-map faces the frame captured: the glass's and its coarse copy's (twelve), and
-    /// the metal's (six more, in the whitted look with reflection).
+    /// the metal's (six more, in the enhanced look with reflection).
     pub cube_ms: f64,
     /// The main view, including the MSAA resolve.
     pub main_ms: f64,

@@ -5,10 +5,12 @@
 //! - The shadow map needs a light that casts shadows, shadows switched on, and a sphere to cast
 //!   one (the floor casts on nothing).
 //! - The glass sphere's cube maps (fine and coarse) exist for the glass alone: no glass, none.
-//! - The metal sphere's cube map is read only by its mirror: the whitted look with reflection on
+//! - The metal sphere's cube map is read only by its mirror: the enhanced look with reflection on
 //!   and a mirror fraction above zero.
 
-use illum_scene::{Look, WhittedScene};
+use illum_scene::Look;
+
+use crate::scene::RasterScene;
 
 use crate::options::Options;
 use crate::shadow_fit::ShadowFit;
@@ -32,10 +34,10 @@ pub struct FramePlan {
 }
 
 impl FramePlan {
-    pub fn new(scene: &WhittedScene, options: &Options, fit: &ShadowFit) -> Self {
+    pub fn new(scene: &RasterScene, options: &Options, fit: &ShadowFit) -> Self {
         let glass = scene.glass.is_some();
-        let shadow_pass = options.effects.shadows && scene.light.casts_shadows && !scene.spheres().is_empty();
-        let metal_cube = options.look == Look::Whitted
+        let shadow_pass = options.effects.shadows && !scene.spheres().is_empty();
+        let metal_cube = options.look == Look::Enhanced
             && options.effects.reflection
             && scene.metal.is_some_and(|metal| metal.mirror > 0.0);
         FramePlan {
@@ -78,40 +80,37 @@ mod tests {
     use super::*;
     use crate::shadow_fit::fit_shadow;
 
-    fn scene() -> WhittedScene {
+    fn scene() -> RasterScene {
         let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/whitted.toml"))
             .expect("scenes/whitted.toml");
-        WhittedScene::from_toml_str(&text, "whitted.toml").expect("valid")
+        RasterScene::from_toml_str(&text, "whitted.toml").expect("valid")
     }
 
-    fn plan(scene: &WhittedScene, options: &Options) -> FramePlan {
+    fn plan(scene: &RasterScene, options: &Options) -> FramePlan {
         FramePlan::new(scene, options, &fit_shadow(scene, 8192))
     }
 
     #[test]
-    fn metal_cube_only_for_whitted_reflections_of_a_mirror() {
+    fn metal_cube_only_for_enhanced_reflections_of_a_mirror() {
         let s = scene();
         assert!(!plan(&s, &Options::all_on(Look::Figure)).metal_cube);
-        assert!(plan(&s, &Options::all_on(Look::Whitted)).metal_cube);
-        let mut o = Options::all_on(Look::Whitted);
+        assert!(plan(&s, &Options::all_on(Look::Enhanced)).metal_cube);
+        let mut o = Options::all_on(Look::Enhanced);
         o.effects.reflection = false;
         assert!(!plan(&s, &o).metal_cube);
         let mut matte = s.clone();
         matte.metal.as_mut().expect("metal").mirror = 0.0;
-        assert!(!plan(&matte, &Options::all_on(Look::Whitted)).metal_cube);
+        assert!(!plan(&matte, &Options::all_on(Look::Enhanced)).metal_cube);
     }
 
     #[test]
-    fn shadow_pass_needs_shadows_a_casting_light_and_a_caster() {
+    fn shadow_pass_needs_shadows_and_a_caster() {
         let s = scene();
         assert!(plan(&s, &Options::all_on(Look::Figure)).shadow_pass);
         let mut o = Options::all_on(Look::Figure);
         o.effects.shadows = false;
         assert!(!plan(&s, &o).shadow_pass);
-        let mut unlit = s.clone();
-        unlit.light.casts_shadows = false;
-        assert!(!plan(&unlit, &Options::all_on(Look::Figure)).shadow_pass);
-        let bare = WhittedScene { glass: None, metal: None, ..s };
+        let bare = RasterScene { glass: None, metal: None, ..s };
         let p = plan(&bare, &Options::all_on(Look::Figure));
         assert!(!p.shadow_pass && p.shadow_casters().is_empty() && p.pass_names() == ["main"]);
     }

@@ -1,10 +1,10 @@
-//! [`WhittedRenderer`]: owns the GPU resources and turns a scene plus [`Options`] into frames.
+//! [`RasterRenderer`]: owns the GPU resources and turns a scene plus [`Options`] into frames.
 
+use crate::scene::{RasterLimits, RasterScene};
 use glam::Vec3;
 use illum_gpu::timing::PassTimer;
 use illum_gpu::{GpuContext, readback, wgpu};
 use illum_image::RgbImage32;
-use illum_scene::{RasterLimits, WhittedScene};
 
 use crate::RasterError;
 use crate::bindings::{Samplers, TextureGroups, Uniforms};
@@ -35,9 +35,9 @@ struct Keys {
 const BYTES_PER_PIXEL: u32 = 4;
 
 /// The Whitted look-alike renderer: a scene, a fixed output size and the GPU resources for them.
-pub struct WhittedRenderer {
+pub struct RasterRenderer {
     gpu: GpuContext,
-    scene: WhittedScene,
+    scene: RasterScene,
     width: u32,
     height: u32,
     pipelines: Pipelines,
@@ -55,10 +55,10 @@ pub struct WhittedRenderer {
     staging: Option<wgpu::Buffer>,
 }
 
-impl WhittedRenderer {
+impl RasterRenderer {
     /// Compiles the pipelines and allocates everything for `width` x `height` output, after
     /// checking the size (and the scene's cube maps) against the device's limits.
-    pub fn new(gpu: &GpuContext, scene: &WhittedScene, width: u32, height: u32) -> Result<Self, RasterError> {
+    pub fn new(gpu: &GpuContext, scene: &RasterScene, width: u32, height: u32) -> Result<Self, RasterError> {
         let scene = Self::sized(gpu, scene, width, height)?;
         let pipelines = Pipelines::new(gpu)?;
         let uniforms = Uniforms::new(gpu, &pipelines.uniforms_layout)?;
@@ -68,7 +68,7 @@ impl WhittedRenderer {
         let cubes = CubeSet::new(gpu, scene.quality.cube_size)?;
         let texture_groups =
             TextureGroups::new(gpu, &pipelines.textures_layout, &samplers, &shadow_map, &cubes)?;
-        Ok(WhittedRenderer {
+        Ok(RasterRenderer {
             gpu: gpu.clone(),
             scene,
             width,
@@ -90,12 +90,12 @@ impl WhittedRenderer {
     /// `scene` with the output size set to `width` x `height`, checked against the device.
     fn sized(
         gpu: &GpuContext,
-        scene: &WhittedScene,
+        scene: &RasterScene,
         width: u32,
         height: u32,
-    ) -> Result<WhittedScene, RasterError> {
+    ) -> Result<RasterScene, RasterError> {
         let mut scene = scene.clone();
-        scene.set_resolution(Some(width), Some(height), "WhittedRenderer")?;
+        scene.set_resolution(Some(width), Some(height), "RasterRenderer")?;
         let limits = gpu.device.limits();
         scene.check_device_limits(&RasterLimits {
             max_texture_dimension_2d: limits.max_texture_dimension_2d,
@@ -108,7 +108,7 @@ impl WhittedRenderer {
         gpu.device.limits().max_texture_dimension_2d.min(MAX_SHADOW_MAP)
     }
 
-    pub fn scene(&self) -> &WhittedScene {
+    pub fn scene(&self) -> &RasterScene {
         &self.scene
     }
 
@@ -123,7 +123,7 @@ impl WhittedRenderer {
 
     /// Replaces the scene (a moved sphere or light, other colours): refits the shadow map and,
     /// if the cube size changed, reallocates the cube maps. The output size stays.
-    pub fn set_scene(&mut self, scene: &WhittedScene) -> Result<(), RasterError> {
+    pub fn set_scene(&mut self, scene: &RasterScene) -> Result<(), RasterError> {
         let scene = Self::sized(&self.gpu, scene, self.width, self.height)?;
         let fit = fit_shadow(&scene, Self::max_shadow_map(&self.gpu));
         let cube_size = scene.quality.cube_size;

@@ -7,8 +7,8 @@
 //! [`PCF_REACH_TEXELS`] texels, so texel = pcf_radius / PCF_REACH_TEXELS makes the soft edge
 //! exactly pcf_radius wide on either side, whatever the scene's scale.
 
+use crate::scene::RasterScene;
 use glam::{Mat2, Mat4, Vec2, Vec3, Vec4};
-use illum_scene::WhittedScene;
 
 /// How far the PCF kernel of lighting.wgsl reaches, in texels: taps half a texel either side of
 /// the centre, each a bilinear 2 x 2 comparison reaching one texel further.
@@ -72,7 +72,7 @@ fn perpendicular_frame(w: Vec3) -> (Vec3, Vec3) {
 /// Fits the shadow map to `scene`'s spheres, at most `max_size` texels on a side (the device's
 /// texture limit, capped at [`MAX_SHADOW_MAP`]). When the wanted resolution exceeds that, the
 /// texel grows and the soft edge with it.
-pub fn fit_shadow(scene: &WhittedScene, max_size: u32) -> ShadowFit {
+pub fn fit_shadow(scene: &RasterScene, max_size: u32) -> ShadowFit {
     let direction = scene.light.direction();
     let (u, v) = perpendicular_frame(direction);
     // Without a sphere nothing casts a shadow and no shadow pass runs (plan.rs); the map is then
@@ -160,7 +160,7 @@ pub fn fit_shadow(scene: &WhittedScene, max_size: u32) -> ShadowFit {
 /// map's corners (-1, -1), (1, -1), (-1, 1) map back through A^-1 to the parallelogram's corner
 /// and the ends of its two edges. A nearly singular A (light grazing the floor) falls back to
 /// the floor rectangle.
-fn receiver_on_floor(view_proj: &Mat4, floor: &illum_scene::CheckerFloor) -> [Vec2; 3] {
+fn receiver_on_floor(view_proj: &Mat4, floor: &crate::scene::CheckerFloor) -> [Vec2; 3] {
     let rows = [view_proj.row(0), view_proj.row(1)];
     let a = Mat2::from_cols(Vec2::new(rows[0].x, rows[1].x), Vec2::new(rows[0].z, rows[1].z));
     let h = floor.height();
@@ -186,13 +186,13 @@ fn receiver_on_floor(view_proj: &Mat4, floor: &illum_scene::CheckerFloor) -> [Ve
 mod tests {
     use super::*;
 
-    fn scene() -> WhittedScene {
+    fn scene() -> RasterScene {
         let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/whitted.toml"))
             .unwrap();
-        WhittedScene::from_toml_str(&text, "whitted.toml").unwrap()
+        RasterScene::from_toml_str(&text, "whitted.toml").unwrap()
     }
 
-    fn glass(s: &WhittedScene) -> illum_scene::GlassSphere {
+    fn glass(s: &RasterScene) -> crate::scene::GlassSphere {
         s.glass.expect("whitted.toml has a glass sphere")
     }
 
@@ -259,8 +259,8 @@ mod tests {
         }
         // A light grazing the floor gives the whole floor.
         let mut grazing = s.clone();
-        grazing.light.position = Vec3::new(10.0, 0.0, -2.0);
-        grazing.light.target = Vec3::new(0.0, 0.0, -2.0);
+        // From (10, 0, -2) toward (0, 0, -2): level with the floor.
+        grazing.light.direction = Vec3::NEG_X;
         let whole = fit_shadow(&grazing, 8192).receiver;
         assert_eq!(whole[0], s.floor.min_corner());
     }
@@ -269,7 +269,7 @@ mod tests {
     fn spheres_shadow_each_other_only_where_the_light_lines_them_up() {
         let s = scene();
         let fit = fit_shadow(&s, 8192);
-        // scene-facts' light: nothing lies between the glass and the light, while light reaching
+        // docs/scenes.md's light: nothing lies between the glass and the light, while light reaching
         // the metal's right side passes within 0.1 of the glass, inside the soft edge's reach.
         assert!(!fit.glass_shadowed && fit.metal_shadowed);
         // Metal straight below the glass along the light: shadowed, and the glass not.
@@ -279,7 +279,8 @@ mod tests {
         assert!(fit.metal_shadowed && !fit.glass_shadowed);
         // A light low enough to graze the metal past the glass.
         let mut low = s.clone();
-        low.light.position = Vec3::new(10.0, 2.5, -2.0);
+        // From (10, 2.5, -2) toward the origin.
+        low.light.direction = Vec3::new(-10.0, -2.5, 2.0).normalize();
         assert!(fit_shadow(&low, 8192).metal_shadowed);
         let d = Vec3::X;
         assert!(!can_shadow((Vec3::ZERO, 1.0), (Vec3::new(5.0, 2.5, 0.0), 1.0), d, 0.1));

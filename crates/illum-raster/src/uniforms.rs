@@ -1,9 +1,9 @@
 //! The uniform blocks as the shaders see them: plain-old-data structs laid out like `Scene` and
 //! `View` in shaders/raster/scene.wgsl (every member a vec4 or mat4, so no hidden padding).
 
+use crate::scene::RasterScene;
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
-use illum_scene::WhittedScene;
 
 use crate::shadow_fit::ShadowFit;
 
@@ -70,7 +70,7 @@ fn env_params(size: u32) -> [f32; 4] {
 }
 
 /// The frame's scene constants.
-pub fn scene_uniform(scene: &WhittedScene, shadow: &ShadowFit) -> SceneUniform {
+pub fn scene_uniform(scene: &RasterScene, shadow: &ShadowFit) -> SceneUniform {
     let floor = &scene.floor;
     let (lo, hi) = (floor.min_corner(), floor.max_corner());
     // An absent sphere's constants stay zero: nothing draws it or looks it up (plan.rs).
@@ -98,7 +98,7 @@ pub fn scene_uniform(scene: &WhittedScene, shadow: &ShadowFit) -> SceneUniform {
     SceneUniform {
         to_light: v4(scene.light.to_light(), 0.0),
         light_radiance: v4(scene.light.radiance(), 0.0),
-        ambient: v4(scene.ambient.radiance(), 0.0),
+        ambient: v4(scene.ambient, 0.0),
         background: v4(scene.background, 1.0),
         floor_rect: [lo.x, lo.y, hi.x, hi.y],
         floor_params: [floor.height(), floor.tile, 0.0, 0.0],

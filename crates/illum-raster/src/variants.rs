@@ -1,6 +1,6 @@
 //! Which pipeline variant draws each surface of a frame.
 //!
-//! The entry shaders declare override constants (WHITTED, SHADOWS, ...; see `Switches` in
+//! The entry shaders declare override constants (ENHANCED, SHADOWS, ...; see `Switches` in
 //! scene.wgsl) that fix the effects when a pipeline is created, so the driver compiles out the
 //! paths not taken. On lavapipe, which runs both sides of a branch under a lane mask, this made
 //! the sphere shading several times faster than branching on uniform flags. Keys leave out the
@@ -42,7 +42,7 @@ impl Target {
 /// The override constants of one pipeline (names as in the entry shaders).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct Switches {
-    pub whitted: bool,
+    pub enhanced: bool,
     pub shadows: bool,
     pub pcf: bool,
     pub refraction: bool,
@@ -66,14 +66,14 @@ impl PipelineKey {
     /// the main pass of a frame that captured its cube map.
     pub fn new(surface: Surface, target: Target, options: &Options, plan: &FramePlan) -> Self {
         let e = &options.effects;
-        let whitted = options.look == Look::Whitted;
+        let enhanced = options.look == Look::Enhanced;
         let switches = match surface {
             Surface::Floor => Switches::default(),
             Surface::FloorReceiver => Switches { shadows: true, pcf: e.pcf, ..Default::default() },
             // The figure's glass is unlit: only refraction matters.
-            Surface::Glass if !whitted => Switches { refraction: e.refraction, ..Default::default() },
+            Surface::Glass if !enhanced => Switches { refraction: e.refraction, ..Default::default() },
             Surface::Glass => Switches {
-                whitted,
+                enhanced,
                 shadows: plan.glass_shadowed,
                 pcf: e.pcf,
                 refraction: e.refraction,
@@ -84,7 +84,7 @@ impl PipelineKey {
             Surface::Metal => {
                 let mirror = plan.metal_cube && matches!(target, Target::Main { .. });
                 Switches {
-                    whitted: mirror,
+                    enhanced: mirror,
                     shadows: plan.metal_shadowed,
                     pcf: e.pcf,
                     reflection: mirror,
@@ -110,7 +110,7 @@ impl PipelineKey {
             constants.extend([
                 ("SPHERE", sphere),
                 ("SAMPLES", f64::from(self.target.samples())),
-                ("WHITTED", flag(s.whitted)),
+                ("ENHANCED", flag(s.enhanced)),
                 ("REFRACTION", flag(s.refraction)),
                 ("REFLECTION", flag(s.reflection)),
                 ("FRESNEL", flag(s.fresnel)),
@@ -136,7 +136,7 @@ mod tests {
             shadow_pass,
             glass_shadowed: shadow_pass && shadowed,
             metal_shadowed: shadow_pass && shadowed,
-            metal_cube: options.look == Look::Whitted && options.effects.reflection,
+            metal_cube: options.look == Look::Enhanced && options.effects.reflection,
         }
     }
 
@@ -164,21 +164,21 @@ mod tests {
     }
 
     #[test]
-    fn the_metal_mirrors_only_in_the_whitted_main_pass() {
-        let whitted = Options::all_on(Look::Whitted);
+    fn the_metal_mirrors_only_in_the_enhanced_main_pass() {
+        let enhanced = Options::all_on(Look::Enhanced);
         assert!(
-            PipelineKey::new(Surface::Metal, Target::Main { samples: 1 }, &whitted, &plan(&whitted, true))
+            PipelineKey::new(Surface::Metal, Target::Main { samples: 1 }, &enhanced, &plan(&enhanced, true))
                 .switches
                 .metal_env
         );
         assert!(
-            !PipelineKey::new(Surface::Metal, Target::Cube, &whitted, &plan(&whitted, true))
+            !PipelineKey::new(Surface::Metal, Target::Cube, &enhanced, &plan(&enhanced, true))
                 .switches
                 .metal_env
         );
         // A metal whose cube map the frame skips (mirror = 0) has no lookup into it.
-        let unmirrored = FramePlan { metal_cube: false, ..plan(&whitted, true) };
-        let key = PipelineKey::new(Surface::Metal, Target::Main { samples: 1 }, &whitted, &unmirrored);
+        let unmirrored = FramePlan { metal_cube: false, ..plan(&enhanced, true) };
+        let key = PipelineKey::new(Surface::Metal, Target::Main { samples: 1 }, &enhanced, &unmirrored);
         assert!(!key.switches.metal_env && !key.switches.reflection);
         let figure = Options::all_on(Look::Figure);
         assert!(
@@ -190,7 +190,7 @@ mod tests {
 
     #[test]
     fn a_sphere_out_of_reach_of_the_other_has_no_shadow_lookup() {
-        let options = Options::all_on(Look::Whitted);
+        let options = Options::all_on(Look::Enhanced);
         for surface in [Surface::Glass, Surface::Metal] {
             let target = Target::Main { samples: 4 };
             assert!(PipelineKey::new(surface, target, &options, &plan(&options, true)).switches.shadows);
@@ -204,20 +204,20 @@ mod tests {
         let key = PipelineKey::new(
             Surface::Glass,
             Target::Main { samples: 4 },
-            &Options::all_on(Look::Whitted),
-            &plan(&Options::all_on(Look::Whitted), true),
+            &Options::all_on(Look::Enhanced),
+            &plan(&Options::all_on(Look::Enhanced), true),
         );
         let c = key.constants();
         assert!(
-            c.contains(&("SPHERE", 0.0)) && c.contains(&("SAMPLES", 4.0)) && c.contains(&("WHITTED", 1.0))
+            c.contains(&("SPHERE", 0.0)) && c.contains(&("SAMPLES", 4.0)) && c.contains(&("ENHANCED", 1.0))
         );
-        let whitted = Options::all_on(Look::Whitted);
+        let enhanced = Options::all_on(Look::Enhanced);
         let receiver =
-            PipelineKey::new(Surface::FloorReceiver, Target::Cube, &whitted, &plan(&whitted, true))
+            PipelineKey::new(Surface::FloorReceiver, Target::Cube, &enhanced, &plan(&enhanced, true))
                 .constants();
         assert_eq!(receiver, vec![("RECEIVER", 1.0), ("PCF", 1.0)]);
         let floor =
-            PipelineKey::new(Surface::Floor, Target::Cube, &whitted, &plan(&whitted, true)).constants();
+            PipelineKey::new(Surface::Floor, Target::Cube, &enhanced, &plan(&enhanced, true)).constants();
         assert_eq!(floor, vec![("RECEIVER", 0.0), ("PCF", 0.0)]);
     }
 }

@@ -2,7 +2,9 @@
 //! faces of a cube map. wgpu's clip space has x right, y up and depth z / w in [0, 1].
 
 use glam::{Mat4, Vec3};
-use illum_scene::{ClipPlanes, WhittedScene};
+use illum_scene::ClipPlanes;
+
+use crate::scene::RasterScene;
 
 /// World -> clip for a pinhole at `origin` with screen axes `right`, `up` and viewing direction
 /// `forward` (orthonormal), where a point at 1 unit ahead and `1 / sx` units right lands on the
@@ -20,7 +22,7 @@ fn pinhole(origin: Vec3, [right, up, forward]: [Vec3; 3], sx: f32, sy: f32, clip
 /// The main camera for an output of `width` x `height` pixels, in the frame of illum-scene's
 /// camera basis (right = forward x up, as three.js): the image plane at distance 1 is
 /// tan(vfov / 2) high (half-height) and aspect times that wide.
-pub fn main_view_proj(scene: &WhittedScene, width: u32, height: u32) -> Mat4 {
+pub fn main_view_proj(scene: &RasterScene, width: u32, height: u32) -> Mat4 {
     let basis = scene.camera.basis();
     let aspect = width as f32 / height as f32;
     let sy = 1.0 / basis.tan_half_fov;
@@ -59,7 +61,7 @@ pub fn cube_face_view_proj(center: Vec3, face: usize, clip: ClipPlanes) -> Mat4 
 /// mirrors. Far reaches the farthest floor corner and the far side of the other sphere (with
 /// 1% slack); near is the camera's, but at most half the distance to the nearest surface (the
 /// floor's plane or the other sphere), so nothing the capture should see is clipped.
-pub fn capture_clip(scene: &WhittedScene, center: Vec3) -> ClipPlanes {
+pub fn capture_clip(scene: &RasterScene, center: Vec3) -> ClipPlanes {
     let floor = &scene.floor;
     let (lo, hi) = (floor.min_corner(), floor.max_corner());
     let y = floor.height();
@@ -136,7 +138,7 @@ mod tests {
     fn captures_see_the_whole_floor_whatever_the_camera_clips() {
         let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/whitted.toml"))
             .unwrap();
-        let mut scene = WhittedScene::from_toml_str(&text, "whitted.toml").unwrap();
+        let mut scene = RasterScene::from_toml_str(&text, "whitted.toml").unwrap();
         scene.clip = ClipPlanes { near: 0.6, far: 5.0 };
         let clip = capture_clip(&scene, scene.glass.expect("glass").center);
         // The floor's farthest corner from the glass (4.2, 2.6, -4.2) is (-23, 0, 7.5): 29.7 away.
@@ -161,7 +163,7 @@ mod tests {
     fn main_camera_puts_the_target_in_the_middle_and_world_minus_z_to_the_right() {
         let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/whitted.toml"))
             .unwrap();
-        let scene = WhittedScene::from_toml_str(&text, "whitted.toml").unwrap();
+        let scene = RasterScene::from_toml_str(&text, "whitted.toml").unwrap();
         let m = main_view_proj(&scene, 320, 180);
         let project = |p: Vec3| {
             let c = m * p.extend(1.0);
@@ -169,7 +171,7 @@ mod tests {
         };
         let target = project(scene.camera.target);
         assert!(target.x.abs() < 1e-5 && target.y.abs() < 1e-5, "{target:?}");
-        // scene-facts: the camera looks along -X, so screen-right is world -Z, up is +Y.
+        // docs/scenes.md: the camera looks along -X, so screen-right is world -Z, up is +Y.
         assert!(project(scene.camera.target + Vec3::NEG_Z).x > 0.1);
         assert!(project(scene.camera.target + Vec3::Y).y > 0.1);
         // The top edge of the view is 30 degrees above the axis (vfov 60).

@@ -14,7 +14,37 @@
 
 use glam::Vec3;
 
-use crate::types::{Camera, CameraBasis};
+/// Pinhole camera. `vfov_deg` is the full vertical field of view in degrees, in (0, 180).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    pub eye: Vec3,
+    pub target: Vec3,
+    pub up: Vec3,
+    pub vfov_deg: f32,
+    pub width: u32,
+    pub height: u32,
+}
+
+/// Orthonormal camera frame. `right` is screen-right, `up` is screen-up, `forward` points from the
+/// eye to the target; the frame is right-handed as in three.js (right = forward x up).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraBasis {
+    pub forward: Vec3,
+    pub right: Vec3,
+    pub up: Vec3,
+    /// tan(vfov / 2): half the image plane's height at distance 1.
+    pub tan_half_fov: f32,
+    /// width / height.
+    pub aspect: f32,
+}
+
+/// Near and far clip distances of a rasterizer's camera, 0 < near < far (the ray tracers need
+/// none).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClipPlanes {
+    pub near: f32,
+    pub far: f32,
+}
 
 /// `v / |v|`, computed after dividing by the largest component so that neither very small nor
 /// very large (but finite) vectors underflow or overflow in the squared length. `None` for zero
@@ -60,7 +90,7 @@ impl Camera {
 mod tests {
     use super::*;
 
-    /// The assignment's Cornell camera (scene-facts section 2).
+    /// The assignment's Cornell camera (docs/scenes.md).
     fn cornell() -> Camera {
         Camera {
             eye: Vec3::new(278.0, 278.0, -724.26),
@@ -109,7 +139,7 @@ mod tests {
 
     #[test]
     fn field_of_view_spans_the_back_plane() {
-        // scene-facts: the eye sits 300 / tan(22.5 deg) in front of z = 0, so the top edge of
+        // docs/scenes.md: the eye sits 300 / tan(22.5 deg) in front of z = 0, so the top edge of
         // the view meets z = 0 at y = 278 + 300.
         let cam = cornell();
         let d = cam.ray_direction(256.0, 0.0);
@@ -141,7 +171,7 @@ mod tests {
         assert!(b.right.dot(cam.up).abs() < 1e-6);
         assert!((b.aspect - 640.0 / 480.0).abs() < 1e-6);
 
-        // scene-facts section 1: with up = +Y this camera looks along -X and screen-right is
+        // docs/scenes.md, the Whitted scene: with up = +Y this camera looks along -X and screen-right is
         // world -Z.
         let level = Camera { up: Vec3::Y, ..cam }.basis();
         assert!(close(level.forward, Vec3::NEG_X), "{:?}", level.forward);

@@ -29,18 +29,30 @@ pub enum SceneError {
     Invalid {
         /// The file label, or the origin of the value (e.g. "command line").
         file: String,
-        /// Dotted path of the field, e.g. `render.spp` or `--spp`.
+        /// Dotted path of the field, e.g. `pathtrace.spp` or `--spp`.
         field: String,
         /// The value as given, in TOML-like notation.
         value: String,
         /// What would have been accepted.
         allowed: String,
     },
+
+    /// A valid scene that asks for something a renderer does not implement.
+    #[error("{file}: {place}: the {renderer} cannot render {feature}")]
+    Unsupported {
+        file: String,
+        /// Where the scene uses it, e.g. `objects[11] ("light"), material "light"`.
+        place: String,
+        /// What it is, e.g. "an area light (a quad with an emitting material)".
+        feature: String,
+        /// The renderer, e.g. "rasterizer".
+        renderer: String,
+    },
 }
 
 impl SceneError {
     /// Builds a [`SceneError::Invalid`].
-    pub(crate) fn invalid(
+    pub fn invalid(
         file: &str,
         field: impl Into<String>,
         value: impl Into<String>,
@@ -91,8 +103,8 @@ fn line_column(text: &str, offset: usize) -> (usize, usize) {
 }
 
 /// A value given as text (a command-line flag) that is not one of the allowed spellings.
-/// Returned by the `FromStr` impls of [`Bounces`](crate::Bounces) and
-/// [`Sampling`](crate::Sampling).
+/// Returned by the `FromStr` impls of the settings' enums ([`Bounces`](crate::Bounces),
+/// [`Sampling`](crate::Sampling), [`Look`](crate::Look), ...).
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 #[error("{value:?}: {allowed}")]
 pub struct ParseValueError {
@@ -121,7 +133,7 @@ mod tests {
 
     #[test]
     fn invalid_display_has_file_field_value_allowed() {
-        let e = SceneError::invalid("scenes/x.toml", "render.spp", "0", "must be at least 1");
-        assert_eq!(e.to_string(), "scenes/x.toml: render.spp = 0: must be at least 1");
+        let e = SceneError::invalid("scenes/x.toml", "pathtrace.spp", "0", "must be at least 1");
+        assert_eq!(e.to_string(), "scenes/x.toml: pathtrace.spp = 0: must be at least 1");
     }
 }

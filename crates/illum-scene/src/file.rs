@@ -5,32 +5,66 @@
 //! f64 / i64 so that range checks (`spp = 0`, `width = -1`, `vfov = 1e40`) happen in validation,
 //! where the error can name the field, rather than inside serde.
 //!
-//! Format (all lengths in scene units, angles in degrees):
+//! Format (lengths in scene units, angles in degrees, colours linear RGB). Every section but
+//! `[camera]` and `[[objects]]` is optional:
 //!
 //! ```toml
-//! name = "cornell"                 # optional; default: the file's stem
+//! name = "cornell"                 # default: the file's stem
+//! renderer = "pathtrace"           # the renderer tools use by default: "pathtrace" or "raster"
 //! [camera]                         # pinhole camera
 //! eye = [278.0, 278.0, -724.26]
 //! target = [278.0, 278.0, 0.0]
 //! up = [0.0, 1.0, 0.0]
-//! vfov = 45.0                      # full vertical field of view
+//! vfov = 45.0                      # full vertical field of view, in (0, 180)
 //! width = 512                      # output size in pixels
 //! height = 512
-//! [render]                         # optional, as is each key in it
-//! spp = 16                         # samples per pixel, >= 1
-//! bounces = 2                      # 0..=MAX_BOUNCES, or "unbounded" (Russian roulette)
-//! seed = 0
-//! sampling = "cosine"              # or "uniform"
-//! [materials.NAME]                 # any number of Lambertian materials
-//! albedo = [0.5, 0.5, 0.5]         # default [0, 0, 0]; each channel in [0, 1]
-//! emission = [0.0, 0.0, 0.0]       # default [0, 0, 0]; radiance, each channel >= 0
+//! near = 0.1                       # clip planes, 0 < near < far: only the rasterizer needs them
+//! far = 3000.0
+//! [environment]                    # constant radiance seen by every ray that leaves the scene
+//! radiance = [0.3, 0.5, 0.9]
+//! [directional_light]              # a light at infinity
+//! direction = [-10.0, -13.0, 2.0]  # the way its light travels (any length)
+//! irradiance = [3.14159265, 3.14159265, 3.14159265]  # on a surface facing it
+//! angular_radius = 0.0             # the sun disc's half-angle, in [0, 90); 0 = delta light
+//! [materials.NAME]                 # exactly one of these keys per material:
+//! albedo = [0.5, 0.5, 0.5]         #   Lambertian, each channel in [0, 1]
+//! checker = { even = [..], odd = [..], tile = 1.0 }  # Lambertian checkerboard (quads only)
+//! dielectric = { ior = 1.43 }      #   smooth glass, index of refraction > 0
+//! mirror = { reflectance = [..] }  #   smooth tinted mirror, each channel in [0, 1]
+//! emission = [30.0, 30.0, 30.0]    #   area light: emitted radiance >= 0 (quads only)
 //! [[objects]]                      # one table per object, each with exactly one shape
-//! name = "..."                     # optional; default "objects[i]"
+//! name = "..."                     # default "objects[i]"
 //! material = "NAME"
 //! box = { center = [..], half_extent = [..] }            # or min = [..], max = [..];
 //!                                                        # optional rotate_y, pivot, translate
 //! quad = { corner = [..], edge_u = [..], edge_v = [..] } # front side: edge_u x edge_v
 //! sphere = { center = [..], radius = 1.0 }
+//! [pathtrace]                      # the path tracer
+//! spp = 16                         # samples per pixel, >= 1
+//! bounces = 2                      # 0..=MAX_BOUNCES, or "unbounded" (Russian roulette)
+//! seed = 0
+//! sampling = "cosine"              # or "uniform"
+//! sequence = "independent"         # or "low-discrepancy"
+//! [raster]                         # the rasterizer
+//! look = "figure"                  # or "enhanced"
+//! pcf_radius = 0.05                # half-width of the soft shadow edge
+//! cube_size = 256                  # side of each cube-map face, in texels
+//! glass_color = [1.0, 1.0, 1.0]    # figure: (1 - r) glass_color + r environment; enhanced: tint
+//! glass_reflectivity = 0.9         # the r above, in [0, 1]
+//! [raster.effects]                 # every toggle defaults to true
+//! shadows = true
+//! pcf = true
+//! refraction = true
+//! reflection = true
+//! fresnel = true
+//! msaa = true
+//! [whitted]                        # the Whitted ray tracer
+//! depth = 8                        # recursion depth, 0..=64
+//! aa = 2                           # n x n rays per pixel, 1..=16
+//! [shading]                        # local Phong model of the rasterizer and Whitted ray tracer
+//! ambient = [0.23, 0.23, 0.23]
+//! dielectric = { shininess = 200.0 }
+//! mirror = { specular = [1.0, 1.0, 1.0], shininess = 30.0, weight = 0.6 }
 //! ```
 
 use std::collections::BTreeMap;
@@ -44,14 +78,23 @@ use serde::de::{self, Deserializer, SeqAccess, Visitor};
 #[serde(deny_unknown_fields)]
 pub(crate) struct RawScene {
     pub name: Option<String>,
+    pub renderer: Option<String>,
     pub camera: RawCamera,
-    #[serde(default)]
-    pub render: RawRender,
+    pub environment: Option<RawEnvironment>,
+    pub directional_light: Option<RawDirectionalLight>,
     /// Sorted by name; `Scene::materials` keeps this order.
     #[serde(default)]
     pub materials: BTreeMap<String, RawMaterial>,
     #[serde(default)]
     pub objects: Vec<RawObject>,
+    #[serde(default)]
+    pub pathtrace: RawPathTrace,
+    #[serde(default)]
+    pub raster: RawRaster,
+    #[serde(default)]
+    pub whitted: RawWhitted,
+    #[serde(default)]
+    pub shading: RawShading,
 }
 
 #[derive(Debug, Deserialize)]
@@ -63,38 +106,183 @@ pub(crate) struct RawCamera {
     pub vfov: Num,
     pub width: Int,
     pub height: Int,
+    pub near: Option<Num>,
+    pub far: Option<Num>,
 }
 
-/// `[render]`: every key optional. `bounces` is kept as a raw TOML value because it is either an
-/// integer or the string "unbounded"; validation tells the two apart with a precise message.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawEnvironment {
+    pub radiance: RawVec3,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawDirectionalLight {
+    pub direction: RawVec3,
+    pub irradiance: RawVec3,
+    #[serde(default)]
+    pub angular_radius: Num,
+}
+
+/// `[pathtrace]`: every key optional. `bounces` is kept as a raw TOML value because it is
+/// either an integer or the string "unbounded"; validation tells the two apart with a precise
+/// message.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields, default)]
-pub(crate) struct RawRender {
+pub(crate) struct RawPathTrace {
     pub spp: Int,
     pub bounces: toml::Value,
     pub seed: Int,
     pub sampling: String,
+    pub sequence: String,
 }
 
-impl Default for RawRender {
+impl Default for RawPathTrace {
     /// The assignment's defaults: 16 spp, two bounces (its figure 3), seed 0, cosine sampling.
     fn default() -> Self {
-        RawRender {
+        RawPathTrace {
             spp: Int(16),
             bounces: toml::Value::Integer(2),
             seed: Int(0),
             sampling: "cosine".to_owned(),
+            sequence: "independent".to_owned(),
+        }
+    }
+}
+
+/// `[raster]`: every key optional.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub(crate) struct RawRaster {
+    pub look: String,
+    pub pcf_radius: Num,
+    pub cube_size: Int,
+    pub glass_color: RawVec3,
+    pub glass_reflectivity: Num,
+    pub effects: RawEffects,
+}
+
+impl Default for RawRaster {
+    fn default() -> Self {
+        RawRaster {
+            look: "figure".to_owned(),
+            pcf_radius: Num(0.05),
+            cube_size: Int(256),
+            glass_color: RawVec3([1.0; 3]),
+            glass_reflectivity: Num(0.9),
+            effects: RawEffects::default(),
+        }
+    }
+}
+
+/// Effect toggles; each absent key is on.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub(crate) struct RawEffects {
+    pub shadows: bool,
+    pub pcf: bool,
+    pub refraction: bool,
+    pub reflection: bool,
+    pub fresnel: bool,
+    pub msaa: bool,
+}
+
+impl Default for RawEffects {
+    fn default() -> Self {
+        RawEffects { shadows: true, pcf: true, refraction: true, reflection: true, fresnel: true, msaa: true }
+    }
+}
+
+/// `[whitted]`: every key optional.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub(crate) struct RawWhitted {
+    pub depth: Int,
+    pub aa: Int,
+}
+
+impl Default for RawWhitted {
+    fn default() -> Self {
+        RawWhitted { depth: Int(8), aa: Int(2) }
+    }
+}
+
+/// `[shading]`: every key optional.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub(crate) struct RawShading {
+    pub ambient: RawVec3,
+    pub dielectric: RawDielectricShading,
+    pub mirror: RawMirrorShading,
+}
+
+impl Default for RawShading {
+    fn default() -> Self {
+        RawShading {
+            ambient: RawVec3([0.0; 3]),
+            dielectric: RawDielectricShading::default(),
+            mirror: RawMirrorShading::default(),
         }
     }
 }
 
 #[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub(crate) struct RawDielectricShading {
+    pub shininess: Num,
+}
+
+impl Default for RawDielectricShading {
+    fn default() -> Self {
+        RawDielectricShading { shininess: Num(200.0) }
+    }
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub(crate) struct RawMirrorShading {
+    pub specular: RawVec3,
+    pub shininess: Num,
+    pub weight: Num,
+}
+
+impl Default for RawMirrorShading {
+    fn default() -> Self {
+        RawMirrorShading { specular: RawVec3([1.0; 3]), shininess: Num(30.0), weight: Num(0.6) }
+    }
+}
+
+/// One `[materials.NAME]` table. The kind keys are all optional here; validation insists on
+/// exactly one.
+#[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct RawMaterial {
-    #[serde(default)]
-    pub albedo: RawVec3,
-    #[serde(default)]
-    pub emission: RawVec3,
+    pub albedo: Option<RawVec3>,
+    pub checker: Option<RawChecker>,
+    pub dielectric: Option<RawDielectric>,
+    pub mirror: Option<RawMirror>,
+    pub emission: Option<RawVec3>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawChecker {
+    pub even: RawVec3,
+    pub odd: RawVec3,
+    pub tile: Num,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawDielectric {
+    pub ior: Num,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawMirror {
+    pub reflectance: RawVec3,
 }
 
 /// One `[[objects]]` entry. The three shape keys are all optional here; validation insists on
@@ -265,7 +453,7 @@ mod tests {
 
     #[test]
     fn integers_reject_floats() {
-        let err = toml::from_str::<RawRender>("spp = 1.5").unwrap_err();
+        let err = toml::from_str::<RawPathTrace>("spp = 1.5").unwrap_err();
         assert!(err.message().contains("an integer"), "{}", err.message());
     }
 }

@@ -1,9 +1,15 @@
-//! illum-scene: the TOML scene format, its validation, and camera math.
+//! illum-scene: one physical scene description for every renderer, its TOML file format,
+//! validation, and camera math.
 //!
-//! A scene file is parsed into the raw structs of `file.rs` (which mirror the TOML
-//! one to one and reject unknown keys), then checked and converted by `validate` into the
-//! [`Scene`] the renderers consume. Every error names the file, the field, the offending value
-//! and what would have been allowed (see [`SceneError`]).
+//! A scene file is parsed into the raw structs of `file.rs` (which mirror the TOML one to one
+//! and reject unknown keys), then checked and converted by `validate` into the [`Scene`] the
+//! renderers consume. Every error names the file, the field, the offending value and what would
+//! have been allowed (see [`SceneError`]).
+//!
+//! The modules follow the scene's concepts: [`Camera`] (`camera.rs`), shapes (`shapes.rs`),
+//! materials (`materials.rs`), lights (`lights.rs`; area lights are emitting quads), the
+//! per-renderer sections (`renderers.rs`), and what a renderer must implement to render a scene
+//! (`features.rs`).
 //!
 //! ```
 //! let text = r#"
@@ -22,29 +28,31 @@
 //! "#;
 //! let scene = illum_scene::Scene::from_toml_str(text, "example.toml").unwrap();
 //! assert_eq!(scene.name, "example");
-//! assert_eq!(scene.render.spp, 16);
+//! assert_eq!(scene.pathtrace.spp, 16);
 //! ```
-//!
-//! The same folder holds scenes for the Whitted look-alike rasterizer, marked with a top-level
-//! `renderer = "raster"`: [`scene_kind`] tells the two formats apart, and [`WhittedScene`] loads
-//! the rasterizer's (format in `whitted_file.rs`).
 
 mod camera;
 mod error;
+mod features;
 mod file;
-mod kind;
-mod load;
+mod lights;
+mod materials;
+mod renderers;
+mod scene;
 mod settings;
-mod types;
+mod shapes;
 mod validate;
-mod whitted;
-mod whitted_file;
-mod whitted_validate;
+mod validate_sections;
 
+pub use camera::{Camera, CameraBasis, ClipPlanes};
 pub use error::{ParseValueError, SceneError};
-pub use kind::{SceneKind, scene_kind};
-pub use types::*;
-pub use whitted::{
-    AmbientLight, CheckerFloor, ClipPlanes, DirectionalLight, Effects, GlassSphere, Look, MetalSphere,
-    RasterLimits, RasterQuality, WhittedScene,
+pub use features::Feature;
+pub use lights::{DirectionalLight, Environment};
+pub use materials::{Checker, Material, MaterialKind};
+pub use renderers::{
+    Bounces, DielectricShading, Effects, Look, MAX_BOUNCES, MAX_WHITTED_AA, MAX_WHITTED_DEPTH, MirrorShading,
+    PathTraceSettings, RasterSettings, RendererKind, Sampling, Sequence, Shading, WhittedSettings,
 };
+pub use scene::{DeviceLimits, Object, Overrides, Scene};
+pub use shapes::{BoxShape, Quad, Shape, Sphere};
+pub use validate::{fmt_f32, toml_key};

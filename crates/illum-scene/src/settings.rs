@@ -1,11 +1,11 @@
-//! Text forms of the render settings, shared by the scene file and the command line, so that
+//! Text forms of the renderer settings, shared by the scene file and the command line, so that
 //! `--bounces unbounded` and `bounces = "unbounded"` mean the same and `Display` round-trips.
 
 use std::fmt;
 use std::str::FromStr;
 
 use crate::error::ParseValueError;
-use crate::types::{Bounces, MAX_BOUNCES, Sampling};
+use crate::renderers::{Bounces, Look, MAX_BOUNCES, RendererKind, Sampling, Sequence};
 
 /// The spelling of "no fixed depth" in files and on the command line.
 pub(crate) const UNBOUNDED: &str = "unbounded";
@@ -70,6 +70,91 @@ impl fmt::Display for Sampling {
     }
 }
 
+/// What `sequence` accepts, for error messages.
+pub(crate) const SEQUENCE_ALLOWED: &str = "must be \"independent\" or \"low-discrepancy\"";
+
+impl Sequence {
+    /// The name used in files and on the command line.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Sequence::Independent => "independent",
+            Sequence::LowDiscrepancy => "low-discrepancy",
+        }
+    }
+}
+
+impl FromStr for Sequence {
+    type Err = ParseValueError;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "independent" => Ok(Sequence::Independent),
+            "low-discrepancy" => Ok(Sequence::LowDiscrepancy),
+            _ => Err(ParseValueError { value: s.to_owned(), allowed: SEQUENCE_ALLOWED.to_owned() }),
+        }
+    }
+}
+
+impl fmt::Display for Sequence {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// What `look` accepts, for error messages.
+pub(crate) const LOOK_ALLOWED: &str = "must be \"figure\" or \"enhanced\"";
+
+impl Look {
+    pub const ALL: [Look; 2] = [Look::Figure, Look::Enhanced];
+
+    /// The name used in files and on the command line.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Look::Figure => "figure",
+            Look::Enhanced => "enhanced",
+        }
+    }
+}
+
+impl FromStr for Look {
+    type Err = ParseValueError;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "figure" => Ok(Look::Figure),
+            "enhanced" => Ok(Look::Enhanced),
+            _ => Err(ParseValueError { value: s.to_owned(), allowed: LOOK_ALLOWED.to_owned() }),
+        }
+    }
+}
+
+impl fmt::Display for Look {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// What `renderer` accepts, for error messages.
+pub(crate) const RENDERER_ALLOWED: &str = "must be \"raster\" or \"pathtrace\"";
+
+impl FromStr for RendererKind {
+    type Err = ParseValueError;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "raster" => Ok(RendererKind::Raster),
+            "pathtrace" => Ok(RendererKind::PathTrace),
+            _ => Err(ParseValueError { value: s.to_owned(), allowed: RENDERER_ALLOWED.to_owned() }),
+        }
+    }
+}
+
+impl fmt::Display for RendererKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -110,5 +195,24 @@ mod tests {
         let text = err.to_string();
         assert!(text.contains("\"importance\""), "{text}");
         assert!(text.contains("\"cosine\"") && text.contains("\"uniform\""), "{text}");
+    }
+
+    #[test]
+    fn look_sequence_and_renderer_round_trip_and_reject_other_words() {
+        for look in Look::ALL {
+            assert_eq!(look.to_string().parse::<Look>(), Ok(look));
+        }
+        for seq in [Sequence::Independent, Sequence::LowDiscrepancy] {
+            assert_eq!(seq.to_string().parse::<Sequence>(), Ok(seq));
+        }
+        for kind in RendererKind::ALL {
+            assert_eq!(kind.to_string().parse::<RendererKind>(), Ok(kind));
+        }
+        // The raster's second look was called "whitted" before the Whitted ray tracer existed;
+        // the name now belongs to the ray tracer only.
+        let err = "whitted".parse::<Look>().unwrap_err();
+        assert!(err.to_string().contains("\"enhanced\""), "{err}");
+        assert!("sobol".parse::<Sequence>().unwrap_err().to_string().contains("low-discrepancy"));
+        assert!("opengl".parse::<RendererKind>().unwrap_err().to_string().contains("\"pathtrace\""));
     }
 }

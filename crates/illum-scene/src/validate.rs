@@ -9,16 +9,16 @@ use std::collections::BTreeMap;
 
 use glam::Vec3;
 
-use crate::camera::robust_normalize;
+use crate::camera::{Camera, ClipPlanes, robust_normalize};
 use crate::error::SceneError;
-use crate::file::{Int, Num, RawBox, RawCamera, RawMaterial, RawObject, RawRender, RawScene, RawVec3};
-use crate::settings::{UNBOUNDED, bounces_allowed};
-use crate::types::{
-    Bounces, BoxShape, Camera, MAX_BOUNCES, Material, Object, Quad, RenderSettings, Sampling, Scene, Shape,
-    Sphere,
-};
+use crate::file::{Int, Num, RawBox, RawCamera, RawMaterial, RawObject, RawScene, RawVec3};
+use crate::materials::{Checker, Material, MaterialKind};
+use crate::renderers::RendererKind;
+use crate::scene::{Object, Scene};
+use crate::settings::RENDERER_ALLOWED;
+use crate::shapes::{BoxShape, Quad, Shape, Sphere};
 
-const FINITE_ALLOWED: &str =
+pub(crate) const FINITE_ALLOWED: &str =
     "must be a finite number within f32 range (|x| <= 3.4e38); nan and inf are not allowed";
 
 /// The relative size of |edge_u x edge_v| below which a quad counts as degenerate:
@@ -29,11 +29,22 @@ const QUAD_DEGENERATE_SIN: f64 = 1e-12;
 /// vector would be dominated by rounding.
 const CAMERA_PARALLEL_SIN: f32 = 1e-6;
 
+/// More checker tiles than this along one edge of a quad and the f32 tile coordinate of the far
+/// edge loses its fraction (2^24 / 100000 ~ 168 steps per tile remain), so the board would break
+/// up.
+const MAX_TILES_PER_EDGE: f64 = 100_000.0;
+
 /// Validates `raw` (read from `file`) into a scene named `raw.name` or else `default_name`.
 pub(crate) fn scene_from_raw(raw: RawScene, file: &str, default_name: &str) -> Result<Scene, SceneError> {
     let check = Check { file };
+    let renderer = match &raw.renderer {
+        None => RendererKind::PathTrace,
+        Some(s) => s.parse().map_err(|_| check.invalid("renderer", format!("{s:?}"), RENDERER_ALLOWED))?,
+    };
     let camera = check.camera(&raw.camera)?;
-    let render = check.render(&raw.render)?;
+    let clip = check.clip_planes(raw.camera.near, raw.camera.far)?;
+    let environment = raw.environment.as_ref().map(|e| check.environment(e)).transpose()?;
+    let directional_light = raw.directional_light.as_ref().map(|l| check.directional_light(l)).transpose()?;
     let (materials, index_of) = check.materials(&raw.materials)?;
     if raw.objects.is_empty() {
         return Err(check.invalid(
@@ -46,19 +57,27 @@ pub(crate) fn scene_from_raw(raw: RawScene, file: &str, default_name: &str) -> R
         .objects
         .iter()
         .enumerate()
-        .map(|(i, o)| check.object(i, o, &materials, &index_of))
+        .map(|(i, o)| check.object(i, o, &materials, &index_of, &raw.materials))
         .collect::<Result<Vec<_>, _>>()?;
     Ok(Scene {
         name: raw.name.unwrap_or_else(|| default_name.to_owned()),
+        source: file.to_owned(),
+        renderer,
         camera,
-        render,
+        clip,
         materials,
         objects,
+        directional_light,
+        environment,
+        pathtrace: check.pathtrace(&raw.pathtrace)?,
+        raster: check.raster(&raw.raster)?,
+        whitted: check.whitted(&raw.whitted)?,
+        shading: check.shading(&raw.shading)?,
     })
 }
 
-/// Validation context: the file label every error carries. Shared with the Whitted scene's
-/// validation (`whitted_validate.rs`), so both formats word their errors the same way.
+/// Validation context: the file label every error carries. The sections' checks are in
+/// `validate_sections.rs`.
 pub(crate) struct Check<'a> {
     pub(crate) file: &'a str,
 }
@@ -150,34 +169,28 @@ impl Check<'_> {
         Ok(())
     }
 
-    fn render(&self, raw: &RawRender) -> Result<RenderSettings, SceneError> {
-        let spp = self.u32_at_least("render.spp", raw.spp, 1)?;
-        let bounces = self.bounces(&raw.bounces)?;
-        let seed = self.u32_at_least("render.seed", raw.seed, 0)?;
-        let sampling: Sampling = raw.sampling.parse().map_err(|e: crate::ParseValueError| {
-            self.invalid("render.sampling", format!("{:?}", raw.sampling), e.allowed)
-        })?;
-        Ok(RenderSettings { spp, bounces, seed, sampling })
-    }
-
-    /// `bounces` is an integer in 0..=MAX_BOUNCES or exactly the string "unbounded".
-    fn bounces(&self, value: &toml::Value) -> Result<Bounces, SceneError> {
-        match value {
-            toml::Value::Integer(n) => {
-                if let Ok(n) = u32::try_from(*n)
-                    && n <= MAX_BOUNCES
-                {
-                    return Ok(Bounces::Fixed(n));
-                }
+    /// `camera.near` and `camera.far`: both or neither, 0 < near < far.
+    fn clip_planes(&self, near: Option<Num>, far: Option<Num>) -> Result<Option<ClipPlanes>, SceneError> {
+        let (near, far) = match (near, far) {
+            (None, None) => return Ok(None),
+            (Some(near), Some(far)) => (near, far),
+            (Some(_), None) => {
+                return Err(self.invalid("camera.far", "(missing)", "must be given with camera.near"));
             }
-            toml::Value::String(s) if s == UNBOUNDED => return Ok(Bounces::Unbounded),
-            _ => {}
-        }
-        let shown = match value {
-            toml::Value::String(s) => format!("{s:?}"),
-            other => other.to_string(),
+            (None, Some(_)) => {
+                return Err(self.invalid("camera.near", "(missing)", "must be given with camera.far"));
+            }
         };
-        Err(self.invalid("render.bounces", shown, bounces_allowed()))
+        let near32 = self.positive("camera.near", near)?;
+        let far32 = self.number("camera.far", far)?;
+        if far32 <= near32 {
+            return Err(self.invalid(
+                "camera.far",
+                fmt_num(far.0),
+                format!("must be greater than camera.near = {}", fmt_num(near.0)),
+            ));
+        }
+        Ok(Some(ClipPlanes { near: near32, far: far32 }))
     }
 
     /// Materials in sorted-name order, plus the name -> index map objects resolve against.
@@ -189,29 +202,74 @@ impl Check<'_> {
         let mut index_of = BTreeMap::new();
         for (name, m) in raw {
             let path = format!("materials.{}", toml_key(name));
-            let albedo_path = format!("{path}.albedo");
-            let albedo = self.vec3(&albedo_path, m.albedo)?;
-            // A Lambertian surface reflects at most what it receives: albedo in [0, 1].
-            if !(albedo.cmpge(Vec3::ZERO).all() && albedo.cmple(Vec3::ONE).all()) {
-                return Err(self.invalid(
-                    albedo_path,
-                    fmt_vec(m.albedo.0),
-                    "every channel must be in [0, 1] (the fraction of light reflected)",
-                ));
-            }
-            let emission_path = format!("{path}.emission");
-            let emission = self.vec3(&emission_path, m.emission)?;
-            if !emission.cmpge(Vec3::ZERO).all() {
-                return Err(self.invalid(
-                    emission_path,
-                    fmt_vec(m.emission.0),
-                    "every channel must be >= 0 (emitted radiance)",
-                ));
-            }
             index_of.insert(name.clone(), materials.len());
-            materials.push(Material { name: name.clone(), albedo, emission });
+            materials.push(Material { name: name.clone(), kind: self.material_kind(&path, m)? });
         }
         Ok((materials, index_of))
+    }
+
+    fn material_kind(&self, path: &str, m: &RawMaterial) -> Result<MaterialKind, SceneError> {
+        let given: Vec<&str> = [
+            (m.albedo.is_some(), "albedo"),
+            (m.checker.is_some(), "checker"),
+            (m.dielectric.is_some(), "dielectric"),
+            (m.mirror.is_some(), "mirror"),
+            (m.emission.is_some(), "emission"),
+        ]
+        .into_iter()
+        .filter_map(|(present, key)| present.then_some(key))
+        .collect();
+        if given.len() != 1 {
+            let value =
+                if given.is_empty() { "{}".to_owned() } else { format!("{{ {} }}", given.join(", ")) };
+            return Err(self.invalid(
+                path,
+                value,
+                "a material needs exactly one of albedo (Lambertian), checker (Lambertian \
+                 checkerboard), dielectric (glass), mirror, emission (area light)",
+            ));
+        }
+        if let Some(albedo) = m.albedo {
+            return Ok(MaterialKind::Lambertian {
+                albedo: self.reflectance(&format!("{path}.albedo"), albedo)?,
+            });
+        }
+        if let Some(c) = &m.checker {
+            return Ok(MaterialKind::Checker(Checker {
+                even: self.reflectance(&format!("{path}.checker.even"), c.even)?,
+                odd: self.reflectance(&format!("{path}.checker.odd"), c.odd)?,
+                tile: self.positive(&format!("{path}.checker.tile"), c.tile)?,
+            }));
+        }
+        if let Some(d) = &m.dielectric {
+            let field = format!("{path}.dielectric.ior");
+            let ior = self.number(&field, d.ior)?;
+            if ior <= 0.0 {
+                return Err(self.invalid(
+                    field,
+                    fmt_num(d.ior.0),
+                    "must be > 0 (the index of refraction inside; outside is 1, so 1 makes the \
+                     surface vanish and 1.43 is glass)",
+                ));
+            }
+            return Ok(MaterialKind::Dielectric { ior });
+        }
+        if let Some(mirror) = &m.mirror {
+            let reflectance = self.reflectance(&format!("{path}.mirror.reflectance"), mirror.reflectance)?;
+            return Ok(MaterialKind::Mirror { reflectance });
+        }
+        let raw = m.emission.expect("exactly one key is present");
+        let field = format!("{path}.emission");
+        let radiance = self.vec3(&field, raw)?;
+        if !(radiance.cmpge(Vec3::ZERO).all() && radiance.max_element() > 0.0) {
+            return Err(self.invalid(
+                field,
+                fmt_vec(raw.0),
+                "every channel must be >= 0 and one > 0 (emitted radiance; for a black surface \
+                 write albedo = [0, 0, 0])",
+            ));
+        }
+        Ok(MaterialKind::Emitter { radiance })
     }
 
     fn object(
@@ -220,6 +278,7 @@ impl Check<'_> {
         raw: &RawObject,
         materials: &[Material],
         index_of: &BTreeMap<String, usize>,
+        raw_materials: &BTreeMap<String, RawMaterial>,
     ) -> Result<Object, SceneError> {
         let label = match &raw.name {
             Some(name) => format!("objects[{i}] ({name:?})"),
@@ -272,29 +331,56 @@ impl Check<'_> {
             };
             return Err(self.invalid(material_path, format!("{:?}", raw.material), allowed));
         };
-        // The path tracer's next-event estimation samples points on rectangles only, so an
-        // emitting box or sphere would be lit by nothing and light nothing directly.
-        let kind = match shape {
-            Shape::Box(_) => Some("box"),
-            Shape::Sphere(_) => Some("sphere"),
-            Shape::Quad(_) => None,
-        };
-        if let Some(kind) = kind
-            && materials[material].is_emitter()
-        {
-            return Err(self.invalid(
-                material_path,
-                format!("{:?}", raw.material),
-                format!(
-                    "emission is supported on quad objects only (this object is a {kind} and \
-                     material {:?} emits {}; the path tracer samples only rectangular lights)",
-                    raw.material,
-                    fmt_vec32(materials[material].emission)
-                ),
-            ));
-        }
-
+        let raw_tile = raw_materials.get(&raw.material).and_then(|m| m.checker.as_ref()).map(|c| c.tile.0);
+        self.material_fits_shape(&material_path, &raw.material, &materials[material], raw_tile, &shape)?;
         Ok(Object { name: raw.name.clone().unwrap_or_else(|| format!("objects[{i}]")), material, shape })
+    }
+
+    /// Emitters and checkerboards are defined on quads only: area lights are sampled as
+    /// rectangles, and a checkerboard counts its tiles along a quad's edges.
+    fn material_fits_shape(
+        &self,
+        field: &str,
+        name: &str,
+        material: &Material,
+        raw_tile: Option<f64>,
+        shape: &Shape,
+    ) -> Result<(), SceneError> {
+        let quad = match shape {
+            Shape::Quad(quad) => quad,
+            other => {
+                let allowed = match material.kind {
+                    MaterialKind::Emitter { radiance } => format!(
+                        "emission is supported on quad objects only (this object is a {} and material \
+                         {name:?} emits {}; area lights are sampled as rectangles)",
+                        other.kind(),
+                        fmt_vec32(radiance)
+                    ),
+                    MaterialKind::Checker(_) => format!(
+                        "a checkerboard is supported on quad objects only (this object is a {} and \
+                         material {name:?} is a checker; its tiles are counted along a quad's edges)",
+                        other.kind()
+                    ),
+                    _ => return Ok(()),
+                };
+                return Err(self.invalid(field, format!("{name:?}"), allowed));
+            }
+        };
+        if let MaterialKind::Checker(c) = material.kind {
+            let tiles = f64::from(quad.edge_u.length().max(quad.edge_v.length())) / f64::from(c.tile);
+            if tiles > MAX_TILES_PER_EDGE {
+                return Err(self.invalid(
+                    format!("materials.{}.checker.tile", toml_key(name)),
+                    raw_tile.map_or_else(|| fmt_f32(c.tile), fmt_num),
+                    format!(
+                        "must give at most {MAX_TILES_PER_EDGE} tiles along each edge of a quad it is on \
+                         (this quad gives {}); f32 tile coordinates lose their fraction beyond that",
+                        fmt_num(tiles)
+                    ),
+                ));
+            }
+        }
+        Ok(())
     }
 
     fn box_shape(&self, path: &str, raw: &RawBox) -> Result<BoxShape, SceneError> {
@@ -408,23 +494,25 @@ pub(crate) fn fmt_vec(v: [f64; 3]) -> String {
     format!("[{}, {}, {}]", fmt_num(v[0]), fmt_num(v[1]), fmt_num(v[2]))
 }
 
-/// f32 values print in their own shortest form (0.5608, not 0.5608000159263611), by the same
-/// rules as `fmt_num`.
+/// An f32 in its own shortest form (0.5608, not 0.5608000159263611), by the same rules as
+/// `fmt_num`: how errors show a number that validation has already converted.
+pub fn fmt_f32(x: f32) -> String {
+    if x.is_finite() && (x == 0.0 || (1e-5..1e16).contains(&x.abs())) {
+        x.to_string()
+    } else if x.is_finite() {
+        format!("{x:e}")
+    } else {
+        fmt_num(f64::from(x))
+    }
+}
+
+/// A vector of f32s, each as [`fmt_f32`] shows it.
 pub(crate) fn fmt_vec32(v: Vec3) -> String {
-    let f = |x: f32| {
-        if x.is_finite() && (x == 0.0 || (1e-5..1e16).contains(&x.abs())) {
-            x.to_string()
-        } else if x.is_finite() {
-            format!("{x:e}")
-        } else {
-            fmt_num(f64::from(x))
-        }
-    };
-    format!("[{}, {}, {}]", f(v.x), f(v.y), f(v.z))
+    format!("[{}, {}, {}]", fmt_f32(v.x), fmt_f32(v.y), fmt_f32(v.z))
 }
 
 /// A TOML key as it would be written in a dotted path: bare if it can be, quoted otherwise.
-fn toml_key(name: &str) -> String {
+pub fn toml_key(name: &str) -> String {
     let bare = !name.is_empty() && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
     if bare { name.to_owned() } else { format!("{name:?}") }
 }

@@ -3,7 +3,9 @@
 //! command-line overrides and device limits.
 
 use glam::Vec3;
-use illum_scene::{Bounces, DeviceLimits, MAX_BOUNCES, Overrides, Sampling, Scene, SceneError, Shape};
+use illum_scene::{
+    Bounces, DeviceLimits, MAX_BOUNCES, MaterialKind, Overrides, Sampling, Scene, SceneError, Shape,
+};
 
 const FILE: &str = "scenes/test.toml";
 
@@ -18,7 +20,7 @@ vfov = 45.0
 width = 64
 height = 32
 
-[render]
+[pathtrace]
 spp = 4
 bounces = 3
 seed = 7
@@ -125,16 +127,16 @@ fn base_scene_loads_with_the_written_values() {
     assert_eq!(s.name, "test");
     assert_eq!(s.camera.eye, Vec3::new(0.0, 1.0, -5.0));
     assert_eq!((s.camera.width, s.camera.height), (64, 32));
-    assert_eq!(s.render.spp, 4);
-    assert_eq!(s.render.bounces, Bounces::Fixed(3));
-    assert_eq!(s.render.seed, 7);
-    assert_eq!(s.render.sampling, Sampling::Uniform);
+    assert_eq!(s.pathtrace.spp, 4);
+    assert_eq!(s.pathtrace.bounces, Bounces::Fixed(3));
+    assert_eq!(s.pathtrace.seed, 7);
+    assert_eq!(s.pathtrace.sampling, Sampling::Uniform);
 
     let names: Vec<&str> = s.materials.iter().map(|m| m.name.as_str()).collect();
     assert_eq!(names, ["grey", "lamp"]);
-    assert_eq!(s.materials[1].emission, Vec3::splat(5.0));
-    assert_eq!(s.materials[1].albedo, Vec3::ZERO, "albedo defaults to black");
-    assert_eq!(s.materials[0].emission, Vec3::ZERO, "emission defaults to none");
+    assert_eq!(s.materials[1].kind, MaterialKind::Emitter { radiance: Vec3::splat(5.0) });
+    assert_eq!(s.materials[1].diffuse_albedo(), Some(Vec3::ZERO), "an emitter reflects nothing");
+    assert_eq!(s.materials[0].emission(), Vec3::ZERO, "a Lambertian material emits nothing");
 
     let obj_names: Vec<&str> = s.objects.iter().map(|o| o.name.as_str()).collect();
     assert_eq!(obj_names, ["block", "slab", "lamp", "objects[3]"]);
@@ -172,23 +174,23 @@ fn base_scene_loads_with_the_written_values() {
 #[test]
 fn optional_parts_take_their_defaults() {
     let text = edit("spp = 4\nbounces = 3\nseed = 7\nsampling = \"uniform\"\n", "");
-    let text = edit_text(&text, "[render]\n", "");
+    let text = edit_text(&text, "[pathtrace]\n", "");
     let text = edit_text(&text, "name = \"test\"\n", "");
     let s = parse(&text).unwrap();
     assert_eq!(s.name, "test", "file stem of scenes/test.toml");
-    assert_eq!(s.render.spp, 16);
-    assert_eq!(s.render.bounces, Bounces::Fixed(2));
-    assert_eq!(s.render.seed, 0);
-    assert_eq!(s.render.sampling, Sampling::Cosine);
+    assert_eq!(s.pathtrace.spp, 16);
+    assert_eq!(s.pathtrace.bounces, Bounces::Fixed(2));
+    assert_eq!(s.pathtrace.seed, 0);
+    assert_eq!(s.pathtrace.sampling, Sampling::Cosine);
     // Integers are accepted where numbers are expected.
     let s = parse(&edit("radius = 0.5", "radius = 2")).unwrap();
     let Shape::Sphere(ball) = s.objects[3].shape else { panic!() };
     assert_eq!(ball.radius, 2.0);
     // "unbounded" and the top of the range are accepted.
     let s = parse(&edit("bounces = 3", "bounces = \"unbounded\"")).unwrap();
-    assert_eq!(s.render.bounces, Bounces::Unbounded);
+    assert_eq!(s.pathtrace.bounces, Bounces::Unbounded);
     let s = parse(&edit("bounces = 3", &format!("bounces = {MAX_BOUNCES}"))).unwrap();
-    assert_eq!(s.render.bounces, Bounces::Fixed(MAX_BOUNCES));
+    assert_eq!(s.pathtrace.bounces, Bounces::Fixed(MAX_BOUNCES));
     // Nearly parallel but not degenerate quad edges (sin = 1e-6) are fine.
     parse(&edit("edge_v = [0.0, 0.0, 1.0]", "edge_v = [1.0, 0.0, 1e-6]")).unwrap();
     // Extreme but valid field of view.
@@ -434,15 +436,15 @@ fn camera_resolution_must_be_positive() {
 
 #[test]
 fn spp_must_be_at_least_one() {
-    expect_invalid(&edit("spp = 4", "spp = 0"), "render.spp", "0", "must be at least 1");
+    expect_invalid(&edit("spp = 4", "spp = 0"), "pathtrace.spp", "0", "must be at least 1");
     // The exact message of the design document's example.
     let err = parse(&edit("spp = 4", "spp = 0")).unwrap_err();
-    assert_eq!(err.to_string(), "scenes/test.toml: render.spp = 0: must be at least 1");
+    assert_eq!(err.to_string(), "scenes/test.toml: pathtrace.spp = 0: must be at least 1");
 }
 
 #[test]
 fn seed_must_fit_u32() {
-    expect_invalid(&edit("seed = 7", "seed = -1"), "render.seed", "-1", "must be at least 0");
+    expect_invalid(&edit("seed = 7", "seed = -1"), "pathtrace.seed", "-1", "must be at least 0");
 }
 
 #[test]
@@ -458,7 +460,7 @@ fn bounces_must_be_in_range_or_unbounded() {
         ("bounces = true", "true"),
     ];
     for (to, shown) in cases {
-        expect_invalid(&edit("bounces = 3", to), "render.bounces", shown, allowed);
+        expect_invalid(&edit("bounces = 3", to), "pathtrace.bounces", shown, allowed);
     }
 }
 
@@ -466,7 +468,7 @@ fn bounces_must_be_in_range_or_unbounded() {
 fn sampling_must_be_cosine_or_uniform() {
     expect_invalid(
         &edit("sampling = \"uniform\"", "sampling = \"importance\""),
-        "render.sampling",
+        "pathtrace.sampling",
         "\"importance\"",
         "must be \"cosine\" or \"uniform\"",
     );
@@ -580,9 +582,9 @@ fn unknown_keys_are_named_at_their_position() {
     let (line, column) = position_of(&text, "rotate_z");
     expect_syntax(&text, line, column, "unknown field `rotate_z`");
 
-    let text = edit("[render]", "[rendering]");
-    let (line, column) = position_of(&text, "rendering");
-    expect_syntax(&text, line, column, "unknown field `rendering`");
+    let text = edit("[pathtrace]", "[render]");
+    let (line, column) = position_of(&text, "render]");
+    expect_syntax(&text, line, column, "unknown field `render`");
 
     let text = edit("albedo = [0.5, 0.5, 0.5]", "albedo = [0.5, 0.5, 0.5]\nroughness = 0.2");
     let (line, column) = position_of(&text, "roughness");
@@ -651,14 +653,16 @@ fn overrides_replace_file_values() {
         bounces: Some(Bounces::Unbounded),
         seed: Some(99),
         sampling: Some(Sampling::Cosine),
+        sequence: Some(illum_scene::Sequence::LowDiscrepancy),
         width: Some(800),
         height: Some(600),
     };
     s.apply_overrides(&o, "command line").unwrap();
-    assert_eq!(s.render.spp, 64);
-    assert_eq!(s.render.bounces, Bounces::Unbounded);
-    assert_eq!(s.render.seed, 99);
-    assert_eq!(s.render.sampling, Sampling::Cosine);
+    assert_eq!(s.pathtrace.sequence, illum_scene::Sequence::LowDiscrepancy);
+    assert_eq!(s.pathtrace.spp, 64);
+    assert_eq!(s.pathtrace.bounces, Bounces::Unbounded);
+    assert_eq!(s.pathtrace.seed, 99);
+    assert_eq!(s.pathtrace.sampling, Sampling::Cosine);
     assert_eq!((s.camera.width, s.camera.height), (800, 600));
     assert_eq!(s.objects, before.objects);
 }

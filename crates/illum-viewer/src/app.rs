@@ -11,7 +11,7 @@ use illum_gpu::GpuContext;
 use crate::frame_rate::FrameRate;
 use crate::pathtrace_panel::PathTraceMode;
 use crate::raster_panel::RasterMode;
-use crate::scene_file::{self, DEFAULT_PATHTRACE_SCENE, DEFAULT_RASTER_SCENE, LoadedScene};
+use crate::scene_file::{self, DEFAULT_PATHTRACE_SCENE, DEFAULT_RASTER_SCENE};
 use crate::screenshot::ScreenshotJob;
 
 /// Which renderer the window shows.
@@ -130,32 +130,32 @@ impl ViewerApp {
         self.raster.as_mut().ok()
     }
 
-    /// Opens a scene file into the mode of its kind and returns that mode. On error nothing
-    /// changes and the loader's message is returned.
+    /// Opens a scene file in every mode that can render it and returns the mode to show (the
+    /// file's `renderer`, when it can). A mode that cannot render it keeps its scene. On error
+    /// nothing changes and the loader's message is returned.
     pub fn open(&mut self, path: &Path) -> Result<Mode, String> {
         // The path as given names the scene in the UI and in saved metadata.
         let given = path.to_path_buf();
-        match scene_file::load(path)? {
-            LoadedScene::PathTrace(scene) => {
-                match &mut self.pathtrace {
-                    Ok(mode) => mode.set_scene(given, scene),
-                    Err(_) => self.pathtrace = Ok(PathTraceMode::new(given, scene)),
-                }
-                Ok(Mode::PathTrace)
-            }
-            LoadedScene::Raster(scene) => {
-                match &mut self.raster {
-                    Ok(mode) => mode.set_scene(given, scene),
-                    Err(_) => self.raster = Ok(RasterMode::new(given, scene)),
-                }
-                Ok(Mode::Raster)
+        let loaded = scene_file::load(path)?;
+        let mode = loaded.mode();
+        if let Ok(scene) = loaded.pathtrace {
+            match &mut self.pathtrace {
+                Ok(mode) => mode.set_scene(given.clone(), scene),
+                Err(_) => self.pathtrace = Ok(PathTraceMode::new(given.clone(), scene)),
             }
         }
+        if let Ok(scene) = loaded.raster {
+            match &mut self.raster {
+                Ok(mode) => mode.set_scene(given, scene),
+                Err(_) => self.raster = Ok(RasterMode::new(given, scene)),
+            }
+        }
+        Ok(mode)
     }
 
     fn top_bar(&mut self, ui: &mut egui::Ui) {
         ui.horizontal(|ui| {
-            ui.selectable_value(&mut self.mode, Mode::Raster, "Whitted raster");
+            ui.selectable_value(&mut self.mode, Mode::Raster, "Raster");
             ui.selectable_value(&mut self.mode, Mode::PathTrace, "Path tracer");
             ui.separator();
             let label = ui.label("Scene");
@@ -249,17 +249,11 @@ impl ViewerApp {
 }
 
 fn load_pathtrace(path: &Path) -> Result<PathTraceMode, String> {
-    match scene_file::load(path)? {
-        LoadedScene::PathTrace(scene) => Ok(PathTraceMode::new(path.to_path_buf(), scene)),
-        LoadedScene::Raster(_) => Err(format!("{} is a raster scene", path.display())),
-    }
+    Ok(PathTraceMode::new(path.to_path_buf(), scene_file::load(path)?.pathtrace?))
 }
 
 fn load_raster(path: &Path) -> Result<RasterMode, String> {
-    match scene_file::load(path)? {
-        LoadedScene::Raster(scene) => Ok(RasterMode::new(path.to_path_buf(), scene)),
-        LoadedScene::PathTrace(_) => Err(format!("{} is a path-tracer scene", path.display())),
-    }
+    Ok(RasterMode::new(path.to_path_buf(), scene_file::load(path)?.raster?))
 }
 
 impl eframe::App for ViewerApp {

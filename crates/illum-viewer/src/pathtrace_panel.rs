@@ -51,10 +51,10 @@ impl PathTraceSettings {
     /// The scene file's render settings, with no stop rule beyond its spp.
     pub fn from_scene(scene: &Scene) -> Self {
         PathTraceSettings {
-            bounces: scene.render.bounces,
+            bounces: scene.pathtrace.bounces,
             spp_target: None,
-            sampling: scene.render.sampling,
-            seed: scene.render.seed,
+            sampling: scene.pathtrace.sampling,
+            seed: scene.pathtrace.seed,
             resolution_scale: DEFAULT_SCALE,
             exposure: 0.0,
             target_error: None,
@@ -162,11 +162,11 @@ impl PathTraceMode {
     fn desired_scene(&self, width: u32, height: u32) -> Scene {
         let mut scene = self.scene.clone();
         scene.camera = self.camera.camera(width, height);
-        scene.render.bounces = self.settings.bounces;
-        scene.render.sampling = self.settings.sampling;
-        scene.render.seed = self.settings.seed;
+        scene.pathtrace.bounces = self.settings.bounces;
+        scene.pathtrace.sampling = self.settings.sampling;
+        scene.pathtrace.seed = self.settings.seed;
         if let Some(spp) = self.settings.spp_target {
-            scene.render.spp = spp.max(1);
+            scene.pathtrace.spp = spp.max(1);
         }
         scene
     }
@@ -341,7 +341,7 @@ impl PathTraceMode {
         });
         ui.horizontal(|ui| {
             let mut unlimited = s.spp_target.is_none();
-            let mut spp = s.spp_target.unwrap_or(self.scene.render.spp.max(1));
+            let mut spp = s.spp_target.unwrap_or(self.scene.pathtrace.spp.max(1));
             let label = ui.label("spp target");
             ui.add_enabled(!unlimited, egui::DragValue::new(&mut spp).range(1..=1_000_000).speed(1.0))
                 .labelled_by(label.id);

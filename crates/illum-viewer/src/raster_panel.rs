@@ -1,4 +1,4 @@
-//! The Whitted raster mode: look and effect toggles, the `WhittedRenderer` on the shared device,
+//! The raster mode: look and effect toggles, the `RasterRenderer` on the shared device,
 //! and its frame rate and GPU time per pass.
 //!
 //! The renderer draws into its own output texture on eframe's device, which is registered with
@@ -9,8 +9,7 @@
 use std::path::{Path, PathBuf};
 
 use illum_gpu::GpuContext;
-use illum_raster::{Look, Options, PassTimes, WhittedRenderer};
-use illum_scene::WhittedScene;
+use illum_raster::{Look, Options, PassTimes, RasterRenderer, RasterScene};
 
 use crate::camera::OrbitCamera;
 use crate::frame_rate::FrameRate;
@@ -18,12 +17,12 @@ use crate::frame_rate::FrameRate;
 /// The raster mode.
 pub struct RasterMode {
     scene_path: PathBuf,
-    scene: WhittedScene,
+    scene: RasterScene,
     pub options: Options,
     pub camera: OrbitCamera,
-    renderer: Option<RasterRenderer>,
+    renderer: Option<RasterState>,
     /// The (scene, size) the renderer last failed to be created for, not retried every frame.
-    failed: Option<(WhittedScene, u32, u32)>,
+    failed: Option<(RasterScene, u32, u32)>,
     /// Frames drawn by the renderer, for its frame rate.
     frame_rate: FrameRate,
     pass_times: Option<PassTimes>,
@@ -32,13 +31,13 @@ pub struct RasterMode {
 }
 
 /// The renderer and the egui texture its output is registered as.
-struct RasterRenderer {
-    renderer: WhittedRenderer,
+struct RasterState {
+    renderer: RasterRenderer,
     texture: Option<egui::TextureId>,
 }
 
 impl RasterMode {
-    pub fn new(scene_path: PathBuf, scene: WhittedScene) -> Self {
+    pub fn new(scene_path: PathBuf, scene: RasterScene) -> Self {
         RasterMode {
             options: Options::from_scene(&scene),
             camera: OrbitCamera::new(scene.camera),
@@ -53,7 +52,7 @@ impl RasterMode {
     }
 
     /// Replaces the scene (opened from the UI); look, effects and camera start from its own.
-    pub fn set_scene(&mut self, scene_path: PathBuf, scene: WhittedScene) {
+    pub fn set_scene(&mut self, scene_path: PathBuf, scene: RasterScene) {
         let renderer = self.renderer.take();
         *self = RasterMode::new(scene_path, scene);
         // Keep the renderer (and its registered egui texture): only the scene changes.
@@ -128,7 +127,7 @@ impl RasterMode {
     fn sync_renderer(
         &mut self,
         gpu: &GpuContext,
-        scene: &WhittedScene,
+        scene: &RasterScene,
         width: u32,
         height: u32,
     ) -> Result<(), String> {
@@ -137,8 +136,8 @@ impl RasterMode {
             if self.failed.as_ref() == Some(&attempt) {
                 return Err(self.message.clone().unwrap_or_default());
             }
-            match WhittedRenderer::new(gpu, scene, width, height) {
-                Ok(renderer) => self.renderer = Some(RasterRenderer { renderer, texture: None }),
+            match RasterRenderer::new(gpu, scene, width, height) {
+                Ok(renderer) => self.renderer = Some(RasterState { renderer, texture: None }),
                 Err(e) => {
                     self.failed = Some(attempt);
                     return Err(e.to_string());
@@ -157,7 +156,7 @@ impl RasterMode {
 
     /// The panel's controls.
     pub fn panel(&mut self, ui: &mut egui::Ui) {
-        ui.heading("Whitted raster");
+        ui.heading("Raster");
         ui.horizontal(|ui| {
             ui.label("Look");
             for look in Look::ALL {
@@ -168,10 +167,10 @@ impl RasterMode {
         ui.checkbox(&mut e.shadows, "Shadows");
         ui.add_enabled(e.shadows, egui::Checkbox::new(&mut e.pcf, "PCF soft shadows"));
         ui.checkbox(&mut e.refraction, "Refraction");
-        // Reflection and Fresnel exist only in the whitted look.
-        let whitted = self.options.look == Look::Whitted;
-        ui.add_enabled(whitted, egui::Checkbox::new(&mut e.reflection, "Reflection"));
-        ui.add_enabled(whitted, egui::Checkbox::new(&mut e.fresnel, "Fresnel"));
+        // Reflection and Fresnel exist only in the enhanced look.
+        let enhanced = self.options.look == Look::Enhanced;
+        ui.add_enabled(enhanced, egui::Checkbox::new(&mut e.reflection, "Reflection"));
+        ui.add_enabled(enhanced, egui::Checkbox::new(&mut e.fresnel, "Fresnel"));
         ui.checkbox(&mut e.msaa, "MSAA 4x");
         if ui.add_enabled(!self.camera.is_home(), egui::Button::new("Reset camera")).clicked() {
             self.camera.reset();

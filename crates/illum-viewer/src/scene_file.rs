@@ -1,20 +1,36 @@
-//! Opening scene files of either kind. Every failure becomes the loader's own message (which
-//! names the file, the field and what is allowed), for the UI to show; nothing panics.
+//! Opening scene files. One scene file can be shown by every mode whose renderer can render
+//! it; each failure becomes the loader's own message (which names the file, the field and what
+//! is allowed, or the feature a renderer lacks), for the UI to show; nothing panics.
 
 use std::path::{Path, PathBuf};
 
-use illum_scene::{Scene, SceneKind, WhittedScene, scene_kind};
+use illum_raster::RasterScene;
+use illum_scene::{RendererKind, Scene};
+
+use crate::app::Mode;
 
 /// The path tracer's scene when none is given: the assignment's Cornell box.
 pub const DEFAULT_PATHTRACE_SCENE: &str = "scenes/cornell.toml";
 /// The raster's scene when none is given: the assignment's glass and metal spheres.
 pub const DEFAULT_RASTER_SCENE: &str = "scenes/whitted.toml";
 
-/// A loaded scene, by kind.
+/// A scene file as each mode sees it: the scene, or why that mode's renderer cannot render it.
 #[derive(Clone, Debug)]
-pub enum LoadedScene {
-    PathTrace(Scene),
-    Raster(WhittedScene),
+pub struct LoadedScene {
+    pub pathtrace: Result<Scene, String>,
+    pub raster: Result<RasterScene, String>,
+    /// The mode of the file's `renderer`.
+    pub preferred: Mode,
+}
+
+impl LoadedScene {
+    /// The mode to show: the file's own when it can render the scene, else the other.
+    pub fn mode(&self) -> Mode {
+        match (self.preferred, &self.pathtrace, &self.raster) {
+            (Mode::Raster, _, Ok(_)) | (Mode::PathTrace, Err(_), _) => Mode::Raster,
+            _ => Mode::PathTrace,
+        }
+    }
 }
 
 /// `path` as given when it exists; a relative path that does not exist from the working
@@ -30,15 +46,23 @@ pub fn resolve(path: &Path) -> PathBuf {
     path.to_path_buf()
 }
 
-/// Loads a scene file of either kind (told apart by its `renderer` key).
+/// Loads a scene file for every mode. An error when the file does not load, or when no mode
+/// can render it (with each renderer's reason).
 pub fn load(path: &Path) -> Result<LoadedScene, String> {
-    let resolved = resolve(path);
-    let kind = scene_kind(&resolved).map_err(|e| e.to_string())?;
-    match kind {
-        SceneKind::PathTrace => Scene::load(&resolved).map(LoadedScene::PathTrace),
-        SceneKind::Raster => WhittedScene::load(&resolved).map(LoadedScene::Raster),
+    let scene = Scene::load(&resolve(path)).map_err(|e| e.to_string())?;
+    let pathtrace = scene
+        .require(RendererKind::PathTrace, illum_pathtrace::FEATURES)
+        .map(|()| scene.clone())
+        .map_err(|e| e.to_string());
+    let raster = RasterScene::from_scene(&scene).map_err(|e| e.to_string());
+    if let (Err(p), Err(r)) = (&pathtrace, &raster) {
+        return Err(format!("no mode can show it: {p}; {r}"));
     }
-    .map_err(|e| e.to_string())
+    let preferred = match scene.renderer {
+        RendererKind::Raster => Mode::Raster,
+        RendererKind::PathTrace => Mode::PathTrace,
+    };
+    Ok(LoadedScene { pathtrace, raster, preferred })
 }
 
 #[cfg(test)]
@@ -46,9 +70,17 @@ mod tests {
     use super::*;
 
     #[test]
-    fn default_scenes_load_as_their_kind() {
-        assert!(matches!(load(Path::new(DEFAULT_PATHTRACE_SCENE)), Ok(LoadedScene::PathTrace(_))));
-        assert!(matches!(load(Path::new(DEFAULT_RASTER_SCENE)), Ok(LoadedScene::Raster(_))));
+    fn default_scenes_open_in_the_modes_that_can_render_them() {
+        let cornell = load(Path::new(DEFAULT_PATHTRACE_SCENE)).unwrap();
+        assert_eq!(cornell.mode(), Mode::PathTrace);
+        assert!(cornell.pathtrace.is_ok());
+        let why = cornell.raster.unwrap_err();
+        assert!(why.contains("rasterizer cannot render"), "{why}");
+        let whitted = load(Path::new(DEFAULT_RASTER_SCENE)).unwrap();
+        assert_eq!(whitted.mode(), Mode::Raster);
+        assert!(whitted.raster.is_ok());
+        let why = whitted.pathtrace.unwrap_err();
+        assert!(why.contains("path tracer cannot render"), "{why}");
     }
 
     #[test]

@@ -55,10 +55,10 @@ fn switching_modes_keeps_each_modes_settings() {
     harness.get_by_label("Uniform").click();
     harness.run_steps(1);
 
-    harness.get_by_label("Whitted raster").click();
+    harness.get_by_label("Raster").click();
     harness.run_steps(2);
     assert_eq!(harness.state().mode(), Mode::Raster);
-    harness.get_by_label("whitted").click();
+    harness.get_by_label("enhanced").click();
     harness.get_by_label("MSAA 4x").click();
     harness.run_steps(2);
 
@@ -68,10 +68,10 @@ fn switching_modes_keeps_each_modes_settings() {
     let settings = harness.state().pathtrace().unwrap().settings;
     assert_eq!(settings.sampling, illum_scene::Sampling::Uniform);
 
-    harness.get_by_label("Whitted raster").click();
+    harness.get_by_label("Raster").click();
     harness.run_steps(2);
     let options = harness.state().raster().unwrap().options;
-    assert_eq!(options.look, illum_raster::Look::Whitted);
+    assert_eq!(options.look, illum_raster::Look::Enhanced);
     assert!(!options.effects.msaa);
 }
 

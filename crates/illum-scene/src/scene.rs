@@ -1,14 +1,83 @@
-//! The public entry points on [`Scene`]: loading, command-line overrides, device-limit checks,
-//! and the list of emitters.
+//! The scene: one physical description that every renderer reads, plus the per-renderer
+//! sections. Loading, command-line overrides, device-limit checks and the list of emitters.
 
 use std::path::Path;
 
+use crate::camera::{Camera, ClipPlanes};
 use crate::error::SceneError;
 use crate::file::RawScene;
-use crate::kind::SceneKind;
+use crate::lights::{DirectionalLight, Environment};
+use crate::materials::Material;
+use crate::renderers::{
+    Bounces, MAX_BOUNCES, PathTraceSettings, RasterSettings, RendererKind, Sampling, Sequence, Shading,
+    WhittedSettings,
+};
 use crate::settings::bounces_allowed;
-use crate::types::{Bounces, DeviceLimits, MAX_BOUNCES, Object, Overrides, Quad, Scene, Shape};
+use crate::shapes::{Quad, Shape};
 use crate::validate::scene_from_raw;
+
+/// A whole scene as loaded from TOML. Every value has passed validation (see `validate.rs`):
+/// vectors are finite, extents positive, the camera is not degenerate and material indices are
+/// in range.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    /// Scene name (the file's `name`, or its file stem).
+    pub name: String,
+    /// Where the scene came from (the file as it was given), for error messages.
+    pub source: String,
+    /// The renderer a tool uses when the user does not choose one (the file's `renderer`;
+    /// default: the path tracer).
+    pub renderer: RendererKind,
+    /// Pinhole camera and output resolution.
+    pub camera: Camera,
+    /// The camera's clip planes (`camera.near`, `camera.far`); only a rasterizer needs them.
+    pub clip: Option<ClipPlanes>,
+    /// Materials, referenced by index from `objects`.
+    pub materials: Vec<Material>,
+    /// Geometry, in file order. Quads whose material emits are the area lights.
+    pub objects: Vec<Object>,
+    /// `[directional_light]`, if any.
+    pub directional_light: Option<DirectionalLight>,
+    /// `[environment]`, if any: the radiance every escaping ray sees (black without one).
+    pub environment: Option<Environment>,
+    /// `[pathtrace]`.
+    pub pathtrace: PathTraceSettings,
+    /// `[raster]`.
+    pub raster: RasterSettings,
+    /// `[whitted]`.
+    pub whitted: WhittedSettings,
+    /// `[shading]`.
+    pub shading: Shading,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Object {
+    pub name: String,
+    /// Index into `Scene::materials`.
+    pub material: usize,
+    pub shape: Shape,
+}
+
+/// Command-line overrides of the file's settings; `None` keeps the file's value.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Overrides {
+    pub spp: Option<u32>,
+    pub bounces: Option<Bounces>,
+    pub seed: Option<u32>,
+    pub sampling: Option<Sampling>,
+    pub sequence: Option<Sequence>,
+    pub width: Option<u32>,
+    pub height: Option<u32>,
+}
+
+/// What the device allows, for the resolution check (filled in from `wgpu::Limits` by the caller).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DeviceLimits {
+    /// Largest 2D texture side.
+    pub max_texture_dimension_2d: u32,
+    /// Largest single storage buffer binding, in bytes.
+    pub max_storage_buffer_binding_size: u64,
+}
 
 impl Scene {
     /// Reads and validates a scene file. Errors name the file as `path` was given.
@@ -22,17 +91,6 @@ impl Scene {
     /// Parses and validates scene text. `file_label` names the source in errors, and its file
     /// stem is the scene's name when the text has no `name`.
     pub fn from_toml_str(text: &str, file_label: &str) -> Result<Scene, SceneError> {
-        // A rasterizer scene would otherwise fail on its first unknown key; say what it is.
-        if SceneKind::from_toml_str(text, file_label)? == SceneKind::Raster {
-            return Err(SceneError::invalid(
-                file_label,
-                crate::kind::RENDERER_KEY,
-                format!("{:?}", crate::kind::RASTER),
-                "this is a Whitted look-alike scene for the rasterizer, not a path-tracer scene; \
-                 load it with illum_scene::WhittedScene::load (the render example picks the \
-                 renderer from the file by itself)",
-            ));
-        }
         let raw: RawScene = toml::from_str(text).map_err(|e| SceneError::from_toml(&e, text, file_label))?;
         let default_name = Path::new(file_label)
             .file_stem()
@@ -59,11 +117,12 @@ impl Scene {
             return Err(SceneError::invalid(origin, "--bounces", n.to_string(), bounces_allowed()));
         }
 
-        let r = &mut self.render;
+        let r = &mut self.pathtrace;
         r.spp = o.spp.unwrap_or(r.spp);
         r.bounces = o.bounces.unwrap_or(r.bounces);
         r.seed = o.seed.unwrap_or(r.seed);
         r.sampling = o.sampling.unwrap_or(r.sampling);
+        r.sequence = o.sequence.unwrap_or(r.sequence);
         let c = &mut self.camera;
         c.width = o.width.unwrap_or(c.width);
         c.height = o.height.unwrap_or(c.height);
@@ -106,13 +165,36 @@ impl Scene {
         Ok(())
     }
 
-    /// The light sources: (object index, object, its quad) for every object whose material
+    /// The area lights: (object index, object, its quad) for every object whose material
     /// emits. Validation guarantees emitters are quads; anything else is skipped.
     pub fn emitters(&self) -> impl Iterator<Item = (usize, &Object, &Quad)> {
         self.objects.iter().enumerate().filter_map(move |(i, object)| match &object.shape {
             Shape::Quad(quad) if self.materials.get(object.material).is_some_and(|m| m.is_emitter()) => {
                 Some((i, object, quad))
             }
+            _ => None,
+        })
+    }
+
+    /// How errors name object `i`: `objects[3] ("tall block")`, or `objects[3]` for an object
+    /// the file left unnamed (validation's own label).
+    pub fn object_label(&self, i: usize) -> String {
+        let name = &self.objects[i].name;
+        if *name == format!("objects[{i}]") { name.clone() } else { format!("objects[{i}] ({name:?})") }
+    }
+
+    /// The material of `object`.
+    pub fn material_of(&self, object: &Object) -> &Material {
+        &self.materials[object.material]
+    }
+
+    /// The spheres with the given kind of material, in file order, as (object, sphere).
+    pub fn spheres_where(
+        &self,
+        keep: impl Fn(&Material) -> bool,
+    ) -> impl Iterator<Item = (&Object, crate::Sphere)> {
+        self.objects.iter().filter_map(move |o| match o.shape {
+            Shape::Sphere(s) if keep(self.material_of(o)) => Some((o, s)),
             _ => None,
         })
     }

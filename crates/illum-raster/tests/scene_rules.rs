@@ -1,0 +1,826 @@
+//! Every rule a scene must pass for the rasterizer to draw it, triggered by an edited copy of a
+//! small valid scene, with the message checked for file, field, value and what is allowed: the
+//! physical scene's own validation (as the rasterizer sees it), `Scene::require` refusing what
+//! the rasterizer does not implement, and `RasterScene::from_scene` refusing arrangements it
+//! cannot draw; plus resolution overrides and device limits.
+//!
+//! Ported from the rules of the old raster-only format (illum-scene's `whitted_errors.rs`): each
+//! old rule is tested at its new field path; where a rule changed, a comment says how.
+
+use glam::{Vec2, Vec3};
+use illum_raster::scene::FEATURES;
+use illum_raster::{Effects, Look, RasterLimits, RasterScene};
+use illum_scene::{Feature, RendererKind, Scene, SceneError};
+
+const FILE: &str = "scenes/w.toml";
+
+/// A valid scene with every optional key written out: the old format's BASE in the physical
+/// model. The old light of intensity 1 is irradiance pi; the old `[ambient]` colour x intensity
+/// is `[shading] ambient`; the old look "whitted" is "enhanced".
+const BASE: &str = r#"renderer = "raster"
+name = "w"
+
+[camera]
+eye = [7.5, 2.3, -4.2]
+target = [4.2, 2.3, -4.2]
+up = [0.0, 1.0, 0.0]
+vfov = 60.0
+near = 0.1
+far = 3000.0
+width = 64
+height = 36
+
+[environment]
+radiance = [0.3, 0.5, 0.9]
+
+[directional_light]
+direction = [-10.0, -13.0, 2.0]
+irradiance = [3.14159265, 3.14159265, 3.14159265]
+angular_radius = 0.0
+
+[materials.floor]
+checker = { even = [0.8, 0.8, 0.0], odd = [0.8, 0.0, 0.0], tile = 1.0 }
+
+[materials.glass]
+dielectric = { ior = 1.4285715 }
+
+[materials.metal]
+mirror = { reflectance = [0.792, 0.863, 0.851] }
+
+[materials.grey]
+albedo = [0.5, 0.5, 0.5]
+
+[[objects]]
+name = "floor"
+material = "floor"
+quad = { corner = [-23.0, 0.0, -7.5], edge_u = [0.0, 0.0, 15.0], edge_v = [30.0, 0.0, 0.0] }
+
+[[objects]]
+name = "glass sphere"
+material = "glass"
+sphere = { center = [4.2, 2.6, -4.2], radius = 1.0 }
+
+[[objects]]
+name = "metal sphere"
+material = "metal"
+sphere = { center = [2.0, 1.9, -2.5], radius = 1.0 }
+
+[shading]
+ambient = [0.23, 0.23, 0.23]
+dielectric = { shininess = 200.0 }
+mirror = { specular = [1.0, 1.0, 1.0], shininess = 30.0, weight = 0.6 }
+
+[raster]
+look = "enhanced"
+pcf_radius = 0.05
+cube_size = 128
+glass_color = [1.0, 1.0, 1.0]
+glass_reflectivity = 0.9
+
+[raster.effects]
+shadows = true
+pcf = false
+refraction = true
+reflection = true
+fresnel = true
+msaa = false
+"#;
+
+/// The glass sphere's `[[objects]]` table of BASE, whole.
+const GLASS_OBJECT: &str = "[[objects]]\nname = \"glass sphere\"\nmaterial = \"glass\"\n\
+                            sphere = { center = [4.2, 2.6, -4.2], radius = 1.0 }\n\n";
+/// The metal sphere's `[[objects]]` table of BASE, whole.
+const METAL_OBJECT: &str = "[[objects]]\nname = \"metal sphere\"\nmaterial = \"metal\"\n\
+                            sphere = { center = [2.0, 1.9, -2.5], radius = 1.0 }\n\n";
+/// The floor's quad line of BASE.
+const FLOOR_QUAD: &str =
+    "quad = { corner = [-23.0, 0.0, -7.5], edge_u = [0.0, 0.0, 15.0], edge_v = [30.0, 0.0, 0.0] }";
+
+/// `BASE` with `from` replaced by `to`; `from` must occur exactly once.
+fn edit(from: &str, to: &str) -> String {
+    edit_text(BASE, from, to)
+}
+
+fn edit_text(text: &str, from: &str, to: &str) -> String {
+    assert_eq!(text.matches(from).count(), 1, "{from:?} must occur once");
+    text.replacen(from, to, 1)
+}
+
+/// `BASE` with `table` (TOML text ending in a newline) appended after the last object.
+fn with_object(table: &str) -> String {
+    edit("[shading]\n", &format!("{table}\n[shading]\n"))
+}
+
+fn parse(text: &str) -> Result<RasterScene, SceneError> {
+    RasterScene::from_toml_str(text, FILE)
+}
+
+fn check_invalid(err: &SceneError, file: &str, field: &str, value: &str, allowed: &str) {
+    let SceneError::Invalid { file: f, field: fd, value: v, allowed: a } = err else {
+        panic!("expected Invalid on {field}, got {err:?}");
+    };
+    assert_eq!((f.as_str(), fd.as_str(), v.as_str()), (file, field, value), "{err}");
+    assert!(a.contains(allowed), "allowed {a:?} lacks {allowed:?}");
+    assert!(err.to_string().starts_with(&format!("{file}: {field} = {value}: ")), "{err}");
+}
+
+fn expect_invalid(text: &str, field: &str, value: &str, allowed: &str) {
+    match parse(text) {
+        Ok(_) => panic!("expected an error on {field} = {value}, but the scene loaded"),
+        Err(e) => check_invalid(&e, FILE, field, value, allowed),
+    }
+}
+
+/// Asserts `text` is a valid scene that the rasterizer refuses because `place` uses `feature`.
+fn expect_unsupported(text: &str, place: &str, feature: Feature) {
+    Scene::from_toml_str(text, FILE).expect("the scene itself is valid");
+    let err = parse(text).expect_err("expected the rasterizer to refuse the scene");
+    let SceneError::Unsupported { file, place: p, feature: f, renderer } = &err else {
+        panic!("expected Unsupported at {place}, got {err:?}");
+    };
+    assert_eq!(
+        (file.as_str(), p.as_str(), f.as_str(), renderer.as_str()),
+        (FILE, place, feature.to_string().as_str(), "rasterizer"),
+        "{err}"
+    );
+    assert_eq!(err.to_string(), format!("{FILE}: {place}: the rasterizer cannot render {feature}"));
+}
+
+/// A scene file of the repository, by its path from the workspace root.
+fn repo_file(name: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join(name)
+}
+
+// ---------------------------------------------------------------------------------------------
+// Loading.
+
+#[test]
+fn base_scene_loads_with_the_written_values() {
+    let s = parse(BASE).unwrap();
+    assert_eq!(s.name, "w");
+    assert_eq!(s.source, FILE);
+    assert_eq!(s.look, Look::Enhanced);
+    assert_eq!((s.camera.width, s.camera.height), (64, 36));
+    assert_eq!((s.clip.near, s.clip.far), (0.1, 3000.0));
+    assert_eq!(s.effects, Effects { pcf: false, msaa: false, ..Effects::ALL_ON });
+    assert_eq!(s.quality.cube_size, 128);
+    assert_eq!(s.quality.pcf_radius, 0.05);
+    assert_eq!(s.background, Vec3::new(0.3, 0.5, 0.9));
+    assert_eq!(s.ambient, Vec3::splat(0.23));
+    let direction = Vec3::new(-10.0, -13.0, 2.0).normalize();
+    assert!(s.light.direction().abs_diff_eq(direction, 1e-6), "{:?}", s.light.direction());
+    assert!((s.light.direction().length() - 1.0).abs() < 1e-6);
+    assert_eq!(s.light.to_light(), -s.light.direction());
+    assert_eq!(s.light.radiance(), Vec3::ONE, "irradiance pi is the old intensity 1");
+
+    let floor = s.floor;
+    assert_eq!(floor.center, Vec3::new(-8.0, 0.0, 0.0));
+    assert_eq!(floor.size, Vec2::new(30.0, 15.0));
+    assert_eq!((floor.min_corner(), floor.max_corner()), (Vec2::new(-23.0, -7.5), Vec2::new(7.0, 7.5)));
+    assert_eq!((floor.height(), floor.tile), (0.0, 1.0));
+    assert_eq!(floor.colors, [Vec3::new(0.8, 0.8, 0.0), Vec3::new(0.8, 0.0, 0.0)]);
+
+    let glass = s.glass.unwrap();
+    assert_eq!((glass.center, glass.radius), (Vec3::new(4.2, 2.6, -4.2), 1.0));
+    assert_eq!((glass.color, glass.reflectivity, glass.shininess), (Vec3::ONE, 0.9, 200.0));
+    // 1.4285715 is the shortest decimal of the f32 nearest 1 / 0.7, whose reciprocal is 0.7f32.
+    assert_eq!(glass.refraction_ratio, 0.7f32);
+    let metal = s.metal.unwrap();
+    assert_eq!((metal.center, metal.radius), (Vec3::new(2.0, 1.9, -2.5), 1.0));
+    assert_eq!(metal.color, Vec3::new(0.792, 0.863, 0.851));
+    assert_eq!((metal.specular, metal.shininess, metal.mirror), (Vec3::ONE, 30.0, 0.6));
+    assert_eq!(s.spheres(), vec![(glass.center, 1.0), (metal.center, 1.0)]);
+}
+
+#[test]
+fn whitted_toml_gives_the_skeletons_numbers_exactly() {
+    let s = RasterScene::load(&repo_file("scenes/whitted.toml")).unwrap();
+    assert_eq!(s.name, "whitted");
+    assert_eq!(s.look, Look::Figure);
+    assert!((s.glass.unwrap().refraction_ratio - 0.7).abs() < 1e-7);
+    // irradiance = 3.14159265 rounds to f32 pi, so irradiance / pi is the skeleton's intensity 1.
+    assert_eq!(s.light.radiance(), Vec3::ONE);
+    assert_eq!(s.ambient, Vec3::splat(0.23));
+    assert_eq!(s.floor.min_corner(), Vec2::new(-23.0, -7.5));
+    assert_eq!(s.floor.size, Vec2::new(30.0, 15.0));
+    assert_eq!(s.metal.unwrap().mirror, 0.6);
+    assert_eq!(s.effects, Effects::ALL_ON);
+    assert_eq!((s.quality.pcf_radius, s.quality.cube_size), (0.05, 256));
+}
+
+/// The skeleton's refraction ratio is 0.7; whitted.toml's `ior = 1.4285714` parses to the f32
+/// 1.4285713, whose reciprocal is 0.70000005. `ior = 1.4285715` (or 1.4285714285714286) would
+/// give 0.7f32 exactly.
+#[test]
+fn whitted_toml_refraction_ratio_is_exactly_the_skeletons() {
+    let s = RasterScene::load(&repo_file("scenes/whitted.toml")).unwrap();
+    assert_eq!(s.glass.unwrap().refraction_ratio, 0.7f32);
+}
+
+#[test]
+fn optional_parts_take_their_defaults() {
+    let mut text = BASE.to_owned();
+    for cut in [
+        "name = \"w\"\n",
+        "angular_radius = 0.0\n",
+        "[environment]\nradiance = [0.3, 0.5, 0.9]\n",
+        "[shading]\nambient = [0.23, 0.23, 0.23]\ndielectric = { shininess = 200.0 }\n\
+         mirror = { specular = [1.0, 1.0, 1.0], shininess = 30.0, weight = 0.6 }\n",
+        "[raster]\nlook = \"enhanced\"\npcf_radius = 0.05\ncube_size = 128\n\
+         glass_color = [1.0, 1.0, 1.0]\nglass_reflectivity = 0.9\n",
+        "[raster.effects]\nshadows = true\npcf = false\nrefraction = true\nreflection = true\n\
+         fresnel = true\nmsaa = false\n",
+    ] {
+        text = edit_text(&text, cut, "");
+    }
+    let s = parse(&text).unwrap();
+    assert_eq!(s.name, "w", "file stem of scenes/w.toml");
+    assert_eq!(s.look, Look::Figure);
+    assert_eq!(s.light.radiance(), Vec3::ONE);
+    assert_eq!(s.background, Vec3::ZERO, "no environment, black background");
+    assert_eq!(s.ambient, Vec3::ZERO, "no [shading] ambient, no ambient light");
+    let glass = s.glass.unwrap();
+    assert_eq!((glass.color, glass.reflectivity, glass.shininess), (Vec3::ONE, 0.9, 200.0));
+    let metal = s.metal.unwrap();
+    assert_eq!((metal.specular, metal.shininess, metal.mirror), (Vec3::ONE, 30.0, 0.6));
+    // The old light's `casts_shadows` is gone: shadows are the effect toggle, on by default.
+    assert_eq!(s.effects, Effects::ALL_ON);
+    assert_eq!((s.quality.pcf_radius, s.quality.cube_size), (0.05, 256));
+}
+
+/// The old test "the two formats refuse each other" has no subject any more: there is one
+/// format. `renderer` is now only the tools' default renderer, so the same text loads as a
+/// `Scene` and as a `RasterScene` whatever it says, and only its spelling is checked.
+#[test]
+fn the_renderer_key_is_only_a_default() {
+    assert_eq!(Scene::from_toml_str(BASE, FILE).unwrap().renderer, RendererKind::Raster);
+    let without = edit("renderer = \"raster\"\n", "");
+    assert_eq!(Scene::from_toml_str(&without, FILE).unwrap().renderer, RendererKind::PathTrace);
+    assert_eq!(parse(&without).unwrap(), parse(BASE).unwrap());
+    let pathtrace = edit("renderer = \"raster\"", "renderer = \"pathtrace\"");
+    assert_eq!(parse(&pathtrace).unwrap(), parse(BASE).unwrap());
+    let other = edit("renderer = \"raster\"", "renderer = \"vulkan\"");
+    expect_invalid(&other, "renderer", "\"vulkan\"", "must be \"raster\" or \"pathtrace\"");
+    let old_word = edit("renderer = \"raster\"", "renderer = \"whitted\"");
+    expect_invalid(&old_word, "renderer", "\"whitted\"", "must be \"raster\" or \"pathtrace\"");
+}
+
+// ---------------------------------------------------------------------------------------------
+// The scene's own validation, at the fields the old format's rules moved to.
+
+#[test]
+fn non_finite_numbers_are_rejected() {
+    let cases = [
+        ("eye = [7.5, 2.3, -4.2]", "eye = [nan, 2.3, -4.2]", "camera.eye"),
+        ("near = 0.1", "near = inf", "camera.near"),
+        ("far = 3000.0", "far = 1e39", "camera.far"),
+        ("direction = [-10.0, -13.0, 2.0]", "direction = [-10.0, inf, 2.0]", "directional_light.direction"),
+        ("irradiance = [3.14159265,", "irradiance = [nan,", "directional_light.irradiance"),
+        ("ambient = [0.23, 0.23, 0.23]", "ambient = [0.23, nan, 0.23]", "shading.ambient"),
+        ("radiance = [0.3, 0.5, 0.9]", "radiance = [0.3, 0.5, -inf]", "environment.radiance"),
+        ("corner = [-23.0, 0.0, -7.5]", "corner = [-23.0, nan, -7.5]", "objects[0] (\"floor\").quad.corner"),
+        ("edge_u = [0.0, 0.0, 15.0]", "edge_u = [0.0, 0.0, inf]", "objects[0] (\"floor\").quad.edge_u"),
+        ("tile = 1.0", "tile = nan", "materials.floor.checker.tile"),
+        (
+            "center = [4.2, 2.6, -4.2], radius = 1.0",
+            "center = [4.2, 2.6, -4.2], radius = nan",
+            "objects[1] (\"glass sphere\").sphere.radius",
+        ),
+        ("ior = 1.4285715", "ior = nan", "materials.glass.dielectric.ior"),
+        (
+            "center = [2.0, 1.9, -2.5]",
+            "center = [2.0, -inf, -2.5]",
+            "objects[2] (\"metal sphere\").sphere.center",
+        ),
+        ("reflectance = [0.792,", "reflectance = [1e39,", "materials.metal.mirror.reflectance"),
+        ("pcf_radius = 0.05", "pcf_radius = nan", "raster.pcf_radius"),
+        ("weight = 0.6", "weight = inf", "shading.mirror.weight"),
+    ];
+    for (from, to, field) in cases {
+        let err = parse(&edit(from, to)).unwrap_err();
+        let SceneError::Invalid { field: f, allowed, .. } = &err else { panic!("{field}: {err:?}") };
+        assert_eq!(f, field, "{err}");
+        assert!(allowed.contains("finite"), "{err}");
+    }
+}
+
+#[test]
+fn camera_rules_are_the_path_tracers() {
+    expect_invalid(&edit("vfov = 60.0", "vfov = 180.0"), "camera.vfov", "180", "open interval (0, 180)");
+    expect_invalid(&edit("width = 64", "width = 0"), "camera.width", "0", "at least 1");
+    expect_invalid(&edit("height = 36", "height = -3"), "camera.height", "-3", "at least 1");
+    expect_invalid(
+        &edit("target = [4.2, 2.3, -4.2]", "target = [7.5, 2.3, -4.2]"),
+        "camera.target",
+        "[7.5, 2.3, -4.2]",
+        "must differ from camera.eye",
+    );
+    expect_invalid(
+        &edit("up = [0.0, 1.0, 0.0]", "up = [-1.0, 0.0, 0.0]"),
+        "camera.up",
+        "[-1, 0, 0]",
+        "not parallel",
+    );
+    expect_invalid(&edit("near = 0.1", "near = 0.0"), "camera.near", "0", "must be > 0");
+    expect_invalid(&edit("far = 3000.0", "far = 0.1"), "camera.far", "0.1", "greater than camera.near = 0.1");
+}
+
+#[test]
+fn geometry_and_material_ranges() {
+    expect_invalid(
+        &edit("center = [4.2, 2.6, -4.2], radius = 1.0", "center = [4.2, 2.6, -4.2], radius = 0.0"),
+        "objects[1] (\"glass sphere\").sphere.radius",
+        "0",
+        "must be > 0",
+    );
+    expect_invalid(
+        &edit("center = [2.0, 1.9, -2.5], radius = 1.0", "center = [2.0, 1.9, -2.5], radius = -1"),
+        "objects[2] (\"metal sphere\").sphere.radius",
+        "-1",
+        "must be > 0",
+    );
+    // The old `floor.size[0] = 0` is a floor quad with a zero edge.
+    expect_invalid(
+        &edit("edge_v = [30.0, 0.0, 0.0]", "edge_v = [0.0, 0.0, 0.0]"),
+        "objects[0] (\"floor\").quad",
+        "{ edge_u = [0, 0, 15], edge_v = [0, 0, 0] }",
+        "must be non-zero and not parallel",
+    );
+    expect_invalid(&edit("tile = 1.0", "tile = 0.0"), "materials.floor.checker.tile", "0", "must be > 0");
+    // 2^-15 is exact in f32, so the value is shown as written: 30 / 2^-15 = 983040 tiles.
+    expect_invalid(
+        &edit("tile = 1.0", "tile = 0.000030517578125"),
+        "materials.floor.checker.tile",
+        "0.000030517578125",
+        "at most 100000 tiles along each edge of a quad it is on (this quad gives 983040)",
+    );
+    // 30 / 3e-4 = 100000 tiles exactly (in f64 of the f32 tile: just under), the limit itself.
+    parse(&edit("tile = 1.0", "tile = 0.0003")).unwrap();
+    expect_invalid(
+        &edit("odd = [0.8, 0.0, 0.0]", "odd = [1.5, 0.0, 0.0]"),
+        "materials.floor.checker.odd",
+        "[1.5, 0, 0]",
+        "every channel must be in [0, 1]",
+    );
+    expect_invalid(
+        &edit("reflectance = [0.792, 0.863, 0.851]", "reflectance = [0.792, -0.1, 0.851]"),
+        "materials.metal.mirror.reflectance",
+        "[0.792, -0.1, 0.851]",
+        "every channel must be in [0, 1]",
+    );
+    // The old `refraction_ratio = 0` is ior 0, refused by the scene for every renderer.
+    expect_invalid(&edit("ior = 1.4285715", "ior = 0"), "materials.glass.dielectric.ior", "0", "must be > 0");
+    expect_invalid(
+        &edit("ior = 1.4285715", "ior = -1.5"),
+        "materials.glass.dielectric.ior",
+        "-1.5",
+        "must be > 0",
+    );
+    expect_invalid(
+        &edit("glass_reflectivity = 0.9", "glass_reflectivity = 1.1"),
+        "raster.glass_reflectivity",
+        "1.1",
+        "[0, 1]",
+    );
+    expect_invalid(
+        &edit("glass_color = [1.0, 1.0, 1.0]", "glass_color = [1.0, 2.0, 1.0]"),
+        "raster.glass_color",
+        "[1, 2, 1]",
+        "[0, 1]",
+    );
+    expect_invalid(&edit("weight = 0.6", "weight = -0.1"), "shading.mirror.weight", "-0.1", "[0, 1]");
+    expect_invalid(
+        &edit("shininess = 30.0", "shininess = 0"),
+        "shading.mirror.shininess",
+        "0",
+        "must be > 0",
+    );
+    expect_invalid(
+        &edit("shininess = 200.0", "shininess = -2"),
+        "shading.dielectric.shininess",
+        "-2",
+        "must be > 0",
+    );
+    expect_invalid(
+        &edit("specular = [1.0, 1.0, 1.0]", "specular = [1.0, 1.0, 1.5]"),
+        "shading.mirror.specular",
+        "[1, 1, 1.5]",
+        "[0, 1]",
+    );
+    expect_invalid(
+        &edit("ambient = [0.23, 0.23, 0.23]", "ambient = [0.23, -0.23, 0.23]"),
+        "shading.ambient",
+        "[0.23, -0.23, 0.23]",
+        ">= 0",
+    );
+    // The old `background.color` is the environment's radiance.
+    expect_invalid(
+        &edit("radiance = [0.3, 0.5, 0.9]", "radiance = [0.3, -0.5, 0.9]"),
+        "environment.radiance",
+        "[0.3, -0.5, 0.9]",
+        ">= 0",
+    );
+    // The old `light.intensity = -1` is a negative irradiance.
+    expect_invalid(
+        &edit("irradiance = [3.14159265, 3.14159265, 3.14159265]", "irradiance = [-1.0, 1.0, 1.0]"),
+        "directional_light.irradiance",
+        "[-1, 1, 1]",
+        ">= 0",
+    );
+    // The old `light.target == light.position` is a zero direction.
+    expect_invalid(
+        &edit("direction = [-10.0, -13.0, 2.0]", "direction = [0.0, 0.0, 0.0]"),
+        "directional_light.direction",
+        "[0, 0, 0]",
+        "must be non-zero",
+    );
+    expect_invalid(&edit("cube_size = 128", "cube_size = 0"), "raster.cube_size", "0", "at least 1");
+    expect_invalid(
+        &edit("cube_size = 128", "cube_size = 4294967296"),
+        "raster.cube_size",
+        "4294967296",
+        "at most 4294967295",
+    );
+    expect_invalid(&edit("pcf_radius = 0.05", "pcf_radius = 0"), "raster.pcf_radius", "0", "must be > 0");
+    expect_invalid(
+        &edit("look = \"enhanced\"", "look = \"photo\""),
+        "raster.look",
+        "\"photo\"",
+        "\"figure\" or \"enhanced\"",
+    );
+    // The old format's second look was "whitted"; the word now names the Whitted ray tracer.
+    expect_invalid(
+        &edit("look = \"enhanced\"", "look = \"whitted\""),
+        "raster.look",
+        "\"whitted\"",
+        "\"figure\" or \"enhanced\"",
+    );
+}
+
+#[test]
+fn shapes_lose_their_old_two_number_forms() {
+    // The old `floor.size` took two numbers and `floor.colors` two colours; now every vector
+    // is three numbers and a checker names both colours, and a wrong shape is a syntax error.
+    for (from, to, needle) in [
+        ("edge_u = [0.0, 0.0, 15.0]", "edge_u = [0.0, 15.0]", "array of three numbers"),
+        ("edge_u = [0.0, 0.0, 15.0]", "edge_u = [0.0, 0.0, 15.0, 1.0]", "length 4"),
+        (
+            "even = [0.8, 0.8, 0.0], odd = [0.8, 0.0, 0.0], ",
+            "even = [0.8, 0.8, 0.0], ",
+            "missing field `odd`",
+        ),
+    ] {
+        let err = parse(&edit(from, to)).unwrap_err();
+        assert!(matches!(err, SceneError::Syntax { .. }), "{err:?}");
+        assert!(err.to_string().contains(needle), "{err}");
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The rasterizer's own rules: what it implements and how the scene must be arranged.
+
+/// Where the old format said "refraction_ratio in (0, 1]", the physical scene allows any
+/// ior > 0; the rasterizer refracts only into a denser medium, so it asks for ior >= 1.
+#[test]
+fn the_glass_must_be_denser_than_air_for_the_rasterizer() {
+    for (ior, ratio) in [("1", 1.0), ("1.0001", 1.0 / 1.0001f32), ("4", 0.25)] {
+        let s = parse(&edit("ior = 1.4285715", &format!("ior = {ior}"))).unwrap();
+        assert_eq!(s.glass.unwrap().refraction_ratio, ratio, "ior = {ior}");
+    }
+    let text = edit("ior = 1.4285715", "ior = 0.5");
+    Scene::from_toml_str(&text, FILE).expect("ior 0.5 is a valid scene for the path tracer");
+    let err = parse(&text).unwrap_err();
+    let SceneError::Invalid { field, value, allowed, .. } = &err else { panic!("{err:?}") };
+    assert_eq!(value, "0.5", "{err}");
+    assert!(allowed.contains("ior must be >= 1"), "{err}");
+    assert!(field.ends_with(".dielectric.ior") && field.contains("glass"), "{err}");
+}
+
+/// The field path of the ior refusal should be the one validation uses, `materials.glass...`;
+/// `RasterScene::from_scene` writes the name with `{:?}`, giving `materials."glass"....`.
+#[test]
+fn the_ior_refusal_names_the_field_as_validation_does() {
+    expect_invalid(
+        &edit("ior = 1.4285715", "ior = 0.5"),
+        "materials.glass.dielectric.ior",
+        "0.5",
+        "ior must be >= 1",
+    );
+}
+
+#[test]
+fn the_camera_must_be_outside_the_spheres_and_the_spheres_apart() {
+    expect_invalid(
+        &edit("eye = [7.5, 2.3, -4.2]", "eye = [4.5, 2.6, -4.2]"),
+        "camera.eye",
+        "[4.5, 2.6, -4.2]",
+        "must lie outside objects[1] (\"glass sphere\") (centre [4.2, 2.6, -4.2], radius 1",
+    );
+    expect_invalid(
+        &edit("center = [2.0, 1.9, -2.5]", "center = [3.5, 2.6, -4.2]"),
+        "objects[2] (\"metal sphere\").sphere.center",
+        "[3.5, 2.6, -4.2]",
+        "must not touch or overlap",
+    );
+    // Touching counts: centres exactly 2 apart along X, radii 1 + 1.
+    expect_invalid(
+        &edit("center = [2.0, 1.9, -2.5]", "center = [2.2, 2.6, -4.2]"),
+        "objects[2] (\"metal sphere\").sphere.center",
+        "[2.2, 2.6, -4.2]",
+        "must not touch or overlap",
+    );
+}
+
+#[test]
+fn spheres_are_optional_and_shadows_are_an_effect() {
+    let glassless = parse(&edit(GLASS_OBJECT, "")).unwrap();
+    assert!(glassless.glass.is_none() && glassless.metal.is_some());
+    assert_eq!(glassless.spheres(), vec![(Vec3::new(2.0, 1.9, -2.5), 1.0)]);
+    let metalless = parse(&edit(METAL_OBJECT, "")).unwrap();
+    assert!(metalless.glass.is_some() && metalless.metal.is_none());
+    let bare = parse(&edit(GLASS_OBJECT, "").replacen(METAL_OBJECT, "", 1)).unwrap();
+    assert!(bare.spheres().is_empty(), "a floor under a light is a scene too");
+
+    // The remaining sphere is still checked: the eye inside the metal, with no glass (the metal
+    // is then objects[1]).
+    let eye_in_metal = edit_text(&edit(GLASS_OBJECT, ""), "eye = [7.5, 2.3, -4.2]", "eye = [2.0, 1.9, -2.4]");
+    let err = parse(&eye_in_metal).unwrap_err();
+    check_invalid(&err, FILE, "camera.eye", "[2, 1.9, -2.4]", "outside objects[1] (\"metal sphere\")");
+
+    // The old light's `casts_shadows = false` is now `[raster.effects] shadows = false`.
+    let unshadowed = parse(&edit("shadows = true", "shadows = false")).unwrap();
+    assert!(!unshadowed.effects.shadows);
+    let err = parse(&edit("shadows = true", "shadows = 0")).unwrap_err();
+    assert!(err.to_string().contains("expected a boolean"), "{err}");
+    let err =
+        parse(&edit("angular_radius = 0.0\n", "angular_radius = 0.0\ncasts_shadows = false\n")).unwrap_err();
+    assert!(err.to_string().contains("unknown field `casts_shadows`"), "{err}");
+}
+
+#[test]
+fn the_cornell_box_is_refused_by_the_rasterizer() {
+    let path = repo_file("scenes/cornell.toml");
+    let scene = Scene::load(&path).unwrap();
+    let err = RasterScene::from_scene(&scene).unwrap_err();
+    let SceneError::Unsupported { place, feature, renderer, .. } = &err else { panic!("{err:?}") };
+    assert_eq!(renderer, "rasterizer", "{err}");
+    assert!(err.to_string().contains("the rasterizer cannot render"), "{err}");
+    // `Scene::require` names the first feature the rasterizer lacks, in file order: the walls
+    // (boxes) come before the light.
+    assert_eq!((place.as_str(), feature.as_str()), ("objects[0] (\"left wall\")", "a box"), "{err}");
+    // The area light is among what it cannot render; alone, it is what the refusal names.
+    let light = scene.features().into_iter().find(|(f, _)| *f == Feature::AreaLight).unwrap();
+    assert_eq!(light.1, "objects[5] (\"light\"), material \"light\"");
+    assert!(!FEATURES.contains(&Feature::AreaLight));
+    let mut lit = scene.clone();
+    lit.objects.retain(|o| !matches!(o.shape, illum_scene::Shape::Box(_)));
+    let err = RasterScene::from_scene(&lit).unwrap_err();
+    let SceneError::Unsupported { place, feature, renderer, .. } = &err else { panic!("{err:?}") };
+    assert_eq!(
+        (place.as_str(), feature.as_str(), renderer.as_str()),
+        (
+            "objects[0] (\"light\"), material \"light\"",
+            "an area light (a quad with an emitting material)",
+            "rasterizer"
+        ),
+        "{err}"
+    );
+}
+
+#[test]
+fn features_the_rasterizer_lacks_are_refused_by_name() {
+    let crate_ = "[[objects]]\nname = \"crate\"\nmaterial = \"grey\"\n\
+                  box = { center = [-5.0, 1.0, 3.0], half_extent = [1.0, 1.0, 1.0] }\n";
+    expect_unsupported(&with_object(crate_), "objects[3] (\"crate\")", Feature::BoxShape);
+
+    let lamp = "[materials.lamp]\nemission = [5.0, 5.0, 5.0]\n\n[[objects]]\nname = \"lamp\"\n\
+                material = \"lamp\"\nquad = { corner = [-5.0, 8.0, -1.0], edge_u = [1.0, 0.0, 0.0], \
+                edge_v = [0.0, 0.0, 1.0] }\n";
+    // The lamp's quad is a quad (which the rasterizer has), its material an area light.
+    expect_unsupported(&with_object(lamp), "objects[3] (\"lamp\"), material \"lamp\"", Feature::AreaLight);
+
+    let sun = edit("angular_radius = 0.0", "angular_radius = 0.5");
+    expect_unsupported(&sun, "[directional_light]", Feature::SunDisc);
+    assert!(Feature::SunDisc.to_string().contains("sun disc"));
+}
+
+#[test]
+fn each_sphere_needs_a_glass_or_mirror_material() {
+    let lambertian = edit_text(METAL_OBJECT, "material = \"metal\"", "material = \"grey\"");
+    expect_invalid(
+        &edit(METAL_OBJECT, &lambertian),
+        "objects[2] (\"metal sphere\").material",
+        "\"grey\"",
+        "the rasterizer draws a sphere only with a dielectric or mirror material",
+    );
+}
+
+#[test]
+fn at_most_one_glass_and_one_metal_sphere() {
+    let glass2 = "[[objects]]\nname = \"glass 2\"\nmaterial = \"glass\"\n\
+                  sphere = { center = [-5.0, 1.0, 3.0], radius = 1.0 }\n";
+    expect_invalid(
+        &with_object(glass2),
+        "objects[3] (\"glass 2\")",
+        "a second dielectric sphere",
+        "at most one glass sphere",
+    );
+    let metal2 = "[[objects]]\nname = \"metal 2\"\nmaterial = \"metal\"\n\
+                  sphere = { center = [-5.0, 1.0, 3.0], radius = 1.0 }\n";
+    expect_invalid(
+        &with_object(metal2),
+        "objects[3] (\"metal 2\")",
+        "a second mirror sphere",
+        "at most one metal sphere",
+    );
+    // Two glass materials are still two glass spheres.
+    let other_glass = "[materials.glass2]\ndielectric = { ior = 1.5 }\n\n[[objects]]\nname = \"flint\"\n\
+                       material = \"glass2\"\n\
+                       sphere = { center = [-5.0, 1.0, 3.0], radius = 1.0 }\n";
+    let err = parse(&with_object(other_glass)).unwrap_err();
+    check_invalid(&err, FILE, "objects[3] (\"flint\")", "a second dielectric sphere", "one glass sphere");
+}
+
+#[test]
+fn the_floor_is_one_horizontal_quad_facing_up_from_its_minimum_corner() {
+    let allowed = "horizontal rectangle facing up (+Y)";
+    let field = "objects[0] (\"floor\").quad";
+    // Tilted: edge_v climbs.
+    expect_invalid(
+        &edit("edge_v = [30.0, 0.0, 0.0]", "edge_v = [30.0, 1.0, 0.0]"),
+        field,
+        "{ corner = [-23, 0, -7.5], edge_u = [0, 0, 15], edge_v = [30, 1, 0] }",
+        allowed,
+    );
+    // Horizontal but its edges not along X and Z.
+    expect_invalid(
+        &edit("edge_v = [30.0, 0.0, 0.0]", "edge_v = [30.0, 0.0, 1.0]"),
+        field,
+        "{ corner = [-23, 0, -7.5], edge_u = [0, 0, 15], edge_v = [30, 0, 1] }",
+        allowed,
+    );
+    // Facing down: the edges swapped, edge_u x edge_v = -Y.
+    let down = "quad = { corner = [-23.0, 0.0, -7.5], edge_u = [30.0, 0.0, 0.0], edge_v = [0.0, 0.0, 15.0] }";
+    Scene::from_toml_str(&edit(FLOOR_QUAD, down), FILE).expect("a valid quad, facing down");
+    expect_invalid(
+        &edit(FLOOR_QUAD, down),
+        field,
+        "{ corner = [-23, 0, -7.5], edge_u = [30, 0, 0], edge_v = [0, 0, 15] }",
+        allowed,
+    );
+    // Facing up, but the corner is the maximum one and the edges point back.
+    let from_max =
+        "quad = { corner = [7.0, 0.0, 7.5], edge_u = [0.0, 0.0, -15.0], edge_v = [-30.0, 0.0, 0.0] }";
+    expect_invalid(
+        &edit(FLOOR_QUAD, from_max),
+        field,
+        "{ corner = [7, 0, 7.5], edge_u = [0, 0, -15], edge_v = [-30, 0, 0] }",
+        "corner at its minimum x and z",
+    );
+    // A floor off the ground is fine.
+    let lower = edit("corner = [-23.0, 0.0, -7.5]", "corner = [-23.0, -1.0, -7.5]");
+    let s = parse(&lower).unwrap();
+    assert_eq!((s.floor.height(), s.floor.min_corner()), (-1.0, Vec2::new(-23.0, -7.5)));
+
+    // One floor, no more, no less.
+    let second = "[[objects]]\nname = \"rug\"\nmaterial = \"floor\"\n\
+                  quad = { corner = [-5.0, 0.5, -1.0], edge_u = [0.0, 0.0, 2.0], edge_v = [2.0, 0.0, 0.0] }\n";
+    expect_invalid(&with_object(second), "objects[3] (\"rug\")", "a second quad", "one quad, the floor");
+    let floor_object = format!("[[objects]]\nname = \"floor\"\nmaterial = \"floor\"\n{FLOOR_QUAD}\n\n");
+    expect_invalid(&edit(&floor_object, ""), "objects", "(missing)", "a floor: one horizontal quad");
+}
+
+#[test]
+fn the_floor_is_checkered_or_plain() {
+    let plain = parse(&edit("material = \"floor\"", "material = \"grey\"")).unwrap();
+    assert_eq!(plain.floor.colors, [Vec3::splat(0.5); 2], "a Lambertian floor is one colour");
+    assert_eq!(plain.floor.tile, 30.0, "one tile covers it");
+    expect_invalid(
+        &edit("material = \"floor\"", "material = \"glass\""),
+        "objects[0] (\"floor\").material",
+        "dielectric",
+        "floor needs a Lambertian or checker material",
+    );
+    expect_invalid(
+        &edit("material = \"floor\"", "material = \"metal\""),
+        "objects[0] (\"floor\").material",
+        "mirror",
+        "floor needs a Lambertian or checker material",
+    );
+}
+
+#[test]
+fn clip_planes_and_a_delta_light_are_required() {
+    let no_clip = edit("near = 0.1\nfar = 3000.0\n", "");
+    assert_eq!(Scene::from_toml_str(&no_clip, FILE).unwrap().clip, None, "the path tracer needs none");
+    expect_invalid(
+        &no_clip,
+        "camera.near",
+        "(missing)",
+        "the rasterizer needs the camera's clip planes near and far",
+    );
+    // One without the other is refused by the scene itself.
+    expect_invalid(&edit("near = 0.1\n", ""), "camera.near", "(missing)", "must be given with camera.far");
+    expect_invalid(&edit("far = 3000.0\n", ""), "camera.far", "(missing)", "must be given with camera.near");
+
+    let no_light = edit(
+        "[directional_light]\ndirection = [-10.0, -13.0, 2.0]\n\
+         irradiance = [3.14159265, 3.14159265, 3.14159265]\nangular_radius = 0.0\n",
+        "",
+    );
+    expect_invalid(&no_light, "directional_light", "(missing)", "the rasterizer needs a directional light");
+    // A black light is still a light.
+    let dark =
+        parse(&edit("irradiance = [3.14159265, 3.14159265, 3.14159265]", "irradiance = [0, 0, 0]")).unwrap();
+    assert_eq!(dark.light.radiance(), Vec3::ZERO);
+}
+
+#[test]
+fn unknown_and_mistyped_keys_are_syntax_errors() {
+    for (from, to, needle) in [
+        ("weight = 0.6 }", "weight = 0.6, roughness = 0.1 }", "unknown field `roughness`"),
+        ("msaa = false", "msaa = false\nbloom = true", "unknown field `bloom`"),
+        ("msaa = false", "msaa = \"no\"", "expected a boolean"),
+        ("cube_size = 128", "cube_size = 12.5", "expected an integer"),
+        ("[raster.effects]", "[raster.effect]", "unknown field `effect`"),
+        ("[shading]", "[shadng]", "unknown field `shadng`"),
+        ("ior = 1.4285715", "refraction_ratio = 0.7", "unknown field `refraction_ratio`"),
+    ] {
+        let err = parse(&edit(from, to)).unwrap_err();
+        assert!(matches!(err, SceneError::Syntax { .. }), "{err:?}");
+        assert!(err.to_string().contains(needle), "{err}");
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// After loading.
+
+#[test]
+fn resolution_overrides_are_checked_and_leave_the_scene_unchanged_on_error() {
+    let base = parse(BASE).unwrap();
+    let mut s = base.clone();
+    s.set_resolution(Some(320), None, "command line").unwrap();
+    assert_eq!((s.camera.width, s.camera.height), (320, 36));
+    s.set_resolution(None, Some(200), "command line").unwrap();
+    assert_eq!((s.camera.width, s.camera.height), (320, 200));
+    for (w, h, field) in [(Some(0), Some(10), "--width"), (Some(10), Some(0), "--height")] {
+        let mut s = base.clone();
+        let err = s.set_resolution(w, h, "command line").unwrap_err();
+        check_invalid(&err, "command line", field, "0", "must be at least 1");
+        assert_eq!(s, base);
+    }
+}
+
+#[test]
+fn device_limits_name_the_limit() {
+    let limits = RasterLimits { max_texture_dimension_2d: 16384, max_buffer_size: 1 << 28 };
+    let mut s = parse(BASE).unwrap();
+    s.check_device_limits(&limits).unwrap();
+    s.camera.width = 16385;
+    let err = s.check_device_limits(&limits).unwrap_err();
+    let label = "scene \"w\"";
+    check_invalid(
+        &err,
+        label,
+        "camera.width",
+        "16385",
+        "at most 16384, the device's max_texture_dimension_2d",
+    );
+    s.camera.width = 64;
+    s.camera.height = 16385;
+    let err = s.check_device_limits(&limits).unwrap_err();
+    check_invalid(&err, label, "camera.height", "16385", "max_texture_dimension_2d");
+    s.camera.height = 36;
+    s.quality.cube_size = 20000;
+    let err = s.check_device_limits(&limits).unwrap_err();
+    check_invalid(&err, label, "raster.cube_size", "20000", "max_texture_dimension_2d");
+    s.quality.cube_size = 16384;
+    s.check_device_limits(&limits).unwrap();
+    // 8192 x 8192 x 4 bytes = 2^28: exactly at the limit; one more row is over it.
+    s.camera.width = 8192;
+    s.camera.height = 8192;
+    s.check_device_limits(&limits).unwrap();
+    s.camera.height = 8193;
+    let err = s.check_device_limits(&limits).unwrap_err();
+    check_invalid(
+        &err,
+        label,
+        "camera.width x camera.height",
+        "8192 x 8193 (268468224 bytes to read back)",
+        "must fit in 268435456 bytes, the device's max_buffer_size",
+    );
+    // Rows are padded to 256 bytes: width 1 reads back 256 bytes per row.
+    let tight = RasterLimits { max_texture_dimension_2d: 16384, max_buffer_size: 256 * 36 };
+    s.camera.width = 1;
+    s.camera.height = 36;
+    s.check_device_limits(&tight).unwrap();
+    s.camera.height = 37;
+    let err = s.check_device_limits(&tight).unwrap_err();
+    check_invalid(
+        &err,
+        label,
+        "camera.width x camera.height",
+        "1 x 37 (9472 bytes to read back)",
+        "9216 bytes",
+    );
+}
