@@ -7,10 +7,10 @@ use clap::Parser;
 use crate::app::Mode;
 
 #[derive(Parser, Debug, Clone)]
-#[command(name = "illum-viewer", about = "Interactive viewer for illum's Whitted raster and path tracer")]
+#[command(name = "illum-viewer", about = "Interactive viewer for illum's rasterizer and path tracer")]
 pub struct Args {
-    /// Scene file (TOML) of either kind: a path-tracer scene or a `renderer = "raster"` scene.
-    /// It opens in its own mode; the other mode keeps its default scene.
+    /// Scene file (TOML). It opens in every mode that can render it and is shown in the mode of
+    /// its `renderer`; a mode that cannot render it keeps its default scene.
     #[arg(default_value = crate::scene_file::DEFAULT_PATHTRACE_SCENE)]
     pub scene: PathBuf,
     /// The mode shown first. Default: the mode of SCENE.
