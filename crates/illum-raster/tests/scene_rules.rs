@@ -10,6 +10,7 @@
 use glam::{Vec2, Vec3};
 use illum_raster::scene::FEATURES;
 use illum_raster::{Effects, Look, RasterLimits, RasterScene};
+use illum_scene::testing::{check_invalid, edit_once as edit_text};
 use illum_scene::{Feature, RendererKind, Scene, SceneError};
 
 const FILE: &str = "scenes/w.toml";
@@ -101,11 +102,6 @@ fn edit(from: &str, to: &str) -> String {
     edit_text(BASE, from, to)
 }
 
-fn edit_text(text: &str, from: &str, to: &str) -> String {
-    assert_eq!(text.matches(from).count(), 1, "{from:?} must occur once");
-    text.replacen(from, to, 1)
-}
-
 /// `BASE` with `table` (TOML text ending in a newline) appended after the last object.
 fn with_object(table: &str) -> String {
     edit("[shading]\n", &format!("{table}\n[shading]\n"))
@@ -113,15 +109,6 @@ fn with_object(table: &str) -> String {
 
 fn parse(text: &str) -> Result<RasterScene, SceneError> {
     RasterScene::from_toml_str(text, FILE)
-}
-
-fn check_invalid(err: &SceneError, file: &str, field: &str, value: &str, allowed: &str) {
-    let SceneError::Invalid { file: f, field: fd, value: v, allowed: a } = err else {
-        panic!("expected Invalid on {field}, got {err:?}");
-    };
-    assert_eq!((f.as_str(), fd.as_str(), v.as_str()), (file, field, value), "{err}");
-    assert!(a.contains(allowed), "allowed {a:?} lacks {allowed:?}");
-    assert!(err.to_string().starts_with(&format!("{file}: {field} = {value}: ")), "{err}");
 }
 
 fn expect_invalid(text: &str, field: &str, value: &str, allowed: &str) {

@@ -73,6 +73,8 @@ use std::fmt;
 use serde::Deserialize;
 use serde::de::{self, Deserializer, SeqAccess, Visitor};
 
+use crate::renderers::Effects;
+
 /// A whole scene file.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -160,7 +162,9 @@ pub(crate) struct RawRaster {
     pub cube_size: Int,
     pub glass_color: RawVec3,
     pub glass_reflectivity: Num,
-    pub effects: RawEffects,
+    /// Read straight into [`Effects`]: plain booleans need no validation, and each absent key
+    /// takes `Effects::default()`'s value (on).
+    pub effects: Effects,
 }
 
 impl Default for RawRaster {
@@ -171,26 +175,8 @@ impl Default for RawRaster {
             cube_size: Int(256),
             glass_color: RawVec3([1.0; 3]),
             glass_reflectivity: Num(0.9),
-            effects: RawEffects::default(),
+            effects: Effects::default(),
         }
-    }
-}
-
-/// Effect toggles; each absent key is on.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub(crate) struct RawEffects {
-    pub shadows: bool,
-    pub pcf: bool,
-    pub refraction: bool,
-    pub reflection: bool,
-    pub fresnel: bool,
-    pub msaa: bool,
-}
-
-impl Default for RawEffects {
-    fn default() -> Self {
-        RawEffects { shadows: true, pcf: true, refraction: true, reflection: true, fresnel: true, msaa: true }
     }
 }
 

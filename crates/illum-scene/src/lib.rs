@@ -41,6 +41,7 @@ mod renderers;
 mod scene;
 mod settings;
 mod shapes;
+pub mod testing;
 mod validate;
 mod validate_sections;
 

@@ -103,8 +103,10 @@ pub enum Look {
 }
 
 /// Effect toggles of the rasterizer. Reflection and Fresnel belong to the enhanced look (the
-/// figure has neither); the others apply to both looks.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+/// figure has neither); the others apply to both looks. In a file (`[raster.effects]`) each
+/// absent key is on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
 pub struct Effects {
     /// Shadows from the directional light (a shadow map; off: no shadow pass at all).
     pub shadows: bool,

@@ -11,7 +11,7 @@ use crate::file::{
 };
 use crate::lights::{DirectionalLight, Environment};
 use crate::renderers::{
-    Bounces, DielectricShading, Effects, Look, MAX_BOUNCES, MAX_WHITTED_AA, MAX_WHITTED_DEPTH, MirrorShading,
+    Bounces, DielectricShading, Look, MAX_BOUNCES, MAX_WHITTED_AA, MAX_WHITTED_DEPTH, MirrorShading,
     PathTraceSettings, RasterSettings, Sampling, Sequence, Shading, WhittedSettings,
 };
 use crate::settings::{LOOK_ALLOWED, UNBOUNDED, bounces_allowed};
@@ -128,17 +128,9 @@ impl Check<'_> {
             .look
             .parse()
             .map_err(|_| self.invalid("raster.look", format!("{:?}", raw.look), LOOK_ALLOWED))?;
-        let e = &raw.effects;
         Ok(RasterSettings {
             look,
-            effects: Effects {
-                shadows: e.shadows,
-                pcf: e.pcf,
-                refraction: e.refraction,
-                reflection: e.reflection,
-                fresnel: e.fresnel,
-                msaa: e.msaa,
-            },
+            effects: raw.effects,
             pcf_radius: self.positive("raster.pcf_radius", raw.pcf_radius)?,
             cube_size: self.u32_at_least("raster.cube_size", raw.cube_size, 1)?,
             glass_color: self.reflectance("raster.glass_color", raw.glass_color)?,

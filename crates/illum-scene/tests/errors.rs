@@ -3,6 +3,7 @@
 //! command-line overrides and device limits.
 
 use glam::Vec3;
+use illum_scene::testing::{check_invalid, edit_once as edit_text};
 use illum_scene::{
     Bounces, DeviceLimits, MAX_BOUNCES, MaterialKind, Overrides, Sampling, Scene, SceneError, Shape,
 };
@@ -58,11 +59,6 @@ fn edit(from: &str, to: &str) -> String {
     edit_text(BASE, from, to)
 }
 
-fn edit_text(text: &str, from: &str, to: &str) -> String {
-    assert_eq!(text.matches(from).count(), 1, "{from:?} must occur once");
-    text.replacen(from, to, 1)
-}
-
 fn parse(text: &str) -> Result<Scene, SceneError> {
     Scene::from_toml_str(text, FILE)
 }
@@ -75,21 +71,6 @@ fn expect_invalid(text: &str, field: &str, value: &str, allowed: &str) {
         Err(e) => e,
     };
     check_invalid(&err, FILE, field, value, allowed);
-}
-
-fn check_invalid(err: &SceneError, file: &str, field: &str, value: &str, allowed: &str) {
-    let SceneError::Invalid { file: f, field: fd, value: v, allowed: a } = err else {
-        panic!("expected Invalid on {field}, got {err:?}");
-    };
-    assert_eq!(f, file, "{err}");
-    assert_eq!(fd, field, "{err}");
-    assert_eq!(v, value, "{err}");
-    assert!(a.contains(allowed), "allowed {a:?} lacks {allowed:?}");
-    let shown = err.to_string();
-    for part in [file, field, value, allowed] {
-        assert!(shown.contains(part), "{shown:?} lacks {part:?}");
-    }
-    assert!(shown.starts_with(&format!("{file}: {field} = {value}: ")), "{shown}");
 }
 
 /// Asserts a syntax error at 1-based (line, column) whose message contains `needle`.

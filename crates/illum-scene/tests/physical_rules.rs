@@ -6,6 +6,7 @@
 //! (`errors.rs` has the camera, shape and path-tracer rules shared with the old format.)
 
 use glam::Vec3;
+use illum_scene::testing::{check_invalid, edit_once as edit_text};
 use illum_scene::{
     Checker, Effects, Feature, Look, MaterialKind, RendererKind, Scene, SceneError, Sequence, Shading,
     WhittedSettings,
@@ -116,11 +117,6 @@ fn edit(from: &str, to: &str) -> String {
     edit_text(BASE, from, to)
 }
 
-fn edit_text(text: &str, from: &str, to: &str) -> String {
-    assert_eq!(text.matches(from).count(), 1, "{from:?} must occur once");
-    text.replacen(from, to, 1)
-}
-
 fn parse(text: &str) -> Result<Scene, SceneError> {
     Scene::from_toml_str(text, FILE)
 }
@@ -138,21 +134,6 @@ fn expect_invalid(text: &str, field: &str, value: &str, allowed: &str) {
         Err(e) => e,
     };
     check_invalid(&err, FILE, field, value, allowed);
-}
-
-fn check_invalid(err: &SceneError, file: &str, field: &str, value: &str, allowed: &str) {
-    let SceneError::Invalid { file: f, field: fd, value: v, allowed: a } = err else {
-        panic!("expected Invalid on {field}, got {err:?}");
-    };
-    assert_eq!(f, file, "{err}");
-    assert_eq!(fd, field, "{err}");
-    assert_eq!(v, value, "{err}");
-    assert!(a.contains(allowed), "allowed {a:?} lacks {allowed:?}");
-    let shown = err.to_string();
-    for part in [file, field, value, allowed] {
-        assert!(shown.contains(part), "{shown:?} lacks {part:?}");
-    }
-    assert!(shown.starts_with(&format!("{file}: {field} = {value}: ")), "{shown}");
 }
 
 /// Asserts a syntax error whose message contains `needle`.
