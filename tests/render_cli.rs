@@ -288,3 +288,33 @@ fn a_signal_before_the_first_complete_pass_writes_nothing_and_says_so() {
         );
     }
 }
+
+/// The examples' executables, found like [`render_binary`].
+fn example_binary(name: &str) -> PathBuf {
+    render_binary().with_file_name(format!("{name}{}", std::env::consts::EXE_SUFFIX))
+}
+
+#[test]
+fn every_examples_help_says_what_it_does_and_documents_each_flag() {
+    for name in ["render", "figures", "convergence", "bench", "raster_bench", "raster_figures"] {
+        let binary = example_binary(name);
+        assert!(binary.exists(), "{} is missing (cargo test builds the examples)", binary.display());
+        let out = Command::new(&binary).arg("--help").output().expect("runs");
+        assert!(out.status.success(), "{name} --help failed");
+        let help = text(&out.stdout);
+        let first = help.lines().next().unwrap_or_default();
+        assert!(!first.starts_with("Usage"), "{name} --help has no description line:\n{help}");
+        // Every flag and argument line has text after its name (clap puts it on the same line).
+        let mut section = "";
+        for line in help.lines() {
+            if line.ends_with(':') && !line.starts_with(' ') {
+                section = line;
+                continue;
+            }
+            if (section == "Options:" || section == "Arguments:") && line.starts_with("  ") {
+                let described = line.trim().split("  ").filter(|part| !part.trim().is_empty()).count() >= 2;
+                assert!(described, "{name}: undocumented: {line:?}\n{help}");
+            }
+        }
+    }
+}
