@@ -304,16 +304,24 @@ fn every_examples_help_says_what_it_does_and_documents_each_flag() {
         let help = text(&out.stdout);
         let first = help.lines().next().unwrap_or_default();
         assert!(!first.starts_with("Usage"), "{name} --help has no description line:\n{help}");
-        // Every flag and argument line has text after its name (clap puts it on the same line).
+        // Every flag and argument has a description: after its name on the same line, or (when
+        // clap wraps a long help) on the next, more indented line.
+        let lines: Vec<&str> = help.lines().collect();
         let mut section = "";
-        for line in help.lines() {
+        for (i, line) in lines.iter().enumerate() {
             if line.ends_with(':') && !line.starts_with(' ') {
                 section = line;
                 continue;
             }
-            if (section == "Options:" || section == "Arguments:") && line.starts_with("  ") {
-                let described = line.trim().split("  ").filter(|part| !part.trim().is_empty()).count() >= 2;
-                assert!(described, "{name}: undocumented: {line:?}\n{help}");
+            let is_entry = line.starts_with("  ") && line.trim_start().starts_with(['-', '[', '<']);
+            if (section == "Options:" || section == "Arguments:") && is_entry {
+                let same_line = line.trim().split("  ").filter(|part| !part.trim().is_empty()).count() >= 2;
+                let next = lines.get(i + 1).copied().unwrap_or_default();
+                let indent = |l: &str| l.len() - l.trim_start().len();
+                let next_line = !next.trim().is_empty()
+                    && indent(next) > indent(line)
+                    && !next.trim_start().starts_with('-');
+                assert!(same_line || next_line, "{name}: undocumented: {line:?}\n{help}");
             }
         }
     }
