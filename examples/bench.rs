@@ -23,6 +23,8 @@ use illum::raster::{Look, Options, bench_frames};
 use illum::scene::{Bounces, Scene};
 
 #[derive(Parser, Debug)]
+#[command(about = "Measure path-tracer throughput (samples/s, rays/s, GPU time per submission; generic \
+             against specialised pipelines) and the Whitted look-alike's frame time")]
 struct Args {
     /// Scene to benchmark.
     #[arg(default_value = cli::DEFAULT_SCENE)]

@@ -26,10 +26,13 @@ struct Args {
     /// Output directory.
     #[arg(long, default_value = "out/figures")]
     out: PathBuf,
+    /// Image width in pixels (default: the scene's).
     #[arg(long)]
     width: Option<u32>,
+    /// Image height in pixels (default: the scene's).
     #[arg(long)]
     height: Option<u32>,
+    /// Random seed (default: the scene's).
     #[arg(long)]
     seed: Option<u32>,
 }

@@ -20,12 +20,16 @@ use illum::raster::{Look, bench_frames};
 use illum::raster_cli::RasterArgs;
 
 #[derive(Parser, Debug)]
+#[command(about = "Measure the Whitted look-alike's frame rate and the GPU time of each pass (shadow, \
+             cube capture, main)")]
 struct Args {
     /// Rasterizer scene file.
     #[arg(default_value = "scenes/whitted.toml")]
     scene: PathBuf,
+    /// Frame width in pixels.
     #[arg(long, default_value_t = 1280)]
     width: u32,
+    /// Frame height in pixels.
     #[arg(long, default_value_t = 720)]
     height: u32,
     /// Timed frames (the median is reported).

@@ -2,8 +2,10 @@
 //! contact sheet of the effect toggles.
 //!
 //! ```text
-//! cargo run --release --example raster_figures -- [--out docs/images]
+//! cargo run --release --example raster_figures -- [--out out/raster-figures]
 //! ```
+//! The default folder is under `out/`, like every example's; `--out docs/images` replaces the
+//! pictures the docs show.
 //! Writes `whitted-figure.png` and `whitted-enhanced.png` (640 x 360) and `whitted-effects.png`
 //! (eight labelled 400 x 225 panels). PNGs are linear, as the assignment's figure 1.
 
@@ -16,9 +18,11 @@ use illum::image::{Encoding, contact_sheet, save_png, save_rgba8_png, to_rgba8};
 use illum::raster::{Effects, Look, Options, RasterRenderer, RasterScene};
 
 #[derive(Parser, Debug)]
+#[command(about = "Render the Whitted look-alike's pictures: both looks, and a contact sheet of the \
+             effect toggles (use --out docs/images to update the docs' copies)")]
 struct Args {
     /// Output folder.
-    #[arg(long, default_value = "docs/images")]
+    #[arg(long, default_value = "out/raster-figures")]
     out: PathBuf,
 }
 

@@ -83,6 +83,48 @@ pub fn main_with<A: clap::Parser>(run: impl FnOnce(A) -> anyhow::Result<()>) {
     }
 }
 
+/// Parses a number of stops for `--exposure`: any finite number, negative ones as typed
+/// (`--exposure -1`; declare the flag with `allow_negative_numbers`).
+pub fn exposure_arg(text: &str) -> Result<f32, String> {
+    match text.trim().parse::<f32>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        _ => Err(format!("{text:?} is not a finite number of stops (for example -1, 0 or 2.5)")),
+    }
+}
+
+/// Parses `--target-error` (see [`illum_pathtrace::parse_target_error`]).
+pub fn target_error_arg(text: &str) -> Result<f64, String> {
+    let value = text.trim().parse::<f64>().map_err(|_| format!("{text:?} is not a number"))?;
+    illum_pathtrace::parse_target_error("--target-error", value)
+}
+
+/// Parses `--time-budget` in seconds (see [`illum_pathtrace::parse_time_budget`]).
+pub fn time_budget_arg(text: &str) -> Result<std::time::Duration, String> {
+    let value = text.trim().parse::<f64>().map_err(|_| format!("{text:?} is not a number of seconds"))?;
+    illum_pathtrace::parse_time_budget("--time-budget", value)
+}
+
+/// Checks every output before any rendering, so that a finished render is never lost to a bad
+/// name: a known extension, a folder that can take the file, not a directory or a read-only
+/// file. `png_flags` are the PNG-only flags given (`--encoding`, `--exposure`): an error when no
+/// output is a PNG, since they would do nothing.
+pub fn check_outputs(outputs: &[PathBuf], png_flags: &[&str]) -> anyhow::Result<()> {
+    let mut any_png = false;
+    for output in outputs {
+        any_png |= output_format(output)? == OutputFormat::Png;
+    }
+    if !any_png && !png_flags.is_empty() {
+        anyhow::bail!(
+            "{} only to PNG output (EXR files are linear and never scaled), and no -o file is a .png",
+            png_flags.join(", ").to_owned() + if png_flags.len() == 1 { " applies" } else { " apply" }
+        );
+    }
+    for output in outputs {
+        illum_image::check_output(output)?;
+    }
+    Ok(())
+}
+
 /// An output file's format, from its extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum OutputFormat {

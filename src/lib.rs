@@ -1,8 +1,10 @@
 //! illum: a Rust + wgpu renderer for the two scenes of an illumination assignment.
 //!
 //! This facade re-exports the workspace crates so that `examples/` and `tests/` can use one name,
-//! and holds the command-line pieces the examples share ([`cli`]).
+//! and holds the command-line pieces the examples share ([`cli`], [`interrupt`], [`progress`]).
 pub mod cli;
+pub mod interrupt;
+pub mod progress;
 pub mod raster_cli;
 
 pub use illum_gpu as gpu;

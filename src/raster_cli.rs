@@ -106,7 +106,8 @@ pub struct RasterRequest<'a> {
     pub outputs: &'a [PathBuf],
     /// PNG encoding; `None`: linear, as the assignment's figure was written.
     pub encoding: Option<Encoding>,
-    pub exposure: f32,
+    /// PNG exposure in stops; `None`: 0.
+    pub exposure: Option<f32>,
     /// Path-tracer-only flags of the example that were given (e.g. "--target-error"): an error.
     pub path_tracer_flags: Vec<&'static str>,
 }
@@ -134,7 +135,7 @@ fn prepare(request: &RasterRequest) -> anyhow::Result<(RasterScene, Options, Vec
         bail!(
             "{}: {} {} only to the path tracer; this render uses the rasterizer (--renderer raster), \
              whose flags are --look, --no-shadows, --no-pcf, --no-refraction, --no-reflection, \
-             --no-fresnel, --no-msaa, --width, --height",
+             --no-fresnel, --no-msaa, --width, --height, --encoding, --exposure, -o",
             request.scene.display(),
             flags.join(", "),
             verb(flags.len())
@@ -148,9 +149,11 @@ fn prepare(request: &RasterRequest) -> anyhow::Result<(RasterScene, Options, Vec
     } else {
         request.outputs.to_vec()
     };
-    for output in &outputs {
-        output_format(output)?;
-    }
+    let png_flags = [(request.encoding.is_some(), "--encoding"), (request.exposure.is_some(), "--exposure")];
+    cli::check_outputs(
+        &outputs,
+        &png_flags.into_iter().filter_map(|(on, f)| on.then_some(f)).collect::<Vec<_>>(),
+    )?;
     Ok((scene, options, outputs))
 }
 
@@ -206,22 +209,21 @@ fn render_prepared(
             t.shadow_ms, t.cube_ms, t.main_ms
         )
     });
+    // The raster's own settings; none of the path tracer's keys (spp, bounces, seed, sampling).
     let metadata = ExrMetadata {
+        renderer: "raster".to_owned(),
         scene: scene.name.clone(),
-        spp: u64::from(options.samples()),
-        bounces: "rasterized".to_owned(),
-        seed: 0,
-        sampling: format!("raster {}", options.look),
         render_seconds: seconds,
-        extra: vec![
-            ("renderer".into(), "raster".into()),
+        fields: vec![
+            ("look".into(), options.look.to_string()),
             ("options".into(), describe(options)),
+            ("msaa_samples".into(), options.samples().to_string()),
             ("adapter".into(), gpu.adapter_info.name.clone()),
         ],
     };
     for output in outputs {
         match output_format(output)? {
-            OutputFormat::Png => save_png(output, &frame.image, request.exposure, encoding)?,
+            OutputFormat::Png => save_png(output, &frame.image, request.exposure.unwrap_or(0.0), encoding)?,
             OutputFormat::Exr => save_exr(output, &frame.image, &metadata)?,
         }
     }

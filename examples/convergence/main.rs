@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! cargo run --release --example convergence -- [SCENE] [--width W --height H] [--bounces B]
-//!     [--spp 1,2,4,...,4096] [--time-budgets 0.5,1,2] [--reference FILE.exr]
+//!     [--seed S] [--spp-list 1,2,4,...,4096] [--time-budgets 0.5,1,2] [--reference FILE.exr]
 //!     [--reference-factor 64] [--bounces-spp 1024] [--out DIR]
 //! ```
 //! For each option (cosine or uniform hemisphere sampling; independent or low-discrepancy
@@ -11,7 +11,9 @@
 //! reference* from the per-pixel variance, and efficiency 1 / (relMSE x time).
 //!
 //! The reference is the given EXR, or a render with `reference-factor` times the largest spp
-//! (default 64x), made once and kept in the output folder for later runs. A second table gives
+//! any row reached (default 64x; time-budget rows included), made once and kept in the output
+//! folder for later runs, under a name derived from everything that changes it (the scene's
+//! content after the flags, the seed, the spp). A second table gives
 //! the mean radiance per bounce count (0 to 8 and unbounded): how the series converges.
 //!
 //! Outputs in DIR: convergence.csv, convergence.md, bounces.csv, and the plots
@@ -23,20 +25,23 @@ use std::fmt::Write as _;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
-use std::time::Duration;
 
 use anyhow::{Context, bail};
 use clap::Parser;
 use illum::cli::{self, SceneArgs};
 use illum::gpu::GpuContext;
 use illum::image::{ExrMetadata, RgbImage32, load_exr, mean_luminance_bias, rel_mse, rmse, save_exr};
-use illum::pathtrace::{PathTracer, Sequence, StopRules, TracerOptions, render_progressive};
+use illum::pathtrace::{
+    PathTracer, Sequence, StopRules, TracerOptions, parse_time_budget, render_progressive,
+};
 use illum::scene::{Bounces, Sampling, Scene};
 use plot::Line;
 
 #[derive(Parser, Debug)]
-#[command(about = "Measure error against time and spp for the path tracer's options")]
+#[command(about = "Measure error against time and spp for the path tracer's options (cosine or uniform \
+             sampling, independent or low-discrepancy numbers), against a reference image")]
 struct Args {
+    /// Scene file (TOML).
     #[arg(default_value = cli::DEFAULT_SCENE)]
     scene: PathBuf,
     #[command(flatten)]
@@ -60,6 +65,7 @@ struct Args {
     /// Samples per pixel for the bounce-count table (0 skips it).
     #[arg(long, default_value_t = 1024)]
     bounces_spp: u32,
+    /// Folder for the tables, plots and the cached reference.
     #[arg(long, default_value = "out/convergence")]
     out: PathBuf,
 }
@@ -81,6 +87,16 @@ const VARIANTS: [Variant; 3] = [
         sequence: Sequence::LowDiscrepancy,
     },
 ];
+
+/// A render taken for a row, before the reference is known.
+struct Taken {
+    variant: &'static str,
+    image: RgbImage32,
+    spp: u64,
+    seconds: f64,
+    samples_per_second: f64,
+    estimated_rel_mse: f64,
+}
 
 struct Row {
     variant: &'static str,
@@ -111,8 +127,18 @@ fn run(mut args: Args) -> anyhow::Result<()> {
     }
     args.spp_list.sort_unstable();
     args.spp_list.dedup();
-    if let Some(bad) = args.time_budgets.iter().find(|t| !(t.is_finite() && **t > 0.0)) {
-        bail!("--time-budgets: {bad} is not a positive number of seconds");
+    let budgets = args
+        .time_budgets
+        .iter()
+        .map(|&t| parse_time_budget("--time-budgets", t))
+        .collect::<Result<Vec<_>, String>>()
+        .map_err(anyhow::Error::msg)?;
+    // Flags this tool sets itself: refuse them rather than ignore them.
+    if args.settings.spp.is_some() {
+        bail!("--spp does not apply here: the rows' spp counts are --spp-list (e.g. --spp-list 1,4,16)");
+    }
+    if args.settings.sampling.is_some() {
+        bail!("--sampling does not apply here: the tool measures both cosine and uniform sampling");
     }
     if args.reference_factor < 1 {
         bail!("--reference-factor = 0: must be at least 1");
@@ -120,18 +146,12 @@ fn run(mut args: Args) -> anyhow::Result<()> {
     let scene = cli::load_scene(&args.scene, &args.settings)?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     let gpu = cli::gpu()?;
-    let max_spp = *args.spp_list.last().expect("checked non-empty");
-    let reference = reference_image(&gpu, &scene, &args, max_spp)?;
     println!(
-        "scene {} at {}x{}, bounces {}; reference mean luminance {:.5}",
-        scene.name,
-        scene.camera.width,
-        scene.camera.height,
-        scene.pathtrace.bounces,
-        reference.mean_luminance()
+        "scene {} at {}x{}, bounces {}",
+        scene.name, scene.camera.width, scene.camera.height, scene.pathtrace.bounces
     );
 
-    let mut rows = Vec::new();
+    let mut taken = Vec::new();
     for variant in VARIANTS {
         let mut variant_scene = scene.clone();
         variant_scene.pathtrace.sampling = variant.sampling;
@@ -142,19 +162,27 @@ fn run(mut args: Args) -> anyhow::Result<()> {
         tracer.reset();
         for &spp in &args.spp_list {
             tracer.render(spp)?;
-            rows.push(measure(variant.name, &tracer, &reference)?);
-            print_row(rows.last().expect("just pushed"));
+            // Time in submissions (readback and f64 fold included), not the measuring between rows.
+            taken.push(take(variant.name, &tracer, tracer.wall_seconds()));
         }
-        for &budget in &args.time_budgets {
+        for &budget in &budgets {
             let mut tracer = PathTracer::with_options(&gpu, &variant_scene, options)?;
             tracer.render(1)?;
             tracer.reset();
-            let rules =
-                StopRules { time_budget: Some(Duration::from_secs_f64(budget)), ..Default::default() };
-            render_progressive(&mut tracer, &rules, &AtomicBool::new(false), |_| {})?;
-            rows.push(measure(variant.name, &tracer, &reference)?);
-            print_row(rows.last().expect("just pushed"));
+            let rules = StopRules { time_budget: Some(budget), ..Default::default() };
+            let (_, progressive) =
+                render_progressive(&mut tracer, &rules, &AtomicBool::new(false), |_, _| {})?;
+            taken.push(take(variant.name, &tracer, progressive.clock().elapsed().as_secs_f64()));
         }
+    }
+    // The reference must out-sample every row it judges, time-budget rows included.
+    let max_spp = taken.iter().map(|t| t.spp).max().unwrap_or(1).min(u64::from(u32::MAX)) as u32;
+    let reference = reference_image(&gpu, &scene, &args, max_spp)?;
+    println!("reference mean luminance {:.5}", reference.mean_luminance());
+    let mut rows = Vec::new();
+    for t in taken {
+        rows.push(measure(t, &reference)?);
+        print_row(rows.last().expect("just pushed"));
     }
     write_tables(&args.out, &rows)?;
     plot_rows(&args.out, &rows)?;
@@ -182,49 +210,66 @@ fn reference_image(gpu: &GpuContext, scene: &Scene, args: &Args, max_spp: u32) -
         return Ok(image);
     }
     let spp = max_spp.saturating_mul(args.reference_factor);
-    let path = args.out.join(format!(
-        "reference-{}-{}x{}-b{}-{}spp.exr",
-        scene.name, scene.camera.width, scene.camera.height, scene.pathtrace.bounces, spp
-    ));
-    if path.exists() {
-        let (image, _) = load_exr(&path)?;
-        println!("reusing reference {}", path.display());
-        return Ok(image);
-    }
-    println!("rendering the reference: {spp} spp (cached as {})", path.display());
     let mut reference_scene = scene.clone();
     reference_scene.pathtrace.sampling = Sampling::Cosine;
+    reference_scene.pathtrace.spp = spp;
     // A seed the measured runs do not use, so reference and test noise are independent.
     reference_scene.pathtrace.seed = scene.pathtrace.seed.wrapping_add(0x5eed);
+    // Everything that changes the reference image: the whole scene as loaded and overridden
+    // (geometry, materials, emission, camera, bounces, seed, spp).
+    let key = format!("{reference_scene:?}");
+    let path = args.out.join(format!("reference-{}-{:016x}.exr", scene.name, fnv1a(key.as_bytes())));
+    if path.exists() {
+        let (image, attributes) = load_exr(&path)?;
+        let stored = ExrMetadata::from_attributes(&path, &attributes)?;
+        if stored.as_ref().and_then(|m| m.get("reference_key")) == Some(key.as_str()) {
+            println!("reusing reference {}", path.display());
+            return Ok(image);
+        }
+        println!("{} was made for other settings: rendering it again", path.display());
+    }
+    println!("rendering the reference: {spp} spp (cached as {})", path.display());
     let mut tracer = PathTracer::new(gpu, &reference_scene)?;
     tracer.render(spp)?;
     let image = tracer.accumulator().mean_image();
-    let metadata = ExrMetadata {
-        scene: scene.name.clone(),
-        spp: spp as u64,
-        bounces: scene.pathtrace.bounces.to_string(),
-        seed: reference_scene.pathtrace.seed,
-        sampling: "cosine".into(),
-        render_seconds: tracer.wall_seconds(),
-        extra: vec![("role".into(), "convergence reference".into())],
-    };
+    let mut metadata = illum::pathtrace::metadata::exr_metadata(
+        &tracer,
+        tracer.wall_seconds(),
+        Some(illum::pathtrace::StopReason::SppReached),
+        "convergence reference",
+    );
+    metadata.fields.push(("reference_key".into(), key));
     save_exr(&path, &image, &metadata)?;
     Ok(image)
 }
 
-fn measure(variant: &'static str, tracer: &PathTracer, reference: &RgbImage32) -> anyhow::Result<Row> {
+/// 64-bit FNV-1a: a stable hash for the cache's file name (the full key is checked on reuse).
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3))
+}
+
+fn take(variant: &'static str, tracer: &PathTracer, seconds: f64) -> Taken {
     let acc = tracer.accumulator();
-    let image = acc.mean_image();
-    let seconds = tracer.wall_seconds();
-    Ok(Row {
+    Taken {
         variant,
+        image: acc.mean_image(),
         spp: acc.min_samples(),
         seconds,
         samples_per_second: acc.total_samples() as f64 / seconds,
-        rmse: rmse(&image, reference)?,
-        rel_mse: rel_mse(&image, reference)?,
-        bias: mean_luminance_bias(&image, reference)?,
         estimated_rel_mse: acc.estimated_rel_mse(),
+    }
+}
+
+fn measure(t: Taken, reference: &RgbImage32) -> anyhow::Result<Row> {
+    Ok(Row {
+        variant: t.variant,
+        spp: t.spp,
+        seconds: t.seconds,
+        samples_per_second: t.samples_per_second,
+        rmse: rmse(&t.image, reference)?,
+        rel_mse: rel_mse(&t.image, reference)?,
+        bias: mean_luminance_bias(&t.image, reference)?,
+        estimated_rel_mse: t.estimated_rel_mse,
     })
 }
 
@@ -251,29 +296,47 @@ fn write_text(path: &Path, text: &str) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// A CSV file from a header and rows, quoted where a field needs it (RFC 4180, by the csv crate).
+fn csv_text(header: &[&str], rows: &[Vec<String>]) -> anyhow::Result<String> {
+    let mut writer = csv::Writer::from_writer(Vec::new());
+    writer.write_record(header)?;
+    for row in rows {
+        writer.write_record(row)?;
+    }
+    Ok(String::from_utf8(writer.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?)?)
+}
+
 fn write_tables(out: &Path, rows: &[Row]) -> anyhow::Result<()> {
-    let mut csv = String::from(
-        "variant,spp,seconds,samples_per_second,rmse,rel_mse,mean_luminance_bias,estimated_rel_mse,estimated_over_true,efficiency\n",
-    );
+    let header = [
+        "variant",
+        "spp",
+        "seconds",
+        "samples_per_second",
+        "rmse",
+        "rel_mse",
+        "mean_luminance_bias",
+        "estimated_rel_mse",
+        "estimated_over_true",
+        "efficiency",
+    ];
+    let mut csv_rows = Vec::new();
     let mut md = String::from(
         "| option | spp | time (s) | Msamples/s | RMSE | relMSE | bias | estimated relMSE | est./true | efficiency |\n|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let ratio = r.estimated_rel_mse / r.rel_mse;
-        writeln!(
-            csv,
-            "{},{},{},{},{},{},{},{},{},{}",
-            r.variant,
-            r.spp,
-            r.seconds,
-            r.samples_per_second,
-            r.rmse,
-            r.rel_mse,
-            r.bias,
-            r.estimated_rel_mse,
-            ratio,
-            r.efficiency()
-        )?;
+        csv_rows.push(vec![
+            r.variant.to_owned(),
+            r.spp.to_string(),
+            r.seconds.to_string(),
+            r.samples_per_second.to_string(),
+            r.rmse.to_string(),
+            r.rel_mse.to_string(),
+            r.bias.to_string(),
+            r.estimated_rel_mse.to_string(),
+            ratio.to_string(),
+            r.efficiency().to_string(),
+        ]);
         writeln!(
             md,
             "| {} | {} | {:.3} | {:.2} | {:.4} | {:.3e} | {:+.4} | {:.3e} | {:.2} | {:.3e} |",
@@ -289,7 +352,7 @@ fn write_tables(out: &Path, rows: &[Row]) -> anyhow::Result<()> {
             r.efficiency()
         )?;
     }
-    write_text(&out.join("convergence.csv"), &csv)?;
+    write_text(&out.join("convergence.csv"), &csv_text(&header, &csv_rows)?)?;
     write_text(&out.join("convergence.md"), &md)
 }
 
@@ -360,7 +423,7 @@ fn plot_rows(out: &Path, rows: &[Row]) -> anyhow::Result<()> {
 
 /// Mean radiance of the image per bounce count: each bounce adds a term of the Neumann series.
 fn bounce_table(gpu: &GpuContext, scene: &Scene, spp: u32, out: &Path) -> anyhow::Result<()> {
-    let mut csv = String::from("bounces,mean_luminance,standard_error,increment\n");
+    let mut csv_rows = Vec::new();
     let mut md = String::from(
         "| bounces | mean luminance | standard error | added by this bounce |\n|---|---|---|---|\n",
     );
@@ -386,7 +449,12 @@ fn bounce_table(gpu: &GpuContext, scene: &Scene, spp: u32, out: &Path) -> anyhow
         mean /= n as f64;
         let standard_error = variance.sqrt() / n as f64;
         let increment = mean - previous;
-        writeln!(csv, "{bounces},{mean},{standard_error},{increment}")?;
+        csv_rows.push(vec![
+            bounces.to_string(),
+            mean.to_string(),
+            standard_error.to_string(),
+            increment.to_string(),
+        ]);
         writeln!(md, "| {bounces} | {mean:.5} | {standard_error:.5} | {increment:+.5} |")?;
         if let Bounces::Fixed(b) = bounces {
             points.push(((b + 1) as f64, increment.max(1e-12)));
@@ -394,7 +462,8 @@ fn bounce_table(gpu: &GpuContext, scene: &Scene, spp: u32, out: &Path) -> anyhow
         previous = mean;
         println!("bounces {bounces:>9}: mean luminance {mean:.5} +- {standard_error:.5}");
     }
-    write_text(&out.join("bounces.csv"), &csv)?;
+    let header = ["bounces", "mean_luminance", "standard_error", "increment"];
+    write_text(&out.join("bounces.csv"), &csv_text(&header, &csv_rows)?)?;
     write_text(&out.join("bounces.md"), &md)?;
     plot::log_log(
         &out.join("bounces.png"),

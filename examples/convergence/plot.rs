@@ -29,6 +29,26 @@ fn register_font() {
     });
 }
 
+/// A short tick label: "1", "20", "0.5", "1e-4", at most 2 significant digits, no trailing
+/// zeros, so that neighbouring labels on a log axis do not run into each other.
+pub fn tick_label(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let magnitude = v.abs().log10().floor() as i32;
+    if (-2..=4).contains(&magnitude) {
+        // Round to 2 significant digits, then print without padding.
+        let scale = 10f64.powi(1 - magnitude);
+        let rounded = (v * scale).round() / scale;
+        let decimals = (1 - magnitude).max(0) as usize;
+        let text = format!("{rounded:.decimals$}");
+        if text.contains('.') { text.trim_end_matches('0').trim_end_matches('.').to_owned() } else { text }
+    } else {
+        let text = format!("{v:.1e}");
+        text.replace(".0e", "e")
+    }
+}
+
 /// Writes a log-log plot to `path` (PNG). Lines of markers share the colour of the solid line
 /// drawn just before them.
 pub fn log_log(path: &Path, title: &str, x_label: &str, y_label: &str, lines: &[Line]) -> anyhow::Result<()> {
@@ -59,8 +79,10 @@ pub fn log_log(path: &Path, title: &str, x_label: &str, y_label: &str, lines: &[
             .x_desc(x_label)
             .y_desc(y_label)
             .label_style(("sans-serif", 14))
-            .x_label_formatter(&|x| format!("{x:.3}"))
-            .y_label_formatter(&|y| format!("{y:.1e}"))
+            .x_labels(8)
+            .y_labels(8)
+            .x_label_formatter(&|x| tick_label(*x))
+            .y_label_formatter(&|y| tick_label(*y))
             .draw()?;
         let mut colour_index = 0;
         for (i, line) in lines.iter().enumerate() {
@@ -95,4 +117,27 @@ pub fn log_log(path: &Path, title: &str, x_label: &str, y_label: &str, lines: &[
     }
     std::fs::rename(&temporary, path)?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::tick_label;
+
+    #[test]
+    fn tick_labels_are_short() {
+        let cases = [
+            (1.0, "1"),
+            (9.0, "9"),
+            (10.0, "10"),
+            (1000.0, "1000"),
+            (0.5, "0.5"),
+            (0.03, "0.03"),
+            (2.5e-4, "2.5e-4"),
+            (1e-5, "1e-5"),
+            (3e6, "3e6"),
+        ];
+        for (v, want) in cases {
+            assert_eq!(tick_label(v), want, "{v}");
+        }
+    }
 }

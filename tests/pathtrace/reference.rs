@@ -9,7 +9,7 @@
 //!
 //! Regenerate with `ILLUM_BLESS=1 cargo test --test pathtrace reference` after an intended change.
 
-use illum::image::{ExrMetadata, load_exr, save_diff_images, save_exr, z_test_pass_fraction};
+use illum::image::{load_exr, save_diff_images, save_exr, z_test_pass_fraction};
 use illum::scene::{Bounces, Overrides};
 
 use crate::common;
@@ -32,14 +32,12 @@ fn check_against_reference(bounces: u32) {
     };
     if std::env::var_os("ILLUM_BLESS").is_some() {
         let tracer = common::render(&common::scene("cornell", overrides(REFERENCE_SPP, 1000)));
-        let metadata = ExrMetadata {
-            scene: "cornell".into(),
-            spp: REFERENCE_SPP as u64,
-            bounces: bounces.to_string(),
-            seed: 1000,
-            sampling: "cosine".into(),
-            ..Default::default()
-        };
+        let metadata = illum::pathtrace::metadata::exr_metadata(
+            &tracer,
+            0.0,
+            Some(illum::pathtrace::StopReason::SppReached),
+            "tests/pathtrace/reference.rs (ILLUM_BLESS)",
+        );
         save_exr(&mean_path, &tracer.accumulator().mean_image(), &metadata).expect("write mean");
         save_exr(&variance_path, &tracer.accumulator().variance_image(), &metadata).expect("write variance");
     }

@@ -14,7 +14,7 @@ fn request<'a>(settings: &'a SceneArgs, raster: &'a RasterArgs, outputs: &'a [Pa
         raster,
         outputs,
         encoding: None,
-        exposure: 0.0,
+        exposure: None,
         path_tracer_flags: Vec::new(),
     }
 }

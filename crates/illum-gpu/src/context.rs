@@ -4,6 +4,7 @@ use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use crate::error::GpuError;
+use crate::policy;
 
 /// How long any single wait for the GPU may take before it is reported as a hang. Submissions are
 /// kept to a fraction of a second, so this is only reached when something is badly wrong.
@@ -31,43 +32,28 @@ pub struct GpuContext {
 impl GpuContext {
     /// Creates a headless device.
     ///
-    /// Backends come from `WGPU_BACKEND` (default: Vulkan, Metal and DX12; GL is left out because
-    /// the path tracer needs compute). `WGPU_ADAPTER_NAME` picks an adapter by case-insensitive
-    /// substring. Otherwise a hardware adapter is preferred, and under CI (`CI` set) lavapipe is
-    /// preferred so that reference images are compared on the driver that made them.
+    /// Backends, adapter, features and limits follow [`crate::policy`]: `WGPU_BACKEND` (default:
+    /// Vulkan, Metal and DX12), `WGPU_ADAPTER_NAME`, a hardware adapter first except under CI
+    /// (`CI` set), where lavapipe is preferred.
     pub fn new() -> Result<Self, GpuError> {
         pollster::block_on(Self::new_async())
     }
 
     async fn new_async() -> Result<Self, GpuError> {
         let mut instance_desc = wgpu::InstanceDescriptor::new_without_display_handle();
-        instance_desc.backends = wgpu::Backends::VULKAN | wgpu::Backends::METAL | wgpu::Backends::DX12;
+        instance_desc.backends = policy::backends();
+        // Other WGPU_* variables (validation flags, DX12 compiler, ...) as wgpu reads them.
         let instance_desc = instance_desc.with_env();
         let backends = instance_desc.backends;
         let instance = wgpu::Instance::new(instance_desc);
 
         let adapters = instance.enumerate_adapters(backends).await;
-        let adapter = choose_adapter(adapters, backends)?;
+        let adapter = policy::choose_adapter(adapters, backends, policy::prefer_software_from_env())?;
         let info = adapter.get_info();
         log::info!("GPU adapter: {} ({:?}, {})", info.name, info.backend, info.driver);
 
-        let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
-        let mut required_features = wgpu::Features::empty();
-        if timestamps {
-            required_features |= wgpu::Features::TIMESTAMP_QUERY;
-        }
-        // Ask for everything the adapter offers: large storage buffers and textures are what let
-        // big renders proceed, and the resolution check reports against these same limits.
-        let required_limits = adapter.limits();
         let (device, queue) = adapter
-            .request_device(&wgpu::DeviceDescriptor {
-                label: Some("illum device"),
-                required_features,
-                required_limits,
-                experimental_features: wgpu::ExperimentalFeatures::disabled(),
-                memory_hints: wgpu::MemoryHints::Performance,
-                trace: wgpu::Trace::Off,
-            })
+            .request_device(&policy::device_descriptor(&adapter, "illum device"))
             .await
             .map_err(|e| GpuError::RequestDevice { adapter: info.name.clone(), message: e.to_string() })?;
         Ok(Self::from_device(device, queue, info))
@@ -157,41 +143,4 @@ fn convert_error(context: &str, error: wgpu::Error) -> GpuError {
             GpuError::Validation { context: context.to_owned(), message: description }
         }
     }
-}
-
-fn choose_adapter(adapters: Vec<wgpu::Adapter>, backends: wgpu::Backends) -> Result<wgpu::Adapter, GpuError> {
-    if adapters.is_empty() {
-        return Err(GpuError::NoAdapter { backends: format!("{backends:?}") });
-    }
-    let describe = |adapters: &[wgpu::Adapter]| {
-        adapters
-            .iter()
-            .map(|a| {
-                let info = a.get_info();
-                format!("{:?} ({:?})", info.name, info.backend)
-            })
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
-    if let Ok(wanted) = std::env::var("WGPU_ADAPTER_NAME") {
-        let needle = wanted.to_lowercase();
-        let available = describe(&adapters);
-        return adapters
-            .into_iter()
-            .find(|a| a.get_info().name.to_lowercase().contains(&needle))
-            .ok_or(GpuError::AdapterNotFound { wanted, available });
-    }
-    let under_ci = std::env::var_os("CI").is_some();
-    let rank = |a: &wgpu::Adapter| {
-        let t = a.get_info().device_type;
-        let software = t == wgpu::DeviceType::Cpu;
-        match (under_ci, software, t) {
-            (true, true, _) => 0,
-            (_, false, wgpu::DeviceType::DiscreteGpu) => 1,
-            (_, false, wgpu::DeviceType::IntegratedGpu) => 2,
-            (_, false, _) => 3,
-            (false, true, _) => 4,
-        }
-    };
-    Ok(adapters.into_iter().min_by_key(rank).expect("checked non-empty above"))
 }

@@ -3,12 +3,14 @@
 //! - [`GpuContext`]: instance, adapter and device creation that works headless on Mesa lavapipe,
 //!   honours `WGPU_BACKEND` / `WGPU_ADAPTER_NAME`, and turns "no adapter", device loss and
 //!   validation errors into [`GpuError`]s instead of panics or hangs.
+//! - [`policy`]: the backends, adapter choice, features and limits, shared with the viewer.
 //! - [`readback`]: copy a GPU buffer back to the CPU.
 //! - [`timing`]: GPU pass timing with timestamp queries, where the adapter has them.
 //! - [`shader`]: WGSL composition (naga_oil) and validation.
 
 mod context;
 mod error;
+pub mod policy;
 pub mod readback;
 pub mod shader;
 pub mod timing;

@@ -12,24 +12,40 @@ use std::path::{Path, PathBuf};
 
 use crate::ImageError;
 
-/// Writes `path` atomically. `write` receives the temporary file (seekable, as some encoders
-/// need); it should write the whole content and may return any [`ImageError`], which is
-/// passed on after the temporary file has been removed. The parent directory is created if
-/// it is missing.
-pub fn write_atomically<F>(path: impl AsRef<Path>, write: F) -> Result<(), ImageError>
-where
-    F: FnOnce(&mut File) -> Result<(), ImageError>,
-{
-    let path = path.as_ref();
+/// The target's folder ("." for a bare file name) and its file name, after the checks every
+/// output needs: the path names a file, is not an existing directory, and is not a read-only
+/// file (the rename would silently replace it).
+fn target_parts(path: &Path) -> Result<(PathBuf, &std::ffi::OsStr), ImageError> {
     let file_name = path
         .file_name()
         .ok_or_else(|| ImageError::invalid(path, "the path names no file (it is empty or ends in '..')"))?;
+    if let Ok(metadata) = std::fs::metadata(path) {
+        if metadata.is_dir() {
+            return Err(ImageError::invalid(
+                path,
+                "it is a directory; give a file name ending in .png or .exr",
+            ));
+        }
+        if metadata.permissions().readonly() {
+            return Err(ImageError::invalid(
+                path,
+                "the file exists and is read-only; illum does not replace read-only files \
+                 (make it writable, or choose another name)",
+            ));
+        }
+    }
     let dir: PathBuf = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
     };
-    std::fs::create_dir_all(&dir).map_err(|e| ImageError::io(&dir, "creating the output directory", e))?;
+    Ok((dir, file_name))
+}
 
+/// Creates the temporary file next to `path` that [`write_atomically`] writes into (creating
+/// the folder if it is missing).
+fn temporary_next_to(path: &Path) -> Result<tempfile::NamedTempFile, ImageError> {
+    let (dir, file_name) = target_parts(path)?;
+    std::fs::create_dir_all(&dir).map_err(|e| ImageError::io(path, "creating the folder", e))?;
     // A dot-prefixed name that shows what it will become, e.g. ".render.png.a1B2c3.tmp".
     let mut prefix = std::ffi::OsString::from(".");
     prefix.push(file_name);
@@ -37,16 +53,41 @@ where
     let mut builder = tempfile::Builder::new();
     builder.prefix(&prefix).suffix(".tmp");
     // tempfile creates files readable by the owner only; output images should get the usual
-    // permissions (0o666 less the umask), as a plain `File::create` would give them.
+    // permissions (0o666 less the umask), as a plain `File::create` would give them, or those
+    // of the file they replace.
     #[cfg(unix)]
     {
         use std::os::unix::fs::PermissionsExt;
-        builder.permissions(std::fs::Permissions::from_mode(0o666));
+        match std::fs::metadata(path) {
+            Ok(existing) => builder.permissions(existing.permissions()),
+            Err(_) => builder.permissions(std::fs::Permissions::from_mode(0o666)),
+        };
     }
-    // From here on, dropping `tmp` (on any early return) deletes the temporary file.
-    let mut tmp = builder
+    builder
         .tempfile_in(&dir)
-        .map_err(|e| ImageError::io(path, "creating a temporary file next to the output", e))?;
+        .map_err(|e| ImageError::io(path, "creating a temporary file next to the output", e))
+}
+
+/// Checks, before a long render, that [`write_atomically`] will be able to write `path`: it
+/// names a file that is not a directory and not read-only, and a file can be created in its
+/// folder (which is created if it is missing). Nothing is left behind but the folder.
+pub fn check_output(path: impl AsRef<Path>) -> Result<(), ImageError> {
+    temporary_next_to(path.as_ref()).map(drop)
+}
+
+/// Writes `path` atomically. `write` receives the temporary file (seekable, as some encoders
+/// need); it should write the whole content and may return any [`ImageError`], which is
+/// passed on after the temporary file has been removed. The parent directory is created if
+/// it is missing. An existing file is replaced and keeps its permissions; a read-only one is
+/// refused, and so is a directory.
+pub fn write_atomically<F>(path: impl AsRef<Path>, write: F) -> Result<(), ImageError>
+where
+    F: FnOnce(&mut File) -> Result<(), ImageError>,
+{
+    let path = path.as_ref();
+    // From here on, dropping `tmp` (on any early return) deletes the temporary file.
+    let mut tmp = temporary_next_to(path)?;
+    let (dir, _) = target_parts(path)?;
 
     write(tmp.as_file_mut())?;
 
@@ -56,6 +97,13 @@ where
     // file with missing data on some file systems.
     file.sync_all().map_err(|e| ImageError::io(path, "syncing the temporary file to disk", e))?;
 
+    // Keep the mode of the file being replaced exactly (creating the temporary file applied
+    // the umask to it).
+    if let Ok(existing) = std::fs::metadata(path) {
+        tmp.as_file()
+            .set_permissions(existing.permissions())
+            .map_err(|e| ImageError::io(path, "giving the new file the old one's permissions", e))?;
+    }
     tmp.persist(path).map_err(|e| {
         // `e.file` is the temporary file; dropping it with `e` deletes it.
         ImageError::io(path, "renaming the temporary file onto the output", e.error)
@@ -142,6 +190,45 @@ mod tests {
         std::fs::File::create(&plain).unwrap();
         let plain_mode = std::fs::metadata(&plain).unwrap().permissions().mode() & 0o777;
         assert_eq!(mode, plain_mode, "atomic {mode:o} vs plain {plain_mode:o}");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_replaced_file_keeps_its_mode_and_a_read_only_one_is_refused() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("kept.bin");
+        std::fs::write(&target, b"old").unwrap();
+        std::fs::set_permissions(&target, std::fs::Permissions::from_mode(0o640)).unwrap();
+        write_atomically(&target, |f| f.write_all(b"new").map_err(|e| ImageError::io("x", "writing", e)))
+            .unwrap();
+        assert_eq!(std::fs::metadata(&target).unwrap().permissions().mode() & 0o777, 0o640);
+
+        std::fs::set_permissions(&target, std::fs::Permissions::from_mode(0o444)).unwrap();
+        for err in [check_output(&target).unwrap_err(), write_atomically(&target, |_| Ok(())).unwrap_err()] {
+            assert!(
+                err.to_string().contains("kept.bin") && format!("{err:?}").contains("read-only"),
+                "{err:?}"
+            );
+        }
+        assert_eq!(std::fs::read(&target).unwrap(), b"new");
+        assert_eq!(std::fs::metadata(&target).unwrap().permissions().mode() & 0o777, 0o444);
+    }
+
+    #[test]
+    fn check_output_refuses_directories_and_unwritable_folders_and_leaves_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        let err = check_output(dir.path()).unwrap_err();
+        assert!(format!("{err:?}").contains("is a directory"), "{err:?}");
+        // A folder that cannot exist: its parent is a file.
+        let file = dir.path().join("plain");
+        std::fs::write(&file, b"x").unwrap();
+        let err = check_output(file.join("out.png")).unwrap_err();
+        assert!(matches!(err, ImageError::Io { .. }), "{err:?}");
+        let fine = dir.path().join("new/out.png");
+        check_output(&fine).unwrap();
+        assert!(!fine.exists());
+        assert!(entries(&dir.path().join("new")).is_empty(), "the probe left a file");
     }
 
     #[test]

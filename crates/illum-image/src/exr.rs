@@ -23,46 +23,41 @@ use crate::rgb_image::RgbImage32;
 /// Prefix of every attribute illum writes.
 pub const ATTRIBUTE_PREFIX: &str = "illum.";
 
-/// Names (without [`ATTRIBUTE_PREFIX`]) of the fixed fields of [`ExrMetadata`].
-const FIELD_NAMES: [&str; 6] = ["scene", "spp", "bounces", "seed", "sampling", "render_seconds"];
+/// Names (without [`ATTRIBUTE_PREFIX`]) of the fields every illum EXR has.
+const FIELD_NAMES: [&str; 3] = ["renderer", "scene", "render_seconds"];
 
-/// The settings a render was made with, stored in its EXR file.
+/// What made an image, stored in its EXR file: the fields every renderer has, and the
+/// renderer's own settings and results (a path tracer's spp and bounces mean nothing for a
+/// rasterized image, so they are not fixed fields).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct ExrMetadata {
-    /// The scene file or scene name.
+    /// The renderer that made the image (`pathtrace`, `raster`).
+    pub renderer: String,
+    /// The scene's name.
     pub scene: String,
-    /// Samples per pixel accumulated in the image.
-    pub spp: u64,
-    /// The path-length setting, as the user gave it (e.g. "5" or "0..=5").
-    pub bounces: String,
-    /// The seed of the random number streams.
-    pub seed: u32,
-    /// The sampling strategy (e.g. "nee", "bsdf", "mis").
-    pub sampling: String,
     /// Wall-clock render time in seconds (a record, never asserted on).
     pub render_seconds: f64,
-    /// Further settings, each stored as `illum.<key>`. Read back sorted by key.
-    pub extra: Vec<(String, String)>,
+    /// The renderer's settings and results, each stored as `illum.<key>`. Read back sorted by
+    /// key.
+    pub fields: Vec<(String, String)>,
 }
 
 impl ExrMetadata {
+    /// The value of one of [`Self::fields`].
+    pub fn get(&self, key: &str) -> Option<&str> {
+        self.fields.iter().find(|(k, _)| k == key).map(|(_, v)| v.as_str())
+    }
+
     /// The attributes this metadata is stored as: full names (with [`ATTRIBUTE_PREFIX`]) and
     /// text values. Numbers are written in Rust's shortest round-trip form, so they parse
     /// back to the same value.
     pub fn to_attributes(&self) -> Vec<(String, String)> {
-        let fixed = [
-            self.scene.clone(),
-            self.spp.to_string(),
-            self.bounces.clone(),
-            self.seed.to_string(),
-            self.sampling.clone(),
-            self.render_seconds.to_string(),
-        ];
+        let fixed = [self.renderer.clone(), self.scene.clone(), self.render_seconds.to_string()];
         FIELD_NAMES
             .iter()
             .zip(fixed)
             .map(|(name, value)| (format!("{ATTRIBUTE_PREFIX}{name}"), value))
-            .chain(self.extra.iter().map(|(k, v)| (format!("{ATTRIBUTE_PREFIX}{k}"), v.clone())))
+            .chain(self.fields.iter().map(|(k, v)| (format!("{ATTRIBUTE_PREFIX}{k}"), v.clone())))
             .collect()
     }
 
@@ -91,31 +86,24 @@ impl ExrMetadata {
                 ),
             })
         };
-        fn parse<T: std::str::FromStr>(
-            path: &Path,
-            field: &str,
-            value: &str,
-            allowed: &str,
-        ) -> Result<T, ImageError> {
-            value.trim().parse().map_err(|_| ImageError::BadContent {
-                path: path.to_path_buf(),
-                reason: format!("attribute '{ATTRIBUTE_PREFIX}{field}' is '{value}'; expected {allowed}"),
-            })
-        }
-        let mut extra: Vec<(String, String)> = ours
+        let seconds = get("render_seconds")?;
+        let render_seconds = seconds.trim().parse().map_err(|_| ImageError::BadContent {
+            path: path.to_path_buf(),
+            reason: format!(
+                "attribute '{ATTRIBUTE_PREFIX}render_seconds' is '{seconds}'; expected a number of seconds"
+            ),
+        })?;
+        let mut fields: Vec<(String, String)> = ours
             .iter()
             .filter(|(k, _)| !FIELD_NAMES.contains(k))
             .map(|(k, v)| ((*k).to_owned(), (*v).to_owned()))
             .collect();
-        extra.sort();
+        fields.sort();
         Ok(Some(ExrMetadata {
+            renderer: get("renderer")?.to_owned(),
             scene: get("scene")?.to_owned(),
-            spp: parse(path, "spp", get("spp")?, "a whole number >= 0")?,
-            bounces: get("bounces")?.to_owned(),
-            seed: parse(path, "seed", get("seed")?, "a whole number in 0..=4294967295")?,
-            sampling: get("sampling")?.to_owned(),
-            render_seconds: parse(path, "render_seconds", get("render_seconds")?, "a number of seconds")?,
-            extra,
+            render_seconds,
+            fields,
         }))
     }
 }
@@ -270,13 +258,14 @@ mod tests {
 
     fn metadata() -> ExrMetadata {
         ExrMetadata {
+            renderer: "pathtrace".into(),
             scene: "scenes/cornell.toml — Ünïcode".into(),
-            spp: 1 << 40,
-            bounces: "0..=5".into(),
-            seed: u32::MAX,
-            sampling: "nee".into(),
             render_seconds: 12.345_678_901_234_5,
-            extra: vec![("adapter".into(), "llvmpipe (LLVM 19)".into()), ("a".into(), String::new())],
+            fields: vec![
+                ("spp".into(), (1u64 << 40).to_string()),
+                ("adapter".into(), "llvmpipe (LLVM 19)".into()),
+                ("a".into(), String::new()),
+            ],
         }
     }
 
@@ -310,7 +299,8 @@ mod tests {
         assert!(attrs.contains(&("illum.spp".to_string(), "1099511627776".to_string())), "{attrs:?}");
         let parsed = ExrMetadata::from_attributes(&path, &attrs).unwrap().unwrap();
         let mut expected = meta;
-        expected.extra.sort();
+        expected.fields.sort();
+        assert_eq!(parsed.get("adapter"), Some("llvmpipe (LLVM 19)"));
         assert_eq!(parsed, expected);
     }
 
@@ -346,13 +336,13 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("dup.exr");
         let mut meta = metadata();
-        meta.extra.push(("spp".into(), "3".into()));
+        meta.fields.push(("scene".into(), "3".into()));
         let err = save_exr(&path, &RgbImage32::new(1, 1), &meta).unwrap_err().to_string();
-        assert!(err.contains("dup.exr") && err.contains("'illum.spp' is given twice"), "{err}");
+        assert!(err.contains("dup.exr") && err.contains("'illum.scene' is given twice"), "{err}");
         assert!(!path.exists());
 
         let mut meta = metadata();
-        meta.extra.push(("k".repeat(300), "v".into()));
+        meta.fields.push(("k".repeat(300), "v".into()));
         let err = save_exr(&path, &RgbImage32::new(1, 1), &meta).unwrap_err().to_string();
         assert!(err.contains("at most 255"), "{err}");
     }
@@ -361,12 +351,12 @@ mod tests {
     fn unparsable_or_missing_fields_are_reported() {
         let attrs = ExrMetadata::default().to_attributes();
         let mut bad = attrs.clone();
-        bad.iter_mut().find(|(k, _)| k == "illum.spp").unwrap().1 = "many".into();
+        bad.iter_mut().find(|(k, _)| k == "illum.render_seconds").unwrap().1 = "many".into();
         let err = ExrMetadata::from_attributes("x.exr", &bad).unwrap_err().to_string();
-        assert!(err.contains("x.exr") && err.contains("'illum.spp' is 'many'"), "{err}");
+        assert!(err.contains("x.exr") && err.contains("'illum.render_seconds' is 'many'"), "{err}");
 
-        let partial: Vec<_> = attrs.into_iter().filter(|(k, _)| k != "illum.seed").collect();
+        let partial: Vec<_> = attrs.into_iter().filter(|(k, _)| k != "illum.renderer").collect();
         let err = ExrMetadata::from_attributes("x.exr", &partial).unwrap_err().to_string();
-        assert!(err.contains("'illum.seed' is missing"), "{err}");
+        assert!(err.contains("'illum.renderer' is missing"), "{err}");
     }
 }

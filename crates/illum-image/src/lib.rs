@@ -22,7 +22,7 @@ pub mod tonemap;
 
 use std::path::PathBuf;
 
-pub use atomic::write_atomically;
+pub use atomic::{check_output, write_atomically};
 pub use contact_sheet::contact_sheet;
 pub use diff::{DiffImages, save_diff_images};
 pub use exr::{ExrMetadata, load_exr, save_exr};

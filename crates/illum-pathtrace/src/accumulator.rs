@@ -17,7 +17,50 @@ pub struct Accumulator {
     sum: Vec<[f64; 3]>,
     sum_sq: Vec<[f64; 3]>,
     count: Vec<u64>,
+    /// Sum of `count`, kept as batches are folded so that reading it does not cost a pass over
+    /// the image (progress reports read it after every band).
+    total: u64,
     dropped: u64,
+}
+
+/// Host bytes per pixel of the f64 statistics: sum and sum of squares (3 x f64 each) and the
+/// sample count (u64).
+pub const STATISTICS_BYTES_PER_PIXEL: u64 = 56;
+const _: () = assert!(
+    STATISTICS_BYTES_PER_PIXEL as usize == 2 * std::mem::size_of::<[f64; 3]>() + std::mem::size_of::<u64>()
+);
+
+/// Host bytes per pixel a whole render needs at its peak: the statistics, the f32 mean image
+/// written to files (12) and an 8-bit PNG's pixels (3).
+pub const RENDER_HOST_BYTES_PER_PIXEL: u64 = STATISTICS_BYTES_PER_PIXEL + 12 + 3;
+
+/// Checks, before anything is allocated, that a `width x height` render fits in `available`
+/// bytes of host memory (`None`: unknown, not checked). The error says how much it would need.
+pub fn check_host_memory(width: u32, height: u32, available: Option<u64>) -> Result<(), String> {
+    let needed = u64::from(width) * u64::from(height) * RENDER_HOST_BYTES_PER_PIXEL;
+    match available {
+        Some(available) if needed > available => Err(format!(
+            "camera.width x camera.height = {width} x {height}: the render needs {:.1} GiB of host memory \
+             ({RENDER_HOST_BYTES_PER_PIXEL} bytes per pixel: f64 statistics and the output image), \
+             but only {:.1} GiB are available",
+            gib(needed),
+            gib(available)
+        )),
+        _ => Ok(()),
+    }
+}
+
+fn gib(bytes: u64) -> f64 {
+    bytes as f64 / (1u64 << 30) as f64
+}
+
+/// Host memory available to a new allocation without swapping (Linux: `MemAvailable` in
+/// /proc/meminfo); `None` where that is not known.
+pub fn available_host_memory() -> Option<u64> {
+    let meminfo = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = meminfo.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
 }
 
 impl Accumulator {
@@ -29,6 +72,7 @@ impl Accumulator {
             sum: vec![[0.0; 3]; n],
             sum_sq: vec![[0.0; 3]; n],
             count: vec![0; n],
+            total: 0,
             dropped: 0,
         }
     }
@@ -37,7 +81,7 @@ impl Accumulator {
     /// allocate them (a very large image: 56 bytes per pixel).
     pub fn try_new(width: u32, height: u32) -> Result<Self, u64> {
         let n = width as usize * height as usize;
-        let bytes = n as u64 * (2 * std::mem::size_of::<[f64; 3]>() + std::mem::size_of::<u64>()) as u64;
+        let bytes = n as u64 * STATISTICS_BYTES_PER_PIXEL;
         let mut sum = Vec::new();
         let mut sum_sq = Vec::new();
         let mut count = Vec::new();
@@ -47,7 +91,7 @@ impl Accumulator {
         sum.resize(n, [0.0; 3]);
         sum_sq.resize(n, [0.0; 3]);
         count.resize(n, 0);
-        Ok(Self { width, height, sum, sum_sq, count, dropped: 0 })
+        Ok(Self { width, height, sum, sum_sq, count, total: 0, dropped: 0 })
     }
 
     /// Folds one batch for consecutive pixels starting at `first_pixel`. `sums[i]` is (sum, finite
@@ -60,6 +104,7 @@ impl Accumulator {
                 self.sum_sq[p][c] += q[c] as f64;
             }
             self.count[p] += s[3] as u64;
+            self.total += s[3] as u64;
             self.dropped += q[3] as u64;
         }
     }
@@ -74,8 +119,9 @@ impl Accumulator {
         self.count.iter().copied().min().unwrap_or(0)
     }
 
+    /// Finite samples over all pixels (kept as a running total: constant time).
     pub fn total_samples(&self) -> u64 {
-        self.count.iter().sum()
+        self.total
     }
 
     /// Sum of the pixel's finite samples, per channel.
@@ -164,11 +210,23 @@ mod tests {
         acc.fold(0, &[[6.0, 6.0, 6.0, 3.0]], &[[14.0, 14.0, 14.0, 0.0]]);
         acc.fold(0, &[[9.0, 9.0, 9.0, 2.0]], &[[41.0, 41.0, 41.0, 1.0]]);
         assert_eq!(acc.min_samples(), 5);
+        assert_eq!(acc.total_samples(), 5);
         assert_eq!(acc.dropped_samples(), 1);
         assert_eq!(acc.pixel_mean(0), [3.0; 3]);
         // Sample variance of 1..5 is 2.5; of the mean, 2.5 / 5 = 0.5.
         let v = acc.pixel_variance_of_mean(0);
         assert!((v[0] - 0.5).abs() < 1e-12, "{v:?}");
+    }
+
+    #[test]
+    fn a_render_larger_than_memory_is_refused_with_what_it_needs() {
+        let err = check_host_memory(8192, 8192, Some(2 << 30)).unwrap_err();
+        assert!(err.contains("8192 x 8192") && err.contains("4.4 GiB") && err.contains("2.0 GiB"), "{err}");
+        assert!(check_host_memory(16384, 16384, None).is_ok());
+        assert!(check_host_memory(512, 512, Some(1 << 30)).is_ok());
+        if cfg!(target_os = "linux") {
+            assert!(available_host_memory().is_some_and(|b| b > 0));
+        }
     }
 
     #[test]

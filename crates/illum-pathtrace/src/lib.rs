@@ -11,6 +11,7 @@ pub mod accumulator;
 pub mod display_sum;
 mod error;
 pub mod gpu_scene;
+pub mod metadata;
 pub mod planner;
 pub mod progressive;
 pub mod spawn;
@@ -22,7 +23,10 @@ pub use display_sum::{DISPLAY_PIXEL_BYTES, DISPLAY_SUM_SHADER};
 pub use error::PathTraceError;
 pub use gpu_scene::FEATURES;
 pub use illum_scene::Sequence;
-pub use progressive::{StopReason, StopRules, render_progressive};
+pub use progressive::{
+    Progress, Progressive, RenderClock, Rule, Status, StopReason, StopRules, parse_target_error,
+    parse_time_budget, render_progressive,
+};
 pub use tracer::{
     CHUNK_SAMPLES, GENERIC_TRAVERSAL, PATHTRACE_SHADER, PathTracer, SCENE_MODULE, SLOT_BYTES, StepReport,
     TracerOptions, Traversal, shader_modules,

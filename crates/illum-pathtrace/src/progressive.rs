@@ -1,12 +1,22 @@
 //! Progressive rendering with stop rules: a sample target, a relative-error target, a time budget,
 //! and cancellation (Ctrl-C), checked between short submissions.
+//!
+//! This is the one implementation of the stop rules: the `render` example, the convergence tool
+//! and the viewer all drive a [`Progressive`]. Its time is **wall-clock time** since the render
+//! started ([`RenderClock`]), paused only while a caller pauses it (the viewer's Pause button):
+//! it includes the host's readback and f64 fold and, in the viewer, drawing the window, so
+//! "samples per second" and "after a time budget" mean what a stopwatch would say.
+//!
+//! Every rule but cancellation waits for a **complete pass**: a pass covers the whole image, so
+//! a render that stops by spp, error or time always has at least one sample in every pixel.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use crate::{PathTraceError, PathTracer};
 
-/// When to stop. With every field `None` the render runs until cancelled.
+/// When to stop. With every field `None` the render runs until cancelled. The first rule that
+/// holds stops the render.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct StopRules {
     /// Stop when every pixel has this many samples.
@@ -15,8 +25,107 @@ pub struct StopRules {
     /// variance-based relMSE estimate, [`crate::Accumulator::estimated_relative_error`]) falls
     /// to this value. Checked only after each completed pass with at least 2 spp.
     pub target_error: Option<f64>,
-    /// Stop after this much wall time.
+    /// Stop after this much wall-clock time ([`RenderClock`]), once at least one pass is
+    /// complete.
     pub time_budget: Option<Duration>,
+}
+
+impl StopRules {
+    /// The rules of a command line. `scene_spp` is the scene file's spp, `spp` the value of an
+    /// `--spp` flag. A target error or a time budget given without `--spp` lifts the scene's spp:
+    /// the render runs until the error or the time rule fires (a target error that is never
+    /// reached runs until cancelled). With `--spp` too, whichever rule holds first stops it.
+    /// With neither, the render stops at `spp` or else the scene's spp.
+    pub fn from_command_line(
+        scene_spp: u32,
+        spp: Option<u32>,
+        target_error: Option<f64>,
+        time_budget: Option<Duration>,
+    ) -> Self {
+        let open_ended = target_error.is_some() || time_budget.is_some();
+        StopRules {
+            spp: if open_ended { spp } else { Some(spp.unwrap_or(scene_spp)) },
+            target_error,
+            time_budget,
+        }
+    }
+
+    /// The first rule that holds for `status`, in the order spp, error, time.
+    pub fn check(&self, status: &Status) -> Option<StopReason> {
+        if self.spp.is_some_and(|spp| status.spp_done >= spp) {
+            return Some(StopReason::SppReached);
+        }
+        if let (Some(target), Some(error)) = (self.target_error, status.relative_error)
+            && error <= target
+        {
+            return Some(StopReason::ErrorReached);
+        }
+        if status.spp_done >= 1 && self.time_budget.is_some_and(|budget| status.elapsed >= budget) {
+            return Some(StopReason::TimeBudget);
+        }
+        None
+    }
+
+    /// How far the render is toward the rule that will stop it first: the largest fraction
+    /// among the rules given (`None` when no rule is given). For the error rule the fraction is
+    /// (target / error)^2, the share of the samples needed that are done, since the error falls
+    /// as 1 / sqrt(samples).
+    pub fn progress(&self, status: &Status, pixels: u64) -> Option<Progress> {
+        let mut best: Option<Progress> = None;
+        let mut consider = |rule: Rule, fraction: f64| {
+            let fraction = if fraction.is_finite() { fraction.clamp(0.0, 1.0) } else { 0.0 };
+            if best.is_none_or(|b| fraction > b.fraction) {
+                best = Some(Progress { rule, fraction });
+            }
+        };
+        if let Some(spp) = self.spp {
+            // Samples, not complete passes, so the bar moves within a long pass.
+            consider(Rule::Spp, status.samples as f64 / (pixels.max(1) as f64 * f64::from(spp.max(1))));
+        }
+        if let Some(target) = self.target_error {
+            let fraction =
+                status.relative_error.map_or(0.0, |e| if e > 0.0 { (target / e).powi(2) } else { 1.0 });
+            consider(Rule::Error, fraction);
+        }
+        if let Some(budget) = self.time_budget {
+            consider(Rule::Time, status.elapsed.as_secs_f64() / budget.as_secs_f64().max(1e-9));
+        }
+        best
+    }
+}
+
+/// Checks a target relative error given by the user: a finite number above 0. `name` is the
+/// flag or field, for the message.
+pub fn parse_target_error(name: &str, value: f64) -> Result<f64, String> {
+    if value > 0.0 && value.is_finite() {
+        Ok(value)
+    } else {
+        Err(format!("{name} = {}: must be a finite number above 0 (for example 0.01 for 1%)", number(value)))
+    }
+}
+
+/// Checks a time budget in seconds given by the user: a finite number above 0 that a
+/// [`Duration`] can hold. `name` is the flag or field, for the message.
+pub fn parse_time_budget(name: &str, seconds: f64) -> Result<Duration, String> {
+    if !(seconds > 0.0 && seconds.is_finite()) {
+        return Err(format!("{name} = {}: must be a finite number of seconds above 0", number(seconds)));
+    }
+    Duration::try_from_secs_f64(seconds).map_err(|_| {
+        format!(
+            "{name} = {}: too large; at most {:e} seconds",
+            number(seconds),
+            Duration::MAX.as_secs() as f64
+        )
+    })
+}
+
+/// A number as a user would write it: 1e30 rather than thirty-one digits.
+fn number(value: f64) -> String {
+    if value != 0.0 && value.is_finite() && !(1e-4..1e9).contains(&value.abs()) {
+        format!("{value:e}")
+    } else {
+        format!("{value}")
+    }
 }
 
 /// Why a progressive render stopped.
@@ -28,33 +137,310 @@ pub enum StopReason {
     Cancelled,
 }
 
-/// Renders until a rule fires. `on_step` runs after every submission (for progress bars).
+impl StopReason {
+    /// A short name, as stored in EXR metadata (`illum.stopped_by`).
+    pub fn name(self) -> &'static str {
+        match self {
+            StopReason::SppReached => "spp",
+            StopReason::ErrorReached => "target_error",
+            StopReason::TimeBudget => "time_budget",
+            StopReason::Cancelled => "cancelled",
+        }
+    }
+
+    /// What happened, for people.
+    pub fn describe(self) -> &'static str {
+        match self {
+            StopReason::SppReached => "spp target reached",
+            StopReason::ErrorReached => "error target reached",
+            StopReason::TimeBudget => "time budget spent",
+            StopReason::Cancelled => "interrupted",
+        }
+    }
+}
+
+/// The rule a [`Progress`] measures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Rule {
+    Spp,
+    Error,
+    Time,
+}
+
+/// Progress toward the nearest stop rule.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Progress {
+    pub rule: Rule,
+    /// In [0, 1].
+    pub fraction: f64,
+}
+
+impl Progress {
+    /// Time left at the rate so far, once there is a rate to go by.
+    pub fn eta(&self, elapsed: Duration) -> Option<Duration> {
+        (self.fraction > 0.0).then(|| {
+            let left = elapsed.as_secs_f64() * (1.0 - self.fraction) / self.fraction;
+            Duration::try_from_secs_f64(left).unwrap_or(Duration::MAX)
+        })
+    }
+}
+
+/// What the stop rules look at.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Status {
+    /// Samples per pixel of the completed passes.
+    pub spp_done: u32,
+    /// Finite samples taken, over all pixels.
+    pub samples: u64,
+    /// Wall-clock time of the render ([`RenderClock`]).
+    pub elapsed: Duration,
+    /// The estimated relative error after the last completed pass, once it has 2 spp.
+    pub relative_error: Option<f64>,
+}
+
+impl Status {
+    /// Samples per second of wall-clock time (0 before any time has passed).
+    pub fn samples_per_second(&self) -> f64 {
+        let seconds = self.elapsed.as_secs_f64();
+        if seconds > 0.0 { self.samples as f64 / seconds } else { 0.0 }
+    }
+}
+
+/// Wall-clock time of a render that a caller may pause.
+#[derive(Clone, Copy, Debug)]
+pub struct RenderClock {
+    running_since: Option<Instant>,
+    before: Duration,
+}
+
+impl RenderClock {
+    /// A clock that starts now.
+    pub fn started() -> Self {
+        RenderClock { running_since: Some(Instant::now()), before: Duration::ZERO }
+    }
+
+    pub fn elapsed(&self) -> Duration {
+        self.before + self.running_since.map_or(Duration::ZERO, |t| t.elapsed())
+    }
+
+    /// Stops counting (a paused render); [`Self::resume`] goes on.
+    pub fn pause(&mut self) {
+        if let Some(since) = self.running_since.take() {
+            self.before += since.elapsed();
+        }
+    }
+
+    pub fn resume(&mut self) {
+        if self.running_since.is_none() {
+            self.running_since = Some(Instant::now());
+        }
+    }
+
+    pub fn is_running(&self) -> bool {
+        self.running_since.is_some()
+    }
+}
+
+/// A progressive render of one [`PathTracer`] under [`StopRules`]: its clock, the error after
+/// the last completed pass, and the reason it stopped.
+#[derive(Clone, Debug)]
+pub struct Progressive {
+    pub rules: StopRules,
+    clock: RenderClock,
+    relative_error: Option<f64>,
+    /// `spp_done` when `relative_error` was computed.
+    error_at_spp: u32,
+    stopped: Option<StopReason>,
+}
+
+impl Progressive {
+    /// Starts the clock now.
+    pub fn new(rules: StopRules) -> Self {
+        Progressive {
+            rules,
+            clock: RenderClock::started(),
+            relative_error: None,
+            error_at_spp: 0,
+            stopped: None,
+        }
+    }
+
+    /// Starts again (after the tracer was reset): a new clock (paused if this one was), no error,
+    /// not stopped.
+    pub fn restart(&mut self) {
+        let running = self.clock.is_running();
+        *self = Progressive::new(self.rules);
+        if !running {
+            self.clock.pause();
+        }
+    }
+
+    pub fn clock(&self) -> &RenderClock {
+        &self.clock
+    }
+
+    pub fn clock_mut(&mut self) -> &mut RenderClock {
+        &mut self.clock
+    }
+
+    /// Why it stopped, once it has.
+    pub fn stopped(&self) -> Option<StopReason> {
+        self.stopped
+    }
+
+    /// Marks the render as cancelled, and stops its clock.
+    pub fn cancel(&mut self) {
+        self.stopped.get_or_insert(StopReason::Cancelled);
+        self.clock.pause();
+    }
+
+    /// The tracer's status now. The error is the one of the last completed pass (computing it
+    /// reads every pixel, so it is done once per pass, not per submission).
+    pub fn status(&self, tracer: &PathTracer) -> Status {
+        Status {
+            spp_done: tracer.spp_done(),
+            samples: tracer.accumulator().total_samples(),
+            elapsed: self.clock.elapsed(),
+            relative_error: self.relative_error,
+        }
+    }
+
+    /// Progress toward the nearest rule.
+    pub fn progress(&self, tracer: &PathTracer) -> Option<Progress> {
+        let camera = tracer.scene().camera;
+        self.rules.progress(&self.status(tracer), u64::from(camera.width) * u64::from(camera.height))
+    }
+
+    /// Checks the rules, and when none holds runs one submission. Returns why the render
+    /// stopped, once it has (and from then on without doing anything).
+    pub fn step(&mut self, tracer: &mut PathTracer) -> Result<Option<StopReason>, PathTraceError> {
+        if self.stopped.is_some() {
+            return Ok(self.stopped);
+        }
+        self.refresh_error(tracer);
+        self.stopped = self.rules.check(&self.status(tracer));
+        if self.stopped.is_none() {
+            let report = tracer.step(self.rules.spp)?;
+            if report.pass_completed {
+                // Tools and tests watch for this line (RUST_LOG=illum_pathtrace=debug).
+                log::debug!("pass complete: {} spp", tracer.spp_done());
+                self.refresh_error(tracer);
+                self.stopped = self.rules.check(&self.status(tracer));
+            }
+        }
+        if self.stopped.is_some() {
+            // The render is over: its time stands.
+            self.clock.pause();
+        }
+        Ok(self.stopped)
+    }
+
+    fn refresh_error(&mut self, tracer: &PathTracer) {
+        let spp = tracer.spp_done();
+        if spp != self.error_at_spp || (self.relative_error.is_none() && spp >= 2) {
+            self.error_at_spp = spp;
+            self.relative_error = (spp >= 2).then(|| tracer.accumulator().estimated_relative_error());
+        }
+    }
+}
+
+/// Renders until a rule fires or `cancel` is set. `on_step` runs after every submission (for
+/// progress bars).
 pub fn render_progressive(
     tracer: &mut PathTracer,
     rules: &StopRules,
     cancel: &AtomicBool,
-    mut on_step: impl FnMut(&PathTracer),
-) -> Result<StopReason, PathTraceError> {
-    let started = Instant::now();
+    mut on_step: impl FnMut(&PathTracer, &Progressive),
+) -> Result<(StopReason, Progressive), PathTraceError> {
+    let mut progressive = Progressive::new(*rules);
+    log::debug!("render started: {rules:?}");
     loop {
         if cancel.load(Ordering::Relaxed) {
-            return Ok(StopReason::Cancelled);
+            progressive.cancel();
         }
-        if rules.spp.is_some_and(|spp| tracer.spp_done() >= spp) {
-            return Ok(StopReason::SppReached);
+        if let Some(reason) = progressive.step(tracer)? {
+            return Ok((reason, progressive));
         }
-        if rules.time_budget.is_some_and(|budget| started.elapsed() >= budget) {
-            return Ok(StopReason::TimeBudget);
-        }
-        let report = tracer.step(rules.spp)?;
-        on_step(tracer);
-        if report.pass_completed
-            && tracer.spp_done() >= 2
-            && rules
-                .target_error
-                .is_some_and(|target| tracer.accumulator().estimated_relative_error() <= target)
-        {
-            return Ok(StopReason::ErrorReached);
-        }
+        on_step(tracer, &progressive);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn status(spp_done: u32, seconds: f64, error: Option<f64>) -> Status {
+        Status { spp_done, samples: 0, elapsed: Duration::from_secs_f64(seconds), relative_error: error }
+    }
+
+    #[test]
+    fn command_line_rules_lift_the_scene_spp() {
+        let plain = StopRules::from_command_line(16, None, None, None);
+        assert_eq!(plain.spp, Some(16));
+        let error = StopRules::from_command_line(16, None, Some(0.01), None);
+        assert_eq!(error.spp, None, "--target-error alone must not stop at the scene's 16 spp");
+        let both = StopRules::from_command_line(16, Some(64), Some(0.01), None);
+        assert_eq!(both.spp, Some(64));
+        let time = StopRules::from_command_line(16, None, None, Some(Duration::from_secs(1)));
+        assert_eq!(time.spp, None);
+    }
+
+    #[test]
+    fn the_time_budget_waits_for_a_complete_pass() {
+        let rules = StopRules { time_budget: Some(Duration::from_millis(1)), ..Default::default() };
+        assert_eq!(rules.check(&status(0, 10.0, None)), None);
+        assert_eq!(rules.check(&status(1, 10.0, None)), Some(StopReason::TimeBudget));
+    }
+
+    #[test]
+    fn the_error_rule_needs_an_estimate() {
+        let rules = StopRules { target_error: Some(0.1), ..Default::default() };
+        assert_eq!(rules.check(&status(1, 0.0, None)), None);
+        assert_eq!(rules.check(&status(4, 0.0, Some(0.2))), None);
+        assert_eq!(rules.check(&status(16, 0.0, Some(0.1))), Some(StopReason::ErrorReached));
+    }
+
+    #[test]
+    fn progress_follows_the_nearest_rule() {
+        let rules = StopRules {
+            spp: Some(100_000),
+            target_error: Some(0.01),
+            time_budget: Some(Duration::from_secs(4)),
+        };
+        let s = Status { samples: 10 * 100, ..status(10, 1.0, Some(0.04)) };
+        let p = rules.progress(&s, 100).unwrap();
+        assert_eq!(p.rule, Rule::Time);
+        assert!((p.fraction - 0.25).abs() < 1e-12);
+        assert!((p.eta(s.elapsed).unwrap().as_secs_f64() - 3.0).abs() < 1e-9);
+        let s = status(10, 1.0, Some(0.011));
+        let p = rules.progress(&s, 100).unwrap();
+        assert_eq!(p.rule, Rule::Error);
+        assert!((p.fraction - (0.01f64 / 0.011).powi(2)).abs() < 1e-12);
+        assert_eq!(StopRules::default().progress(&s, 100), None);
+    }
+
+    #[test]
+    fn user_values_are_checked_with_their_name() {
+        assert!(
+            parse_time_budget("--time-budget", 1e30).unwrap_err().contains("--time-budget = 1e30: too large")
+        );
+        assert!(parse_time_budget("--time-budget", 0.0).unwrap_err().contains("above 0"));
+        assert!(parse_time_budget("--time-budget", f64::NAN).is_err());
+        assert_eq!(parse_time_budget("x", 1.5), Ok(Duration::from_millis(1500)));
+        assert!(parse_target_error("--target-error", -0.1).unwrap_err().contains("--target-error = -0.1"));
+        assert!(parse_target_error("--target-error", 0.0).is_err());
+        assert!(parse_target_error("--target-error", f64::INFINITY).is_err());
+    }
+
+    #[test]
+    fn a_paused_clock_stands_still() {
+        let mut clock = RenderClock::started();
+        clock.pause();
+        let a = clock.elapsed();
+        std::thread::sleep(Duration::from_millis(5));
+        assert_eq!(clock.elapsed(), a);
+        clock.resume();
+        std::thread::sleep(Duration::from_millis(2));
+        assert!(clock.elapsed() > a);
     }
 }

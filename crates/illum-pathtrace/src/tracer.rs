@@ -175,6 +175,12 @@ impl PathTracer {
         )?;
         let max_slots = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size) / SLOT_BYTES;
         check_row_fits(scene, max_slots)?;
+        crate::accumulator::check_host_memory(
+            scene.camera.width,
+            scene.camera.height,
+            crate::accumulator::available_host_memory(),
+        )
+        .map_err(|message| PathTraceError::Unsupported { scene: scene.name.clone(), message })?;
         let accumulator = Accumulator::try_new(scene.camera.width, scene.camera.height).map_err(|bytes| {
             PathTraceError::Unsupported {
                 scene: scene.name.clone(),
@@ -270,6 +276,16 @@ impl PathTracer {
 
     pub fn accumulator(&self) -> &Accumulator {
         &self.accumulator
+    }
+
+    /// The traversal and sample sequence this tracer was built with.
+    pub fn options(&self) -> TracerOptions {
+        self.options
+    }
+
+    /// The name of the GPU adapter it renders on.
+    pub fn adapter_name(&self) -> &str {
+        &self.gpu.adapter_info.name
     }
 
     /// Keeps, from now on, a running sum of the image on the GPU for display: one storage buffer

@@ -241,6 +241,8 @@ impl RasterRenderer {
     fn record(&mut self, options: &Options) -> Result<wgpu::CommandEncoder, RasterError> {
         let samples = options.samples();
         if self.main.as_ref().is_none_or(|m| m.samples != samples) {
+            crate::targets::check_main_targets(&self.gpu.device.limits(), self.width, self.height, samples)
+                .map_err(RasterError::Unsupported)?;
             self.main = Some(MainTargets::new(&self.gpu, self.width, self.height, samples)?);
         }
         let main = Target::Main { samples };

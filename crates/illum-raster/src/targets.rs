@@ -163,6 +163,41 @@ pub struct MainTargets {
     pub depth: wgpu::TextureView,
 }
 
+/// Checks the main targets of a `width` x `height` frame with `samples` samples per pixel
+/// before creating them: each texture must fit the device's largest single allocation.
+/// wgpu has no limit for a texture's bytes; `max_buffer_size` is the device's allocation limit
+/// that it does report, and a multisampled 16384 x 16384 target beyond it fails on lavapipe
+/// with an unhelpful "texture is invalid". The error names the size, the bytes and the way out.
+pub fn check_main_targets(
+    limits: &wgpu::Limits,
+    width: u32,
+    height: u32,
+    samples: u32,
+) -> Result<(), String> {
+    let pixels = u64::from(width) * u64::from(height);
+    let mut textures = vec![("output", pixels * 4), ("depth buffer", pixels * 4 * u64::from(samples))];
+    if samples > 1 {
+        textures.push(("multisampled colour buffer", pixels * 4 * u64::from(samples)));
+    }
+    for (name, bytes) in textures {
+        if bytes > limits.max_buffer_size {
+            let msaa = if samples > 1 { format!(" with {samples}x MSAA") } else { String::new() };
+            let hint = if samples > 1 {
+                "turn MSAA off (--no-msaa, effects.msaa = false) or render"
+            } else {
+                "render"
+            };
+            return Err(format!(
+                "camera.width x camera.height = {width} x {height}{msaa}: the {name} needs {:.2} GiB, more than \
+                 the {:.2} GiB the device allows in one allocation (max_buffer_size); {hint} at a smaller size",
+                bytes as f64 / (1u64 << 30) as f64,
+                limits.max_buffer_size as f64 / (1u64 << 30) as f64,
+            ));
+        }
+    }
+    Ok(())
+}
+
 impl MainTargets {
     pub fn new(gpu: &GpuContext, width: u32, height: u32, samples: u32) -> Result<Self, GpuError> {
         gpu.scoped("creating the main render targets", || {
@@ -193,5 +228,20 @@ impl MainTargets {
             .create_view(&Default::default());
             MainTargets { samples, output, output_view, multisampled, depth }
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn multisampled_targets_beyond_one_allocation_are_refused_with_the_way_out() {
+        let limits = wgpu::Limits { max_buffer_size: 2 << 30, ..wgpu::Limits::default() };
+        let err = check_main_targets(&limits, 16384, 16384, 4).unwrap_err();
+        assert!(err.contains("16384 x 16384 with 4x MSAA") && err.contains("--no-msaa"), "{err}");
+        assert!(err.contains("4.00 GiB") && err.contains("2.00 GiB"), "{err}");
+        assert!(check_main_targets(&limits, 16384, 16384, 1).is_ok());
+        assert!(check_main_targets(&limits, 1280, 720, 4).is_ok());
     }
 }

@@ -59,8 +59,10 @@ pub struct ViewerApp {
     /// Each mode, or why its scene could not be loaded.
     pathtrace: Result<PathTraceMode, String>,
     raster: Result<RasterMode, String>,
-    /// The "open scene" text field.
+    /// The "open scene" text field: the shown mode's scene file (or a path being typed).
     pub scene_field: String,
+    /// Whether the settings panel is shown (the top bar's "Hide settings" / "Show settings").
+    pub show_panel: bool,
     /// The last open attempt's error (the current scenes stay).
     pub open_error: Option<String>,
     screenshot: Option<ScreenshotJob>,
@@ -84,6 +86,7 @@ impl ViewerApp {
             pathtrace: Err("no path-tracer scene loaded".to_owned()),
             raster: Err("no raster scene loaded".to_owned()),
             scene_field: options.scene.display().to_string(),
+            show_panel: true,
             open_error: None,
             screenshot: options.screenshot,
             frame_rate: FrameRate::default(),
@@ -98,7 +101,22 @@ impl ViewerApp {
         if let Some(mode) = options.mode {
             app.mode = mode;
         }
+        // The field names the scene shown, unless the given file failed to open (then it keeps
+        // the path, to be corrected).
+        if app.open_error.is_none()
+            && let Some(current) = app.current_scene_path()
+        {
+            app.scene_field = current;
+        }
         app
+    }
+
+    /// The scene file of the mode shown, as it was given.
+    fn current_scene_path(&self) -> Option<String> {
+        match self.mode {
+            Mode::Raster => self.raster.as_ref().ok().map(|m| m.scene_path().display().to_string()),
+            Mode::PathTrace => self.pathtrace.as_ref().ok().map(|m| m.scene_path().display().to_string()),
+        }
     }
 
     pub fn mode(&self) -> Mode {
@@ -154,9 +172,21 @@ impl ViewerApp {
     }
 
     fn top_bar(&mut self, ui: &mut egui::Ui) {
-        ui.horizontal(|ui| {
+        ui.horizontal_wrapped(|ui| {
+            let panel_button = if self.show_panel { "Hide settings" } else { "Show settings" };
+            if ui.button(panel_button).clicked() {
+                self.show_panel = !self.show_panel;
+            }
+            let before = self.mode;
             ui.selectable_value(&mut self.mode, Mode::Raster, "Raster");
             ui.selectable_value(&mut self.mode, Mode::PathTrace, "Path tracer");
+            if self.mode != before
+                && let Some(current) = self.current_scene_path()
+            {
+                // The field follows the mode: it names the scene now shown.
+                self.scene_field = current;
+                self.open_error = None;
+            }
             ui.separator();
             let label = ui.label("Scene");
             let field = ui
@@ -173,11 +203,7 @@ impl ViewerApp {
                     Err(e) => self.open_error = Some(e),
                 }
             }
-            let current = match self.mode {
-                Mode::Raster => self.raster.as_ref().ok().map(|m| m.scene_path().display().to_string()),
-                Mode::PathTrace => self.pathtrace.as_ref().ok().map(|m| m.scene_path().display().to_string()),
-            };
-            if let Some(current) = current {
+            if let Some(current) = self.current_scene_path() {
                 ui.weak(format!("showing {current}"));
             }
             if let Some(fps) = self.frame_rate.fps() {
@@ -259,8 +285,21 @@ fn load_raster(path: &Path) -> Result<RasterMode, String> {
 impl eframe::App for ViewerApp {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         self.frame_rate.tick();
+        // The path tracer's wall clock runs only while its mode is shown.
+        let showing_pathtrace = self.mode == Mode::PathTrace;
+        if let Ok(pathtrace) = &mut self.pathtrace {
+            pathtrace.set_active(showing_pathtrace);
+        }
         egui::Panel::top("top bar").show(ui, |ui| self.top_bar(ui));
-        egui::Panel::left("settings").resizable(true).default_size(320.0).show(ui, |ui| self.side_panel(ui));
+        if self.show_panel {
+            // At most half the window, so a small window still shows the image.
+            let max = (ui.available_width() * 0.5).max(1.0);
+            egui::Panel::left("settings")
+                .resizable(true)
+                .default_size(320.0f32.min(max))
+                .max_size(max)
+                .show(ui, |ui| self.side_panel(ui));
+        }
         egui::CentralPanel::default().show(ui, |ui| self.view(ui));
         if let Some(job) = &mut self.screenshot {
             job.tick(ui.ctx(), self.frame_rate.fps());

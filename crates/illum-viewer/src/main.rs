@@ -12,6 +12,15 @@ use illum_viewer::{StartOptions, ViewerApp};
 fn main() {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let args = Args::parse();
+    // A screenshot run is a check (the smoke test's): a scene that does not open must fail it,
+    // not draw a window with the error in it and exit 0. Without --screenshot the window opens
+    // and shows the error, so that another file can be opened.
+    if args.screenshot.is_some()
+        && let Err(e) = illum_viewer::scene_file::load(&args.scene)
+    {
+        eprintln!("error: {e}");
+        std::process::exit(1);
+    }
     let outcome: Outcome = Arc::default();
     let screenshot =
         args.screenshot.clone().map(|path| ScreenshotJob::new(path, args.frames, outcome.clone()));
@@ -24,7 +33,7 @@ fn main() {
         ..Default::default()
     };
     // Under CI (as in the tests) prefer lavapipe, as illum_gpu::GpuContext::new does.
-    native.wgpu_options.wgpu_setup = wgpu_setup(std::env::var_os("CI").is_some());
+    native.wgpu_options.wgpu_setup = wgpu_setup(illum_gpu::policy::prefer_software_from_env());
     // No vsync: the frame rate is bounded by the work (path-tracing slices, raster frames), and
     // on software drivers FIFO presentation adds a wait to every frame.
     native.wgpu_options.surface.present_mode = egui_wgpu::wgpu::PresentMode::AutoNoVsync;

@@ -6,6 +6,11 @@
 //! setting goes through `PathTracer::update_scene`, which restarts the accumulation without
 //! recompiling the pipeline.
 //!
+//! Stop rules and time: the panel drives an [`illum_pathtrace::Progressive`], the stop rules
+//! the `render` example uses too. Its clock is wall-clock time while this mode renders (not
+//! while it is paused, stopped or hidden behind the raster mode), so "Elapsed", "Samples/s" and
+//! "After time budget" include drawing the window, as a stopwatch would.
+//!
 //! Display: the tracer's display sum (on the GPU) is drawn by [`Display`] whenever new samples
 //! arrived or the exposure changed; the f64 statistics are only read for the panel's numbers and
 //! for saving.
@@ -13,8 +18,8 @@
 use std::path::{Path, PathBuf};
 
 use illum_gpu::GpuContext;
-use illum_image::{Encoding, ExrMetadata, RgbImage32, save_exr, save_png};
-use illum_pathtrace::{PathTracer, StopReason};
+use illum_image::{Encoding, RgbImage32, save_exr, save_png};
+use illum_pathtrace::{PathTracer, Progressive, StopReason, StopRules};
 use illum_scene::{Bounces, Sampling, Scene};
 
 use crate::camera::OrbitCamera;
@@ -43,7 +48,7 @@ pub struct PathTraceSettings {
     pub exposure: f32,
     /// Stop once the estimated relative error falls to this.
     pub target_error: Option<f64>,
-    /// Stop after this many seconds of rendering.
+    /// Stop after this many seconds of wall-clock time spent rendering.
     pub time_budget: Option<f64>,
 }
 
@@ -63,11 +68,25 @@ impl PathTraceSettings {
     }
 }
 
+impl PathTraceSettings {
+    /// The stop rules these settings ask for. A time budget that a `Duration` cannot hold is
+    /// no budget (the UI offers at most a day).
+    pub fn stop_rules(&self) -> StopRules {
+        StopRules {
+            spp: self.spp_target,
+            target_error: self.target_error,
+            time_budget: self.time_budget.and_then(|s| std::time::Duration::try_from_secs_f64(s).ok()),
+        }
+    }
+}
+
 /// The statistics shown in the panel, refreshed as samples arrive.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Stats {
     pub spp: u32,
+    /// Samples per second of wall-clock rendering time.
     pub samples_per_second: f64,
+    /// Wall-clock time spent rendering (not paused, not in the other mode).
     pub elapsed_seconds: f64,
     /// Estimated relative standard error; `None` before two samples per pixel.
     pub relative_error: Option<f64>,
@@ -87,7 +106,10 @@ pub struct PathTraceMode {
     failed: Option<Scene>,
     display: Option<Display>,
     paused: bool,
-    stopped: Option<StopReason>,
+    /// Whether this mode is the one shown (its clock stands still while it is not).
+    active: bool,
+    /// Stop rules, wall clock and why the render stopped.
+    progressive: Progressive,
     stats: Stats,
     /// Total samples at the last statistics update, to tell when new samples arrived.
     shown_samples: u64,
@@ -100,8 +122,10 @@ pub struct PathTraceMode {
 impl PathTraceMode {
     pub fn new(scene_path: PathBuf, scene: Scene) -> Self {
         let stem = scene.name.clone();
+        let settings = PathTraceSettings::from_scene(&scene);
         PathTraceMode {
-            settings: PathTraceSettings::from_scene(&scene),
+            progressive: Progressive::new(settings.stop_rules()),
+            settings,
             camera: OrbitCamera::new(scene.camera),
             scene_path,
             scene,
@@ -109,7 +133,7 @@ impl PathTraceMode {
             failed: None,
             display: None,
             paused: false,
-            stopped: None,
+            active: true,
             stats: Stats::default(),
             shown_samples: 0,
             shown_exposure: 0.0,
@@ -139,12 +163,41 @@ impl PathTraceMode {
     }
 
     pub fn stop_reason(&self) -> Option<StopReason> {
-        self.stopped
+        self.progressive.stopped()
     }
 
     /// Still has work to do this frame (so the window should keep repainting).
     pub fn is_rendering(&self) -> bool {
-        !self.paused && self.stopped.is_none()
+        !self.paused && self.progressive.stopped().is_none()
+    }
+
+    /// Wall-clock seconds spent rendering the current accumulation (the clock of the stop
+    /// rules, "Elapsed" in the panel).
+    pub fn render_seconds(&self) -> f64 {
+        self.progressive.clock().elapsed().as_secs_f64()
+    }
+
+    /// Pauses or resumes sampling (and the clock).
+    pub fn set_paused(&mut self, paused: bool) {
+        self.paused = paused;
+        self.sync_clock();
+    }
+
+    /// Tells the mode whether it is the one shown: its clock runs only while it is.
+    pub fn set_active(&mut self, active: bool) {
+        self.active = active;
+        self.sync_clock();
+    }
+
+    /// The clock runs while this mode is shown, not paused, and not stopped.
+    fn sync_clock(&mut self) {
+        let running = self.active && !self.paused && self.progressive.stopped().is_none();
+        let clock = self.progressive.clock_mut();
+        if running {
+            clock.resume();
+        } else {
+            clock.pause();
+        }
     }
 
     /// Discards the accumulated samples and starts again.
@@ -152,7 +205,8 @@ impl PathTraceMode {
         if let Some(tracer) = &mut self.tracer {
             tracer.reset();
         }
-        self.stopped = None;
+        self.progressive.restart();
+        self.sync_clock();
         self.stats = Stats { width: self.stats.width, height: self.stats.height, ..Stats::default() };
         self.shown_samples = u64::MAX;
     }
@@ -189,28 +243,21 @@ impl PathTraceMode {
         }
         self.failed = None;
         let Some(tracer) = self.tracer.as_mut() else { return };
-        // Fields, not `is_rendering()`: `tracer` borrows `self.tracer` mutably.
-        if !self.paused && self.stopped.is_none() {
-            self.stopped = Self::stop_rule(tracer, &self.settings);
-        }
-        if !self.paused && self.stopped.is_none() {
-            match tracer.step(self.settings.spp_target) {
-                Ok(report) => {
-                    if report.pass_completed {
-                        self.stopped = Self::stop_rule(tracer, &self.settings);
-                    }
-                }
-                Err(e) => {
-                    self.message = Some(format!("path tracer: {e}"));
-                    self.paused = true;
-                }
-            }
+        // The rules follow the panel (a changed spp target restarts the accumulation through
+        // the scene; a changed error target or budget applies from now on).
+        self.progressive.rules = self.settings.stop_rules();
+        if !self.paused
+            && let Err(e) = self.progressive.step(tracer)
+        {
+            self.message = Some(format!("path tracer: {e}"));
+            self.set_paused(true);
+            return;
         }
         let total = tracer.accumulator().total_samples();
         let display = self.display.get_or_insert_with(|| Display::new(gpu));
         if total != self.shown_samples {
             self.shown_samples = total;
-            self.stats = Self::measure(tracer);
+            self.stats = Self::measure(tracer, &self.progressive);
             let camera = tracer.scene().camera;
             if let Some(display_sum) = tracer.display_sum_buffer() {
                 let mut renderer = render_state.renderer.write();
@@ -253,39 +300,21 @@ impl PathTraceMode {
                 self.tracer = Some(tracer);
             }
         }
-        // A fresh accumulation: the stop rules start over too.
-        self.stopped = None;
+        // A fresh accumulation: the stop rules and the clock start over too.
+        self.progressive.restart();
+        self.sync_clock();
         self.shown_samples = u64::MAX;
         Ok(())
     }
 
-    /// The first stop rule that holds, checked between submissions.
-    fn stop_rule(tracer: &PathTracer, settings: &PathTraceSettings) -> Option<StopReason> {
-        if settings.spp_target.is_some_and(|spp| tracer.spp_done() >= spp) {
-            return Some(StopReason::SppReached);
-        }
-        if settings.time_budget.is_some_and(|budget| tracer.wall_seconds() >= budget) {
-            return Some(StopReason::TimeBudget);
-        }
-        if tracer.spp_done() >= 2
-            && settings
-                .target_error
-                .is_some_and(|target| tracer.accumulator().estimated_relative_error() <= target)
-        {
-            return Some(StopReason::ErrorReached);
-        }
-        None
-    }
-
-    fn measure(tracer: &PathTracer) -> Stats {
+    fn measure(tracer: &PathTracer, progressive: &Progressive) -> Stats {
         let accumulator = tracer.accumulator();
-        let elapsed = tracer.wall_seconds();
-        let total = accumulator.total_samples();
+        let status = progressive.status(tracer);
         Stats {
-            spp: tracer.spp_done(),
-            samples_per_second: if elapsed > 0.0 { total as f64 / elapsed } else { 0.0 },
-            elapsed_seconds: elapsed,
-            relative_error: (tracer.spp_done() >= 2).then(|| accumulator.estimated_relative_error()),
+            spp: status.spp_done,
+            samples_per_second: status.samples_per_second(),
+            elapsed_seconds: status.elapsed.as_secs_f64(),
+            relative_error: status.relative_error,
             dropped_samples: accumulator.dropped_samples(),
             width: accumulator.width,
             height: accumulator.height,
@@ -305,18 +334,12 @@ impl PathTraceMode {
         }
         let image: RgbImage32 = tracer.accumulator().mean_image();
         let result = if extension == "exr" {
-            let metadata = ExrMetadata {
-                scene: self.scene_path.display().to_string(),
-                spp: u64::from(tracer.spp_done()),
-                bounces: self.settings.bounces.to_string(),
-                seed: self.settings.seed,
-                sampling: self.settings.sampling.to_string(),
-                render_seconds: tracer.wall_seconds(),
-                extra: vec![
-                    ("source".to_owned(), "illum-viewer".to_owned()),
-                    ("dropped_samples".to_owned(), tracer.accumulator().dropped_samples().to_string()),
-                ],
-            };
+            let metadata = illum_pathtrace::metadata::exr_metadata(
+                tracer,
+                self.progressive.clock().elapsed().as_secs_f64(),
+                self.progressive.stopped(),
+                "illum-viewer",
+            );
             save_exr(&path, &image, &metadata)
         } else {
             // The PNG is the image as rendered: gamma 2.2, no display exposure.
@@ -386,7 +409,7 @@ impl PathTraceMode {
         ui.horizontal(|ui| {
             let label = if self.paused { "Resume" } else { "Pause" };
             if ui.button(label).clicked() {
-                self.paused = !self.paused;
+                self.set_paused(!self.paused);
             }
             if ui.button("Reset").clicked() {
                 self.reset();
@@ -427,14 +450,15 @@ impl PathTraceMode {
             };
             row("Resolution", format!("{} x {}", st.width, st.height));
             row("spp done", st.spp.to_string());
-            row("Samples/s", format!("{:.3} M", st.samples_per_second / 1e6));
-            row("Elapsed", format!("{:.1} s", st.elapsed_seconds));
+            // Both over wall-clock time spent rendering, drawing the window included.
+            row("Samples/s (wall)", format!("{:.3} M", st.samples_per_second / 1e6));
+            row("Elapsed (wall)", format!("{:.1} s", st.elapsed_seconds));
             row(
                 "Rel. error",
                 st.relative_error.map_or("(needs 2 spp)".to_owned(), |e| format!("{:.2} %", e * 100.0)),
             );
             row("Dropped NaN/Inf", st.dropped_samples.to_string());
-            let state = match (self.paused, self.stopped) {
+            let state = match (self.paused, self.progressive.stopped()) {
                 (true, _) => "paused".to_owned(),
                 (false, Some(StopReason::SppReached)) => "done: spp target reached".to_owned(),
                 (false, Some(StopReason::ErrorReached)) => "done: error target reached".to_owned(),

@@ -84,3 +84,20 @@ fn both_modes_draw_under_xvfb() {
     let d = difference(&raster, &pathtrace);
     assert!(d > 5.0, "the two modes' screenshots barely differ (mean difference {d:.2})");
 }
+
+/// A screenshot run is a check: a scene that does not open fails it (before any window opens,
+/// so this needs no X display).
+#[test]
+fn a_screenshot_run_with_a_missing_scene_fails() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let shot = dir.path().join("never.png");
+    let output = Command::new(env!("CARGO_BIN_EXE_illum-viewer"))
+        .args(["no/such/scene.toml", "--frames", "1", "--screenshot"])
+        .arg(&shot)
+        .output()
+        .expect("starting the viewer");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("no/such/scene.toml"), "{stderr}");
+    assert!(!shot.exists());
+}

@@ -1,0 +1,50 @@
+//! The EXR metadata of a path-traced image: one builder for every program that saves one (the
+//! `render` example, the viewer, the convergence tool), so that each key means the same
+//! everywhere.
+
+use illum_image::ExrMetadata;
+
+use crate::{PathTracer, StopReason};
+
+/// The renderer name path-traced images carry (`illum.renderer`).
+pub const RENDERER: &str = "pathtrace";
+
+/// Metadata for the tracer's current image. Keys (each stored as `illum.<key>`):
+///
+/// - `renderer` = `pathtrace`, `scene` = the scene's name, `render_seconds` = `render_seconds`
+///   (wall-clock time, see [`crate::progressive::RenderClock`]);
+/// - `spp`: samples per pixel of the completed passes (every pixel has at least this many
+///   paths; an interrupted pass may have added more to some rows), `bounces`, `seed`,
+///   `sampling`, `sequence`: the settings;
+/// - `estimated_relative_error`: [`crate::Accumulator::estimated_relative_error`] (`inf` below
+///   2 spp); `dropped_samples`: NaN/Inf samples left out;
+/// - `stopped_by`: the stop rule that ended the render (`spp`, `target_error`, `time_budget`,
+///   `cancelled`), or `none` for an image saved while rendering (the viewer);
+/// - `adapter`: the GPU adapter's name; `source`: the program that wrote the file.
+pub fn exr_metadata(
+    tracer: &PathTracer,
+    render_seconds: f64,
+    stopped_by: Option<StopReason>,
+    source: &str,
+) -> ExrMetadata {
+    let scene = tracer.scene();
+    let accumulator = tracer.accumulator();
+    let fields = [
+        ("spp", tracer.spp_done().to_string()),
+        ("bounces", scene.pathtrace.bounces.to_string()),
+        ("seed", scene.pathtrace.seed.to_string()),
+        ("sampling", scene.pathtrace.sampling.to_string()),
+        ("sequence", tracer.options().sequence.to_string()),
+        ("estimated_relative_error", accumulator.estimated_relative_error().to_string()),
+        ("dropped_samples", accumulator.dropped_samples().to_string()),
+        ("stopped_by", stopped_by.map_or("none", StopReason::name).to_owned()),
+        ("adapter", tracer.adapter_name().to_owned()),
+        ("source", source.to_owned()),
+    ];
+    ExrMetadata {
+        renderer: RENDERER.to_owned(),
+        scene: scene.name.clone(),
+        render_seconds,
+        fields: fields.into_iter().map(|(k, v)| (k.to_owned(), v)).collect(),
+    }
+}
