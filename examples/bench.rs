@@ -32,7 +32,7 @@ struct Args {
     /// Repetitions per configuration (the median is reported).
     #[arg(long, default_value_t = 5)]
     runs: usize,
-    /// Only the headline configuration (256 x 256, 64 spp, bounces 2 and 8).
+    /// Only the headline configuration (256 x 256, 64 spp, bounces 2 and 8).
     #[arg(long)]
     quick: bool,
 }
