@@ -22,7 +22,7 @@
 //! let mut scene = illum_scene::Scene::load(std::path::Path::new(path)).unwrap();
 //! scene.camera.width = 4;
 //! scene.camera.height = 4;
-//! let image = illum_oracle::render(&scene, 2, 0);
+//! let image = illum_oracle::render(&scene, 2, 0).unwrap();
 //! assert_eq!(image.mean.len(), 16);
 //! ```
 
