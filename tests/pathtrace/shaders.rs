@@ -87,7 +87,6 @@ fn every_wgsl_file_composes_and_validates() {
     }
     let missing: Vec<_> = on_disk.difference(&covered).collect();
     assert!(missing.is_empty(), "WGSL files not validated by any composition: {missing:?}");
-    let _ = pathtrace::GENERIC_TRAVERSAL;
 }
 
 /// Shader sets of the other renderers: (modules, entry) pairs.

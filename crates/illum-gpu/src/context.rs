@@ -93,11 +93,6 @@ impl GpuContext {
         self.id
     }
 
-    /// True for CPU implementations (lavapipe / llvmpipe, WARP, SwiftShader).
-    pub fn is_software(&self) -> bool {
-        self.adapter_info.device_type == wgpu::DeviceType::Cpu
-    }
-
     /// Returns the first error the device reported since the last call, if any.
     pub fn check(&self) -> Result<(), GpuError> {
         let mut errors = self.errors.lock().unwrap_or_else(|p| p.into_inner());

@@ -30,10 +30,6 @@ impl BatchPlanner {
         Self { target_seconds, seconds_per_sample: None }
     }
 
-    pub fn target_seconds(&self) -> f64 {
-        self.target_seconds
-    }
-
     /// Plans a pass over a `width` x `height` image with at most `max_spp` samples per pixel.
     pub fn plan(&self, width: u32, height: u32, max_spp: u32) -> PassPlan {
         let max_spp = max_spp.max(1);
@@ -62,11 +58,6 @@ impl BatchPlanner {
             None => cost,
             Some(old) => 0.5 * old + 0.5 * cost,
         });
-    }
-
-    /// Forget the measured cost (the scene or settings changed).
-    pub fn reset(&mut self) {
-        self.seconds_per_sample = None;
     }
 }
 

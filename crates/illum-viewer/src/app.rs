@@ -123,15 +123,6 @@ impl ViewerApp {
         self.mode
     }
 
-    /// The window's repaint rate over the last frames.
-    pub fn window_fps(&self) -> Option<f64> {
-        self.frame_rate.fps()
-    }
-
-    pub fn set_mode(&mut self, mode: Mode) {
-        self.mode = mode;
-    }
-
     pub fn pathtrace(&self) -> Option<&PathTraceMode> {
         self.pathtrace.as_ref().ok()
     }
@@ -142,10 +133,6 @@ impl ViewerApp {
 
     pub fn raster(&self) -> Option<&RasterMode> {
         self.raster.as_ref().ok()
-    }
-
-    pub fn raster_mut(&mut self) -> Option<&mut RasterMode> {
-        self.raster.as_mut().ok()
     }
 
     /// Opens a scene file in every mode that can render it and returns the mode to show (the
