@@ -325,4 +325,12 @@ fn every_examples_help_says_what_it_does_and_documents_each_flag() {
             }
         }
     }
+    // The convergence tool sets spp (--spp-list) and sampling (it measures both) itself: its
+    // help must not offer flags it would refuse.
+    let out = Command::new(example_binary("convergence")).arg("--help").output().expect("runs");
+    let help = text(&out.stdout);
+    for flag in ["--spp ", "--sampling"] {
+        assert!(!help.contains(flag), "convergence --help offers {flag}:\n{help}");
+    }
+    assert!(help.contains("--spp-list") && help.contains("--bounces"), "{help}");
 }

@@ -45,7 +45,7 @@ struct Args {
     #[arg(default_value = cli::DEFAULT_SCENE)]
     scene: PathBuf,
     #[command(flatten)]
-    settings: SceneArgs,
+    settings: SceneFlags,
     /// Samples per pixel at which to record a row (comma-separated).
     #[arg(
         long = "spp-list",
@@ -68,6 +68,36 @@ struct Args {
     /// Folder for the tables, plots and the cached reference.
     #[arg(long, default_value = "out/convergence")]
     out: PathBuf,
+}
+
+/// The scene flags this tool takes. Not `--spp` (the rows' counts are `--spp-list`) nor
+/// `--sampling` (the tool measures both), so `--help` lists neither.
+#[derive(clap::Args, Debug)]
+struct SceneFlags {
+    /// Bounces of indirect light: 0 = direct only, up to 256, or `unbounded` (Russian roulette).
+    #[arg(long)]
+    bounces: Option<Bounces>,
+    /// Random seed.
+    #[arg(long)]
+    seed: Option<u32>,
+    /// Image width in pixels (default 64).
+    #[arg(long)]
+    width: Option<u32>,
+    /// Image height in pixels (default 64).
+    #[arg(long)]
+    height: Option<u32>,
+}
+
+impl SceneFlags {
+    fn scene_args(&self) -> SceneArgs {
+        SceneArgs {
+            bounces: self.bounces,
+            seed: self.seed,
+            width: Some(self.width.unwrap_or(64)),
+            height: Some(self.height.unwrap_or(64)),
+            ..Default::default()
+        }
+    }
 }
 
 /// One option of the comparison.
@@ -120,8 +150,6 @@ fn main() {
 }
 
 fn run(mut args: Args) -> anyhow::Result<()> {
-    args.settings.width.get_or_insert(64);
-    args.settings.height.get_or_insert(64);
     if args.spp_list.is_empty() || args.spp_list.contains(&0) {
         bail!("--spp-list = {:?}: give one or more counts, each at least 1", args.spp_list);
     }
@@ -133,17 +161,10 @@ fn run(mut args: Args) -> anyhow::Result<()> {
         .map(|&t| parse_time_budget("--time-budgets", t))
         .collect::<Result<Vec<_>, String>>()
         .map_err(anyhow::Error::msg)?;
-    // Flags this tool sets itself: refuse them rather than ignore them.
-    if args.settings.spp.is_some() {
-        bail!("--spp does not apply here: the rows' spp counts are --spp-list (e.g. --spp-list 1,4,16)");
-    }
-    if args.settings.sampling.is_some() {
-        bail!("--sampling does not apply here: the tool measures both cosine and uniform sampling");
-    }
     if args.reference_factor < 1 {
         bail!("--reference-factor = 0: must be at least 1");
     }
-    let scene = cli::load_scene(&args.scene, &args.settings)?;
+    let scene = cli::load_scene(&args.scene, &args.settings.scene_args())?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     let gpu = cli::gpu()?;
     println!(
