@@ -1,5 +1,6 @@
 //! The `render` example as a user runs it: the real binary, its exit status, its messages and
-//! the files it leaves. (Issue 16: stop rules that stop, work that is never lost.)
+//! the files it leaves: stop rules that stop, work that is never lost, and a README whose
+//! commands and pictures exist.
 //!
 //! The example is built by `cargo test` (examples are built with the tests); this finds it next
 //! to the test binary, in `target/<profile>/examples/`.
@@ -333,4 +334,45 @@ fn every_examples_help_says_what_it_does_and_documents_each_flag() {
         assert!(!help.contains(flag), "convergence --help offers {flag}:\n{help}");
     }
     assert!(help.contains("--spp-list") && help.contains("--bounces"), "{help}");
+}
+
+/// Every picture the README shows exists, every `--example NAME` it names is an example, and
+/// every flag on a line that runs an example is one that example's `--help` lists. (The numbers
+/// it quotes are re-measured by `scripts/readme-figures.sh`; timings cannot be asserted.)
+#[test]
+fn the_readme_shows_only_pictures_examples_and_flags_that_exist() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let readme = std::fs::read_to_string(root.join("README.md")).expect("README.md");
+    for (i, _) in readme.match_indices("](docs/images/") {
+        let rest = &readme[i + 2..];
+        let path = &rest[..rest.find(')').expect("closing parenthesis")];
+        assert!(root.join(path).exists(), "README shows {path}, which does not exist");
+    }
+    let mut checked = 0;
+    for line in readme.lines() {
+        let Some(at) = line.find("--example ") else { continue };
+        let name: String = line[at + "--example ".len()..]
+            .chars()
+            .take_while(|c| c.is_alphanumeric() || *c == '_')
+            .collect();
+        let help = Command::new(example_binary(&name)).arg("--help").output().expect("the example starts");
+        assert!(help.status.success(), "README names --example {name}, which has no working --help");
+        let help = text(&help.stdout);
+        // The flags after the example's name, as the line spells them (`--spp N`, `[--look ...]`).
+        for word in line[at..].split(|c: char| c.is_whitespace() || "[]`|=,()".contains(c)).skip(2) {
+            if let Some(flag) =
+                word.strip_prefix("--").filter(|f| f.chars().all(|c| c.is_ascii_lowercase() || c == '-'))
+            {
+                if flag.is_empty() || flag == "release" || flag == "example" {
+                    continue;
+                }
+                assert!(
+                    help.contains(&format!("--{flag}")),
+                    "README runs `{name}` with --{flag}, which its --help lacks"
+                );
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 20, "only {checked} flags found in the README's example lines");
 }

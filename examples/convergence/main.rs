@@ -231,14 +231,7 @@ fn reference_image(gpu: &GpuContext, scene: &Scene, args: &Args, max_spp: u32) -
         return Ok(image);
     }
     let spp = max_spp.saturating_mul(args.reference_factor);
-    let mut reference_scene = scene.clone();
-    reference_scene.pathtrace.sampling = Sampling::Cosine;
-    reference_scene.pathtrace.spp = spp;
-    // A seed the measured runs do not use, so reference and test noise are independent.
-    reference_scene.pathtrace.seed = scene.pathtrace.seed.wrapping_add(0x5eed);
-    // Everything that changes the reference image: the whole scene as loaded and overridden
-    // (geometry, materials, emission, camera, bounces, seed, spp).
-    let key = format!("{reference_scene:?}");
+    let (reference_scene, key) = reference_settings(scene, spp);
     let path = args.out.join(format!("reference-{}-{:016x}.exr", scene.name, fnv1a(key.as_bytes())));
     if path.exists() {
         let (image, attributes) = load_exr(&path)?;
@@ -262,6 +255,19 @@ fn reference_image(gpu: &GpuContext, scene: &Scene, args: &Args, max_spp: u32) -
     metadata.fields.push(("reference_key".into(), key));
     save_exr(&path, &image, &metadata)?;
     Ok(image)
+}
+
+/// The scene the reference is rendered with (cosine sampling, `spp`, a seed of its own), and
+/// its cache key: everything that changes the reference image, i.e. the whole scene as loaded
+/// and overridden (geometry, materials, emission, camera, bounces, seed, spp).
+fn reference_settings(scene: &Scene, spp: u32) -> (Scene, String) {
+    let mut reference_scene = scene.clone();
+    reference_scene.pathtrace.sampling = Sampling::Cosine;
+    reference_scene.pathtrace.spp = spp;
+    // A seed the measured runs do not use, so reference and test noise are independent.
+    reference_scene.pathtrace.seed = scene.pathtrace.seed.wrapping_add(0x5eed);
+    let key = format!("{reference_scene:?}");
+    (reference_scene, key)
 }
 
 /// 64-bit FNV-1a: a stable hash for the cache's file name (the full key is checked on reuse).
@@ -493,4 +499,59 @@ fn bounce_table(gpu: &GpuContext, scene: &Scene, spp: u32, out: &Path) -> anyhow
         "added mean luminance",
         &[Line { label: "increment".into(), points, markers_only: false }],
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn csv_rows_with_commas_in_a_field_keep_their_column_count() {
+        let header = ["variant", "spp", "relmse"];
+        let rows = vec![
+            vec!["cosine, independent".to_owned(), "16".to_owned(), "0.01".to_owned()],
+            vec!["say \"hi\", twice".to_owned(), "32".to_owned(), "0.005".to_owned()],
+        ];
+        let text = csv_text(&header, &rows).unwrap();
+        let mut reader = csv::Reader::from_reader(text.as_bytes());
+        assert_eq!(reader.headers().unwrap().len(), 3);
+        let read: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
+        assert_eq!(read.len(), 2);
+        for (record, row) in read.iter().zip(&rows) {
+            assert_eq!(record.len(), 3, "{text}");
+            assert_eq!(record.iter().collect::<Vec<_>>(), row.iter().map(String::as_str).collect::<Vec<_>>());
+        }
+    }
+
+    #[test]
+    fn the_reference_cache_key_changes_with_anything_that_changes_the_image() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/cornell.toml");
+        let scene = Scene::load(Path::new(path)).unwrap();
+        let (_, key) = reference_settings(&scene, 1024);
+        assert_eq!(reference_settings(&scene.clone(), 1024).1, key, "the same scene, the same key");
+        // A copy with the light twice as bright and the same name (the case that used to reuse
+        // the old reference), more spp, another seed, another size.
+        let mut brighter = scene.clone();
+        for m in &mut brighter.materials {
+            if let illum::scene::MaterialKind::Emitter { radiance } = &mut m.kind {
+                *radiance *= 2.0;
+            }
+        }
+        let mut seeded = scene.clone();
+        seeded.pathtrace.seed += 1;
+        let mut wider = scene.clone();
+        wider.camera.width += 1;
+        for (what, other) in [
+            ("emission", reference_settings(&brighter, 1024).1),
+            ("spp", reference_settings(&scene, 2048).1),
+            ("seed", reference_settings(&seeded, 1024).1),
+            ("width", reference_settings(&wider, 1024).1),
+        ] {
+            assert_ne!(other, key, "{what} changed but the key did not");
+        }
+        // The sampling of the measured rows does not change the reference (always cosine).
+        let mut uniform = scene.clone();
+        uniform.pathtrace.sampling = Sampling::Uniform;
+        assert_eq!(reference_settings(&uniform, 1024).1, key);
+    }
 }

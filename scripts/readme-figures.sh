@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# Regenerates every picture the README shows and re-measures every number it quotes, from the
+# code as it is now. One command:
+#
+#     scripts/readme-figures.sh
+#
+# Pictures are written over docs/images/; the numbers are printed, each under the README line it
+# backs, for the README to be updated by hand where they moved. Timings are only meaningful on an
+# idle machine (a parallel build doubles them). Needs the Vulkan driver, and xvfb-run for the
+# viewer's screenshots (sudo apt-get install mesa-vulkan-drivers xvfb xauth). About 5 minutes
+# after the release build on this project's 2-core machine.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+cargo build --release --examples -p illum
+cargo build --release -p illum-viewer
+bin=target/release/examples
+out=out/readme-figures
+mkdir -p "$out" docs/images
+export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d)}"
+
+echo "== Pictures"
+"$bin/render" scenes/cornell.toml --spp 2048 -o docs/images/cornell.png
+"$bin/raster_figures" --out docs/images
+"$bin/figures" --out "$out/figures"
+cp "$out/figures/contact-sheet.png" docs/images/figures.png
+if command -v xvfb-run > /dev/null; then
+    xvfb-run -a -s "-screen 0 1280x800x24" target/release/illum-viewer scenes/cornell.toml \
+        --screenshot docs/images/viewer-pathtrace.png --frames 60
+    xvfb-run -a -s "-screen 0 1280x800x24" target/release/illum-viewer scenes/whitted.toml \
+        --screenshot docs/images/viewer-raster.png --frames 60
+else
+    echo "xvfb-run is missing: the viewer screenshots were not redone (sudo apt-get install xvfb xauth)"
+fi
+
+echo
+echo "== 'reaches 1% estimated relative error at about N spp' (512 x 512, the default scene)"
+"$bin/render" --target-error 0.01 -o "$out/cornell-1pct.exr"
+echo
+echo "== 'A relMSE of 10^-2 (10% RMS error) takes about N spp'"
+"$bin/render" --target-error 0.1 -o "$out/cornell-10pct.exr"
+echo
+echo "== 'The pipeline generated for each scene is about N times faster than the generic one'"
+"$bin/bench" --quick
+echo
+echo "== 'Whitted look-alike: 1280 x 720 with every effect on, median frame about N ms'"
+"$bin/raster_bench" --look enhanced
