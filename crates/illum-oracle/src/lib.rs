@@ -5,6 +5,9 @@
 //! numbers, so that tests and the convergence tool can compare the two statistically. It is
 //! slow and simple on purpose: no acceleration structure, no SIMD, one ray at a time.
 //!
+//! It also holds [`whitted`], Whitted's deterministic 1980 algorithm in f64, the reference a GPU
+//! Whitted ray tracer is to match pixel by pixel (its module documentation states the model).
+//!
 //! What is estimated (see `integrator.rs` for the derivation):
 //! - pinhole camera, rays jittered uniformly inside each pixel (`camera.rs`);
 //! - boxes (rotated about +Y), parallelograms and spheres, all Lambertian and two-sided;
@@ -33,11 +36,13 @@ mod render;
 mod rng;
 mod sampling;
 mod scene;
+pub mod whitted;
 
 pub use camera::PinholeCamera;
 pub use integrator::Oracle;
 pub use render::{OracleImage, PixelEstimate};
 pub use rng::Rng;
+pub use whitted::WhittedOracle;
 
 use illum_scene::{Scene, SceneError};
 

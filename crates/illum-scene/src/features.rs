@@ -87,13 +87,19 @@ impl Scene {
     /// Ok if `renderer` implements every feature the scene uses; otherwise the first one it
     /// lacks, as [`SceneError::Unsupported`].
     pub fn require(&self, renderer: RendererKind, supported: &[Feature]) -> Result<(), SceneError> {
+        self.require_for(renderer.noun(), supported)
+    }
+
+    /// [`Scene::require`] for a renderer named in words (one that is not a [`RendererKind`]
+    /// yet, such as the oracle's copy of Whitted's algorithm).
+    pub fn require_for(&self, renderer: &str, supported: &[Feature]) -> Result<(), SceneError> {
         match self.features().into_iter().find(|(f, _)| !supported.contains(f)) {
             None => Ok(()),
             Some((feature, place)) => Err(SceneError::Unsupported {
                 file: self.source.clone(),
                 place,
                 feature: feature.to_string(),
-                renderer: renderer.noun().to_owned(),
+                renderer: renderer.to_owned(),
             }),
         }
     }

@@ -1,0 +1,387 @@
+//! Whitted's 1980 ray tracer in f64: the independent CPU copy the GPU Whitted ray tracer is to be
+//! checked against, pixel by pixel.
+//!
+//! At each hit point p with unit normal n turned toward the arriving ray, view direction v and
+//! colour c (a Lambertian or checker albedo, or a mirror's reflectance), with the `[shading]`
+//! parameters of the scene (ambient a; the mirror's weight w, specular s and shininess; the
+//! dielectric's shininess):
+//!
+//! - **Lambertian, checker**: c x (a + sum over lights of E_l x max(n.l, 0) x V_l);
+//! - **mirror**: (1 - w) x c x (a + sum E_l x max(n.l, 0) x V_l) + w x c x trace(reflected)
+//!   + s x sum E_l x H_l;
+//! - **dielectric**: F x trace(reflected) + (1 - F) x trace(refracted) + sum E_l x H_l, with the
+//!   exact unpolarised Fresnel reflectance F of the interface (F = 1 under total internal
+//!   reflection, when no refracted ray exists);
+//! - **emitter**: its radiance on its front side, black behind;
+//! - a ray that leaves the scene sees the environment's radiance (black without one).
+//!
+//! E_l is what light l contributes to a white Lambertian surface facing it, per unit n.l: for the
+//! directional light its irradiance / pi (a three.js intensity); V_l is 1 where a hard shadow ray
+//! toward the light meets no object (every object blocks it, glass and mirror included; emitters
+//! do not); H_l = max(n.h, 0)^shininess x V_l where n.l > 0 is the Blinn-Phong highlight with the
+//! half vector h = normalize(l + v). An area light (an emitting quad, as in the Cornell box) is
+//! treated as a point light at its centre with the quad's power pattern: radiant intensity
+//! L x area x cos(theta_light) toward the point, so E_l = L x area x cos(theta_light) / (pi r^2).
+//!
+//! Recursion: reflected and refracted rays are followed `depth` times; past that they contribute
+//! nothing (black). Anti-aliasing: an n x n grid of rays through each pixel at the cell centres
+//! ((i + 0.5) / n), averaged: deterministic.
+
+use std::f64::consts::PI;
+use std::sync::atomic::{AtomicU32, Ordering};
+
+use glam::DVec3;
+use illum_scene::{Feature, MaterialKind, Scene, SceneError, Shape};
+
+use crate::camera::PinholeCamera;
+use crate::geometry::{Ball, OrientedBox, Parallelogram, Surface};
+
+/// What this copy of the Whitted ray tracer renders: every shape and material of the scene
+/// model, a delta directional light, area lights (as point lights) and a constant environment.
+/// A sun of finite size is refused: Whitted's shadow rays are hard.
+pub const FEATURES: &[Feature] = &[
+    Feature::BoxShape,
+    Feature::QuadShape,
+    Feature::SphereShape,
+    Feature::Lambertian,
+    Feature::Checker,
+    Feature::Dielectric,
+    Feature::Mirror,
+    Feature::AreaLight,
+    Feature::DeltaDirectionalLight,
+    Feature::Environment,
+];
+
+/// One object: its surface and its material.
+#[derive(Clone, Copy, Debug)]
+struct Item {
+    surface: Surface,
+    material: MaterialKind,
+}
+
+/// A light as Whitted sees it: a direction at infinity or a point with a power pattern.
+#[derive(Clone, Copy, Debug)]
+enum Light {
+    /// `to_light` is the unit vector toward the light; `radiance` = irradiance / pi.
+    Directional { to_light: DVec3, radiance: DVec3 },
+    /// The centre of an emitting quad with normal `normal` (its front side), radiance x area.
+    Point { position: DVec3, normal: DVec3, power: DVec3 },
+}
+
+/// Whitted's algorithm on one scene, with the scene's `[whitted]` depth and anti-aliasing and
+/// its `[shading]` parameters (which callers may change before rendering).
+#[derive(Clone, Debug)]
+pub struct WhittedOracle {
+    items: Vec<Item>,
+    lights: Vec<Light>,
+    background: DVec3,
+    camera: PinholeCamera,
+    ambient: DVec3,
+    mirror_specular: DVec3,
+    mirror_shininess: f64,
+    mirror_weight: f64,
+    dielectric_shininess: f64,
+    /// Reflected and refracted rays are followed this many times.
+    pub depth: u32,
+    /// Rays per pixel: `aa` x `aa`.
+    pub aa: u32,
+}
+
+/// Below this distance, scaled by the size of the coordinates, a new ray's origin is moved off
+/// its surface (f64 roundoff at p is about 1e-16 |p|; 1e-9 leaves a wide margin and is far
+/// below any feature of the scenes).
+const SPAWN_EPSILON: f64 = 1e-9;
+
+fn dvec(v: glam::Vec3) -> DVec3 {
+    v.as_dvec3()
+}
+
+impl WhittedOracle {
+    /// Prepares `scene`, or says which of its features Whitted's algorithm does not model.
+    pub fn new(scene: &Scene) -> Result<WhittedOracle, SceneError> {
+        scene.require_for("Whitted ray tracer", FEATURES)?;
+        let mut items = Vec::with_capacity(scene.objects.len());
+        let mut lights = Vec::new();
+        for object in &scene.objects {
+            let material = scene.material_of(object).kind;
+            let surface = match &object.shape {
+                Shape::Box(b) => Surface::Box(OrientedBox::from_shape(b)),
+                Shape::Quad(q) => {
+                    let p = Parallelogram::new(dvec(q.corner), dvec(q.edge_u), dvec(q.edge_v));
+                    if let MaterialKind::Emitter { radiance } = material {
+                        lights.push(Light::Point {
+                            position: p.point(0.5, 0.5),
+                            normal: p.normal,
+                            power: dvec(radiance) * p.area,
+                        });
+                    }
+                    Surface::Parallelogram(p)
+                }
+                Shape::Sphere(s) => {
+                    Surface::Ball(Ball { center: dvec(s.center), radius: f64::from(s.radius) })
+                }
+            };
+            items.push(Item { surface, material });
+        }
+        if let Some(sun) = &scene.directional_light {
+            lights.push(Light::Directional {
+                to_light: -dvec(sun.direction).normalize(),
+                radiance: dvec(sun.irradiance) / PI,
+            });
+        }
+        let shading = &scene.shading;
+        Ok(WhittedOracle {
+            items,
+            lights,
+            background: scene.environment.map_or(DVec3::ZERO, |e| dvec(e.radiance)),
+            camera: PinholeCamera::new(&scene.camera),
+            ambient: dvec(shading.ambient),
+            mirror_specular: dvec(shading.mirror.specular),
+            mirror_shininess: f64::from(shading.mirror.shininess),
+            mirror_weight: f64::from(shading.mirror.weight),
+            dielectric_shininess: f64::from(shading.dielectric.shininess),
+            depth: scene.whitted.depth,
+            aa: scene.whitted.aa,
+        })
+    }
+
+    /// The pixel (x, y): the mean of its `aa` x `aa` rays.
+    pub fn pixel(&self, x: u32, y: u32) -> [f64; 3] {
+        let n = self.aa.max(1);
+        let mut sum = DVec3::ZERO;
+        for j in 0..n {
+            for i in 0..n {
+                let (jx, jy) = ((f64::from(i) + 0.5) / f64::from(n), (f64::from(j) + 0.5) / f64::from(n));
+                let d = self.camera.direction(x, y, jx, jy);
+                sum += self.trace(self.camera.eye, d, self.depth);
+            }
+        }
+        (sum / f64::from(n * n)).to_array()
+    }
+
+    /// The whole image, row-major from the top-left, on `threads` threads (the result does not
+    /// depend on it).
+    pub fn render(&self, threads: usize) -> Vec<[f64; 3]> {
+        let (width, height) = (self.camera.width, self.camera.height);
+        let next_row = AtomicU32::new(0);
+        let threads = threads.clamp(1, height.max(1) as usize);
+        let mut rows: Vec<(u32, Vec<[f64; 3]>)> = std::thread::scope(|scope| {
+            let workers: Vec<_> = (0..threads)
+                .map(|_| {
+                    scope.spawn(|| {
+                        let mut done = Vec::new();
+                        loop {
+                            let y = next_row.fetch_add(1, Ordering::Relaxed);
+                            if y >= height {
+                                break done;
+                            }
+                            done.push((y, (0..width).map(|x| self.pixel(x, y)).collect()));
+                        }
+                    })
+                })
+                .collect();
+            workers.into_iter().flat_map(|w| w.join().expect("whitted worker panicked")).collect()
+        });
+        rows.sort_unstable_by_key(|(y, _)| *y);
+        rows.into_iter().flat_map(|(_, row)| row).collect()
+    }
+
+    /// The closest hit of o + t d, t > 0: (t, geometric normal, item index). An emitter wins a
+    /// tie with a coplanar surface (the Cornell light set into its ceiling), whatever their
+    /// order: it counts as closer unless the other surface is nearer by more than roundoff.
+    fn closest(&self, o: DVec3, d: DVec3) -> Option<(f64, DVec3, usize)> {
+        const TIE: f64 = 1e-9;
+        let mut best: Option<(f64, DVec3, usize, bool)> = None;
+        for (i, item) in self.items.iter().enumerate() {
+            let Some(hit) = item.surface.intersect(o, d, f64::INFINITY) else { continue };
+            let emitter = matches!(item.material, MaterialKind::Emitter { .. });
+            let wins = match best {
+                None => true,
+                Some((t, _, _, best_is_emitter)) => match (emitter, best_is_emitter) {
+                    (true, false) => hit.t <= t * (1.0 + TIE),
+                    (false, true) => hit.t < t * (1.0 - TIE),
+                    _ => hit.t < t,
+                },
+            };
+            if wins {
+                best = Some((hit.t, hit.normal, i, emitter));
+            }
+        }
+        best.map(|(t, n, i, _)| (t, n, i))
+    }
+
+    /// Whether any non-emitting object lies on o + t d for 0 < t < t_max.
+    fn blocked(&self, o: DVec3, d: DVec3, t_max: f64) -> bool {
+        self.items.iter().any(|item| {
+            !matches!(item.material, MaterialKind::Emitter { .. })
+                && item.surface.intersect(o, d, t_max).is_some()
+        })
+    }
+
+    /// For each light seen from p (normal n): (unit vector toward it, E_l, visibility).
+    fn lights_at(&self, p: DVec3, n: DVec3) -> Vec<(DVec3, DVec3, f64)> {
+        let origin = offset(p, n);
+        self.lights
+            .iter()
+            .map(|light| match *light {
+                Light::Directional { to_light, radiance } => {
+                    let visible = !self.blocked(origin, to_light, f64::INFINITY);
+                    (to_light, radiance, f64::from(u8::from(visible)))
+                }
+                Light::Point { position, normal, power } => {
+                    let to = position - p;
+                    let r2 = to.length_squared();
+                    let l = to / r2.sqrt();
+                    let cos_light = (-l).dot(normal).max(0.0);
+                    let visible = cos_light > 0.0 && !self.blocked(origin, l, r2.sqrt() * (1.0 - 1e-9));
+                    (l, power * cos_light / (PI * r2), f64::from(u8::from(visible)))
+                }
+            })
+            .collect()
+    }
+
+    /// Radiance arriving at o along unit d, with `depth` reflections or refractions left.
+    fn trace(&self, o: DVec3, d: DVec3, depth: u32) -> DVec3 {
+        let Some((t, geometric_normal, index)) = self.closest(o, d) else { return self.background };
+        let item = &self.items[index];
+        let p = o + t * d;
+        let front = geometric_normal.dot(d) < 0.0;
+        // The normal against the ray.
+        let n = if front { geometric_normal } else { -geometric_normal };
+        let v = -d;
+        let lambert = |c: DVec3| {
+            let direct: DVec3 =
+                self.lights_at(p, n).iter().map(|&(l, e, vis)| e * n.dot(l).max(0.0) * vis).sum();
+            c * (self.ambient + direct)
+        };
+        let highlights = |shininess: f64| -> DVec3 {
+            self.lights_at(p, n)
+                .iter()
+                .filter(|(l, _, _)| n.dot(*l) > 0.0)
+                .map(|&(l, e, vis)| e * (n.dot((l + v).normalize()).max(0.0)).powf(shininess) * vis)
+                .sum()
+        };
+        let reflected = |depth: u32| {
+            if depth == 0 {
+                return DVec3::ZERO;
+            }
+            let r = d - 2.0 * d.dot(n) * n;
+            self.trace(offset(p, n), r, depth - 1)
+        };
+        match item.material {
+            MaterialKind::Emitter { radiance } => {
+                if front {
+                    dvec(radiance)
+                } else {
+                    DVec3::ZERO
+                }
+            }
+            MaterialKind::Lambertian { albedo } => lambert(dvec(albedo)),
+            MaterialKind::Checker(checker) => {
+                let Surface::Parallelogram(quad) = item.surface else {
+                    unreachable!("validation puts checkers on quads only")
+                };
+                lambert(checker_albedo(&quad, checker, p))
+            }
+            MaterialKind::Mirror { reflectance } => {
+                let c = dvec(reflectance);
+                let w = self.mirror_weight;
+                (1.0 - w) * lambert(c)
+                    + w * c * reflected(depth)
+                    + self.mirror_specular * highlights(self.mirror_shininess)
+            }
+            MaterialKind::Dielectric { ior } => {
+                // Entering through the front (outward normal against the ray) or leaving.
+                let eta = if front { 1.0 / f64::from(ior) } else { f64::from(ior) };
+                let cos_i = v.dot(n);
+                let spark = highlights(self.dielectric_shininess);
+                match refract(d, n, eta) {
+                    None => reflected(depth) + spark,
+                    Some(refracted) => {
+                        let f = fresnel(cos_i, -refracted.dot(n), eta);
+                        let transmitted = if depth == 0 {
+                            DVec3::ZERO
+                        } else {
+                            self.trace(offset(p, -n), refracted, depth - 1)
+                        };
+                        f * reflected(depth) + (1.0 - f) * transmitted + spark
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// p moved off its surface along n by a bound on its rounding error.
+fn offset(p: DVec3, n: DVec3) -> DVec3 {
+    p + n * SPAWN_EPSILON * (1.0 + p.abs().max_element())
+}
+
+/// The checker's albedo at p on `quad`: tile (i, j) counted from the corner along the edges.
+fn checker_albedo(quad: &Parallelogram, checker: illum_scene::Checker, p: DVec3) -> DVec3 {
+    let q = p - quad.corner;
+    // Coordinates along the edges, in units of each edge's length, then in tiles.
+    let (lu, lv) = (quad.u.length(), quad.v.length());
+    let (s, r) = (q.dot(quad.u) / (lu * lu), q.dot(quad.v) / (lv * lv));
+    let tile = f64::from(checker.tile);
+    let (i, j) = ((s * lu / tile).floor() as i64, (r * lv / tile).floor() as i64);
+    if (i + j).rem_euclid(2) == 0 { dvec(checker.even) } else { dvec(checker.odd) }
+}
+
+/// Snell's law: the refracted unit direction of unit `d` at unit normal `n` (against the ray)
+/// with eta = n_from / n_to, or `None` under total internal reflection.
+fn refract(d: DVec3, n: DVec3, eta: f64) -> Option<DVec3> {
+    let cos_i = -d.dot(n);
+    let sin2_t = eta * eta * (1.0 - cos_i * cos_i);
+    if sin2_t > 1.0 {
+        return None;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    Some((eta * d + (eta * cos_i - cos_t) * n).normalize())
+}
+
+/// The exact unpolarised Fresnel reflectance of a dielectric interface: the mean of the s- and
+/// p-polarised reflectances, for cosines of incidence `cos_i` and transmission `cos_t` and
+/// eta = n_from / n_to.
+pub fn fresnel(cos_i: f64, cos_t: f64, eta: f64) -> f64 {
+    // With n_from = eta and n_to = 1 (only the ratio matters):
+    let rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    0.5 * (rs * rs + rp * rp)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fresnel_at_normal_incidence_and_its_symmetry() {
+        // ((n - 1) / (n + 1))^2 at normal incidence, from either side.
+        for n in [1.0001f64, 1.4285715, 1.5, 4.0] {
+            let f0 = ((n - 1.0) / (n + 1.0)).powi(2);
+            assert!((fresnel(1.0, 1.0, 1.0 / n) - f0).abs() < 1e-15, "n = {n}");
+            assert!((fresnel(1.0, 1.0, n) - f0).abs() < 1e-15, "n = {n}");
+        }
+        // Index 1: nothing is reflected at any angle.
+        for c in [0.01f64, 0.3, 0.9] {
+            assert!(fresnel(c, c, 1.0).abs() < 1e-15);
+        }
+        // Grazing incidence from outside reflects everything.
+        let eta = 1.0 / 1.5;
+        let cos_t = (1.0f64 - eta * eta).sqrt();
+        assert!((fresnel(0.0, cos_t, eta) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn refraction_obeys_snell_and_reports_total_internal_reflection() {
+        let n = DVec3::Z;
+        let d = DVec3::new(0.6, 0.0, -0.8);
+        let eta = 1.0 / 1.5;
+        let t = refract(d, n, eta).unwrap();
+        // sin_t = eta sin_i.
+        assert!((t.x - eta * 0.6).abs() < 1e-15 && (t.length() - 1.0).abs() < 1e-15);
+        // From inside glass at 45 degrees (beyond the critical angle 41.8 degrees): none.
+        let inside = DVec3::new(0.5f64.sqrt(), 0.0, -(0.5f64.sqrt()));
+        assert!(refract(inside, n, 1.5).is_none());
+    }
+}
