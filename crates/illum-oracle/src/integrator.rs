@@ -17,15 +17,17 @@
 //! most 0.95) and its throughput is divided by q, which keeps the expectation unchanged
 //! (Russian roulette).
 
-use std::f64::consts::FRAC_1_PI;
+use std::f64::consts::{FRAC_1_PI, PI};
 
 use glam::DVec3;
-use illum_scene::{Bounces, Sampling, Scene};
+use illum_scene::{Bounces, MaterialKind, Sampling, Scene};
 
 use crate::camera::PinholeCamera;
+use crate::geometry::Surface;
 use crate::rng::Rng;
-use crate::sampling::{cosine_hemisphere, local_to_world, uniform_hemisphere};
+use crate::sampling::{cosine_hemisphere, local_to_world, uniform_cone, uniform_hemisphere};
 use crate::scene::{Primitive, TraceScene};
+use crate::whitted::{reflect, refract};
 
 /// Relative distance by which an emitter may lie behind the nearest other surface and still
 /// be the one that is hit: lights set into a coplanar ceiling win the tie.
@@ -146,62 +148,163 @@ impl Oracle {
         }
     }
 
+    /// One sample of the directional light's contribution to the integral of incoming radiance
+    /// x cos over the hemisphere at x (offset off the surface) with facing normal n: for a delta
+    /// light E cos V; for a disc, one direction uniform in its cone (pdf 1 / (2 pi (1 - cos_max)))
+    /// with L_sun cos V / pdf.
+    fn sun_sample(&self, x: DVec3, n: DVec3, rng: &mut Rng) -> DVec3 {
+        let Some(sun) = self.scene.sun else { return DVec3::ZERO };
+        if sun.is_delta() {
+            let cos = n.dot(sun.to_light);
+            if cos <= 0.0 || self.blocked(x, sun.to_light, f64::INFINITY) {
+                return DVec3::ZERO;
+            }
+            return sun.irradiance * cos;
+        }
+        let (u1, u2) = (rng.uniform(), rng.uniform());
+        let w = local_to_world(sun.to_light, uniform_cone(u1, u2, sun.cos_max)).normalize();
+        let cos = n.dot(w);
+        if cos <= 0.0 || self.blocked(x, w, f64::INFINITY) {
+            return DVec3::ZERO;
+        }
+        sun.radiance() * (cos * 2.0 * PI * (1.0 - sun.cos_max))
+    }
+
+    /// What a ray leaving the scene along d sees: the sky, and the sun's disc where it counts
+    /// (camera and specular rays only: next-event estimation already counted it for diffuse
+    /// ones). A delta sun is never seen.
+    fn escaped(&self, d: DVec3, direct_counts: bool) -> DVec3 {
+        let sun = match self.scene.sun {
+            Some(sun) if direct_counts && !sun.is_delta() && d.dot(sun.to_light) >= sun.cos_max => {
+                sun.radiance()
+            }
+            _ => DVec3::ZERO,
+        };
+        self.scene.sky + sun
+    }
+
+    /// Russian roulette in unbounded mode from the fourth continuation on: survives with
+    /// probability q = min(max channel of `weight`, 0.95) and then divides `throughput` by q.
+    /// Returns false when the path ends.
+    fn roulette(&self, taken: u32, weight: DVec3, throughput: &mut DVec3, rng: &mut Rng) -> bool {
+        if self.bounces == Bounces::Unbounded && taken >= ROULETTE_AFTER {
+            let q = weight.max_element().min(ROULETTE_MAX_SURVIVAL);
+            if !(q > 0.0 && rng.uniform() < q) {
+                return false;
+            }
+            *throughput /= q;
+        }
+        true
+    }
+
     /// One sample of the radiance arriving at `origin` from direction -`dir` (the quantity a
     /// camera ray from `origin` along `dir` measures). `dir` need not be normalised.
     pub fn radiance(&self, origin: DVec3, dir: DVec3, rng: &mut Rng) -> DVec3 {
         let mut d = dir.normalize();
-        let Some(mut hit) = self.closest_hit(origin, d) else {
-            return DVec3::ZERO;
-        };
-        if hit.primitive.emitter {
-            // One-sided: only the front (normal against the ray) emits.
-            return if hit.normal.dot(d) < 0.0 { hit.primitive.emission } else { DVec3::ZERO };
-        }
         let mut o = origin;
         let mut sum = DVec3::ZERO;
         let mut throughput = DVec3::ONE;
         let mut taken = 0u32;
+        // Whether light reaching this ray straight from an emitter or the sun's disc counts: for
+        // the camera ray and after specular scattering, which next-event estimation cannot
+        // follow; not after a diffuse bounce, whose point already sampled the lights.
+        let mut direct_counts = true;
         loop {
-            let x = o + hit.t * d;
-            let n = if hit.normal.dot(d) > 0.0 { -hit.normal } else { hit.normal };
-            let albedo = hit.primitive.albedo;
-            let x_off = x + n * (SPAWN_OFFSET * x.abs().max_element().max(1.0));
-            sum += throughput * albedo * FRAC_1_PI * self.light_sample(x_off, n, rng);
-
-            if !self.may_continue(taken) {
+            let Some(hit) = self.closest_hit(o, d) else {
+                sum += throughput * self.escaped(d, direct_counts);
+                break;
+            };
+            if hit.primitive.emitter {
+                // One-sided: only the front (normal against the ray) emits.
+                if direct_counts && hit.normal.dot(d) < 0.0 {
+                    sum += throughput * hit.primitive.emission;
+                }
                 break;
             }
-            if self.bounces == Bounces::Unbounded && taken >= ROULETTE_AFTER {
-                let q = (throughput * albedo).max_element().min(ROULETTE_MAX_SURVIVAL);
-                let survives = q > 0.0 && rng.uniform() < q;
-                if !survives {
-                    break;
+            let x = o + hit.t * d;
+            let front = hit.normal.dot(d) < 0.0;
+            let n = if front { hit.normal } else { -hit.normal };
+            let lift = SPAWN_OFFSET * x.abs().max_element().max(1.0);
+            match hit.primitive.material {
+                MaterialKind::Mirror { reflectance } => {
+                    // A smooth mirror: one direction, weight = its reflectance.
+                    let reflectance = reflectance.as_dvec3();
+                    if !self.may_continue(taken)
+                        || !self.roulette(taken, throughput * reflectance, &mut throughput, rng)
+                    {
+                        break;
+                    }
+                    throughput *= reflectance;
+                    d = reflect(d, n);
+                    o = x + n * lift;
+                    direct_counts = true;
                 }
-                throughput /= q;
+                MaterialKind::Dielectric { ior } => {
+                    // Reflect with probability F (the exact Fresnel reflectance), else refract:
+                    // the weight F / F = (1 - F) / (1 - F) = 1. Radiance is not scaled by eta^2
+                    // across the interface: every diffuse surface and light is outside, so a
+                    // path enters and leaves a ball as often and the factors cancel.
+                    if !self.may_continue(taken) || !self.roulette(taken, throughput, &mut throughput, rng) {
+                        break;
+                    }
+                    let eta = if front { 1.0 / f64::from(ior) } else { f64::from(ior) };
+                    let cos_i = -d.dot(n);
+                    let refracted = refract(d, n, eta).filter(|t| {
+                        let f = crate::whitted::fresnel(cos_i, -t.dot(n), eta);
+                        rng.uniform() >= f
+                    });
+                    match refracted {
+                        Some(t) => {
+                            d = t;
+                            o = x - n * lift;
+                        }
+                        None => {
+                            d = reflect(d, n);
+                            o = x + n * lift;
+                        }
+                    }
+                    direct_counts = true;
+                }
+                MaterialKind::Lambertian { .. } | MaterialKind::Checker(_) => {
+                    let albedo = match (hit.primitive.material, hit.primitive.surface) {
+                        (MaterialKind::Checker(c), Surface::Parallelogram(quad)) => {
+                            crate::whitted::checker_albedo(&quad, c, x)
+                        }
+                        _ => hit.primitive.albedo,
+                    };
+                    let x_off = x + n * lift;
+                    sum += throughput
+                        * albedo
+                        * FRAC_1_PI
+                        * (self.light_sample(x_off, n, rng) + self.sun_sample(x_off, n, rng));
+                    if !self.may_continue(taken)
+                        || !self.roulette(taken, throughput * albedo, &mut throughput, rng)
+                    {
+                        break;
+                    }
+                    let (u1, u2) = (rng.uniform(), rng.uniform());
+                    let local = match self.sampling {
+                        Sampling::Cosine => {
+                            // (rho/pi) cos / (cos/pi) = rho
+                            throughput *= albedo;
+                            cosine_hemisphere(u1, u2)
+                        }
+                        Sampling::Uniform => {
+                            let local = uniform_hemisphere(u1, u2);
+                            // (rho/pi) cos / (1/(2 pi)) = 2 rho cos
+                            throughput *= albedo * (2.0 * local.z);
+                            local
+                        }
+                    };
+                    d = local_to_world(n, local).normalize();
+                    o = x_off;
+                    direct_counts = false;
+                }
+                MaterialKind::Emitter { .. } => unreachable!("emitters are handled above"),
             }
-            let (u1, u2) = (rng.uniform(), rng.uniform());
-            let local = match self.sampling {
-                Sampling::Cosine => {
-                    // (rho/pi) cos / (cos/pi) = rho
-                    throughput *= albedo;
-                    cosine_hemisphere(u1, u2)
-                }
-                Sampling::Uniform => {
-                    let local = uniform_hemisphere(u1, u2);
-                    // (rho/pi) cos / (1/(2 pi)) = 2 rho cos
-                    throughput *= albedo * (2.0 * local.z);
-                    local
-                }
-            };
             // Nothing more can be added once every channel is zero (or not a number).
             if !throughput.cmpgt(DVec3::ZERO).any() {
                 break;
-            }
-            d = local_to_world(n, local).normalize();
-            o = x_off;
-            match self.closest_hit(o, d) {
-                Some(next) if !next.primitive.emitter => hit = next,
-                _ => break,
             }
             taken += 1;
         }

@@ -1,4 +1,4 @@
-//! illum-oracle: an independent, scalar CPU reference for the Cornell box path tracer, in f64.
+//! illum-oracle: an independent, scalar CPU reference for illum's renderers, in f64.
 //!
 //! It estimates the same per-pixel quantity as the GPU path tracer (`shaders/pathtrace/`) —
 //! equal in expectation, not sample for sample — from its own mathematics and its own random
@@ -10,12 +10,20 @@
 //!
 //! What is estimated (see `integrator.rs` for the derivation):
 //! - pinhole camera, rays jittered uniformly inside each pixel (`camera.rs`);
-//! - boxes (rotated about +Y), parallelograms and spheres, all Lambertian and two-sided;
+//! - boxes (rotated about +Y), parallelograms and spheres; Lambertian (constant or checker,
+//!   two-sided), smooth mirrors (weight = reflectance) and smooth dielectrics (reflect with the
+//!   exact Fresnel probability, else refract; no eta^2 scaling, as every light and diffuse
+//!   surface is outside);
 //! - emitting parallelograms, one-sided (front = edge_u x edge_v), seen directly only by camera
-//!   rays, winning ties against a coplanar surface; black background;
+//!   and specular rays, winning ties against a coplanar surface;
+//! - a directional light: delta (next-event estimation along its direction) or a sun disc
+//!   (next-event estimation uniform in its cone, and seen directly by camera and specular rays
+//!   only); a constant environment seen by every escaping ray (no next-event estimation, so no
+//!   double counting). Light that a delta light sends through glass onto a diffuse surface
+//!   (the caustic, paths L S+ D E) is not found by this estimator;
 //! - next-event estimation at every diffuse hit with a point uniform on the union of the lights
-//!   by area; `Bounces::Fixed(n)` continuation rays or unbounded with Russian roulette; cosine
-//!   or uniform hemisphere sampling (`Sampling`).
+//!   by area; `Bounces::Fixed(n)` continuation rays (specular ones count) or unbounded with
+//!   Russian roulette; cosine or uniform hemisphere sampling (`Sampling`).
 //!
 //! Random numbers: SplitMix64 (`rng.rs`) keyed by (seed, pixel, sample), so results do not
 //! depend on threading or on how samples are grouped.

@@ -49,6 +49,16 @@ pub fn cosine_hemisphere(u1: f64, u2: f64) -> DVec3 {
     DVec3::new(r * c, r * s, (1.0 - u1).max(0.0).sqrt())
 }
 
+/// A direction uniform in the cone of half-angle acos(cos_max) around +z, in the local frame:
+/// cos(theta) = 1 - u1 (1 - cos_max) (the solid angle is linear in cos theta), phi = 2 pi u2;
+/// pdf 1 / (2 pi (1 - cos_max)).
+pub fn uniform_cone(u1: f64, u2: f64, cos_max: f64) -> DVec3 {
+    let cos = 1.0 - u1 * (1.0 - cos_max);
+    let sin = (1.0 - cos * cos).max(0.0).sqrt();
+    let phi = 2.0 * std::f64::consts::PI * u2;
+    DVec3::new(sin * phi.cos(), sin * phi.sin(), cos)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,27 +1,62 @@
-//! The scene in the form the oracle traces: f64 shapes, each with its material, and the list of
-//! emitting parallelograms for light sampling.
+//! The scene in the form the oracle traces: f64 shapes, each with its material, the list of
+//! emitting parallelograms for light sampling, the directional light and the sky.
 
 use glam::{DVec3, Vec3};
-use illum_scene::{Feature, RendererKind, Scene, SceneError, Shape};
+use illum_scene::{Feature, MaterialKind, Scene, SceneError, Shape};
 
 use crate::geometry::{Ball, OrientedBox, Parallelogram, Surface};
 
-/// What the oracle implements: the same scenes as the GPU path tracer today, written
-/// independently (it shares no code with the WGSL).
-pub const FEATURES: &[Feature] =
-    &[Feature::BoxShape, Feature::QuadShape, Feature::SphereShape, Feature::Lambertian, Feature::AreaLight];
+/// What the oracle implements: every feature of the scene model, written independently of the
+/// GPU path tracer (it shares no code with the WGSL). The GPU path tracer implements a subset.
+pub const FEATURES: &[Feature] = &[
+    Feature::BoxShape,
+    Feature::QuadShape,
+    Feature::SphereShape,
+    Feature::Lambertian,
+    Feature::Checker,
+    Feature::Dielectric,
+    Feature::Mirror,
+    Feature::AreaLight,
+    Feature::DeltaDirectionalLight,
+    Feature::SunDisc,
+    Feature::Environment,
+];
 
 pub(crate) fn dvec(v: Vec3) -> DVec3 {
     v.as_dvec3()
 }
 
-/// One object: its surface and, as Lambertian albedo or emitted radiance, its material.
+/// One object: its surface and its material (`albedo` is the Lambertian albedo, zero for every
+/// other kind; `emission` an emitter's radiance).
 #[derive(Clone, Copy, Debug)]
 pub struct Primitive {
     pub surface: Surface,
+    pub material: MaterialKind,
     pub albedo: DVec3,
     pub emission: DVec3,
     pub emitter: bool,
+}
+
+/// The directional light: `to_light` is the unit vector toward it (the disc's centre),
+/// `irradiance` what a surface facing it receives. `cos_max` = cos(angular radius): 1 for a
+/// delta light. A disc of angular radius a and uniform radiance L gives irradiance
+/// L pi sin^2(a) at normal incidence, so its radiance is `irradiance / (pi sin^2 a)`.
+#[derive(Clone, Copy, Debug)]
+pub struct Sun {
+    pub to_light: DVec3,
+    pub irradiance: DVec3,
+    pub cos_max: f64,
+}
+
+impl Sun {
+    pub fn is_delta(&self) -> bool {
+        self.cos_max >= 1.0
+    }
+
+    /// The radiance of a finite disc.
+    pub fn radiance(&self) -> DVec3 {
+        self.irradiance / (std::f64::consts::PI * (1.0 - self.cos_max * self.cos_max))
+    }
 }
 
 /// An emitting parallelogram and the running total of light area up to and including it.
@@ -41,16 +76,29 @@ pub struct TraceScene {
     pub emitters: Vec<Primitive>,
     pub lights: Vec<Light>,
     pub light_area: f64,
+    pub sun: Option<Sun>,
+    /// The environment's radiance (zero without one).
+    pub sky: DVec3,
 }
 
 impl TraceScene {
-    /// Converts a validated scene of Lambertian surfaces and area lights (anything else is
-    /// refused by name). Objects whose material emits are emitters; validation allows emission
-    /// on quads only.
+    /// Converts a validated scene. Objects whose material emits are emitters; validation allows
+    /// emission on quads only.
     pub fn new(scene: &Scene) -> Result<TraceScene, SceneError> {
-        scene.require(RendererKind::PathTrace, FEATURES)?;
-        let mut out =
-            TraceScene { surfaces: Vec::new(), emitters: Vec::new(), lights: Vec::new(), light_area: 0.0 };
+        scene.require_for("oracle", FEATURES)?;
+        let sun = scene.directional_light.map(|l| Sun {
+            to_light: -dvec(l.direction).normalize(),
+            irradiance: dvec(l.irradiance),
+            cos_max: f64::from(l.angular_radius_deg).to_radians().cos(),
+        });
+        let mut out = TraceScene {
+            surfaces: Vec::new(),
+            emitters: Vec::new(),
+            lights: Vec::new(),
+            light_area: 0.0,
+            sun,
+            sky: scene.environment.map_or(DVec3::ZERO, |e| dvec(e.radiance)),
+        };
         for object in &scene.objects {
             let material = &scene.materials[object.material];
             let surface = match &object.shape {
@@ -64,6 +112,7 @@ impl TraceScene {
             };
             let primitive = Primitive {
                 surface,
+                material: material.kind,
                 albedo: dvec(material.diffuse_albedo().unwrap_or_default()),
                 emission: dvec(material.emission()),
                 emitter: material.is_emitter(),

@@ -265,8 +265,7 @@ impl WhittedOracle {
             if depth == 0 {
                 return DVec3::ZERO;
             }
-            let r = d - 2.0 * d.dot(n) * n;
-            self.trace(offset(p, n), r, depth - 1)
+            self.trace(offset(p, n), reflect(d, n), depth - 1)
         };
         match item.material {
             MaterialKind::Emitter { radiance } => {
@@ -318,7 +317,7 @@ fn offset(p: DVec3, n: DVec3) -> DVec3 {
 }
 
 /// The checker's albedo at p on `quad`: tile (i, j) counted from the corner along the edges.
-fn checker_albedo(quad: &Parallelogram, checker: illum_scene::Checker, p: DVec3) -> DVec3 {
+pub(crate) fn checker_albedo(quad: &Parallelogram, checker: illum_scene::Checker, p: DVec3) -> DVec3 {
     let q = p - quad.corner;
     // Coordinates along the edges, in units of each edge's length, then in tiles.
     let (lu, lv) = (quad.u.length(), quad.v.length());
@@ -328,9 +327,14 @@ fn checker_albedo(quad: &Parallelogram, checker: illum_scene::Checker, p: DVec3)
     if (i + j).rem_euclid(2) == 0 { dvec(checker.even) } else { dvec(checker.odd) }
 }
 
+/// The mirror direction of `d` at unit normal `n`.
+pub(crate) fn reflect(d: DVec3, n: DVec3) -> DVec3 {
+    d - 2.0 * d.dot(n) * n
+}
+
 /// Snell's law: the refracted unit direction of unit `d` at unit normal `n` (against the ray)
 /// with eta = n_from / n_to, or `None` under total internal reflection.
-fn refract(d: DVec3, n: DVec3, eta: f64) -> Option<DVec3> {
+pub(crate) fn refract(d: DVec3, n: DVec3, eta: f64) -> Option<DVec3> {
     let cos_i = -d.dot(n);
     let sin2_t = eta * eta * (1.0 - cos_i * cos_i);
     if sin2_t > 1.0 {
