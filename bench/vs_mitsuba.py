@@ -1,0 +1,223 @@
+#!/usr/bin/env python3
+"""illum's path tracer side by side with Mitsuba 3 on the same Cornell box.
+
+Builds the box of scenes/cornell.toml in Mitsuba 3 (boxes as `cube` shapes, Lambertian
+`diffuse` in `twosided`, the light a one-sided `rectangle` emitter, `path` integrator with
+max_depth = bounces + 2 and rr_depth = max_depth, box pixel filter, float32 `hdrfilm`), renders
+it with Mitsuba's `llvm_ad_rgb` variant and with illum's `render` example at the same size, spp
+and bounces, and prints for each: the wall time of the whole process (start to written EXR),
+the throughput, the relMSE against a converged reference and the efficiency
+1 / (relMSE x time). Optional: not part of `cargo test`.
+
+    python3 -m venv venv && venv/bin/pip install mitsuba==3.9.1 numpy
+    sudo apt-get install libllvm19        # Dr.Jit's LLVM backend; the preinstalled LLVM 15 aborts
+    cargo build --release --example render
+    venv/bin/python bench/vs_mitsuba.py [--size 256] [--spp 1024] [--bounces 2]
+        [--samplers independent,multijitter,orthogonal,ldsampler] [--reference-spp 16384]
+
+Run it on an idle machine: a parallel build doubles every time. The reference is an illum render
+with --sequence low-discrepancy at --reference-spp, cached in out/vs-mitsuba/; its own relMSE
+adds about spp / reference-spp to every figure.
+"""
+
+import argparse
+import math
+import os
+import subprocess
+import sys
+import time
+import tomllib
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+OUT = os.path.join(ROOT, "out", "vs-mitsuba")
+RENDER = os.path.join(ROOT, "target", "release", "examples", "render")
+
+
+def load_exr(path):
+    """Linear RGB float image of an EXR, as a numpy array (height, width, 3)."""
+    import mitsuba as mi
+    import numpy as np
+
+    bitmap = mi.Bitmap(path)
+    image = np.array(bitmap, dtype=np.float64)
+    return image[:, :, :3]
+
+
+def rel_mse(image, reference):
+    """Mean over pixels and channels of (image - reference)^2 / (reference^2 + 1e-2)."""
+    import numpy as np
+
+    return float(np.mean((image - reference) ** 2 / (reference**2 + 1e-2)))
+
+
+def mitsuba_scene(scene_path, size, spp, bounces, sampler):
+    """The scene file's Cornell box as a Mitsuba 3 scene dictionary."""
+    import mitsuba as mi
+
+    T = mi.ScalarTransform4f
+    with open(scene_path, "rb") as f:
+        scene = tomllib.load(f)
+    cam = scene["camera"]
+    materials = {}
+    for name, m in scene["materials"].items():
+        if "albedo" in m:
+            materials[name] = {
+                "type": "twosided",
+                "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": m["albedo"]}},
+            }
+        elif "emission" in m:
+            materials[name] = None
+        else:
+            sys.exit(f"{scene_path}: materials.{name}: only albedo and emission are translated")
+    out = {
+        "type": "scene",
+        "integrator": {"type": "path", "max_depth": bounces + 2, "rr_depth": bounces + 2},
+        "sensor": {
+            "type": "perspective",
+            "fov": cam["vfov"],
+            "fov_axis": "y",
+            "to_world": T().look_at(origin=cam["eye"], target=cam["target"], up=cam["up"]),
+            "sampler": {"type": sampler, "sample_count": spp},
+            "film": {
+                "type": "hdrfilm",
+                "width": size,
+                "height": size,
+                "rfilter": {"type": "box"},
+                "pixel_format": "rgb",
+                "component_format": "float32",
+            },
+        },
+    }
+    for i, obj in enumerate(scene["objects"]):
+        material = obj["material"]
+        if "box" in obj:
+            b = obj["box"]
+            if "center" in b:
+                lo = [c - h for c, h in zip(b["center"], b["half_extent"])]
+                hi = [c + h for c, h in zip(b["center"], b["half_extent"])]
+            else:
+                lo, hi = b["min"], b["max"]
+            centre = [(l + h) / 2 for l, h in zip(lo, hi)]
+            half = [(h - l) / 2 for l, h in zip(lo, hi)]
+            pivot = b.get("pivot", [0.0, 0.0, 0.0])
+            move = b.get("translate", [0.0, 0.0, 0.0])
+            # world = R_y (local - pivot) + pivot + translate; local = centre + half * cube.
+            to_world = (
+                T()
+                .translate([p + t for p, t in zip(pivot, move)])
+                .rotate([0, 1, 0], b.get("rotate_y", 0.0))
+                .translate([-p for p in pivot])
+                .translate(centre)
+                .scale(half)
+            )
+            out[f"object{i}"] = {"type": "cube", "to_world": to_world, "bsdf": materials[material]}
+        elif "quad" in obj:
+            q = obj["quad"]
+            u, v, corner = q["edge_u"], q["edge_v"], q["corner"]
+            n = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
+            length = math.sqrt(sum(c * c for c in n))
+            n = [c / length for c in n]
+            centre = [c + (a + b) / 2 for c, a, b in zip(corner, u, v)]
+            # Mitsuba's rectangle is [-1, 1]^2 in z = 0 facing +z: columns u/2, v/2, n, centre.
+            matrix = [
+                [u[0] / 2, v[0] / 2, n[0], centre[0]],
+                [u[1] / 2, v[1] / 2, n[1], centre[1]],
+                [u[2] / 2, v[2] / 2, n[2], centre[2]],
+                [0, 0, 0, 1],
+            ]
+            shape = {"type": "rectangle", "to_world": T(matrix)}
+            emission = scene["materials"][material].get("emission")
+            if emission is not None:
+                shape["emitter"] = {"type": "area", "radiance": {"type": "rgb", "value": emission}}
+                shape["bsdf"] = {"type": "diffuse", "reflectance": {"type": "rgb", "value": [0, 0, 0]}}
+            else:
+                shape["bsdf"] = materials[material]
+            out[f"object{i}"] = shape
+        else:
+            sys.exit(f"{scene_path}: objects[{i}]: only boxes and quads are translated")
+    return out
+
+
+def run_mitsuba(args, sampler, path):
+    """Renders with Mitsuba in a child process and returns its whole wall time."""
+    started = time.perf_counter()
+    subprocess.run(
+        [sys.executable, __file__, "--mitsuba-child", sampler, path, "--size", str(args.size),
+         "--spp", str(args.spp), "--bounces", str(args.bounces), "--scene", args.scene],
+        check=True,
+    )
+    return time.perf_counter() - started
+
+
+def mitsuba_child(args):
+    import mitsuba as mi
+
+    mi.set_variant("llvm_ad_rgb")
+    sampler, path = args.mitsuba_child
+    scene = mi.load_dict(mitsuba_scene(args.scene, args.size, args.spp, args.bounces, sampler))
+    image = mi.render(scene, spp=args.spp)
+    mi.util.write_bitmap(path, image)
+
+
+def run_illum(args, path, spp, sequence):
+    started = time.perf_counter()
+    subprocess.run(
+        [RENDER, args.scene, "--width", str(args.size), "--height", str(args.size), "--spp", str(spp),
+         "--bounces", str(args.bounces), "--sequence", sequence, "-o", path],
+        check=True, stdout=subprocess.DEVNULL,
+    )
+    return time.perf_counter() - started
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--scene", default=os.path.join(ROOT, "scenes", "cornell.toml"))
+    parser.add_argument("--size", type=int, default=256)
+    parser.add_argument("--spp", type=int, default=1024)
+    parser.add_argument("--bounces", type=int, default=2)
+    parser.add_argument("--samplers", default="independent,multijitter,orthogonal,ldsampler")
+    parser.add_argument("--reference-spp", type=int, default=16384)
+    parser.add_argument("--mitsuba-child", nargs=2, help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.mitsuba_child:
+        return mitsuba_child(args)
+    if not os.path.exists(RENDER):
+        sys.exit(f"{RENDER} is missing: cargo build --release --example render")
+    os.makedirs(OUT, exist_ok=True)
+
+    tag = f"{os.path.basename(args.scene)}-{args.size}-b{args.bounces}"
+    reference_path = os.path.join(OUT, f"reference-{tag}-{args.reference_spp}spp.exr")
+    if not os.path.exists(reference_path):
+        print(f"rendering the reference ({args.reference_spp} spp, illum, low-discrepancy) ...", flush=True)
+        run_illum(args, reference_path, args.reference_spp, "low-discrepancy")
+    reference = load_exr(reference_path)
+
+    rows = []
+    for sequence in ["independent", "low-discrepancy"]:
+        path = os.path.join(OUT, f"illum-{sequence}-{tag}.exr")
+        seconds = run_illum(args, path, args.spp, sequence)
+        image = load_exr(path)
+        rows.append((f"illum ({sequence})", seconds, rel_mse(image, reference), image.mean() / reference.mean()))
+    for sampler in args.samplers.split(","):
+        path = os.path.join(OUT, f"mitsuba-{sampler}-{tag}.exr")
+        seconds = run_mitsuba(args, sampler, path)
+        image = load_exr(path)
+        rows.append((f"Mitsuba llvm_ad_rgb ({sampler})", seconds, rel_mse(image, reference), image.mean() / reference.mean()))
+
+    samples = args.size * args.size * args.spp
+    print(f"\n{args.size} x {args.size}, {args.spp} spp, bounces {args.bounces}, whole process each")
+    # The mean ratio shows both renderers compute the same image (1 within the noise).
+    print("| renderer | wall s | Msamples/s | relMSE | efficiency 1/(relMSE x s) | mean / reference mean |")
+    print("|---|---|---|---|---|---|")
+    for name, seconds, error, ratio in rows:
+        print(f"| {name} | {seconds:.2f} | {samples / seconds / 1e6:.2f} | {error:.3e} | {1 / (error * seconds):.0f} | {ratio:.4f} |")
+    best_mitsuba_time = min(s for n, s, _, _ in rows if n.startswith("Mitsuba"))
+    best_mitsuba_eff = max(1 / (e * s) for n, s, e, _ in rows if n.startswith("Mitsuba"))
+    illum_time = rows[0][1]
+    illum_eff = max(1 / (e * s) for n, s, e, _ in rows if n.startswith("illum"))
+    print(f"\nthroughput illum / Mitsuba (fastest sampler): {best_mitsuba_time / illum_time:.2f}x")
+    print(f"efficiency illum / Mitsuba (best of each): {illum_eff / best_mitsuba_eff:.2f}x")
+
+
+if __name__ == "__main__":
+    main()
