@@ -17,6 +17,7 @@ use std::path::PathBuf;
 
 use clap::Parser;
 use illum::cli::{self, SceneArgs};
+use illum::image::median;
 use illum::pathtrace::{PathTracer, TracerOptions, Traversal};
 use illum::raster::RasterScene;
 use illum::raster::{Look, Options, bench_frames};
@@ -46,11 +47,6 @@ struct Config {
 
 fn main() {
     illum::cli::main_with(run);
-}
-
-fn median(values: &mut [f64]) -> f64 {
-    values.sort_by(f64::total_cmp);
-    values[values.len() / 2]
 }
 
 /// Upper bound on rays per path for a fixed bounce count: one camera ray, then at each of the

@@ -10,7 +10,6 @@ use illum::image::RgbImage32;
 use illum::pathtrace::PathTracer;
 use illum::scene::{Overrides, Scene};
 
-pub mod closed_form;
 pub mod edit;
 
 /// The device every test in this binary shares. Without a Vulkan adapter this panics with the

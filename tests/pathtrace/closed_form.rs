@@ -5,7 +5,7 @@
 //! and the irradiance from a uniformly emitting polygon of radiance Le is Lambert's formula
 //!     E(x) = Le / 2 * | sum_i theta_i (n . g_i) |,
 //! where theta_i is the angle subtended at x by the edge (v_i, v_{i+1}) and g_i is the unit
-//! normal of the plane through x and that edge. The formula (tests/common/closed_form.rs) is
+//! normal of the plane through x and that edge. The formula (`illum_oracle::closed_form`) is
 //! evaluated in f64, independently of the shader, and compared with the GPU estimate within 4
 //! standard errors.
 
@@ -15,7 +15,7 @@ use illum::scene::Scene;
 
 use crate::common;
 
-use common::closed_form::lambert_irradiance_factor;
+use illum_oracle::closed_form::lambert_irradiance_factor;
 
 /// The assignment's box without the two blocks, so nothing but the geometry of the light
 /// decides the direct light on the floor. Camera placeholders are replaced per point.

@@ -17,8 +17,8 @@ use illum::scene::{Bounces, Camera, MaterialKind, Overrides, Sampling, Scene, Sh
 
 use crate::common;
 
-use common::closed_form::{Room, expected_pixel};
 use common::edit::{set_albedo, transformed};
+use illum_oracle::closed_form::{Room, expected_pixel};
 
 /// A finished render's statistics.
 struct Rendered {

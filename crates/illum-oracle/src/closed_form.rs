@@ -1,5 +1,5 @@
-//! Direct light in an empty room, in closed form, evaluated in f64 and sharing no code with the
-//! shader.
+//! Direct light in closed form, evaluated in f64 and sharing no code with the shader: the
+//! expected values that the path tracer's and the oracle's tests compare against.
 //!
 //! With bounces = 0 the radiance leaving a Lambertian point x (unit normal n) is
 //!     L(x) = albedo / pi * Le * F(x, n),
@@ -16,10 +16,11 @@
 //! a pixel's footprint, which is what the jittered estimator converges to.
 
 use glam::DVec3;
-use illum::scene::{Camera, Scene};
+use illum_scene::{Camera, Scene};
 
-/// Lambert's form factor integral at `x` (unit normal `n`) from `polygon` (unit radiance):
-/// the irradiance is `Le` times this. The polygon must lie in front of x's tangent plane.
+/// Lambert's form factor integral (Lambert, 1760) at `x` (unit normal `n`) from `polygon` (unit
+/// radiance): the irradiance is `Le` times this. The polygon must lie in front of x's tangent
+/// plane (see [`clip_to_front`]); edges of zero length are skipped.
 pub fn lambert_irradiance_factor(x: DVec3, n: DVec3, polygon: &[DVec3]) -> f64 {
     let mut sum = 0.0;
     for i in 0..polygon.len() {
