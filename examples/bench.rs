@@ -94,13 +94,13 @@ fn run(args: Args) -> anyhow::Result<()> {
         let options = TracerOptions { traversal: config.traversal, ..Default::default() };
         let mut tracer = PathTracer::with_options(&gpu, &scene, options)?;
         // Warm-up: compiles the pipeline on the driver and teaches the planner the cost.
-        tracer.render(1)?;
+        tracer.render_to_spp(1)?;
         let (mut wall, mut gpu_rate, mut per_submission) = (Vec::new(), Vec::new(), Vec::new());
         for _ in 0..args.runs.max(1) {
             tracer.reset();
             let mut submissions = 0u32;
             while tracer.spp_done() < config.spp {
-                tracer.step(Some(config.spp))?;
+                tracer.render_step(Some(config.spp))?;
                 submissions += 1;
             }
             let samples = (config.size as f64).powi(2) * config.spp as f64;

@@ -158,16 +158,16 @@ fn run(mut args: Args) -> anyhow::Result<()> {
         let options = TracerOptions { sequence: variant.sequence, ..Default::default() };
         let mut tracer = PathTracer::with_options(&gpu, &variant_scene, options)?;
         // The driver compiles a pipeline on its first dispatch: keep that out of the timings.
-        tracer.render(1)?;
+        tracer.render_to_spp(1)?;
         tracer.reset();
         for &spp in &args.spp_list {
-            tracer.render(spp)?;
+            tracer.render_to_spp(spp)?;
             // Time in submissions (readback and f64 fold included), not the measuring between rows.
             taken.push(take(variant.name, &tracer, tracer.wall_seconds()));
         }
         for &budget in &budgets {
             let mut tracer = PathTracer::with_options(&gpu, &variant_scene, options)?;
-            tracer.render(1)?;
+            tracer.render_to_spp(1)?;
             tracer.reset();
             let rules = StopRules { time_budget: Some(budget), ..Default::default() };
             let (_, progressive) =
@@ -230,7 +230,7 @@ fn reference_image(gpu: &GpuContext, scene: &Scene, args: &Args, max_spp: u32) -
     }
     println!("rendering the reference: {spp} spp (cached as {})", path.display());
     let mut tracer = PathTracer::new(gpu, &reference_scene)?;
-    tracer.render(spp)?;
+    tracer.render_to_spp(spp)?;
     let image = tracer.accumulator().mean_image();
     let mut metadata = illum::pathtrace::metadata::exr_metadata(
         &tracer,
@@ -434,7 +434,7 @@ fn bounce_table(gpu: &GpuContext, scene: &Scene, spp: u32, out: &Path) -> anyhow
         let mut s = scene.clone();
         s.pathtrace.bounces = bounces;
         let mut tracer = PathTracer::new(gpu, &s)?;
-        tracer.render(spp)?;
+        tracer.render_to_spp(spp)?;
         let acc = tracer.accumulator();
         let n = (acc.width * acc.height) as usize;
         let weights = [0.2126, 0.7152, 0.0722];

@@ -44,7 +44,7 @@ pub fn render(scene: &Scene) -> PathTracer {
     // One pass of all the samples: `render` would size its passes by measured speed, which
     // tests running in parallel change, and the grouping of samples into f32 chunk sums with
     // it; a test comparing two renders bit for bit needs the same grouping every time.
-    tracer.render_pass(scene.pathtrace.spp).expect("render succeeds");
+    tracer.add_samples_in_one_pass(scene.pathtrace.spp).expect("render succeeds");
     tracer
 }
 

@@ -76,7 +76,7 @@ fn estimate_floor_radiance(x: DVec3, spp: u32) -> (f64, f64) {
     scene.camera.vfov_deg = 0.01;
     scene.pathtrace.spp = spp;
     let mut tracer = PathTracer::new(common::gpu(), &scene).expect("builds");
-    tracer.render(spp).expect("renders");
+    tracer.render_to_spp(spp).expect("renders");
     assert_eq!(tracer.accumulator().dropped_samples(), 0);
     let (mean, variance) = common::image_mean_and_variance(&tracer, 0);
     (mean, variance.sqrt())

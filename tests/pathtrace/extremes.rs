@@ -679,7 +679,7 @@ fn looking_into_the_light(spp: u32) -> Scene {
 fn a_constant_pixel_stays_exactly_constant_over_a_million_samples() {
     let spp = 1 << 20;
     let mut tracer = PathTracer::new(common::gpu(), &looking_into_the_light(spp)).expect("builds");
-    tracer.render(spp).expect("renders");
+    tracer.render_to_spp(spp).expect("renders");
     let acc = tracer.accumulator();
     println!(
         "2^20 spp of a constant 30: mean {:?}, variance of the mean {:?}, samples {}",
@@ -709,7 +709,7 @@ fn pixel_means(scene: &Scene, pass_spp: u32, chunk: u32) -> Vec<[f64; 3]> {
     let mut tracer = PathTracer::new(common::gpu(), scene).expect("builds");
     tracer.set_chunk_samples(chunk);
     while tracer.spp_done() < scene.pathtrace.spp {
-        tracer.render_pass(pass_spp).expect("renders");
+        tracer.add_samples_in_one_pass(pass_spp).expect("renders");
     }
     let acc = tracer.accumulator();
     assert_eq!(acc.min_samples(), scene.pathtrace.spp as u64);
@@ -827,7 +827,7 @@ fn render_capped(scene: &Scene, bytes: Option<u64>) -> (PathTracer, usize) {
     }
     let mut submissions = 0;
     while tracer.spp_done() < scene.pathtrace.spp {
-        tracer.step(Some(scene.pathtrace.spp)).expect("renders");
+        tracer.render_step(Some(scene.pathtrace.spp)).expect("renders");
         submissions += 1;
     }
     (tracer, submissions)

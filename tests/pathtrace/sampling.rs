@@ -11,8 +11,9 @@ use std::f64::consts::PI;
 
 use glam::DVec3;
 use illum::gpu::readback::read_buffer;
-use illum::gpu::shader::{self, COMMON_MODULES, ShaderFile};
+use illum::gpu::shader::{self, ShaderFile};
 use illum::gpu::wgpu;
+use illum::pathtrace::SAMPLING_MODULES;
 use illum_oracle::chi_square;
 
 use crate::common;
@@ -39,7 +40,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {{
 "
     );
     let entry = ShaderFile::generated("sampling harness".into(), source);
-    let pipeline = shader::compute_pipeline(gpu, COMMON_MODULES, &entry, &[], "sampling harness")
+    let pipeline = shader::compute_pipeline(gpu, SAMPLING_MODULES, &entry, &[], "sampling harness")
         .unwrap_or_else(|e| panic!("the harness compiles: {e}"));
     let size = N as u64 * 16;
     let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {

@@ -71,7 +71,7 @@ fn the_low_discrepancy_sequence_is_unbiased_and_less_noisy() {
         let mut t =
             PathTracer::with_options(common::gpu(), &scene, TracerOptions { sequence, ..Default::default() })
                 .expect("builds");
-        t.render(256).expect("renders");
+        t.render_to_spp(256).expect("renders");
         t
     };
     let independent = render(Sequence::Independent);
@@ -111,10 +111,10 @@ fn batching_does_not_change_the_image() {
     // trace the same paths; only the f32 rounding of the per-batch sums differs.
     let scene = cornell(24, 64, 2, Sampling::Cosine, 3);
     let mut one = PathTracer::new(common::gpu(), &scene).expect("builds");
-    one.render_pass(64).expect("renders");
+    one.add_samples_in_one_pass(64).expect("renders");
     let mut four = PathTracer::new(common::gpu(), &scene).expect("builds");
     for _ in 0..4 {
-        four.render_pass(16).expect("renders");
+        four.add_samples_in_one_pass(16).expect("renders");
     }
     let (a, b) = (one.accumulator().mean_image(), four.accumulator().mean_image());
     let mut worst = 0.0f32;
@@ -137,7 +137,7 @@ fn generic_and_specialised_traversal_give_the_same_image() {
             TracerOptions { traversal, ..Default::default() },
         )
         .expect("builds");
-        tracer.render(16).expect("renders");
+        tracer.render_to_spp(16).expect("renders");
         tracer.accumulator().mean_image()
     };
     let (generic, specialised) = (render(Traversal::Generic), render(Traversal::Specialised));
@@ -164,7 +164,7 @@ fn the_background_outside_the_box_is_black_and_the_light_is_its_radiance() {
             TracerOptions { traversal, ..Default::default() },
         )
         .expect("builds");
-        tracer.render(4).expect("renders");
+        tracer.render_to_spp(4).expect("renders");
         let image = tracer.accumulator().mean_image();
         for (x, y) in [(0, 0), (63, 0), (0, 63), (63, 63)] {
             assert_eq!(

@@ -320,7 +320,7 @@ impl Progressive {
         self.refresh_error(tracer);
         self.stopped = self.rules.check(&self.status(tracer));
         if self.stopped.is_none() {
-            let report = tracer.step(self.rules.spp)?;
+            let report = tracer.render_step(self.rules.spp)?;
             if report.pass_completed {
                 // Tools and tests watch for this line (RUST_LOG=illum_pathtrace=debug).
                 log::debug!("pass complete: {} spp", tracer.spp_done());

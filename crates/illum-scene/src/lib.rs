@@ -56,6 +56,6 @@ pub use renderers::{
     Bounces, DielectricShading, Effects, Look, MAX_BOUNCES, MAX_WHITTED_AA, MAX_WHITTED_DEPTH, MirrorShading,
     PathTraceSettings, RasterSettings, RendererKind, Sampling, Sequence, Shading, WhittedSettings,
 };
-pub use scene::{DeviceLimits, Object, Overrides, Scene};
+pub use scene::{Object, Overrides, Scene};
 pub use shapes::{BoxShape, Quad, Shape, Sphere};
 pub use validate::{fmt_f32, toml_key};

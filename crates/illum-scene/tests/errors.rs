@@ -1,12 +1,10 @@
 //! Every validation rule, triggered by an edited copy of a small valid scene, with the message
 //! checked for file, field, value and what is allowed; plus syntax errors (line, column, key),
-//! command-line overrides and device limits.
+//! command-line overrides. (Device limits are checked by the GPU crates, with their tests.)
 
 use glam::Vec3;
 use illum_scene::testing::{check_invalid, edit_once as edit_text};
-use illum_scene::{
-    Bounces, DeviceLimits, MAX_BOUNCES, MaterialKind, Overrides, Sampling, Scene, SceneError, Shape,
-};
+use illum_scene::{Bounces, MAX_BOUNCES, MaterialKind, Overrides, Sampling, Scene, SceneError, Shape};
 
 const FILE: &str = "scenes/test.toml";
 
@@ -670,56 +668,4 @@ fn overrides_are_validated_and_leave_the_scene_unchanged_on_error() {
         check_invalid(&err, "command line", field, value, allowed);
         assert_eq!(s, base, "{field}: scene changed despite the error");
     }
-}
-
-// ---------------------------------------------------------------------------------------------
-// Device limits.
-
-const LIMITS: DeviceLimits =
-    DeviceLimits { max_texture_dimension_2d: 8192, max_storage_buffer_binding_size: 128 << 20 };
-
-fn with_size(w: u32, h: u32) -> Scene {
-    let mut s = parse(BASE).unwrap();
-    s.camera.width = w;
-    s.camera.height = h;
-    s
-}
-
-#[test]
-fn resolution_within_limits_passes() {
-    with_size(8192, 1024).check_device_limits(&LIMITS, 16).unwrap();
-    // Exactly at the buffer limit: 4096 x 2048 x 16 bytes = 128 MiB.
-    with_size(4096, 2048).check_device_limits(&LIMITS, 16).unwrap();
-}
-
-#[test]
-fn resolution_beyond_the_texture_limit_names_it() {
-    let label = "scene \"test\"";
-    let err = with_size(8193, 16).check_device_limits(&LIMITS, 16).unwrap_err();
-    check_invalid(
-        &err,
-        label,
-        "camera.width",
-        "8193",
-        "must be at most 8192, the device's max_texture_dimension_2d",
-    );
-    let err = with_size(16, 10000).check_device_limits(&LIMITS, 16).unwrap_err();
-    check_invalid(&err, label, "camera.height", "10000", "max_texture_dimension_2d");
-}
-
-#[test]
-fn resolution_beyond_the_buffer_limit_names_it() {
-    let label = "scene \"test\"";
-    let err = with_size(4096, 2049).check_device_limits(&LIMITS, 16).unwrap_err();
-    // 4096 * 2049 * 16 = 134283264 bytes > 134217728.
-    check_invalid(
-        &err,
-        label,
-        "camera.width x camera.height",
-        "4096 x 2049 (x 16 bytes per pixel = 134283264 bytes)",
-        "must fit in 134217728 bytes, the device's max_storage_buffer_binding_size",
-    );
-    // An absurd per-pixel size saturates instead of wrapping around to a small number.
-    let err = with_size(8192, 8192).check_device_limits(&LIMITS, u64::MAX).unwrap_err();
-    assert!(err.to_string().contains("max_storage_buffer_binding_size"), "{err}");
 }
