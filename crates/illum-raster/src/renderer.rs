@@ -1,6 +1,6 @@
 //! [`RasterRenderer`]: owns the GPU resources and turns a scene plus [`Options`] into frames.
 
-use crate::scene::{RasterLimits, RasterScene};
+use crate::scene::RasterScene;
 use glam::Vec3;
 use illum_gpu::timing::PassTimer;
 use illum_gpu::{GpuContext, readback, wgpu};
@@ -96,11 +96,7 @@ impl RasterRenderer {
     ) -> Result<RasterScene, RasterError> {
         let mut scene = scene.clone();
         scene.set_resolution(Some(width), Some(height), "RasterRenderer")?;
-        let limits = gpu.device.limits();
-        scene.check_device_limits(&RasterLimits {
-            max_texture_dimension_2d: limits.max_texture_dimension_2d,
-            max_buffer_size: limits.max_buffer_size,
-        })?;
+        crate::limits::check_device_limits(&scene, &gpu.device.limits())?;
         Ok(scene)
     }
 

@@ -148,21 +148,6 @@ pub struct RasterQuality {
     pub cube_size: u32,
 }
 
-/// What the device allows, for [`RasterScene::check_device_limits`] (filled in from
-/// `wgpu::Limits` by the caller).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct RasterLimits {
-    /// Largest 2D texture side (also bounds cube-map faces).
-    pub max_texture_dimension_2d: u32,
-    /// Largest buffer, in bytes (the image is read back through one).
-    pub max_buffer_size: u64,
-}
-
-/// Bytes per output pixel (RGBA, 8 bits per channel) and the row alignment GPU copies need
-/// (`wgpu::COPY_BYTES_PER_ROW_ALIGNMENT`).
-const READBACK_BYTES_PER_PIXEL: u64 = 4;
-const READBACK_ROW_ALIGNMENT: u64 = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT as u64;
-
 impl RasterScene {
     /// Reads a scene file and checks that the rasterizer can draw it.
     pub fn load(path: &Path) -> Result<RasterScene, SceneError> {
@@ -316,39 +301,6 @@ impl RasterScene {
         }
         self.camera.width = width.unwrap_or(self.camera.width);
         self.camera.height = height.unwrap_or(self.camera.height);
-        Ok(())
-    }
-
-    /// Checks that the output and the cube maps fit the device: every texture side within
-    /// `max_texture_dimension_2d`, and the readback buffer (4 bytes per pixel, rows padded to
-    /// 256 bytes) within `max_buffer_size`. Errors are labelled `scene "NAME"`, since the
-    /// resolution may come from the file or from the command line.
-    pub fn check_device_limits(&self, limits: &RasterLimits) -> Result<(), SceneError> {
-        let label = format!("scene {:?}", self.name);
-        let max = limits.max_texture_dimension_2d;
-        let (w, h) = (self.camera.width, self.camera.height);
-        for (field, side) in
-            [("camera.width", w), ("camera.height", h), ("raster.cube_size", self.quality.cube_size)]
-        {
-            if side > max {
-                return Err(SceneError::invalid(
-                    &label,
-                    field,
-                    side.to_string(),
-                    format!("must be at most {max}, the device's max_texture_dimension_2d"),
-                ));
-            }
-        }
-        let row = (u64::from(w) * READBACK_BYTES_PER_PIXEL).next_multiple_of(READBACK_ROW_ALIGNMENT);
-        let bytes = row.saturating_mul(u64::from(h));
-        if bytes > limits.max_buffer_size {
-            return Err(SceneError::invalid(
-                &label,
-                "camera.width x camera.height",
-                format!("{w} x {h} ({bytes} bytes to read back)"),
-                format!("must fit in {} bytes, the device's max_buffer_size", limits.max_buffer_size),
-            ));
-        }
         Ok(())
     }
 }

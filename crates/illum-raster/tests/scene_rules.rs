@@ -8,8 +8,9 @@
 //! old rule is tested at its new field path; where a rule changed, a comment says how.
 
 use glam::{Vec2, Vec3};
+use illum_gpu::wgpu;
 use illum_raster::scene::FEATURES;
-use illum_raster::{Effects, Look, RasterLimits, RasterScene};
+use illum_raster::{Effects, Look, RasterScene, check_device_limits};
 use illum_scene::testing::{check_invalid, edit_once as edit_text};
 use illum_scene::{Feature, RendererKind, Scene, SceneError};
 
@@ -758,13 +759,17 @@ fn resolution_overrides_are_checked_and_leave_the_scene_unchanged_on_error() {
     }
 }
 
+fn device_limits(max_texture_dimension_2d: u32, max_buffer_size: u64) -> wgpu::Limits {
+    wgpu::Limits { max_texture_dimension_2d, max_buffer_size, ..wgpu::Limits::default() }
+}
+
 #[test]
 fn device_limits_name_the_limit() {
-    let limits = RasterLimits { max_texture_dimension_2d: 16384, max_buffer_size: 1 << 28 };
+    let limits = device_limits(16384, 1 << 28);
     let mut s = parse(BASE).unwrap();
-    s.check_device_limits(&limits).unwrap();
+    check_device_limits(&s, &limits).unwrap();
     s.camera.width = 16385;
-    let err = s.check_device_limits(&limits).unwrap_err();
+    let err = check_device_limits(&s, &limits).unwrap_err();
     let label = "scene \"w\"";
     check_invalid(
         &err,
@@ -775,20 +780,20 @@ fn device_limits_name_the_limit() {
     );
     s.camera.width = 64;
     s.camera.height = 16385;
-    let err = s.check_device_limits(&limits).unwrap_err();
+    let err = check_device_limits(&s, &limits).unwrap_err();
     check_invalid(&err, label, "camera.height", "16385", "max_texture_dimension_2d");
     s.camera.height = 36;
     s.quality.cube_size = 20000;
-    let err = s.check_device_limits(&limits).unwrap_err();
+    let err = check_device_limits(&s, &limits).unwrap_err();
     check_invalid(&err, label, "raster.cube_size", "20000", "max_texture_dimension_2d");
     s.quality.cube_size = 16384;
-    s.check_device_limits(&limits).unwrap();
+    check_device_limits(&s, &limits).unwrap();
     // 8192 x 8192 x 4 bytes = 2^28: exactly at the limit; one more row is over it.
     s.camera.width = 8192;
     s.camera.height = 8192;
-    s.check_device_limits(&limits).unwrap();
+    check_device_limits(&s, &limits).unwrap();
     s.camera.height = 8193;
-    let err = s.check_device_limits(&limits).unwrap_err();
+    let err = check_device_limits(&s, &limits).unwrap_err();
     check_invalid(
         &err,
         label,
@@ -797,12 +802,12 @@ fn device_limits_name_the_limit() {
         "must fit in 268435456 bytes, the device's max_buffer_size",
     );
     // Rows are padded to 256 bytes: width 1 reads back 256 bytes per row.
-    let tight = RasterLimits { max_texture_dimension_2d: 16384, max_buffer_size: 256 * 36 };
+    let tight = device_limits(16384, 256 * 36);
     s.camera.width = 1;
     s.camera.height = 36;
-    s.check_device_limits(&tight).unwrap();
+    check_device_limits(&s, &tight).unwrap();
     s.camera.height = 37;
-    let err = s.check_device_limits(&tight).unwrap_err();
+    let err = check_device_limits(&s, &tight).unwrap_err();
     check_invalid(
         &err,
         label,
