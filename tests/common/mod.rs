@@ -8,7 +8,7 @@ use std::sync::OnceLock;
 use illum::gpu::GpuContext;
 use illum::image::RgbImage32;
 use illum::pathtrace::PathTracer;
-use illum::scene::{Overrides, Scene};
+use illum::scene::{Bounces, Overrides, Sampling, Scene};
 
 pub mod edit;
 
@@ -32,6 +32,22 @@ pub fn scene(name: &str, overrides: Overrides) -> Scene {
     let mut scene = Scene::load(&workspace_path(&format!("scenes/{name}.toml"))).expect("scene loads");
     scene.apply_overrides(&overrides, "test").expect("valid overrides");
     scene
+}
+
+/// The Cornell box at `size` x `size` with these render settings.
+pub fn cornell(size: u32, spp: u32, bounces: Bounces, sampling: Sampling, seed: u32) -> Scene {
+    scene(
+        "cornell",
+        Overrides {
+            width: Some(size),
+            height: Some(size),
+            spp: Some(spp),
+            bounces: Some(bounces),
+            seed: Some(seed),
+            sampling: Some(sampling),
+            sequence: None,
+        },
+    )
 }
 
 pub fn small(width: u32, height: u32, spp: u32) -> Overrides {

@@ -19,42 +19,7 @@ use illum_oracle::closed_form::lambert_irradiance_factor;
 
 /// The assignment's box without the two blocks, so nothing but the geometry of the light
 /// decides the direct light on the floor. Camera placeholders are replaced per point.
-const ROOM: &str = r#"
-name = "room"
-[camera]
-eye = [278.0, 278.0, -724.26]
-target = [278.0, 278.0, 0.0]
-up = [0.0, 1.0, 0.0]
-vfov = 45.0
-width = 8
-height = 8
-[pathtrace]
-spp = 1024
-bounces = 0
-[materials.white]
-albedo = [0.5, 0.5, 0.5]
-[materials.light]
-emission = [30.0, 30.0, 30.0]
-[[objects]]
-material = "white"
-box = { center = [556.0, 278.0, 278.0], half_extent = [1.0, 278.0, 278.0] }
-[[objects]]
-material = "white"
-box = { center = [0.0, 278.0, 278.0], half_extent = [1.0, 278.0, 278.0] }
-[[objects]]
-material = "white"
-box = { center = [278.0, 556.0, 278.0], half_extent = [278.0, 1.0, 278.0] }
-[[objects]]
-material = "white"
-box = { center = [278.0, 0.0, 278.0], half_extent = [278.0, 1.0, 278.0] }
-[[objects]]
-material = "white"
-box = { center = [278.0, 278.0, 556.0], half_extent = [278.0, 278.0, 1.0] }
-[[objects]]
-name = "light"
-material = "light"
-quad = { corner = [213.0, 555.0, 225.5], edge_u = [130.0, 0.0, 0.0], edge_v = [0.0, 0.0, 105.0] }
-"#;
+const ROOM: &str = include_str!("room.toml");
 
 const LIGHT: [DVec3; 4] = [
     DVec3::new(213.0, 555.0, 225.5),

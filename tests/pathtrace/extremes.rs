@@ -13,7 +13,7 @@ use std::sync::OnceLock;
 use glam::{DVec3, Vec3};
 use illum::image::{RgbImage32, z_test_pass_fraction};
 use illum::pathtrace::PathTracer;
-use illum::scene::{Bounces, Camera, MaterialKind, Overrides, Sampling, Scene, Shape};
+use illum::scene::{Bounces, Camera, MaterialKind, Sampling, Scene, Shape};
 
 use crate::common;
 
@@ -87,18 +87,7 @@ fn assert_same_image(a: &Rendered, b: &Rendered, what: &str) -> (f64, f64) {
 }
 
 fn cornell(size: u32, spp: u32, bounces: Bounces, seed: u32) -> Scene {
-    common::scene(
-        "cornell",
-        Overrides {
-            width: Some(size),
-            height: Some(size),
-            spp: Some(spp),
-            bounces: Some(bounces),
-            seed: Some(seed),
-            sampling: Some(Sampling::Cosine),
-            sequence: None,
-        },
-    )
+    common::cornell(size, spp, bounces, Sampling::Cosine, seed)
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -665,14 +654,19 @@ fn one_sample_per_pixel_is_finite_and_unbiased() {
     }
 }
 
+/// The Cornell box with 2 bounces at `size` x `size`, seen from `eye` toward `target` (up +Z).
+fn cornell_view(size: u32, spp: u32, seed: u32, eye: Vec3, target: Vec3, vfov_deg: f32) -> Scene {
+    let mut scene = cornell(size, spp, Bounces::Fixed(2), seed);
+    scene.camera.eye = eye;
+    scene.camera.target = target;
+    scene.camera.up = Vec3::Z;
+    scene.camera.vfov_deg = vfov_deg;
+    scene
+}
+
 /// A 1 x 1 image that sees nothing but the light: every sample is exactly 30.
 fn looking_into_the_light(spp: u32) -> Scene {
-    let mut scene = cornell(1, spp, Bounces::Fixed(2), 53);
-    scene.camera.eye = Vec3::new(278.0, 500.0, 278.0);
-    scene.camera.target = Vec3::new(278.0, 555.0, 278.0);
-    scene.camera.up = Vec3::Z;
-    scene.camera.vfov_deg = 10.0;
-    scene
+    cornell_view(1, spp, 53, Vec3::new(278.0, 500.0, 278.0), Vec3::new(278.0, 555.0, 278.0), 10.0)
 }
 
 #[test]
@@ -695,12 +689,7 @@ fn a_constant_pixel_stays_exactly_constant_over_a_million_samples() {
 
 /// A 2 x 2 image of the floor under the light with 2 bounces: every sample differs.
 fn noisy_pixels(spp: u32) -> Scene {
-    let mut scene = cornell(2, spp, Bounces::Fixed(2), 59);
-    scene.camera.eye = Vec3::new(278.0, 2.0, 278.0);
-    scene.camera.target = Vec3::new(278.0, 1.0, 278.0);
-    scene.camera.up = Vec3::Z;
-    scene.camera.vfov_deg = 1.0;
-    scene
+    cornell_view(2, spp, 59, Vec3::new(278.0, 2.0, 278.0), Vec3::new(278.0, 1.0, 278.0), 1.0)
 }
 
 /// Renders `scene` in passes of `pass_spp` with `chunk` samples per invocation and returns the

@@ -8,18 +8,7 @@ use illum::scene::{Bounces, Overrides, Sampling};
 use crate::common;
 
 fn cornell(size: u32, spp: u32, bounces: u32, sampling: Sampling, seed: u32) -> illum::scene::Scene {
-    common::scene(
-        "cornell",
-        Overrides {
-            width: Some(size),
-            height: Some(size),
-            spp: Some(spp),
-            bounces: Some(Bounces::Fixed(bounces)),
-            sampling: Some(sampling),
-            sequence: None,
-            seed: Some(seed),
-        },
-    )
+    common::cornell(size, spp, Bounces::Fixed(bounces), sampling, seed)
 }
 
 #[test]

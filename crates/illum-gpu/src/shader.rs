@@ -160,6 +160,15 @@ pub fn compute_pipeline(
     Ok(pipeline)
 }
 
+/// The `(name, byte offset)` of each listed field of a Rust struct, for
+/// [`WgslStruct::assert_matches`]: `members!(GpuParams: eye, tan_half_fov, ...)`.
+#[macro_export]
+macro_rules! members {
+    ($ty:ty: $($field:ident),* $(,)?) => {
+        [$((stringify!($field), ::std::mem::offset_of!($ty, $field))),*]
+    };
+}
+
 /// A WGSL struct as naga lays it out: its size and each member's byte offset.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct WgslStruct {

@@ -207,20 +207,7 @@ fn sphere_enclosure_matches_the_closed_form_for_every_bounce_setting() {
 /// itself on a surface behind it lit by a second lamp.
 #[test]
 fn emitters_are_one_sided_for_camera_rays() {
-    let text = r#"
-        [camera]
-        eye = [0.0, 0.0, -5.0]
-        target = [0.0, 0.0, 0.0]
-        up = [0.0, 1.0, 0.0]
-        vfov = 10.0
-        width = 1
-        height = 1
-        [materials.lamp]
-        emission = [3.0, 2.0, 1.0]
-        [[objects]]
-        material = "lamp"
-        quad = { corner = [-1.0, -1.0, 0.0], edge_u = [0.0, 2.0, 0.0], edge_v = [2.0, 0.0, 0.0] }
-    "#;
+    let text = include_str!("scenes/lamp.toml");
     // Front normal (0,2,0) x (2,0,0) = (0, 0, -4): toward -z, i.e. toward the camera. The
     // pixel sees 5 tan(5 deg) = 0.44 units either side of the centre: all lamp.
     let scene = Scene::from_toml_str(text, "lamp.toml").unwrap();

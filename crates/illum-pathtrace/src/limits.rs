@@ -65,25 +65,11 @@ mod tests {
         }
     }
 
+    /// The Cornell box, named "test", at `w` x `h`.
     fn with_size(w: u32, h: u32) -> Scene {
-        let mut s = Scene::from_toml_str(
-            r#"name = "test"
-            [camera]
-            eye = [0.0, 1.0, -5.0]
-            target = [0.0, 1.0, 0.0]
-            up = [0.0, 1.0, 0.0]
-            vfov = 45.0
-            width = 64
-            height = 32
-            [materials.lamp]
-            emission = [5.0, 5.0, 5.0]
-            [[objects]]
-            material = "lamp"
-            quad = { corner = [-0.5, 3.0, -0.5], edge_u = [1.0, 0.0, 0.0], edge_v = [0.0, 0.0, 1.0] }
-            "#,
-            "scenes/test.toml",
-        )
-        .unwrap();
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/cornell.toml");
+        let mut s = Scene::load(std::path::Path::new(path)).unwrap();
+        s.name = "test".to_owned();
         s.camera.width = w;
         s.camera.height = h;
         s

@@ -59,8 +59,9 @@ pub(crate) fn pathtrace_pipeline(
 
 #[cfg(test)]
 mod tests {
-    use std::mem::{offset_of, size_of};
+    use std::mem::size_of;
 
+    use illum_gpu::members;
     use illum_gpu::shader::wgsl_struct;
     use illum_scene::{RendererKind, Sequence};
 
@@ -149,66 +150,24 @@ mod tests {
             &PATHTRACE_SHADER,
             &[],
         );
-        let check = |name: &str, size: usize, members: &[(&str, usize)]| {
-            let wgsl = wgsl_struct(&module, "illum::pathtrace::scene", name)
-                .unwrap_or_else(|| panic!("no struct {name} in scene.wgsl"));
-            wgsl.assert_matches(size, members);
+        let wgsl = |name: &str| {
+            wgsl_struct(&module, "illum::pathtrace::scene", name)
+                .unwrap_or_else(|| panic!("no struct {name} in scene.wgsl"))
         };
-        check(
-            "Params",
+        wgsl("Params").assert_matches(
             size_of::<GpuParams>(),
-            &[
-                ("eye", offset_of!(GpuParams, eye)),
-                ("tan_half_fov", offset_of!(GpuParams, tan_half_fov)),
-                ("right", offset_of!(GpuParams, right)),
-                ("aspect", offset_of!(GpuParams, aspect)),
-                ("up", offset_of!(GpuParams, up)),
-                ("light_area", offset_of!(GpuParams, light_area)),
-                ("forward", offset_of!(GpuParams, forward)),
-                ("num_objects", offset_of!(GpuParams, num_objects)),
-                ("width", offset_of!(GpuParams, width)),
-                ("height", offset_of!(GpuParams, height)),
-                ("row_offset", offset_of!(GpuParams, row_offset)),
-                ("rows", offset_of!(GpuParams, rows)),
-                ("sample_base", offset_of!(GpuParams, sample_base)),
-                ("sample_count", offset_of!(GpuParams, sample_count)),
-                ("seed", offset_of!(GpuParams, seed)),
-                ("bounces", offset_of!(GpuParams, bounces)),
-                ("sampling", offset_of!(GpuParams, sampling)),
-                ("num_lights", offset_of!(GpuParams, num_lights)),
-                ("first_emitter", offset_of!(GpuParams, first_emitter)),
-                ("chunk_samples", offset_of!(GpuParams, chunk_samples)),
-            ],
+            &members!(GpuParams: eye, tan_half_fov, right, aspect, up, light_area, forward, num_objects,
+                width, height, row_offset, rows, sample_base, sample_count, seed, bounces, sampling,
+                num_lights, first_emitter, chunk_samples),
         );
-        check(
-            "Object",
+        wgsl("Object").assert_matches(
             size_of::<ObjectRecord>(),
-            &[
-                ("kind", offset_of!(ObjectRecord, kind)),
-                ("material", offset_of!(ObjectRecord, material)),
-                ("emitter", offset_of!(ObjectRecord, emitter)),
-                ("padding", offset_of!(ObjectRecord, padding)),
-                ("a", offset_of!(ObjectRecord, a)),
-                ("b", offset_of!(ObjectRecord, b)),
-                ("c", offset_of!(ObjectRecord, c)),
-                ("d", offset_of!(ObjectRecord, d)),
-            ],
+            &members!(ObjectRecord: kind, material, emitter, padding, a, b, c, d),
         );
-        check(
-            "Material",
-            size_of::<GpuMaterial>(),
-            &[("albedo", offset_of!(GpuMaterial, albedo)), ("emission", offset_of!(GpuMaterial, emission))],
-        );
-        check(
-            "Light",
+        wgsl("Material").assert_matches(size_of::<GpuMaterial>(), &members!(GpuMaterial: albedo, emission));
+        wgsl("Light").assert_matches(
             size_of::<GpuLight>(),
-            &[
-                ("corner", offset_of!(GpuLight, corner)),
-                ("edge_u", offset_of!(GpuLight, edge_u)),
-                ("edge_v", offset_of!(GpuLight, edge_v)),
-                ("normal", offset_of!(GpuLight, normal)),
-                ("emission", offset_of!(GpuLight, emission)),
-            ],
+            &members!(GpuLight: corner, edge_u, edge_v, normal, emission),
         );
     }
 

@@ -136,7 +136,8 @@ mod tests {
     /// scene.wgsl (16 vec4 + mat4 + 2 vec4 = 352 bytes; mat4 + vec4 = 80 bytes).
     #[test]
     fn layouts_match_the_wgsl_structs() {
-        use std::mem::{offset_of, size_of};
+        use illum_gpu::members;
+        use std::mem::size_of;
         assert_eq!(size_of::<SceneUniform>(), 352);
         assert_eq!(size_of::<ViewUniform>(), 80);
         let module = crate::shaders::compose(&crate::shaders::FLOOR_SHADER).unwrap_or_else(|e| panic!("{e}"));
@@ -144,11 +145,6 @@ mod tests {
             illum_gpu::shader::wgsl_struct(&module, "illum::raster::scene", name)
                 .unwrap_or_else(|| panic!("no struct {name} in scene.wgsl"))
         };
-        macro_rules! members {
-            ($ty:ty: $($field:ident),* $(,)?) => {
-                [$((stringify!($field), offset_of!($ty, $field))),*]
-            };
-        }
         wgsl("Scene").assert_matches(
             size_of::<SceneUniform>(),
             &members!(SceneUniform: to_light, light_radiance, ambient, background, floor_rect, floor_params,

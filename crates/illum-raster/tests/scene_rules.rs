@@ -19,74 +19,7 @@ const FILE: &str = "scenes/w.toml";
 /// A valid scene with every optional key written out: the old format's BASE in the physical
 /// model. The old light of intensity 1 is irradiance pi; the old `[ambient]` colour x intensity
 /// is `[shading] ambient`; the old look "whitted" is "enhanced".
-const BASE: &str = r#"renderer = "raster"
-name = "w"
-
-[camera]
-eye = [7.5, 2.3, -4.2]
-target = [4.2, 2.3, -4.2]
-up = [0.0, 1.0, 0.0]
-vfov = 60.0
-near = 0.1
-far = 3000.0
-width = 64
-height = 36
-
-[environment]
-radiance = [0.3, 0.5, 0.9]
-
-[directional_light]
-direction = [-10.0, -13.0, 2.0]
-irradiance = [3.14159265, 3.14159265, 3.14159265]
-angular_radius = 0.0
-
-[materials.floor]
-checker = { even = [0.8, 0.8, 0.0], odd = [0.8, 0.0, 0.0], tile = 1.0 }
-
-[materials.glass]
-dielectric = { ior = 1.4285715 }
-
-[materials.metal]
-mirror = { reflectance = [0.792, 0.863, 0.851] }
-
-[materials.grey]
-albedo = [0.5, 0.5, 0.5]
-
-[[objects]]
-name = "floor"
-material = "floor"
-quad = { corner = [-23.0, 0.0, -7.5], edge_u = [0.0, 0.0, 15.0], edge_v = [30.0, 0.0, 0.0] }
-
-[[objects]]
-name = "glass sphere"
-material = "glass"
-sphere = { center = [4.2, 2.6, -4.2], radius = 1.0 }
-
-[[objects]]
-name = "metal sphere"
-material = "metal"
-sphere = { center = [2.0, 1.9, -2.5], radius = 1.0 }
-
-[shading]
-ambient = [0.23, 0.23, 0.23]
-dielectric = { shininess = 200.0 }
-mirror = { specular = [1.0, 1.0, 1.0], shininess = 30.0, weight = 0.6 }
-
-[raster]
-look = "enhanced"
-pcf_radius = 0.05
-cube_size = 128
-glass_color = [1.0, 1.0, 1.0]
-glass_reflectivity = 0.9
-
-[raster.effects]
-shadows = true
-pcf = false
-refraction = true
-reflection = true
-fresnel = true
-msaa = false
-"#;
+const BASE: &str = include_str!("scenes/w.toml");
 
 /// The glass sphere's `[[objects]]` table of BASE, whole.
 const GLASS_OBJECT: &str = "[[objects]]\nname = \"glass sphere\"\nmaterial = \"glass\"\n\

@@ -9,47 +9,7 @@ use illum_scene::{Bounces, MAX_BOUNCES, MaterialKind, Overrides, Sampling, Scene
 const FILE: &str = "scenes/test.toml";
 
 /// A valid scene using every construct of the format once.
-const BASE: &str = r#"name = "test"
-
-[camera]
-eye = [0.0, 1.0, -5.0]
-target = [0.0, 1.0, 0.0]
-up = [0.0, 1.0, 0.0]
-vfov = 45.0
-width = 64
-height = 32
-
-[pathtrace]
-spp = 4
-bounces = 3
-seed = 7
-sampling = "uniform"
-
-[materials.grey]
-albedo = [0.5, 0.5, 0.5]
-
-[materials.lamp]
-emission = [5.0, 5.0, 5.0]
-
-[[objects]]
-name = "block"
-material = "grey"
-box = { center = [0.0, 0.0, 0.0], half_extent = [1.0, 1.0, 1.0] }
-
-[[objects]]
-name = "slab"
-material = "grey"
-box = { min = [-2.0, -1.0, -2.0], max = [2.0, -0.5, 2.0], rotate_y = 30.0, pivot = [1.0, 0.0, 1.0], translate = [0.0, 0.0, 3.0] }
-
-[[objects]]
-name = "lamp"
-material = "lamp"
-quad = { corner = [-0.5, 3.0, -0.5], edge_u = [1.0, 0.0, 0.0], edge_v = [0.0, 0.0, 1.0] }
-
-[[objects]]
-material = "grey"
-sphere = { center = [2.0, 1.0, 0.0], radius = 0.5 }
-"#;
+const BASE: &str = include_str!("scenes/test.toml");
 
 /// `BASE` with `from` replaced by `to`; `from` must occur exactly once, so a typo in a test
 /// fails loudly instead of silently testing the unedited scene.
