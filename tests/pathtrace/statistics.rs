@@ -116,16 +116,16 @@ fn batching_does_not_change_the_image() {
     assert_eq!(one.spp_done(), four.spp_done());
 }
 
+fn with_traversal(scene: &illum::scene::Scene, traversal: Traversal) -> PathTracer {
+    PathTracer::with_options(common::gpu(), scene, TracerOptions { traversal, ..Default::default() })
+        .expect("builds")
+}
+
 #[test]
 fn generic_and_specialised_traversal_give_the_same_image() {
     let scene = cornell(24, 16, 2, Sampling::Cosine, 5);
     let render = |traversal| {
-        let mut tracer = PathTracer::with_options(
-            common::gpu(),
-            &scene,
-            TracerOptions { traversal, ..Default::default() },
-        )
-        .expect("builds");
+        let mut tracer = with_traversal(&scene, traversal);
         tracer.render_to_spp(16).expect("renders");
         tracer.accumulator().mean_image()
     };
@@ -147,12 +147,7 @@ fn the_background_outside_the_box_is_black_and_the_light_is_its_radiance() {
     // so the image's corners look past the walls (x in [-1, 557], y in [0, 556]) into nothing.
     for traversal in [Traversal::Generic, Traversal::Specialised] {
         let scene = cornell(64, 4, 2, Sampling::Cosine, 1);
-        let mut tracer = PathTracer::with_options(
-            common::gpu(),
-            &scene,
-            TracerOptions { traversal, ..Default::default() },
-        )
-        .expect("builds");
+        let mut tracer = with_traversal(&scene, traversal);
         tracer.render_to_spp(4).expect("renders");
         let image = tracer.accumulator().mean_image();
         for (x, y) in [(0, 0), (63, 0), (0, 63), (63, 63)] {

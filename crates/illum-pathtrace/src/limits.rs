@@ -75,6 +75,11 @@ mod tests {
         s
     }
 
+    /// Why a `w` x `h` image of `bytes_per_pixel` is refused.
+    fn refused(w: u32, h: u32, bytes_per_pixel: u64) -> SceneError {
+        check_resolution(&with_size(w, h), &limits(), bytes_per_pixel).unwrap_err()
+    }
+
     #[test]
     fn resolution_within_limits_passes() {
         check_resolution(&with_size(8192, 1024), &limits(), 16).unwrap();
@@ -85,7 +90,7 @@ mod tests {
     #[test]
     fn resolution_beyond_the_texture_limit_names_it() {
         let label = "scene \"test\"";
-        let err = check_resolution(&with_size(8193, 16), &limits(), 16).unwrap_err();
+        let err = refused(8193, 16, 16);
         check_invalid(
             &err,
             label,
@@ -93,24 +98,23 @@ mod tests {
             "8193",
             "must be at most 8192, the device's max_texture_dimension_2d",
         );
-        let err = check_resolution(&with_size(16, 10000), &limits(), 16).unwrap_err();
+        let err = refused(16, 10000, 16);
         check_invalid(&err, label, "camera.height", "10000", "max_texture_dimension_2d");
     }
 
     #[test]
     fn resolution_beyond_the_buffer_limit_names_it() {
-        let label = "scene \"test\"";
-        let err = check_resolution(&with_size(4096, 2049), &limits(), 16).unwrap_err();
+        let err = refused(4096, 2049, 16);
         // 4096 * 2049 * 16 = 134283264 bytes > 134217728.
         check_invalid(
             &err,
-            label,
+            "scene \"test\"",
             "camera.width x camera.height",
             "4096 x 2049 (x 16 bytes per pixel = 134283264 bytes)",
             "must fit in 134217728 bytes, the device's max_storage_buffer_binding_size",
         );
         // An absurd per-pixel size saturates instead of wrapping around to a small number.
-        let err = check_resolution(&with_size(8192, 8192), &limits(), u64::MAX).unwrap_err();
+        let err = refused(8192, 8192, u64::MAX);
         assert!(err.to_string().contains("max_storage_buffer_binding_size"), "{err}");
     }
 }

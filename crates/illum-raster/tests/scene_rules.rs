@@ -11,7 +11,7 @@ use glam::{Vec2, Vec3};
 use illum_gpu::wgpu;
 use illum_raster::scene::FEATURES;
 use illum_raster::{Effects, Look, RasterScene, check_device_limits};
-use illum_scene::testing::{check_invalid, edit_once as edit_text};
+use illum_scene::testing::{check_invalid, edit_once as edit_text, without};
 use illum_scene::{Feature, RendererKind, Scene, SceneError};
 
 const FILE: &str = "scenes/w.toml";
@@ -140,20 +140,20 @@ fn whitted_toml_refraction_ratio_is_exactly_the_skeletons() {
 
 #[test]
 fn optional_parts_take_their_defaults() {
-    let mut text = BASE.to_owned();
-    for cut in [
-        "name = \"w\"\n",
-        "angular_radius = 0.0\n",
-        "[environment]\nradiance = [0.3, 0.5, 0.9]\n",
-        "[shading]\nambient = [0.23, 0.23, 0.23]\ndielectric = { shininess = 200.0 }\n\
+    let text = without(
+        BASE,
+        &[
+            "name = \"w\"\n",
+            "angular_radius = 0.0\n",
+            "[environment]\nradiance = [0.3, 0.5, 0.9]\n",
+            "[shading]\nambient = [0.23, 0.23, 0.23]\ndielectric = { shininess = 200.0 }\n\
          mirror = { specular = [1.0, 1.0, 1.0], shininess = 30.0, weight = 0.6 }\n",
-        "[raster]\nlook = \"enhanced\"\npcf_radius = 0.05\ncube_size = 128\n\
+            "[raster]\nlook = \"enhanced\"\npcf_radius = 0.05\ncube_size = 128\n\
          glass_color = [1.0, 1.0, 1.0]\nglass_reflectivity = 0.9\n",
-        "[raster.effects]\nshadows = true\npcf = false\nrefraction = true\nreflection = true\n\
+            "[raster.effects]\nshadows = true\npcf = false\nrefraction = true\nreflection = true\n\
          fresnel = true\nmsaa = false\n",
-    ] {
-        text = edit_text(&text, cut, "");
-    }
+        ],
+    );
     let s = parse(&text).unwrap();
     assert_eq!(s.name, "w", "file stem of scenes/w.toml");
     assert_eq!(s.look, Look::Figure);

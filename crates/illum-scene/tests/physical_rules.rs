@@ -6,7 +6,7 @@
 //! (`errors.rs` has the camera, shape and path-tracer rules shared with the old format.)
 
 use glam::Vec3;
-use illum_scene::testing::{check_invalid, edit_once as edit_text};
+use illum_scene::testing::{check_invalid, edit_once as edit_text, without};
 use illum_scene::{
     Checker, Effects, Feature, Look, MaterialKind, RendererKind, Scene, SceneError, Sequence, Shading,
     WhittedSettings,
@@ -107,23 +107,23 @@ fn base_scene_loads_with_the_written_values() {
 
 #[test]
 fn optional_sections_take_their_defaults() {
-    let mut text = BASE.to_owned();
-    for cut in [
-        "renderer = \"pathtrace\"\n",
-        "near = 0.1\nfar = 100.0\n",
-        "[environment]\nradiance = [0.3, 0.5, 0.9]\n",
-        "angular_radius = 0.25\n",
-        "sequence = \"low-discrepancy\"\n",
-        "[raster]\nlook = \"enhanced\"\npcf_radius = 0.1\ncube_size = 64\nglass_color = [0.9, 1.0, 0.9]\n\
+    let text = without(
+        BASE,
+        &[
+            "renderer = \"pathtrace\"\n",
+            "near = 0.1\nfar = 100.0\n",
+            "[environment]\nradiance = [0.3, 0.5, 0.9]\n",
+            "angular_radius = 0.25\n",
+            "sequence = \"low-discrepancy\"\n",
+            "[raster]\nlook = \"enhanced\"\npcf_radius = 0.1\ncube_size = 64\nglass_color = [0.9, 1.0, 0.9]\n\
          glass_reflectivity = 0.5\n",
-        "[raster.effects]\nshadows = false\npcf = true\nrefraction = true\nreflection = false\n\
+            "[raster.effects]\nshadows = false\npcf = true\nrefraction = true\nreflection = false\n\
          fresnel = true\nmsaa = true\n",
-        "[whitted]\ndepth = 5\naa = 3\n",
-        "[shading]\nambient = [0.1, 0.1, 0.1]\ndielectric = { shininess = 100.0 }\n\
+            "[whitted]\ndepth = 5\naa = 3\n",
+            "[shading]\nambient = [0.1, 0.1, 0.1]\ndielectric = { shininess = 100.0 }\n\
          mirror = { specular = [0.9, 0.9, 0.9], shininess = 20.0, weight = 0.4 }\n",
-    ] {
-        text = edit_text(&text, cut, "");
-    }
+        ],
+    );
     let s = parse(&text).unwrap();
     assert_eq!(s.renderer, RendererKind::PathTrace);
     assert_eq!(s.clip, None);
