@@ -92,6 +92,11 @@ pub fn time_budget_arg(text: &str) -> Result<std::time::Duration, String> {
     illum_pathtrace::parse_time_budget("--time-budget", value)
 }
 
+/// The names of the flags that were given, from (given, name) pairs, in order.
+pub fn given_flags(flags: &[(bool, &'static str)]) -> Vec<&'static str> {
+    flags.iter().filter_map(|&(given, flag)| given.then_some(flag)).collect()
+}
+
 /// Checks every output before any rendering, so that a finished render is never lost to a bad
 /// name: a known extension, a folder that can take the file, not a directory or a read-only
 /// file. `png_flags` are the PNG-only flags given (`--encoding`, `--exposure`): an error when no

@@ -386,20 +386,12 @@ fn plot_rows(out: &Path, rows: &[Row]) -> anyhow::Result<()> {
             })
             .collect()
     };
-    plot::log_log(
-        &out.join("error-vs-time-sampling.png"),
-        "Cosine vs uniform hemisphere sampling",
-        "wall time (s)",
-        "relMSE",
-        &pair([VARIANTS[0].name, VARIANTS[1].name]),
-    )?;
-    plot::log_log(
-        &out.join("error-vs-time-sequence.png"),
-        "Independent vs low-discrepancy numbers",
-        "wall time (s)",
-        "relMSE",
-        &pair([VARIANTS[0].name, VARIANTS[2].name]),
-    )?;
+    for (file, title, other) in [
+        ("error-vs-time-sampling.png", "Cosine vs uniform hemisphere sampling", VARIANTS[1].name),
+        ("error-vs-time-sequence.png", "Independent vs low-discrepancy numbers", VARIANTS[2].name),
+    ] {
+        plot::log_log(&out.join(file), title, "wall time (s)", "relMSE", &pair([VARIANTS[0].name, other]))?;
+    }
     let spp = |r: &Row| r.spp as f64;
     let mut lines: Vec<Line> = VARIANTS
         .iter()

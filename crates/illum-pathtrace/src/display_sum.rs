@@ -101,12 +101,11 @@ impl DisplaySum {
                     | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             });
-            let params = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("pathtrace display sum params"),
-                size: std::mem::size_of::<DisplayParams>() as u64,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
+            let params = illum_gpu::buffers::uniform_buffer(
+                device,
+                "pathtrace display sum params",
+                std::mem::size_of::<DisplayParams>() as u64,
+            );
             (buffer, params)
         })?;
         Ok(Self { width, height, buffer, params, pipeline, bound: None })

@@ -108,12 +108,11 @@ impl Display {
             multiview_mask: None,
             cache: None,
         });
-        let params = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("viewer display params"),
-            size: std::mem::size_of::<Params>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let params = illum_gpu::buffers::uniform_buffer(
+            device,
+            "viewer display params",
+            std::mem::size_of::<Params>() as u64,
+        );
         Display { pipeline, layout, params, target: None, source: None, texture_id: None }
     }
 
