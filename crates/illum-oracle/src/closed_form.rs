@@ -101,7 +101,7 @@ impl Room {
             light_u: DVec3::new(side, 0.0, 0.0),
             light_v: DVec3::new(0.0, 0.0, side),
             radiance: ASSIGNMENT_RADIANCE_AREA / (side * side),
-            albedo: 0.5,
+            ..Room::assignment()
         }
     }
 

@@ -175,26 +175,24 @@ impl RasterScene {
             let material = scene.material_of(object);
             match (object.shape, material.kind) {
                 (Shape::Quad(quad), kind) => {
-                    if floor.is_some() {
-                        return Err(SceneError::invalid(
-                            file,
-                            scene.object_label(i),
-                            "a second quad",
-                            "the rasterizer draws one quad, the floor",
-                        ));
-                    }
+                    only_one(
+                        floor.is_some(),
+                        file,
+                        &scene.object_label(i),
+                        "a second quad",
+                        "the rasterizer draws one quad, the floor",
+                    )?;
                     floor = Some(checker_floor(file, &scene.object_label(i), quad, kind)?);
                 }
                 (Shape::Sphere(sphere), MaterialKind::Dielectric { ior }) => {
                     let field = scene.object_label(i);
-                    if glass.is_some() {
-                        return Err(SceneError::invalid(
-                            file,
-                            field,
-                            "a second dielectric sphere",
-                            "the rasterizer draws at most one glass sphere (one refraction cube map)",
-                        ));
-                    }
+                    only_one(
+                        glass.is_some(),
+                        file,
+                        &field,
+                        "a second dielectric sphere",
+                        "the rasterizer draws at most one glass sphere (one refraction cube map)",
+                    )?;
                     if ior < 1.0 {
                         return Err(SceneError::invalid(
                             file,
@@ -216,14 +214,13 @@ impl RasterScene {
                     ));
                 }
                 (Shape::Sphere(sphere), MaterialKind::Mirror { reflectance }) => {
-                    if metal.is_some() {
-                        return Err(SceneError::invalid(
-                            file,
-                            scene.object_label(i),
-                            "a second mirror sphere",
-                            "the rasterizer draws at most one metal sphere (one mirror cube map)",
-                        ));
-                    }
+                    only_one(
+                        metal.is_some(),
+                        file,
+                        &scene.object_label(i),
+                        "a second mirror sphere",
+                        "the rasterizer draws at most one metal sphere (one mirror cube map)",
+                    )?;
                     let shading = scene.shading.mirror;
                     metal = Some((
                         i,
@@ -303,6 +300,11 @@ impl RasterScene {
         self.camera.height = height.unwrap_or(self.camera.height);
         Ok(())
     }
+}
+
+/// Refuses a second object of a kind the rasterizer draws once (`taken`: one was found already).
+fn only_one(taken: bool, file: &str, field: &str, what: &str, allowed: &str) -> Result<(), SceneError> {
+    if taken { Err(SceneError::invalid(file, field, what, allowed)) } else { Ok(()) }
 }
 
 /// The floor: a horizontal quad facing +Y, edges along X and Z, `corner` at its minimum (x, z)

@@ -169,17 +169,23 @@ fn a_bad_scene_file_shows_its_error_and_keeps_the_scene() {
     assert!(harness.state().open_error.is_none());
 }
 
-#[test]
-fn snapshot_path_tracer() {
+/// The path-tracer window run until its spp target stops it (within 200 frames).
+fn stopped_at(spp_target: u32) -> Harness<'static, ViewerApp> {
     let mut harness = harness(Mode::PathTrace);
-    // A fixed spp target makes the image deterministic; the run stops there.
-    harness.state_mut().pathtrace_mut().unwrap().settings.spp_target = Some(4);
+    harness.state_mut().pathtrace_mut().unwrap().settings.spp_target = Some(spp_target);
     for _ in 0..200 {
         harness.run_steps(1);
         if harness.state().pathtrace().unwrap().stop_reason().is_some() {
             break;
         }
     }
+    harness
+}
+
+#[test]
+fn snapshot_path_tracer() {
+    // A fixed spp target makes the image deterministic; the run stops there.
+    let mut harness = stopped_at(4);
     assert_eq!(spp(&harness), 4);
     harness.run_steps(2);
     harness.snapshot("viewer_pathtrace");
@@ -199,14 +205,7 @@ fn the_window_shows_what_save_png_writes() {
     // same samples with gamma 2.2, so they may differ only where f32 rounding tips a value over
     // a rounding boundary: by one level at most.
     let dir = tempfile::tempdir().unwrap();
-    let mut harness = harness(Mode::PathTrace);
-    harness.state_mut().pathtrace_mut().unwrap().settings.spp_target = Some(3);
-    for _ in 0..200 {
-        harness.run_steps(1);
-        if harness.state().pathtrace().unwrap().stop_reason().is_some() {
-            break;
-        }
-    }
+    let mut harness = stopped_at(3);
     assert_eq!(spp(&harness), 3);
     let mode = harness.state_mut().pathtrace_mut().unwrap();
     mode.save_path = dir.path().join("shown.png").display().to_string();
