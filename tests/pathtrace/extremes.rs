@@ -7,6 +7,8 @@
 //! mean (a false alarm once in about 16 000 runs) and, per pixel, a two-sample Z-test at
 //! alpha = 0.01 that at least 97% of pixels must pass. Every measured number is printed
 //! (`cargo test --test pathtrace extremes -- --nocapture`); docs/accuracy.md records them.
+//!
+//! Long (one test per extreme) but one concept: the path tracer where floats run out.
 
 use std::sync::OnceLock;
 

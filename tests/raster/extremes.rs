@@ -1,7 +1,9 @@
-//! Issue 6, section 3: the raster scene at the extremes. Every case checks that the image is
+//! The raster scene at the extremes. Every case checks that the image is
 //! finite and measures a physical property against a value computed here (ray casts in f64, or a
 //! second render that must agree). Each prints what it measured; docs/accuracy.md's table
 //! "Raster extremes" quotes these numbers.
+//!
+//! Long (one test per extreme) but one concept: the rasterizer at the extremes of its inputs.
 
 use glam::{DVec3, Vec3};
 use illum::image::RgbImage32;

@@ -6,6 +6,8 @@
 //!
 //! Ported from the rules of the old raster-only format (illum-scene's `whitted_errors.rs`): each
 //! old rule is tested at its new field path; where a rule changed, a comment says how.
+//!
+//! Long (one test per rule) but one concept: every rule of the raster's view of a scene file.
 
 use glam::{Vec2, Vec3};
 use illum_gpu::wgpu;

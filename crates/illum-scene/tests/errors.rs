@@ -1,6 +1,8 @@
 //! Every validation rule, triggered by an edited copy of a small valid scene, with the message
 //! checked for file, field, value and what is allowed; plus syntax errors (line, column, key),
 //! command-line overrides. (Device limits are checked by the GPU crates, with their tests.)
+//!
+//! Long (one test per rule) but one concept: every error of the file format and its overrides.
 
 use glam::Vec3;
 use illum_scene::testing::{check_invalid, edit_once as edit_text};

@@ -4,6 +4,8 @@
 //! rule is triggered by an edited copy of a small valid scene, with the message checked for
 //! file, field, value and what is allowed; the extremes each side of every range are tried.
 //! (`errors.rs` has the camera, shape and path-tracer rules shared with the old format.)
+//!
+//! Long (one test per rule) but one concept: every rule of the physical model.
 
 use glam::Vec3;
 use illum_scene::testing::{check_invalid, edit_once as edit_text, without};
