@@ -81,6 +81,15 @@ pub struct Room {
 /// The assignment's light's power divided by pi: radiance x area = 30 x 130 x 105.
 pub const ASSIGNMENT_RADIANCE_AREA: f64 = 30.0 * 130.0 * 105.0;
 
+/// The room's five walls as boxes 2 units thick: (name, centre, half extent) in TOML.
+const ROOM_WALLS: [(&str, &str, &str); 5] = [
+    ("left wall", "[556.0, 278.0, 278.0]", "[1.0, 278.0, 278.0]"),
+    ("right wall", "[0.0, 278.0, 278.0]", "[1.0, 278.0, 278.0]"),
+    ("ceiling", "[278.0, 556.0, 278.0]", "[278.0, 1.0, 278.0]"),
+    ("floor", "[278.0, 0.0, 278.0]", "[278.0, 1.0, 278.0]"),
+    ("back wall", "[278.0, 278.0, 556.0]", "[278.0, 278.0, 1.0]"),
+];
+
 impl Room {
     /// The assignment's light: 130 x 105 at y = 555, radiance 30; white albedo 0.5.
     pub fn assignment() -> Self {
@@ -131,27 +140,7 @@ seed = {seed}
 albedo = [{albedo:?}, {albedo:?}, {albedo:?}]
 [materials.light]
 emission = [{radiance:?}, {radiance:?}, {radiance:?}]
-[[objects]]
-name = "left wall"
-material = "white"
-box = {{ center = [556.0, 278.0, 278.0], half_extent = [1.0, 278.0, 278.0] }}
-[[objects]]
-name = "right wall"
-material = "white"
-box = {{ center = [0.0, 278.0, 278.0], half_extent = [1.0, 278.0, 278.0] }}
-[[objects]]
-name = "ceiling"
-material = "white"
-box = {{ center = [278.0, 556.0, 278.0], half_extent = [278.0, 1.0, 278.0] }}
-[[objects]]
-name = "floor"
-material = "white"
-box = {{ center = [278.0, 0.0, 278.0], half_extent = [278.0, 1.0, 278.0] }}
-[[objects]]
-name = "back wall"
-material = "white"
-box = {{ center = [278.0, 278.0, 556.0], half_extent = [278.0, 278.0, 1.0] }}
-[[objects]]
+{walls}[[objects]]
 name = "light"
 material = "light"
 quad = {{ corner = {corner}, edge_u = {u}, edge_v = {v} }}
@@ -167,6 +156,13 @@ quad = {{ corner = {corner}, edge_u = {u}, edge_v = {v} }}
             corner = v(self.light_corner),
             u = v(self.light_u),
             v = v(self.light_v),
+            walls = ROOM_WALLS
+                .iter()
+                .map(|(name, center, half_extent)| format!(
+                    "[[objects]]\nname = \"{name}\"\nmaterial = \"white\"\n\
+                     box = {{ center = {center}, half_extent = {half_extent} }}\n"
+                ))
+                .collect::<String>(),
         );
         Scene::from_toml_str(&text, "room.toml").expect("the generated room parses")
     }
