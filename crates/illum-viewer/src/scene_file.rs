@@ -45,10 +45,7 @@ pub fn load(path: &Path) -> Result<LoadedScene, String> {
     if let (Err(p), Err(r)) = (&pathtrace, &raster) {
         return Err(format!("no mode can show it: {p}; {r}"));
     }
-    let preferred = match scene.renderer {
-        RendererKind::Raster => Mode::Raster,
-        RendererKind::PathTrace => Mode::PathTrace,
-    };
+    let preferred = Mode::from(scene.renderer);
     Ok(LoadedScene { pathtrace, raster, preferred })
 }
 
