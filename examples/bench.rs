@@ -17,6 +17,7 @@ use std::path::PathBuf;
 
 use clap::Parser;
 use illum::cli::{self, SceneArgs};
+use illum::image::median;
 use illum::pathtrace::{PathTracer, TracerOptions, Traversal};
 use illum::raster::RasterScene;
 use illum::raster::{Look, Options, bench_frames};
@@ -46,11 +47,6 @@ struct Config {
 
 fn main() {
     illum::cli::main_with(run);
-}
-
-fn median(values: &mut [f64]) -> f64 {
-    values.sort_by(f64::total_cmp);
-    values[values.len() / 2]
 }
 
 /// Upper bound on rays per path for a fixed bounce count: one camera ray, then at each of the
@@ -98,13 +94,13 @@ fn run(args: Args) -> anyhow::Result<()> {
         let options = TracerOptions { traversal: config.traversal, ..Default::default() };
         let mut tracer = PathTracer::with_options(&gpu, &scene, options)?;
         // Warm-up: compiles the pipeline on the driver and teaches the planner the cost.
-        tracer.render(1)?;
+        tracer.render_to_spp(1)?;
         let (mut wall, mut gpu_rate, mut per_submission) = (Vec::new(), Vec::new(), Vec::new());
         for _ in 0..args.runs.max(1) {
             tracer.reset();
             let mut submissions = 0u32;
             while tracer.spp_done() < config.spp {
-                tracer.step(Some(config.spp))?;
+                tracer.render_step(Some(config.spp))?;
                 submissions += 1;
             }
             let samples = (config.size as f64).powi(2) * config.spp as f64;

@@ -62,7 +62,7 @@ fn run(args: Args) -> anyhow::Result<()> {
             "figure settings",
         )?;
         let mut tracer = PathTracer::new(&gpu, &scene)?;
-        tracer.render(spp)?;
+        tracer.render_to_spp(spp)?;
         let image = tracer.accumulator().mean_image();
         let path = args.out.join(format!("{stem}.png"));
         save_png(&path, &image, 0.0, Encoding::Gamma22)?;

@@ -111,11 +111,9 @@ fn run(args: Args) -> anyhow::Result<()> {
     } else {
         args.outputs.clone()
     };
-    let png_flags = [(args.encoding.is_some(), "--encoding"), (args.exposure.is_some(), "--exposure")];
-    cli::check_outputs(
-        &outputs,
-        &png_flags.into_iter().filter_map(|(on, f)| on.then_some(f)).collect::<Vec<_>>(),
-    )?;
+    let png_flags =
+        cli::given_flags(&[(args.encoding.is_some(), "--encoding"), (args.exposure.is_some(), "--exposure")]);
+    cli::check_outputs(&outputs, &png_flags)?;
     let sequence = scene.pathtrace.sequence;
 
     let gpu = cli::gpu()?;

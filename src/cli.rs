@@ -4,6 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use clap::Args;
+pub use illum_scene::resolve_scene_path;
 use illum_scene::{Bounces, Overrides, Sampling, Scene};
 
 /// The default scene: the assignment's Cornell box.
@@ -44,19 +45,6 @@ impl SceneArgs {
             height: self.height,
         }
     }
-}
-
-/// Resolves a scene path given on the command line. A relative path that does not exist from
-/// the current directory is also looked up from the workspace root, so examples work from any
-/// directory inside the checkout.
-pub fn resolve_scene_path(path: &Path) -> PathBuf {
-    if path.is_relative() && !path.exists() {
-        let from_root = Path::new(env!("CARGO_MANIFEST_DIR")).join(path);
-        if from_root.exists() {
-            return from_root;
-        }
-    }
-    path.to_path_buf()
 }
 
 /// Loads a scene file and applies the command-line overrides.
@@ -102,6 +90,11 @@ pub fn target_error_arg(text: &str) -> Result<f64, String> {
 pub fn time_budget_arg(text: &str) -> Result<std::time::Duration, String> {
     let value = text.trim().parse::<f64>().map_err(|_| format!("{text:?} is not a number of seconds"))?;
     illum_pathtrace::parse_time_budget("--time-budget", value)
+}
+
+/// The names of the flags that were given, from (given, name) pairs, in order.
+pub fn given_flags(flags: &[(bool, &'static str)]) -> Vec<&'static str> {
+    flags.iter().filter_map(|&(given, flag)| given.then_some(flag)).collect()
 }
 
 /// Checks every output before any rendering, so that a finished render is never lost to a bad

@@ -114,15 +114,12 @@ pub struct RasterRequest<'a> {
 
 /// The path tracer's flags in [`SceneArgs`] that were given.
 fn path_tracer_settings(settings: &SceneArgs) -> Vec<&'static str> {
-    [
+    cli::given_flags(&[
         (settings.spp.is_some(), "--spp"),
         (settings.bounces.is_some(), "--bounces"),
         (settings.seed.is_some(), "--seed"),
         (settings.sampling.is_some(), "--sampling"),
-    ]
-    .into_iter()
-    .filter_map(|(given, flag)| given.then_some(flag))
-    .collect()
+    ])
 }
 
 /// Loads the scene, applies `--width` / `--height`, and checks every flag and output name,
@@ -149,11 +146,11 @@ fn prepare(request: &RasterRequest) -> anyhow::Result<(RasterScene, Options, Vec
     } else {
         request.outputs.to_vec()
     };
-    let png_flags = [(request.encoding.is_some(), "--encoding"), (request.exposure.is_some(), "--exposure")];
-    cli::check_outputs(
-        &outputs,
-        &png_flags.into_iter().filter_map(|(on, f)| on.then_some(f)).collect::<Vec<_>>(),
-    )?;
+    let png_flags = cli::given_flags(&[
+        (request.encoding.is_some(), "--encoding"),
+        (request.exposure.is_some(), "--exposure"),
+    ]);
+    cli::check_outputs(&outputs, &png_flags)?;
     Ok((scene, options, outputs))
 }
 

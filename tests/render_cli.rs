@@ -52,14 +52,21 @@ fn assert_no_panic(output: &Output) {
     assert!(!stderr.contains("panicked") && output.status.code() != Some(101), "{stderr}");
 }
 
+/// Renders 16 x 16 with `flags` to an EXR, which must succeed, and returns its metadata.
+fn render_16_exr(flags: &[&str]) -> illum::image::ExrMetadata {
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("out.exr");
+    let mut args = vec!["--width", "16", "--height", "16"];
+    args.extend(flags);
+    args.extend(["-o", exr.to_str().unwrap()]);
+    let out = run(&args);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    metadata(&exr)
+}
+
 #[test]
 fn target_error_takes_the_render_past_the_scenes_spp() {
-    let dir = tempfile::tempdir().unwrap();
-    let exr = dir.path().join("e.exr");
-    let out =
-        run(&["--width", "16", "--height", "16", "--target-error", "0.05", "-o", exr.to_str().unwrap()]);
-    assert!(out.status.success(), "{}", text(&out.stderr));
-    let meta = metadata(&exr);
+    let meta = render_16_exr(&["--target-error", "0.05"]);
     assert_eq!(field(&meta, "stopped_by"), "target_error");
     let spp: u32 = field(&meta, "spp").parse().unwrap();
     assert!(spp > 16, "stopped at {spp} spp: the scene's spp = 16 capped the error target");
@@ -70,12 +77,7 @@ fn target_error_takes_the_render_past_the_scenes_spp() {
 
 #[test]
 fn a_time_budget_finishes_one_pass_and_says_it_stopped_on_time() {
-    let dir = tempfile::tempdir().unwrap();
-    let exr = dir.path().join("t.exr");
-    let out =
-        run(&["--width", "16", "--height", "16", "--time-budget", "0.001", "-o", exr.to_str().unwrap()]);
-    assert!(out.status.success(), "{}", text(&out.stderr));
-    let meta = metadata(&exr);
+    let meta = render_16_exr(&["--time-budget", "0.001"]);
     assert_eq!(field(&meta, "stopped_by"), "time_budget");
     let spp: u32 = field(&meta, "spp").parse().unwrap();
     assert!(spp >= 1, "a time budget must not stop inside the first pass");

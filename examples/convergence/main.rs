@@ -18,6 +18,8 @@
 //!
 //! Outputs in DIR: convergence.csv, convergence.md, bounces.csv, and the plots
 //! error-vs-time-sampling.png, error-vs-time-sequence.png, error-vs-spp.png, bounces.png.
+//!
+//! Over 400 lines, one concept: one study from its rows to its tables (plots are `plot.rs`).
 
 mod plot;
 
@@ -179,16 +181,16 @@ fn run(mut args: Args) -> anyhow::Result<()> {
         let options = TracerOptions { sequence: variant.sequence, ..Default::default() };
         let mut tracer = PathTracer::with_options(&gpu, &variant_scene, options)?;
         // The driver compiles a pipeline on its first dispatch: keep that out of the timings.
-        tracer.render(1)?;
+        tracer.render_to_spp(1)?;
         tracer.reset();
         for &spp in &args.spp_list {
-            tracer.render(spp)?;
+            tracer.render_to_spp(spp)?;
             // Time in submissions (readback and f64 fold included), not the measuring between rows.
             taken.push(take(variant.name, &tracer, tracer.wall_seconds()));
         }
         for &budget in &budgets {
             let mut tracer = PathTracer::with_options(&gpu, &variant_scene, options)?;
-            tracer.render(1)?;
+            tracer.render_to_spp(1)?;
             tracer.reset();
             let rules = StopRules { time_budget: Some(budget), ..Default::default() };
             let (_, progressive) =
@@ -244,7 +246,7 @@ fn reference_image(gpu: &GpuContext, scene: &Scene, args: &Args, max_spp: u32) -
     }
     println!("rendering the reference: {spp} spp (cached as {})", path.display());
     let mut tracer = PathTracer::new(gpu, &reference_scene)?;
-    tracer.render(spp)?;
+    tracer.render_to_spp(spp)?;
     let image = tracer.accumulator().mean_image();
     let mut metadata = illum::pathtrace::metadata::exr_metadata(
         &tracer,
@@ -413,20 +415,12 @@ fn plot_rows(out: &Path, rows: &[Row]) -> anyhow::Result<()> {
             })
             .collect()
     };
-    plot::log_log(
-        &out.join("error-vs-time-sampling.png"),
-        "Cosine vs uniform hemisphere sampling",
-        "wall time (s)",
-        "relMSE",
-        &pair([VARIANTS[0].name, VARIANTS[1].name]),
-    )?;
-    plot::log_log(
-        &out.join("error-vs-time-sequence.png"),
-        "Independent vs low-discrepancy numbers",
-        "wall time (s)",
-        "relMSE",
-        &pair([VARIANTS[0].name, VARIANTS[2].name]),
-    )?;
+    for (file, title, other) in [
+        ("error-vs-time-sampling.png", "Cosine vs uniform hemisphere sampling", VARIANTS[1].name),
+        ("error-vs-time-sequence.png", "Independent vs low-discrepancy numbers", VARIANTS[2].name),
+    ] {
+        plot::log_log(&out.join(file), title, "wall time (s)", "relMSE", &pair([VARIANTS[0].name, other]))?;
+    }
     let spp = |r: &Row| r.spp as f64;
     let mut lines: Vec<Line> = VARIANTS
         .iter()
@@ -461,7 +455,7 @@ fn bounce_table(gpu: &GpuContext, scene: &Scene, spp: u32, out: &Path) -> anyhow
         let mut s = scene.clone();
         s.pathtrace.bounces = bounces;
         let mut tracer = PathTracer::new(gpu, &s)?;
-        tracer.render(spp)?;
+        tracer.render_to_spp(spp)?;
         let acc = tracer.accumulator();
         let n = (acc.width * acc.height) as usize;
         let weights = [0.2126, 0.7152, 0.0722];

@@ -8,9 +8,8 @@ use std::sync::OnceLock;
 use illum::gpu::GpuContext;
 use illum::image::RgbImage32;
 use illum::pathtrace::PathTracer;
-use illum::scene::{Overrides, Scene};
+use illum::scene::{Bounces, Overrides, Sampling, Scene};
 
-pub mod closed_form;
 pub mod edit;
 
 /// The device every test in this binary shares. Without a Vulkan adapter this panics with the
@@ -35,6 +34,22 @@ pub fn scene(name: &str, overrides: Overrides) -> Scene {
     scene
 }
 
+/// The Cornell box at `size` x `size` with these render settings.
+pub fn cornell(size: u32, spp: u32, bounces: Bounces, sampling: Sampling, seed: u32) -> Scene {
+    scene(
+        "cornell",
+        Overrides {
+            width: Some(size),
+            height: Some(size),
+            spp: Some(spp),
+            bounces: Some(bounces),
+            seed: Some(seed),
+            sampling: Some(sampling),
+            sequence: None,
+        },
+    )
+}
+
 pub fn small(width: u32, height: u32, spp: u32) -> Overrides {
     Overrides { width: Some(width), height: Some(height), spp: Some(spp), ..Default::default() }
 }
@@ -45,7 +60,7 @@ pub fn render(scene: &Scene) -> PathTracer {
     // One pass of all the samples: `render` would size its passes by measured speed, which
     // tests running in parallel change, and the grouping of samples into f32 chunk sums with
     // it; a test comparing two renders bit for bit needs the same grouping every time.
-    tracer.render_pass(scene.pathtrace.spp).expect("render succeeds");
+    tracer.add_samples_in_one_pass(scene.pathtrace.spp).expect("render succeeds");
     tracer
 }
 

@@ -5,7 +5,7 @@
 //! and the irradiance from a uniformly emitting polygon of radiance Le is Lambert's formula
 //!     E(x) = Le / 2 * | sum_i theta_i (n . g_i) |,
 //! where theta_i is the angle subtended at x by the edge (v_i, v_{i+1}) and g_i is the unit
-//! normal of the plane through x and that edge. The formula (tests/common/closed_form.rs) is
+//! normal of the plane through x and that edge. The formula (`illum_oracle::closed_form`) is
 //! evaluated in f64, independently of the shader, and compared with the GPU estimate within 4
 //! standard errors.
 
@@ -15,46 +15,11 @@ use illum::scene::Scene;
 
 use crate::common;
 
-use common::closed_form::lambert_irradiance_factor;
+use illum_oracle::closed_form::lambert_irradiance_factor;
 
 /// The assignment's box without the two blocks, so nothing but the geometry of the light
 /// decides the direct light on the floor. Camera placeholders are replaced per point.
-const ROOM: &str = r#"
-name = "room"
-[camera]
-eye = [278.0, 278.0, -724.26]
-target = [278.0, 278.0, 0.0]
-up = [0.0, 1.0, 0.0]
-vfov = 45.0
-width = 8
-height = 8
-[pathtrace]
-spp = 1024
-bounces = 0
-[materials.white]
-albedo = [0.5, 0.5, 0.5]
-[materials.light]
-emission = [30.0, 30.0, 30.0]
-[[objects]]
-material = "white"
-box = { center = [556.0, 278.0, 278.0], half_extent = [1.0, 278.0, 278.0] }
-[[objects]]
-material = "white"
-box = { center = [0.0, 278.0, 278.0], half_extent = [1.0, 278.0, 278.0] }
-[[objects]]
-material = "white"
-box = { center = [278.0, 556.0, 278.0], half_extent = [278.0, 1.0, 278.0] }
-[[objects]]
-material = "white"
-box = { center = [278.0, 0.0, 278.0], half_extent = [278.0, 1.0, 278.0] }
-[[objects]]
-material = "white"
-box = { center = [278.0, 278.0, 556.0], half_extent = [278.0, 278.0, 1.0] }
-[[objects]]
-name = "light"
-material = "light"
-quad = { corner = [213.0, 555.0, 225.5], edge_u = [130.0, 0.0, 0.0], edge_v = [0.0, 0.0, 105.0] }
-"#;
+const ROOM: &str = include_str!("room.toml");
 
 const LIGHT: [DVec3; 4] = [
     DVec3::new(213.0, 555.0, 225.5),
@@ -76,7 +41,7 @@ fn estimate_floor_radiance(x: DVec3, spp: u32) -> (f64, f64) {
     scene.camera.vfov_deg = 0.01;
     scene.pathtrace.spp = spp;
     let mut tracer = PathTracer::new(common::gpu(), &scene).expect("builds");
-    tracer.render(spp).expect("renders");
+    tracer.render_to_spp(spp).expect("renders");
     assert_eq!(tracer.accumulator().dropped_samples(), 0);
     let (mean, variance) = common::image_mean_and_variance(&tracer, 0);
     (mean, variance.sqrt())

@@ -13,6 +13,11 @@ fn cornell(width: u32, height: u32, spp: u32, seed: u32) -> Scene {
     common::scene("cornell", Overrides { seed: Some(seed), ..common::small(width, height, spp) })
 }
 
+/// A tracer of the Cornell box at `width` x `height`.
+fn tracer(width: u32, height: u32, spp: u32, seed: u32) -> PathTracer {
+    PathTracer::new(common::gpu(), &cornell(width, height, spp, seed)).expect("builds")
+}
+
 /// The display sum read back: (rgb sum, count) per pixel.
 fn read_display_sum(tracer: &PathTracer) -> Vec<[f32; 4]> {
     let buffer = tracer.display_sum_buffer().expect("display sum enabled");
@@ -59,33 +64,30 @@ fn assert_matches_statistics(tracer: &PathTracer, spp: u32, what: &str) {
 
 #[test]
 fn the_display_sum_is_the_mean_of_the_same_samples() {
-    let scene = cornell(40, 24, 40, 3);
-    let mut tracer = PathTracer::new(common::gpu(), &scene).expect("builds");
+    let mut tracer = tracer(40, 24, 40, 3);
     tracer.enable_display_sum().expect("a small image fits");
     tracer.enable_display_sum().expect("enabling twice does nothing");
     // Several passes of several chunks each (16 samples per chunk): 16 + 24 spp.
-    tracer.render_pass(16).expect("renders");
-    tracer.render_pass(24).expect("renders");
+    tracer.add_samples_in_one_pass(16).expect("renders");
+    tracer.add_samples_in_one_pass(24).expect("renders");
     assert_matches_statistics(&tracer, 40, "two passes");
 }
 
 #[test]
 fn enabling_late_starts_from_the_samples_already_taken() {
-    let scene = cornell(32, 20, 12, 5);
-    let mut tracer = PathTracer::new(common::gpu(), &scene).expect("builds");
+    let mut tracer = tracer(32, 20, 12, 5);
     assert!(tracer.display_sum_buffer().is_none(), "opt-in: no display sum by default");
-    tracer.render_pass(5).expect("renders");
+    tracer.add_samples_in_one_pass(5).expect("renders");
     tracer.enable_display_sum().expect("a small image fits");
-    tracer.render_pass(7).expect("renders");
+    tracer.add_samples_in_one_pass(7).expect("renders");
     assert_matches_statistics(&tracer, 12, "enabled after 5 spp");
 }
 
 #[test]
 fn reset_scene_updates_and_resizes_restart_the_display_sum() {
-    let scene = cornell(32, 20, 8, 7);
-    let mut tracer = PathTracer::new(common::gpu(), &scene).expect("builds");
+    let mut tracer = tracer(32, 20, 8, 7);
     tracer.enable_display_sum().expect("fits");
-    tracer.render_pass(8).expect("renders");
+    tracer.add_samples_in_one_pass(8).expect("renders");
     assert_matches_statistics(&tracer, 8, "before reset");
 
     tracer.reset();
@@ -93,15 +95,15 @@ fn reset_scene_updates_and_resizes_restart_the_display_sum() {
         read_display_sum(&tracer).iter().all(|s| *s == [0.0; 4]),
         "reset leaves samples in the display sum"
     );
-    tracer.render_pass(3).expect("renders");
+    tracer.add_samples_in_one_pass(3).expect("renders");
     assert_matches_statistics(&tracer, 3, "after reset");
 
     // Another camera at the same size: the same buffer, cleared.
-    let mut moved = scene.clone();
+    let mut moved = tracer.scene().clone();
     moved.camera.eye.x += 20.0;
     tracer.update_scene(&moved).expect("same geometry");
     assert!(read_display_sum(&tracer).iter().all(|s| *s == [0.0; 4]), "a camera change keeps old samples");
-    tracer.render_pass(4).expect("renders");
+    tracer.add_samples_in_one_pass(4).expect("renders");
     assert_matches_statistics(&tracer, 4, "after a camera change");
 
     // Another resolution: a new buffer of the new size, still enabled.
@@ -111,7 +113,7 @@ fn reset_scene_updates_and_resizes_restart_the_display_sum() {
     tracer.update_scene(&larger).expect("same geometry");
     assert!(tracer.display_sum_buffer().is_some(), "a resize must keep the display sum enabled");
     assert!(read_display_sum(&tracer).iter().all(|s| *s == [0.0; 4]), "a resize starts from zero");
-    tracer.render_pass(6).expect("renders");
+    tracer.add_samples_in_one_pass(6).expect("renders");
     assert_matches_statistics(&tracer, 6, "after a resize");
 }
 
@@ -119,13 +121,12 @@ fn reset_scene_updates_and_resizes_restart_the_display_sum() {
 fn every_band_of_a_tiled_pass_reaches_the_display_sum() {
     // Batch buffers capped at two rows of one chunk: a 32 spp pass (2 chunks) goes one row per
     // submission, an 8 spp pass (1 chunk) two rows per submission.
-    let scene = cornell(36, 22, 40, 11);
-    let mut tracer = PathTracer::new(common::gpu(), &scene).expect("builds");
+    let mut tracer = tracer(36, 22, 40, 11);
     tracer.limit_batch_bytes(2 * 36 * SLOT_BYTES).expect("two rows fit");
     tracer.enable_display_sum().expect("fits");
     let mut submissions = 0;
     while tracer.spp_done() < 40 {
-        tracer.step(Some(40)).expect("renders");
+        tracer.render_step(Some(40)).expect("renders");
         submissions += 1;
     }
     println!("36 x 22, 40 spp in bands: {submissions} submissions");

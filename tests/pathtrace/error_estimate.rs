@@ -41,7 +41,7 @@ fn estimated_relative_error_tracks_the_true_error_within_a_factor_of_1_5() {
     let mut tracer = PathTracer::new(common::gpu(), &scene).expect("builds");
     let mut log_points = Vec::new();
     for spp in [8, 32, 128, 512, 1024] {
-        tracer.render(spp).expect("renders");
+        tracer.render_to_spp(spp).expect("renders");
         let estimated = tracer.accumulator().estimated_rel_mse();
         let measured =
             rel_mse(&tracer.accumulator().mean_image(), &reference).expect("same size") - reference_noise;

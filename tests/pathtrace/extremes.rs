@@ -7,18 +7,20 @@
 //! mean (a false alarm once in about 16 000 runs) and, per pixel, a two-sample Z-test at
 //! alpha = 0.01 that at least 97% of pixels must pass. Every measured number is printed
 //! (`cargo test --test pathtrace extremes -- --nocapture`); docs/accuracy.md records them.
+//!
+//! Long (one test per extreme) but one concept: the path tracer where floats run out.
 
 use std::sync::OnceLock;
 
 use glam::{DVec3, Vec3};
 use illum::image::{RgbImage32, z_test_pass_fraction};
 use illum::pathtrace::PathTracer;
-use illum::scene::{Bounces, Camera, MaterialKind, Overrides, Sampling, Scene, Shape};
+use illum::scene::{Bounces, Camera, MaterialKind, Sampling, Scene, Shape};
 
 use crate::common;
 
-use common::closed_form::{Room, expected_pixel};
 use common::edit::{set_albedo, transformed};
+use illum_oracle::closed_form::{Room, expected_pixel};
 
 /// A finished render's statistics.
 struct Rendered {
@@ -87,18 +89,7 @@ fn assert_same_image(a: &Rendered, b: &Rendered, what: &str) -> (f64, f64) {
 }
 
 fn cornell(size: u32, spp: u32, bounces: Bounces, seed: u32) -> Scene {
-    common::scene(
-        "cornell",
-        Overrides {
-            width: Some(size),
-            height: Some(size),
-            spp: Some(spp),
-            bounces: Some(bounces),
-            seed: Some(seed),
-            sampling: Some(Sampling::Cosine),
-            sequence: None,
-        },
-    )
+    common::cornell(size, spp, bounces, Sampling::Cosine, seed)
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -665,21 +656,26 @@ fn one_sample_per_pixel_is_finite_and_unbiased() {
     }
 }
 
+/// The Cornell box with 2 bounces at `size` x `size`, seen from `eye` toward `target` (up +Z).
+fn cornell_view(size: u32, spp: u32, seed: u32, eye: Vec3, target: Vec3, vfov_deg: f32) -> Scene {
+    let mut scene = cornell(size, spp, Bounces::Fixed(2), seed);
+    scene.camera.eye = eye;
+    scene.camera.target = target;
+    scene.camera.up = Vec3::Z;
+    scene.camera.vfov_deg = vfov_deg;
+    scene
+}
+
 /// A 1 x 1 image that sees nothing but the light: every sample is exactly 30.
 fn looking_into_the_light(spp: u32) -> Scene {
-    let mut scene = cornell(1, spp, Bounces::Fixed(2), 53);
-    scene.camera.eye = Vec3::new(278.0, 500.0, 278.0);
-    scene.camera.target = Vec3::new(278.0, 555.0, 278.0);
-    scene.camera.up = Vec3::Z;
-    scene.camera.vfov_deg = 10.0;
-    scene
+    cornell_view(1, spp, 53, Vec3::new(278.0, 500.0, 278.0), Vec3::new(278.0, 555.0, 278.0), 10.0)
 }
 
 #[test]
 fn a_constant_pixel_stays_exactly_constant_over_a_million_samples() {
     let spp = 1 << 20;
     let mut tracer = PathTracer::new(common::gpu(), &looking_into_the_light(spp)).expect("builds");
-    tracer.render(spp).expect("renders");
+    tracer.render_to_spp(spp).expect("renders");
     let acc = tracer.accumulator();
     println!(
         "2^20 spp of a constant 30: mean {:?}, variance of the mean {:?}, samples {}",
@@ -695,12 +691,7 @@ fn a_constant_pixel_stays_exactly_constant_over_a_million_samples() {
 
 /// A 2 x 2 image of the floor under the light with 2 bounces: every sample differs.
 fn noisy_pixels(spp: u32) -> Scene {
-    let mut scene = cornell(2, spp, Bounces::Fixed(2), 59);
-    scene.camera.eye = Vec3::new(278.0, 2.0, 278.0);
-    scene.camera.target = Vec3::new(278.0, 1.0, 278.0);
-    scene.camera.up = Vec3::Z;
-    scene.camera.vfov_deg = 1.0;
-    scene
+    cornell_view(2, spp, 59, Vec3::new(278.0, 2.0, 278.0), Vec3::new(278.0, 1.0, 278.0), 1.0)
 }
 
 /// Renders `scene` in passes of `pass_spp` with `chunk` samples per invocation and returns the
@@ -709,7 +700,7 @@ fn pixel_means(scene: &Scene, pass_spp: u32, chunk: u32) -> Vec<[f64; 3]> {
     let mut tracer = PathTracer::new(common::gpu(), scene).expect("builds");
     tracer.set_chunk_samples(chunk);
     while tracer.spp_done() < scene.pathtrace.spp {
-        tracer.render_pass(pass_spp).expect("renders");
+        tracer.add_samples_in_one_pass(pass_spp).expect("renders");
     }
     let acc = tracer.accumulator();
     assert_eq!(acc.min_samples(), scene.pathtrace.spp as u64);
@@ -827,7 +818,7 @@ fn render_capped(scene: &Scene, bytes: Option<u64>) -> (PathTracer, usize) {
     }
     let mut submissions = 0;
     while tracer.spp_done() < scene.pathtrace.spp {
-        tracer.step(Some(scene.pathtrace.spp)).expect("renders");
+        tracer.render_step(Some(scene.pathtrace.spp)).expect("renders");
         submissions += 1;
     }
     (tracer, submissions)

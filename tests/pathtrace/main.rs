@@ -11,8 +11,9 @@
 //! - `extremes`: the path tracer where floats run out;
 //! - `display_sum`: the viewer's GPU-resident running image agrees with the f64 statistics;
 //! - `specialisation`: each scene's pipeline holds what it uses, is cached, refuses others,
-//!   and keeps the caller's submission size across a resize;
-//! - `shaders`: naga validates every WGSL file in shaders/ (the raster's and viewer's too).
+//!   and keeps the caller's submission size across a resize.
+//!
+//! naga validates the shaders without a GPU in each crate's own tests (see tests/shaders.rs).
 
 #[path = "../common/mod.rs"]
 mod common;
@@ -24,6 +25,5 @@ mod extremes;
 mod oracle_agreement;
 mod reference;
 mod sampling;
-mod shaders;
 mod specialisation;
 mod statistics;

@@ -11,9 +11,10 @@ use std::f64::consts::PI;
 
 use glam::DVec3;
 use illum::gpu::readback::read_buffer;
-use illum::gpu::shader::{self, COMMON_MODULES, ShaderFile};
+use illum::gpu::shader::{self, ShaderFile};
 use illum::gpu::wgpu;
-use illum::image::inverse_normal_cdf;
+use illum::pathtrace::SAMPLING_MODULES;
+use illum_oracle::chi_square;
 
 use crate::common;
 
@@ -39,7 +40,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {{
 "
     );
     let entry = ShaderFile::generated("sampling harness".into(), source);
-    let pipeline = shader::compute_pipeline(gpu, COMMON_MODULES, &entry, &[], "sampling harness")
+    let pipeline = shader::compute_pipeline(gpu, SAMPLING_MODULES, &entry, &[], "sampling harness")
         .unwrap_or_else(|e| panic!("the harness compiles: {e}"));
     let size = N as u64 * 16;
     let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
@@ -72,35 +73,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {{
         .collect()
 }
 
-/// Chi-square critical value for `dof` degrees of freedom at upper-tail probability `alpha`.
-fn chi_square_critical(dof: usize, alpha: f64) -> f64 {
-    let k = dof as f64;
-    let z = inverse_normal_cdf(1.0 - alpha);
-    k * (1.0 - 2.0 / (9.0 * k) + z * (2.0 / (9.0 * k)).sqrt()).powi(3)
-}
-
-/// Pearson's test of observed counts against cell probabilities (pooling cells expecting < 5).
+/// Pearson's test of observed counts against cell probabilities (`illum_oracle::chi_square`,
+/// which pools cells expecting < 5) at alpha = [`ALPHA`].
 fn chi_square_test(name: &str, observed: &[u64], probability: &[f64]) {
-    let total: u64 = observed.iter().sum();
-    let p_sum: f64 = probability.iter().sum();
-    assert!((p_sum - 1.0).abs() < 1e-9, "{name}: cell probabilities sum to {p_sum}");
-    let mut cells: Vec<(f64, f64)> = Vec::new();
-    let (mut pool_o, mut pool_e) = (0.0, 0.0);
-    for (&o, &p) in observed.iter().zip(probability) {
-        let e = p * total as f64;
-        if e < 5.0 {
-            pool_o += o as f64;
-            pool_e += e;
-        } else {
-            cells.push((o as f64, e));
-        }
-    }
-    if pool_e > 0.0 {
-        cells.push((pool_o, pool_e));
-    }
-    let statistic: f64 = cells.iter().map(|(o, e)| (o - e) * (o - e) / e).sum();
-    let critical = chi_square_critical(cells.len() - 1, ALPHA);
-    println!("{name}: chi2 = {statistic:.1}, critical {critical:.1} ({} cells)", cells.len());
+    let outcome = chi_square::pearson(observed, probability, ALPHA);
+    let (statistic, critical) = (outcome.statistic, outcome.critical);
+    println!("{name}: chi2 = {statistic:.1}, critical {critical:.1} ({} cells)", outcome.cells);
     assert!(statistic < critical, "{name}: chi-square {statistic:.1} exceeds {critical:.1} at alpha {ALPHA}");
 }
 

@@ -34,7 +34,7 @@ fn each_scene_file_picks_the_specialisation_it_should() {
         let gpu_scene = GpuScene::new(&scene).expect("uploads");
         let key = specialise(&scene, &gpu_scene);
         // Walls, floor, ceiling are axis-aligned boxes, the blocks rotated boxes, the light a quad.
-        assert_eq!(key.kinds.iter().copied().collect::<Vec<_>>(), ["aabb", "box", "quad"], "{file}");
+        assert_eq!(key.kind_names(), ["aabb", "box", "quad"], "{file}");
         assert_eq!(key.lights, 1, "{file}");
         let mut occluders = names_of(&scene, &key.occluders);
         occluders.sort();
@@ -70,7 +70,7 @@ fn a_sphere_and_a_second_light_bring_their_code_and_nothing_else() {
     let scene = cornell_with_sphere_and_two_lights();
     let gpu_scene = GpuScene::new(&scene).expect("uploads");
     let key = specialise(&scene, &gpu_scene);
-    assert!(key.kinds.contains("sphere"));
+    assert!(key.kind_names().contains(&"sphere"));
     assert_eq!(key.lights, 2);
     assert!(key.source.contains("hit_sphere(") && key.source.contains("pick <"));
     let occluders = names_of(&scene, &key.occluders);
@@ -117,7 +117,7 @@ fn a_scene_the_pipeline_was_not_built_for_is_refused() {
         Overrides { width: Some(8), height: Some(8), spp: Some(2), ..Default::default() },
     );
     let mut tracer = PathTracer::new(common::gpu(), &scene).expect("builds");
-    tracer.render(2).expect("renders");
+    tracer.render_to_spp(2).expect("renders");
 
     // A new camera and settings are fine and restart the accumulation.
     let mut moved = scene.clone();
@@ -146,12 +146,12 @@ fn a_resize_keeps_the_submission_size_the_caller_chose() {
     let scene = common::scene("cornell", common::small(40, 30, 4));
     let mut tracer = PathTracer::new(common::gpu(), &scene).expect("builds");
     tracer.set_target_seconds(1e-9);
-    tracer.step(None).expect("renders"); // the probe, which measures a sample's cost
-    assert_eq!(tracer.step(None).expect("renders").samples, 40, "one row per submission");
+    tracer.render_step(None).expect("renders"); // the probe, which measures a sample's cost
+    assert_eq!(tracer.render_step(None).expect("renders").samples, 40, "one row per submission");
     let mut larger = scene.clone();
     larger.camera.width = 52;
     larger.camera.height = 36;
     tracer.update_scene(&larger).expect("same geometry, new size");
-    let report = tracer.step(None).expect("renders");
+    let report = tracer.render_step(None).expect("renders");
     assert_eq!(report.samples, 52, "after the resize: {} samples in one submission", report.samples);
 }

@@ -8,18 +8,7 @@ use illum::scene::{Bounces, Overrides, Sampling};
 use crate::common;
 
 fn cornell(size: u32, spp: u32, bounces: u32, sampling: Sampling, seed: u32) -> illum::scene::Scene {
-    common::scene(
-        "cornell",
-        Overrides {
-            width: Some(size),
-            height: Some(size),
-            spp: Some(spp),
-            bounces: Some(Bounces::Fixed(bounces)),
-            sampling: Some(sampling),
-            sequence: None,
-            seed: Some(seed),
-        },
-    )
+    common::cornell(size, spp, Bounces::Fixed(bounces), sampling, seed)
 }
 
 #[test]
@@ -71,7 +60,7 @@ fn the_low_discrepancy_sequence_is_unbiased_and_less_noisy() {
         let mut t =
             PathTracer::with_options(common::gpu(), &scene, TracerOptions { sequence, ..Default::default() })
                 .expect("builds");
-        t.render(256).expect("renders");
+        t.render_to_spp(256).expect("renders");
         t
     };
     let independent = render(Sequence::Independent);
@@ -111,10 +100,10 @@ fn batching_does_not_change_the_image() {
     // trace the same paths; only the f32 rounding of the per-batch sums differs.
     let scene = cornell(24, 64, 2, Sampling::Cosine, 3);
     let mut one = PathTracer::new(common::gpu(), &scene).expect("builds");
-    one.render_pass(64).expect("renders");
+    one.add_samples_in_one_pass(64).expect("renders");
     let mut four = PathTracer::new(common::gpu(), &scene).expect("builds");
     for _ in 0..4 {
-        four.render_pass(16).expect("renders");
+        four.add_samples_in_one_pass(16).expect("renders");
     }
     let (a, b) = (one.accumulator().mean_image(), four.accumulator().mean_image());
     let mut worst = 0.0f32;
@@ -127,17 +116,17 @@ fn batching_does_not_change_the_image() {
     assert_eq!(one.spp_done(), four.spp_done());
 }
 
+fn with_traversal(scene: &illum::scene::Scene, traversal: Traversal) -> PathTracer {
+    PathTracer::with_options(common::gpu(), scene, TracerOptions { traversal, ..Default::default() })
+        .expect("builds")
+}
+
 #[test]
 fn generic_and_specialised_traversal_give_the_same_image() {
     let scene = cornell(24, 16, 2, Sampling::Cosine, 5);
     let render = |traversal| {
-        let mut tracer = PathTracer::with_options(
-            common::gpu(),
-            &scene,
-            TracerOptions { traversal, ..Default::default() },
-        )
-        .expect("builds");
-        tracer.render(16).expect("renders");
+        let mut tracer = with_traversal(&scene, traversal);
+        tracer.render_to_spp(16).expect("renders");
         tracer.accumulator().mean_image()
     };
     let (generic, specialised) = (render(Traversal::Generic), render(Traversal::Specialised));
@@ -158,13 +147,8 @@ fn the_background_outside_the_box_is_black_and_the_light_is_its_radiance() {
     // so the image's corners look past the walls (x in [-1, 557], y in [0, 556]) into nothing.
     for traversal in [Traversal::Generic, Traversal::Specialised] {
         let scene = cornell(64, 4, 2, Sampling::Cosine, 1);
-        let mut tracer = PathTracer::with_options(
-            common::gpu(),
-            &scene,
-            TracerOptions { traversal, ..Default::default() },
-        )
-        .expect("builds");
-        tracer.render(4).expect("renders");
+        let mut tracer = with_traversal(&scene, traversal);
+        tracer.render_to_spp(4).expect("renders");
         let image = tracer.accumulator().mean_image();
         for (x, y) in [(0, 0), (63, 0), (0, 63), (63, 63)] {
             assert_eq!(

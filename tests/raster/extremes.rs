@@ -1,7 +1,9 @@
-//! Issue 6, section 3: the raster scene at the extremes. Every case checks that the image is
+//! The raster scene at the extremes. Every case checks that the image is
 //! finite and measures a physical property against a value computed here (ray casts in f64, or a
 //! second render that must agree). Each prints what it measured; docs/accuracy.md's table
 //! "Raster extremes" quotes these numbers.
+//!
+//! Long (one test per extreme) but one concept: the rasterizer at the extremes of its inputs.
 
 use glam::{DVec3, Vec3};
 use illum::image::RgbImage32;
@@ -97,6 +99,22 @@ fn trace(s: &RasterScene, origin: Vec3, dir: Vec3, with_glass: bool) -> Hit {
     best.1
 }
 
+/// Pixels whose ray meets nothing, and how many of them do not show the background exactly.
+#[derive(Default)]
+struct SkyCount {
+    sky: u32,
+    wrong: u32,
+}
+
+impl SkyCount {
+    fn add(&mut self, image: &RgbImage32, x: u32, y: u32, background: [i32; 3]) {
+        self.sky += 1;
+        if image.get(x, y).map(level) != background {
+            self.wrong += 1;
+        }
+    }
+}
+
 /// What pixel (x, y) sees, if its centre and four points 0.6 px away see the same kind of
 /// surface (no silhouette or floor edge within the pixel). Floor hits return the centre's point.
 fn interior(s: &RasterScene, cam: &Camera, x: u32, y: u32) -> Option<Hit> {
@@ -150,11 +168,7 @@ fn measure_shadows(s: &RasterScene) -> ShadowMeasure {
     let unshadowed = render(s, &off);
     finite(&unshadowed, "shadows off");
     let cam = camera(s, WIDTH, HEIGHT);
-    let [a, b] = s.floor.colors;
-    assert_eq!(a.x, b.x, "the visibility is read off the red channel, equal on both tiles");
-    let red = a.x;
-    let ambient = s.ambient.x;
-    let direct = s.light.radiance().x * s.light.to_light().y;
+    let (red, ambient, direct) = crate::floor_red_lighting(s, "the visibility");
     let lit_level = level(red * (ambient + direct));
     // The soft edge: the PCF kernel's reach (1.5 pcf_radius, measured across the light, which
     // is what exact_margin measures) plus a shadow-map texel and rounding.
@@ -373,16 +387,11 @@ fn near_plane_cutting_the_glass_sphere() {
     finite(&image, "near plane");
     let cam = camera(&s, WIDTH, HEIGHT);
     let background = s.background.to_array().map(level);
-    let (mut sky, mut sky_wrong, mut cut) = (0, 0, 0);
+    let (mut sky_count, mut cut) = (SkyCount::default(), 0);
     for y in 0..HEIGHT {
         for x in 0..WIDTH {
             match interior(&s, &cam, x, y) {
-                Some(Hit::Sky) => {
-                    sky += 1;
-                    if image.get(x, y).map(level) != background {
-                        sky_wrong += 1;
-                    }
-                }
+                Some(Hit::Sky) => sky_count.add(&image, x, y, background),
                 Some(Hit::Glass) => {
                     let dir = cam.ray_direction(x as f32 + 0.5, y as f32 + 0.5);
                     let t = ray_sphere(cam.eye, dir, s.glass.unwrap().center, s.glass.unwrap().radius)
@@ -395,6 +404,7 @@ fn near_plane_cutting_the_glass_sphere() {
             }
         }
     }
+    let SkyCount { sky, wrong: sky_wrong } = sky_count;
     let (glass, darkest) = check_glass_pixels(&s, &image, Look::Figure, 40, "near plane");
     println!(
         "near plane 0.6, eye 0.5 from the glass: {glass} glass pixels ({cut} of them nearer than the near plane), \
@@ -494,7 +504,7 @@ fn orbiting_down_to_the_horizon() {
         finite(&image, &what);
         let cam = camera(&s, WIDTH, HEIGHT);
         let background = s.background.to_array().map(level);
-        let (mut sky, mut sky_wrong, mut under, mut under_wrong) = (0, 0, 0, 0);
+        let (mut sky_count, mut under, mut under_wrong) = (SkyCount::default(), 0, 0);
         let underside = level(s.floor.colors[0].x * s.ambient.x);
         // The far floor band: pixels whose footprint spans more than two tiles along X, clear of
         // any shadow. The filtered checker must give the even blend of the two tiles there.
@@ -502,12 +512,7 @@ fn orbiting_down_to_the_horizon() {
         for y in 0..HEIGHT {
             for x in 0..WIDTH {
                 match interior(&s, &cam, x, y) {
-                    Some(Hit::Sky) => {
-                        sky += 1;
-                        if image.get(x, y).map(level) != background {
-                            sky_wrong += 1;
-                        }
-                    }
+                    Some(Hit::Sky) => sky_count.add(&image, x, y, background),
                     Some(Hit::Floor(_)) if cam.eye.y < s.floor.height() => {
                         // The floor's underside faces away from the light: ambient only.
                         under += 1;
@@ -531,6 +536,7 @@ fn orbiting_down_to_the_horizon() {
                 }
             }
         }
+        let SkyCount { sky, wrong: sky_wrong } = sky_count;
         let blend = 0.5
             * (s.floor.colors[0].y + s.floor.colors[1].y)
             * (s.ambient.y + s.light.radiance().y * s.light.to_light().y);

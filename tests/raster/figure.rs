@@ -160,11 +160,7 @@ fn shadow_centre(scene: &RasterScene, center: Vec3) -> Vec3 {
 fn check_shadow_placement(s: &RasterScene, label: &str) {
     let image: RgbImage32 = render(s, &figure());
     let cam = camera(s, WIDTH, HEIGHT);
-    let [a, b] = s.floor.colors;
-    assert_eq!(a.x, b.x, "the shadow fraction is read off the red channel, equal on both tiles");
-    let red = a.x;
-    let ambient = s.ambient.x;
-    let direct = s.light.radiance().x * s.light.to_light().y;
+    let (red, ambient, direct) = crate::floor_red_lighting(s, "the shadow fraction");
     let forward = cam.basis().forward;
     for (k, sphere) in spheres(s).into_iter().enumerate() {
         let centre = shadow_centre(s, sphere.0);

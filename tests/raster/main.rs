@@ -109,3 +109,12 @@ pub fn floor_hit(scene: &RasterScene, camera: &Camera, px: f32, py: f32) -> Opti
         scene.spheres().into_iter().any(|(c, r)| ray_sphere(eye, dir, c, r).is_some_and(|ts| ts < t));
     (inside && !hidden).then_some(p)
 }
+
+/// The floor's red channel as shadow tests read it: (red albedo, ambient, direct irradiance
+/// N.L x radiance), after checking both tiles have the same red, so that `what` (a shadow
+/// fraction or visibility) can be read off it on any tile.
+pub fn floor_red_lighting(s: &RasterScene, what: &str) -> (f32, f32, f32) {
+    let [a, b] = s.floor.colors;
+    assert_eq!(a.x, b.x, "{what} is read off the red channel, equal on both tiles");
+    (a.x, s.ambient.x, s.light.radiance().x * s.light.to_light().y)
+}

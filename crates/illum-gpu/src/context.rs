@@ -1,10 +1,12 @@
 //! Adapter and device creation, and the device's error channel.
 
+use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use crate::error::GpuError;
 use crate::policy;
+use crate::shader::ComputePipelineKey;
 
 /// How long any single wait for the GPU may take before it is reported as a hang. Submissions are
 /// kept to a fraction of a second, so this is only reached when something is badly wrong.
@@ -21,9 +23,9 @@ pub struct GpuContext {
     pub adapter_info: wgpu::AdapterInfo,
     /// True when the device was created with `TIMESTAMP_QUERY`, so passes can be timed on the GPU.
     pub timestamps: bool,
-    /// Unique within the process: caches of device objects key on it (wgpu's own device ids
-    /// repeat across instances).
-    id: u64,
+    /// The compute pipelines built on this device (see [`crate::shader::compute_pipeline`]),
+    /// shared by the clones of this context and dropped with the last of them.
+    pub(crate) compute_pipelines: Arc<Mutex<HashMap<ComputePipelineKey, wgpu::ComputePipeline>>>,
     /// Errors raised outside any error scope (validation, out of memory) and device loss, drained
     /// by [`GpuContext::check`] after each submission.
     errors: Arc<Mutex<Vec<GpuError>>>,
@@ -83,14 +85,7 @@ impl GpuContext {
                 }
             });
         }
-        static NEXT_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
-        let id = NEXT_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        Self { device, queue, adapter_info, timestamps, id, errors }
-    }
-
-    /// This context's process-unique id (clones share it).
-    pub fn id(&self) -> u64 {
-        self.id
+        Self { device, queue, adapter_info, timestamps, errors, compute_pipelines: Arc::default() }
     }
 
     /// Returns the first error the device reported since the last call, if any.

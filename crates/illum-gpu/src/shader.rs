@@ -44,15 +44,6 @@ macro_rules! shader_file {
     };
 }
 
-/// Shared modules, in dependency order (a module may import only those before it).
-pub const COMMON_MODULES: &[ShaderFile] = &[
-    crate::shader_file!("shaders/common/constants.wgsl"),
-    crate::shader_file!("shaders/common/rng.wgsl"),
-    crate::shader_file!("shaders/common/sampling.wgsl"),
-    crate::shader_file!("shaders/common/sampler.wgsl"),
-    crate::shader_file!("shaders/common/spawn.wgsl"),
-];
-
 /// A shader def: `#ifdef NAME` / `#if NAME == value` in WGSL.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Def {
@@ -124,9 +115,21 @@ pub fn create_module(
     })
 }
 
+/// What a compute pipeline was built from: every module's and the entry file's text, and the
+/// shader defs. Equal keys give the same pipeline.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub(crate) struct ComputePipelineKey {
+    sources: Vec<String>,
+    defs: Vec<(String, Def)>,
+}
+
 /// Composes `entry` with `modules` under `defs` and builds a compute pipeline of its `main`
 /// entry point, with the bind group layout derived from the shader. Composition, validation and
 /// out-of-memory errors come back as [`GpuError`]s that name `label`.
+///
+/// Pipelines are cached in `gpu` (and shared by its clones) by the text they are built from, so
+/// building the same one again, for example for a scene with the same specialisation, does not
+/// compile it again. The cache dies with the context.
 pub fn compute_pipeline(
     gpu: &GpuContext,
     modules: &[ShaderFile],
@@ -134,8 +137,16 @@ pub fn compute_pipeline(
     defs: &[(&str, Def)],
     label: &str,
 ) -> Result<wgpu::ComputePipeline, GpuError> {
+    let key = ComputePipelineKey {
+        sources: modules.iter().chain([entry]).map(|m| m.source.to_string()).collect(),
+        defs: defs.iter().map(|(name, value)| ((*name).to_owned(), *value)).collect(),
+    };
+    let cache = || gpu.compute_pipelines.lock().unwrap_or_else(|p| p.into_inner());
+    if let Some(pipeline) = cache().get(&key) {
+        return Ok(pipeline.clone());
+    }
     let module = create_module(gpu, compose(modules, entry, defs)?, &entry.path)?;
-    gpu.scoped(&format!("creating the {label} pipeline"), || {
+    let pipeline = gpu.scoped(&format!("creating the {label} pipeline"), || {
         gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some(label),
             layout: None,
@@ -144,5 +155,60 @@ pub fn compute_pipeline(
             compilation_options: Default::default(),
             cache: None,
         })
+    })?;
+    cache().insert(key, pipeline.clone());
+    Ok(pipeline)
+}
+
+/// The `(name, byte offset)` of each listed field of a Rust struct, for
+/// [`WgslStruct::assert_matches`]: `members!(GpuParams: eye, tan_half_fov, ...)`.
+#[macro_export]
+macro_rules! members {
+    ($ty:ty: $($field:ident),* $(,)?) => {
+        [$((stringify!($field), ::std::mem::offset_of!($ty, $field))),*]
+    };
+}
+
+/// A WGSL struct as naga lays it out: its size and each member's byte offset.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct WgslStruct {
+    pub name: String,
+    pub size: u32,
+    pub members: Vec<(String, u32)>,
+}
+
+impl WgslStruct {
+    /// Asserts that a Rust mirror of `size` bytes has exactly these members at these offsets
+    /// (use `size_of` and `offset_of!` on the Rust struct), naming the first difference.
+    ///
+    /// # Panics
+    /// When the size, the member names or any offset differ.
+    pub fn assert_matches(&self, size: usize, members: &[(&str, usize)]) {
+        assert_eq!(size, self.size as usize, "size of the Rust mirror of WGSL struct {}", self.name);
+        let wgsl: Vec<(&str, usize)> = self.members.iter().map(|(n, o)| (n.as_str(), *o as usize)).collect();
+        assert_eq!(
+            members,
+            wgsl.as_slice(),
+            "members (name, offset) of the Rust mirror of WGSL struct {}",
+            self.name
+        );
+    }
+}
+
+/// The layout of struct `name` of module `import_path` (as it declares with
+/// `#define_import_path`) in a composed `module`, or `None` when the module does not contain it.
+pub fn wgsl_struct(module: &naga::Module, import_path: &str, name: &str) -> Option<WgslStruct> {
+    let decorated = Composer::decorated_name(Some(import_path), name);
+    module.types.iter().find_map(|(_, ty)| match &ty.inner {
+        naga::TypeInner::Struct { members, span }
+            if ty.name.as_deref().is_some_and(|n| n == name || n == decorated) =>
+        {
+            Some(WgslStruct {
+                name: name.to_owned(),
+                size: *span,
+                members: members.iter().map(|m| (m.name.clone().unwrap_or_default(), m.offset)).collect(),
+            })
+        }
+        _ => None,
     })
 }

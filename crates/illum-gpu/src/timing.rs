@@ -52,21 +52,29 @@ impl PassTimer {
         }) as u32
     }
 
-    pub fn compute_writes(&self, pass: &str) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+    /// The query set and the (beginning, end) query indices of `pass`, with timestamp queries.
+    fn writes(&self, pass: &str) -> Option<(&wgpu::QuerySet, Option<u32>, Option<u32>)> {
         let i = self.index(pass);
-        self.queries.as_ref().map(|q| wgpu::ComputePassTimestampWrites {
-            query_set: &q.set,
-            beginning_of_pass_write_index: Some(2 * i),
-            end_of_pass_write_index: Some(2 * i + 1),
+        self.queries.as_ref().map(|q| (&q.set, Some(2 * i), Some(2 * i + 1)))
+    }
+
+    pub fn compute_writes(&self, pass: &str) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+        self.writes(pass).map(|(query_set, beginning_of_pass_write_index, end_of_pass_write_index)| {
+            wgpu::ComputePassTimestampWrites {
+                query_set,
+                beginning_of_pass_write_index,
+                end_of_pass_write_index,
+            }
         })
     }
 
     pub fn render_writes(&self, pass: &str) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
-        let i = self.index(pass);
-        self.queries.as_ref().map(|q| wgpu::RenderPassTimestampWrites {
-            query_set: &q.set,
-            beginning_of_pass_write_index: Some(2 * i),
-            end_of_pass_write_index: Some(2 * i + 1),
+        self.writes(pass).map(|(query_set, beginning_of_pass_write_index, end_of_pass_write_index)| {
+            wgpu::RenderPassTimestampWrites {
+                query_set,
+                beginning_of_pass_write_index,
+                end_of_pass_write_index,
+            }
         })
     }
 

@@ -27,7 +27,7 @@ pub use contact_sheet::contact_sheet;
 pub use diff::{DiffImages, save_diff_images};
 pub use exr::{ExrMetadata, load_exr, save_exr};
 pub use metrics::{
-    MetricsError, inverse_normal_cdf, mean_luminance_bias, rel_mse, rmse, z_test_pass_fraction,
+    MetricsError, inverse_normal_cdf, mean_luminance_bias, median, rel_mse, rmse, z_test_pass_fraction,
 };
 pub use png::{save_png, save_rgba8_png};
 pub use rgb_image::{RgbImage32, luminance};

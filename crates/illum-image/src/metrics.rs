@@ -4,6 +4,9 @@
 //! Non-finite pixel values are not filtered: they make RMSE / relMSE / bias NaN or infinite,
 //! which is the honest answer (check [`RgbImage32::has_non_finite`] first if that matters);
 //! in the Z-test a non-finite mean fails its pixel.
+//!
+//! One file for one concept, the measures of an image against a reference, kept whole (over
+//! 400 lines with their tests) so each metric's definition sits beside its checks.
 
 use crate::rgb_image::RgbImage32;
 
@@ -224,6 +227,17 @@ pub fn inverse_normal_cdf(p: f64) -> f64 {
     }
 }
 
+/// The median of `values` (sorted in place): the middle value, or the mean of the two middle
+/// values for an even count; NaN for an empty list. Benchmarks report it.
+pub fn median(values: &mut [f64]) -> f64 {
+    if values.is_empty() {
+        return f64::NAN;
+    }
+    values.sort_by(f64::total_cmp);
+    let mid = values.len() / 2;
+    if values.len() % 2 == 1 { values[mid] } else { 0.5 * (values[mid - 1] + values[mid]) }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -405,5 +419,12 @@ mod tests {
         let (mc, vc) = mc_render(3, 256, 1.3);
         let shifted = z_test_pass_fraction(&ma, &va, &mc, &vc, 0.01).unwrap();
         assert!(shifted < 0.2, "a 30% brighter render passes on {shifted} of the pixels");
+    }
+
+    #[test]
+    fn median_of_odd_and_even_counts() {
+        assert_eq!(median(&mut [3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(&mut [4.0, 1.0, 3.0, 2.0]), 2.5);
+        assert!(median(&mut []).is_nan());
     }
 }

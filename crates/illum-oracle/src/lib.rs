@@ -36,8 +36,14 @@
 //! let image = illum_oracle::render(&scene, 2, 0).unwrap();
 //! assert_eq!(image.mean.len(), 16);
 //! ```
+//!
+//! Beside the oracle, the statistical tools every test uses, as library code: Pearson's
+//! chi-square test ([`chi_square`]) and direct light in closed form ([`closed_form`]: Lambert's
+//! polygon formula and an empty room lit through its ceiling).
 
 mod camera;
+pub mod chi_square;
+pub mod closed_form;
 mod geometry;
 mod integrator;
 mod render;

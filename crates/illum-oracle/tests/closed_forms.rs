@@ -8,24 +8,15 @@
 use std::f64::consts::PI;
 
 use glam::DVec3;
+use illum_oracle::closed_form::lambert_irradiance_factor;
 use illum_oracle::{Oracle, Rng};
 use illum_scene::{Bounces, Sampling, Scene};
 
 /// Irradiance at x (unit normal n) from a planar polygon of uniform radiance `le`, fully
-/// visible from x and facing it (Lambert, 1760): with a_i = unit vector from x to vertex i,
-///     E = le / 2 * | sum_i theta_i (n . g_i) |,
-/// where theta_i = acos(a_i . a_(i+1)) is the angle the edge subtends at x and g_i = the unit
-/// normal of the plane through x and that edge, normalize(a_i x a_(i+1)).
+/// visible from x and facing it: `le` times Lambert's form factor integral
+/// ([`lambert_irradiance_factor`]).
 fn polygon_irradiance(x: DVec3, n: DVec3, vertices: &[DVec3], le: f64) -> f64 {
-    let k = vertices.len();
-    let mut sum = 0.0;
-    for i in 0..k {
-        let a = (vertices[i] - x).normalize();
-        let b = (vertices[(i + 1) % k] - x).normalize();
-        let theta = a.dot(b).clamp(-1.0, 1.0).acos();
-        sum += theta * n.dot(a.cross(b).normalize());
-    }
-    le / 2.0 * sum.abs()
+    le * lambert_irradiance_factor(x, n, vertices)
 }
 
 /// Mean and variance of the mean of `n` independent samples of a vector quantity.
@@ -216,20 +207,7 @@ fn sphere_enclosure_matches_the_closed_form_for_every_bounce_setting() {
 /// itself on a surface behind it lit by a second lamp.
 #[test]
 fn emitters_are_one_sided_for_camera_rays() {
-    let text = r#"
-        [camera]
-        eye = [0.0, 0.0, -5.0]
-        target = [0.0, 0.0, 0.0]
-        up = [0.0, 1.0, 0.0]
-        vfov = 10.0
-        width = 1
-        height = 1
-        [materials.lamp]
-        emission = [3.0, 2.0, 1.0]
-        [[objects]]
-        material = "lamp"
-        quad = { corner = [-1.0, -1.0, 0.0], edge_u = [0.0, 2.0, 0.0], edge_v = [2.0, 0.0, 0.0] }
-    "#;
+    let text = include_str!("scenes/lamp.toml");
     // Front normal (0,2,0) x (2,0,0) = (0, 0, -4): toward -z, i.e. toward the camera. The
     // pixel sees 5 tan(5 deg) = 0.44 units either side of the centre: all lamp.
     let scene = Scene::from_toml_str(text, "lamp.toml").unwrap();

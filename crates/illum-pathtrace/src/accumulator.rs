@@ -5,10 +5,9 @@
 //! f64 keeps 10^6 spp free of drift: f32 only ever sums one short batch.
 
 use illum_image::RgbImage32;
-
-/// Epsilon in the relative error denominators, the same as `illum_image::metrics::rel_mse`,
-/// so that the estimated and the measured relMSE are the same quantity.
-pub const REL_EPSILON: f64 = 1e-2;
+// The epsilon of `illum_image::metrics::rel_mse` itself, so that the estimated and the measured
+// relMSE are the same quantity.
+use illum_image::metrics::REL_MSE_EPSILON;
 
 #[derive(Clone, Debug)]
 pub struct Accumulator {
@@ -182,7 +181,7 @@ impl Accumulator {
             let mean = self.pixel_mean(p);
             let var = self.pixel_variance_of_mean(p);
             for c in 0..3 {
-                total += var[c] / (mean[c] * mean[c] + REL_EPSILON);
+                total += var[c] / (mean[c] * mean[c] + REL_MSE_EPSILON);
                 terms += 1;
             }
         }

@@ -14,9 +14,6 @@
 //! The f64 fold remains the source of truth for saved images, statistics and stop rules; the
 //! display sum is never read back by illum itself.
 
-use std::collections::HashMap;
-use std::sync::{Mutex, OnceLock};
-
 use bytemuck::{Pod, Zeroable};
 use illum_gpu::shader::{self, ShaderFile};
 use illum_gpu::{GpuContext, shader_file, wgpu};
@@ -39,20 +36,10 @@ struct DisplayParams {
     chunks: u32,
 }
 
-/// One compiled display-sum pipeline per GPU context (keyed by illum's context id): every
-/// tracer on a device uses the same one, so a tracer rebuilt for a new size does not recompile.
-fn pipeline_cache() -> &'static Mutex<HashMap<u64, wgpu::ComputePipeline>> {
-    static CACHE: OnceLock<Mutex<HashMap<u64, wgpu::ComputePipeline>>> = OnceLock::new();
-    CACHE.get_or_init(Mutex::default)
-}
-
+/// The display-sum pipeline (cached in the context: every tracer on a device uses the same one,
+/// so a tracer rebuilt for a new size does not recompile).
 fn pipeline(gpu: &GpuContext) -> Result<wgpu::ComputePipeline, PathTraceError> {
-    if let Some(pipeline) = pipeline_cache().lock().unwrap_or_else(|p| p.into_inner()).get(&gpu.id()) {
-        return Ok(pipeline.clone());
-    }
-    let pipeline = shader::compute_pipeline(gpu, &[], &DISPLAY_SUM_SHADER, &[], "display-sum")?;
-    pipeline_cache().lock().unwrap_or_else(|p| p.into_inner()).insert(gpu.id(), pipeline.clone());
-    Ok(pipeline)
+    Ok(shader::compute_pipeline(gpu, &[], &DISPLAY_SUM_SHADER, &[], "display-sum")?)
 }
 
 /// Refuses an image whose display sum would not fit in one storage binding of `limit` bytes
@@ -114,12 +101,11 @@ impl DisplaySum {
                     | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             });
-            let params = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("pathtrace display sum params"),
-                size: std::mem::size_of::<DisplayParams>() as u64,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
+            let params = illum_gpu::buffers::uniform_buffer(
+                device,
+                "pathtrace display sum params",
+                std::mem::size_of::<DisplayParams>() as u64,
+            );
             (buffer, params)
         })?;
         Ok(Self { width, height, buffer, params, pipeline, bound: None })

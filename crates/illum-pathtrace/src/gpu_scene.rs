@@ -1,6 +1,7 @@
 //! The scene as the shader sees it: plain-old-data structs laid out like the WGSL ones.
 
 use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
 use illum_scene::{Bounces, Feature, RendererKind, Sampling, Scene, Shape};
 
 use crate::PathTraceError;
@@ -10,18 +11,143 @@ use crate::PathTraceError;
 pub const FEATURES: &[Feature] =
     &[Feature::BoxShape, Feature::QuadShape, Feature::SphereShape, Feature::Lambertian, Feature::AreaLight];
 
-pub const KIND_BOX: u32 = 0;
-pub const KIND_QUAD: u32 = 1;
-pub const KIND_SPHERE: u32 = 2;
-/// A box without rotation, stored by its world bounds: the shader skips the frame change.
-pub const KIND_AABB: u32 = 3;
 /// `Params::bounces` value meaning "unbounded, with Russian roulette".
 pub const UNBOUNDED: u32 = u32::MAX;
 
-/// Mirrors `struct Object` in pathtrace.wgsl (see there for what a..d hold per kind).
+/// The kinds of shape the shader tests rays against. Declared in the order of their names, so
+/// that a set of kinds lists them as the generated code expects.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum ShapeKind {
+    /// A box without rotation, stored by its world bounds: the shader skips the frame change.
+    Aabb,
+    /// A box rotated about +Y.
+    Box,
+    Quad,
+    Sphere,
+}
+
+impl ShapeKind {
+    /// Its `KIND_*` value in scene.wgsl.
+    pub fn code(self) -> u32 {
+        match self {
+            ShapeKind::Box => 0,
+            ShapeKind::Quad => 1,
+            ShapeKind::Sphere => 2,
+            ShapeKind::Aabb => 3,
+        }
+    }
+
+    /// Its name: "aabb", "box", "quad" or "sphere".
+    pub fn name(self) -> &'static str {
+        match self {
+            ShapeKind::Aabb => "aabb",
+            ShapeKind::Box => "box",
+            ShapeKind::Quad => "quad",
+            ShapeKind::Sphere => "sphere",
+        }
+    }
+
+    /// The name of its `KIND_*` constant in scene.wgsl.
+    pub fn wgsl_constant(self) -> &'static str {
+        match self {
+            ShapeKind::Aabb => "KIND_AABB",
+            ShapeKind::Box => "KIND_BOX",
+            ShapeKind::Quad => "KIND_QUAD",
+            ShapeKind::Sphere => "KIND_SPHERE",
+        }
+    }
+
+    /// The scene.wgsl function that reconstructs its surface at a hit point.
+    pub fn surface_function(self) -> &'static str {
+        match self {
+            ShapeKind::Aabb => "surface_aabb",
+            ShapeKind::Box => "surface_box",
+            ShapeKind::Quad => "surface_quad",
+            ShapeKind::Sphere => "surface_sphere",
+        }
+    }
+}
+
+/// One shape as the shader tests it, in world space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum GpuShape {
+    /// An axis-aligned box `[min, max]`.
+    Aabb {
+        min: Vec3,
+        max: Vec3,
+    },
+    /// A box `[local_min, local_max]` rotated about +Y by the angle of (`cos`, `sin`), then moved
+    /// by `offset`: world = R_y local + offset.
+    Box {
+        local_min: Vec3,
+        local_max: Vec3,
+        cos: f32,
+        sin: f32,
+        offset: Vec3,
+    },
+    /// The parallelogram `corner + s edge_u + t edge_v`, s and t in [0, 1].
+    Quad {
+        corner: Vec3,
+        edge_u: Vec3,
+        edge_v: Vec3,
+    },
+    Sphere {
+        center: Vec3,
+        radius: f32,
+    },
+}
+
+impl GpuShape {
+    pub fn kind(&self) -> ShapeKind {
+        match self {
+            GpuShape::Aabb { .. } => ShapeKind::Aabb,
+            GpuShape::Box { .. } => ShapeKind::Box,
+            GpuShape::Quad { .. } => ShapeKind::Quad,
+            GpuShape::Sphere { .. } => ShapeKind::Sphere,
+        }
+    }
+}
+
+/// One object of the uploaded scene: its shape, its material (an index into
+/// [`GpuScene::materials`]) and whether it emits.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GpuObject {
+    pub shape: GpuShape,
+    pub material: u32,
+    pub emitter: bool,
+}
+
+impl GpuObject {
+    /// The record the shader reads (see [`ObjectRecord`]).
+    pub fn record(&self) -> ObjectRecord {
+        let (a, b, c, d) = match self.shape {
+            GpuShape::Aabb { min, max } => (v4(min, 0.0), v4(max, 0.0), [0.0; 4], [0.0; 4]),
+            GpuShape::Box { local_min, local_max, cos, sin, offset } => {
+                (v4(local_min, cos), v4(local_max, sin), v4(offset, 0.0), [0.0; 4])
+            }
+            GpuShape::Quad { corner, edge_u, edge_v } => {
+                (v4(corner, 0.0), v4(edge_u, 0.0), v4(edge_v, 0.0), v4(edge_u.cross(edge_v), 0.0))
+            }
+            GpuShape::Sphere { center, radius } => (v4(center, radius), [0.0; 4], [0.0; 4], [0.0; 4]),
+        };
+        ObjectRecord {
+            kind: self.shape.kind().code(),
+            material: self.material,
+            emitter: self.emitter as u32,
+            padding: 0,
+            a,
+            b,
+            c,
+            d,
+        }
+    }
+}
+
+/// Mirrors `struct Object` in scene.wgsl: the storage form of a [`GpuObject`], whose four
+/// vectors `a..d` hold each kind's own numbers (see there); only [`GpuObject::record`] fills it.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
-pub struct GpuObject {
+pub struct ObjectRecord {
     pub kind: u32,
     pub material: u32,
     pub emitter: u32,
@@ -51,7 +177,7 @@ pub struct GpuLight {
     pub emission: [f32; 4],
 }
 
-/// Mirrors `struct Params` in pathtrace.wgsl.
+/// Mirrors `struct Params` in scene.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
 pub struct GpuParams {
@@ -93,7 +219,7 @@ pub struct GpuScene {
     pub first_emitter: u32,
 }
 
-fn v4(v: glam::Vec3, w: f32) -> [f32; 4] {
+fn v4(v: Vec3, w: f32) -> [f32; 4] {
     [v.x, v.y, v.z, w]
 }
 
@@ -105,7 +231,7 @@ impl GpuScene {
             .materials
             .iter()
             .map(|m| GpuMaterial {
-                albedo: v4(m.diffuse_albedo().unwrap_or(glam::Vec3::ZERO), 0.0),
+                albedo: v4(m.diffuse_albedo().unwrap_or(Vec3::ZERO), 0.0),
                 emission: v4(m.emission(), 0.0),
             })
             .collect();
@@ -116,34 +242,15 @@ impl GpuScene {
         for object in &scene.objects {
             let material = &scene.materials[object.material];
             let emitter = material.is_emitter();
-            let gpu = match object.shape {
+            let shape = match object.shape {
                 Shape::Box(b) if b.rotate_y_deg == 0.0 => {
-                    let offset = b.translate;
-                    GpuObject {
-                        kind: KIND_AABB,
-                        material: object.material as u32,
-                        emitter: emitter as u32,
-                        padding: 0,
-                        a: v4(b.min + offset, 0.0),
-                        b: v4(b.max + offset, 0.0),
-                        c: [0.0; 4],
-                        d: [0.0; 4],
-                    }
+                    GpuShape::Aabb { min: b.min + b.translate, max: b.max + b.translate }
                 }
                 Shape::Box(b) => {
                     let (rotation, offset) = b.local_to_world();
                     // rotation is R_y(angle): its first column is (cos, 0, -sin).
                     let (cos, sin) = (rotation.x_axis.x, -rotation.x_axis.z);
-                    GpuObject {
-                        kind: KIND_BOX,
-                        material: object.material as u32,
-                        emitter: emitter as u32,
-                        padding: 0,
-                        a: v4(b.min, cos),
-                        b: v4(b.max, sin),
-                        c: v4(offset, 0.0),
-                        d: [0.0; 4],
-                    }
+                    GpuShape::Box { local_min: b.min, local_max: b.max, cos, sin, offset }
                 }
                 Shape::Quad(q) => {
                     if emitter {
@@ -157,28 +264,11 @@ impl GpuScene {
                             emission: v4(material.emission(), 0.0),
                         });
                     }
-                    GpuObject {
-                        kind: KIND_QUAD,
-                        material: object.material as u32,
-                        emitter: emitter as u32,
-                        padding: 0,
-                        a: v4(q.corner, 0.0),
-                        b: v4(q.edge_u, 0.0),
-                        c: v4(q.edge_v, 0.0),
-                        d: v4(q.edge_u.cross(q.edge_v), 0.0),
-                    }
+                    GpuShape::Quad { corner: q.corner, edge_u: q.edge_u, edge_v: q.edge_v }
                 }
-                Shape::Sphere(s) => GpuObject {
-                    kind: KIND_SPHERE,
-                    material: object.material as u32,
-                    emitter: emitter as u32,
-                    padding: 0,
-                    a: v4(s.center, s.radius),
-                    b: [0.0; 4],
-                    c: [0.0; 4],
-                    d: [0.0; 4],
-                },
+                Shape::Sphere(s) => GpuShape::Sphere { center: s.center, radius: s.radius },
             };
+            let gpu = GpuObject { shape, material: object.material as u32, emitter };
             if emitter {
                 if !matches!(object.shape, Shape::Quad(_)) {
                     return Err(PathTraceError::Unsupported {
@@ -205,6 +295,13 @@ impl GpuScene {
         let first_emitter = objects.len() as u32;
         objects.extend(emitters);
         Ok(Self { objects, materials, lights, light_area, first_emitter })
+    }
+}
+
+impl GpuScene {
+    /// The objects as the shader's storage buffer holds them.
+    pub fn object_records(&self) -> Vec<ObjectRecord> {
+        self.objects.iter().map(GpuObject::record).collect()
     }
 }
 
@@ -237,6 +334,6 @@ pub fn params(scene: &Scene, gpu_scene: &GpuScene) -> GpuParams {
         },
         num_lights: gpu_scene.lights.len() as u32,
         first_emitter: gpu_scene.first_emitter,
-        chunk_samples: crate::tracer::CHUNK_SAMPLES,
+        chunk_samples: crate::batch::CHUNK_SAMPLES,
     }
 }

@@ -2,32 +2,38 @@
 //!
 //! A WGSL compute shader (`shaders/pathtrace/pathtrace.wgsl`) traces paths over the scene's
 //! analytic boxes, quads and spheres with next-event estimation on rectangular lights. The host
-//! side here uploads the scene ([`gpu_scene`]), plans short GPU submissions ([`planner`]),
-//! and folds each batch's f32 sums into f64 per-pixel statistics ([`accumulator`]). For viewers,
+//! side here uploads the scene ([`gpu_scene`]), composes the pipeline ([`shaders`], with a
+//! traversal generated per scene by [`specialise`]), checks the device's limits ([`limits`]),
+//! plans short GPU submissions ([`planner`]), and folds each batch's f32 sums into f64
+//! per-pixel statistics ([`accumulator`]). For viewers,
 //! an opt-in running image stays on the GPU ([`display_sum`]) so that showing it needs no copy
 //! through the CPU.
 
 pub mod accumulator;
+mod batch;
 pub mod display_sum;
 mod error;
 pub mod gpu_scene;
+pub mod limits;
 pub mod metadata;
+mod options;
 pub mod planner;
 pub mod progressive;
+pub mod shaders;
 pub mod spawn;
 pub mod specialise;
 mod tracer;
 
 pub use accumulator::Accumulator;
+pub use batch::{CHUNK_SAMPLES, SLOT_BYTES};
 pub use display_sum::{DISPLAY_PIXEL_BYTES, DISPLAY_SUM_SHADER};
 pub use error::PathTraceError;
 pub use gpu_scene::FEATURES;
 pub use illum_scene::Sequence;
+pub use options::{TracerOptions, Traversal};
 pub use progressive::{
     Progress, Progressive, RenderClock, Rule, Status, StopReason, StopRules, parse_target_error,
     parse_time_budget, render_progressive,
 };
-pub use tracer::{
-    CHUNK_SAMPLES, GENERIC_TRAVERSAL, PATHTRACE_SHADER, PathTracer, SCENE_MODULE, SLOT_BYTES, StepReport,
-    TracerOptions, Traversal, shader_modules,
-};
+pub use shaders::{GENERIC_TRAVERSAL, PATHTRACE_SHADER, SAMPLING_MODULES, SCENE_MODULE, shader_modules};
+pub use tracer::{PathTracer, StepReport};

@@ -9,6 +9,9 @@
 //!
 //! Every rule but cancellation waits for a **complete pass**: a pass covers the whole image, so
 //! a render that stops by spp, error or time always has at least one sample in every pixel.
+//!
+//! Over 400 lines with its tests, and one concept: the stop rules and the loop that applies them
+//! read better whole, since each rule's meaning is defined by how the loop checks it.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
@@ -320,7 +323,7 @@ impl Progressive {
         self.refresh_error(tracer);
         self.stopped = self.rules.check(&self.status(tracer));
         if self.stopped.is_none() {
-            let report = tracer.step(self.rules.spp)?;
+            let report = tracer.render_step(self.rules.spp)?;
             if report.pass_completed {
                 // Tools and tests watch for this line (RUST_LOG=illum_pathtrace=debug).
                 log::debug!("pass complete: {} spp", tracer.spp_done());

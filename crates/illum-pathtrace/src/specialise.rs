@@ -15,13 +15,15 @@ use std::collections::BTreeSet;
 use illum_gpu::shader::ShaderFile;
 use illum_scene::Scene;
 
-use crate::gpu_scene::{GpuObject, GpuScene, KIND_AABB, KIND_BOX, KIND_QUAD, KIND_SPHERE};
+use glam::Vec3;
+
+use crate::gpu_scene::{GpuObject, GpuScene, GpuShape, ShapeKind};
 
 /// What a specialised pipeline was built for. Two scenes with equal keys share a pipeline.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct Specialisation {
-    /// Kinds of shape with code in the pipeline ("aabb", "box", "quad", "sphere").
-    pub kinds: BTreeSet<&'static str>,
+    /// Kinds of shape with code in the pipeline.
+    pub kinds: BTreeSet<ShapeKind>,
     /// Number of lights (1 means no light-selection code).
     pub lights: usize,
     /// Indices (into the uploaded objects) of the objects shadow rays test.
@@ -30,13 +32,10 @@ pub struct Specialisation {
     pub source: String,
 }
 
-fn kind_name(kind: u32) -> &'static str {
-    match kind {
-        KIND_AABB => "aabb",
-        KIND_BOX => "box",
-        KIND_QUAD => "quad",
-        KIND_SPHERE => "sphere",
-        other => unreachable!("gpu_scene produced an unknown object kind {other}"),
+impl Specialisation {
+    /// The names of [`Self::kinds`] ("aabb", "box", "quad", "sphere"), in order.
+    pub fn kind_names(&self) -> Vec<&'static str> {
+        self.kinds.iter().map(|k| k.name()).collect()
     }
 }
 
@@ -46,32 +45,30 @@ fn lit(x: f32) -> String {
     format!("{x:?}")
 }
 
-fn vec3(v: [f32; 4]) -> String {
-    format!("vec3<f32>({}, {}, {})", lit(v[0]), lit(v[1]), lit(v[2]))
+fn vec3(v: Vec3) -> String {
+    format!("vec3<f32>({}, {}, {})", lit(v.x), lit(v.y), lit(v.z))
 }
 
 /// The WGSL expression for the object's hit distance along (o, d); `inv_d` = 1 / d.
 fn hit_expression(object: &GpuObject) -> String {
-    match object.kind {
-        KIND_AABB => format!("hit_slabs(o, inv_d, {}, {})", vec3(object.a), vec3(object.b)),
-        KIND_BOX => format!(
+    match object.shape {
+        GpuShape::Aabb { min, max } => format!("hit_slabs(o, inv_d, {}, {})", vec3(min), vec3(max)),
+        GpuShape::Box { local_min, local_max, cos, sin, offset } => format!(
             "hit_box(o, d, {}, {}, {}, {}, {})",
-            vec3(object.a),
-            vec3(object.b),
-            lit(object.a[3]),
-            lit(object.b[3]),
-            vec3(object.c)
+            vec3(local_min),
+            vec3(local_max),
+            lit(cos),
+            lit(sin),
+            vec3(offset)
         ),
-        KIND_QUAD => {
-            format!(
-                "hit_quad(o, d, {}, {}, {}, {})",
-                vec3(object.a),
-                vec3(object.b),
-                vec3(object.c),
-                vec3(object.d)
-            )
-        }
-        _ => format!("hit_sphere(o, d, {}, {})", vec3(object.a), lit(object.a[3])),
+        GpuShape::Quad { corner, edge_u, edge_v } => format!(
+            "hit_quad(o, d, {}, {}, {}, {})",
+            vec3(corner),
+            vec3(edge_u),
+            vec3(edge_v),
+            vec3(edge_u.cross(edge_v))
+        ),
+        GpuShape::Sphere { center, radius } => format!("hit_sphere(o, d, {}, {})", vec3(center), lit(radius)),
     }
 }
 
@@ -84,36 +81,31 @@ struct Bounds {
 
 impl Bounds {
     fn of(object: &GpuObject) -> Self {
-        let points: Vec<[f32; 3]> = match object.kind {
-            KIND_AABB => vec![xyz(object.a), xyz(object.b)],
-            KIND_BOX => {
+        let points: Vec<[f32; 3]> = match object.shape {
+            GpuShape::Aabb { min, max } => vec![min.to_array(), max.to_array()],
+            GpuShape::Box { local_min, local_max, cos: c, sin: s, offset } => {
                 // The eight corners of the rotated box.
-                let (c, s) = (object.a[3], object.b[3]);
                 let mut corners = Vec::new();
                 for i in 0..8 {
                     let l = [
-                        if i & 1 == 0 { object.a[0] } else { object.b[0] },
-                        if i & 2 == 0 { object.a[1] } else { object.b[1] },
-                        if i & 4 == 0 { object.a[2] } else { object.b[2] },
+                        if i & 1 == 0 { local_min.x } else { local_max.x },
+                        if i & 2 == 0 { local_min.y } else { local_max.y },
+                        if i & 4 == 0 { local_min.z } else { local_max.z },
                     ];
                     corners.push([
-                        c * l[0] + s * l[2] + object.c[0],
-                        l[1] + object.c[1],
-                        -s * l[0] + c * l[2] + object.c[2],
+                        c * l[0] + s * l[2] + offset.x,
+                        l[1] + offset.y,
+                        -s * l[0] + c * l[2] + offset.z,
                     ]);
                 }
                 corners
             }
-            KIND_QUAD => {
-                let (p, u, v) = (xyz(object.a), xyz(object.b), xyz(object.c));
+            GpuShape::Quad { corner, edge_u, edge_v } => {
+                let (p, u, v) = (corner.to_array(), edge_u.to_array(), edge_v.to_array());
                 vec![p, add(p, u), add(p, v), add(add(p, u), v)]
             }
-            _ => {
-                let r = object.a[3];
-                vec![
-                    [object.a[0] - r, object.a[1] - r, object.a[2] - r],
-                    [object.a[0] + r, object.a[1] + r, object.a[2] + r],
-                ]
+            GpuShape::Sphere { center, radius: r } => {
+                vec![[center.x - r, center.y - r, center.z - r], [center.x + r, center.y + r, center.z + r]]
             }
         };
         let mut bounds = Bounds { lo: [f32::MAX; 3], hi: [f32::MIN; 3] };
@@ -166,7 +158,7 @@ fn light_corners(scene: &GpuScene) -> Vec<[f32; 3]> {
 /// estimation only traces rays leaving a surface on its outer side.
 pub fn can_block_light(scene: &GpuScene, index: usize) -> bool {
     let object = &scene.objects[index];
-    if object.kind != KIND_AABB || object.emitter != 0 {
+    if object.shape.kind() != ShapeKind::Aabb || object.emitter {
         return true;
     }
     let o = Bounds::of(object);
@@ -181,7 +173,7 @@ pub fn can_block_light(scene: &GpuScene, index: usize) -> bool {
                 continue;
             }
             let others_clear = scene.objects.iter().enumerate().all(|(j, b)| {
-                if j == index || b.emitter != 0 {
+                if j == index || b.emitter {
                     return true; // paths end at emitters: no shading points there
                 }
                 let bounds = Bounds::of(b);
@@ -196,7 +188,7 @@ pub fn can_block_light(scene: &GpuScene, index: usize) -> bool {
                 if !reaches_past || o.contains(&clipped) {
                     return true;
                 }
-                if b.kind != KIND_AABB {
+                if b.shape.kind() != ShapeKind::Aabb {
                     return false;
                 }
                 // An axis-aligned B: each of its faces that some light point is in front of
@@ -239,7 +231,7 @@ pub fn specialise(scene: &Scene, gpu_scene: &GpuScene) -> Specialisation {
             }
         }
     }
-    let kinds: BTreeSet<&'static str> = gpu_scene.objects.iter().map(|o| kind_name(o.kind)).collect();
+    let kinds: BTreeSet<ShapeKind> = gpu_scene.objects.iter().map(|o| o.shape.kind()).collect();
     let mut closest = String::new();
     let mut occluded = String::new();
     let mut occluders = Vec::new();
@@ -247,7 +239,7 @@ pub fn specialise(scene: &Scene, gpu_scene: &GpuScene) -> Specialisation {
         let name = names.get(i).copied().unwrap_or("?").replace(['\n', '\r'], " ");
         let hit = hit_expression(object);
         closest.push_str(&format!("    // {i}: {name}\n    t = {hit};\n"));
-        if object.emitter != 0 {
+        if object.emitter {
             // The emitter wins a tie with the surface it is set into (see scene.wgsl); the cap at
             // FAR keeps a missed emitter (which reports FAR) from counting as a hit.
             closest.push_str(&format!(
@@ -271,22 +263,11 @@ pub fn specialise(scene: &Scene, gpu_scene: &GpuScene) -> Specialisation {
     let mut normal_cases = String::new();
     let last_kind = kinds.iter().next_back().copied();
     for kind in &kinds {
-        let call = match *kind {
-            "aabb" => "surface_aabb(obj, p)",
-            "box" => "surface_box(obj, p)",
-            "quad" => "surface_quad(obj, p)",
-            _ => "surface_sphere(obj, p)",
-        };
-        let constant = match *kind {
-            "aabb" => "KIND_AABB",
-            "box" => "KIND_BOX",
-            "quad" => "KIND_QUAD",
-            _ => "KIND_SPHERE",
-        };
+        let call = format!("{}(obj, p)", kind.surface_function());
         if Some(*kind) == last_kind {
             normal_cases.push_str(&format!("        default: {{ return {call}; }}\n"));
         } else {
-            normal_cases.push_str(&format!("        case {constant}: {{ return {call}; }}\n"));
+            normal_cases.push_str(&format!("        case {}: {{ return {call}; }}\n", kind.wgsl_constant()));
         }
     }
     let choose_light = if gpu_scene.lights.len() == 1 {
@@ -334,7 +315,7 @@ fn choose_light(pick: f32) -> u32 {{
 ",
         scene_name = scene.name,
         count = gpu_scene.objects.len(),
-        kind_list = kinds.iter().copied().collect::<Vec<_>>().join(", "),
+        kind_list = kinds.iter().map(|k| k.name()).collect::<Vec<_>>().join(", "),
     );
     Specialisation { kinds, lights: gpu_scene.lights.len(), occluders, source }
 }

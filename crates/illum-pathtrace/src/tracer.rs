@@ -1,87 +1,24 @@
-//! The path tracer's GPU side: pipeline, buffers, and the submit-readback-fold loop.
+//! The path tracer: a scene's buffers on the GPU, and the submit-readback-fold loop that renders
+//! it progressively, band by band, into the f64 accumulator.
+//!
+//! The pipeline comes from `shaders.rs`, the batch buffers and their decoding from `batch.rs`,
+//! the size of each submission from `planner.rs`; one submission (a band traced, read back and
+//! folded) is `tracer/submit.rs`.
 
-use std::collections::HashMap;
-use std::sync::{Mutex, OnceLock};
-use std::time::Instant;
-
-use illum_gpu::shader::{self, COMMON_MODULES, Def, ShaderFile};
-use illum_gpu::shader_file;
 use illum_gpu::timing::PassTimer;
-use illum_gpu::{GpuContext, readback, wgpu};
-use illum_scene::{DeviceLimits, Scene, Sequence};
+use illum_gpu::{GpuContext, wgpu};
+use illum_scene::Scene;
 use wgpu::util::DeviceExt;
 
+use crate::batch::{self, BatchBuffers, CHUNK_SAMPLES, SLOT_BYTES};
 use crate::display_sum::DisplaySum;
 use crate::gpu_scene::{self, GpuParams, GpuScene};
+use crate::options::{TracerOptions, Traversal};
 use crate::planner::{BatchPlanner, DEFAULT_TARGET_SECONDS, PassPlan};
-use crate::{Accumulator, PathTraceError, specialise};
+use crate::{Accumulator, PathTraceError, limits, shaders, specialise};
 
-/// The integrator (entry point `main`).
-pub const PATHTRACE_SHADER: ShaderFile = shader_file!("shaders/pathtrace/pathtrace.wgsl");
-/// Scene layout, bindings and ray-shape tests.
-pub const SCENE_MODULE: ShaderFile = shader_file!("shaders/pathtrace/scene.wgsl");
-/// The generic traversal (a loop over the object buffer).
-pub const GENERIC_TRAVERSAL: ShaderFile = shader_file!("shaders/pathtrace/traversal.wgsl");
+mod submit;
 
-/// How rays find what they hit.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum Traversal {
-    /// Traversal code generated from the scene: every object's test unrolled with its numbers as
-    /// constants (see `specialise.rs`). The default.
-    #[default]
-    Specialised,
-    /// One loop over the object buffer, the same pipeline for every scene.
-    Generic,
-}
-
-/// Pipeline choices that do not change the expected image, only speed or noise.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub struct TracerOptions {
-    pub traversal: Traversal,
-    pub sequence: Sequence,
-}
-
-impl TracerOptions {
-    /// naga_oil shader defs for these options.
-    pub fn shader_defs(&self) -> Vec<(&'static str, Def)> {
-        match self.sequence {
-            Sequence::Independent => Vec::new(),
-            Sequence::LowDiscrepancy => vec![("LOW_DISCREPANCY", Def::Bool(true))],
-        }
-    }
-}
-
-/// Compiled pipelines by (GPU context id, traversal source, shader defs): two scenes with the
-/// same specialisation share one pipeline, so switching back to a scene does not recompile.
-/// (Keyed by illum's context id, not `wgpu::Device`, whose ids repeat across wgpu instances.)
-type PipelineKey = (u64, String, Vec<(&'static str, Def)>);
-
-fn pipeline_cache() -> &'static Mutex<HashMap<PipelineKey, wgpu::ComputePipeline>> {
-    static CACHE: OnceLock<Mutex<HashMap<PipelineKey, wgpu::ComputePipeline>>> = OnceLock::new();
-    CACHE.get_or_init(Mutex::default)
-}
-
-/// The shader modules, in import order, for `scene` with `traversal`.
-pub fn shader_modules(scene: &Scene, gpu_scene: &GpuScene, traversal: Traversal) -> Vec<ShaderFile> {
-    let mut modules = COMMON_MODULES.to_vec();
-    modules.push(SCENE_MODULE);
-    modules.push(match traversal {
-        Traversal::Generic => GENERIC_TRAVERSAL,
-        Traversal::Specialised => specialise::traversal_module(scene, gpu_scene),
-    });
-    modules
-}
-
-/// Bytes of one slot of a batch buffer: a vec4 of f32 (the sum buffer and the sum-of-squares
-/// buffer each hold one per slot).
-pub const SLOT_BYTES: u64 = 16;
-/// Default samples per invocation (one chunk, one slot). An f32 sum of n positive terms is within
-/// (n - 1) u of the exact sum, relatively (u = 2^-24): with 16, 15 u < 1e-6, so every batch the
-/// CPU folds in f64 is within 1e-6 of the f64 fold of the very same samples. It also bounds one
-/// invocation's work: lavapipe silently ends an invocation's loops after 65535 iterations (in
-/// total), which a single invocation looping over thousands of samples used to hit, losing them.
-pub const CHUNK_SAMPLES: u32 = 16;
-const WORKGROUP: u32 = 8;
 const TIMED_PASS: &str = "pathtrace";
 
 /// What one submission did.
@@ -95,13 +32,6 @@ pub struct StepReport {
     pub gpu_seconds: Option<f64>,
     /// True when this submission finished a pass over the whole image.
     pub pass_completed: bool,
-}
-
-struct BatchBuffers {
-    slots: u64,
-    sum: wgpu::Buffer,
-    sum_sq: wgpu::Buffer,
-    bind_group: wgpu::BindGroup,
 }
 
 struct ActivePass {
@@ -164,17 +94,9 @@ impl PathTracer {
         // fit one storage binding, see `fit`), so the storage limit applies to a band, not to the
         // whole image: only the texture-size limit is checked against the full resolution here,
         // and one row of one chunk must fit (below).
-        scene.check_device_limits(
-            &DeviceLimits {
-                max_texture_dimension_2d: limits.max_texture_dimension_2d,
-                max_storage_buffer_binding_size: limits
-                    .max_storage_buffer_binding_size
-                    .min(limits.max_buffer_size),
-            },
-            0,
-        )?;
-        let max_slots = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size) / SLOT_BYTES;
-        check_row_fits(scene, max_slots)?;
+        limits::check_texture_size(scene, &limits)?;
+        let max_slots = batch::device_max_slots(&limits);
+        batch::check_row_fits(scene, max_slots)?;
         crate::accumulator::check_host_memory(
             scene.camera.width,
             scene.camera.height,
@@ -195,24 +117,7 @@ impl PathTracer {
         })?;
         let gpu_scene = GpuScene::new(scene)?;
         let base_params = gpu_scene::params(scene, &gpu_scene);
-
-        let modules = shader_modules(scene, &gpu_scene, options.traversal);
-        let defs = options.shader_defs();
-        let key: PipelineKey =
-            (gpu.id(), modules.last().expect("traversal").source.to_string(), defs.clone());
-        let cached = pipeline_cache().lock().unwrap_or_else(|p| p.into_inner()).get(&key).cloned();
-        let pipeline = match cached {
-            Some(pipeline) => pipeline,
-            None => {
-                let pipeline =
-                    shader::compute_pipeline(gpu, &modules, &PATHTRACE_SHADER, &defs, "path-tracing")?;
-                pipeline_cache()
-                    .lock()
-                    .unwrap_or_else(|p| p.into_inner())
-                    .insert(key.clone(), pipeline.clone());
-                pipeline
-            }
-        };
+        let (pipeline, traversal_source) = shaders::pathtrace_pipeline(gpu, scene, &gpu_scene, options)?;
 
         let device = &gpu.device;
         let storage = |label: &str, contents: &[u8]| {
@@ -231,7 +136,7 @@ impl PathTracer {
                 });
                 (
                     params_buffer,
-                    storage("pathtrace objects", bytemuck::cast_slice(&gpu_scene.objects)),
+                    storage("pathtrace objects", bytemuck::cast_slice(&gpu_scene.object_records())),
                     storage("pathtrace materials", bytemuck::cast_slice(&gpu_scene.materials)),
                     storage("pathtrace lights", bytemuck::cast_slice(&gpu_scene.lights)),
                 )
@@ -241,7 +146,7 @@ impl PathTracer {
             gpu: gpu.clone(),
             scene: scene.clone(),
             options,
-            traversal_source: key.1,
+            traversal_source,
             base_params,
             pipeline,
             params_buffer,
@@ -268,8 +173,8 @@ impl PathTracer {
         &self.scene
     }
 
-    /// Whether `self` and `other` run the very same compiled pipeline: the cache found an equal
-    /// specialisation instead of compiling again.
+    /// Whether `self` and `other` run the very same compiled pipeline: the context's cache found
+    /// an equal specialisation instead of compiling again.
     pub fn shares_pipeline_with(&self, other: &PathTracer) -> bool {
         self.pipeline == other.pipeline
     }
@@ -350,7 +255,9 @@ impl PathTracer {
             {
                 format!(
                     "its geometry needs a pipeline specialised for shapes {:?}, {} light(s) and shadow-ray occluders {:?}",
-                    needed.kinds, needed.lights, needed.occluders
+                    needed.kind_names(),
+                    needed.lights,
+                    needed.occluders
                 )
             } else {
                 "its objects or materials differ from the uploaded ones".to_owned()
@@ -397,9 +304,8 @@ impl PathTracer {
     /// in bands of rows that fit; tests use it to force that tiling on small images.
     pub fn limit_batch_bytes(&mut self, bytes: u64) -> Result<(), PathTraceError> {
         let limits = self.gpu.device.limits();
-        let device_slots = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size) / SLOT_BYTES;
-        let slots = (bytes / SLOT_BYTES).min(device_slots);
-        check_row_fits(&self.scene, slots)?;
+        let slots = (bytes / SLOT_BYTES).min(batch::device_max_slots(&limits));
+        batch::check_row_fits(&self.scene, slots)?;
         self.max_slots = slots;
         Ok(())
     }
@@ -416,9 +322,11 @@ impl PathTracer {
         self.gpu_seconds = 0.0;
     }
 
-    /// Runs one short submission toward `target_spp` samples per pixel (`None`: no limit).
-    /// Returns a report with `samples == 0` once the target is reached.
-    pub fn step(&mut self, target_spp: Option<u32>) -> Result<StepReport, PathTraceError> {
+    /// Runs one short submission (one band of rows of the current pass; about 0.15 s, see
+    /// [`Self::set_target_seconds`]) toward `target_spp` samples per pixel (`None`: no limit).
+    /// Returns a report with `samples == 0` once the target is reached. Progressive renderers
+    /// call it in a loop, between frames or checks of their stop rules.
+    pub fn render_step(&mut self, target_spp: Option<u32>) -> Result<StepReport, PathTraceError> {
         let camera = self.scene.camera;
         if self.pass.is_none() {
             let remaining = match target_spp {
@@ -434,12 +342,23 @@ impl PathTracer {
         Ok(report)
     }
 
-    /// Renders exactly `spp` more samples per pixel, as one pass when the device allows (split
-    /// into bands only if the image is too large for one short submission or one storage binding,
-    /// and into several passes only if one dispatch cannot carry `spp` chunks). Tests use it to
+    /// Renders until every pixel has `spp` samples in all (those already taken count), in
+    /// submissions sized by the measured speed.
+    pub fn render_to_spp(&mut self, spp: u32) -> Result<(), PathTraceError> {
+        while self.spp_done < spp {
+            self.render_step(Some(spp))?;
+        }
+        Ok(())
+    }
+
+    /// Adds exactly `spp` samples per pixel in one pass over the image when the device allows
+    /// (split into bands only if the image is too large for one short submission or one storage
+    /// binding, and into several passes only if one dispatch cannot carry `spp` chunks). Unlike
+    /// [`Self::render_to_spp`], the grouping of samples into f32 chunk sums then depends on the
+    /// call alone, never on measured speed: tests use it to compare renders bit for bit and to
     /// control batching.
-    pub fn render_pass(&mut self, spp: u32) -> Result<(), PathTraceError> {
-        assert!(self.pass.is_none(), "render_pass called in the middle of a pass");
+    pub fn add_samples_in_one_pass(&mut self, spp: u32) -> Result<(), PathTraceError> {
+        assert!(self.pass.is_none(), "add_samples_in_one_pass called in the middle of a pass");
         let camera = self.scene.camera;
         let mut remaining = spp;
         while remaining > 0 {
@@ -454,231 +373,5 @@ impl PathTracer {
             remaining -= plan.spp;
         }
         Ok(())
-    }
-
-    /// Shrinks a pass plan to what the device can take: at most `max_chunks` chunks per dispatch
-    /// (the z dimension), and a band of at most `max_slots` slots (rows x width x chunks) per
-    /// batch buffer, so an image of any size is rendered band by band.
-    fn fit(&self, plan: PassPlan) -> PassPlan {
-        let width = u64::from(self.scene.camera.width);
-        let chunk = u64::from(self.chunk_samples);
-        // check_row_fits guarantees max_slots >= width, so at least one chunk fits.
-        let max_chunks = u64::from(self.max_chunks).min(self.max_slots / width).max(1);
-        let spp = u64::from(plan.spp.max(1)).min(max_chunks * chunk);
-        let chunks = spp.div_ceil(chunk);
-        let max_rows = (self.max_slots / (width * chunks)).max(1);
-        let rows = u64::from(plan.rows).clamp(1, max_rows);
-        PassPlan { spp: spp as u32, rows: rows as u32 }
-    }
-
-    /// Steps until every pixel has `spp` samples.
-    pub fn render(&mut self, spp: u32) -> Result<(), PathTraceError> {
-        while self.spp_done < spp {
-            self.step(Some(spp))?;
-        }
-        Ok(())
-    }
-
-    /// Makes sure the batch buffers hold at least `slots` slots (growing them, within
-    /// `max_slots`, and rebinding).
-    fn ensure_batch_capacity(&mut self, slots: u64) -> Result<(), PathTraceError> {
-        if self.batch.as_ref().is_some_and(|b| b.slots >= slots) {
-            return Ok(());
-        }
-        // Grow geometrically (within max_slots) so that passes of slowly rising spp do not
-        // reallocate every time; never below what this band needs (a pass planned before a
-        // lower cap was set still needs its own size).
-        let doubled = self.batch.as_ref().map_or(0, |b| 2 * b.slots).min(self.max_slots);
-        let slots = slots.max(doubled);
-        let device = &self.gpu.device;
-        let batch = self.gpu.scoped("allocating path-tracer batch buffers", || {
-            let buffer = |label: &str| {
-                device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some(label),
-                    size: slots * SLOT_BYTES,
-                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-                    mapped_at_creation: false,
-                })
-            };
-            let sum = buffer("pathtrace batch sum");
-            let sum_sq = buffer("pathtrace batch sum of squares");
-            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("pathtrace"),
-                layout: &self.pipeline.get_bind_group_layout(0),
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: self.params_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: self.objects_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 2, resource: self.materials_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 3, resource: self.lights_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 4, resource: sum.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 5, resource: sum_sq.as_entire_binding() },
-                ],
-            });
-            BatchBuffers { slots, sum, sum_sq, bind_group }
-        })?;
-        self.batch = Some(batch);
-        Ok(())
-    }
-
-    fn submit_band(&mut self) -> Result<StepReport, PathTraceError> {
-        let started = Instant::now();
-        let width = self.scene.camera.width;
-        let height = self.scene.camera.height;
-        let pass = self.pass.as_ref().expect("submit_band needs an active pass");
-        let row_offset = pass.next_row;
-        let rows = pass.plan.rows.min(height - row_offset);
-        let spp = pass.plan.spp;
-        let sample_base = pass.sample_base;
-        let chunk = self.chunk_samples;
-        let chunks = spp.div_ceil(chunk);
-        let band_pixels = rows as usize * width as usize;
-        let slots = band_pixels as u64 * u64::from(chunks);
-        self.ensure_batch_capacity(slots)?;
-
-        let mut params = self.base_params;
-        params.row_offset = row_offset;
-        params.rows = rows;
-        params.sample_base = sample_base;
-        params.sample_count = spp;
-        params.chunk_samples = chunk;
-        self.gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&params));
-
-        let bytes = slots * SLOT_BYTES;
-        let staging_size = 2 * bytes + self.timer.result_size();
-        if self.staging.as_ref().is_none_or(|s| s.size() < staging_size) {
-            self.staging = Some(self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("pathtrace staging"),
-                size: staging_size,
-                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }));
-        }
-        let staging = self.staging.as_ref().expect("allocated above");
-        let batch = self.batch.as_ref().expect("allocated above");
-
-        let mut encoder = self
-            .gpu
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("pathtrace band") });
-        {
-            let mut compute = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("pathtrace"),
-                timestamp_writes: self.timer.compute_writes(TIMED_PASS),
-            });
-            compute.set_pipeline(&self.pipeline);
-            compute.set_bind_group(0, &batch.bind_group, &[]);
-            compute.dispatch_workgroups(width.div_ceil(WORKGROUP), rows.div_ceil(WORKGROUP), chunks);
-        }
-        // The display sum reads the slots on the GPU in the same submission (wgpu orders the two
-        // passes); the copies below for the f64 fold are unchanged.
-        if let Some(display) = &mut self.display_sum {
-            display.record(&self.gpu, &mut encoder, &batch.sum, rows, row_offset, chunks);
-        }
-        encoder.copy_buffer_to_buffer(&batch.sum, 0, staging, 0, bytes);
-        encoder.copy_buffer_to_buffer(&batch.sum_sq, 0, staging, bytes, bytes);
-        self.timer.copy_results(&mut encoder, staging, 2 * bytes);
-        self.gpu.queue.submit([encoder.finish()]);
-
-        let data =
-            readback::read_mapped(&self.gpu, staging, staging_size, "reading back a path-tracing batch")?;
-        let floats: Vec<[f32; 4]> = data[..(2 * bytes) as usize]
-            .chunks_exact(16)
-            .map(|c| {
-                let f = |i: usize| f32::from_le_bytes(c[4 * i..4 * i + 4].try_into().expect("4 bytes"));
-                [f(0), f(1), f(2), f(3)]
-            })
-            .collect();
-        let (sums, sums_sq) = floats.split_at(floats.len() / 2);
-        // Every slot must account for all of its chunk's samples (finite + dropped). A shortfall
-        // means the driver ended the invocation early; its statistics would silently be short.
-        for k in 0..chunks {
-            let expected = chunk.min(spp - k * chunk);
-            let range = k as usize * band_pixels..(k as usize + 1) * band_pixels;
-            for (s, q) in sums[range.clone()].iter().zip(&sums_sq[range]) {
-                let found = s[3] as u64 + q[3] as u64;
-                if found != u64::from(expected) {
-                    // The accumulator drops this band, but the display pass already added it:
-                    // set the display sum back to the accumulator's samples.
-                    if let Some(display) = &self.display_sum {
-                        display.seed(&self.gpu, &self.accumulator);
-                    }
-                    return Err(PathTraceError::IncompleteBatch { expected, found });
-                }
-            }
-        }
-        for k in 0..chunks as usize {
-            let range = k * band_pixels..(k + 1) * band_pixels;
-            self.accumulator.fold(
-                row_offset as usize * width as usize,
-                &sums[range.clone()],
-                &sums_sq[range],
-            );
-        }
-        let gpu_seconds = self.timer.decode(&data[(2 * bytes) as usize..]).map(|timings| timings[0].1 * 1e-3);
-
-        let pass = self.pass.as_mut().expect("still active");
-        pass.next_row += rows;
-        let pass_completed = pass.next_row >= height;
-        if pass_completed {
-            self.spp_done += spp;
-            self.pass = None;
-        }
-        let wall_seconds = started.elapsed().as_secs_f64();
-        self.wall_seconds += wall_seconds;
-        self.gpu_seconds += gpu_seconds.unwrap_or(0.0);
-        Ok(StepReport {
-            samples: rows as u64 * width as u64 * spp as u64,
-            wall_seconds,
-            gpu_seconds,
-            pass_completed,
-        })
-    }
-}
-
-/// One row of one chunk is the smallest band; it must fit in one batch buffer.
-fn check_row_fits(scene: &Scene, max_slots: u64) -> Result<(), PathTraceError> {
-    let width = u64::from(scene.camera.width);
-    if width > max_slots {
-        return Err(PathTraceError::Unsupported {
-            scene: scene.name.clone(),
-            message: format!(
-                "camera.width = {width}: one row needs {} bytes per batch buffer, more than the {} \
-                 bytes allowed (the device's max_storage_buffer_binding_size, or a lower cap)",
-                width * SLOT_BYTES,
-                max_slots * SLOT_BYTES
-            ),
-        });
-    }
-    Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    /// The WGSL constant LD_INV_PHI is 1/phi_16, phi_16 the positive root of x^17 = x + 1
-    /// (Roberts' generalised golden ratio), and its powers are the R_16 sequence's alphas.
-    #[test]
-    fn ld_alpha_matches_roberts_definition() {
-        let source = include_str!("../../../shaders/common/sampler.wgsl");
-        let constant: f64 = source
-            .split("const LD_INV_PHI: f32 = ")
-            .nth(1)
-            .and_then(|rest| rest.split(';').next())
-            .expect("LD_INV_PHI present")
-            .parse()
-            .expect("a number");
-        // Fixed-point iteration x <- (1 + x)^(1/17) converges to phi_16.
-        let mut phi = 2.0f64;
-        for _ in 0..200 {
-            phi = (1.0 + phi).powf(1.0 / 17.0);
-        }
-        assert!((phi.powi(17) - phi - 1.0).abs() < 1e-12);
-        assert!(((constant as f32) as f64 - 1.0 / phi).abs() < 1e-7, "{constant} vs {}", 1.0 / phi);
-        // The shader's f32 recurrence stays within 1e-6 of (1/phi)^(j+1) over the 16 dimensions.
-        let mut alpha = constant as f32;
-        for j in 0..16 {
-            let exact = (1.0 / phi).powi(j + 1);
-            assert!((alpha as f64 - exact).abs() < 1e-6, "alpha_{j}: {alpha} vs {exact}");
-            alpha *= constant as f32;
-        }
     }
 }

@@ -8,6 +8,7 @@ use std::time::Instant;
 
 use crate::scene::RasterScene;
 use illum_gpu::GpuContext;
+use illum_image::median;
 
 use crate::{Options, PassTimes, RasterError, RasterRenderer};
 
@@ -24,15 +25,6 @@ pub struct BenchReport {
     /// Shadow-map side in texels and cube-map face side, as rendered.
     pub shadow_map_size: u32,
     pub cube_size: u32,
-}
-
-fn median(values: &mut [f64]) -> f64 {
-    if values.is_empty() {
-        return f64::NAN;
-    }
-    values.sort_by(f64::total_cmp);
-    let mid = values.len() / 2;
-    if values.len() % 2 == 1 { values[mid] } else { 0.5 * (values[mid - 1] + values[mid]) }
 }
 
 impl BenchReport {
@@ -91,16 +83,4 @@ pub fn bench_frames(
         shadow_map_size: renderer.shadow_map_resolution().0,
         cube_size: renderer.scene().quality.cube_size,
     })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn median_of_odd_and_even_counts() {
-        assert_eq!(median(&mut [3.0, 1.0, 2.0]), 2.0);
-        assert_eq!(median(&mut [4.0, 1.0, 3.0, 2.0]), 2.5);
-        assert!(median(&mut []).is_nan());
-    }
 }

@@ -22,14 +22,7 @@ impl Uniforms {
         let alignment = u64::from(device.limits().min_uniform_buffer_offset_alignment);
         let view_stride = (std::mem::size_of::<ViewUniform>() as u64).next_multiple_of(alignment);
         let (scene, views) = gpu.scoped("allocating the raster uniforms", || {
-            let buffer = |label: &str, size: u64| {
-                device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some(label),
-                    size,
-                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                    mapped_at_creation: false,
-                })
-            };
+            let buffer = |label: &str, size: u64| illum_gpu::buffers::uniform_buffer(device, label, size);
             (
                 buffer("raster scene uniform", std::mem::size_of::<SceneUniform>() as u64),
                 buffer("raster view uniforms", view_stride * VIEW_COUNT as u64),

@@ -18,7 +18,7 @@
 use illum_gpu::timing::PassTimer;
 use illum_gpu::wgpu;
 
-use crate::plan::FramePlan;
+use crate::plan::{Cube, FramePlan, Pass};
 use crate::views::CUBE_FACE_NAMES;
 
 /// Slots of the view uniform buffer.
@@ -108,46 +108,43 @@ impl FrameResources<'_> {
         })
     }
 
-    /// Records the passes of one frame that its plan includes.
+    /// Records the passes of the frame's plan, in its order.
     pub fn record(&self, encoder: &mut wgpu::CommandEncoder) {
-        if self.plan.shadow_pass {
-            self.shadow_pass(encoder);
+        for pass in self.plan.passes() {
+            match pass {
+                Pass::Shadow => self.shadow_pass(encoder),
+                Pass::Capture(cube) => self.capture(encoder, &self.capture_of(cube)),
+                Pass::Main => self.main_pass(encoder),
+            }
         }
-        if self.plan.glass {
-            // Seen from the glass sphere's centre: everything but the glass; then the same views
-            // at an eighth of the side, the glass's prefiltered level.
-            let glass = Capture {
-                name: "glass",
+    }
+
+    /// What the capture of `cube` renders into and draws.
+    fn capture_of(&self, cube: Cube) -> Capture<'_> {
+        match cube {
+            Cube::Glass => Capture {
+                name: cube.name(),
                 faces: self.glass_faces,
                 depth: self.cube_depth,
                 first_view: GLASS_FACE_VIEWS,
                 textures: self.glass_capture_textures,
                 sphere: self.cube_metal,
-            };
-            self.capture(encoder, &glass);
-            self.capture(
-                encoder,
-                &Capture {
-                    name: "glass coarse",
-                    faces: self.glass_coarse_faces,
-                    depth: self.coarse_depth,
-                    ..glass
-                },
-            );
-        }
-        if self.plan.metal_cube {
-            // Seen from the metal sphere's centre: everything but the metal.
-            let metal = Capture {
-                name: "metal",
+            },
+            Cube::GlassCoarse => Capture {
+                faces: self.glass_coarse_faces,
+                depth: self.coarse_depth,
+                name: cube.name(),
+                ..self.capture_of(Cube::Glass)
+            },
+            Cube::Metal => Capture {
+                name: cube.name(),
                 faces: self.metal_faces,
                 depth: self.cube_depth,
                 first_view: METAL_FACE_VIEWS,
                 textures: self.metal_capture_textures,
                 sphere: self.cube_glass,
-            };
-            self.capture(encoder, &metal);
+            },
         }
-        self.main_pass(encoder);
     }
 
     /// The six faces of one cube map.

@@ -33,6 +33,7 @@ mod bench;
 mod bindings;
 mod error;
 pub mod frame;
+pub mod limits;
 mod options;
 mod pass_times;
 mod pipelines;
@@ -49,13 +50,12 @@ pub mod views;
 pub use bench::{BenchReport, bench_frames};
 pub use error::RasterError;
 pub use illum_scene::{Effects, Look};
+pub use limits::check_device_limits;
 pub use options::Options;
 pub use pass_times::{Frame, PassTimes};
 pub use plan::FramePlan;
 pub use renderer::RasterRenderer;
-pub use scene::{
-    CheckerFloor, GlassSphere, MetalSphere, RasterLight, RasterLimits, RasterQuality, RasterScene,
-};
+pub use scene::{CheckerFloor, GlassSphere, MetalSphere, RasterLight, RasterQuality, RasterScene};
 pub use shaders::{MODULES, SHADERS};
 
 /// Samples per pixel of the main pass with MSAA on.

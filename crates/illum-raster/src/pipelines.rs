@@ -9,6 +9,7 @@
 
 use std::collections::HashMap;
 
+use illum_gpu::buffers::pipeline_layout;
 use illum_gpu::{GpuContext, GpuError, shader, wgpu};
 
 use crate::shaders::{self, FLOOR_SHADER, SHADOW_SHADER, SPHERES_SHADER};
@@ -165,16 +166,8 @@ impl Pipelines {
                 (uniforms, textures)
             })?;
         let (shadow_layout, surface_layout) = gpu.scoped("creating the raster pipeline layouts", || {
-            let shadow = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("raster shadow"),
-                bind_group_layouts: &[Some(&uniforms_layout)],
-                immediate_size: 0,
-            });
-            let surface = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("raster surfaces"),
-                bind_group_layouts: &[Some(&uniforms_layout), Some(&textures_layout)],
-                immediate_size: 0,
-            });
+            let shadow = pipeline_layout(device, "raster shadow", &[&uniforms_layout]);
+            let surface = pipeline_layout(device, "raster surfaces", &[&uniforms_layout, &textures_layout]);
             (shadow, surface)
         })?;
 

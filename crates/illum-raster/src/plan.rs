@@ -16,6 +16,49 @@ use crate::options::Options;
 use crate::shadow_fit::ShadowFit;
 use crate::views::CUBE_FACE_NAMES;
 
+/// A cube map a frame captures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Cube {
+    /// Six faces from the glass sphere's centre, showing everything but the glass.
+    Glass,
+    /// The same six views at an eighth of the side: the glass's prefiltered level.
+    GlassCoarse,
+    /// Six faces from the metal sphere's centre, showing everything but the metal.
+    Metal,
+}
+
+impl Cube {
+    /// Its name in the timed passes ("cube NAME +X", ...).
+    pub fn name(self) -> &'static str {
+        match self {
+            Cube::Glass => "glass",
+            Cube::GlassCoarse => "glass coarse",
+            Cube::Metal => "metal",
+        }
+    }
+}
+
+/// One pass of a frame (see [`FramePlan::passes`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Pass {
+    /// The spheres' depth from the light, into the shadow map.
+    Shadow,
+    /// The six faces of a cube map.
+    Capture(Cube),
+    /// The view of the camera, multisampled and resolved into the output.
+    Main,
+}
+
+/// What one pass draws (see [`FramePlan::draws`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Draws {
+    pub floor: bool,
+    /// The floor's shadow receiver.
+    pub receiver: bool,
+    pub glass: bool,
+    pub metal: bool,
+}
+
 /// The passes of one frame and what each sphere's pipelines may rely on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct FramePlan {
@@ -50,20 +93,53 @@ impl FramePlan {
         }
     }
 
+    /// The passes of the frame, in recording order: the shadow pass, the glass sphere's cube
+    /// map and its coarse level, the metal sphere's cube map, the main pass; each only when the
+    /// frame needs it. The frame walks this list.
+    pub fn passes(&self) -> Vec<Pass> {
+        let mut passes = Vec::new();
+        if self.shadow_pass {
+            passes.push(Pass::Shadow);
+        }
+        if self.glass {
+            passes.extend([Pass::Capture(Cube::Glass), Pass::Capture(Cube::GlassCoarse)]);
+        }
+        if self.metal_cube {
+            passes.push(Pass::Capture(Cube::Metal));
+        }
+        passes.push(Pass::Main);
+        passes
+    }
+
+    /// What `pass` draws. The shadow pass draws the spheres' depth only (see
+    /// [`Self::shadow_casters`]); every other pass draws the floor, with its shadow receiver when
+    /// the shadow pass ran, and the spheres it can see: a cube map shows everything but the
+    /// sphere it is captured from.
+    pub fn draws(&self, pass: Pass) -> Draws {
+        let receiver = self.shadow_pass;
+        match pass {
+            Pass::Shadow => Draws { floor: false, receiver: false, glass: self.glass, metal: self.metal },
+            Pass::Capture(Cube::Glass | Cube::GlassCoarse) => {
+                Draws { floor: true, receiver, glass: false, metal: self.metal }
+            }
+            Pass::Capture(Cube::Metal) => Draws { floor: true, receiver, glass: self.glass, metal: false },
+            Pass::Main => Draws { floor: true, receiver, glass: self.glass, metal: self.metal },
+        }
+    }
+
     /// The timed passes, in recording order: "shadow", the cube faces ("cube glass +X", ...,
     /// "cube glass coarse +X", ..., "cube metal +X", ...), "main".
     pub fn pass_names(&self) -> Vec<String> {
         let mut names = Vec::new();
-        if self.shadow_pass {
-            names.push("shadow".to_owned());
-        }
-        let cubes = [("glass", self.glass), ("glass coarse", self.glass), ("metal", self.metal_cube)];
-        for (cube, captured) in cubes {
-            if captured {
-                names.extend(CUBE_FACE_NAMES.iter().map(|face| format!("cube {cube} {face}")));
+        for pass in self.passes() {
+            match pass {
+                Pass::Shadow => names.push("shadow".to_owned()),
+                Pass::Capture(cube) => {
+                    names.extend(CUBE_FACE_NAMES.iter().map(|face| format!("cube {} {face}", cube.name())))
+                }
+                Pass::Main => names.push("main".to_owned()),
             }
         }
-        names.push("main".to_owned());
         names
     }
 
@@ -113,5 +189,24 @@ mod tests {
         let bare = RasterScene { glass: None, metal: None, ..s };
         let p = plan(&bare, &Options::all_on(Look::Figure));
         assert!(!p.shadow_pass && p.shadow_casters().is_empty() && p.pass_names() == ["main"]);
+    }
+
+    #[test]
+    fn passes_are_recorded_in_order_and_cube_maps_hide_their_own_sphere() {
+        let s = scene();
+        let p = plan(&s, &Options::all_on(Look::Enhanced));
+        assert_eq!(
+            p.passes(),
+            [
+                Pass::Shadow,
+                Pass::Capture(Cube::Glass),
+                Pass::Capture(Cube::GlassCoarse),
+                Pass::Capture(Cube::Metal),
+                Pass::Main
+            ]
+        );
+        assert!(!p.draws(Pass::Capture(Cube::Glass)).glass && p.draws(Pass::Capture(Cube::Glass)).metal);
+        assert!(p.draws(Pass::Capture(Cube::Metal)).glass && !p.draws(Pass::Capture(Cube::Metal)).metal);
+        assert_eq!(p.pass_names().len(), 1 + 3 * 6 + 1);
     }
 }

@@ -1,6 +1,6 @@
 //! [`RasterRenderer`]: owns the GPU resources and turns a scene plus [`Options`] into frames.
 
-use crate::scene::{RasterLimits, RasterScene};
+use crate::scene::RasterScene;
 use glam::Vec3;
 use illum_gpu::timing::PassTimer;
 use illum_gpu::{GpuContext, readback, wgpu};
@@ -12,7 +12,7 @@ use crate::frame::{FrameResources, GLASS_FACE_VIEWS, MAIN_VIEW, METAL_FACE_VIEWS
 use crate::options::Options;
 use crate::pass_times::{Frame, PassTimes};
 use crate::pipelines::Pipelines;
-use crate::plan::FramePlan;
+use crate::plan::{FramePlan, Pass};
 use crate::shadow_fit::{MAX_SHADOW_MAP, ShadowFit, fit_shadow};
 use crate::targets::{CubeSet, MainTargets, ShadowMap};
 use crate::uniforms::{self, ViewUniform};
@@ -96,11 +96,7 @@ impl RasterRenderer {
     ) -> Result<RasterScene, RasterError> {
         let mut scene = scene.clone();
         scene.set_resolution(Some(width), Some(height), "RasterRenderer")?;
-        let limits = gpu.device.limits();
-        scene.check_device_limits(&RasterLimits {
-            max_texture_dimension_2d: limits.max_texture_dimension_2d,
-            max_buffer_size: limits.max_buffer_size,
-        })?;
+        crate::limits::check_device_limits(&scene, &gpu.device.limits())?;
         Ok(scene)
     }
 
@@ -264,23 +260,21 @@ impl RasterRenderer {
             main_glass: key(Surface::Glass, main),
             main_metal: key(Surface::Metal, main),
         };
-        let shadows = plan.shadow_pass;
-        // The glass's cube faces draw the metal; the metal's cube faces draw the glass.
-        let cube_metal = plan.glass && plan.metal;
-        let cube_glass = plan.metal_cube && plan.glass;
-        let cubes = plan.glass || plan.metal_cube;
-        for (key, needed) in [
-            (keys.cube_floor, cubes),
-            (keys.cube_receiver, cubes && shadows),
-            (keys.cube_metal, cube_metal),
-            (keys.cube_glass, cube_glass),
-            (keys.main_floor, true),
-            (keys.main_receiver, shadows),
-            (keys.main_glass, plan.glass),
-            (keys.main_metal, plan.metal),
-        ] {
-            if needed {
-                self.pipelines.ensure(&self.gpu, key)?;
+        // The pipelines the plan's passes draw with.
+        let mut needed = std::collections::HashSet::new();
+        for pass in plan.passes() {
+            let draws = plan.draws(pass);
+            let keys = match pass {
+                Pass::Shadow => continue,
+                Pass::Capture(_) => [keys.cube_floor, keys.cube_receiver, keys.cube_glass, keys.cube_metal],
+                Pass::Main => [keys.main_floor, keys.main_receiver, keys.main_glass, keys.main_metal],
+            };
+            for (key, drawn) in keys.into_iter().zip([draws.floor, draws.receiver, draws.glass, draws.metal])
+            {
+                if drawn {
+                    self.pipelines.ensure(&self.gpu, key)?;
+                    needed.insert(key);
+                }
             }
         }
         self.write_uniforms();
@@ -290,6 +284,7 @@ impl RasterRenderer {
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("raster frame") });
         let main = self.main.as_ref().expect("made above");
+        let get = |key: PipelineKey| needed.contains(&key).then(|| self.pipelines.get(&key));
         let resources = FrameResources {
             plan,
             timer: &self.timer,
@@ -297,11 +292,11 @@ impl RasterRenderer {
             view_stride: self.uniforms.view_stride,
             shadow_pipeline: &self.pipelines.shadow,
             shadow_map: &self.shadow_map.view,
-            cube_floor: cubes.then(|| self.pipelines.get(&keys.cube_floor)),
-            cube_floor_receiver: (cubes && shadows).then(|| self.pipelines.get(&keys.cube_receiver)),
-            main_floor_receiver: shadows.then(|| self.pipelines.get(&keys.main_receiver)),
-            cube_metal: cube_metal.then(|| self.pipelines.get(&keys.cube_metal)),
-            cube_glass: cube_glass.then(|| self.pipelines.get(&keys.cube_glass)),
+            cube_floor: get(keys.cube_floor),
+            cube_floor_receiver: get(keys.cube_receiver),
+            main_floor_receiver: get(keys.main_receiver),
+            cube_metal: get(keys.cube_metal),
+            cube_glass: get(keys.cube_glass),
             cube_depth: &self.cubes.depth,
             coarse_depth: &self.cubes.coarse_depth,
             glass_faces: &self.cubes.glass.face_views,
@@ -310,9 +305,9 @@ impl RasterRenderer {
             glass_capture_textures: &self.texture_groups.glass_capture,
             metal_capture_textures: &self.texture_groups.metal_capture,
             main_textures: &self.texture_groups.main,
-            main_floor: self.pipelines.get(&keys.main_floor),
-            main_glass: plan.glass.then(|| self.pipelines.get(&keys.main_glass)),
-            main_metal: plan.metal.then(|| self.pipelines.get(&keys.main_metal)),
+            main_floor: get(keys.main_floor).expect("the main pass draws the floor"),
+            main_glass: get(keys.main_glass),
+            main_metal: get(keys.main_metal),
             main_multisampled: main.multisampled.as_ref(),
             main_output: &main.output_view,
             main_depth: &main.depth,

@@ -148,21 +148,6 @@ pub struct RasterQuality {
     pub cube_size: u32,
 }
 
-/// What the device allows, for [`RasterScene::check_device_limits`] (filled in from
-/// `wgpu::Limits` by the caller).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct RasterLimits {
-    /// Largest 2D texture side (also bounds cube-map faces).
-    pub max_texture_dimension_2d: u32,
-    /// Largest buffer, in bytes (the image is read back through one).
-    pub max_buffer_size: u64,
-}
-
-/// Bytes per output pixel (RGBA, 8 bits per channel) and the row alignment GPU copies need
-/// (`wgpu::COPY_BYTES_PER_ROW_ALIGNMENT`).
-const READBACK_BYTES_PER_PIXEL: u64 = 4;
-const READBACK_ROW_ALIGNMENT: u64 = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT as u64;
-
 impl RasterScene {
     /// Reads a scene file and checks that the rasterizer can draw it.
     pub fn load(path: &Path) -> Result<RasterScene, SceneError> {
@@ -190,26 +175,24 @@ impl RasterScene {
             let material = scene.material_of(object);
             match (object.shape, material.kind) {
                 (Shape::Quad(quad), kind) => {
-                    if floor.is_some() {
-                        return Err(SceneError::invalid(
-                            file,
-                            scene.object_label(i),
-                            "a second quad",
-                            "the rasterizer draws one quad, the floor",
-                        ));
-                    }
+                    only_one(
+                        floor.is_some(),
+                        file,
+                        &scene.object_label(i),
+                        "a second quad",
+                        "the rasterizer draws one quad, the floor",
+                    )?;
                     floor = Some(checker_floor(file, &scene.object_label(i), quad, kind)?);
                 }
                 (Shape::Sphere(sphere), MaterialKind::Dielectric { ior }) => {
                     let field = scene.object_label(i);
-                    if glass.is_some() {
-                        return Err(SceneError::invalid(
-                            file,
-                            field,
-                            "a second dielectric sphere",
-                            "the rasterizer draws at most one glass sphere (one refraction cube map)",
-                        ));
-                    }
+                    only_one(
+                        glass.is_some(),
+                        file,
+                        &field,
+                        "a second dielectric sphere",
+                        "the rasterizer draws at most one glass sphere (one refraction cube map)",
+                    )?;
                     if ior < 1.0 {
                         return Err(SceneError::invalid(
                             file,
@@ -231,14 +214,13 @@ impl RasterScene {
                     ));
                 }
                 (Shape::Sphere(sphere), MaterialKind::Mirror { reflectance }) => {
-                    if metal.is_some() {
-                        return Err(SceneError::invalid(
-                            file,
-                            scene.object_label(i),
-                            "a second mirror sphere",
-                            "the rasterizer draws at most one metal sphere (one mirror cube map)",
-                        ));
-                    }
+                    only_one(
+                        metal.is_some(),
+                        file,
+                        &scene.object_label(i),
+                        "a second mirror sphere",
+                        "the rasterizer draws at most one metal sphere (one mirror cube map)",
+                    )?;
                     let shading = scene.shading.mirror;
                     metal = Some((
                         i,
@@ -318,39 +300,11 @@ impl RasterScene {
         self.camera.height = height.unwrap_or(self.camera.height);
         Ok(())
     }
+}
 
-    /// Checks that the output and the cube maps fit the device: every texture side within
-    /// `max_texture_dimension_2d`, and the readback buffer (4 bytes per pixel, rows padded to
-    /// 256 bytes) within `max_buffer_size`. Errors are labelled `scene "NAME"`, since the
-    /// resolution may come from the file or from the command line.
-    pub fn check_device_limits(&self, limits: &RasterLimits) -> Result<(), SceneError> {
-        let label = format!("scene {:?}", self.name);
-        let max = limits.max_texture_dimension_2d;
-        let (w, h) = (self.camera.width, self.camera.height);
-        for (field, side) in
-            [("camera.width", w), ("camera.height", h), ("raster.cube_size", self.quality.cube_size)]
-        {
-            if side > max {
-                return Err(SceneError::invalid(
-                    &label,
-                    field,
-                    side.to_string(),
-                    format!("must be at most {max}, the device's max_texture_dimension_2d"),
-                ));
-            }
-        }
-        let row = (u64::from(w) * READBACK_BYTES_PER_PIXEL).next_multiple_of(READBACK_ROW_ALIGNMENT);
-        let bytes = row.saturating_mul(u64::from(h));
-        if bytes > limits.max_buffer_size {
-            return Err(SceneError::invalid(
-                &label,
-                "camera.width x camera.height",
-                format!("{w} x {h} ({bytes} bytes to read back)"),
-                format!("must fit in {} bytes, the device's max_buffer_size", limits.max_buffer_size),
-            ));
-        }
-        Ok(())
-    }
+/// Refuses a second object of a kind the rasterizer draws once (`taken`: one was found already).
+fn only_one(taken: bool, file: &str, field: &str, what: &str, allowed: &str) -> Result<(), SceneError> {
+    if taken { Err(SceneError::invalid(file, field, what, allowed)) } else { Ok(()) }
 }
 
 /// The floor: a horizontal quad facing +Y, edges along X and Z, `corner` at its minimum (x, z)

@@ -1,10 +1,10 @@
 //! The rasterizer's WGSL: three composable modules and three entry files in `shaders/raster/`.
 //!
-//! Every entry file is composed with illum-gpu's [`COMMON_MODULES`] followed by [`MODULES`]
-//! (see [`compose`]); the naga validation test walks [`SHADERS`] the same way.
+//! Every entry file is composed with [`MODULES`] (see [`compose`]), and imports nothing else;
+//! the naga validation test below walks [`SHADERS`] the same way.
 
 use illum_gpu::GpuError;
-use illum_gpu::shader::{self, COMMON_MODULES, ShaderFile};
+use illum_gpu::shader::{self, ShaderFile};
 
 /// Uniform layout and helpers shared by every raster pass (`illum::raster::scene`).
 pub const SCENE_MODULE: ShaderFile = illum_gpu::shader_file!("shaders/raster/scene.wgsl");
@@ -16,9 +16,9 @@ pub const LIGHTING_MODULE: ShaderFile = illum_gpu::shader_file!("shaders/raster/
 /// The raster modules, in dependency order (each imports only those before it).
 pub const MODULES: &[ShaderFile] = &[SCENE_MODULE, SPHERE_MODULE, LIGHTING_MODULE];
 
-/// The modules every entry file is composed with: `COMMON_MODULES` then [`MODULES`].
+/// The modules every entry file is composed with: [`MODULES`].
 pub fn modules() -> Vec<ShaderFile> {
-    COMMON_MODULES.iter().chain(MODULES).cloned().collect()
+    MODULES.to_vec()
 }
 
 /// The shadow pass: sphere depth from the light (`vs_main`, `fs_main`).
@@ -28,7 +28,7 @@ pub const FLOOR_SHADER: ShaderFile = illum_gpu::shader_file!("shaders/raster/flo
 /// The glass and metal spheres (`vs_main`, `fs_main`).
 pub const SPHERES_SHADER: ShaderFile = illum_gpu::shader_file!("shaders/raster/spheres.wgsl");
 
-/// The entry files, each composed with `COMMON_MODULES` + [`MODULES`].
+/// The entry files, each composed with [`MODULES`].
 pub const SHADERS: &[ShaderFile] = &[SHADOW_SHADER, FLOOR_SHADER, SPHERES_SHADER];
 
 /// Composes one of [`SHADERS`] into a naga module (validated by naga_oil's composer).

@@ -132,11 +132,26 @@ pub fn shadow_view(shadow: &ShadowFit) -> ViewUniform {
 mod tests {
     use super::*;
 
+    /// The uniform structs have naga's size and member offsets of `Scene` and `View` in
+    /// scene.wgsl (16 vec4 + mat4 + 2 vec4 = 352 bytes; mat4 + vec4 = 80 bytes).
     #[test]
     fn layouts_match_the_wgsl_structs() {
-        // 16 vec4 + mat4 + 2 vec4 = 352 bytes; mat4 + vec4 = 80 bytes.
-        assert_eq!(std::mem::size_of::<SceneUniform>(), 352);
-        assert_eq!(std::mem::size_of::<ViewUniform>(), 80);
+        use illum_gpu::members;
+        use std::mem::size_of;
+        assert_eq!(size_of::<SceneUniform>(), 352);
+        assert_eq!(size_of::<ViewUniform>(), 80);
+        let module = crate::shaders::compose(&crate::shaders::FLOOR_SHADER).unwrap_or_else(|e| panic!("{e}"));
+        let wgsl = |name: &str| {
+            illum_gpu::shader::wgsl_struct(&module, "illum::raster::scene", name)
+                .unwrap_or_else(|| panic!("no struct {name} in scene.wgsl"))
+        };
+        wgsl("Scene").assert_matches(
+            size_of::<SceneUniform>(),
+            &members!(SceneUniform: to_light, light_radiance, ambient, background, floor_rect, floor_params,
+                receiver, receiver_v, floor_color_a, floor_color_b, glass_sphere, glass_color, glass_params,
+                metal_sphere, metal_color, metal_specular, shadow_view_proj, shadow_params, env_params),
+        );
+        wgsl("View").assert_matches(size_of::<ViewUniform>(), &members!(ViewUniform: view_proj, eye));
     }
 
     #[test]

@@ -6,11 +6,14 @@
 //!
 //! Ported from the rules of the old raster-only format (illum-scene's `whitted_errors.rs`): each
 //! old rule is tested at its new field path; where a rule changed, a comment says how.
+//!
+//! Long (one test per rule) but one concept: every rule of the raster's view of a scene file.
 
 use glam::{Vec2, Vec3};
+use illum_gpu::wgpu;
 use illum_raster::scene::FEATURES;
-use illum_raster::{Effects, Look, RasterLimits, RasterScene};
-use illum_scene::testing::{check_invalid, edit_once as edit_text};
+use illum_raster::{Effects, Look, RasterScene, check_device_limits};
+use illum_scene::testing::{check_invalid, edit_once as edit_text, without};
 use illum_scene::{Feature, RendererKind, Scene, SceneError};
 
 const FILE: &str = "scenes/w.toml";
@@ -18,74 +21,7 @@ const FILE: &str = "scenes/w.toml";
 /// A valid scene with every optional key written out: the old format's BASE in the physical
 /// model. The old light of intensity 1 is irradiance pi; the old `[ambient]` colour x intensity
 /// is `[shading] ambient`; the old look "whitted" is "enhanced".
-const BASE: &str = r#"renderer = "raster"
-name = "w"
-
-[camera]
-eye = [7.5, 2.3, -4.2]
-target = [4.2, 2.3, -4.2]
-up = [0.0, 1.0, 0.0]
-vfov = 60.0
-near = 0.1
-far = 3000.0
-width = 64
-height = 36
-
-[environment]
-radiance = [0.3, 0.5, 0.9]
-
-[directional_light]
-direction = [-10.0, -13.0, 2.0]
-irradiance = [3.14159265, 3.14159265, 3.14159265]
-angular_radius = 0.0
-
-[materials.floor]
-checker = { even = [0.8, 0.8, 0.0], odd = [0.8, 0.0, 0.0], tile = 1.0 }
-
-[materials.glass]
-dielectric = { ior = 1.4285715 }
-
-[materials.metal]
-mirror = { reflectance = [0.792, 0.863, 0.851] }
-
-[materials.grey]
-albedo = [0.5, 0.5, 0.5]
-
-[[objects]]
-name = "floor"
-material = "floor"
-quad = { corner = [-23.0, 0.0, -7.5], edge_u = [0.0, 0.0, 15.0], edge_v = [30.0, 0.0, 0.0] }
-
-[[objects]]
-name = "glass sphere"
-material = "glass"
-sphere = { center = [4.2, 2.6, -4.2], radius = 1.0 }
-
-[[objects]]
-name = "metal sphere"
-material = "metal"
-sphere = { center = [2.0, 1.9, -2.5], radius = 1.0 }
-
-[shading]
-ambient = [0.23, 0.23, 0.23]
-dielectric = { shininess = 200.0 }
-mirror = { specular = [1.0, 1.0, 1.0], shininess = 30.0, weight = 0.6 }
-
-[raster]
-look = "enhanced"
-pcf_radius = 0.05
-cube_size = 128
-glass_color = [1.0, 1.0, 1.0]
-glass_reflectivity = 0.9
-
-[raster.effects]
-shadows = true
-pcf = false
-refraction = true
-reflection = true
-fresnel = true
-msaa = false
-"#;
+const BASE: &str = include_str!("scenes/w.toml");
 
 /// The glass sphere's `[[objects]]` table of BASE, whole.
 const GLASS_OBJECT: &str = "[[objects]]\nname = \"glass sphere\"\nmaterial = \"glass\"\n\
@@ -206,20 +142,20 @@ fn whitted_toml_refraction_ratio_is_exactly_the_skeletons() {
 
 #[test]
 fn optional_parts_take_their_defaults() {
-    let mut text = BASE.to_owned();
-    for cut in [
-        "name = \"w\"\n",
-        "angular_radius = 0.0\n",
-        "[environment]\nradiance = [0.3, 0.5, 0.9]\n",
-        "[shading]\nambient = [0.23, 0.23, 0.23]\ndielectric = { shininess = 200.0 }\n\
+    let text = without(
+        BASE,
+        &[
+            "name = \"w\"\n",
+            "angular_radius = 0.0\n",
+            "[environment]\nradiance = [0.3, 0.5, 0.9]\n",
+            "[shading]\nambient = [0.23, 0.23, 0.23]\ndielectric = { shininess = 200.0 }\n\
          mirror = { specular = [1.0, 1.0, 1.0], shininess = 30.0, weight = 0.6 }\n",
-        "[raster]\nlook = \"enhanced\"\npcf_radius = 0.05\ncube_size = 128\n\
+            "[raster]\nlook = \"enhanced\"\npcf_radius = 0.05\ncube_size = 128\n\
          glass_color = [1.0, 1.0, 1.0]\nglass_reflectivity = 0.9\n",
-        "[raster.effects]\nshadows = true\npcf = false\nrefraction = true\nreflection = true\n\
+            "[raster.effects]\nshadows = true\npcf = false\nrefraction = true\nreflection = true\n\
          fresnel = true\nmsaa = false\n",
-    ] {
-        text = edit_text(&text, cut, "");
-    }
+        ],
+    );
     let s = parse(&text).unwrap();
     assert_eq!(s.name, "w", "file stem of scenes/w.toml");
     assert_eq!(s.look, Look::Figure);
@@ -758,13 +694,17 @@ fn resolution_overrides_are_checked_and_leave_the_scene_unchanged_on_error() {
     }
 }
 
+fn device_limits(max_texture_dimension_2d: u32, max_buffer_size: u64) -> wgpu::Limits {
+    wgpu::Limits { max_texture_dimension_2d, max_buffer_size, ..wgpu::Limits::default() }
+}
+
 #[test]
 fn device_limits_name_the_limit() {
-    let limits = RasterLimits { max_texture_dimension_2d: 16384, max_buffer_size: 1 << 28 };
+    let limits = device_limits(16384, 1 << 28);
     let mut s = parse(BASE).unwrap();
-    s.check_device_limits(&limits).unwrap();
+    check_device_limits(&s, &limits).unwrap();
     s.camera.width = 16385;
-    let err = s.check_device_limits(&limits).unwrap_err();
+    let err = check_device_limits(&s, &limits).unwrap_err();
     let label = "scene \"w\"";
     check_invalid(
         &err,
@@ -775,20 +715,20 @@ fn device_limits_name_the_limit() {
     );
     s.camera.width = 64;
     s.camera.height = 16385;
-    let err = s.check_device_limits(&limits).unwrap_err();
+    let err = check_device_limits(&s, &limits).unwrap_err();
     check_invalid(&err, label, "camera.height", "16385", "max_texture_dimension_2d");
     s.camera.height = 36;
     s.quality.cube_size = 20000;
-    let err = s.check_device_limits(&limits).unwrap_err();
+    let err = check_device_limits(&s, &limits).unwrap_err();
     check_invalid(&err, label, "raster.cube_size", "20000", "max_texture_dimension_2d");
     s.quality.cube_size = 16384;
-    s.check_device_limits(&limits).unwrap();
+    check_device_limits(&s, &limits).unwrap();
     // 8192 x 8192 x 4 bytes = 2^28: exactly at the limit; one more row is over it.
     s.camera.width = 8192;
     s.camera.height = 8192;
-    s.check_device_limits(&limits).unwrap();
+    check_device_limits(&s, &limits).unwrap();
     s.camera.height = 8193;
-    let err = s.check_device_limits(&limits).unwrap_err();
+    let err = check_device_limits(&s, &limits).unwrap_err();
     check_invalid(
         &err,
         label,
@@ -797,12 +737,12 @@ fn device_limits_name_the_limit() {
         "must fit in 268435456 bytes, the device's max_buffer_size",
     );
     // Rows are padded to 256 bytes: width 1 reads back 256 bytes per row.
-    let tight = RasterLimits { max_texture_dimension_2d: 16384, max_buffer_size: 256 * 36 };
+    let tight = device_limits(16384, 256 * 36);
     s.camera.width = 1;
     s.camera.height = 36;
-    s.check_device_limits(&tight).unwrap();
+    check_device_limits(&s, &tight).unwrap();
     s.camera.height = 37;
-    let err = s.check_device_limits(&tight).unwrap_err();
+    let err = check_device_limits(&s, &tight).unwrap_err();
     check_invalid(
         &err,
         label,

@@ -66,6 +66,9 @@
 //! dielectric = { shininess = 200.0 }
 //! mirror = { specular = [1.0, 1.0, 1.0], shininess = 30.0, weight = 0.6 }
 //! ```
+//!
+//! Over 400 lines, one concept: the file format's raw structs, mirroring the TOML one to one,
+//! read better together than split by section.
 
 use std::collections::BTreeMap;
 use std::fmt;

@@ -37,6 +37,7 @@ mod features;
 mod file;
 mod lights;
 mod materials;
+mod paths;
 mod renderers;
 mod scene;
 mod settings;
@@ -50,10 +51,11 @@ pub use error::{ParseValueError, SceneError};
 pub use features::Feature;
 pub use lights::{DirectionalLight, Environment};
 pub use materials::{Checker, Material, MaterialKind};
+pub use paths::resolve_scene_path;
 pub use renderers::{
     Bounces, DielectricShading, Effects, Look, MAX_BOUNCES, MAX_WHITTED_AA, MAX_WHITTED_DEPTH, MirrorShading,
     PathTraceSettings, RasterSettings, RendererKind, Sampling, Sequence, Shading, WhittedSettings,
 };
-pub use scene::{DeviceLimits, Object, Overrides, Scene};
+pub use scene::{Object, Overrides, Scene};
 pub use shapes::{BoxShape, Quad, Shape, Sphere};
 pub use validate::{fmt_f32, toml_key};

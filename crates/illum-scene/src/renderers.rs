@@ -35,14 +35,6 @@ pub enum RendererKind {
 impl RendererKind {
     pub const ALL: [RendererKind; 2] = [RendererKind::Raster, RendererKind::PathTrace];
 
-    /// The name used in files and on the command line.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            RendererKind::Raster => "raster",
-            RendererKind::PathTrace => "pathtrace",
-        }
-    }
-
     /// The name used in sentences ("the rasterizer cannot render ...").
     pub fn noun(self) -> &'static str {
         match self {

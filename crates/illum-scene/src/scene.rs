@@ -70,15 +70,6 @@ pub struct Overrides {
     pub height: Option<u32>,
 }
 
-/// What the device allows, for the resolution check (filled in from `wgpu::Limits` by the caller).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct DeviceLimits {
-    /// Largest 2D texture side.
-    pub max_texture_dimension_2d: u32,
-    /// Largest single storage buffer binding, in bytes.
-    pub max_storage_buffer_binding_size: u64,
-}
-
 impl Scene {
     /// Reads and validates a scene file. Errors name the file as `path` was given.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
@@ -126,42 +117,6 @@ impl Scene {
         let c = &mut self.camera;
         c.width = o.width.unwrap_or(c.width);
         c.height = o.height.unwrap_or(c.height);
-        Ok(())
-    }
-
-    /// Checks that the output fits the device: each side within `max_texture_dimension_2d`, and
-    /// width x height x `bytes_per_pixel` (the caller's per-pixel storage, e.g. an accumulation
-    /// buffer) within `max_storage_buffer_binding_size`. Errors are labelled `scene "NAME"`,
-    /// since the resolution may come from the file or from overrides.
-    pub fn check_device_limits(&self, limits: &DeviceLimits, bytes_per_pixel: u64) -> Result<(), SceneError> {
-        let label = format!("scene {:?}", self.name);
-        let (w, h) = (self.camera.width, self.camera.height);
-        for (field, side) in [("camera.width", w), ("camera.height", h)] {
-            if side > limits.max_texture_dimension_2d {
-                return Err(SceneError::invalid(
-                    &label,
-                    field,
-                    side.to_string(),
-                    format!(
-                        "must be at most {}, the device's max_texture_dimension_2d",
-                        limits.max_texture_dimension_2d
-                    ),
-                ));
-            }
-        }
-        // u64 holds 2^32 * 2^32 pixels only without the factor; saturate rather than wrap.
-        let bytes = u64::from(w).saturating_mul(u64::from(h)).saturating_mul(bytes_per_pixel);
-        if bytes > limits.max_storage_buffer_binding_size {
-            return Err(SceneError::invalid(
-                &label,
-                "camera.width x camera.height",
-                format!("{w} x {h} (x {bytes_per_pixel} bytes per pixel = {bytes} bytes)"),
-                format!(
-                    "must fit in {} bytes, the device's max_storage_buffer_binding_size",
-                    limits.max_storage_buffer_binding_size
-                ),
-            ));
-        }
         Ok(())
     }
 

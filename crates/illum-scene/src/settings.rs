@@ -15,8 +15,51 @@ pub(crate) fn bounces_allowed() -> String {
     format!("must be an integer in 0..={MAX_BOUNCES} or \"{UNBOUNDED}\"")
 }
 
-/// What `sampling` accepts, for error messages.
-pub(crate) const SAMPLING_ALLOWED: &str = "must be \"cosine\" or \"uniform\"";
+/// `as_str` (the name used in files and on the command line), `FromStr` and `Display` for an
+/// enum of two fixed words, and the constant `$allowed` that error messages show.
+macro_rules! named_words {
+    ($ty:ident, $allowed:ident, $a:ident => $a_word:literal, $b:ident => $b_word:literal) => {
+        #[doc = concat!("What a `", stringify!($ty), "` accepts, for error messages.")]
+        pub(crate) const $allowed: &str = concat!("must be \"", $a_word, "\" or \"", $b_word, "\"");
+
+        impl $ty {
+            /// The name used in files and on the command line.
+            pub fn as_str(self) -> &'static str {
+                match self {
+                    $ty::$a => $a_word,
+                    $ty::$b => $b_word,
+                }
+            }
+        }
+
+        impl FromStr for $ty {
+            type Err = ParseValueError;
+
+            fn from_str(s: &str) -> Result<Self, Self::Err> {
+                match s {
+                    $a_word => Ok($ty::$a),
+                    $b_word => Ok($ty::$b),
+                    _ => Err(ParseValueError { value: s.to_owned(), allowed: $allowed.to_owned() }),
+                }
+            }
+        }
+
+        impl fmt::Display for $ty {
+            fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str(self.as_str())
+            }
+        }
+    };
+}
+
+named_words!(Sampling, SAMPLING_ALLOWED, Cosine => "cosine", Uniform => "uniform");
+named_words!(Sequence, SEQUENCE_ALLOWED, Independent => "independent", LowDiscrepancy => "low-discrepancy");
+named_words!(Look, LOOK_ALLOWED, Figure => "figure", Enhanced => "enhanced");
+named_words!(RendererKind, RENDERER_ALLOWED, Raster => "raster", PathTrace => "pathtrace");
+
+impl Look {
+    pub const ALL: [Look; 2] = [Look::Figure, Look::Enhanced];
+}
 
 impl FromStr for Bounces {
     type Err = ParseValueError;
@@ -39,119 +82,6 @@ impl fmt::Display for Bounces {
             Bounces::Fixed(n) => write!(f, "{n}"),
             Bounces::Unbounded => f.write_str(UNBOUNDED),
         }
-    }
-}
-
-impl Sampling {
-    /// The name used in files and on the command line.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Sampling::Cosine => "cosine",
-            Sampling::Uniform => "uniform",
-        }
-    }
-}
-
-impl FromStr for Sampling {
-    type Err = ParseValueError;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "cosine" => Ok(Sampling::Cosine),
-            "uniform" => Ok(Sampling::Uniform),
-            _ => Err(ParseValueError { value: s.to_owned(), allowed: SAMPLING_ALLOWED.to_owned() }),
-        }
-    }
-}
-
-impl fmt::Display for Sampling {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.as_str())
-    }
-}
-
-/// What `sequence` accepts, for error messages.
-pub(crate) const SEQUENCE_ALLOWED: &str = "must be \"independent\" or \"low-discrepancy\"";
-
-impl Sequence {
-    /// The name used in files and on the command line.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Sequence::Independent => "independent",
-            Sequence::LowDiscrepancy => "low-discrepancy",
-        }
-    }
-}
-
-impl FromStr for Sequence {
-    type Err = ParseValueError;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "independent" => Ok(Sequence::Independent),
-            "low-discrepancy" => Ok(Sequence::LowDiscrepancy),
-            _ => Err(ParseValueError { value: s.to_owned(), allowed: SEQUENCE_ALLOWED.to_owned() }),
-        }
-    }
-}
-
-impl fmt::Display for Sequence {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.as_str())
-    }
-}
-
-/// What `look` accepts, for error messages.
-pub(crate) const LOOK_ALLOWED: &str = "must be \"figure\" or \"enhanced\"";
-
-impl Look {
-    pub const ALL: [Look; 2] = [Look::Figure, Look::Enhanced];
-
-    /// The name used in files and on the command line.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Look::Figure => "figure",
-            Look::Enhanced => "enhanced",
-        }
-    }
-}
-
-impl FromStr for Look {
-    type Err = ParseValueError;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "figure" => Ok(Look::Figure),
-            "enhanced" => Ok(Look::Enhanced),
-            _ => Err(ParseValueError { value: s.to_owned(), allowed: LOOK_ALLOWED.to_owned() }),
-        }
-    }
-}
-
-impl fmt::Display for Look {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.as_str())
-    }
-}
-
-/// What `renderer` accepts, for error messages.
-pub(crate) const RENDERER_ALLOWED: &str = "must be \"raster\" or \"pathtrace\"";
-
-impl FromStr for RendererKind {
-    type Err = ParseValueError;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "raster" => Ok(RendererKind::Raster),
-            "pathtrace" => Ok(RendererKind::PathTrace),
-            _ => Err(ParseValueError { value: s.to_owned(), allowed: RENDERER_ALLOWED.to_owned() }),
-        }
-    }
-}
-
-impl fmt::Display for RendererKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.as_str())
     }
 }
 

@@ -11,6 +11,11 @@ pub fn edit_once(text: &str, from: &str, to: &str) -> String {
     text.replacen(from, to, 1)
 }
 
+/// `text` without each of `cuts`, each of which must occur exactly once (see [`edit_once`]).
+pub fn without(text: &str, cuts: &[&str]) -> String {
+    cuts.iter().fold(text.to_owned(), |text, cut| edit_once(&text, cut, ""))
+}
+
 /// Asserts that `err` is [`SceneError::Invalid`] for `file` and `field` with the shown `value`,
 /// that what it allows contains `allowed`, and that the displayed message starts with
 /// `FILE: FIELD = VALUE: ` and contains all four parts.

@@ -4,6 +4,9 @@
 //! Every number is checked for finiteness *after* conversion to f32 — TOML happily accepts
 //! `nan` and `inf`, and a finite f64 such as 1e39 becomes infinite in f32 — before any check
 //! that compares it, because NaN fails every comparison silently.
+//!
+//! Over 400 lines, one concept: the conversion of the raw file into a `Scene`, every rule in
+//! the order the file is read (the per-renderer sections are in `validate_sections.rs`).
 
 use std::collections::BTreeMap;
 

@@ -1,57 +1,17 @@
 //! Every validation rule, triggered by an edited copy of a small valid scene, with the message
 //! checked for file, field, value and what is allowed; plus syntax errors (line, column, key),
-//! command-line overrides and device limits.
+//! command-line overrides. (Device limits are checked by the GPU crates, with their tests.)
+//!
+//! Long (one test per rule) but one concept: every error of the file format and its overrides.
 
 use glam::Vec3;
 use illum_scene::testing::{check_invalid, edit_once as edit_text};
-use illum_scene::{
-    Bounces, DeviceLimits, MAX_BOUNCES, MaterialKind, Overrides, Sampling, Scene, SceneError, Shape,
-};
+use illum_scene::{Bounces, MAX_BOUNCES, MaterialKind, Overrides, Sampling, Scene, SceneError, Shape};
 
 const FILE: &str = "scenes/test.toml";
 
 /// A valid scene using every construct of the format once.
-const BASE: &str = r#"name = "test"
-
-[camera]
-eye = [0.0, 1.0, -5.0]
-target = [0.0, 1.0, 0.0]
-up = [0.0, 1.0, 0.0]
-vfov = 45.0
-width = 64
-height = 32
-
-[pathtrace]
-spp = 4
-bounces = 3
-seed = 7
-sampling = "uniform"
-
-[materials.grey]
-albedo = [0.5, 0.5, 0.5]
-
-[materials.lamp]
-emission = [5.0, 5.0, 5.0]
-
-[[objects]]
-name = "block"
-material = "grey"
-box = { center = [0.0, 0.0, 0.0], half_extent = [1.0, 1.0, 1.0] }
-
-[[objects]]
-name = "slab"
-material = "grey"
-box = { min = [-2.0, -1.0, -2.0], max = [2.0, -0.5, 2.0], rotate_y = 30.0, pivot = [1.0, 0.0, 1.0], translate = [0.0, 0.0, 3.0] }
-
-[[objects]]
-name = "lamp"
-material = "lamp"
-quad = { corner = [-0.5, 3.0, -0.5], edge_u = [1.0, 0.0, 0.0], edge_v = [0.0, 0.0, 1.0] }
-
-[[objects]]
-material = "grey"
-sphere = { center = [2.0, 1.0, 0.0], radius = 0.5 }
-"#;
+const BASE: &str = include_str!("scenes/test.toml");
 
 /// `BASE` with `from` replaced by `to`; `from` must occur exactly once, so a typo in a test
 /// fails loudly instead of silently testing the unedited scene.
@@ -670,56 +630,4 @@ fn overrides_are_validated_and_leave_the_scene_unchanged_on_error() {
         check_invalid(&err, "command line", field, value, allowed);
         assert_eq!(s, base, "{field}: scene changed despite the error");
     }
-}
-
-// ---------------------------------------------------------------------------------------------
-// Device limits.
-
-const LIMITS: DeviceLimits =
-    DeviceLimits { max_texture_dimension_2d: 8192, max_storage_buffer_binding_size: 128 << 20 };
-
-fn with_size(w: u32, h: u32) -> Scene {
-    let mut s = parse(BASE).unwrap();
-    s.camera.width = w;
-    s.camera.height = h;
-    s
-}
-
-#[test]
-fn resolution_within_limits_passes() {
-    with_size(8192, 1024).check_device_limits(&LIMITS, 16).unwrap();
-    // Exactly at the buffer limit: 4096 x 2048 x 16 bytes = 128 MiB.
-    with_size(4096, 2048).check_device_limits(&LIMITS, 16).unwrap();
-}
-
-#[test]
-fn resolution_beyond_the_texture_limit_names_it() {
-    let label = "scene \"test\"";
-    let err = with_size(8193, 16).check_device_limits(&LIMITS, 16).unwrap_err();
-    check_invalid(
-        &err,
-        label,
-        "camera.width",
-        "8193",
-        "must be at most 8192, the device's max_texture_dimension_2d",
-    );
-    let err = with_size(16, 10000).check_device_limits(&LIMITS, 16).unwrap_err();
-    check_invalid(&err, label, "camera.height", "10000", "max_texture_dimension_2d");
-}
-
-#[test]
-fn resolution_beyond_the_buffer_limit_names_it() {
-    let label = "scene \"test\"";
-    let err = with_size(4096, 2049).check_device_limits(&LIMITS, 16).unwrap_err();
-    // 4096 * 2049 * 16 = 134283264 bytes > 134217728.
-    check_invalid(
-        &err,
-        label,
-        "camera.width x camera.height",
-        "4096 x 2049 (x 16 bytes per pixel = 134283264 bytes)",
-        "must fit in 134217728 bytes, the device's max_storage_buffer_binding_size",
-    );
-    // An absurd per-pixel size saturates instead of wrapping around to a small number.
-    let err = with_size(8192, 8192).check_device_limits(&LIMITS, u64::MAX).unwrap_err();
-    assert!(err.to_string().contains("max_storage_buffer_binding_size"), "{err}");
 }

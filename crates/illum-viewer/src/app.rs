@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
 use illum_gpu::GpuContext;
+use illum_scene::RendererKind;
 
 use crate::frame_rate::FrameRate;
 use crate::pathtrace_panel::PathTraceMode;
@@ -21,24 +22,36 @@ pub enum Mode {
     PathTrace,
 }
 
+/// A mode is named like the renderer it shows (`--mode raster|pathtrace`).
+impl From<Mode> for RendererKind {
+    fn from(mode: Mode) -> Self {
+        match mode {
+            Mode::Raster => RendererKind::Raster,
+            Mode::PathTrace => RendererKind::PathTrace,
+        }
+    }
+}
+
+impl From<RendererKind> for Mode {
+    fn from(kind: RendererKind) -> Self {
+        match kind {
+            RendererKind::Raster => Mode::Raster,
+            RendererKind::PathTrace => Mode::PathTrace,
+        }
+    }
+}
+
 impl FromStr for Mode {
     type Err = String;
 
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "raster" => Ok(Mode::Raster),
-            "pathtrace" => Ok(Mode::PathTrace),
-            _ => Err(format!("unknown mode {s:?}: must be \"raster\" or \"pathtrace\"")),
-        }
+        s.parse::<RendererKind>().map(Mode::from).map_err(|e| format!("unknown mode {s:?}: {}", e.allowed))
     }
 }
 
 impl fmt::Display for Mode {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            Mode::Raster => "raster",
-            Mode::PathTrace => "pathtrace",
-        })
+        f.write_str(RendererKind::from(*self).as_str())
     }
 }
 

@@ -82,11 +82,7 @@ impl Display {
                 },
             ],
         });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("viewer display"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
+        let pipeline_layout = illum_gpu::buffers::pipeline_layout(device, "viewer display", &[&layout]);
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("viewer display"),
             layout: Some(&pipeline_layout),
@@ -108,12 +104,11 @@ impl Display {
             multiview_mask: None,
             cache: None,
         });
-        let params = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("viewer display params"),
-            size: std::mem::size_of::<Params>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let params = illum_gpu::buffers::uniform_buffer(
+            device,
+            "viewer display params",
+            std::mem::size_of::<Params>() as u64,
+        );
         Display { pipeline, layout, params, target: None, source: None, texture_id: None }
     }
 

@@ -14,6 +14,9 @@
 //! Display: the tracer's display sum (on the GPU) is drawn by [`Display`] whenever new samples
 //! arrived or the exposure changed; the f64 statistics are only read for the panel's numbers and
 //! for saving.
+//!
+//! Over 400 lines, one concept: the path tracer's mode of the viewer (its settings, its panel,
+//! its stepping and saving), which reads better whole than split between widgets and state.
 
 use std::path::{Path, PathBuf};
 

@@ -2,10 +2,10 @@
 //! it; each failure becomes the loader's own message (which names the file, the field and what
 //! is allowed, or the feature a renderer lacks), for the UI to show; nothing panics.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use illum_raster::RasterScene;
-use illum_scene::{RendererKind, Scene};
+use illum_scene::{RendererKind, Scene, resolve_scene_path};
 
 use crate::app::Mode;
 
@@ -33,23 +33,10 @@ impl LoadedScene {
     }
 }
 
-/// `path` as given when it exists; a relative path that does not exist from the working
-/// directory is tried from the workspace root too, so `scenes/cornell.toml` works from
-/// `cargo run` anywhere in the workspace and from the crate's tests.
-pub fn resolve(path: &Path) -> PathBuf {
-    if path.is_relative() && !path.exists() {
-        let from_root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join(path);
-        if from_root.exists() {
-            return from_root;
-        }
-    }
-    path.to_path_buf()
-}
-
 /// Loads a scene file for every mode. An error when the file does not load, or when no mode
 /// can render it (with each renderer's reason).
 pub fn load(path: &Path) -> Result<LoadedScene, String> {
-    let scene = Scene::load(&resolve(path)).map_err(|e| e.to_string())?;
+    let scene = Scene::load(&resolve_scene_path(path)).map_err(|e| e.to_string())?;
     let pathtrace = scene
         .require(RendererKind::PathTrace, illum_pathtrace::FEATURES)
         .map(|()| scene.clone())
@@ -58,10 +45,7 @@ pub fn load(path: &Path) -> Result<LoadedScene, String> {
     if let (Err(p), Err(r)) = (&pathtrace, &raster) {
         return Err(format!("no mode can show it: {p}; {r}"));
     }
-    let preferred = match scene.renderer {
-        RendererKind::Raster => Mode::Raster,
-        RendererKind::PathTrace => Mode::PathTrace,
-    };
+    let preferred = Mode::from(scene.renderer);
     Ok(LoadedScene { pathtrace, raster, preferred })
 }
 

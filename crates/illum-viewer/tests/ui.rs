@@ -44,6 +44,12 @@ fn harness(mode: Mode) -> Harness<'static, ViewerApp> {
         })
 }
 
+/// Clicks the widget labelled `label` and runs the frame that reacts to it.
+fn click(harness: &mut Harness<'_, ViewerApp>, label: &str) {
+    harness.get_by_label(label).click();
+    harness.run_steps(1);
+}
+
 fn spp(harness: &Harness<'_, ViewerApp>) -> u32 {
     harness.state().pathtrace().expect("path tracer loaded").stats().spp
 }
@@ -52,8 +58,7 @@ fn spp(harness: &Harness<'_, ViewerApp>) -> u32 {
 fn switching_modes_keeps_each_modes_settings() {
     let mut harness = harness(Mode::PathTrace);
     harness.run_steps(2);
-    harness.get_by_label("Uniform").click();
-    harness.run_steps(1);
+    click(&mut harness, "Uniform");
 
     harness.get_by_label("Raster").click();
     harness.run_steps(2);
@@ -90,8 +95,7 @@ fn changing_bounces_restarts_the_accumulation() {
     harness.get_by_role_and_label(egui::accesskit::Role::Slider, "Bounces").set_value_accesskit(5.0);
     harness.run_steps(1);
     assert_eq!(harness.state().pathtrace().unwrap().settings.bounces, Bounces::Fixed(5));
-    harness.get_by_label("Unbounded").click();
-    harness.run_steps(1);
+    click(&mut harness, "Unbounded");
     assert_eq!(harness.state().pathtrace().unwrap().settings.bounces, Bounces::Unbounded);
     assert!(spp(&harness) < before.max(2), "a bounce change must restart: {} >= {before}", spp(&harness));
 }
@@ -100,8 +104,7 @@ fn changing_bounces_restarts_the_accumulation() {
 fn pause_and_reset() {
     let mut harness = harness(Mode::PathTrace);
     harness.run_steps(6);
-    harness.get_by_label("Pause").click();
-    harness.run_steps(1);
+    click(&mut harness, "Pause");
     assert!(harness.state().pathtrace().unwrap().paused());
     harness.get_by_label("Reset").click();
     harness.run_steps(2);
@@ -120,10 +123,8 @@ fn saves_png_and_exr_into_a_directory() {
     harness.run_steps(4);
     harness.state_mut().pathtrace_mut().unwrap().save_path = target.display().to_string();
     harness.run_steps(1);
-    harness.get_by_label("Save PNG").click();
-    harness.run_steps(1);
-    harness.get_by_label("Save EXR").click();
-    harness.run_steps(1);
+    click(&mut harness, "Save PNG");
+    click(&mut harness, "Save EXR");
 
     let png = image::open(&target).unwrap_or_else(|e| panic!("{}: {e}", target.display()));
     let (w, h) = (png.width(), png.height());
@@ -169,17 +170,23 @@ fn a_bad_scene_file_shows_its_error_and_keeps_the_scene() {
     assert!(harness.state().open_error.is_none());
 }
 
-#[test]
-fn snapshot_path_tracer() {
+/// The path-tracer window run until its spp target stops it (within 200 frames).
+fn stopped_at(spp_target: u32) -> Harness<'static, ViewerApp> {
     let mut harness = harness(Mode::PathTrace);
-    // A fixed spp target makes the image deterministic; the run stops there.
-    harness.state_mut().pathtrace_mut().unwrap().settings.spp_target = Some(4);
+    harness.state_mut().pathtrace_mut().unwrap().settings.spp_target = Some(spp_target);
     for _ in 0..200 {
         harness.run_steps(1);
         if harness.state().pathtrace().unwrap().stop_reason().is_some() {
             break;
         }
     }
+    harness
+}
+
+#[test]
+fn snapshot_path_tracer() {
+    // A fixed spp target makes the image deterministic; the run stops there.
+    let mut harness = stopped_at(4);
     assert_eq!(spp(&harness), 4);
     harness.run_steps(2);
     harness.snapshot("viewer_pathtrace");
@@ -199,14 +206,7 @@ fn the_window_shows_what_save_png_writes() {
     // same samples with gamma 2.2, so they may differ only where f32 rounding tips a value over
     // a rounding boundary: by one level at most.
     let dir = tempfile::tempdir().unwrap();
-    let mut harness = harness(Mode::PathTrace);
-    harness.state_mut().pathtrace_mut().unwrap().settings.spp_target = Some(3);
-    for _ in 0..200 {
-        harness.run_steps(1);
-        if harness.state().pathtrace().unwrap().stop_reason().is_some() {
-            break;
-        }
-    }
+    let mut harness = stopped_at(3);
     assert_eq!(spp(&harness), 3);
     let mode = harness.state_mut().pathtrace_mut().unwrap();
     mode.save_path = dir.path().join("shown.png").display().to_string();
@@ -246,8 +246,7 @@ fn dragging_orbits_the_camera_and_reset_camera_restores_it() {
     harness.run_steps(4);
     assert!(spp(&harness) > 0);
     // Paused, so that the restart caused by the camera change stays visible as 0 spp.
-    harness.get_by_label("Pause").click();
-    harness.run_steps(1);
+    click(&mut harness, "Pause");
     // The image fills the central panel, right of the settings panel.
     let start = egui::pos2(600.0, 300.0);
     harness.event(egui::Event::PointerMoved(start));
@@ -298,8 +297,7 @@ fn the_scene_field_follows_the_mode() {
     let mut harness = harness(Mode::Raster);
     harness.run_steps(1);
     assert_eq!(harness.state().scene_field, "scenes/whitted.toml");
-    harness.get_by_label("Path tracer").click();
-    harness.run_steps(1);
+    click(&mut harness, "Path tracer");
     assert_eq!(harness.state().scene_field, "scenes/cornell.toml");
 }
 
@@ -316,8 +314,7 @@ fn a_small_window_still_shows_the_image_and_the_panel_hides() {
     assert!(!harness.state().show_panel);
     let without = harness.state().pathtrace().unwrap().stats();
     assert!(without.width > with_panel.width, "{with_panel:?} -> {without:?}");
-    harness.get_by_label("Show settings").click();
-    harness.run_steps(1);
+    click(&mut harness, "Show settings");
     assert!(harness.state().show_panel);
 }
 

@@ -1,5 +1,5 @@
-//! Direct light in an empty room, in closed form, evaluated in f64 and sharing no code with the
-//! shader.
+//! Direct light in closed form, evaluated in f64 and sharing no code with the shader: the
+//! expected values that the path tracer's and the oracle's tests compare against.
 //!
 //! With bounces = 0 the radiance leaving a Lambertian point x (unit normal n) is
 //!     L(x) = albedo / pi * Le * F(x, n),
@@ -16,10 +16,11 @@
 //! a pixel's footprint, which is what the jittered estimator converges to.
 
 use glam::DVec3;
-use illum::scene::{Camera, Scene};
+use illum_scene::{Camera, Scene};
 
-/// Lambert's form factor integral at `x` (unit normal `n`) from `polygon` (unit radiance):
-/// the irradiance is `Le` times this. The polygon must lie in front of x's tangent plane.
+/// Lambert's form factor integral (Lambert, 1760) at `x` (unit normal `n`) from `polygon` (unit
+/// radiance): the irradiance is `Le` times this. The polygon must lie in front of x's tangent
+/// plane (see [`clip_to_front`]); edges of zero length are skipped.
 pub fn lambert_irradiance_factor(x: DVec3, n: DVec3, polygon: &[DVec3]) -> f64 {
     let mut sum = 0.0;
     for i in 0..polygon.len() {
@@ -80,6 +81,15 @@ pub struct Room {
 /// The assignment's light's power divided by pi: radiance x area = 30 x 130 x 105.
 pub const ASSIGNMENT_RADIANCE_AREA: f64 = 30.0 * 130.0 * 105.0;
 
+/// The room's five walls as boxes 2 units thick: (name, centre, half extent) in TOML.
+const ROOM_WALLS: [(&str, &str, &str); 5] = [
+    ("left wall", "[556.0, 278.0, 278.0]", "[1.0, 278.0, 278.0]"),
+    ("right wall", "[0.0, 278.0, 278.0]", "[1.0, 278.0, 278.0]"),
+    ("ceiling", "[278.0, 556.0, 278.0]", "[278.0, 1.0, 278.0]"),
+    ("floor", "[278.0, 0.0, 278.0]", "[278.0, 1.0, 278.0]"),
+    ("back wall", "[278.0, 278.0, 556.0]", "[278.0, 278.0, 1.0]"),
+];
+
 impl Room {
     /// The assignment's light: 130 x 105 at y = 555, radiance 30; white albedo 0.5.
     pub fn assignment() -> Self {
@@ -100,7 +110,7 @@ impl Room {
             light_u: DVec3::new(side, 0.0, 0.0),
             light_v: DVec3::new(0.0, 0.0, side),
             radiance: ASSIGNMENT_RADIANCE_AREA / (side * side),
-            albedo: 0.5,
+            ..Room::assignment()
         }
     }
 
@@ -130,27 +140,7 @@ seed = {seed}
 albedo = [{albedo:?}, {albedo:?}, {albedo:?}]
 [materials.light]
 emission = [{radiance:?}, {radiance:?}, {radiance:?}]
-[[objects]]
-name = "left wall"
-material = "white"
-box = {{ center = [556.0, 278.0, 278.0], half_extent = [1.0, 278.0, 278.0] }}
-[[objects]]
-name = "right wall"
-material = "white"
-box = {{ center = [0.0, 278.0, 278.0], half_extent = [1.0, 278.0, 278.0] }}
-[[objects]]
-name = "ceiling"
-material = "white"
-box = {{ center = [278.0, 556.0, 278.0], half_extent = [278.0, 1.0, 278.0] }}
-[[objects]]
-name = "floor"
-material = "white"
-box = {{ center = [278.0, 0.0, 278.0], half_extent = [278.0, 1.0, 278.0] }}
-[[objects]]
-name = "back wall"
-material = "white"
-box = {{ center = [278.0, 278.0, 556.0], half_extent = [278.0, 278.0, 1.0] }}
-[[objects]]
+{walls}[[objects]]
 name = "light"
 material = "light"
 quad = {{ corner = {corner}, edge_u = {u}, edge_v = {v} }}
@@ -166,6 +156,13 @@ quad = {{ corner = {corner}, edge_u = {u}, edge_v = {v} }}
             corner = v(self.light_corner),
             u = v(self.light_u),
             v = v(self.light_v),
+            walls = ROOM_WALLS
+                .iter()
+                .map(|(name, center, half_extent)| format!(
+                    "[[objects]]\nname = \"{name}\"\nmaterial = \"white\"\n\
+                     box = {{ center = {center}, half_extent = {half_extent} }}\n"
+                ))
+                .collect::<String>(),
         );
         Scene::from_toml_str(&text, "room.toml").expect("the generated room parses")
     }

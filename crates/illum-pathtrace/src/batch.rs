@@ -1,0 +1,149 @@
+//! The batch buffers: where one submission's samples land on the GPU, and how they come back.
+//!
+//! A pass over the image is split into bands of rows. Each invocation traces one chunk of a
+//! pixel's samples and writes one slot of each batch buffer: the f32 sum of its finite samples
+//! (rgb) with their count (w), and their sum of squares (rgb) with the count of dropped NaN/Inf
+//! samples (w). The slots of a band are laid out chunk by chunk, `rows x width` slots each.
+
+use illum_gpu::{GpuContext, GpuError, wgpu};
+use illum_scene::Scene;
+
+use crate::PathTraceError;
+
+/// Bytes of one slot of a batch buffer: a vec4 of f32 (the sum buffer and the sum-of-squares
+/// buffer each hold one per slot).
+pub const SLOT_BYTES: u64 = 16;
+/// Default samples per invocation (one chunk, one slot). An f32 sum of n positive terms is within
+/// (n - 1) u of the exact sum, relatively (u = 2^-24): with 16, 15 u < 1e-6, so every batch the
+/// CPU folds in f64 is within 1e-6 of the f64 fold of the very same samples. It also bounds one
+/// invocation's work: lavapipe silently ends an invocation's loops after 65535 iterations (in
+/// total), which a single invocation looping over thousands of samples used to hit, losing them.
+pub const CHUNK_SAMPLES: u32 = 16;
+
+/// The batch buffers (sum, sum of squares) and the bind group of the pipeline that uses them.
+pub(crate) struct BatchBuffers {
+    pub(crate) slots: u64,
+    pub(crate) sum: wgpu::Buffer,
+    pub(crate) sum_sq: wgpu::Buffer,
+    pub(crate) bind_group: wgpu::BindGroup,
+}
+
+impl BatchBuffers {
+    /// Allocates buffers of `slots` slots each and binds them, after the scene's buffers
+    /// (`scene_buffers`: params, objects, materials, lights), to `layout`.
+    pub(crate) fn new(
+        gpu: &GpuContext,
+        slots: u64,
+        layout: &wgpu::BindGroupLayout,
+        scene_buffers: [&wgpu::Buffer; 4],
+    ) -> Result<Self, GpuError> {
+        let device = &gpu.device;
+        gpu.scoped("allocating path-tracer batch buffers", || {
+            let buffer = |label: &str| {
+                device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(label),
+                    size: slots * SLOT_BYTES,
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                    mapped_at_creation: false,
+                })
+            };
+            let sum = buffer("pathtrace batch sum");
+            let sum_sq = buffer("pathtrace batch sum of squares");
+            let [params, objects, materials, lights] = scene_buffers;
+            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("pathtrace"),
+                layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: objects.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 2, resource: materials.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 3, resource: lights.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 4, resource: sum.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 5, resource: sum_sq.as_entire_binding() },
+                ],
+            });
+            BatchBuffers { slots, sum, sum_sq, bind_group }
+        })
+    }
+}
+
+/// Most slots one batch buffer may hold on this device: its storage binding limit (or its buffer
+/// limit, if lower) over [`SLOT_BYTES`].
+pub(crate) fn device_max_slots(limits: &wgpu::Limits) -> u64 {
+    limits.max_storage_buffer_binding_size.min(limits.max_buffer_size) / SLOT_BYTES
+}
+
+/// One row of one chunk is the smallest band; it must fit in one batch buffer.
+pub(crate) fn check_row_fits(scene: &Scene, max_slots: u64) -> Result<(), PathTraceError> {
+    let width = u64::from(scene.camera.width);
+    if width > max_slots {
+        return Err(PathTraceError::Unsupported {
+            scene: scene.name.clone(),
+            message: format!(
+                "camera.width = {width}: one row needs {} bytes per batch buffer, more than the {} \
+                 bytes allowed (the device's max_storage_buffer_binding_size, or a lower cap)",
+                width * SLOT_BYTES,
+                max_slots * SLOT_BYTES
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// The slots read back from the GPU (little-endian f32 vec4s).
+pub(crate) fn decode_slots(bytes: &[u8]) -> Vec<[f32; 4]> {
+    bytes
+        .chunks_exact(SLOT_BYTES as usize)
+        .map(|c| {
+            let f = |i: usize| f32::from_le_bytes(c[4 * i..4 * i + 4].try_into().expect("4 bytes"));
+            [f(0), f(1), f(2), f(3)]
+        })
+        .collect()
+}
+
+/// Checks that every slot accounts for all of its chunk's samples (finite + dropped): `spp`
+/// samples in chunks of `chunk`, `band_pixels` slots per chunk. A shortfall means the driver
+/// ended an invocation early, and the band's statistics would silently be short.
+pub(crate) fn check_complete(
+    sums: &[[f32; 4]],
+    sums_sq: &[[f32; 4]],
+    spp: u32,
+    chunk: u32,
+    band_pixels: usize,
+) -> Result<(), PathTraceError> {
+    for k in 0..spp.div_ceil(chunk) {
+        let expected = chunk.min(spp - k * chunk);
+        let range = k as usize * band_pixels..(k as usize + 1) * band_pixels;
+        for (s, q) in sums[range.clone()].iter().zip(&sums_sq[range]) {
+            let found = s[3] as u64 + q[3] as u64;
+            if found != u64::from(expected) {
+                return Err(PathTraceError::IncompleteBatch { expected, found });
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_slot_short_of_its_chunk_is_an_incomplete_batch() {
+        // 2 pixels, 20 spp in chunks of 16: chunk 0 holds 16 samples, chunk 1 holds 4.
+        let sums = [[0.0, 0.0, 0.0, 16.0], [0.0, 0.0, 0.0, 15.0], [0.0, 0.0, 0.0, 4.0], [0.0, 0.0, 0.0, 3.0]];
+        let sums_sq = [[0.0; 4], [0.0, 0.0, 0.0, 1.0], [0.0; 4], [0.0, 0.0, 0.0, 1.0]];
+        check_complete(&sums, &sums_sq, 20, 16, 2).expect("dropped samples count");
+        let mut short = sums_sq;
+        short[3][3] = 0.0;
+        let error = check_complete(&sums, &short, 20, 16, 2).expect_err("a lost sample");
+        assert!(matches!(error, PathTraceError::IncompleteBatch { expected: 4, found: 3 }), "{error}");
+    }
+
+    #[test]
+    fn slots_decode_as_little_endian_vec4s() {
+        let bytes: Vec<u8> =
+            [1.0f32, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0].iter().flat_map(|f| f.to_le_bytes()).collect();
+        assert_eq!(decode_slots(&bytes), [[1.0, 2.0, 3.0, 4.0], [5.0, 6.0, 7.0, 8.0]]);
+    }
+}

@@ -1,0 +1,201 @@
+//! The path tracer's WGSL: the modules it composes, in import order, and its pipeline.
+//!
+//! The sampling modules (`shaders/common/`: constants, random numbers, sample sequences,
+//! hemisphere and light sampling, ray spawning) are shared ray-tracing code, registered here,
+//! by the crate that composes them; the rasterizer imports none of them and composes only its
+//! own. The scene module and the traversal (generic, or generated per scene by
+//! `specialise.rs`) follow.
+
+use illum_gpu::shader::{self, ShaderFile};
+use illum_gpu::{GpuContext, shader_file, wgpu};
+use illum_scene::Scene;
+
+use crate::gpu_scene::GpuScene;
+use crate::options::{TracerOptions, Traversal};
+use crate::{PathTraceError, specialise};
+
+/// The integrator (entry point `main`).
+pub const PATHTRACE_SHADER: ShaderFile = shader_file!("shaders/pathtrace/pathtrace.wgsl");
+/// Scene layout, bindings and ray-shape tests.
+pub const SCENE_MODULE: ShaderFile = shader_file!("shaders/pathtrace/scene.wgsl");
+/// The generic traversal (a loop over the object buffer).
+pub const GENERIC_TRAVERSAL: ShaderFile = shader_file!("shaders/pathtrace/traversal.wgsl");
+
+/// The sampling modules, in dependency order (a module may import only those before it).
+pub const SAMPLING_MODULES: &[ShaderFile] = &[
+    shader_file!("shaders/common/constants.wgsl"),
+    shader_file!("shaders/common/rng.wgsl"),
+    shader_file!("shaders/common/sampling.wgsl"),
+    shader_file!("shaders/common/sampler.wgsl"),
+    shader_file!("shaders/common/spawn.wgsl"),
+];
+
+/// The shader modules, in import order, for `scene` with `traversal`.
+pub fn shader_modules(scene: &Scene, gpu_scene: &GpuScene, traversal: Traversal) -> Vec<ShaderFile> {
+    let mut modules = SAMPLING_MODULES.to_vec();
+    modules.push(SCENE_MODULE);
+    modules.push(match traversal {
+        Traversal::Generic => GENERIC_TRAVERSAL,
+        Traversal::Specialised => specialise::traversal_module(scene, gpu_scene),
+    });
+    modules
+}
+
+/// The path-tracing pipeline for `scene` with `options`, and the traversal source it was built
+/// with. The context caches pipelines by their source: two scenes with the same specialisation
+/// share one, so switching back to a scene does not recompile.
+pub(crate) fn pathtrace_pipeline(
+    gpu: &GpuContext,
+    scene: &Scene,
+    gpu_scene: &GpuScene,
+    options: TracerOptions,
+) -> Result<(wgpu::ComputePipeline, String), PathTraceError> {
+    let modules = shader_modules(scene, gpu_scene, options.traversal);
+    let traversal_source = modules.last().expect("a traversal").source.to_string();
+    let pipeline =
+        shader::compute_pipeline(gpu, &modules, &PATHTRACE_SHADER, &options.shader_defs(), "path-tracing")?;
+    Ok((pipeline, traversal_source))
+}
+
+#[cfg(test)]
+mod tests {
+    use std::mem::size_of;
+
+    use illum_gpu::members;
+    use illum_gpu::shader::wgsl_struct;
+    use illum_scene::{RendererKind, Sequence};
+
+    use super::*;
+    use crate::display_sum::DISPLAY_SUM_SHADER;
+    use crate::gpu_scene::{GpuLight, GpuMaterial, GpuParams, ObjectRecord};
+
+    /// Every scene file the path tracer can render.
+    fn path_tracer_scenes() -> Vec<Scene> {
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes");
+        let mut scenes = Vec::new();
+        for entry in std::fs::read_dir(dir).expect("scenes/ exists") {
+            let path = entry.expect("readable").path();
+            // Every file loads (illum-scene's test); the ones that use features the path tracer
+            // lacks are refused by name (the raster tests check the Whitted scene's refusal).
+            if path.extension().is_some_and(|e| e == "toml") {
+                let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+                if scene.require(RendererKind::PathTrace, crate::FEATURES).is_ok() {
+                    scenes.push(scene);
+                }
+            }
+        }
+        assert!(scenes.iter().any(|s| s.name == "cornell"), "scenes/cornell.toml did not load");
+        scenes
+    }
+
+    fn compose_and_validate(
+        modules: &[ShaderFile],
+        entry: &ShaderFile,
+        defs: &[(&str, shader::Def)],
+    ) -> naga::Module {
+        let module = shader::compose(modules, entry, defs).unwrap_or_else(|e| panic!("{e}"));
+        shader::validate(&module, &entry.path).unwrap_or_else(|e| panic!("{e}"));
+        module
+    }
+
+    /// naga validates each sampling module on its own (as the import of a trivial entry point),
+    /// the path tracer generic and specialised for every scene file under both sequences, and
+    /// the display-sum pass.
+    #[test]
+    fn every_pathtrace_shader_composes_and_validates() {
+        for (i, module) in SAMPLING_MODULES.iter().enumerate() {
+            let import_path = module
+                .source
+                .lines()
+                .find_map(|l| l.strip_prefix("#define_import_path "))
+                .unwrap_or_else(|| panic!("{} has no #define_import_path", module.path))
+                .trim()
+                .to_owned();
+            let entry = ShaderFile::generated(
+                format!("entry importing {import_path}"),
+                format!("#import {import_path} as m\n@compute @workgroup_size(1)\nfn main() {{}}\n"),
+            );
+            compose_and_validate(&SAMPLING_MODULES[..=i], &entry, &[]);
+        }
+        for scene in path_tracer_scenes() {
+            let gpu_scene = GpuScene::new(&scene).unwrap_or_else(|e| panic!("{e}"));
+            for traversal in [Traversal::Generic, Traversal::Specialised] {
+                for sequence in [Sequence::Independent, Sequence::LowDiscrepancy] {
+                    let defs = TracerOptions { traversal, sequence }.shader_defs();
+                    compose_and_validate(
+                        &shader_modules(&scene, &gpu_scene, traversal),
+                        &PATHTRACE_SHADER,
+                        &defs,
+                    );
+                }
+            }
+        }
+        compose_and_validate(&[], &DISPLAY_SUM_SHADER, &[]);
+    }
+
+    #[test]
+    fn a_broken_shader_is_reported_with_its_file() {
+        let entry = ShaderFile::generated("broken.wgsl".into(), "fn main() { let x: f32 = 1u; }".into());
+        let error = shader::compose(SAMPLING_MODULES, &entry, &[]).expect_err("type error must be caught");
+        assert!(error.to_string().contains("broken.wgsl"), "{error}");
+    }
+
+    /// The Rust mirrors of the scene's WGSL structs have naga's size and member offsets.
+    #[test]
+    fn layouts_match_the_wgsl_structs() {
+        let scene = path_tracer_scenes().remove(0);
+        let gpu_scene = GpuScene::new(&scene).unwrap_or_else(|e| panic!("{e}"));
+        let module = compose_and_validate(
+            &shader_modules(&scene, &gpu_scene, Traversal::Generic),
+            &PATHTRACE_SHADER,
+            &[],
+        );
+        let wgsl = |name: &str| {
+            wgsl_struct(&module, "illum::pathtrace::scene", name)
+                .unwrap_or_else(|| panic!("no struct {name} in scene.wgsl"))
+        };
+        wgsl("Params").assert_matches(
+            size_of::<GpuParams>(),
+            &members!(GpuParams: eye, tan_half_fov, right, aspect, up, light_area, forward, num_objects,
+                width, height, row_offset, rows, sample_base, sample_count, seed, bounces, sampling,
+                num_lights, first_emitter, chunk_samples),
+        );
+        wgsl("Object").assert_matches(
+            size_of::<ObjectRecord>(),
+            &members!(ObjectRecord: kind, material, emitter, padding, a, b, c, d),
+        );
+        wgsl("Material").assert_matches(size_of::<GpuMaterial>(), &members!(GpuMaterial: albedo, emission));
+        wgsl("Light").assert_matches(
+            size_of::<GpuLight>(),
+            &members!(GpuLight: corner, edge_u, edge_v, normal, emission),
+        );
+    }
+
+    /// The WGSL constant LD_INV_PHI is 1/phi_16, phi_16 the positive root of x^17 = x + 1
+    /// (Roberts' generalised golden ratio), and its powers are the R_16 sequence's alphas.
+    #[test]
+    fn ld_alpha_matches_roberts_definition() {
+        let source = include_str!("../../../shaders/common/sampler.wgsl");
+        let constant: f64 = source
+            .split("const LD_INV_PHI: f32 = ")
+            .nth(1)
+            .and_then(|rest| rest.split(';').next())
+            .expect("LD_INV_PHI present")
+            .parse()
+            .expect("a number");
+        // Fixed-point iteration x <- (1 + x)^(1/17) converges to phi_16.
+        let mut phi = 2.0f64;
+        for _ in 0..200 {
+            phi = (1.0 + phi).powf(1.0 / 17.0);
+        }
+        assert!((phi.powi(17) - phi - 1.0).abs() < 1e-12);
+        assert!(((constant as f32) as f64 - 1.0 / phi).abs() < 1e-7, "{constant} vs {}", 1.0 / phi);
+        // The shader's f32 recurrence stays within 1e-6 of (1/phi)^(j+1) over the 16 dimensions.
+        let mut alpha = constant as f32;
+        for j in 0..16 {
+            let exact = (1.0 / phi).powi(j + 1);
+            assert!((alpha as f64 - exact).abs() < 1e-6, "alpha_{j}: {alpha} vs {exact}");
+            alpha *= constant as f32;
+        }
+    }
+}

@@ -1,0 +1,147 @@
+//! One submission of the path tracer: a band of rows of the current pass traced on the GPU,
+//! read back, checked for lost samples and folded into the f64 accumulator.
+
+use std::time::Instant;
+
+use illum_gpu::{readback, wgpu};
+
+use super::{PathTracer, StepReport, TIMED_PASS};
+use crate::PathTraceError;
+use crate::batch::{self, BatchBuffers, SLOT_BYTES};
+use crate::planner::PassPlan;
+
+const WORKGROUP: u32 = 8;
+
+impl PathTracer {
+    /// Shrinks a pass plan to what the device can take: at most `max_chunks` chunks per dispatch
+    /// (the z dimension), and a band of at most `max_slots` slots (rows x width x chunks) per
+    /// batch buffer, so an image of any size is rendered band by band.
+    pub(super) fn fit(&self, plan: PassPlan) -> PassPlan {
+        let width = u64::from(self.scene.camera.width);
+        let chunk = u64::from(self.chunk_samples);
+        // check_row_fits guarantees max_slots >= width, so at least one chunk fits.
+        let max_chunks = u64::from(self.max_chunks).min(self.max_slots / width).max(1);
+        let spp = u64::from(plan.spp.max(1)).min(max_chunks * chunk);
+        let chunks = spp.div_ceil(chunk);
+        let max_rows = (self.max_slots / (width * chunks)).max(1);
+        let rows = u64::from(plan.rows).clamp(1, max_rows);
+        PassPlan { spp: spp as u32, rows: rows as u32 }
+    }
+
+    /// Makes sure the batch buffers hold at least `slots` slots (growing them, within
+    /// `max_slots`, and rebinding).
+    fn ensure_batch_capacity(&mut self, slots: u64) -> Result<(), PathTraceError> {
+        if self.batch.as_ref().is_some_and(|b| b.slots >= slots) {
+            return Ok(());
+        }
+        // Grow geometrically (within max_slots) so that passes of slowly rising spp do not
+        // reallocate every time; never below what this band needs (a pass planned before a
+        // lower cap was set still needs its own size).
+        let doubled = self.batch.as_ref().map_or(0, |b| 2 * b.slots).min(self.max_slots);
+        let slots = slots.max(doubled);
+        let layout = self.pipeline.get_bind_group_layout(0);
+        let scene_buffers =
+            [&self.params_buffer, &self.objects_buffer, &self.materials_buffer, &self.lights_buffer];
+        self.batch = Some(BatchBuffers::new(&self.gpu, slots, &layout, scene_buffers)?);
+        Ok(())
+    }
+
+    pub(super) fn submit_band(&mut self) -> Result<StepReport, PathTraceError> {
+        let started = Instant::now();
+        let width = self.scene.camera.width;
+        let height = self.scene.camera.height;
+        let pass = self.pass.as_ref().expect("submit_band needs an active pass");
+        let row_offset = pass.next_row;
+        let rows = pass.plan.rows.min(height - row_offset);
+        let spp = pass.plan.spp;
+        let sample_base = pass.sample_base;
+        let chunk = self.chunk_samples;
+        let chunks = spp.div_ceil(chunk);
+        let band_pixels = rows as usize * width as usize;
+        let slots = band_pixels as u64 * u64::from(chunks);
+        self.ensure_batch_capacity(slots)?;
+
+        let mut params = self.base_params;
+        params.row_offset = row_offset;
+        params.rows = rows;
+        params.sample_base = sample_base;
+        params.sample_count = spp;
+        params.chunk_samples = chunk;
+        self.gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&params));
+
+        let bytes = slots * SLOT_BYTES;
+        let staging_size = 2 * bytes + self.timer.result_size();
+        if self.staging.as_ref().is_none_or(|s| s.size() < staging_size) {
+            self.staging = Some(self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("pathtrace staging"),
+                size: staging_size,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }));
+        }
+        let staging = self.staging.as_ref().expect("allocated above");
+        let batch = self.batch.as_ref().expect("allocated above");
+
+        let mut encoder = self
+            .gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("pathtrace band") });
+        {
+            let mut compute = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("pathtrace"),
+                timestamp_writes: self.timer.compute_writes(TIMED_PASS),
+            });
+            compute.set_pipeline(&self.pipeline);
+            compute.set_bind_group(0, &batch.bind_group, &[]);
+            compute.dispatch_workgroups(width.div_ceil(WORKGROUP), rows.div_ceil(WORKGROUP), chunks);
+        }
+        // The display sum reads the slots on the GPU in the same submission (wgpu orders the two
+        // passes); the copies below for the f64 fold are unchanged.
+        if let Some(display) = &mut self.display_sum {
+            display.record(&self.gpu, &mut encoder, &batch.sum, rows, row_offset, chunks);
+        }
+        encoder.copy_buffer_to_buffer(&batch.sum, 0, staging, 0, bytes);
+        encoder.copy_buffer_to_buffer(&batch.sum_sq, 0, staging, bytes, bytes);
+        self.timer.copy_results(&mut encoder, staging, 2 * bytes);
+        self.gpu.queue.submit([encoder.finish()]);
+
+        let data =
+            readback::read_mapped(&self.gpu, staging, staging_size, "reading back a path-tracing batch")?;
+        let floats = batch::decode_slots(&data[..(2 * bytes) as usize]);
+        let (sums, sums_sq) = floats.split_at(floats.len() / 2);
+        if let Err(error) = batch::check_complete(sums, sums_sq, spp, chunk, band_pixels) {
+            // The accumulator drops this band, but the display pass already added it: set the
+            // display sum back to the accumulator's samples.
+            if let Some(display) = &self.display_sum {
+                display.seed(&self.gpu, &self.accumulator);
+            }
+            return Err(error);
+        }
+        for k in 0..chunks as usize {
+            let range = k * band_pixels..(k + 1) * band_pixels;
+            self.accumulator.fold(
+                row_offset as usize * width as usize,
+                &sums[range.clone()],
+                &sums_sq[range],
+            );
+        }
+        let gpu_seconds = self.timer.decode(&data[(2 * bytes) as usize..]).map(|timings| timings[0].1 * 1e-3);
+
+        let pass = self.pass.as_mut().expect("still active");
+        pass.next_row += rows;
+        let pass_completed = pass.next_row >= height;
+        if pass_completed {
+            self.spp_done += spp;
+            self.pass = None;
+        }
+        let wall_seconds = started.elapsed().as_secs_f64();
+        self.wall_seconds += wall_seconds;
+        self.gpu_seconds += gpu_seconds.unwrap_or(0.0);
+        Ok(StepReport {
+            samples: rows as u64 * width as u64 * spp as u64,
+            wall_seconds,
+            gpu_seconds,
+            pass_completed,
+        })
+    }
+}

@@ -1,0 +1,46 @@
+//! Every WGSL file under shaders/ belongs to some crate's list of shaders, so that the crate's
+//! own naga test validates it without a GPU:
+//! - illum-pathtrace (`shaders.rs`): the sampling modules, the scene module, both traversals,
+//!   the integrator and the display-sum pass, for every scene file;
+//! - illum-raster (`shaders.rs`): its modules and entry files;
+//! - illum-viewer (`display.rs`): its display pass.
+//!
+//! A file no list names would be validated by nobody; this test names it.
+
+use std::collections::BTreeSet;
+use std::path::PathBuf;
+
+use illum::pathtrace::{self, GENERIC_TRAVERSAL, PATHTRACE_SHADER, SAMPLING_MODULES, SCENE_MODULE};
+
+/// The viewer's shader, validated by illum-viewer's own test (the facade does not depend on the
+/// viewer crate, so it is named here by its path).
+const VIEWER_SHADERS: &[&str] = &["shaders/viewer/display.wgsl"];
+
+#[test]
+fn every_wgsl_file_is_validated_by_its_crate() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let mut covered: BTreeSet<String> = SAMPLING_MODULES
+        .iter()
+        .chain([&SCENE_MODULE, &GENERIC_TRAVERSAL, &PATHTRACE_SHADER, &pathtrace::DISPLAY_SUM_SHADER])
+        .chain(illum::raster::shaders::MODULES)
+        .chain(illum::raster::shaders::SHADERS)
+        .map(|file| file.path.to_string())
+        .collect();
+    covered.extend(VIEWER_SHADERS.iter().map(|path| (*path).to_owned()));
+
+    let mut on_disk = BTreeSet::new();
+    let mut stack = vec![root.join("shaders")];
+    while let Some(dir) = stack.pop() {
+        for entry in std::fs::read_dir(&dir).expect("readable dir") {
+            let path = entry.expect("entry").path();
+            if path.is_dir() {
+                stack.push(path);
+            } else if path.extension().is_some_and(|e| e == "wgsl") {
+                let relative = path.strip_prefix(&root).expect("inside workspace");
+                on_disk.insert(relative.to_string_lossy().replace('\\', "/"));
+            }
+        }
+    }
+    let missing: Vec<_> = on_disk.difference(&covered).collect();
+    assert!(missing.is_empty(), "WGSL files not validated by any composition: {missing:?}");
+}
