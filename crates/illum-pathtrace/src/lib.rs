@@ -8,6 +8,7 @@
 //! through the CPU.
 
 pub mod accumulator;
+pub mod checkpoint;
 pub mod display_sum;
 mod error;
 pub mod gpu_scene;
