@@ -31,18 +31,39 @@ pub const STATISTICS_LAYER: &str = "illum.statistics";
 
 const CHANNELS: [&str; 3] = ["R", "G", "B"];
 
-/// 64-bit FNV-1a of the scene's physical content: camera, materials, objects and lights, as
-/// parsed (so a comment, a key's order or the `[raster]` section do not change it; every number
-/// that changes the path-traced image does). Written as 16 hex digits in `illum.scene_hash`.
+/// 64-bit FNV-1a of the scene's physical content: the camera's placement and field of view,
+/// materials, objects and lights, as parsed (so a comment, a key's order or the `[raster]`
+/// section do not change it; every number that changes the path-traced image does). The
+/// resolution is compared on its own, like the other settings. Written as 16 hex digits in
+/// `illum.scene_hash`.
 pub fn scene_content_hash(scene: &Scene) -> String {
+    let c = &scene.camera;
     let content = format!(
-        "{:?}|{:?}|{:?}|{:?}|{:?}",
-        scene.camera, scene.materials, scene.objects, scene.directional_light, scene.environment
+        "{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}",
+        c.eye,
+        c.target,
+        c.up,
+        c.vfov_deg,
+        scene.materials,
+        scene.objects,
+        scene.directional_light,
+        scene.environment
     );
     let hash = content
         .bytes()
         .fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3));
     format!("{hash:016x}")
+}
+
+/// An error and its causes on one line ("reading x.exr as EXR failed: unexpected end of file").
+fn with_causes(error: &dyn std::error::Error) -> String {
+    let mut text = error.to_string();
+    let mut source = error.source();
+    while let Some(cause) = source {
+        text += &format!(": {cause}");
+        source = cause.source();
+    }
+    text
 }
 
 fn split(bits: u64) -> (u32, u32) {
@@ -72,9 +93,13 @@ pub fn statistics_layer(accumulator: &Accumulator) -> U32Layer {
 
 /// Writes the tracer's mean image, `metadata` and the statistics layer to `path`, atomically.
 pub fn save_checkpoint(path: &Path, tracer: &PathTracer, metadata: &ExrMetadata) -> Result<(), String> {
-    let accumulator = tracer.accumulator();
+    save_statistics(path, tracer.accumulator(), metadata)
+}
+
+/// Writes `accumulator`'s mean image, `metadata` and its statistics layer to `path`, atomically.
+pub fn save_statistics(path: &Path, accumulator: &Accumulator, metadata: &ExrMetadata) -> Result<(), String> {
     save_exr_with_layers(path, &accumulator.mean_image(), metadata, &[statistics_layer(accumulator)])
-        .map_err(|e| e.to_string())
+        .map_err(|e| with_causes(&e))
 }
 
 /// A render read back from a checkpoint file.
@@ -95,7 +120,7 @@ pub struct Checkpoint {
 /// missing or unparsable key.
 pub fn load_checkpoint(path: &Path) -> Result<Checkpoint, String> {
     let at = |reason: String| format!("{}: {reason}", path.display());
-    let (image, attributes) = load_exr(path).map_err(|e| e.to_string())?;
+    let (image, attributes) = load_exr(path).map_err(|e| with_causes(&e))?;
     let metadata = ExrMetadata::from_attributes(path, &attributes)
         .map_err(|e| e.to_string())?
         .ok_or_else(|| at("not written by illum (no illum.* metadata), so it cannot be continued".into()))?;
@@ -112,7 +137,7 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint, String> {
     let spp_done = number("spp")?;
     let sample_start = number("sample_start")?;
     let partial = (number("partial_pass_spp")?, number("partial_pass_rows")?);
-    let layer = load_u32_layer(path, STATISTICS_LAYER).map_err(|e| e.to_string())?.ok_or_else(|| {
+    let layer = load_u32_layer(path, STATISTICS_LAYER).map_err(|e| with_causes(&e))?.ok_or_else(|| {
         at(format!(
             "has no {STATISTICS_LAYER} layer (written without the statistics a render continues from)"
         ))
@@ -218,6 +243,124 @@ impl Checkpoint {
             ))
         }
     }
+}
+
+/// The keys two partial renders must agree on to be merged.
+const MERGE_KEYS: [&str; 8] =
+    ["scene", "scene_hash", "width", "height", "bounces", "seed", "sampling", "sequence"];
+
+impl Checkpoint {
+    /// The sample indices this file holds: `sample_start .. sample_start + spp_done`.
+    pub fn sample_range(&self) -> std::ops::Range<u64> {
+        let start = u64::from(self.sample_start);
+        start..start + u64::from(self.spp_done)
+    }
+
+    fn merge_key(&self, key: &str) -> Option<String> {
+        if key == "scene" { Some(self.metadata.scene.clone()) } else { self.setting(key) }
+    }
+}
+
+/// Combines partial renders of the same scene and settings (files from `render --sample-range`)
+/// into one: per pixel, the f64 sums and counts added in the order of their ranges. Refused, with
+/// the files named: a file stopped inside a pass (resume it first), a setting that differs,
+/// overlapping ranges (the same samples twice would bias nothing but count double) and gaps (the
+/// result would not be one range that can be continued). The merged checkpoint's metadata is
+/// the first range's, with the union's spp, the summed times and dropped samples, and the error
+/// of the merged statistics.
+pub fn merge_checkpoints(inputs: Vec<(std::path::PathBuf, Checkpoint)>) -> Result<Checkpoint, String> {
+    let mut inputs = inputs;
+    if inputs.is_empty() {
+        return Err("nothing to merge: give at least one EXR file".to_owned());
+    }
+    for (path, c) in &inputs {
+        if let Some((spp, rows)) = c.partial_pass {
+            return Err(format!(
+                "{}: stopped inside a pass ({rows} rows of {spp} spp done after {} complete spp); finish it first with \
+                 `render --resume {} --spp {}`",
+                path.display(),
+                c.spp_done,
+                path.display(),
+                c.spp_done + spp
+            ));
+        }
+        if c.spp_done == 0 {
+            return Err(format!("{}: holds no complete pass", path.display()));
+        }
+    }
+    let (first_path, first) = &inputs[0];
+    for (path, c) in &inputs[1..] {
+        let differences: Vec<String> = MERGE_KEYS
+            .iter()
+            .filter_map(|key| {
+                let (a, b) = (first.merge_key(key), c.merge_key(key));
+                (a != b).then(|| {
+                    let show = |v: Option<String>| v.unwrap_or_else(|| "(missing)".to_owned());
+                    format!(
+                        "{key}: {} in {}, {} in {}",
+                        show(a),
+                        first_path.display(),
+                        show(b),
+                        path.display()
+                    )
+                })
+            })
+            .collect();
+        if !differences.is_empty() {
+            return Err(format!("these files are renders of different images: {}", differences.join("; ")));
+        }
+    }
+    inputs.sort_by_key(|(_, c)| c.sample_start);
+    for pair in inputs.windows(2) {
+        let ((pa, a), (pb, b)) = (&pair[0], &pair[1]);
+        let (ra, rb) = (a.sample_range(), b.sample_range());
+        if rb.start < ra.end {
+            return Err(format!(
+                "{} (samples {}..{}) and {} (samples {}..{}) overlap: each sample index may be merged once",
+                pa.display(),
+                ra.start,
+                ra.end,
+                pb.display(),
+                rb.start,
+                rb.end
+            ));
+        }
+        if rb.start > ra.end {
+            return Err(format!(
+                "samples {}..{} are missing between {} (ending at {}) and {} (starting at {}): render that range too",
+                ra.end,
+                rb.start,
+                pa.display(),
+                ra.end,
+                pb.display(),
+                rb.start
+            ));
+        }
+    }
+    let total = inputs.iter().map(|(_, c)| u64::from(c.spp_done)).sum::<u64>();
+    let spp_done = u32::try_from(total)
+        .map_err(|_| format!("the merged render would have {total} spp, above {}", u32::MAX))?;
+    let mut iter = inputs.into_iter();
+    let (_, mut merged) = iter.next().expect("not empty");
+    for (_, c) in iter {
+        merged.accumulator.merge(&c.accumulator);
+        merged.metadata.render_seconds += c.metadata.render_seconds;
+    }
+    merged.spp_done = spp_done;
+    let accumulator = &merged.accumulator;
+    for (key, value) in [
+        ("spp", spp_done.to_string()),
+        ("estimated_relative_error", accumulator.estimated_relative_error().to_string()),
+        ("dropped_samples", accumulator.dropped_samples().to_string()),
+        ("stopped_by", "spp".to_owned()),
+        ("source", "merge example".to_owned()),
+    ] {
+        match merged.metadata.fields.iter_mut().find(|(k, _)| k == key) {
+            Some(field) => field.1 = value,
+            None => merged.metadata.fields.push((key.to_owned(), value)),
+        }
+    }
+    Ok(merged)
 }
 
 #[cfg(test)]
