@@ -12,6 +12,7 @@
 //! - `display_sum`: the viewer's GPU-resident running image agrees with the f64 statistics;
 //! - `specialisation`: each scene's pipeline holds what it uses, is cached, refuses others,
 //!   and keeps the caller's submission size across a resize;
+//! - `overflow`: lights up to f32::MAX keep a finite image, error estimate and display sum;
 //! - `random_scenes`: a few hundred random valid scenes render without NaN or dropped samples;
 //! - `shaders`: naga validates every WGSL file in shaders/ (the raster's and viewer's too).
 
@@ -23,6 +24,7 @@ mod display_sum;
 mod error_estimate;
 mod extremes;
 mod oracle_agreement;
+mod overflow;
 mod random_scenes;
 mod reference;
 mod sampling;
