@@ -513,8 +513,7 @@ fn mismatched_corrupt_and_overlapping_inputs_are_refused_by_name() {
     let out = run(&["--resume", &p("truncated.exr"), "--spp", "64", "-o", &p("t.exr")]);
     assert!(!out.status.success() && text(&out.stderr).contains("truncated.exr"), "{}", text(&out.stderr));
     assert!(!Path::new(&p("t.exr")).exists());
-    let mut plain = illum::image::ExrMetadata::default();
-    plain.renderer = "pathtrace".into();
+    let plain = illum::image::ExrMetadata { renderer: "pathtrace".into(), ..Default::default() };
     illum::image::save_exr(p("plain.exr"), &illum::image::RgbImage32::new(2, 2), &plain).unwrap();
     let out = run(&["--resume", &p("plain.exr"), "--spp", "64"]);
     assert!(!out.status.success() && text(&out.stderr).contains("plain.exr"), "{}", text(&out.stderr));

@@ -114,7 +114,7 @@ fn random_scene(rng: &mut Rng) -> String {
     for l in 0..lights {
         let size = rng.log(1e-2, world.max(1.0));
         // Facing either way: a light facing away from everything is valid, and renders black.
-        let flip = if rng.next() % 2 == 0 { 1.0 } else { -1.0 };
+        let flip = if rng.next().is_multiple_of(2) { 1.0 } else { -1.0 };
         text += &format!(
             "[[objects]]\nname = \"light {l}\"\nmaterial = \"light{l}\"\nquad = {{ corner = {}, edge_u = [{size:?}, 0.0, 0.0], edge_v = [0.0, 0.0, {:?}] }}\n\n",
             rng.vec3(world),

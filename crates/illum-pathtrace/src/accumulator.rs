@@ -42,7 +42,7 @@ pub const UNSCALED_RADIANCE_LIMIT: f32 = 65536.0;
 /// The exponent k by which the GPU's radiance is scaled down (2^-k) for a scene whose brightest
 /// emission component is `max_emission` (0 for every emission up to [`UNSCALED_RADIANCE_LIMIT`]).
 pub fn radiance_exponent(max_emission: f32) -> i32 {
-    if !(max_emission > UNSCALED_RADIANCE_LIMIT) {
+    if max_emission.is_nan() || max_emission <= UNSCALED_RADIANCE_LIMIT {
         return 0;
     }
     // max_emission in [2^e, 2^(e+1)), e >= 16; after scaling by 2^-(e - 16) it is below 2^17.
