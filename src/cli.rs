@@ -97,6 +97,23 @@ pub fn given_flags(flags: &[(bool, &'static str)]) -> Vec<&'static str> {
     flags.iter().filter_map(|&(given, flag)| given.then_some(flag)).collect()
 }
 
+/// Parses `--sample-range A..B`: sample indices A to B-1, A < B.
+pub fn sample_range_arg(text: &str) -> Result<std::ops::Range<u32>, String> {
+    let (a, b) = text
+        .split_once("..")
+        .ok_or_else(|| format!("{text:?}: expected A..B, for example 0..256 (sample indices A to B-1)"))?;
+    let parse = |part: &str, which: &str| {
+        part.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("{text:?}: {which} {part:?} is not a whole number 0..={}", u32::MAX))
+    };
+    let (a, b) = (parse(a, "start")?, parse(b, "end")?);
+    if a >= b {
+        return Err(format!("{text:?}: the range is empty; the end must be above the start"));
+    }
+    Ok(a..b)
+}
+
 /// Checks every output before any rendering, so that a finished render is never lost to a bad
 /// name: a known extension, a folder that can take the file, not a directory or a read-only
 /// file. `png_flags` are the PNG-only flags given (`--encoding`, `--exposure`): an error when no

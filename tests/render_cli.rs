@@ -299,7 +299,7 @@ fn example_binary(name: &str) -> PathBuf {
 
 #[test]
 fn every_examples_help_says_what_it_does_and_documents_each_flag() {
-    for name in ["render", "figures", "convergence", "bench", "raster_bench", "raster_figures"] {
+    for name in ["render", "merge", "figures", "convergence", "bench", "raster_bench", "raster_figures"] {
         let binary = example_binary(name);
         assert!(binary.exists(), "{} is missing (cargo test builds the examples)", binary.display());
         let out = Command::new(&binary).arg("--help").output().expect("runs");
@@ -377,4 +377,196 @@ fn the_readme_shows_only_pictures_examples_and_flags_that_exist() {
         }
     }
     assert!(checked > 20, "only {checked} flags found in the README's example lines");
+}
+
+// ---- Long renders: checkpoints, resume, sample ranges and merge ----
+
+/// The merge example's executable.
+fn merge(args: &[&str]) -> Output {
+    Command::new(example_binary("merge"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("the merge example starts")
+}
+
+fn checkpoint(path: &Path) -> illum::pathtrace::checkpoint::Checkpoint {
+    illum::pathtrace::checkpoint::load_checkpoint(path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Every pixel's f64 sum, sum of squares and count, as bits (for exact comparisons).
+fn statistics_bits(path: &Path) -> Vec<u64> {
+    let c = checkpoint(path);
+    let state = c.accumulator.state();
+    let floats = state.sum.iter().chain(state.sum_sq).flatten().map(|v| v.to_bits());
+    floats.chain(state.count.iter().copied()).collect()
+}
+
+/// The largest relative difference between two checkpoints' per-pixel sums and sums of squares
+/// (their counts must be equal).
+fn max_relative_difference(a: &Path, b: &Path) -> f64 {
+    let (a, b) = (checkpoint(a), checkpoint(b));
+    let (sa, sb) = (a.accumulator.state(), b.accumulator.state());
+    assert_eq!(sa.count, sb.count, "different sample counts");
+    let pairs = sa.sum.iter().zip(sb.sum).chain(sa.sum_sq.iter().zip(sb.sum_sq));
+    pairs
+        .flat_map(|(x, y)| (0..3).map(move |c| (x[c], y[c])))
+        .map(|(x, y)| if x == y { 0.0 } else { (x - y).abs() / x.abs().max(y.abs()) })
+        .fold(0.0, f64::max)
+}
+
+const SMALL: [&str; 4] = ["--width", "32", "--height", "32"];
+
+fn render_ok(extra: &[&str]) -> Output {
+    let mut args = SMALL.to_vec();
+    args.extend(extra);
+    let out = run(&args);
+    assert!(out.status.success(), "{args:?}: {}", text(&out.stderr));
+    out
+}
+
+#[cfg(unix)]
+#[test]
+fn sigint_mid_render_then_resume_equals_a_straight_render_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    let (partial, straight) = (dir.path().join("partial.exr"), dir.path().join("straight.exr"));
+    let target = 8192;
+    let (mut child, lines) = start_long_render("32", &target.to_string(), &partial, 1);
+    signal(&child, "INT");
+    let _: Vec<String> = lines.map_while(Result::ok).collect();
+    assert_eq!(child.wait().expect("the render ends").code(), Some(130));
+
+    // The partial file: valid, below the target, no NaN, marked as cancelled.
+    let meta = metadata(&partial);
+    assert_eq!(field(&meta, "stopped_by"), "cancelled");
+    let spp: u32 = field(&meta, "spp").parse().unwrap();
+    assert!((1..target).contains(&spp), "interrupted at {spp} spp of {target}");
+    let (image, _) = illum::image::load_exr(&partial).unwrap();
+    assert!(image.pixels.iter().flatten().all(|v| v.is_finite()), "NaN or Inf in the partial image");
+
+    let resumed = render_ok(&["--resume", partial.to_str().unwrap(), "--spp", &target.to_string()]);
+    assert!(text(&resumed.stdout).contains(&format!("resuming {}: {spp} spp done", partial.display())));
+    render_ok(&["--spp", &target.to_string(), "-o", straight.to_str().unwrap()]);
+    assert_eq!(field(&metadata(&partial), "spp"), target.to_string());
+    assert!(
+        statistics_bits(&partial) == statistics_bits(&straight),
+        "the resumed render differs from the straight one"
+    );
+    let ((a, _), (b, _)) =
+        (illum::image::load_exr(&partial).unwrap(), illum::image::load_exr(&straight).unwrap());
+    assert_eq!(a, b, "mean images differ");
+}
+
+#[test]
+fn three_sample_ranges_merged_equal_one_render() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).to_str().unwrap().to_owned();
+    for (range, name) in [("0..48", "a.exr"), ("48..80", "b.exr"), ("80..160", "c.exr")] {
+        render_ok(&["--sample-range", range, "-o", &p(name)]);
+        assert_eq!(field(&metadata(Path::new(&p(name))), "sample_start"), range.split("..").next().unwrap());
+    }
+    render_ok(&["--spp", "160", "-o", &p("straight.exr")]);
+    // Inputs in any order.
+    let out = merge(&[&p("c.exr"), &p("a.exr"), &p("b.exr"), "-o", &p("merged.exr")]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(text(&out.stdout).contains("samples 0..160 (160 spp)"), "{}", text(&out.stdout));
+    let difference = max_relative_difference(Path::new(&p("merged.exr")), Path::new(&p("straight.exr")));
+    assert!(difference <= 1e-12, "merged differs from one render by {difference:e} relative");
+    assert_eq!(field(&metadata(Path::new(&p("merged.exr"))), "spp"), "160");
+}
+
+/// What `parallel render ... --sample-range {} ::: 0..64 64..128` runs: two processes at once.
+#[test]
+fn two_concurrent_processes_like_gnu_parallel_then_merge_equal_one_render() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).to_str().unwrap().to_owned();
+    let children: Vec<(Child, String)> = [("0..64", "r0.exr"), ("64..128", "r1.exr")]
+        .into_iter()
+        .map(|(range, name)| {
+            let mut args = SMALL.to_vec();
+            args.extend(["--sample-range", range, "-o"]);
+            let path = p(name);
+            let child =
+                render(&args).arg(&path).stdout(Stdio::null()).stderr(Stdio::piped()).spawn().unwrap();
+            (child, path)
+        })
+        .collect();
+    for (child, path) in children {
+        let out = child.wait_with_output().unwrap();
+        assert!(out.status.success(), "{path}: {}", text(&out.stderr));
+    }
+    render_ok(&["--spp", "128", "-o", &p("straight.exr")]);
+    let out = merge(&[&p("r0.exr"), &p("r1.exr"), "-o", &p("merged.exr")]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let difference = max_relative_difference(Path::new(&p("merged.exr")), Path::new(&p("straight.exr")));
+    assert!(difference <= 1e-12, "{difference:e}");
+}
+
+#[test]
+fn mismatched_corrupt_and_overlapping_inputs_are_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).to_str().unwrap().to_owned();
+    render_ok(&["--sample-range", "0..16", "-o", &p("a.exr")]);
+    render_ok(&["--sample-range", "8..32", "-o", &p("overlap.exr")]);
+    render_ok(&["--sample-range", "16..32", "--seed", "7", "-o", &p("seed7.exr")]);
+    render_ok(&["--sample-range", "32..48", "-o", &p("gap.exr")]);
+    let original = std::fs::read(p("a.exr")).unwrap();
+
+    for (inputs, expected) in [
+        (vec![p("a.exr"), p("overlap.exr")], "overlap"),
+        (vec![p("a.exr"), p("seed7.exr")], "seed: 0 in"),
+        (vec![p("a.exr"), p("gap.exr")], "samples 16..32 are missing"),
+    ] {
+        let mut args: Vec<&str> = inputs.iter().map(String::as_str).collect();
+        let out_path = p("never.exr");
+        args.extend(["-o", &out_path]);
+        let out = merge(&args);
+        assert_no_panic(&out);
+        assert!(
+            !out.status.success() && text(&out.stderr).contains(expected),
+            "{args:?}: {}",
+            text(&out.stderr)
+        );
+        assert!(!Path::new(&out_path).exists());
+    }
+
+    // Resuming with another setting, another resolution or an edited scene names what differs.
+    let a = p("a.exr");
+    for (flags, expected) in [
+        (&["--seed", "3"][..], "seed: 0 in the file, 3 now"),
+        (&["--bounces", "5"][..], "bounces: 2 in the file, 5 now"),
+        (&["--width", "16"][..], "width: 32 in the file, 16 now"),
+    ] {
+        let width = if flags[0] == "--width" { flags[1] } else { "32" };
+        let mut args = vec!["--width", width, "--height", "32"];
+        let flags = if flags[0] == "--width" { &[][..] } else { flags };
+        args.extend(["--resume", &a, "--spp", "64"]);
+        args.extend(flags);
+        let out = run(&args);
+        assert!(
+            !out.status.success() && text(&out.stderr).contains(expected),
+            "{flags:?}: {}",
+            text(&out.stderr)
+        );
+    }
+    let edited = dir.path().join("edited.toml");
+    let scene =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.toml")).unwrap();
+    std::fs::write(&edited, scene.replace("vfov = 45.0", "vfov = 46.0")).unwrap();
+    let mut args = vec![edited.to_str().unwrap()];
+    args.extend(SMALL);
+    args.extend(["--resume", &a, "--spp", "64"]);
+    let out = run(&args);
+    assert!(text(&out.stderr).contains("scene content"), "{}", text(&out.stderr));
+    assert_eq!(std::fs::read(p("a.exr")).unwrap(), original, "a refused resume changed the file");
+
+    // A truncated file and a file without statistics: refused, nothing written.
+    std::fs::write(p("truncated.exr"), &original[..original.len() / 2]).unwrap();
+    let out = run(&["--resume", &p("truncated.exr"), "--spp", "64", "-o", &p("t.exr")]);
+    assert!(!out.status.success() && text(&out.stderr).contains("truncated.exr"), "{}", text(&out.stderr));
+    assert!(!Path::new(&p("t.exr")).exists());
+    let plain = illum::image::ExrMetadata { renderer: "pathtrace".into(), ..Default::default() };
+    illum::image::save_exr(p("plain.exr"), &illum::image::RgbImage32::new(2, 2), &plain).unwrap();
+    let out = run(&["--resume", &p("plain.exr"), "--spp", "64"]);
+    assert!(!out.status.success() && text(&out.stderr).contains("plain.exr"), "{}", text(&out.stderr));
 }

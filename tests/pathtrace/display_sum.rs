@@ -19,7 +19,7 @@ fn tracer(width: u32, height: u32, spp: u32, seed: u32) -> PathTracer {
 }
 
 /// The display sum read back: (rgb sum, count) per pixel.
-fn read_display_sum(tracer: &PathTracer) -> Vec<[f32; 4]> {
+pub(crate) fn read_display_sum(tracer: &PathTracer) -> Vec<[f32; 4]> {
     let buffer = tracer.display_sum_buffer().expect("display sum enabled");
     let camera = tracer.scene().camera;
     let size = u64::from(camera.width) * u64::from(camera.height) * DISPLAY_PIXEL_BYTES;

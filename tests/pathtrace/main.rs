@@ -11,7 +11,9 @@
 //! - `extremes`: the path tracer where floats run out;
 //! - `display_sum`: the viewer's GPU-resident running image agrees with the f64 statistics;
 //! - `specialisation`: each scene's pipeline holds what it uses, is cached, refuses others,
-//!   and keeps the caller's submission size across a resize.
+//!   and keeps the caller's submission size across a resize;
+//! - `overflow`: lights up to f32::MAX keep a finite image, error estimate and display sum;
+//! - `random_scenes`: a few hundred random valid scenes render without NaN or dropped samples.
 //!
 //! naga validates the shaders without a GPU in each crate's own tests (see tests/shaders.rs).
 
@@ -23,6 +25,8 @@ mod display_sum;
 mod error_estimate;
 mod extremes;
 mod oracle_agreement;
+mod overflow;
+mod random_scenes;
 mod reference;
 mod sampling;
 mod specialisation;

@@ -187,6 +187,132 @@ pub fn save_exr(
     })
 }
 
+/// An extra EXR layer of 32-bit unsigned integer channels, stored after the RGB image (a
+/// multi-part file): exact data that f32 cannot hold, such as the path tracer's f64 statistics
+/// split into two words (see `illum_pathtrace::checkpoint`). Other EXR readers show the RGB
+/// image and ignore it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct U32Layer {
+    /// The layer's name (the part's `name` attribute).
+    pub name: String,
+    /// Channel names and their values, row-major like the image (one per pixel each).
+    pub channels: Vec<(String, Vec<u32>)>,
+}
+
+/// As [`save_exr`], plus `layers` after the RGB image, all in one atomic write. The RGB layer
+/// is named `rgb` when there are extra layers (a multi-part file needs names).
+pub fn save_exr_with_layers(
+    path: impl AsRef<Path>,
+    image: &RgbImage32,
+    metadata: &ExrMetadata,
+    layers: &[U32Layer],
+) -> Result<(), ImageError> {
+    use exr::prelude::{AnyChannel, AnyChannels, FlatSamples};
+    let path = path.as_ref();
+    if layers.is_empty() {
+        return save_exr(path, image, metadata);
+    }
+    check_writable(path, image)?;
+    let attributes = metadata.to_attributes();
+    check_attribute_names(path, &attributes)?;
+    let pixels = image.width as usize * image.height as usize;
+    for layer in layers {
+        for (name, values) in &layer.channels {
+            if values.len() != pixels {
+                return Err(ImageError::invalid(
+                    path,
+                    format!(
+                        "layer '{}' channel '{name}' has {} values for {pixels} pixels",
+                        layer.name,
+                        values.len()
+                    ),
+                ));
+            }
+        }
+    }
+    let mut layer_attributes = LayerAttributes {
+        software_name: Some(text("illum")),
+        layer_name: Some(text("rgb")),
+        ..LayerAttributes::default()
+    };
+    for (name, value) in &attributes {
+        layer_attributes.other.insert(text(name), AttributeValue::Text(text(value)));
+    }
+    let size = (image.width as usize, image.height as usize);
+    let channel = |name: &str, c: usize| {
+        AnyChannel::new(name, FlatSamples::F32(image.pixels.iter().map(|p| p[c]).collect()))
+    };
+    let rgb = Layer::new(
+        size,
+        layer_attributes,
+        exr::image::Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort([channel("B", 2), channel("G", 1), channel("R", 0)].into_iter().collect()),
+    );
+    let mut all = vec![rgb];
+    for layer in layers {
+        let channels = layer
+            .channels
+            .iter()
+            .map(|(name, values)| AnyChannel::new(name.as_str(), FlatSamples::U32(values.clone())))
+            .collect();
+        all.push(Layer::new(
+            size,
+            LayerAttributes::named(text(&layer.name)),
+            exr::image::Encoding::SMALL_LOSSLESS,
+            AnyChannels::sort(channels),
+        ));
+    }
+    let exr_image = Image::from_layers(
+        exr::prelude::ImageAttributes::new(exr::prelude::IntegerBounds::from_dimensions(size)),
+        all,
+    );
+    write_atomically(path, |file| {
+        exr_image.write().to_unbuffered(file).map_err(|e| ImageError::Encode {
+            path: path.to_path_buf(),
+            format: "EXR",
+            source: Box::new(e),
+        })
+    })
+}
+
+/// Reads the layer named `name` of an EXR file as 32-bit unsigned channels: (channel name,
+/// values). `Ok(None)` when the file has no such layer; an error for an unreadable file or a
+/// channel of another sample type.
+pub fn load_u32_layer(path: impl AsRef<Path>, name: &str) -> Result<Option<U32Layer>, ImageError> {
+    use exr::prelude::{FlatSamples, ReadLayers as _};
+    let path = path.as_ref();
+    let file = File::open(path).map_err(|e| ImageError::io(path, "opening the EXR file", e))?;
+    let image = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .all_layers()
+        .all_attributes()
+        .from_buffered(BufReader::new(file))
+        .map_err(|e| ImageError::Decode { path: path.to_path_buf(), format: "EXR", source: Box::new(e) })?;
+    let Some(layer) =
+        image.layer_data.iter().find(|l| l.attributes.layer_name.as_ref().is_some_and(|n| string(n) == name))
+    else {
+        return Ok(None);
+    };
+    let mut channels = Vec::new();
+    for channel in &layer.channel_data.list {
+        let channel_name = string(&channel.name);
+        match &channel.sample_data {
+            FlatSamples::U32(values) => channels.push((channel_name, values.clone())),
+            _ => {
+                return Err(ImageError::BadContent {
+                    path: path.to_path_buf(),
+                    reason: format!(
+                        "layer '{name}' channel '{channel_name}' is not 32-bit unsigned integers"
+                    ),
+                });
+            }
+        }
+    }
+    Ok(Some(U32Layer { name: name.to_owned(), channels }))
+}
+
 /// Pixels as the reader delivers them, before the size is known to fit in `u32`.
 struct ReadPixels {
     width: usize,
@@ -302,6 +428,26 @@ mod tests {
         expected.fields.sort();
         assert_eq!(parsed.get("adapter"), Some("llvmpipe (LLVM 19)"));
         assert_eq!(parsed, expected);
+    }
+
+    #[test]
+    fn extra_u32_layers_round_trip_and_the_rgb_image_still_loads() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("layers.exr");
+        let img = RgbImage32::from_fn(3, 2, |x, y| [x as f32, y as f32, 0.5]);
+        let layer = U32Layer {
+            name: "state".into(),
+            channels: vec![("a".into(), vec![0, 1, 2, u32::MAX, 4, 5]), ("b".into(), vec![7; 6])],
+        };
+        save_exr_with_layers(&path, &img, &metadata(), std::slice::from_ref(&layer)).unwrap();
+        let (back, attrs) = load_exr(&path).unwrap();
+        assert_eq!(back, img);
+        assert_eq!(
+            ExrMetadata::from_attributes(&path, &attrs).unwrap().unwrap().get("spp"),
+            Some("1099511627776")
+        );
+        assert_eq!(load_u32_layer(&path, "state").unwrap(), Some(layer));
+        assert_eq!(load_u32_layer(&path, "other").unwrap(), None);
     }
 
     #[test]

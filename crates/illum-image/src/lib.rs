@@ -25,7 +25,7 @@ use std::path::PathBuf;
 pub use atomic::{check_output, write_atomically};
 pub use contact_sheet::contact_sheet;
 pub use diff::{DiffImages, save_diff_images};
-pub use exr::{ExrMetadata, load_exr, save_exr};
+pub use exr::{ExrMetadata, U32Layer, load_exr, load_u32_layer, save_exr, save_exr_with_layers};
 pub use metrics::{
     MetricsError, inverse_normal_cdf, mean_luminance_bias, median, rel_mse, rmse, z_test_pass_fraction,
 };

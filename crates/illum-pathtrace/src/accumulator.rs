@@ -20,6 +20,33 @@ pub struct Accumulator {
     /// the image (progress reports read it after every band).
     total: u64,
     dropped: u64,
+    /// 2^k: what the GPU's values are multiplied by when folded (see [`radiance_exponent`]).
+    sum_scale: f64,
+}
+
+/// Largest emitted radiance the GPU traces unscaled: 2^16. Above it the scene's emission is
+/// divided by a power of two 2^k on upload (so that the brightest light is below 2^17) and the
+/// fold multiplies the sums back by 2^k and the sums of squares by 2^(2k), in f64.
+///
+/// Why: a sample is at most about the brightest emission times a geometric factor of the
+/// next-event estimator (light area / distance^2), and the GPU squares it in f32 and sums 16 such
+/// squares. Unscaled, `emission = 1e30` gave squares of 1e60, past f32's 3.4e38: an infinite
+/// variance while the image was still finite. Scaled, a sample squares in range unless that
+/// geometric factor exceeds about 1e13, so every radiance the validator accepts (up to f32::MAX)
+/// keeps a finite error estimate. Multiplying by a power of two is exact in binary floating point
+/// (short of subnormal numbers), so the scaled render is the unscaled one, bit for bit, times 2^-k;
+/// and scenes whose lights are below 2^16 (every scene in scenes/) are not scaled at all.
+pub const UNSCALED_RADIANCE_LIMIT: f32 = 65536.0;
+
+/// The exponent k by which the GPU's radiance is scaled down (2^-k) for a scene whose brightest
+/// emission component is `max_emission` (0 for every emission up to [`UNSCALED_RADIANCE_LIMIT`]).
+pub fn radiance_exponent(max_emission: f32) -> i32 {
+    if max_emission.is_nan() || max_emission <= UNSCALED_RADIANCE_LIMIT {
+        return 0;
+    }
+    // max_emission in [2^e, 2^(e+1)), e >= 16; after scaling by 2^-(e - 16) it is below 2^17.
+    let e = ((max_emission.to_bits() >> 23) & 0xff) as i32 - 127;
+    e - 16
 }
 
 /// Host bytes per pixel of the f64 statistics: sum and sum of squares (3 x f64 each) and the
@@ -73,6 +100,7 @@ impl Accumulator {
             count: vec![0; n],
             total: 0,
             dropped: 0,
+            sum_scale: 1.0,
         }
     }
 
@@ -90,17 +118,74 @@ impl Accumulator {
         sum.resize(n, [0.0; 3]);
         sum_sq.resize(n, [0.0; 3]);
         count.resize(n, 0);
-        Ok(Self { width, height, sum, sum_sq, count, total: 0, dropped: 0 })
+        Ok(Self { width, height, sum, sum_sq, count, total: 0, dropped: 0, sum_scale: 1.0 })
+    }
+
+    /// Folds from now on values the GPU computed with radiance scaled by 2^-`exponent` (see
+    /// [`radiance_exponent`]): sums are multiplied by 2^k, sums of squares by 2^(2k).
+    pub fn set_radiance_exponent(&mut self, exponent: i32) {
+        self.sum_scale = 2f64.powi(exponent);
+    }
+
+    /// The exact state, for checkpoints (see `checkpoint.rs`): per pixel the sum and sum of
+    /// squares of its finite samples (f64, unscaled) and their count, plus the dropped total.
+    pub fn state(&self) -> AccumulatorState<'_> {
+        AccumulatorState { sum: &self.sum, sum_sq: &self.sum_sq, count: &self.count, dropped: self.dropped }
+    }
+
+    /// Rebuilds an accumulator from a saved state (its vectors must have `width x height`
+    /// entries). The running total is recomputed; folding goes on exactly where it stopped.
+    pub fn from_state(
+        width: u32,
+        height: u32,
+        sum: Vec<[f64; 3]>,
+        sum_sq: Vec<[f64; 3]>,
+        count: Vec<u64>,
+        dropped: u64,
+    ) -> Result<Self, String> {
+        let n = width as usize * height as usize;
+        if sum.len() != n || sum_sq.len() != n || count.len() != n {
+            return Err(format!(
+                "the statistics have {} / {} / {} entries for a {width} x {height} image ({n} pixels)",
+                sum.len(),
+                sum_sq.len(),
+                count.len()
+            ));
+        }
+        let total = count.iter().sum();
+        Ok(Self { width, height, sum, sum_sq, count, total, dropped, sum_scale: 1.0 })
+    }
+
+    /// Adds another accumulator's samples of the same image (a disjoint set of sample indices:
+    /// see the `merge` example), pixel by pixel in f64.
+    pub fn merge(&mut self, other: &Accumulator) {
+        assert_eq!(
+            (self.width, self.height),
+            (other.width, other.height),
+            "merging images of different sizes"
+        );
+        for p in 0..self.count.len() {
+            for c in 0..3 {
+                self.sum[p][c] += other.sum[p][c];
+                self.sum_sq[p][c] += other.sum_sq[p][c];
+            }
+            self.count[p] += other.count[p];
+        }
+        self.total += other.total;
+        self.dropped += other.dropped;
     }
 
     /// Folds one batch for consecutive pixels starting at `first_pixel`. `sums[i]` is (sum, finite
     /// count), `sums_sq[i]` is (sum of squares, dropped count), as the shader writes them.
     pub fn fold(&mut self, first_pixel: usize, sums: &[[f32; 4]], sums_sq: &[[f32; 4]]) {
+        // With scale 1 (every scene whose lights are below 2^16) the products are exact no-ops.
+        let scale = self.sum_scale;
+        let scale_sq = scale * scale;
         for (i, (s, q)) in sums.iter().zip(sums_sq).enumerate() {
             let p = first_pixel + i;
             for c in 0..3 {
-                self.sum[p][c] += s[c] as f64;
-                self.sum_sq[p][c] += q[c] as f64;
+                self.sum[p][c] += s[c] as f64 * scale;
+                self.sum_sq[p][c] += q[c] as f64 * scale_sq;
             }
             self.count[p] += s[3] as u64;
             self.total += s[3] as u64;
@@ -157,7 +242,9 @@ impl Accumulator {
     pub fn mean_image(&self) -> RgbImage32 {
         let mut image = RgbImage32::new(self.width, self.height);
         for (p, px) in image.pixels.iter_mut().enumerate() {
-            *px = self.pixel_mean(p).map(|v| v as f32);
+            // A mean beyond f32's range (a light near f32::MAX seen through noise) is stored as
+            // f32::MAX rather than infinity: EXR and PNG hold f32 at most.
+            *px = self.pixel_mean(p).map(|v| v.min(f32::MAX as f64) as f32);
         }
         image
     }
@@ -194,8 +281,19 @@ impl Accumulator {
     }
 
     pub fn reset(&mut self) {
+        let scale = self.sum_scale;
         *self = Self::new(self.width, self.height);
+        self.sum_scale = scale;
     }
+}
+
+/// A borrowed view of an [`Accumulator`]'s exact state (see [`Accumulator::state`]).
+#[derive(Clone, Copy, Debug)]
+pub struct AccumulatorState<'a> {
+    pub sum: &'a [[f64; 3]],
+    pub sum_sq: &'a [[f64; 3]],
+    pub count: &'a [u64],
+    pub dropped: u64,
 }
 
 #[cfg(test)]
@@ -226,6 +324,49 @@ mod tests {
         if cfg!(target_os = "linux") {
             assert!(available_host_memory().is_some_and(|b| b > 0));
         }
+    }
+
+    #[test]
+    fn radiance_is_scaled_only_above_the_limit_and_by_a_power_of_two() {
+        assert_eq!(radiance_exponent(30.0), 0);
+        assert_eq!(radiance_exponent(UNSCALED_RADIANCE_LIMIT), 0);
+        assert_eq!(radiance_exponent(f32::NAN), 0);
+        for m in [65536.5f32, 1e20, 1e30, f32::MAX] {
+            let k = radiance_exponent(m);
+            let scaled = m as f64 * 2f64.powi(-k);
+            assert!((65536.0..131072.0).contains(&scaled), "{m}: k = {k}, scaled {scaled}");
+        }
+        // The fold undoes the scale exactly: a sample of f32::MAX, traced as f32::MAX / 2^k.
+        let k = radiance_exponent(f32::MAX);
+        let traced = f32::MAX * 2f32.powi(-k);
+        let mut acc = Accumulator::new(1, 1);
+        acc.set_radiance_exponent(k);
+        for _ in 0..2 {
+            acc.fold(0, &[[traced, 1.0, 1.0, 1.0]], &[[traced * traced, 1.0, 1.0, 0.0]]);
+        }
+        assert_eq!(acc.pixel_mean(0)[0], f32::MAX as f64);
+        assert!(acc.estimated_relative_error().is_finite());
+    }
+
+    #[test]
+    fn state_round_trips_and_merges_add() {
+        let mut a = Accumulator::new(2, 1);
+        a.fold(
+            0,
+            &[[1.0, 2.0, 3.0, 2.0], [4.0, 5.0, 6.0, 2.0]],
+            &[[1.0, 4.0, 9.0, 0.0], [16.0, 25.0, 36.0, 1.0]],
+        );
+        let s = a.state();
+        let b = Accumulator::from_state(2, 1, s.sum.to_vec(), s.sum_sq.to_vec(), s.count.to_vec(), s.dropped)
+            .unwrap();
+        assert_eq!(b.total_samples(), 4);
+        assert_eq!(b.dropped_samples(), 1);
+        assert_eq!(b.pixel_sum(1), [4.0, 5.0, 6.0]);
+        let mut c = b.clone();
+        c.merge(&a);
+        assert_eq!(c.pixel_sum(0), [2.0, 4.0, 6.0]);
+        assert_eq!(c.pixel_count(1), 4);
+        assert!(Accumulator::from_state(3, 1, vec![], vec![], vec![], 0).unwrap_err().contains("3 x 1"));
     }
 
     #[test]

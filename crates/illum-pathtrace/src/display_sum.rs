@@ -129,7 +129,9 @@ impl DisplaySum {
     /// that never went through the display pass: the display sum was enabled after rendering
     /// started, or a band failed after its display pass had run. This one upload is the only
     /// time the display sum takes data from the CPU.
-    pub(crate) fn seed(&self, gpu: &GpuContext, accumulator: &Accumulator) {
+    /// `radiance_exponent` is the tracer's k: the display sum holds the GPU's samples, which are
+    /// the true ones times 2^-k (see `accumulator::radiance_exponent`).
+    pub(crate) fn seed(&self, gpu: &GpuContext, accumulator: &Accumulator, radiance_exponent: i32) {
         if accumulator.total_samples() == 0 {
             self.clear(gpu);
             return;
@@ -137,7 +139,7 @@ impl DisplaySum {
         let pixels = self.width as usize * self.height as usize;
         let data: Vec<[f32; 4]> = (0..pixels)
             .map(|p| {
-                let [r, g, b] = accumulator.pixel_sum(p).map(|v| v as f32);
+                let [r, g, b] = accumulator.pixel_sum(p).map(|v| (v * 2f64.powi(-radiance_exponent)) as f32);
                 [r, g, b, accumulator.pixel_count(p) as f32]
             })
             .collect();

@@ -217,6 +217,10 @@ pub struct GpuScene {
     pub light_area: f32,
     /// Index of the first emitter in `objects`.
     pub first_emitter: u32,
+    /// Every emission above was multiplied by 2^-`radiance_exponent` (0 unless a light exceeds
+    /// 2^16; see [`crate::accumulator::radiance_exponent`]), so the GPU's samples are the true
+    /// ones times 2^-k, exactly.
+    pub radiance_exponent: i32,
 }
 
 fn v4(v: Vec3, w: f32) -> [f32; 4] {
@@ -226,13 +230,16 @@ fn v4(v: Vec3, w: f32) -> [f32; 4] {
 impl GpuScene {
     pub fn new(scene: &Scene) -> Result<Self, PathTraceError> {
         scene.require(RendererKind::PathTrace, FEATURES)?;
+        let max_emission = scene.materials.iter().map(|m| m.emission().max_element()).fold(0.0f32, f32::max);
+        let radiance_exponent = crate::accumulator::radiance_exponent(max_emission);
+        let emission_scale = 2f32.powi(-radiance_exponent);
         // Every material left is Lambertian or an emitter (which reflects nothing).
         let materials = scene
             .materials
             .iter()
             .map(|m| GpuMaterial {
                 albedo: v4(m.diffuse_albedo().unwrap_or(Vec3::ZERO), 0.0),
-                emission: v4(m.emission(), 0.0),
+                emission: v4(m.emission() * emission_scale, 0.0),
             })
             .collect();
         let mut objects = Vec::with_capacity(scene.objects.len());
@@ -261,7 +268,7 @@ impl GpuScene {
                             edge_u: v4(q.edge_u, area),
                             edge_v: v4(q.edge_v, 0.0),
                             normal: v4(q.normal(), 0.0),
-                            emission: v4(material.emission(), 0.0),
+                            emission: v4(material.emission() * emission_scale, 0.0),
                         });
                     }
                     GpuShape::Quad { corner: q.corner, edge_u: q.edge_u, edge_v: q.edge_v }
@@ -294,7 +301,7 @@ impl GpuScene {
         }
         let first_emitter = objects.len() as u32;
         objects.extend(emitters);
-        Ok(Self { objects, materials, lights, light_area, first_emitter })
+        Ok(Self { objects, materials, lights, light_area, first_emitter, radiance_exponent })
     }
 }
 

@@ -11,6 +11,7 @@
 
 pub mod accumulator;
 mod batch;
+pub mod checkpoint;
 pub mod display_sum;
 mod error;
 pub mod gpu_scene;

@@ -20,7 +20,11 @@ pub const RENDERER: &str = "pathtrace";
 ///   2 spp); `dropped_samples`: NaN/Inf samples left out;
 /// - `stopped_by`: the stop rule that ended the render (`spp`, `target_error`, `time_budget`,
 ///   `cancelled`), or `none` for an image saved while rendering (the viewer);
-/// - `adapter`: the GPU adapter's name; `source`: the program that wrote the file.
+/// - `adapter`: the GPU adapter's name; `source`: the program that wrote the file;
+/// - `scene_hash`: [`crate::checkpoint::scene_content_hash`]; `sample_start`: the first sample
+///   index (see [`PathTracer::set_sample_offset`]); `partial_pass_spp` and `partial_pass_rows`:
+///   a pass the render stopped inside (its spp and the rows it had done; 0 and 0 for none).
+///   With the statistics layer of [`crate::checkpoint`], these let a render be continued.
 pub fn exr_metadata(
     tracer: &PathTracer,
     render_seconds: f64,
@@ -40,6 +44,10 @@ pub fn exr_metadata(
         ("stopped_by", stopped_by.map_or("none", StopReason::name).to_owned()),
         ("adapter", tracer.adapter_name().to_owned()),
         ("source", source.to_owned()),
+        ("scene_hash", crate::checkpoint::scene_content_hash(scene)),
+        ("sample_start", tracer.sample_offset().to_string()),
+        ("partial_pass_spp", tracer.partial_pass().map_or(0, |p| p.0).to_string()),
+        ("partial_pass_rows", tracer.partial_pass().map_or(0, |p| p.1).to_string()),
     ];
     ExrMetadata {
         renderer: RENDERER.to_owned(),

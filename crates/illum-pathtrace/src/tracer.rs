@@ -71,6 +71,13 @@ pub struct PathTracer {
     pass: Option<ActivePass>,
     /// Samples per pixel of all completed passes.
     spp_done: u32,
+    /// The sample index of this tracer's first sample (see [`Self::set_sample_offset`]).
+    sample_offset: u32,
+    /// Whether [`Self::render_step`] ends passes on multiples of the chunk (see
+    /// [`Self::set_chunk_aligned_passes`]).
+    chunk_aligned: bool,
+    /// 2^-k scale of the uploaded emission (see `accumulator::radiance_exponent`).
+    radiance_exponent: i32,
     /// Wall and GPU seconds spent on submissions since the last reset.
     wall_seconds: f64,
     gpu_seconds: f64,
@@ -103,7 +110,7 @@ impl PathTracer {
             crate::accumulator::available_host_memory(),
         )
         .map_err(|message| PathTraceError::Unsupported { scene: scene.name.clone(), message })?;
-        let accumulator = Accumulator::try_new(scene.camera.width, scene.camera.height).map_err(|bytes| {
+        let mut accumulator = Accumulator::try_new(scene.camera.width, scene.camera.height).map_err(|bytes| {
             PathTraceError::Unsupported {
                 scene: scene.name.clone(),
                 message: format!(
@@ -117,6 +124,7 @@ impl PathTracer {
         })?;
         let gpu_scene = GpuScene::new(scene)?;
         let base_params = gpu_scene::params(scene, &gpu_scene);
+        accumulator.set_radiance_exponent(gpu_scene.radiance_exponent);
         let (pipeline, traversal_source) = shaders::pathtrace_pipeline(gpu, scene, &gpu_scene, options)?;
 
         let device = &gpu.device;
@@ -164,6 +172,9 @@ impl PathTracer {
             display_sum: None,
             pass: None,
             spp_done: 0,
+            sample_offset: 0,
+            chunk_aligned: false,
+            radiance_exponent: gpu_scene.radiance_exponent,
             wall_seconds: 0.0,
             gpu_seconds: 0.0,
         })
@@ -208,10 +219,18 @@ impl PathTracer {
         let camera = self.scene.camera;
         let display = DisplaySum::new(&self.gpu, &self.scene.name, camera.width, camera.height)?;
         if self.accumulator.total_samples() > 0 {
-            display.seed(&self.gpu, &self.accumulator);
+            display.seed(&self.gpu, &self.accumulator, self.radiance_exponent);
         }
         self.display_sum = Some(display);
         Ok(())
+    }
+
+    /// What the display sum's values must be multiplied by to be radiance: 2^k, where the
+    /// scene's emission was uploaded scaled by 2^-k so that no f32 sum or square on the GPU
+    /// overflows (1 for every light up to 2^16; see `accumulator::radiance_exponent`). A viewer
+    /// folds it into its exposure.
+    pub fn display_scale(&self) -> f32 {
+        2f32.powi(self.radiance_exponent)
     }
 
     /// The display sum's buffer (usage `STORAGE | COPY_SRC | COPY_DST`) once
@@ -278,6 +297,8 @@ impl PathTracer {
             // a viewer that set short submissions keeps them after the window is resized.
             resized.planner = self.planner.clone();
             resized.chunk_samples = self.chunk_samples;
+            resized.sample_offset = self.sample_offset;
+            resized.chunk_aligned = self.chunk_aligned;
             if self.display_sum.is_some() {
                 resized.enable_display_sum()?;
             }
@@ -310,6 +331,68 @@ impl PathTracer {
         Ok(())
     }
 
+    /// Makes every sample index start at `offset`: the tracer renders sample indices `offset`,
+    /// `offset + 1`, ... of each pixel (`render --sample-range A..B` sets A). Takes effect from
+    /// the next pass; call it before rendering.
+    pub fn set_sample_offset(&mut self, offset: u32) {
+        self.sample_offset = offset;
+    }
+
+    /// The first sample index (see [`Self::set_sample_offset`]).
+    pub fn sample_offset(&self) -> u32 {
+        self.sample_offset
+    }
+
+    /// With `true`, every pass [`Self::render_step`] plans ends on a multiple of the chunk size in
+    /// absolute sample indices (or where the render ends), so each pixel's chunks are always the
+    /// same samples, whatever the batching: two renders with the same seed, or one resumed from
+    /// a checkpoint, fold the same f32 chunk sums in the same order and agree bit for bit. The
+    /// first pass then has a whole chunk (16 spp) rather than the planner's 1-spp probe; the
+    /// bands shrink to keep each submission short. The `render` example turns it on.
+    pub fn set_chunk_aligned_passes(&mut self, aligned: bool) {
+        self.chunk_aligned = aligned;
+    }
+
+    /// The pass in progress, if a render stopped inside one: (its spp, rows done from row 0).
+    pub fn partial_pass(&self) -> Option<(u32, u32)> {
+        self.pass.as_ref().map(|p| (p.plan.spp, p.next_row))
+    }
+
+    /// Continues from a checkpoint: the accumulator, the spp of the completed passes, and a pass
+    /// stopped inside (its spp and the rows done), which the next steps finish first. The
+    /// accumulator must have this tracer's resolution.
+    pub fn restore(
+        &mut self,
+        mut accumulator: Accumulator,
+        spp_done: u32,
+        partial_pass: Option<(u32, u32)>,
+    ) -> Result<(), PathTraceError> {
+        let camera = self.scene.camera;
+        if (accumulator.width, accumulator.height) != (camera.width, camera.height) {
+            return Err(PathTraceError::Unsupported {
+                scene: self.scene.name.clone(),
+                message: format!(
+                    "a checkpoint of {} x {} pixels cannot continue a {} x {} render",
+                    accumulator.width, accumulator.height, camera.width, camera.height
+                ),
+            });
+        }
+        accumulator.set_radiance_exponent(self.radiance_exponent);
+        self.reset();
+        self.accumulator = accumulator;
+        self.spp_done = spp_done;
+        self.pass =
+            partial_pass.filter(|&(_, rows)| rows > 0 && rows < camera.height).map(|(spp, next_row)| {
+                let planned = self.planner.plan(camera.width, camera.height, spp);
+                let rows = if planned.spp >= spp { camera.height } else { planned.rows.max(1) };
+                ActivePass { plan: self.fit(PassPlan { spp, rows }), sample_base: spp_done, next_row }
+            });
+        if let Some(display) = &self.display_sum {
+            display.seed(&self.gpu, &self.accumulator, self.radiance_exponent);
+        }
+        Ok(())
+    }
+
     /// Discards everything accumulated; the next step starts again at sample 0.
     pub fn reset(&mut self) {
         self.accumulator.reset();
@@ -334,7 +417,10 @@ impl PathTracer {
                 Some(t) => t - self.spp_done,
                 None => u32::MAX - self.spp_done,
             };
-            let plan = self.fit(self.planner.plan(camera.width, camera.height, remaining));
+            let mut plan = self.fit(self.planner.plan(camera.width, camera.height, remaining));
+            if self.chunk_aligned {
+                plan = align_pass(plan, self.sample_offset + self.spp_done, remaining, self.chunk_samples);
+            }
             self.pass = Some(ActivePass { plan, sample_base: self.spp_done, next_row: 0 });
         }
         let report = self.submit_band()?;
@@ -374,4 +460,18 @@ impl PathTracer {
         }
         Ok(())
     }
+}
+/// A pass plan changed so that the pass ends on a multiple of `chunk` in absolute sample indices
+/// (`start` is the pass's first index), or at the end of the render (`remaining` samples): one
+/// chunk more when the plan would end inside the first chunk, fewer when it ends past a chunk
+/// boundary. The rows shrink or grow with the spp so that a submission keeps its size.
+fn align_pass(plan: PassPlan, start: u32, remaining: u32, chunk: u32) -> PassPlan {
+    if plan.spp >= remaining {
+        return PassPlan { spp: remaining, ..plan };
+    }
+    let chunk = chunk.max(1);
+    let end = start.saturating_add(plan.spp) / chunk * chunk;
+    let spp = if end > start { end - start } else { chunk - start % chunk }.min(remaining);
+    let rows = (u64::from(plan.rows) * u64::from(plan.spp) / u64::from(spp)).clamp(1, u64::from(u32::MAX));
+    PassPlan { spp, rows: rows as u32 }
 }

@@ -258,23 +258,20 @@ impl PathTraceMode {
         }
         let total = tracer.accumulator().total_samples();
         let display = self.display.get_or_insert_with(|| Display::new(gpu));
+        // The display sum holds radiance scaled by 2^-k for very bright lights (k = 0 below
+        // 2^16): k more stops give the radiance back.
+        let stops = self.settings.exposure + tracer.display_scale().log2();
         if total != self.shown_samples {
             self.shown_samples = total;
             self.stats = Self::measure(tracer, &self.progressive);
             let camera = tracer.scene().camera;
             if let Some(display_sum) = tracer.display_sum_buffer() {
                 let mut renderer = render_state.renderer.write();
-                display.show(
-                    gpu,
-                    &mut renderer,
-                    display_sum,
-                    [camera.width, camera.height],
-                    self.settings.exposure,
-                );
+                display.show(gpu, &mut renderer, display_sum, [camera.width, camera.height], stops);
             }
             self.shown_exposure = self.settings.exposure;
         } else if self.shown_exposure != self.settings.exposure {
-            display.redraw(gpu, self.settings.exposure);
+            display.redraw(gpu, stops);
             self.shown_exposure = self.settings.exposure;
         }
     }

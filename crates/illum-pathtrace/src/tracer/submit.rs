@@ -64,7 +64,7 @@ impl PathTracer {
         let mut params = self.base_params;
         params.row_offset = row_offset;
         params.rows = rows;
-        params.sample_base = sample_base;
+        params.sample_base = self.sample_offset + sample_base;
         params.sample_count = spp;
         params.chunk_samples = chunk;
         self.gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&params));
@@ -113,7 +113,7 @@ impl PathTracer {
             // The accumulator drops this band, but the display pass already added it: set the
             // display sum back to the accumulator's samples.
             if let Some(display) = &self.display_sum {
-                display.seed(&self.gpu, &self.accumulator);
+                display.seed(&self.gpu, &self.accumulator, self.radiance_exponent);
             }
             return Err(error);
         }

@@ -1,0 +1,391 @@
+//! Checkpoints: EXR files that a render can be continued from, and partial renders that can be
+//! merged.
+//!
+//! Every EXR the `render` example writes for the path tracer is a checkpoint: besides the mean
+//! image (the first layer, what any EXR viewer shows) it has a layer named
+//! [`STATISTICS_LAYER`] with, per pixel, the exact f64 sum and sum of squares of the finite
+//! samples (each f64 stored as two 32-bit words, since EXR has no 64-bit samples) and the u64
+//! count (two words as well). Its metadata ([`crate::metadata::exr_metadata`]) names the scene,
+//! every setting that changes the image, a hash of the scene's content
+//! ([`scene_content_hash`]), the first sample index (`sample_start`, for `--sample-range`), the
+//! completed spp and a pass stopped inside (`partial_pass_spp`, `partial_pass_rows`).
+//!
+//! Why a resumed render equals a straight one: a sample's random numbers depend only on (seed,
+//! pixel, sample index); with chunk-aligned passes
+//! ([`crate::PathTracer::set_chunk_aligned_passes`]) every pixel's f32 chunk sums are the same
+//! samples in every run, and the f64 fold adds them in sample order. Restoring the f64 sums
+//! exactly and going on from the same sample index therefore repeats the straight render's
+//! arithmetic: the result is bit-identical. A merge adds whole partial sums instead
+//! ((a + b) + c against a + (b + c) per pixel), so it differs from one render only by f64
+//! rounding: within 1e-12 relative for ranges on chunk boundaries (multiples of 16).
+
+use std::path::Path;
+
+use illum_image::{ExrMetadata, U32Layer, load_exr, load_u32_layer, save_exr_with_layers};
+use illum_scene::Scene;
+
+use crate::{Accumulator, PathTracer, TracerOptions};
+
+/// Name of the EXR layer with the exact per-pixel statistics.
+pub const STATISTICS_LAYER: &str = "illum.statistics";
+
+const CHANNELS: [&str; 3] = ["R", "G", "B"];
+
+/// 64-bit FNV-1a of the scene's physical content: the camera's placement and field of view,
+/// materials, objects and lights, as parsed (so a comment, a key's order or the `[raster]`
+/// section do not change it; every number that changes the path-traced image does). The
+/// resolution is compared on its own, like the other settings. Written as 16 hex digits in
+/// `illum.scene_hash`.
+pub fn scene_content_hash(scene: &Scene) -> String {
+    let c = &scene.camera;
+    let content = format!(
+        "{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}",
+        c.eye,
+        c.target,
+        c.up,
+        c.vfov_deg,
+        scene.materials,
+        scene.objects,
+        scene.directional_light,
+        scene.environment
+    );
+    let hash = content
+        .bytes()
+        .fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3));
+    format!("{hash:016x}")
+}
+
+/// An error and its causes on one line ("reading x.exr as EXR failed: unexpected end of file").
+fn with_causes(error: &dyn std::error::Error) -> String {
+    let mut text = error.to_string();
+    let mut source = error.source();
+    while let Some(cause) = source {
+        text += &format!(": {cause}");
+        source = cause.source();
+    }
+    text
+}
+
+fn split(bits: u64) -> (u32, u32) {
+    ((bits >> 32) as u32, bits as u32)
+}
+
+fn join(hi: u32, lo: u32) -> u64 {
+    (u64::from(hi) << 32) | u64::from(lo)
+}
+
+/// The statistics layer of `accumulator`.
+pub fn statistics_layer(accumulator: &Accumulator) -> U32Layer {
+    let state = accumulator.state();
+    let mut channels = Vec::new();
+    for (prefix, data) in [("sum", state.sum), ("sum_sq", state.sum_sq)] {
+        for (c, name) in CHANNELS.iter().enumerate() {
+            let (hi, lo): (Vec<u32>, Vec<u32>) = data.iter().map(|v| split(v[c].to_bits())).unzip();
+            channels.push((format!("{prefix}.{name}.hi"), hi));
+            channels.push((format!("{prefix}.{name}.lo"), lo));
+        }
+    }
+    let (hi, lo): (Vec<u32>, Vec<u32>) = state.count.iter().map(|&n| split(n)).unzip();
+    channels.push(("count.hi".to_owned(), hi));
+    channels.push(("count.lo".to_owned(), lo));
+    U32Layer { name: STATISTICS_LAYER.to_owned(), channels }
+}
+
+/// Writes the tracer's mean image, `metadata` and the statistics layer to `path`, atomically.
+pub fn save_checkpoint(path: &Path, tracer: &PathTracer, metadata: &ExrMetadata) -> Result<(), String> {
+    save_statistics(path, tracer.accumulator(), metadata)
+}
+
+/// Writes `accumulator`'s mean image, `metadata` and its statistics layer to `path`, atomically.
+pub fn save_statistics(path: &Path, accumulator: &Accumulator, metadata: &ExrMetadata) -> Result<(), String> {
+    save_exr_with_layers(path, &accumulator.mean_image(), metadata, &[statistics_layer(accumulator)])
+        .map_err(|e| with_causes(&e))
+}
+
+/// A render read back from a checkpoint file.
+#[derive(Clone, Debug)]
+pub struct Checkpoint {
+    pub metadata: ExrMetadata,
+    pub accumulator: Accumulator,
+    /// Samples per pixel of the completed passes.
+    pub spp_done: u32,
+    /// The first sample index (0 unless rendered with `--sample-range`).
+    pub sample_start: u32,
+    /// A pass stopped inside: (its spp, rows done from row 0).
+    pub partial_pass: Option<(u32, u32)>,
+}
+
+/// Reads a checkpoint. Every failure names the file and what is wrong with it: not an EXR or
+/// truncated (the decoder's error), not illum's, not the path tracer's, no statistics layer, or a
+/// missing or unparsable key.
+pub fn load_checkpoint(path: &Path) -> Result<Checkpoint, String> {
+    let at = |reason: String| format!("{}: {reason}", path.display());
+    let (image, attributes) = load_exr(path).map_err(|e| with_causes(&e))?;
+    let metadata = ExrMetadata::from_attributes(path, &attributes)
+        .map_err(|e| e.to_string())?
+        .ok_or_else(|| at("not written by illum (no illum.* metadata), so it cannot be continued".into()))?;
+    if metadata.renderer != crate::metadata::RENDERER {
+        return Err(at(format!(
+            "illum.renderer = {}: only path-traced images can be continued",
+            metadata.renderer
+        )));
+    }
+    let number = |key: &str| -> Result<u32, String> {
+        let text = metadata.get(key).ok_or_else(|| at(format!("illum.{key} is missing")))?;
+        text.parse().map_err(|_| at(format!("illum.{key} = {text:?} is not a whole number")))
+    };
+    let spp_done = number("spp")?;
+    let sample_start = number("sample_start")?;
+    let partial = (number("partial_pass_spp")?, number("partial_pass_rows")?);
+    let layer = load_u32_layer(path, STATISTICS_LAYER).map_err(|e| with_causes(&e))?.ok_or_else(|| {
+        at(format!(
+            "has no {STATISTICS_LAYER} layer (written without the statistics a render continues from)"
+        ))
+    })?;
+    let pixels = image.width as usize * image.height as usize;
+    let channel = |name: String| -> Result<&Vec<u32>, String> {
+        let values = layer
+            .channels
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, v)| v)
+            .ok_or_else(|| at(format!("layer {STATISTICS_LAYER} has no channel {name}")))?;
+        if values.len() != pixels {
+            return Err(at(format!("channel {name} has {} values for {pixels} pixels", values.len())));
+        }
+        Ok(values)
+    };
+    let pair = |prefix: &str| -> Result<Vec<[f64; 3]>, String> {
+        let mut out = vec![[0.0; 3]; pixels];
+        for (c, name) in CHANNELS.iter().enumerate() {
+            let hi = channel(format!("{prefix}.{name}.hi"))?;
+            let lo = channel(format!("{prefix}.{name}.lo"))?;
+            for (p, v) in out.iter_mut().enumerate() {
+                v[c] = f64::from_bits(join(hi[p], lo[p]));
+            }
+        }
+        Ok(out)
+    };
+    let sum = pair("sum")?;
+    let sum_sq = pair("sum_sq")?;
+    let (hi, lo) = (channel("count.hi".into())?, channel("count.lo".into())?);
+    let count: Vec<u64> = hi.iter().zip(lo).map(|(&h, &l)| join(h, l)).collect();
+    if sum.iter().chain(&sum_sq).flatten().any(|v| !v.is_finite()) {
+        return Err(at("the statistics hold a NaN or infinite sum: the file is corrupt".into()));
+    }
+    let dropped = match metadata.get("dropped_samples") {
+        Some(text) => {
+            text.parse().map_err(|_| at(format!("illum.dropped_samples = {text:?} is not a count")))?
+        }
+        None => 0,
+    };
+    let accumulator =
+        Accumulator::from_state(image.width, image.height, sum, sum_sq, count, dropped).map_err(at)?;
+    Ok(Checkpoint {
+        metadata,
+        accumulator,
+        spp_done,
+        sample_start,
+        partial_pass: (partial.0 > 0 && partial.1 > 0).then_some(partial),
+    })
+}
+
+/// The settings that change the image, as stored in a checkpoint and as `scene` and `options`
+/// would store them: (key, value). Compared one by one so that a refusal names what differs.
+pub fn image_settings(scene: &Scene, options: TracerOptions) -> Vec<(&'static str, String)> {
+    vec![
+        ("scene_hash", scene_content_hash(scene)),
+        ("width", scene.camera.width.to_string()),
+        ("height", scene.camera.height.to_string()),
+        ("bounces", scene.pathtrace.bounces.to_string()),
+        ("seed", scene.pathtrace.seed.to_string()),
+        ("sampling", scene.pathtrace.sampling.to_string()),
+        ("sequence", options.sequence.to_string()),
+    ]
+}
+
+impl Checkpoint {
+    /// The value of a setting in the file; width and height come from the image itself.
+    fn setting(&self, key: &str) -> Option<String> {
+        match key {
+            "width" => Some(self.accumulator.width.to_string()),
+            "height" => Some(self.accumulator.height.to_string()),
+            _ => self.metadata.get(key).map(str::to_owned),
+        }
+    }
+
+    /// Checks that this checkpoint was rendered from `scene` with `options`: an error naming
+    /// every difference (scene name, content hash, resolution, bounces, seed, sampling,
+    /// sequence), with both values.
+    pub fn check_matches(&self, path: &Path, scene: &Scene, options: TracerOptions) -> Result<(), String> {
+        let mut differences = Vec::new();
+        if self.metadata.scene != scene.name {
+            differences.push(format!("scene: {:?} in the file, {:?} now", self.metadata.scene, scene.name));
+        }
+        for (key, now) in image_settings(scene, options) {
+            let then = self.setting(key).unwrap_or_else(|| "(missing)".to_owned());
+            if then != now {
+                let what = if key == "scene_hash" {
+                    "scene content (camera, materials, objects: the file was edited)".to_owned()
+                } else {
+                    key.to_owned()
+                };
+                differences.push(format!("{what}: {then} in the file, {now} now"));
+            }
+        }
+        if differences.is_empty() {
+            Ok(())
+        } else {
+            Err(format!(
+                "{}: rendered with other settings, so its samples cannot be combined with these: {}",
+                path.display(),
+                differences.join("; ")
+            ))
+        }
+    }
+}
+
+/// The keys two partial renders must agree on to be merged.
+const MERGE_KEYS: [&str; 8] =
+    ["scene", "scene_hash", "width", "height", "bounces", "seed", "sampling", "sequence"];
+
+impl Checkpoint {
+    /// The sample indices this file holds: `sample_start .. sample_start + spp_done`.
+    pub fn sample_range(&self) -> std::ops::Range<u64> {
+        let start = u64::from(self.sample_start);
+        start..start + u64::from(self.spp_done)
+    }
+
+    fn merge_key(&self, key: &str) -> Option<String> {
+        if key == "scene" { Some(self.metadata.scene.clone()) } else { self.setting(key) }
+    }
+}
+
+/// Combines partial renders of the same scene and settings (files from `render --sample-range`)
+/// into one: per pixel, the f64 sums and counts added in the order of their ranges. Refused, with
+/// the files named: a file stopped inside a pass (resume it first), a setting that differs,
+/// overlapping ranges (the same samples twice would bias nothing but count double) and gaps (the
+/// result would not be one range that can be continued). The merged checkpoint's metadata is
+/// the first range's, with the union's spp, the summed times and dropped samples, and the error
+/// of the merged statistics.
+pub fn merge_checkpoints(inputs: Vec<(std::path::PathBuf, Checkpoint)>) -> Result<Checkpoint, String> {
+    let mut inputs = inputs;
+    if inputs.is_empty() {
+        return Err("nothing to merge: give at least one EXR file".to_owned());
+    }
+    for (path, c) in &inputs {
+        if let Some((spp, rows)) = c.partial_pass {
+            return Err(format!(
+                "{}: stopped inside a pass ({rows} rows of {spp} spp done after {} complete spp); finish it first with \
+                 `render --resume {} --spp {}`",
+                path.display(),
+                c.spp_done,
+                path.display(),
+                c.spp_done + spp
+            ));
+        }
+        if c.spp_done == 0 {
+            return Err(format!("{}: holds no complete pass", path.display()));
+        }
+    }
+    let (first_path, first) = &inputs[0];
+    for (path, c) in &inputs[1..] {
+        let differences: Vec<String> = MERGE_KEYS
+            .iter()
+            .filter_map(|key| {
+                let (a, b) = (first.merge_key(key), c.merge_key(key));
+                (a != b).then(|| {
+                    let show = |v: Option<String>| v.unwrap_or_else(|| "(missing)".to_owned());
+                    format!(
+                        "{key}: {} in {}, {} in {}",
+                        show(a),
+                        first_path.display(),
+                        show(b),
+                        path.display()
+                    )
+                })
+            })
+            .collect();
+        if !differences.is_empty() {
+            return Err(format!("these files are renders of different images: {}", differences.join("; ")));
+        }
+    }
+    inputs.sort_by_key(|(_, c)| c.sample_start);
+    for pair in inputs.windows(2) {
+        let ((pa, a), (pb, b)) = (&pair[0], &pair[1]);
+        let (ra, rb) = (a.sample_range(), b.sample_range());
+        if rb.start < ra.end {
+            return Err(format!(
+                "{} (samples {}..{}) and {} (samples {}..{}) overlap: each sample index may be merged once",
+                pa.display(),
+                ra.start,
+                ra.end,
+                pb.display(),
+                rb.start,
+                rb.end
+            ));
+        }
+        if rb.start > ra.end {
+            return Err(format!(
+                "samples {}..{} are missing between {} (ending at {}) and {} (starting at {}): render that range too",
+                ra.end,
+                rb.start,
+                pa.display(),
+                ra.end,
+                pb.display(),
+                rb.start
+            ));
+        }
+    }
+    let total = inputs.iter().map(|(_, c)| u64::from(c.spp_done)).sum::<u64>();
+    let spp_done = u32::try_from(total)
+        .map_err(|_| format!("the merged render would have {total} spp, above {}", u32::MAX))?;
+    let mut iter = inputs.into_iter();
+    let (_, mut merged) = iter.next().expect("not empty");
+    for (_, c) in iter {
+        merged.accumulator.merge(&c.accumulator);
+        merged.metadata.render_seconds += c.metadata.render_seconds;
+    }
+    merged.spp_done = spp_done;
+    let accumulator = &merged.accumulator;
+    for (key, value) in [
+        ("spp", spp_done.to_string()),
+        ("estimated_relative_error", accumulator.estimated_relative_error().to_string()),
+        ("dropped_samples", accumulator.dropped_samples().to_string()),
+        ("stopped_by", "spp".to_owned()),
+        ("source", "merge example".to_owned()),
+    ] {
+        match merged.metadata.fields.iter_mut().find(|(k, _)| k == key) {
+            Some(field) => field.1 = value,
+            None => merged.metadata.fields.push((key.to_owned(), value)),
+        }
+    }
+    Ok(merged)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn f64_and_u64_survive_the_two_word_split() {
+        for v in [0.0f64, -0.0, 1.0 / 3.0, f64::MAX, f64::MIN_POSITIVE, 5e-324] {
+            let (hi, lo) = split(v.to_bits());
+            assert_eq!(f64::from_bits(join(hi, lo)).to_bits(), v.to_bits());
+        }
+        let (hi, lo) = split(u64::MAX - 7);
+        assert_eq!(join(hi, lo), u64::MAX - 7);
+    }
+
+    #[test]
+    fn the_hash_follows_content_not_settings() {
+        let scene = Scene::load(Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/cornell.toml")))
+            .unwrap();
+        let mut other = scene.clone();
+        other.pathtrace.spp = 4096;
+        other.raster.pcf_radius = 1.0;
+        assert_eq!(scene_content_hash(&scene), scene_content_hash(&other));
+        other.camera.vfov_deg += 1.0;
+        assert_ne!(scene_content_hash(&scene), scene_content_hash(&other));
+    }
+}
