@@ -124,7 +124,7 @@ fn run(args: Args) -> anyhow::Result<()> {
     bench_raster(&gpu, args.runs)
 }
 
-/// The Whitted look-alike at 1280 x 720, whitted look, every effect on: frames per second and
+/// The Whitted look-alike at 1280 x 720, enhanced look, every effect on: frames per second and
 /// the GPU time of each pass (more options: `--example raster_bench`).
 fn bench_raster(gpu: &illum::gpu::GpuContext, runs: usize) -> anyhow::Result<()> {
     let path = cli::resolve_scene_path(std::path::Path::new("scenes/whitted.toml"));
@@ -141,7 +141,7 @@ fn bench_raster(gpu: &illum::gpu::GpuContext, runs: usize) -> anyhow::Result<()>
         passes.as_ref().map_or("n/a".to_owned(), |p| format!("{:.2}", f(p)))
     };
     println!(
-        "| whitted look | {:.2} | {:.1} | {} | {} | {} |",
+        "| enhanced look | {:.2} | {:.1} | {} | {} | {} |",
         report.median_frame_ms(),
         report.fps(),
         pass(|p| p.shadow_ms),

@@ -7,7 +7,7 @@
 //! Renders `frames` frames (after `warmup` untimed ones) without reading them back and prints the
 //! median frame time, frames per second, and the median GPU time of each pass (shadow map, the
 //! twelve cube-map faces together, main pass with MSAA resolve) from timestamp queries. With no
-//! flags: `scenes/whitted.toml` at 1280 x 720, whitted look, every effect on. Timings are never
+//! flags: `scenes/whitted.toml` at 1280 x 720, enhanced look, every effect on. Timings are never
 //! asserted in tests; the figures are in docs/performance-raster.md.
 
 use std::path::PathBuf;

@@ -47,7 +47,7 @@ fn each_toggle_changes_the_picture_or_is_documented_not_to() {
         ];
         for (name, off) in toggles {
             let n = changed(&all, &render(&s, &with(look, off))).len();
-            // The figure has no reflections and no Fresnel: those toggles belong to the whitted look.
+            // The figure has no reflections and no Fresnel: those toggles belong to the enhanced look.
             let inert = look == Look::Figure && (name == "reflection" || name == "fresnel");
             if inert {
                 assert_eq!(n, 0, "look {look}: turning {name} off changed {n} pixels");

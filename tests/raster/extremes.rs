@@ -332,7 +332,7 @@ fn max_level(rgb: [f32; 3]) -> i32 {
 }
 
 /// Glass pixel checks shared by several cases: the environment the pixel shows, E (figure look:
-/// pixel = 0.1 white + 0.9 E; whitted look: the pixel itself, a mix of environment lookups plus
+/// pixel = 0.1 white + 0.9 E; enhanced look: the pixel itself, a mix of environment lookups plus
 /// a highlight), must be a colour in [0, 1] whose brightest channel is at least `floor` levels:
 /// no black holes. Returns (glass pixels, darkest max channel of E in levels).
 fn check_glass_pixels(
@@ -639,7 +639,7 @@ fn refraction_ratio_one_makes_the_glass_vanish() {
                 if (0..3).any(|c| (level(p[c]) - level(q[c])).abs() > 1) {
                     bent_vs_straight += 1;
                 }
-                // What the pixel should be: figure look 0.1 white + 0.9 behind; whitted look
+                // What the pixel should be: figure look 0.1 white + 0.9 behind; enhanced look
                 // (F0 = 0 at ratio 1, white tint) what is behind.
                 let b = behind.get(x, y);
                 let want = match look {
@@ -751,7 +751,7 @@ fn totally_reflected_red(s: &RasterScene, cam: &Camera, x: u32, y: u32, eta: f32
 fn total_internal_reflection_mirrors_the_environment() {
     // Ratio 2 (set through the API; see above): beyond 30 degrees of incidence nothing enters
     // the sphere. Where the mirror direction sees the sky or the floor (away from shadow edges),
-    // the red channel must be the figure's 0.1 white + 0.9 E or, in the whitted look (Fresnel 1
+    // the red channel must be the figure's 0.1 white + 0.9 E or, in the enhanced look (Fresnel 1
     // under total reflection), E itself, E the red of what the mirror direction sees.
     let mut s = scene();
     s.glass.as_mut().unwrap().refraction_ratio = 2.0;
