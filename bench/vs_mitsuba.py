@@ -16,7 +16,7 @@ the throughput, the relMSE against a converged reference and the efficiency
         [--samplers independent,multijitter,orthogonal,ldsampler] [--reference-spp 16384]
 
 Run it on an idle machine: a parallel build doubles every time. The reference is an illum render
-with --sequence low-discrepancy at --reference-spp, cached in out/vs-mitsuba/; its own relMSE
+with --sequence low-discrepancy at --reference-spp and its own seed, cached in out/vs-mitsuba/; its own relMSE
 adds about spp / reference-spp to every figure.
 """
 
@@ -164,11 +164,11 @@ def mitsuba_child(args):
     mi.util.write_bitmap(path, image)
 
 
-def run_illum(args, path, spp, sequence):
+def run_illum(args, path, spp, sequence, seed=0):
     started = time.perf_counter()
     subprocess.run(
         [RENDER, args.scene, "--width", str(args.size), "--height", str(args.size), "--spp", str(spp),
-         "--bounces", str(args.bounces), "--sequence", sequence, "-o", path],
+         "--bounces", str(args.bounces), "--sequence", sequence, "--seed", str(seed), "-o", path],
         check=True, stdout=subprocess.DEVNULL,
     )
     return time.perf_counter() - started
@@ -191,10 +191,12 @@ def main():
     os.makedirs(OUT, exist_ok=True)
 
     tag = f"{os.path.basename(args.scene)}-{args.size}-b{args.bounces}"
-    reference_path = os.path.join(OUT, f"reference-{tag}-{args.reference_spp}spp.exr")
+    # Another seed than the measured rows (seed 0): the reference's samples must not include
+    # theirs, or the low-discrepancy row would be compared partly with itself.
+    reference_path = os.path.join(OUT, f"reference-{tag}-{args.reference_spp}spp-seed1.exr")
     if not os.path.exists(reference_path):
-        print(f"rendering the reference ({args.reference_spp} spp, illum, low-discrepancy) ...", flush=True)
-        run_illum(args, reference_path, args.reference_spp, "low-discrepancy")
+        print(f"rendering the reference ({args.reference_spp} spp, illum, low-discrepancy, seed 1) ...", flush=True)
+        run_illum(args, reference_path, args.reference_spp, "low-discrepancy", seed=1)
     reference = load_exr(reference_path)
 
     rows = []
