@@ -77,27 +77,7 @@ impl Oracle {
     pub fn render(&self, spp: u32, seed: u64, threads: usize) -> OracleImage {
         assert!(spp > 0, "illum-oracle: spp must be at least 1");
         let (width, height) = (self.camera.width, self.camera.height);
-        let next_row = AtomicU32::new(0);
-        let threads = threads.clamp(1, height.max(1) as usize);
-        let mut rows: Vec<(u32, Vec<PixelEstimate>)> = std::thread::scope(|scope| {
-            let workers: Vec<_> = (0..threads)
-                .map(|_| {
-                    scope.spawn(|| {
-                        let mut done = Vec::new();
-                        loop {
-                            let y = next_row.fetch_add(1, Ordering::Relaxed);
-                            if y >= height {
-                                break done;
-                            }
-                            done.push((y, (0..width).map(|x| self.pixel(x, y, spp, seed)).collect()));
-                        }
-                    })
-                })
-                .collect();
-            workers.into_iter().flat_map(|w| w.join().expect("oracle worker panicked")).collect()
-        });
-        rows.sort_unstable_by_key(|(y, _)| *y);
-        let pixels = rows.into_iter().flat_map(|(_, row)| row);
+        let pixels = rows_in_parallel(width, height, threads, |x, y| self.pixel(x, y, spp, seed));
         let mut image = OracleImage {
             width,
             height,
@@ -113,6 +93,38 @@ impl Oracle {
         }
         image
     }
+}
+
+/// `pixel(x, y)` for every pixel of a `width` x `height` image, row-major from the top-left,
+/// computed on `threads` threads (at least one) that take rows one at a time. The result does
+/// not depend on `threads`.
+pub(crate) fn rows_in_parallel<T: Send>(
+    width: u32,
+    height: u32,
+    threads: usize,
+    pixel: impl Fn(u32, u32) -> T + Sync,
+) -> Vec<T> {
+    let next_row = AtomicU32::new(0);
+    let threads = threads.clamp(1, height.max(1) as usize);
+    let mut rows: Vec<(u32, Vec<T>)> = std::thread::scope(|scope| {
+        let workers: Vec<_> = (0..threads)
+            .map(|_| {
+                scope.spawn(|| {
+                    let mut done = Vec::new();
+                    loop {
+                        let y = next_row.fetch_add(1, Ordering::Relaxed);
+                        if y >= height {
+                            break done;
+                        }
+                        done.push((y, (0..width).map(|x| pixel(x, y)).collect()));
+                    }
+                })
+            })
+            .collect();
+        workers.into_iter().flat_map(|w| w.join().expect("oracle worker panicked")).collect()
+    });
+    rows.sort_unstable_by_key(|(y, _)| *y);
+    rows.into_iter().flat_map(|(_, row)| row).collect()
 }
 
 /// A rendered estimate: per pixel, row-major from the top-left, the mean radiance and the

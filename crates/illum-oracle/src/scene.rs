@@ -8,19 +8,7 @@ use crate::geometry::{Ball, OrientedBox, Parallelogram, Surface};
 
 /// What the oracle implements: every feature of the scene model, written independently of the
 /// GPU path tracer (it shares no code with the WGSL). The GPU path tracer implements a subset.
-pub const FEATURES: &[Feature] = &[
-    Feature::BoxShape,
-    Feature::QuadShape,
-    Feature::SphereShape,
-    Feature::Lambertian,
-    Feature::Checker,
-    Feature::Dielectric,
-    Feature::Mirror,
-    Feature::AreaLight,
-    Feature::DeltaDirectionalLight,
-    Feature::SunDisc,
-    Feature::Environment,
-];
+pub const FEATURES: &[Feature] = &Feature::ALL;
 
 pub(crate) fn dvec(v: Vec3) -> DVec3 {
     v.as_dvec3()

@@ -28,29 +28,12 @@
 //! ((i + 0.5) / n), averaged: deterministic.
 
 use std::f64::consts::PI;
-use std::sync::atomic::{AtomicU32, Ordering};
 
 use glam::DVec3;
 use illum_scene::{Feature, MaterialKind, Scene, SceneError, Shape};
 
 use crate::camera::PinholeCamera;
 use crate::geometry::{Ball, OrientedBox, Parallelogram, Surface};
-
-/// What this copy of the Whitted ray tracer renders: every shape and material of the scene
-/// model, a delta directional light, area lights (as point lights) and a constant environment.
-/// A sun of finite size is refused: Whitted's shadow rays are hard.
-pub const FEATURES: &[Feature] = &[
-    Feature::BoxShape,
-    Feature::QuadShape,
-    Feature::SphereShape,
-    Feature::Lambertian,
-    Feature::Checker,
-    Feature::Dielectric,
-    Feature::Mirror,
-    Feature::AreaLight,
-    Feature::DeltaDirectionalLight,
-    Feature::Environment,
-];
 
 /// One object: its surface and its material.
 #[derive(Clone, Copy, Debug)]
@@ -99,7 +82,10 @@ fn dvec(v: glam::Vec3) -> DVec3 {
 impl WhittedOracle {
     /// Prepares `scene`, or says which of its features Whitted's algorithm does not model.
     pub fn new(scene: &Scene) -> Result<WhittedOracle, SceneError> {
-        scene.require_for("Whitted ray tracer", FEATURES)?;
+        // Every shape and material of the scene model, a delta directional light, area lights
+        // (as point lights) and a constant environment; not a sun of finite size, since
+        // Whitted's shadow rays are hard.
+        scene.require_where("Whitted ray tracer", |f| f != Feature::SunDisc)?;
         let mut items = Vec::with_capacity(scene.objects.len());
         let mut lights = Vec::new();
         for object in &scene.objects {
@@ -162,28 +148,9 @@ impl WhittedOracle {
     /// The whole image, row-major from the top-left, on `threads` threads (the result does not
     /// depend on it).
     pub fn render(&self, threads: usize) -> Vec<[f64; 3]> {
-        let (width, height) = (self.camera.width, self.camera.height);
-        let next_row = AtomicU32::new(0);
-        let threads = threads.clamp(1, height.max(1) as usize);
-        let mut rows: Vec<(u32, Vec<[f64; 3]>)> = std::thread::scope(|scope| {
-            let workers: Vec<_> = (0..threads)
-                .map(|_| {
-                    scope.spawn(|| {
-                        let mut done = Vec::new();
-                        loop {
-                            let y = next_row.fetch_add(1, Ordering::Relaxed);
-                            if y >= height {
-                                break done;
-                            }
-                            done.push((y, (0..width).map(|x| self.pixel(x, y)).collect()));
-                        }
-                    })
-                })
-                .collect();
-            workers.into_iter().flat_map(|w| w.join().expect("whitted worker panicked")).collect()
-        });
-        rows.sort_unstable_by_key(|(y, _)| *y);
-        rows.into_iter().flat_map(|(_, row)| row).collect()
+        crate::render::rows_in_parallel(self.camera.width, self.camera.height, threads, |x, y| {
+            self.pixel(x, y)
+        })
     }
 
     /// The closest hit of o + t d, t > 0: (t, geometric normal, item index). An emitter wins a

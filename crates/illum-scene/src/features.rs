@@ -31,6 +31,23 @@ pub enum Feature {
     Environment,
 }
 
+impl Feature {
+    /// Every feature of the scene model.
+    pub const ALL: [Feature; 11] = [
+        Feature::BoxShape,
+        Feature::QuadShape,
+        Feature::SphereShape,
+        Feature::Lambertian,
+        Feature::Checker,
+        Feature::Dielectric,
+        Feature::Mirror,
+        Feature::AreaLight,
+        Feature::DeltaDirectionalLight,
+        Feature::SunDisc,
+        Feature::Environment,
+    ];
+}
+
 impl fmt::Display for Feature {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(match self {
@@ -93,7 +110,17 @@ impl Scene {
     /// [`Scene::require`] for a renderer named in words (one that is not a [`RendererKind`]
     /// yet, such as the oracle's copy of Whitted's algorithm).
     pub fn require_for(&self, renderer: &str, supported: &[Feature]) -> Result<(), SceneError> {
-        match self.features().into_iter().find(|(f, _)| !supported.contains(f)) {
+        self.require_where(renderer, |f| supported.contains(&f))
+    }
+
+    /// [`Scene::require_for`] with the supported features given by a predicate (for example
+    /// "everything but a sun disc").
+    pub fn require_where(
+        &self,
+        renderer: &str,
+        supported: impl Fn(Feature) -> bool,
+    ) -> Result<(), SceneError> {
+        match self.features().into_iter().find(|&(f, _)| !supported(f)) {
             None => Ok(()),
             Some((feature, place)) => Err(SceneError::Unsupported {
                 file: self.source.clone(),

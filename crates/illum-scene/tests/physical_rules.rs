@@ -694,19 +694,7 @@ fn near_and_far_come_together_with_near_before_far() {
 const DIFFUSE_ONLY: &[Feature] =
     &[Feature::BoxShape, Feature::QuadShape, Feature::SphereShape, Feature::Lambertian, Feature::AreaLight];
 
-const EVERYTHING: &[Feature] = &[
-    Feature::BoxShape,
-    Feature::QuadShape,
-    Feature::SphereShape,
-    Feature::Lambertian,
-    Feature::Checker,
-    Feature::Dielectric,
-    Feature::Mirror,
-    Feature::AreaLight,
-    Feature::DeltaDirectionalLight,
-    Feature::SunDisc,
-    Feature::Environment,
-];
+const EVERYTHING: &[Feature] = &Feature::ALL;
 
 #[test]
 fn features_list_what_the_scene_uses_where_in_file_order() {
