@@ -136,10 +136,7 @@ fn a_tile_under_the_open_sky_is_albedo_times_the_sky() {
 
 #[test]
 fn the_whitted_scene_renders_finite_with_nothing_dropped() {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/whitted.toml");
-    let mut s = Scene::load(std::path::Path::new(path)).unwrap();
-    s.camera.width = 32;
-    s.camera.height = 18;
+    let s = illum_scene::testing::shipped_scene("whitted.toml", 32, 18);
     let image = render(&s, Bounces::Fixed(8), 4);
     assert!(image.mean.iter().flatten().all(|c| c.is_finite() && *c >= 0.0));
     assert_eq!(image.dropped, 0);

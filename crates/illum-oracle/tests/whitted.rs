@@ -167,10 +167,7 @@ fn extremes_stay_finite_and_bounded() {
 
 #[test]
 fn the_cornell_box_lit_by_its_light_as_a_point() {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/cornell.toml");
-    let mut s = Scene::load(std::path::Path::new(path)).unwrap();
-    s.camera.width = 32;
-    s.camera.height = 32;
+    let s = illum_scene::testing::shipped_scene("cornell.toml", 32, 32);
     let image = WhittedOracle::new(&s).unwrap().render(2);
     assert!(image.iter().all(|p| p.iter().all(|c| c.is_finite() && *c >= 0.0)));
     // The light itself shows its radiance 30 (top centre of the image).

@@ -31,3 +31,13 @@ pub fn check_invalid(err: &SceneError, file: &str, field: &str, value: &str, all
     }
     assert!(shown.starts_with(&format!("{file}: {field} = {value}: ")), "{shown}");
 }
+
+/// A shipped scene file (`scenes/NAME`, found from any crate's tests) at a test's resolution;
+/// panics with the loader's message if it does not load.
+pub fn shipped_scene(name: &str, width: u32, height: u32) -> crate::Scene {
+    let path = crate::resolve_scene_path(&std::path::Path::new("scenes").join(name));
+    let mut scene = crate::Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    scene.camera.width = width;
+    scene.camera.height = height;
+    scene
+}
