@@ -183,7 +183,7 @@ pub fn check_main_targets(
         if bytes > limits.max_buffer_size {
             let msaa = if samples > 1 { format!(" with {samples}x MSAA") } else { String::new() };
             let hint = if samples > 1 {
-                "turn MSAA off (--no-msaa, effects.msaa = false) or render"
+                "turn MSAA off (--no-msaa, or [raster.effects] msaa = false) or render"
             } else {
                 "render"
             };
