@@ -1,6 +1,7 @@
 //! Every WGSL file under shaders/ belongs to some crate's list of shaders, so that the crate's
 //! own naga test validates it without a GPU:
-//! - illum-pathtrace (`shaders.rs`): the sampling modules, the scene module, both traversals,
+//! - illum-pathtrace (`shaders.rs`): the sampling modules, the shared geometry module
+//!   (`shaders/rtcore/`), the scene module, both traversals,
 //!   the integrator and the display-sum pass, for every scene file;
 //! - illum-raster (`shaders.rs`): its modules and entry files;
 //! - illum-viewer (`display.rs`): its display pass.
@@ -10,7 +11,9 @@
 use std::collections::BTreeSet;
 use std::path::PathBuf;
 
-use illum::pathtrace::{self, GENERIC_TRAVERSAL, PATHTRACE_SHADER, SAMPLING_MODULES, SCENE_MODULE};
+use illum::pathtrace::{
+    self, GENERIC_TRAVERSAL, GEOMETRY_MODULE, PATHTRACE_SHADER, SAMPLING_MODULES, SCENE_MODULE,
+};
 
 /// The viewer's shader, validated by illum-viewer's own test (the facade does not depend on the
 /// viewer crate, so it is named here by its path).
@@ -21,7 +24,13 @@ fn every_wgsl_file_is_validated_by_its_crate() {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let mut covered: BTreeSet<String> = SAMPLING_MODULES
         .iter()
-        .chain([&SCENE_MODULE, &GENERIC_TRAVERSAL, &PATHTRACE_SHADER, &pathtrace::DISPLAY_SUM_SHADER])
+        .chain([
+            &GEOMETRY_MODULE,
+            &SCENE_MODULE,
+            &GENERIC_TRAVERSAL,
+            &PATHTRACE_SHADER,
+            &pathtrace::DISPLAY_SUM_SHADER,
+        ])
         .chain(illum::raster::shaders::MODULES)
         .chain(illum::raster::shaders::SHADERS)
         .map(|file| file.path.to_string())

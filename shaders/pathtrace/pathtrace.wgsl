@@ -13,7 +13,8 @@
 #import illum::sampler::{Sampler, sampler_new, sample_1d}
 #import illum::sampling::{sample_cosine_hemisphere, sample_uniform_hemisphere, to_world, sample_parallelogram}
 #import illum::spawn::{spawn_point, spawn_error, max_abs}
-#import illum::pathtrace::scene::{NO_HIT, Surface, params, objects, materials, lights, batch_sum, batch_sum_sq}
+#import illum::rtcore::geometry::{NO_HIT, Surface}
+#import illum::pathtrace::scene::{params, objects, materials, lights, batch_sum, batch_sum_sq}
 #import illum::pathtrace::traversal::{closest_hit, occluded, surface_at, choose_light}
 
 const SAMPLING_COSINE: u32 = 0u;

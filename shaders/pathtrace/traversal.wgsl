@@ -3,7 +3,8 @@
 // Generic traversal: loops over the object buffer, so one pipeline serves every scene.
 // (The specialised pipeline replaces this module with code generated from the scene.)
 
-#import illum::pathtrace::scene::{Hit, Object, FAR, NO_HIT, EMITTER_TIE, KIND_AABB, KIND_BOX, KIND_QUAD, params, objects, lights, safe_inverse, hit_slabs, hit_box, hit_quad, hit_sphere, Surface, surface_aabb, surface_box, surface_quad, surface_sphere}
+#import illum::rtcore::geometry::{Hit, Object, FAR, NO_HIT, KIND_AABB, KIND_BOX, KIND_QUAD, safe_inverse, hit_slabs, hit_box, hit_quad, hit_sphere, Surface, surface_aabb, surface_box, surface_quad, surface_sphere}
+#import illum::pathtrace::scene::{EMITTER_TIE, params, objects, lights}
 
 // Closest hit over all objects. `d` must be unit length. Only the fields a shape's test needs are
 // loaded: on a CPU driver each storage-buffer read is a per-lane memory access.

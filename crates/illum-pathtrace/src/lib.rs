@@ -36,5 +36,8 @@ pub use progressive::{
     Progress, Progressive, RenderClock, Rule, Status, StopReason, StopRules, parse_target_error,
     parse_time_budget, render_progressive,
 };
-pub use shaders::{GENERIC_TRAVERSAL, PATHTRACE_SHADER, SAMPLING_MODULES, SCENE_MODULE, shader_modules};
+pub use shaders::{
+    GENERIC_TRAVERSAL, GEOMETRY_MODULE, PATHTRACE_SHADER, SAMPLING_MODULES, SCENE_MODULE, SPAWN_MODULE,
+    shader_modules,
+};
 pub use tracer::{PathTracer, StepReport};

@@ -27,12 +27,20 @@ pub const SAMPLING_MODULES: &[ShaderFile] = &[
     shader_file!("shaders/common/rng.wgsl"),
     shader_file!("shaders/common/sampling.wgsl"),
     shader_file!("shaders/common/sampler.wgsl"),
-    shader_file!("shaders/common/spawn.wgsl"),
+    SPAWN_MODULE,
 ];
+
+/// Ray spawning off a surface: shared by every compute ray tracer.
+pub const SPAWN_MODULE: ShaderFile = shader_file!("shaders/common/spawn.wgsl");
+
+/// Objects as the GPU stores them and the ray-shape tests: shared by every compute ray tracer
+/// (it imports the spawn module).
+pub const GEOMETRY_MODULE: ShaderFile = shader_file!("shaders/rtcore/geometry.wgsl");
 
 /// The shader modules, in import order, for `scene` with `traversal`.
 pub fn shader_modules(scene: &Scene, gpu_scene: &GpuScene, traversal: Traversal) -> Vec<ShaderFile> {
     let mut modules = SAMPLING_MODULES.to_vec();
+    modules.push(GEOMETRY_MODULE);
     modules.push(SCENE_MODULE);
     modules.push(match traversal {
         Traversal::Generic => GENERIC_TRAVERSAL,
@@ -160,10 +168,12 @@ mod tests {
                 width, height, row_offset, rows, sample_base, sample_count, seed, bounces, sampling,
                 num_lights, first_emitter, chunk_samples),
         );
-        wgsl("Object").assert_matches(
-            size_of::<ObjectRecord>(),
-            &members!(ObjectRecord: kind, material, emitter, padding, a, b, c, d),
-        );
+        wgsl_struct(&module, "illum::rtcore::geometry", "Object")
+            .unwrap_or_else(|| panic!("no struct Object in rtcore/geometry.wgsl"))
+            .assert_matches(
+                size_of::<ObjectRecord>(),
+                &members!(ObjectRecord: kind, material, emitter, padding, a, b, c, d),
+            );
         wgsl("Material").assert_matches(size_of::<GpuMaterial>(), &members!(GpuMaterial: albedo, emission));
         wgsl("Light").assert_matches(
             size_of::<GpuLight>(),
