@@ -4,6 +4,7 @@
 //!   (`shaders/rtcore/`), the scene module, both traversals,
 //!   the integrator and the display-sum pass, for every scene file;
 //! - illum-raster (`shaders.rs`): its modules and entry files;
+//! - illum-whitted (`tracer.rs`): its entry shader, composed with the spawn and geometry modules;
 //! - illum-viewer (`display.rs`): its display pass.
 //!
 //! A file no list names would be validated by nobody; this test names it.
@@ -33,6 +34,7 @@ fn every_wgsl_file_is_validated_by_its_crate() {
         ])
         .chain(illum::raster::shaders::MODULES)
         .chain(illum::raster::shaders::SHADERS)
+        .chain([&illum::whitted::WHITTED_SHADER])
         .map(|file| file.path.to_string())
         .collect();
     covered.extend(VIEWER_SHADERS.iter().map(|path| (*path).to_owned()));

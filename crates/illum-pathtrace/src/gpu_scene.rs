@@ -242,53 +242,33 @@ impl GpuScene {
                 emission: v4(m.emission() * emission_scale, 0.0),
             })
             .collect();
-        let mut objects = Vec::with_capacity(scene.objects.len());
-        let mut emitters = Vec::new();
+        let (objects, first_emitter) = ordered_objects(scene);
         let mut lights = Vec::new();
         let mut light_area = 0.0f32;
-        for object in &scene.objects {
-            let material = &scene.materials[object.material];
-            let emitter = material.is_emitter();
-            let shape = match object.shape {
-                Shape::Box(b) if b.rotate_y_deg == 0.0 => {
-                    GpuShape::Aabb { min: b.min + b.translate, max: b.max + b.translate }
+        for (index, object) in &objects {
+            let material = &scene.materials[object.material as usize];
+            match (object.emitter, scene.objects[*index].shape) {
+                (true, Shape::Quad(q)) => {
+                    let area = q.area();
+                    light_area += area;
+                    lights.push(GpuLight {
+                        corner: v4(q.corner, light_area),
+                        edge_u: v4(q.edge_u, area),
+                        edge_v: v4(q.edge_v, 0.0),
+                        normal: v4(q.normal(), 0.0),
+                        emission: v4(material.emission() * emission_scale, 0.0),
+                    });
                 }
-                Shape::Box(b) => {
-                    let (rotation, offset) = b.local_to_world();
-                    // rotation is R_y(angle): its first column is (cos, 0, -sin).
-                    let (cos, sin) = (rotation.x_axis.x, -rotation.x_axis.z);
-                    GpuShape::Box { local_min: b.min, local_max: b.max, cos, sin, offset }
-                }
-                Shape::Quad(q) => {
-                    if emitter {
-                        let area = q.area();
-                        light_area += area;
-                        lights.push(GpuLight {
-                            corner: v4(q.corner, light_area),
-                            edge_u: v4(q.edge_u, area),
-                            edge_v: v4(q.edge_v, 0.0),
-                            normal: v4(q.normal(), 0.0),
-                            emission: v4(material.emission() * emission_scale, 0.0),
-                        });
-                    }
-                    GpuShape::Quad { corner: q.corner, edge_u: q.edge_u, edge_v: q.edge_v }
-                }
-                Shape::Sphere(s) => GpuShape::Sphere { center: s.center, radius: s.radius },
-            };
-            let gpu = GpuObject { shape, material: object.material as u32, emitter };
-            if emitter {
-                if !matches!(object.shape, Shape::Quad(_)) {
+                (true, _) => {
                     return Err(PathTraceError::Unsupported {
                         scene: scene.name.clone(),
                         message: format!(
                             "object {:?} emits light but is not a quad; only rectangular lights can be sampled",
-                            object.name
+                            scene.objects[*index].name
                         ),
                     });
                 }
-                emitters.push(gpu);
-            } else {
-                objects.push(gpu);
+                (false, _) => {}
             }
         }
         if lights.is_empty() {
@@ -299,10 +279,42 @@ impl GpuScene {
                     .to_owned(),
             });
         }
-        let first_emitter = objects.len() as u32;
-        objects.extend(emitters);
+        let objects = objects.into_iter().map(|(_, object)| object).collect();
         Ok(Self { objects, materials, lights, light_area, first_emitter, radiance_exponent })
     }
+}
+
+/// The shape as the shader tests it: a box without rotation as world bounds, a rotated box by
+/// its local bounds and the rotation's cosine and sine.
+pub fn gpu_shape(shape: &Shape) -> GpuShape {
+    match *shape {
+        Shape::Box(b) if b.rotate_y_deg == 0.0 => {
+            GpuShape::Aabb { min: b.min + b.translate, max: b.max + b.translate }
+        }
+        Shape::Box(b) => {
+            let (rotation, offset) = b.local_to_world();
+            // rotation is R_y(angle): its first column is (cos, 0, -sin).
+            let (cos, sin) = (rotation.x_axis.x, -rotation.x_axis.z);
+            GpuShape::Box { local_min: b.min, local_max: b.max, cos, sin, offset }
+        }
+        Shape::Quad(q) => GpuShape::Quad { corner: q.corner, edge_u: q.edge_u, edge_v: q.edge_v },
+        Shape::Sphere(s) => GpuShape::Sphere { center: s.center, radius: s.radius },
+    }
+}
+
+/// The scene's objects as every compute ray tracer stores them: non-emitters first, then
+/// emitters (the shaders rely on this order to let a light win a tie with the surface it is set
+/// into), each with its index in `scene.objects`; and the index of the first emitter.
+pub fn ordered_objects(scene: &Scene) -> (Vec<(usize, GpuObject)>, u32) {
+    let object = |(i, o): (usize, &illum_scene::Object)| {
+        let emitter = scene.materials[o.material].is_emitter();
+        (i, GpuObject { shape: gpu_shape(&o.shape), material: o.material as u32, emitter })
+    };
+    let (mut ordered, emitters): (Vec<_>, Vec<_>) =
+        scene.objects.iter().enumerate().map(object).partition(|(_, o)| !o.emitter);
+    let first_emitter = ordered.len() as u32;
+    ordered.extend(emitters);
+    (ordered, first_emitter)
 }
 
 impl GpuScene {

@@ -1,0 +1,278 @@
+// Whitted's 1980 ray tracer, one invocation per pixel (see crates/illum-whitted/src/lib.rs for
+// the model; crates/illum-oracle/src/whitted.rs is its independent f64 copy).
+//
+// The ray tree is walked depth-first with an explicit stack (WGSL has no recursion): a hit on a
+// mirror or a dielectric pushes its reflected and refracted rays with their weights. Each entry
+// pushes at most two children one level deeper and the walk always takes the top entry, so the
+// stack holds at most one pending sibling per level plus the entry in hand: depth + 2 entries,
+// MAX_STACK for the deepest recursion the scene format accepts (64).
+
+#import illum::spawn::spawn_point
+#import illum::rtcore::geometry::{Object, Hit, Surface, FAR, NO_HIT, KIND_AABB, KIND_BOX, KIND_QUAD, safe_inverse, hit_slabs, hit_box, hit_quad, hit_sphere, surface_aabb, surface_box, surface_quad, surface_sphere}
+
+const MAX_STACK: u32 = 66u;
+const EMITTER_TIE: f32 = 1.0e-5;
+
+const MAT_LAMBERTIAN: u32 = 0u;
+const MAT_CHECKER: u32 = 1u;
+const MAT_DIELECTRIC: u32 = 2u;
+const MAT_MIRROR: u32 = 3u;
+const MAT_EMITTER: u32 = 4u;
+
+const LIGHT_DIRECTIONAL: u32 = 0u;
+
+struct Params {
+    // xyz: eye, w: tan(vfov / 2)
+    eye: vec4<f32>,
+    // xyz: right, w: aspect
+    right: vec4<f32>,
+    up: vec4<f32>,
+    forward: vec4<f32>,
+    background: vec4<f32>,
+    ambient: vec4<f32>,
+    // rgb: the mirror's highlight colour, w: its shininess
+    mirror_specular: vec4<f32>,
+    // x: the mirror's weight, y: the dielectric's shininess
+    shading: vec4<f32>,
+    // width, height, number of objects, first emitter
+    sizes: vec4<u32>,
+    // number of lights, depth, aa (n of n x n), unused
+    counts: vec4<u32>,
+}
+
+// kind MAT_*; a: albedo, checker even, mirror reflectance or emitted radiance (w: checker tile
+// or dielectric ior); b: checker odd.
+struct Material {
+    kind: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
+    a: vec4<f32>,
+    b: vec4<f32>,
+}
+
+// A directional light: a = (unit vector toward it, 0), power = (irradiance / pi, 0). A point
+// light at an emitting quad's centre: a = (position, 1), normal = (the quad's front normal, 0),
+// power = (radiance x area, 0).
+struct Light {
+    kind: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
+    a: vec4<f32>,
+    normal: vec4<f32>,
+    power: vec4<f32>,
+}
+
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var<storage, read> objects: array<Object>;
+@group(0) @binding(2) var<storage, read> materials: array<Material>;
+@group(0) @binding(3) var<storage, read> lights: array<Light>;
+@group(0) @binding(4) var<storage, read_write> image: array<vec4<f32>>;
+
+struct Ray {
+    o: vec3<f32>,
+    d: vec3<f32>,
+    weight: vec3<f32>,
+    depth: u32,
+}
+
+fn hit_object(o: vec3<f32>, d: vec3<f32>, inv_d: vec3<f32>, i: u32) -> f32 {
+    let obj = objects[i];
+    switch obj.kind {
+        case KIND_AABB: { return hit_slabs(o, inv_d, obj.a.xyz, obj.b.xyz); }
+        case KIND_BOX: { return hit_box(o, d, obj.a.xyz, obj.b.xyz, obj.a.w, obj.b.w, obj.c.xyz); }
+        case KIND_QUAD: { return hit_quad(o, d, obj.a.xyz, obj.b.xyz, obj.c.xyz, obj.d.xyz); }
+        default: { return hit_sphere(o, d, obj.a.xyz, obj.a.w); }
+    }
+}
+
+// The closest hit; emitters (stored last) win a tie with a coplanar surface.
+fn closest_hit(o: vec3<f32>, d: vec3<f32>) -> Hit {
+    var best = Hit(FAR, NO_HIT);
+    let inv_d = safe_inverse(d);
+    for (var i = 0u; i < params.sizes.z; i++) {
+        let t = hit_object(o, d, inv_d, i);
+        let limit = select(best.t, min(best.t * (1.0 + EMITTER_TIE), FAR), i >= params.sizes.w);
+        if (t < limit) {
+            best = Hit(t, i);
+        }
+    }
+    return best;
+}
+
+// Whether a non-emitting object lies on o + t d for 0 < t < t_max.
+fn blocked(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> bool {
+    let inv_d = safe_inverse(d);
+    for (var i = 0u; i < params.sizes.w; i++) {
+        if (hit_object(o, d, inv_d, i) < t_max) {
+            return true;
+        }
+    }
+    return false;
+}
+
+fn surface_of(obj: Object, p: vec3<f32>) -> Surface {
+    switch obj.kind {
+        case KIND_AABB: { return surface_aabb(obj, p); }
+        case KIND_BOX: { return surface_box(obj, p); }
+        case KIND_QUAD: { return surface_quad(obj, p); }
+        default: { return surface_sphere(obj, p); }
+    }
+}
+
+// Light from every light at p (normal n toward the viewer, spawn error err), for a white
+// Lambertian surface (sum E_l max(n.l, 0) V_l) and for a Blinn-Phong highlight of `shininess`
+// seen along v (sum E_l max(n.h, 0)^shininess V_l where n.l > 0).
+struct Lit {
+    diffuse: vec3<f32>,
+    highlight: vec3<f32>,
+}
+
+fn light_at(p: vec3<f32>, n: vec3<f32>, err: f32, v: vec3<f32>, shininess: f32) -> Lit {
+    var lit = Lit(vec3<f32>(0.0), vec3<f32>(0.0));
+    let origin = spawn_point(p, n, err);
+    for (var li = 0u; li < params.counts.x; li++) {
+        let light = lights[li];
+        var l: vec3<f32>;
+        var e: vec3<f32>;
+        var t_max = FAR;
+        if (light.kind == LIGHT_DIRECTIONAL) {
+            l = light.a.xyz;
+            e = light.power.xyz;
+        } else {
+            let to = light.a.xyz - p;
+            let r2 = dot(to, to);
+            let r = sqrt(r2);
+            l = to / r;
+            let cos_light = max(dot(-l, light.normal.xyz), 0.0);
+            e = light.power.xyz * (cos_light / (3.14159265358979 * r2));
+            t_max = r * (1.0 - 1.0e-5);
+        }
+        let cos_n = dot(n, l);
+        if (cos_n <= 0.0 || all(e == vec3<f32>(0.0)) || blocked(origin, l, t_max)) {
+            continue;
+        }
+        lit.diffuse += e * cos_n;
+        lit.highlight += e * pow(max(dot(n, normalize(l + v)), 0.0), shininess);
+    }
+    return lit;
+}
+
+// The checker's albedo at p on the quad obj: tile (i, j) counted from its corner along its edges.
+fn checker_albedo(obj: Object, m: Material, p: vec3<f32>) -> vec3<f32> {
+    let q = p - obj.a.xyz;
+    let lu = length(obj.b.xyz);
+    let lv = length(obj.c.xyz);
+    let i = floor(dot(q, obj.b.xyz) / lu / m.a.w);
+    let j = floor(dot(q, obj.c.xyz) / lv / m.a.w);
+    let odd = (i32(i) + i32(j)) % 2 != 0;
+    return select(m.a.rgb, m.b.rgb, odd);
+}
+
+// Exact unpolarised Fresnel reflectance for cosines of incidence and transmission and
+// eta = n_from / n_to.
+fn fresnel(cos_i: f32, cos_t: f32, eta: f32) -> f32 {
+    let rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    return 0.5 * (rs * rs + rp * rp);
+}
+
+fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
+    var stack: array<Ray, MAX_STACK>;
+    var top = 1u;
+    stack[0] = Ray(eye, dir, vec3<f32>(1.0), params.counts.y);
+    var colour = vec3<f32>(0.0);
+    while (top > 0u) {
+        top -= 1u;
+        let ray = stack[top];
+        let hit = closest_hit(ray.o, ray.d);
+        if (hit.index == NO_HIT) {
+            colour += ray.weight * params.background.rgb;
+            continue;
+        }
+        let obj = objects[hit.index];
+        let m = materials[obj.material];
+        let s = surface_of(obj, ray.o + hit.t * ray.d);
+        let front = dot(s.n, ray.d) < 0.0;
+        let n = select(-s.n, s.n, front);
+        let v = -ray.d;
+        switch m.kind {
+            case MAT_EMITTER: {
+                colour += select(vec3<f32>(0.0), ray.weight * m.a.rgb, front);
+            }
+            case MAT_LAMBERTIAN, MAT_CHECKER: {
+                var c = m.a.rgb;
+                if (m.kind == MAT_CHECKER) {
+                    c = checker_albedo(obj, m, s.p);
+                }
+                let lit = light_at(s.p, n, s.err, v, 1.0);
+                colour += ray.weight * c * (params.ambient.rgb + lit.diffuse);
+            }
+            case MAT_MIRROR: {
+                let c = m.a.rgb;
+                let w = params.shading.x;
+                let lit = light_at(s.p, n, s.err, v, params.mirror_specular.w);
+                colour += ray.weight
+                    * ((1.0 - w) * c * (params.ambient.rgb + lit.diffuse) + params.mirror_specular.rgb * lit.highlight);
+                if (ray.depth > 0u && top < MAX_STACK) {
+                    stack[top] = Ray(spawn_point(s.p, n, s.err), reflect(ray.d, n), ray.weight * w * c, ray.depth - 1u);
+                    top += 1u;
+                }
+            }
+            default: {
+                // Dielectric: entering through the front or leaving.
+                let ior = m.a.w;
+                let eta = select(ior, 1.0 / ior, front);
+                let lit = light_at(s.p, n, s.err, v, params.shading.y);
+                colour += ray.weight * lit.highlight;
+                if (ray.depth > 0u) {
+                    let cos_i = dot(v, n);
+                    let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+                    let reflected = reflect(ray.d, n);
+                    if (k < 0.0) {
+                        if (top < MAX_STACK) {
+                            stack[top] = Ray(spawn_point(s.p, n, s.err), reflected, ray.weight, ray.depth - 1u);
+                            top += 1u;
+                        }
+                    } else {
+                        let cos_t = sqrt(k);
+                        let refracted = normalize(eta * ray.d + (eta * cos_i - cos_t) * n);
+                        let f = fresnel(cos_i, cos_t, eta);
+                        if (top + 1u < MAX_STACK) {
+                            stack[top] = Ray(spawn_point(s.p, n, s.err), reflected, ray.weight * f, ray.depth - 1u);
+                            stack[top + 1u] =
+                                Ray(spawn_point(s.p, -n, s.err), refracted, ray.weight * (1.0 - f), ray.depth - 1u);
+                            top += 2u;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    return colour;
+}
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let width = params.sizes.x;
+    let height = params.sizes.y;
+    if (id.x >= width || id.y >= height) {
+        return;
+    }
+    let n = max(params.counts.z, 1u);
+    var sum = vec3<f32>(0.0);
+    for (var j = 0u; j < n; j++) {
+        for (var i = 0u; i < n; i++) {
+            // The cell centres of an n x n grid over the pixel.
+            let px = f32(id.x) + (f32(i) + 0.5) / f32(n);
+            let py = f32(id.y) + (f32(j) + 0.5) / f32(n);
+            let x = 2.0 * px / f32(width) - 1.0;
+            let y = 1.0 - 2.0 * py / f32(height);
+            let d = normalize(params.forward.xyz + x * params.right.w * params.eye.w * params.right.xyz
+                + y * params.eye.w * params.up.xyz);
+            sum += trace(params.eye.xyz, d);
+        }
+    }
+    image[id.y * width + id.x] = vec4<f32>(sum / f32(n * n), 1.0);
+}
