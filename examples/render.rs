@@ -35,28 +35,33 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use clap::Parser;
-use illum::cli::{self, DEFAULT_SCENE, OutputFormat, SceneArgs, output_format};
+use illum::cli::{self, DEFAULT_SCENE, OutputFormat, RenderWith, SceneArgs, output_format};
 use illum::image::{Encoding, save_png};
 use illum::interrupt::Interrupt;
 use illum::pathtrace::checkpoint::{Checkpoint, load_checkpoint, save_checkpoint};
 use illum::pathtrace::{PathTracer, Sequence, StopReason, StopRules, TracerOptions, render_progressive};
 use illum::progress::RenderProgress;
 use illum::raster_cli::{RasterArgs, RasterRequest, render_raster};
-use illum::scene::{RendererKind, Scene};
+use illum::scene::Scene;
+use illum::whitted_cli::{WhittedArgs, WhittedRequest, render_whitted};
 
 #[derive(Parser, Debug)]
-#[command(about = "Render a scene file to PNG and/or EXR with the path tracer or the rasterizer")]
+#[command(
+    about = "Render a scene file to PNG and/or EXR with the path tracer, the rasterizer or the Whitted ray tracer"
+)]
 struct Args {
     /// Scene file (TOML).
     #[arg(default_value = DEFAULT_SCENE)]
     scene: PathBuf,
-    /// Renderer: `pathtrace` or `raster`. Default: the scene file's `renderer`.
+    /// Renderer: `pathtrace`, `raster` or `whitted`. Default: the scene file's `renderer`.
     #[arg(long)]
-    renderer: Option<RendererKind>,
+    renderer: Option<RenderWith>,
     #[command(flatten)]
     settings: SceneArgs,
     #[command(flatten)]
     raster: RasterArgs,
+    #[command(flatten)]
+    whitted: WhittedArgs,
     /// Output file(s); the extension (.png or .exr) picks the format. Default: out/NAME.png and
     /// out/NAME.exr.
     #[arg(short = 'o', long = "output")]
@@ -111,9 +116,42 @@ fn main() {
 fn run(args: Args) -> anyhow::Result<()> {
     let renderer = match args.renderer {
         Some(renderer) => renderer,
-        None => Scene::load(&cli::resolve_scene_path(&args.scene))?.renderer,
+        None => Scene::load(&cli::resolve_scene_path(&args.scene))?.renderer.into(),
     };
-    if renderer == RendererKind::Raster {
+    let path_tracer_only = cli::given_flags(&[
+        (args.target_error.is_some(), "--target-error"),
+        (args.time_budget.is_some(), "--time-budget"),
+        (args.sequence.is_some(), "--sequence"),
+        (args.resume.is_some(), "--resume"),
+        (args.sample_range.is_some(), "--sample-range"),
+        (args.checkpoint_seconds.is_some(), "--checkpoint-seconds"),
+    ]);
+    if renderer == RenderWith::Whitted {
+        let mut other_flags = path_tracer_only;
+        other_flags.extend(args.raster.given());
+        return render_whitted(&WhittedRequest {
+            scene: &args.scene,
+            settings: &args.settings,
+            whitted: &args.whitted,
+            outputs: &args.outputs,
+            encoding: args.encoding,
+            exposure: args.exposure,
+            other_flags,
+        });
+    }
+    let whitted_flags = args.whitted.given();
+    if !whitted_flags.is_empty() {
+        anyhow::bail!(
+            "{}: {} only to the Whitted ray tracer (--renderer whitted)",
+            args.scene.display(),
+            if whitted_flags.len() == 1 {
+                format!("{} applies", whitted_flags[0])
+            } else {
+                format!("{} apply", whitted_flags.join(", "))
+            }
+        );
+    }
+    if renderer == RenderWith::Raster {
         let given = [
             (args.target_error.is_some(), "--target-error"),
             (args.time_budget.is_some(), "--time-budget"),

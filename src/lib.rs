@@ -1,11 +1,13 @@
 //! illum: a Rust + wgpu renderer for the two scenes of an illumination assignment.
 //!
 //! This facade re-exports the workspace crates so that `examples/` and `tests/` can use one name,
-//! and holds the command-line pieces the examples share ([`cli`], [`interrupt`], [`progress`]).
+//! and holds the command-line pieces the examples share ([`cli`], [`interrupt`], [`progress`], and
+//! each renderer's path of the render example: [`raster_cli`], [`whitted_cli`]).
 pub mod cli;
 pub mod interrupt;
 pub mod progress;
 pub mod raster_cli;
+pub mod whitted_cli;
 
 pub use illum_gpu as gpu;
 pub use illum_image as image;

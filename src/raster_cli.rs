@@ -45,7 +45,7 @@ pub struct RasterArgs {
 
 impl RasterArgs {
     /// The flags given, as typed.
-    fn given(&self) -> Vec<&'static str> {
+    pub fn given(&self) -> Vec<&'static str> {
         [
             (self.look.is_some(), "--look"),
             (self.no_shadows, "--no-shadows"),

@@ -570,3 +570,63 @@ fn mismatched_corrupt_and_overlapping_inputs_are_refused_by_name() {
     let out = run(&["--resume", &p("plain.exr"), "--spp", "64"]);
     assert!(!out.status.success() && text(&out.stderr).contains("plain.exr"), "{}", text(&out.stderr));
 }
+
+#[test]
+fn the_whitted_ray_tracer_renders_both_scenes_and_refuses_the_other_renderers_flags() {
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("w.exr");
+    let png = dir.path().join("w.png");
+    let out = run(&[
+        "scenes/whitted.toml",
+        "--renderer",
+        "whitted",
+        "--width",
+        "32",
+        "--height",
+        "18",
+        "--depth",
+        "3",
+        "--aa",
+        "1",
+        "-o",
+        exr.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(png.exists());
+    let meta = metadata(&exr);
+    assert_eq!(meta.renderer, "whitted");
+    assert_eq!((field(&meta, "depth"), field(&meta, "aa")), ("3".to_owned(), "1".to_owned()));
+    // The Cornell box too (its light as a point light).
+    let cornell = dir.path().join("c.png");
+    let out = run(&[
+        "scenes/cornell.toml",
+        "--renderer",
+        "whitted",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "-o",
+        cornell.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    // Flags of the other renderers, and out-of-range values, are refused before rendering.
+    for (args, expected) in [
+        (vec!["--renderer", "whitted", "--spp", "4"], "--spp applies to the other renderers"),
+        (vec!["--renderer", "whitted", "--no-msaa"], "--no-msaa applies to the other renderers"),
+        (vec!["--renderer", "whitted", "--depth", "65"], "--depth = 65: must be an integer in 0..=64"),
+        (vec!["--renderer", "whitted", "--aa", "0"], "--aa = 0: must be an integer in 1..=16"),
+        (vec!["--depth", "2"], "--depth applies only to the Whitted ray tracer"),
+    ] {
+        let never = dir.path().join("never.png");
+        let mut all = vec!["scenes/whitted.toml"];
+        all.extend(args);
+        all.extend(["-o", never.to_str().unwrap()]);
+        let out = run(&all);
+        assert_eq!(out.status.code(), Some(1), "{all:?}");
+        assert!(text(&out.stderr).contains(expected), "{all:?}: {}", text(&out.stderr));
+        assert!(!never.exists());
+    }
+}
