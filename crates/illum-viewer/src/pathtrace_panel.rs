@@ -21,7 +21,7 @@
 use std::path::{Path, PathBuf};
 
 use illum_gpu::GpuContext;
-use illum_image::{Encoding, RgbImage32, save_exr, save_png};
+use illum_image::{Encoding, RgbImage32, save_png};
 use illum_pathtrace::{PathTracer, Progressive, StopReason, StopRules};
 use illum_scene::{Bounces, Sampling, Scene};
 
@@ -332,20 +332,22 @@ impl PathTraceMode {
         if path.as_os_str().is_empty() || path.file_stem().is_none() {
             return Err(format!("{:?} is not a file name", self.save_path));
         }
-        let image: RgbImage32 = tracer.accumulator().mean_image();
-        let result = if extension == "exr" {
+        if extension == "exr" {
             let metadata = illum_pathtrace::metadata::exr_metadata(
                 tracer,
                 self.progressive.clock().elapsed().as_secs_f64(),
                 self.progressive.stopped(),
                 "illum-viewer",
             );
-            save_exr(&path, &image, &metadata)
+            // With the statistics layer, so that `render --resume` can continue it (at the size
+            // the viewer rendered).
+            illum_pathtrace::checkpoint::save_checkpoint(&path, tracer, &metadata)?;
         } else {
             // The PNG is the image as rendered: gamma 2.2, no display exposure.
-            save_png(&path, &image, 0.0, Encoding::Gamma22)
-        };
-        result.map(|()| path.clone()).map_err(|e| error_chain(&e))
+            let image: RgbImage32 = tracer.accumulator().mean_image();
+            save_png(&path, &image, 0.0, Encoding::Gamma22).map_err(|e| error_chain(&e))?;
+        }
+        Ok(path)
     }
 
     /// The panel's controls.

@@ -141,6 +141,10 @@ fn saves_png_and_exr_into_a_directory() {
         assert!(metadata.get(key).is_some(), "no illum.{key}: {metadata:?}");
     }
     assert_eq!(metadata.get("source"), Some("illum-viewer"));
+    // It is a checkpoint too: the render example can continue it with --resume.
+    let checkpoint = illum_pathtrace::checkpoint::load_checkpoint(&exr).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!((checkpoint.accumulator.width, checkpoint.accumulator.height), (w, h));
+    assert!(checkpoint.spp_done > 0);
     let message = harness.state().pathtrace().unwrap().message.clone().unwrap_or_default();
     assert!(message.starts_with("saved"), "{message}");
 }

@@ -63,3 +63,29 @@ fn a_sun_of_finite_size_is_refused_by_name() {
     let err = WhittedTracer::new(gpu(), &scene).err().expect("refused").to_string();
     assert!(err.contains("Whitted ray tracer cannot render") && err.contains("sun disc"), "{err}");
 }
+
+#[test]
+fn extremes_agree_with_the_f64_copy_and_stay_finite() {
+    // Depth 64 and total-internal-reflection chains (index 4), a glass barely denser than air
+    // (1.0001) and one that vanishes (1), on the Whitted scene.
+    for (ior, depth) in [(4.0f32, 64u32), (1.0001, 8), (1.0, 8), (1.4285715, 64)] {
+        let mut scene = illum_scene::testing::shipped_scene("whitted.toml", 96, 54);
+        for m in &mut scene.materials {
+            if let illum_scene::MaterialKind::Dielectric { ior: value } = &mut m.kind {
+                *value = ior;
+            }
+        }
+        scene.whitted.depth = depth;
+        let image = WhittedTracer::new(gpu(), &scene).unwrap().render().unwrap();
+        assert!(
+            image.pixels.iter().flatten().all(|c| c.is_finite() && *c >= 0.0),
+            "ior {ior}, depth {depth}"
+        );
+        let (agree, _, pixels) = agreement(&scene);
+        assert!(
+            agree >= 0.99,
+            "ior {ior}, depth {depth}: only {:.2}% of {pixels} pixels agree",
+            100.0 * agree
+        );
+    }
+}
