@@ -9,12 +9,12 @@
 // nothing, because that light was already counted by next-event estimation at the previous hit.
 // A camera ray that hits a light sees its emitted radiance.
 
-#import illum::constants::INV_PI
+#import illum::constants::{PI, TWO_PI, INV_PI}
 #import illum::sampler::{Sampler, sampler_new, sample_1d}
 #import illum::sampling::{sample_cosine_hemisphere, sample_uniform_hemisphere, to_world, sample_parallelogram}
 #import illum::spawn::{spawn_point, spawn_error, max_abs}
-#import illum::rtcore::geometry::{NO_HIT, Surface}
-#import illum::pathtrace::scene::{params, objects, materials, lights, batch_sum, batch_sum_sq}
+#import illum::rtcore::geometry::{NO_HIT, FAR, Surface}
+#import illum::pathtrace::scene::{Material, params, objects, materials, lights, batch_sum, batch_sum_sq}
 #import illum::pathtrace::traversal::{closest_hit, occluded, surface_at, choose_light}
 
 const SAMPLING_COSINE: u32 = 0u;
@@ -72,37 +72,169 @@ fn max3(v: vec3<f32>) -> f32 {
     return max(max(v.x, v.y), v.z);
 }
 
+const MATERIAL_CHECKER: u32 = 1u;
+const MATERIAL_DIELECTRIC: u32 = 2u;
+const MATERIAL_MIRROR: u32 = 3u;
+
+#ifdef SUN
+// Next-event estimation toward the directional light from s (rays leave from `origin`): its
+// contribution to the integral of incoming radiance x cos(theta_x), divided by its pdf. A delta
+// light: irradiance x cos. A disc of half-angle a: one direction uniform in its cone (pdf
+// 1 / (2 pi (1 - cos a))) with radiance L = irradiance / (pi sin^2 a). Every object blocks it.
+fn sun_light(s: Surface, origin: vec3<f32>, sampler: ptr<function, Sampler>) -> vec3<f32> {
+#ifdef SUN_DISC
+    let u1 = sample_1d(sampler);
+    let u2 = sample_1d(sampler);
+    let cos_max = params.sun.w;
+    let cos_t = 1.0 - u1 * (1.0 - cos_max);
+    let sin_t = sqrt(max(1.0 - cos_t * cos_t, 0.0));
+    let phi = TWO_PI * u2;
+    let w = normalize(to_world(params.sun.xyz, vec3<f32>(sin_t * cos(phi), sin_t * sin(phi), cos_t)));
+    let weight = sun_radiance() * (TWO_PI * (1.0 - cos_max));
+#else
+    let w = params.sun.xyz;
+    let weight = params.sun_irradiance.xyz;
+#endif
+    let cos_x = dot(s.n, w);
+    if (cos_x > 0.0 && !occluded(origin, w, FAR)) {
+        return weight * cos_x;
+    }
+    return vec3<f32>(0.0);
+}
+#endif
+
+#ifdef SUN_DISC
+fn sun_radiance() -> vec3<f32> {
+    let cos_max = params.sun.w;
+    return params.sun_irradiance.xyz / (PI * (1.0 - cos_max * cos_max));
+}
+#endif
+
+// What a ray leaving the scene along d sees: the sky, and a sun disc where light straight from
+// it counts (camera and specular rays: next-event estimation already counted it for diffuse
+// ones). A delta sun is never seen.
+fn escaped(d: vec3<f32>, direct_counts: bool) -> vec3<f32> {
+    var l = vec3<f32>(0.0);
+#ifdef SKY
+    l += params.sky.xyz;
+#endif
+#ifdef SUN_DISC
+    if (direct_counts && dot(d, params.sun.xyz) >= params.sun.w) {
+        l += sun_radiance();
+    }
+#endif
+    return l;
+}
+
+#ifdef CHECKER
+// The checker's albedo at p on quad obj: tile (i, j) counted from its corner along its edges.
+fn checker_albedo(obj_index: u32, m: Material, p: vec3<f32>) -> vec3<f32> {
+    let obj = objects[obj_index];
+    let q = p - obj.a.xyz;
+    let i = floor(dot(q, obj.b.xyz) / length(obj.b.xyz) / m.emission.w);
+    let j = floor(dot(q, obj.c.xyz) / length(obj.c.xyz) / m.emission.w);
+    return select(m.albedo.rgb, m.emission.rgb, (i32(i) + i32(j)) % 2 != 0);
+}
+#endif
+
+#ifdef SPECULAR
+// Exact unpolarised Fresnel reflectance for cosines of incidence and transmission and
+// eta = n_from / n_to.
+fn fresnel(cos_i: f32, cos_t: f32, eta: f32) -> f32 {
+    let rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    return 0.5 * (rs * rs + rp * rp);
+}
+#endif
+
 // One path's radiance estimate along the camera ray (o, d).
+//
+// Light that reaches a ray straight from an emitter or a sun disc counts for the camera ray and
+// after specular scattering (`direct_counts`), not after a diffuse bounce, whose point already
+// sampled the lights. Specular scattering (shader def SPECULAR): a mirror reflects with weight
+// its reflectance; a dielectric reflects with probability F (exact Fresnel) and else refracts,
+// weight 1 either way, with no eta^2 scaling (every light and diffuse surface is outside, so
+// the factors of entering and leaving cancel). Each scattering counts as a bounce.
 fn radiance(origin: vec3<f32>, direction: vec3<f32>, sampler: ptr<function, Sampler>) -> vec3<f32> {
     var o = origin;
     var d = direction;
-    var hit = closest_hit(o, d);
-    if (hit.index == NO_HIT) {
-        return vec3<f32>(0.0);
-    }
-    var obj = objects[hit.index];
-    if (obj.emitter != 0u) {
-        // One-sided emitter: visible only from its front.
-        let facing = dot(surface_at(obj, o + hit.t * d).n, d) < 0.0;
-        return select(vec3<f32>(0.0), materials[obj.material].emission.xyz, facing);
-    }
     var radiance = vec3<f32>(0.0);
     var throughput = vec3<f32>(1.0);
     var depth = 0u;
+    var direct_counts = true;
     loop {
-        var s = surface_at(obj, o + hit.t * d);
-        if (dot(s.n, d) > 0.0) {
-            s.n = -s.n;
-        }
-        let albedo = materials[obj.material].albedo.xyz;
-        // Every ray leaving this point (shadow and bounce) starts here, off the surface.
-        let spawned = spawn_point(s.p, s.n, s.err);
-        radiance += throughput * albedo * INV_PI * direct_light(s, spawned, sampler);
-
-        if (params.bounces != UNBOUNDED && depth >= params.bounces) {
+        let hit = closest_hit(o, d);
+        if (hit.index == NO_HIT) {
+            radiance += throughput * escaped(d, direct_counts);
             break;
         }
-        if (depth >= UNBOUNDED_DEPTH_CAP) {
+        let obj = objects[hit.index];
+        if (obj.emitter != 0u) {
+            if (direct_counts) {
+                // One-sided emitter: visible only from its front.
+                let facing = dot(surface_at(obj, o + hit.t * d).n, d) < 0.0;
+                radiance += select(vec3<f32>(0.0), throughput * materials[obj.material].emission.xyz, facing);
+            }
+            break;
+        }
+        var s = surface_at(obj, o + hit.t * d);
+        let front = dot(s.n, d) < 0.0;
+        if (!front) {
+            s.n = -s.n;
+        }
+        let last = (params.bounces != UNBOUNDED && depth >= params.bounces) || depth >= UNBOUNDED_DEPTH_CAP;
+#ifdef SPECULAR
+        let m = materials[obj.material];
+        let kind = u32(m.albedo.w);
+        if (kind == MATERIAL_MIRROR || kind == MATERIAL_DIELECTRIC) {
+            // Its only continuation is the bounce it may not take.
+            if (last) {
+                break;
+            }
+            if (kind == MATERIAL_MIRROR) {
+                throughput *= m.albedo.xyz;
+                d = reflect(d, s.n);
+                o = spawn_point(s.p, s.n, s.err);
+            } else {
+                let ior = m.emission.w;
+                let eta = select(ior, 1.0 / ior, front);
+                let cos_i = -dot(d, s.n);
+                let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+                var reflects = k < 0.0;
+                if (!reflects) {
+                    let cos_t = sqrt(k);
+                    reflects = sample_1d(sampler) < fresnel(cos_i, cos_t, eta);
+                    if (!reflects) {
+                        d = normalize(eta * d + (eta * cos_i - cos_t) * s.n);
+                        o = spawn_point(s.p, -s.n, s.err);
+                    }
+                }
+                if (reflects) {
+                    d = reflect(d, s.n);
+                    o = spawn_point(s.p, s.n, s.err);
+                }
+            }
+            direct_counts = true;
+            if (!roulette(depth, &throughput, sampler)) {
+                break;
+            }
+            depth += 1u;
+            continue;
+        }
+#endif
+#ifdef CHECKER
+        let checker = materials[obj.material];
+        var albedo = checker.albedo.xyz;
+        if (u32(checker.albedo.w) == MATERIAL_CHECKER) {
+            albedo = checker_albedo(hit.index, checker, s.p);
+        }
+#else
+        let albedo = materials[obj.material].albedo.xyz;
+#endif
+        // Every ray leaving this point (shadow and bounce) starts here, off the surface.
+        let spawned = spawn_point(s.p, s.n, s.err);
+        radiance += throughput * albedo * INV_PI * direct(s, spawned, sampler);
+        if (last) {
             break;
         }
         let u1 = sample_1d(sampler);
@@ -117,29 +249,40 @@ fn radiance(origin: vec3<f32>, direction: vec3<f32>, sampler: ptr<function, Samp
             d = to_world(s.n, local);
             throughput *= albedo * (2.0 * local.z);
         }
-        if (params.bounces == UNBOUNDED && depth >= RR_START) {
-            // Survive with probability q and divide by q: E[throughput] is unchanged.
-            let q = min(max3(throughput), RR_MAX_SURVIVAL);
-            if (sample_1d(sampler) >= q) {
-                break;
-            }
-            throughput /= q;
-        }
-        if (max3(throughput) <= 0.0) {
+        if (!roulette(depth, &throughput, sampler)) {
             break;
         }
         o = spawned;
-        hit = closest_hit(o, d);
-        if (hit.index == NO_HIT) {
-            break;
-        }
-        obj = objects[hit.index];
-        if (obj.emitter != 0u) {
-            break;
-        }
+        direct_counts = false;
         depth += 1u;
     }
     return radiance;
+}
+
+// Next-event estimation at a diffuse point: the area lights and the directional light.
+fn direct(s: Surface, origin: vec3<f32>, sampler: ptr<function, Sampler>) -> vec3<f32> {
+    var l = vec3<f32>(0.0);
+#ifdef AREA_LIGHTS
+    l += direct_light(s, origin, sampler);
+#endif
+#ifdef SUN
+    l += sun_light(s, origin, sampler);
+#endif
+    return l;
+}
+
+// Russian roulette in unbounded mode from bounce RR_START on: survive with probability
+// q = min(max channel, 0.95) and divide by q, so E[throughput] is unchanged. False: the path
+// ends (also when nothing more can be added).
+fn roulette(depth: u32, throughput: ptr<function, vec3<f32>>, sampler: ptr<function, Sampler>) -> bool {
+    if (params.bounces == UNBOUNDED && depth >= RR_START) {
+        let q = min(max3(*throughput), RR_MAX_SURVIVAL);
+        if (sample_1d(sampler) >= q) {
+            return false;
+        }
+        *throughput /= q;
+    }
+    return max3(*throughput) > 0.0;
 }
 
 // True when no component is Inf or NaN (exponent bits all ones), tested on the bits so no

@@ -36,8 +36,17 @@ struct Params {
     first_emitter: u32,
     // Samples per invocation (one chunk); the dispatch's z dimension counts chunks.
     chunk_samples: u32,
+    // The directional light (shader def SUN): xyz = unit vector toward it, w = cos of its
+    // angular radius (1 for a delta light); its irradiance on a surface facing it.
+    sun: vec4<f32>,
+    sun_irradiance: vec4<f32>,
+    // The environment's radiance (shader def SKY).
+    sky: vec4<f32>,
 }
 
+// albedo.w: the kind (MATERIAL_* in pathtrace.wgsl). Lambertian: albedo.rgb; emitter:
+// emission.rgb; checker: even albedo.rgb, odd emission.rgb, tile emission.w; mirror:
+// reflectance albedo.rgb; dielectric: ior emission.w.
 struct Material {
     albedo: vec4<f32>,
     emission: vec4<f32>,

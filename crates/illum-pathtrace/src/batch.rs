@@ -30,12 +30,14 @@ pub(crate) struct BatchBuffers {
 
 impl BatchBuffers {
     /// Allocates buffers of `slots` slots each and binds them, after the scene's buffers
-    /// (`scene_buffers`: params, objects, materials, lights), to `layout`.
+    /// (`scene_buffers`: params, objects, materials, lights), to `layout`. The lights are bound
+    /// only with `bind_lights`: a pipeline without area lights does not declare them.
     pub(crate) fn new(
         gpu: &GpuContext,
         slots: u64,
         layout: &wgpu::BindGroupLayout,
         scene_buffers: [&wgpu::Buffer; 4],
+        bind_lights: bool,
     ) -> Result<Self, GpuError> {
         let device = &gpu.device;
         gpu.scoped("allocating path-tracer batch buffers", || {
@@ -60,7 +62,11 @@ impl BatchBuffers {
                     wgpu::BindGroupEntry { binding: 3, resource: lights.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 4, resource: sum.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 5, resource: sum_sq.as_entire_binding() },
-                ],
+                ]
+                .iter()
+                .filter(|e| bind_lights || e.binding != 3)
+                .cloned()
+                .collect::<Vec<_>>(),
             });
             BatchBuffers { slots, sum, sum_sq, bind_group }
         })

@@ -2,14 +2,19 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
-use illum_scene::{Bounces, Feature, RendererKind, Sampling, Scene, Shape};
+use illum_scene::{Bounces, Feature, MaterialKind, RendererKind, Sampling, Scene, Shape};
 
 use crate::PathTraceError;
 
-/// What the path tracer implements today: Lambertian boxes, quads and spheres lit by area
-/// lights. Every other feature of the scene model is refused by name (see `Scene::require`).
-pub const FEATURES: &[Feature] =
-    &[Feature::BoxShape, Feature::QuadShape, Feature::SphereShape, Feature::Lambertian, Feature::AreaLight];
+/// What the path tracer implements: every feature of the scene model. Each is compiled into a
+/// scene's pipeline only when the scene uses it (see [`GpuScene::shader_defs`]).
+pub const FEATURES: &[Feature] = &Feature::ALL;
+
+/// `albedo.w` of a [`GpuMaterial`]: what kind of surface it is (MATERIAL_* in pathtrace.wgsl).
+const MATERIAL_LAMBERTIAN: f32 = 0.0;
+const MATERIAL_CHECKER: f32 = 1.0;
+const MATERIAL_DIELECTRIC: f32 = 2.0;
+const MATERIAL_MIRROR: f32 = 3.0;
 
 /// `Params::bounces` value meaning "unbounded, with Russian roulette".
 pub const UNBOUNDED: u32 = u32::MAX;
@@ -203,6 +208,12 @@ pub struct GpuParams {
     /// Samples per invocation: each invocation traces one chunk of a pixel's samples and writes
     /// its own slot (see the tracer).
     pub chunk_samples: u32,
+    /// The directional light: xyz toward it, w = cos(angular radius); its irradiance (scaled
+    /// like every emission by 2^-radiance_exponent).
+    pub sun: [f32; 4],
+    pub sun_irradiance: [f32; 4],
+    /// The environment's radiance (scaled likewise).
+    pub sky: [f32; 4],
 }
 
 /// The uploaded form of a scene.
@@ -217,6 +228,8 @@ pub struct GpuScene {
     pub light_area: f32,
     /// Index of the first emitter in `objects`.
     pub first_emitter: u32,
+    /// The shader defs of the features this scene uses (see [`GpuScene::shader_defs`]).
+    pub defs: Vec<&'static str>,
     /// Every emission above was multiplied by 2^-`radiance_exponent` (0 unless a light exceeds
     /// 2^16; see [`crate::accumulator::radiance_exponent`]), so the GPU's samples are the true
     /// ones times 2^-k, exactly.
@@ -230,18 +243,35 @@ fn v4(v: Vec3, w: f32) -> [f32; 4] {
 impl GpuScene {
     pub fn new(scene: &Scene) -> Result<Self, PathTraceError> {
         scene.require(RendererKind::PathTrace, FEATURES)?;
-        let max_emission = scene.materials.iter().map(|m| m.emission().max_element()).fold(0.0f32, f32::max);
+        let sun = scene.directional_light.map_or(0.0, |l| l.irradiance.max_element());
+        let sky = scene.environment.map_or(0.0, |e| e.radiance.max_element());
+        let max_emission =
+            scene.materials.iter().map(|m| m.emission().max_element()).fold(sun.max(sky), f32::max);
         let radiance_exponent = crate::accumulator::radiance_exponent(max_emission);
         let emission_scale = 2f32.powi(-radiance_exponent);
-        // Every material left is Lambertian or an emitter (which reflects nothing).
         let materials = scene
             .materials
             .iter()
-            .map(|m| GpuMaterial {
-                albedo: v4(m.diffuse_albedo().unwrap_or(Vec3::ZERO), 0.0),
-                emission: v4(m.emission() * emission_scale, 0.0),
+            .map(|m| match m.kind {
+                MaterialKind::Lambertian { albedo } => {
+                    GpuMaterial { albedo: v4(albedo, MATERIAL_LAMBERTIAN), emission: [0.0; 4] }
+                }
+                MaterialKind::Emitter { radiance } => GpuMaterial {
+                    albedo: v4(Vec3::ZERO, MATERIAL_LAMBERTIAN),
+                    emission: v4(radiance * emission_scale, 0.0),
+                },
+                MaterialKind::Checker(c) => {
+                    GpuMaterial { albedo: v4(c.even, MATERIAL_CHECKER), emission: v4(c.odd, c.tile) }
+                }
+                MaterialKind::Dielectric { ior } => GpuMaterial {
+                    albedo: v4(Vec3::ZERO, MATERIAL_DIELECTRIC),
+                    emission: [0.0, 0.0, 0.0, ior],
+                },
+                MaterialKind::Mirror { reflectance } => {
+                    GpuMaterial { albedo: v4(reflectance, MATERIAL_MIRROR), emission: [0.0; 4] }
+                }
             })
-            .collect();
+            .collect::<Vec<_>>();
         let (objects, first_emitter) = ordered_objects(scene);
         let mut lights = Vec::new();
         let mut light_area = 0.0f32;
@@ -271,16 +301,36 @@ impl GpuScene {
                 (false, _) => {}
             }
         }
-        if lights.is_empty() {
+        if lights.is_empty() && scene.directional_light.is_none() && scene.environment.is_none() {
             return Err(PathTraceError::Unsupported {
                 scene: scene.name.clone(),
-                message: "the scene has no light (a quad whose material has emission > 0); \
-                          the path tracer would render black"
+                message: "the scene has no light (a quad whose material has emission > 0, a \
+                          [directional_light] or an [environment]); the path tracer would render black"
                     .to_owned(),
             });
         }
+        let mut defs = Vec::new();
+        if !lights.is_empty() {
+            defs.push("AREA_LIGHTS");
+        }
+        if let Some(sun) = &scene.directional_light {
+            defs.push("SUN");
+            if !sun.is_delta() {
+                defs.push("SUN_DISC");
+            }
+        }
+        if scene.environment.is_some() {
+            defs.push("SKY");
+        }
+        let kinds = || scene.objects.iter().map(|o| scene.material_of(o).kind);
+        if kinds().any(|k| matches!(k, MaterialKind::Mirror { .. } | MaterialKind::Dielectric { .. })) {
+            defs.push("SPECULAR");
+        }
+        if kinds().any(|k| matches!(k, MaterialKind::Checker(_))) {
+            defs.push("CHECKER");
+        }
         let objects = objects.into_iter().map(|(_, object)| object).collect();
-        Ok(Self { objects, materials, lights, light_area, first_emitter, radiance_exponent })
+        Ok(Self { objects, materials, lights, light_area, first_emitter, defs, radiance_exponent })
     }
 }
 
@@ -318,6 +368,13 @@ pub fn ordered_objects(scene: &Scene) -> (Vec<(usize, GpuObject)>, u32) {
 }
 
 impl GpuScene {
+    /// naga_oil shader defs for the features the scene uses: AREA_LIGHTS, SUN, SUN_DISC, SKY,
+    /// SPECULAR (a mirror or a dielectric), CHECKER. The Cornell box compiles with
+    /// AREA_LIGHTS alone: none of the other features' code is in its pipeline.
+    pub fn shader_defs(&self) -> Vec<(&'static str, illum_gpu::shader::Def)> {
+        self.defs.iter().map(|&d| (d, illum_gpu::shader::Def::Bool(true))).collect()
+    }
+
     /// The objects as the shader's storage buffer holds them.
     pub fn object_records(&self) -> Vec<ObjectRecord> {
         self.objects.iter().map(GpuObject::record).collect()
@@ -327,6 +384,7 @@ impl GpuScene {
 /// The per-dispatch parameters for `scene` with its current render settings.
 pub fn params(scene: &Scene, gpu_scene: &GpuScene) -> GpuParams {
     let basis = scene.camera.basis();
+    let scale = 2f32.powi(-gpu_scene.radiance_exponent);
     GpuParams {
         eye: scene.camera.eye.to_array(),
         tan_half_fov: basis.tan_half_fov,
@@ -354,5 +412,10 @@ pub fn params(scene: &Scene, gpu_scene: &GpuScene) -> GpuParams {
         num_lights: gpu_scene.lights.len() as u32,
         first_emitter: gpu_scene.first_emitter,
         chunk_samples: crate::batch::CHUNK_SAMPLES,
+        sun: scene
+            .directional_light
+            .map_or([0.0; 4], |l| v4(l.to_light(), l.angular_radius_deg.to_radians().cos())),
+        sun_irradiance: scene.directional_light.map_or([0.0; 4], |l| v4(l.irradiance * scale, 1.0)),
+        sky: scene.environment.map_or([0.0; 4], |e| v4(e.radiance * scale, 1.0)),
     }
 }

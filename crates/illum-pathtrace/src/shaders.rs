@@ -60,8 +60,9 @@ pub(crate) fn pathtrace_pipeline(
 ) -> Result<(wgpu::ComputePipeline, String), PathTraceError> {
     let modules = shader_modules(scene, gpu_scene, options.traversal);
     let traversal_source = modules.last().expect("a traversal").source.to_string();
-    let pipeline =
-        shader::compute_pipeline(gpu, &modules, &PATHTRACE_SHADER, &options.shader_defs(), "path-tracing")?;
+    let mut defs = options.shader_defs();
+    defs.extend(gpu_scene.shader_defs());
+    let pipeline = shader::compute_pipeline(gpu, &modules, &PATHTRACE_SHADER, &defs, "path-tracing")?;
     Ok((pipeline, traversal_source))
 }
 
@@ -166,7 +167,7 @@ mod tests {
             size_of::<GpuParams>(),
             &members!(GpuParams: eye, tan_half_fov, right, aspect, up, light_area, forward, num_objects,
                 width, height, row_offset, rows, sample_base, sample_count, seed, bounces, sampling,
-                num_lights, first_emitter, chunk_samples),
+                num_lights, first_emitter, chunk_samples, sun, sun_irradiance, sky),
         );
         wgsl_struct(&module, "illum::rtcore::geometry", "Object")
             .unwrap_or_else(|| panic!("no struct Object in rtcore/geometry.wgsl"))

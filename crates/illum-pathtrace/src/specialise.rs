@@ -158,7 +158,9 @@ fn light_corners(scene: &GpuScene) -> Vec<[f32; 3]> {
 /// estimation only traces rays leaving a surface on its outer side.
 pub fn can_block_light(scene: &GpuScene, index: usize) -> bool {
     let object = &scene.objects[index];
-    if object.shape.kind() != ShapeKind::Aabb || object.emitter {
+    // A directional light shines from everywhere on a hemisphere's worth of directions: the
+    // half-space argument below covers only area lights.
+    if object.shape.kind() != ShapeKind::Aabb || object.emitter || scene.defs.contains(&"SUN") {
         return true;
     }
     let o = Bounds::of(object);
@@ -270,8 +272,8 @@ pub fn specialise(scene: &Scene, gpu_scene: &GpuScene) -> Specialisation {
             normal_cases.push_str(&format!("        case {}: {{ return {call}; }}\n", kind.wgsl_constant()));
         }
     }
-    let choose_light = if gpu_scene.lights.len() == 1 {
-        "    // One light: nothing to choose.\n    return 0u;\n".to_owned()
+    let choose_light = if gpu_scene.lights.len() <= 1 {
+        "    // One light (or none: then nothing calls this): nothing to choose.\n    return 0u;\n".to_owned()
     } else {
         let mut code = String::new();
         for (i, light) in gpu_scene.lights.iter().enumerate().take(gpu_scene.lights.len() - 1) {

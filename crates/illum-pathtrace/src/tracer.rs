@@ -83,6 +83,15 @@ pub struct PathTracer {
     gpu_seconds: f64,
 }
 
+/// The placeholder record bound when a scene has no area light.
+const EMPTY_LIGHT: crate::gpu_scene::GpuLight = crate::gpu_scene::GpuLight {
+    corner: [0.0; 4],
+    edge_u: [0.0; 4],
+    edge_v: [0.0; 4],
+    normal: [0.0; 4],
+    emission: [0.0; 4],
+};
+
 impl PathTracer {
     /// Validates `scene` against the device, compiles the (specialised) pipeline and allocates
     /// the buffers.
@@ -146,7 +155,16 @@ impl PathTracer {
                     params_buffer,
                     storage("pathtrace objects", bytemuck::cast_slice(&gpu_scene.object_records())),
                     storage("pathtrace materials", bytemuck::cast_slice(&gpu_scene.materials)),
-                    storage("pathtrace lights", bytemuck::cast_slice(&gpu_scene.lights)),
+                    // A storage buffer may not be empty: a scene lit only by the sun or the sky
+                    // binds one unused record (num_lights = 0, no AREA_LIGHTS code reads it).
+                    storage(
+                        "pathtrace lights",
+                        if gpu_scene.lights.is_empty() {
+                            bytemuck::bytes_of(&EMPTY_LIGHT)
+                        } else {
+                            bytemuck::cast_slice(&gpu_scene.lights)
+                        },
+                    ),
                 )
             })?;
 

@@ -42,7 +42,8 @@ impl PathTracer {
         let layout = self.pipeline.get_bind_group_layout(0);
         let scene_buffers =
             [&self.params_buffer, &self.objects_buffer, &self.materials_buffer, &self.lights_buffer];
-        self.batch = Some(BatchBuffers::new(&self.gpu, slots, &layout, scene_buffers)?);
+        let bind_lights = self.base_params.num_lights > 0;
+        self.batch = Some(BatchBuffers::new(&self.gpu, slots, &layout, scene_buffers, bind_lights)?);
         Ok(())
     }
 
