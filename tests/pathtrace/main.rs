@@ -24,6 +24,7 @@ mod closed_form;
 mod display_sum;
 mod error_estimate;
 mod extremes;
+mod furnace;
 mod oracle_agreement;
 mod overflow;
 mod random_scenes;
