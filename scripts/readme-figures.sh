@@ -23,6 +23,8 @@ echo "== Pictures"
 "$bin/render" scenes/cornell.toml --spp 2048 -o docs/images/cornell.png
 "$bin/raster_figures" --out docs/images
 "$bin/render" scenes/whitted.toml --renderer whitted --width 640 --height 360 -o docs/images/whitted-raytraced.png
+"$bin/render" scenes/whitted.toml --renderer pathtrace --width 640 --height 360 --spp 1024 --encoding linear \
+    -o docs/images/whitted-pathtraced.png
 "$bin/figures" --out "$out/figures"
 cp "$out/figures/contact-sheet.png" docs/images/figures.png
 if command -v xvfb-run > /dev/null; then
