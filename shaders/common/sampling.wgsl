@@ -26,6 +26,16 @@ fn sample_uniform_hemisphere(u1: f32, u2: f32) -> vec3<f32> {
     return vec3<f32>(r * cos(phi), r * sin(phi), z);
 }
 
+// A direction uniform over the cone of half-angle acos(cos_max) around +z (a sun disc seen from
+// the scene): solid angle is linear in cos(theta), so cos(theta) = 1 - u1 (1 - cos_max);
+// pdf = 1 / (2 pi (1 - cos_max)). Local frame, like the hemispheres above.
+fn sample_uniform_cone(cos_max: f32, u1: f32, u2: f32) -> vec3<f32> {
+    let cos_t = 1.0 - u1 * (1.0 - cos_max);
+    let sin_t = sqrt(max(1.0 - cos_t * cos_t, 0.0));
+    let phi = TWO_PI * u2;
+    return vec3<f32>(sin_t * cos(phi), sin_t * sin(phi), cos_t);
+}
+
 fn uniform_hemisphere_pdf() -> f32 {
     return 0.5 * INV_PI;
 }

@@ -11,7 +11,7 @@
 
 #import illum::constants::{PI, TWO_PI, INV_PI}
 #import illum::sampler::{Sampler, sampler_new, sample_1d}
-#import illum::sampling::{sample_cosine_hemisphere, sample_uniform_hemisphere, to_world, sample_parallelogram}
+#import illum::sampling::{sample_cosine_hemisphere, sample_uniform_hemisphere, sample_uniform_cone, to_world, sample_parallelogram}
 #import illum::spawn::{spawn_point, spawn_error, max_abs}
 #import illum::rtcore::geometry::{NO_HIT, FAR, Surface}
 #import illum::pathtrace::scene::{Material, params, objects, materials, lights, batch_sum, batch_sum_sq}
@@ -86,10 +86,7 @@ fn sun_light(s: Surface, origin: vec3<f32>, sampler: ptr<function, Sampler>) -> 
     let u1 = sample_1d(sampler);
     let u2 = sample_1d(sampler);
     let cos_max = params.sun.w;
-    let cos_t = 1.0 - u1 * (1.0 - cos_max);
-    let sin_t = sqrt(max(1.0 - cos_t * cos_t, 0.0));
-    let phi = TWO_PI * u2;
-    let w = normalize(to_world(params.sun.xyz, vec3<f32>(sin_t * cos(phi), sin_t * sin(phi), cos_t)));
+    let w = normalize(to_world(params.sun.xyz, sample_uniform_cone(cos_max, u1, u2)));
     let weight = sun_radiance() * (TWO_PI * (1.0 - cos_max));
 #else
     let w = params.sun.xyz;

@@ -26,7 +26,7 @@ fn run_on_gpu(expression: &str, seed: u32) -> Vec<DVec3> {
     let gpu = common::gpu();
     let source = format!(
         "#import illum::rng::{{rng_seed, rng_f32}}
-#import illum::sampling::{{sample_cosine_hemisphere, sample_uniform_hemisphere, to_world, sample_parallelogram}}
+#import illum::sampling::{{sample_cosine_hemisphere, sample_uniform_hemisphere, sample_uniform_cone, to_world, sample_parallelogram}}
 @group(0) @binding(0) var<storage, read_write> samples: array<vec4<f32>>;
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {{
@@ -144,6 +144,37 @@ fn uniform_hemisphere_sampling_follows_one_over_two_pi() {
     let counts = bin_directions("uniform", &samples, n);
     // pdf = 1/(2 pi): the theta CDF is 1 - cos(theta).
     chi_square_test("uniform hemisphere", &counts, &theta_cells(|t| 1.0 - t.cos()));
+}
+
+#[test]
+fn sun_disc_sampling_is_uniform_over_its_cone() {
+    // A cone of half-angle 20 degrees around a tilted axis (the sun's next-event estimation).
+    let (n, n_wgsl) = tilted_normal();
+    let theta_max = 20f64.to_radians();
+    let cos_max = theta_max.cos() as f32;
+    let samples =
+        run_on_gpu(&format!("normalize(to_world({n_wgsl}, sample_uniform_cone({cos_max:?}, u1, u2)))"), 6);
+    let (t, b) = frame(n);
+    let mut counts = vec![0u64; THETA_BINS * PHI_BINS];
+    for d in &samples {
+        let theta = d.dot(n).clamp(-1.0, 1.0).acos();
+        assert!(theta <= theta_max + 1e-4, "direction {d} outside the cone ({theta} rad)");
+        let phi = d.dot(b).atan2(d.dot(t)).rem_euclid(2.0 * PI);
+        let i = ((theta / theta_max * THETA_BINS as f64) as usize).min(THETA_BINS - 1);
+        let j = ((phi / (2.0 * PI) * PHI_BINS as f64) as usize).min(PHI_BINS - 1);
+        counts[i * PHI_BINS + j] += 1;
+    }
+    // Uniform over the cone's solid angle: the theta CDF is (1 - cos theta) / (1 - cos theta_max).
+    let cdf = |theta: f64| (1.0 - theta.cos()) / (1.0 - theta_max.cos());
+    let mut p = Vec::new();
+    for i in 0..THETA_BINS {
+        let (t0, t1) =
+            (i as f64 * theta_max / THETA_BINS as f64, (i + 1) as f64 * theta_max / THETA_BINS as f64);
+        for _ in 0..PHI_BINS {
+            p.push((cdf(t1) - cdf(t0)) / PHI_BINS as f64);
+        }
+    }
+    chi_square_test("sun cone", &counts, &p);
 }
 
 #[test]
