@@ -193,8 +193,11 @@ impl Progress {
 pub struct Status {
     /// Samples per pixel of the completed passes.
     pub spp_done: u32,
-    /// Finite samples taken, over all pixels.
+    /// Finite samples taken, over all pixels (including any a resumed render started with).
     pub samples: u64,
+    /// Of those, the samples taken since this render's clock started (what the clock's time
+    /// was spent on).
+    pub run_samples: u64,
     /// Wall-clock time of the render ([`RenderClock`]).
     pub elapsed: Duration,
     /// The estimated relative error after the last completed pass, once it has 2 spp.
@@ -202,10 +205,10 @@ pub struct Status {
 }
 
 impl Status {
-    /// Samples per second of wall-clock time (0 before any time has passed).
+    /// Samples taken per second of this render's wall-clock time (0 before any time has passed).
     pub fn samples_per_second(&self) -> f64 {
         let seconds = self.elapsed.as_secs_f64();
-        if seconds > 0.0 { self.samples as f64 / seconds } else { 0.0 }
+        if seconds > 0.0 { self.run_samples as f64 / seconds } else { 0.0 }
     }
 }
 
@@ -254,6 +257,8 @@ pub struct Progressive {
     /// `spp_done` when `relative_error` was computed.
     error_at_spp: u32,
     stopped: Option<StopReason>,
+    /// The tracer's samples when this render first stepped (a resumed render starts with some).
+    start_samples: Option<u64>,
 }
 
 impl Progressive {
@@ -265,6 +270,7 @@ impl Progressive {
             relative_error: None,
             error_at_spp: 0,
             stopped: None,
+            start_samples: None,
         }
     }
 
@@ -303,6 +309,7 @@ impl Progressive {
         Status {
             spp_done: tracer.spp_done(),
             samples: tracer.accumulator().total_samples(),
+            run_samples: tracer.accumulator().total_samples().saturating_sub(self.start_samples.unwrap_or(0)),
             elapsed: self.clock.elapsed(),
             relative_error: self.relative_error,
         }
@@ -320,6 +327,7 @@ impl Progressive {
         if self.stopped.is_some() {
             return Ok(self.stopped);
         }
+        self.start_samples.get_or_insert(tracer.accumulator().total_samples());
         self.refresh_error(tracer);
         self.stopped = self.rules.check(&self.status(tracer));
         if self.stopped.is_none() {
@@ -373,7 +381,13 @@ mod tests {
     use super::*;
 
     fn status(spp_done: u32, seconds: f64, error: Option<f64>) -> Status {
-        Status { spp_done, samples: 0, elapsed: Duration::from_secs_f64(seconds), relative_error: error }
+        Status {
+            spp_done,
+            samples: 0,
+            run_samples: 0,
+            elapsed: Duration::from_secs_f64(seconds),
+            relative_error: error,
+        }
     }
 
     #[test]
@@ -445,5 +459,13 @@ mod tests {
         clock.resume();
         std::thread::sleep(Duration::from_millis(2));
         assert!(clock.elapsed() > a);
+    }
+
+    #[test]
+    fn the_sample_rate_counts_only_this_runs_samples() {
+        // A render resumed with 1000 samples that took 100 more in 2 s runs at 50 per second,
+        // not (1000 + 100) / 2.
+        let s = Status { samples: 1100, run_samples: 100, ..status(10, 2.0, None) };
+        assert_eq!(s.samples_per_second(), 50.0);
     }
 }
