@@ -35,14 +35,14 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use clap::Parser;
-use illum::cli::{self, DEFAULT_SCENE, OutputFormat, RenderWith, SceneArgs, output_format};
+use illum::cli::{self, DEFAULT_SCENE, OutputFormat, SceneArgs, output_format};
 use illum::image::{Encoding, save_png};
 use illum::interrupt::Interrupt;
 use illum::pathtrace::checkpoint::{Checkpoint, load_checkpoint, save_checkpoint};
 use illum::pathtrace::{PathTracer, Sequence, StopReason, StopRules, TracerOptions, render_progressive};
 use illum::progress::RenderProgress;
 use illum::raster_cli::{RasterArgs, RasterRequest, render_raster};
-use illum::scene::Scene;
+use illum::scene::{RendererKind, Scene};
 use illum::whitted_cli::{WhittedArgs, WhittedRequest, render_whitted};
 
 #[derive(Parser, Debug)]
@@ -55,7 +55,7 @@ struct Args {
     scene: PathBuf,
     /// Renderer: `pathtrace`, `raster` or `whitted`. Default: the scene file's `renderer`.
     #[arg(long)]
-    renderer: Option<RenderWith>,
+    renderer: Option<RendererKind>,
     #[command(flatten)]
     settings: SceneArgs,
     #[command(flatten)]
@@ -116,7 +116,7 @@ fn main() {
 fn run(args: Args) -> anyhow::Result<()> {
     let renderer = match args.renderer {
         Some(renderer) => renderer,
-        None => Scene::load(&cli::resolve_scene_path(&args.scene))?.renderer.into(),
+        None => Scene::load(&cli::resolve_scene_path(&args.scene))?.renderer,
     };
     let path_tracer_only = cli::given_flags(&[
         (args.target_error.is_some(), "--target-error"),
@@ -126,7 +126,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         (args.sample_range.is_some(), "--sample-range"),
         (args.checkpoint_seconds.is_some(), "--checkpoint-seconds"),
     ]);
-    if renderer == RenderWith::Whitted {
+    if renderer == RendererKind::Whitted {
         let mut other_flags = path_tracer_only;
         other_flags.extend(args.raster.given());
         return render_whitted(&WhittedRequest {
@@ -151,7 +151,7 @@ fn run(args: Args) -> anyhow::Result<()> {
             }
         );
     }
-    if renderer == RenderWith::Raster {
+    if renderer == RendererKind::Raster {
         let given = [
             (args.target_error.is_some(), "--target-error"),
             (args.time_budget.is_some(), "--time-budget"),

@@ -10,37 +10,6 @@ use illum_scene::{Bounces, Overrides, Sampling, Scene};
 /// The default scene: the assignment's Cornell box.
 pub const DEFAULT_SCENE: &str = "scenes/cornell.toml";
 
-/// The renderer a command uses: the scene file's `renderer` (a [`RendererKind`]) or the
-/// Whitted ray tracer, which a file cannot name as its default yet.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum RenderWith {
-    PathTrace,
-    Raster,
-    Whitted,
-}
-
-impl From<illum_scene::RendererKind> for RenderWith {
-    fn from(kind: illum_scene::RendererKind) -> Self {
-        match kind {
-            illum_scene::RendererKind::PathTrace => RenderWith::PathTrace,
-            illum_scene::RendererKind::Raster => RenderWith::Raster,
-        }
-    }
-}
-
-impl std::str::FromStr for RenderWith {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "pathtrace" => Ok(RenderWith::PathTrace),
-            "raster" => Ok(RenderWith::Raster),
-            "whitted" => Ok(RenderWith::Whitted),
-            _ => Err(format!("{s:?}: must be \"pathtrace\", \"raster\" or \"whitted\"")),
-        }
-    }
-}
-
 /// Flags that override the scene file's settings (same names in every example).
 #[derive(Args, Clone, Debug, Default)]
 pub struct SceneArgs {

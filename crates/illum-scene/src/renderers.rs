@@ -30,16 +30,19 @@ pub enum RendererKind {
     Raster,
     /// The Monte Carlo path tracer (illum-pathtrace).
     PathTrace,
+    /// Whitted's 1980 ray tracer (illum-whitted).
+    Whitted,
 }
 
 impl RendererKind {
-    pub const ALL: [RendererKind; 2] = [RendererKind::Raster, RendererKind::PathTrace];
+    pub const ALL: [RendererKind; 3] = [RendererKind::Raster, RendererKind::PathTrace, RendererKind::Whitted];
 
     /// The name used in sentences ("the rasterizer cannot render ...").
     pub fn noun(self) -> &'static str {
         match self {
             RendererKind::Raster => "rasterizer",
             RendererKind::PathTrace => "path tracer",
+            RendererKind::Whitted => "Whitted ray tracer",
         }
     }
 }

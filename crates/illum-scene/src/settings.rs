@@ -16,18 +16,17 @@ pub(crate) fn bounces_allowed() -> String {
 }
 
 /// `as_str` (the name used in files and on the command line), `FromStr` and `Display` for an
-/// enum of two fixed words, and the constant `$allowed` that error messages show.
+/// enum of fixed words, and the constant `$allowed` (its text given) that error messages show.
 macro_rules! named_words {
-    ($ty:ident, $allowed:ident, $a:ident => $a_word:literal, $b:ident => $b_word:literal) => {
+    ($ty:ident, $allowed:ident = $allowed_text:expr, $($variant:ident => $word:literal),+ $(,)?) => {
         #[doc = concat!("What a `", stringify!($ty), "` accepts, for error messages.")]
-        pub(crate) const $allowed: &str = concat!("must be \"", $a_word, "\" or \"", $b_word, "\"");
+        pub(crate) const $allowed: &str = $allowed_text;
 
         impl $ty {
             /// The name used in files and on the command line.
             pub fn as_str(self) -> &'static str {
                 match self {
-                    $ty::$a => $a_word,
-                    $ty::$b => $b_word,
+                    $($ty::$variant => $word,)+
                 }
             }
         }
@@ -37,8 +36,7 @@ macro_rules! named_words {
 
             fn from_str(s: &str) -> Result<Self, Self::Err> {
                 match s {
-                    $a_word => Ok($ty::$a),
-                    $b_word => Ok($ty::$b),
+                    $($word => Ok($ty::$variant),)+
                     _ => Err(ParseValueError { value: s.to_owned(), allowed: $allowed.to_owned() }),
                 }
             }
@@ -52,10 +50,21 @@ macro_rules! named_words {
     };
 }
 
-named_words!(Sampling, SAMPLING_ALLOWED, Cosine => "cosine", Uniform => "uniform");
-named_words!(Sequence, SEQUENCE_ALLOWED, Independent => "independent", LowDiscrepancy => "low-discrepancy");
-named_words!(Look, LOOK_ALLOWED, Figure => "figure", Enhanced => "enhanced");
-named_words!(RendererKind, RENDERER_ALLOWED, Raster => "raster", PathTrace => "pathtrace");
+named_words!(Sampling, SAMPLING_ALLOWED = "must be \"cosine\" or \"uniform\"", Cosine => "cosine", Uniform => "uniform");
+named_words!(
+    Sequence,
+    SEQUENCE_ALLOWED = "must be \"independent\" or \"low-discrepancy\"",
+    Independent => "independent",
+    LowDiscrepancy => "low-discrepancy",
+);
+named_words!(Look, LOOK_ALLOWED = "must be \"figure\" or \"enhanced\"", Figure => "figure", Enhanced => "enhanced");
+named_words!(
+    RendererKind,
+    RENDERER_ALLOWED = "must be \"raster\", \"pathtrace\" or \"whitted\"",
+    Raster => "raster",
+    PathTrace => "pathtrace",
+    Whitted => "whitted",
+);
 
 impl Look {
     pub const ALL: [Look; 2] = [Look::Figure, Look::Enhanced];

@@ -640,14 +640,18 @@ fn shading_values_have_their_ranges() {
 }
 
 #[test]
-fn renderer_is_raster_or_pathtrace() {
+fn renderer_is_raster_pathtrace_or_whitted() {
     assert_eq!(accepted("renderer = \"pathtrace\"", "renderer = \"raster\"").renderer, RendererKind::Raster);
-    for bad in ["whitted", "Raster", "path tracer", ""] {
+    assert_eq!(
+        accepted("renderer = \"pathtrace\"", "renderer = \"whitted\"").renderer,
+        RendererKind::Whitted
+    );
+    for bad in ["Whitted", "Raster", "path tracer", ""] {
         expect_invalid(
             &edit("renderer = \"pathtrace\"", &format!("renderer = {bad:?}")),
             "renderer",
             &format!("{bad:?}"),
-            "must be \"raster\" or \"pathtrace\"",
+            "must be \"raster\", \"pathtrace\" or \"whitted\"",
         );
     }
     expect_syntax(&edit("renderer = \"pathtrace\"", "renderer = 1"), "invalid type");

@@ -14,20 +14,23 @@ use crate::pathtrace_panel::PathTraceMode;
 use crate::raster_panel::RasterMode;
 use crate::scene_file::{self, DEFAULT_PATHTRACE_SCENE, DEFAULT_RASTER_SCENE};
 use crate::screenshot::ScreenshotJob;
+use crate::whitted_panel::WhittedMode;
 
 /// Which renderer the window shows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Mode {
     Raster,
     PathTrace,
+    Whitted,
 }
 
-/// A mode is named like the renderer it shows (`--mode raster|pathtrace`).
+/// A mode is named like the renderer it shows (`--mode raster|pathtrace|whitted`).
 impl From<Mode> for RendererKind {
     fn from(mode: Mode) -> Self {
         match mode {
             Mode::Raster => RendererKind::Raster,
             Mode::PathTrace => RendererKind::PathTrace,
+            Mode::Whitted => RendererKind::Whitted,
         }
     }
 }
@@ -37,6 +40,7 @@ impl From<RendererKind> for Mode {
         match kind {
             RendererKind::Raster => Mode::Raster,
             RendererKind::PathTrace => Mode::PathTrace,
+            RendererKind::Whitted => Mode::Whitted,
         }
     }
 }
@@ -72,6 +76,7 @@ pub struct ViewerApp {
     /// Each mode, or why its scene could not be loaded.
     pathtrace: Result<PathTraceMode, String>,
     raster: Result<RasterMode, String>,
+    whitted: Result<WhittedMode, String>,
     /// The "open scene" text field: the shown mode's scene file (or a path being typed).
     pub scene_field: String,
     /// Whether the settings panel is shown (the top bar's "Hide settings" / "Show settings").
@@ -98,6 +103,7 @@ impl ViewerApp {
             gpu,
             pathtrace: Err("no path-tracer scene loaded".to_owned()),
             raster: Err("no raster scene loaded".to_owned()),
+            whitted: Err("no Whitted scene loaded".to_owned()),
             scene_field: options.scene.display().to_string(),
             show_panel: true,
             open_error: None,
@@ -107,6 +113,7 @@ impl ViewerApp {
         // Each mode starts on its default scene; the given file then replaces its mode's.
         app.pathtrace = load_pathtrace(Path::new(DEFAULT_PATHTRACE_SCENE));
         app.raster = load_raster(Path::new(DEFAULT_RASTER_SCENE));
+        app.whitted = load_whitted(Path::new(DEFAULT_RASTER_SCENE));
         match app.open(&options.scene) {
             Ok(mode) => app.mode = mode,
             Err(e) => app.open_error = Some(e),
@@ -129,7 +136,16 @@ impl ViewerApp {
         match self.mode {
             Mode::Raster => self.raster.as_ref().ok().map(|m| m.scene_path().display().to_string()),
             Mode::PathTrace => self.pathtrace.as_ref().ok().map(|m| m.scene_path().display().to_string()),
+            Mode::Whitted => self.whitted.as_ref().ok().map(|m| m.scene_path().display().to_string()),
         }
+    }
+
+    pub fn whitted(&self) -> Option<&WhittedMode> {
+        self.whitted.as_ref().ok()
+    }
+
+    pub fn whitted_mut(&mut self) -> Option<&mut WhittedMode> {
+        self.whitted.as_mut().ok()
     }
 
     pub fn mode(&self) -> Mode {
@@ -164,8 +180,14 @@ impl ViewerApp {
         }
         if let Ok(scene) = loaded.raster {
             match &mut self.raster {
+                Ok(mode) => mode.set_scene(given.clone(), scene),
+                Err(_) => self.raster = Ok(RasterMode::new(given.clone(), scene)),
+            }
+        }
+        if let Ok(scene) = loaded.whitted {
+            match &mut self.whitted {
                 Ok(mode) => mode.set_scene(given, scene),
-                Err(_) => self.raster = Ok(RasterMode::new(given, scene)),
+                Err(_) => self.whitted = Ok(WhittedMode::new(given, scene)),
             }
         }
         Ok(mode)
@@ -180,6 +202,7 @@ impl ViewerApp {
             let before = self.mode;
             ui.selectable_value(&mut self.mode, Mode::Raster, "Raster");
             ui.selectable_value(&mut self.mode, Mode::PathTrace, "Path tracer");
+            ui.selectable_value(&mut self.mode, Mode::Whitted, "Whitted");
             if self.mode != before
                 && let Some(current) = self.current_scene_path()
             {
@@ -220,6 +243,7 @@ impl ViewerApp {
             let result = match self.mode {
                 Mode::Raster => self.raster.as_mut().map(|m| m.panel(ui)),
                 Mode::PathTrace => self.pathtrace.as_mut().map(|m| m.panel(ui)),
+                Mode::Whitted => self.whitted.as_mut().map(|m| m.panel(ui)),
             };
             if let Err(error) = result {
                 ui.colored_label(ui.visuals().error_fg_color, error.as_str());
@@ -247,6 +271,7 @@ impl ViewerApp {
                 m.frame(gpu, render_state, view_pixels);
                 m.texture()
             }),
+            Mode::Whitted => self.whitted.as_mut().ok().and_then(|m| m.frame(gpu, ui.ctx(), view_pixels)),
         };
         let sense = egui::Sense::click_and_drag();
         let response = match texture {
@@ -256,6 +281,7 @@ impl ViewerApp {
         let camera = match self.mode {
             Mode::Raster => self.raster.as_mut().ok().map(|m| &mut m.camera),
             Mode::PathTrace => self.pathtrace.as_mut().ok().map(|m| &mut m.camera),
+            Mode::Whitted => self.whitted.as_mut().ok().map(|m| &mut m.camera),
         };
         if let Some(camera) = camera
             && camera.handle(ui, &response)
@@ -263,10 +289,12 @@ impl ViewerApp {
             ui.ctx().request_repaint();
         }
         // The raster redraws every frame (it is a real-time renderer and its frame rate is
-        // measured); the path tracer while it still has samples to take.
+        // measured); the path tracer while it still has samples to take; Whitted on a change.
         let busy = match self.mode {
             Mode::Raster => self.raster.is_ok(),
             Mode::PathTrace => self.pathtrace.as_ref().is_ok_and(PathTraceMode::is_rendering),
+            // Whitted redraws only when the view changes (handled above).
+            Mode::Whitted => false,
         };
         if busy {
             ui.ctx().request_repaint();
@@ -280,6 +308,10 @@ fn load_pathtrace(path: &Path) -> Result<PathTraceMode, String> {
 
 fn load_raster(path: &Path) -> Result<RasterMode, String> {
     Ok(RasterMode::new(path.to_path_buf(), scene_file::load(path)?.raster?))
+}
+
+fn load_whitted(path: &Path) -> Result<WhittedMode, String> {
+    Ok(WhittedMode::new(path.to_path_buf(), scene_file::load(path)?.whitted?))
 }
 
 impl eframe::App for ViewerApp {

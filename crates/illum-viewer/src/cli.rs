@@ -1,4 +1,4 @@
-//! The command line: `illum-viewer [SCENE] [--mode raster|pathtrace] [--screenshot FILE --frames N]`.
+//! The command line: `illum-viewer [SCENE] [--mode raster|pathtrace|whitted] [--screenshot FILE --frames N]`.
 
 use std::path::PathBuf;
 

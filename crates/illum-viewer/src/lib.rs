@@ -21,5 +21,6 @@ pub mod pathtrace_panel;
 pub mod raster_panel;
 pub mod scene_file;
 pub mod screenshot;
+pub mod whitted_panel;
 
 pub use app::{Mode, StartOptions, ViewerApp};

@@ -1,4 +1,4 @@
-//! `cargo run --release -p illum-viewer -- [SCENE] [--mode raster|pathtrace]
+//! `cargo run --release -p illum-viewer -- [SCENE] [--mode raster|pathtrace|whitted]
 //! [--screenshot FILE --frames N]`
 
 use std::sync::Arc;

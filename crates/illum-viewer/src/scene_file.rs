@@ -19,17 +19,24 @@ pub const DEFAULT_RASTER_SCENE: &str = "scenes/whitted.toml";
 pub struct LoadedScene {
     pub pathtrace: Result<Scene, String>,
     pub raster: Result<RasterScene, String>,
+    pub whitted: Result<Scene, String>,
     /// The mode of the file's `renderer`.
     pub preferred: Mode,
 }
 
 impl LoadedScene {
-    /// The mode to show: the file's own when it can render the scene, else the other.
+    /// The mode to show: the file's own when it can render the scene, else the first of path
+    /// tracer, raster and Whitted that can.
     pub fn mode(&self) -> Mode {
-        match (self.preferred, &self.pathtrace, &self.raster) {
-            (Mode::Raster, _, Ok(_)) | (Mode::PathTrace, Err(_), _) => Mode::Raster,
-            _ => Mode::PathTrace,
-        }
+        let can = |mode: Mode| match mode {
+            Mode::PathTrace => self.pathtrace.is_ok(),
+            Mode::Raster => self.raster.is_ok(),
+            Mode::Whitted => self.whitted.is_ok(),
+        };
+        [self.preferred, Mode::PathTrace, Mode::Raster, Mode::Whitted]
+            .into_iter()
+            .find(|&m| can(m))
+            .unwrap_or(self.preferred)
     }
 }
 
@@ -42,11 +49,15 @@ pub fn load(path: &Path) -> Result<LoadedScene, String> {
         .map(|()| scene.clone())
         .map_err(|e| e.to_string());
     let raster = RasterScene::from_scene(&scene).map_err(|e| e.to_string());
-    if let (Err(p), Err(r)) = (&pathtrace, &raster) {
-        return Err(format!("no mode can show it: {p}; {r}"));
+    let whitted = scene
+        .require_where(RendererKind::Whitted.noun(), |f| f != illum_whitted::FEATURES_BUT)
+        .map(|()| scene.clone())
+        .map_err(|e| e.to_string());
+    if let (Err(p), Err(r), Err(w)) = (&pathtrace, &raster, &whitted) {
+        return Err(format!("no mode can show it: {p}; {r}; {w}"));
     }
     let preferred = Mode::from(scene.renderer);
-    Ok(LoadedScene { pathtrace, raster, preferred })
+    Ok(LoadedScene { pathtrace, raster, whitted, preferred })
 }
 
 #[cfg(test)]
@@ -64,7 +75,7 @@ mod tests {
         // and sky), shown in its file's mode.
         let whitted = load(Path::new(DEFAULT_RASTER_SCENE)).unwrap();
         assert_eq!(whitted.mode(), Mode::Raster);
-        assert!(whitted.raster.is_ok() && whitted.pathtrace.is_ok());
+        assert!(whitted.raster.is_ok() && whitted.pathtrace.is_ok() && whitted.whitted.is_ok());
     }
 
     #[test]

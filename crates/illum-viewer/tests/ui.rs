@@ -336,3 +336,31 @@ fn the_path_tracers_clock_stands_still_while_the_raster_is_shown() {
     harness.run_steps(3);
     assert!(harness.state().pathtrace().unwrap().render_seconds() > before);
 }
+
+#[test]
+fn the_whitted_mode_renders_on_change_and_keeps_its_camera() {
+    let mut harness = harness(Mode::Whitted);
+    harness.run_steps(3);
+    // The viewer starts the Whitted mode on the Whitted scene (its default scene).
+    let first = harness.state().whitted().expect("Whitted mode loaded").frames;
+    assert!(first >= 1, "no frame rendered");
+    assert!(
+        harness.state().whitted().unwrap().message.is_none(),
+        "{:?}",
+        harness.state().whitted().unwrap().message
+    );
+    // Nothing changed: no new frame (Whitted is deterministic).
+    harness.run_steps(3);
+    assert_eq!(harness.state().whitted().unwrap().frames, first);
+    // A new depth renders again.
+    harness.state_mut().whitted_mut().unwrap().depth = 2;
+    harness.run_steps(2);
+    assert_eq!(harness.state().whitted().unwrap().frames, first + 1);
+    // The mode button shows it, and the other modes keep theirs.
+    harness.get_by_label("Path tracer").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().mode(), Mode::PathTrace);
+    harness.get_by_label("Whitted").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().whitted().unwrap().depth, 2);
+}

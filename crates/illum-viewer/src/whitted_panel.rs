@@ -1,0 +1,138 @@
+//! The Whitted ray tracer mode: depth and anti-aliasing, the orbit camera, and the frame time.
+//!
+//! Whitted's algorithm is deterministic, so a frame is rendered only when something that
+//! changes it changes (the camera, the size, a setting); the image is read back and shown as an
+//! egui texture, in linear values like the rasterizer's (the assignment's figure 1 is linear).
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use illum_gpu::GpuContext;
+use illum_scene::{MAX_WHITTED_AA, MAX_WHITTED_DEPTH, Scene};
+use illum_whitted::WhittedTracer;
+
+use crate::camera::OrbitCamera;
+
+/// What a frame depends on: when it is unchanged, the last image stands.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct FrameKey {
+    camera: illum_scene::Camera,
+    depth: u32,
+    aa: u32,
+}
+
+pub struct WhittedMode {
+    scene_path: PathBuf,
+    scene: Scene,
+    pub camera: OrbitCamera,
+    /// Recursion depth (0..=64) and n of the n x n rays per pixel (1..=16).
+    pub depth: u32,
+    pub aa: u32,
+    texture: Option<egui::TextureHandle>,
+    drawn: Option<FrameKey>,
+    /// Wall-clock milliseconds of the last frame (pipeline, upload, dispatch, readback).
+    pub frame_ms: Option<f64>,
+    /// Frames rendered since the scene was opened.
+    pub frames: u64,
+    pub message: Option<String>,
+}
+
+impl WhittedMode {
+    pub fn new(scene_path: PathBuf, scene: Scene) -> Self {
+        WhittedMode {
+            camera: OrbitCamera::new(scene.camera),
+            depth: scene.whitted.depth,
+            aa: scene.whitted.aa,
+            scene_path,
+            scene,
+            texture: None,
+            drawn: None,
+            frame_ms: None,
+            frames: 0,
+            message: None,
+        }
+    }
+
+    pub fn set_scene(&mut self, scene_path: PathBuf, scene: Scene) {
+        *self = WhittedMode { texture: self.texture.take(), ..WhittedMode::new(scene_path, scene) };
+    }
+
+    pub fn scene_path(&self) -> &Path {
+        &self.scene_path
+    }
+
+    /// The image for a view of `view_pixels`, rendered again only when it changed.
+    pub fn frame(
+        &mut self,
+        gpu: &GpuContext,
+        ctx: &egui::Context,
+        view_pixels: [u32; 2],
+    ) -> Option<egui::TextureId> {
+        // A quarter of the view's pixels (half each way): Whitted at depth 8 costs more per
+        // pixel than the rasterizer.
+        let (width, height) = ((view_pixels[0] / 2).max(1), (view_pixels[1] / 2).max(1));
+        let key = FrameKey { camera: self.camera.camera(width, height), depth: self.depth, aa: self.aa };
+        if self.drawn != Some(key) {
+            let mut scene = self.scene.clone();
+            scene.camera = key.camera;
+            scene.whitted.depth = key.depth;
+            scene.whitted.aa = key.aa;
+            let started = Instant::now();
+            match WhittedTracer::new(gpu, &scene).and_then(|t| t.render()) {
+                Ok(image) => {
+                    let pixels: Vec<egui::Color32> = image
+                        .pixels
+                        .iter()
+                        .map(|p| {
+                            let [r, g, b] = p.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8);
+                            egui::Color32::from_rgb(r, g, b)
+                        })
+                        .collect();
+                    let color = egui::ColorImage::new([width as usize, height as usize], pixels);
+                    match &mut self.texture {
+                        Some(handle) => handle.set(color, egui::TextureOptions::LINEAR),
+                        None => {
+                            self.texture =
+                                Some(ctx.load_texture("whitted", color, egui::TextureOptions::LINEAR))
+                        }
+                    }
+                    self.frame_ms = Some(started.elapsed().as_secs_f64() * 1e3);
+                    self.frames += 1;
+                    self.message = None;
+                }
+                Err(e) => self.message = Some(e.to_string()),
+            }
+            self.drawn = Some(key);
+        }
+        self.texture.as_ref().map(egui::TextureHandle::id)
+    }
+
+    /// The panel's controls.
+    pub fn panel(&mut self, ui: &mut egui::Ui) {
+        ui.heading("Whitted ray tracer");
+        ui.horizontal(|ui| {
+            let label = ui.label("Depth");
+            ui.add(egui::Slider::new(&mut self.depth, 0..=MAX_WHITTED_DEPTH)).labelled_by(label.id);
+        });
+        ui.horizontal(|ui| {
+            let label = ui.label("Rays per pixel (n x n)");
+            ui.add(egui::Slider::new(&mut self.aa, 1..=MAX_WHITTED_AA.min(4))).labelled_by(label.id);
+        });
+        if ui.add_enabled(!self.camera.is_home(), egui::Button::new("Reset camera")).clicked() {
+            self.camera.reset();
+        }
+        ui.separator();
+        egui::Grid::new("whitted stats").num_columns(2).show(ui, |ui| {
+            ui.label("Frame time (wall)");
+            ui.label(self.frame_ms.map_or("-".to_owned(), |ms| format!("{ms:.1} ms")));
+            ui.end_row();
+            ui.label("Frames");
+            ui.label(self.frames.to_string());
+            ui.end_row();
+        });
+        ui.weak("Rendered at half the view's size each way; a frame is drawn when the view changes.");
+        if let Some(message) = &self.message {
+            ui.colored_label(ui.visuals().error_fg_color, message);
+        }
+    }
+}
