@@ -127,7 +127,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         (args.checkpoint_seconds.is_some(), "--checkpoint-seconds"),
     ]);
     if renderer == RendererKind::Whitted {
-        let mut other_flags = path_tracer_only;
+        let mut other_flags = path_tracer_only.clone();
         other_flags.extend(args.raster.given());
         return render_whitted(&WhittedRequest {
             scene: &args.scene,
@@ -152,14 +152,6 @@ fn run(args: Args) -> anyhow::Result<()> {
         );
     }
     if renderer == RendererKind::Raster {
-        let given = [
-            (args.target_error.is_some(), "--target-error"),
-            (args.time_budget.is_some(), "--time-budget"),
-            (args.sequence.is_some(), "--sequence"),
-            (args.resume.is_some(), "--resume"),
-            (args.sample_range.is_some(), "--sample-range"),
-            (args.checkpoint_seconds.is_some(), "--checkpoint-seconds"),
-        ];
         return render_raster(&RasterRequest {
             scene: &args.scene,
             settings: &args.settings,
@@ -167,7 +159,7 @@ fn run(args: Args) -> anyhow::Result<()> {
             outputs: &args.outputs,
             encoding: args.encoding,
             exposure: args.exposure,
-            path_tracer_flags: given.into_iter().filter_map(|(on, flag)| on.then_some(flag)).collect(),
+            path_tracer_flags: path_tracer_only,
         });
     }
     args.raster.reject_for_path_tracer(&args.scene)?;

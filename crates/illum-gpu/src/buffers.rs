@@ -10,6 +10,17 @@ pub fn uniform_buffer(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Bu
     })
 }
 
+/// A read-only storage buffer holding `contents` (which must not be empty: wgpu binds no
+/// zero-sized buffer).
+pub fn storage_buffer(device: &wgpu::Device, label: &str, contents: &[u8]) -> wgpu::Buffer {
+    use wgpu::util::DeviceExt;
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents,
+        usage: wgpu::BufferUsages::STORAGE,
+    })
+}
+
 /// A pipeline layout of the bind group `layouts` (group 0, 1, ...) and no immediates.
 pub fn pipeline_layout(
     device: &wgpu::Device,

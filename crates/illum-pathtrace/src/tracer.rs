@@ -137,13 +137,8 @@ impl PathTracer {
         let (pipeline, traversal_source) = shaders::pathtrace_pipeline(gpu, scene, &gpu_scene, options)?;
 
         let device = &gpu.device;
-        let storage = |label: &str, contents: &[u8]| {
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage: wgpu::BufferUsages::STORAGE,
-            })
-        };
+        let storage =
+            |label: &str, contents: &[u8]| illum_gpu::buffers::storage_buffer(device, label, contents);
         let (params_buffer, objects_buffer, materials_buffer, lights_buffer) =
             gpu.scoped("allocating path-tracer buffers", || {
                 let params_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {

@@ -67,13 +67,8 @@ impl WhittedTracer {
 
         let device = &gpu.device;
         // Storage buffers may not be empty: a scene without lights binds one unused record.
-        let storage = |label: &str, contents: &[u8]| {
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage: wgpu::BufferUsages::STORAGE,
-            })
-        };
+        let storage =
+            |label: &str, contents: &[u8]| illum_gpu::buffers::storage_buffer(device, label, contents);
         let lights_or_one = if lights.is_empty() { vec![WhittedLight::default()] } else { lights };
         let materials_or_one =
             if materials.is_empty() { vec![WhittedMaterial::default()] } else { materials };
