@@ -19,12 +19,10 @@
 //! Outputs in DIR: convergence.csv, convergence.md, bounces.csv, and the plots
 //! error-vs-time-sampling.png, error-vs-time-sequence.png, error-vs-spp.png, bounces.png.
 //!
-//! Over 400 lines, one concept: one study from its rows to its tables (plots are `plot.rs`).
-
-mod plot;
+//! Over 400 lines, one concept: one study from its rows to its tables (plots, the cached
+//! reference and the CSV writer are library modules the ladder shares).
 
 use std::fmt::Write as _;
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
@@ -32,12 +30,14 @@ use anyhow::{Context, bail};
 use clap::Parser;
 use illum::cli::{self, SceneArgs};
 use illum::gpu::GpuContext;
-use illum::image::{ExrMetadata, RgbImage32, load_exr, mean_luminance_bias, rel_mse, rmse, save_exr};
+use illum::image::{RgbImage32, mean_luminance_bias, rel_mse, rmse};
 use illum::pathtrace::{
     PathTracer, Sequence, StopRules, TracerOptions, parse_time_budget, render_progressive,
 };
+use illum::plot::{self, Line};
+use illum::reference::{Reference, cached_reference, load_reference};
+use illum::report::{csv_text, write_text};
 use illum::scene::{Bounces, Sampling, Scene};
-use plot::Line;
 
 #[derive(Parser, Debug)]
 #[command(about = "Measure error against time and spp for the path tracer's options (cosine or uniform \
@@ -200,7 +200,16 @@ fn run(mut args: Args) -> anyhow::Result<()> {
     }
     // The reference must out-sample every row it judges, time-budget rows included.
     let max_spp = taken.iter().map(|t| t.spp).max().unwrap_or(1).min(u64::from(u32::MAX)) as u32;
-    let reference = reference_image(&gpu, &scene, &args, max_spp)?;
+    let Reference { image: reference, .. } = match &args.reference {
+        Some(path) => load_reference(path, &scene)?,
+        None => cached_reference(
+            &gpu,
+            &scene,
+            max_spp.saturating_mul(args.reference_factor),
+            &args.out,
+            "convergence reference",
+        )?,
+    };
     println!("reference mean luminance {:.5}", reference.mean_luminance());
     let mut rows = Vec::new();
     for t in taken {
@@ -214,67 +223,6 @@ fn run(mut args: Args) -> anyhow::Result<()> {
     }
     println!("wrote {}", args.out.display());
     Ok(())
-}
-
-/// Loads the user's reference, or renders one (and caches it, keyed by the settings).
-fn reference_image(gpu: &GpuContext, scene: &Scene, args: &Args, max_spp: u32) -> anyhow::Result<RgbImage32> {
-    if let Some(path) = &args.reference {
-        let (image, _) = load_exr(path)?;
-        if (image.width, image.height) != (scene.camera.width, scene.camera.height) {
-            bail!(
-                "reference {} is {}x{} but the render is {}x{}: give --width/--height to match",
-                path.display(),
-                image.width,
-                image.height,
-                scene.camera.width,
-                scene.camera.height
-            );
-        }
-        return Ok(image);
-    }
-    let spp = max_spp.saturating_mul(args.reference_factor);
-    let (reference_scene, key) = reference_settings(scene, spp);
-    let path = args.out.join(format!("reference-{}-{:016x}.exr", scene.name, fnv1a(key.as_bytes())));
-    if path.exists() {
-        let (image, attributes) = load_exr(&path)?;
-        let stored = ExrMetadata::from_attributes(&path, &attributes)?;
-        if stored.as_ref().and_then(|m| m.get("reference_key")) == Some(key.as_str()) {
-            println!("reusing reference {}", path.display());
-            return Ok(image);
-        }
-        println!("{} was made for other settings: rendering it again", path.display());
-    }
-    println!("rendering the reference: {spp} spp (cached as {})", path.display());
-    let mut tracer = PathTracer::new(gpu, &reference_scene)?;
-    tracer.render_to_spp(spp)?;
-    let image = tracer.accumulator().mean_image();
-    let mut metadata = illum::pathtrace::metadata::exr_metadata(
-        &tracer,
-        tracer.wall_seconds(),
-        Some(illum::pathtrace::StopReason::SppReached),
-        "convergence reference",
-    );
-    metadata.fields.push(("reference_key".into(), key));
-    save_exr(&path, &image, &metadata)?;
-    Ok(image)
-}
-
-/// The scene the reference is rendered with (cosine sampling, `spp`, a seed of its own), and
-/// its cache key: everything that changes the reference image, i.e. the whole scene as loaded
-/// and overridden (geometry, materials, emission, camera, bounces, seed, spp).
-fn reference_settings(scene: &Scene, spp: u32) -> (Scene, String) {
-    let mut reference_scene = scene.clone();
-    reference_scene.pathtrace.sampling = Sampling::Cosine;
-    reference_scene.pathtrace.spp = spp;
-    // A seed the measured runs do not use, so reference and test noise are independent.
-    reference_scene.pathtrace.seed = scene.pathtrace.seed.wrapping_add(0x5eed);
-    let key = format!("{reference_scene:?}");
-    (reference_scene, key)
-}
-
-/// 64-bit FNV-1a: a stable hash for the cache's file name (the full key is checked on reuse).
-fn fnv1a(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3))
 }
 
 fn take(variant: &'static str, tracer: &PathTracer, seconds: f64) -> Taken {
@@ -312,27 +260,6 @@ fn print_row(r: &Row) {
         r.estimated_rel_mse,
         r.efficiency()
     );
-}
-
-fn write_text(path: &Path, text: &str) -> anyhow::Result<()> {
-    illum::image::write_atomically(path, |file| {
-        file.write_all(text.as_bytes()).map_err(|e| illum::image::ImageError::Io {
-            path: path.to_path_buf(),
-            action: "writing",
-            source: e,
-        })
-    })?;
-    Ok(())
-}
-
-/// A CSV file from a header and rows, quoted where a field needs it (RFC 4180, by the csv crate).
-fn csv_text(header: &[&str], rows: &[Vec<String>]) -> anyhow::Result<String> {
-    let mut writer = csv::Writer::from_writer(Vec::new());
-    writer.write_record(header)?;
-    for row in rows {
-        writer.write_record(row)?;
-    }
-    Ok(String::from_utf8(writer.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?)?)
 }
 
 fn write_tables(out: &Path, rows: &[Row]) -> anyhow::Result<()> {
@@ -493,59 +420,4 @@ fn bounce_table(gpu: &GpuContext, scene: &Scene, spp: u32, out: &Path) -> anyhow
         "added mean luminance",
         &[Line { label: "increment".into(), points, markers_only: false }],
     )
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn csv_rows_with_commas_in_a_field_keep_their_column_count() {
-        let header = ["variant", "spp", "relmse"];
-        let rows = vec![
-            vec!["cosine, independent".to_owned(), "16".to_owned(), "0.01".to_owned()],
-            vec!["say \"hi\", twice".to_owned(), "32".to_owned(), "0.005".to_owned()],
-        ];
-        let text = csv_text(&header, &rows).unwrap();
-        let mut reader = csv::Reader::from_reader(text.as_bytes());
-        assert_eq!(reader.headers().unwrap().len(), 3);
-        let read: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
-        assert_eq!(read.len(), 2);
-        for (record, row) in read.iter().zip(&rows) {
-            assert_eq!(record.len(), 3, "{text}");
-            assert_eq!(record.iter().collect::<Vec<_>>(), row.iter().map(String::as_str).collect::<Vec<_>>());
-        }
-    }
-
-    #[test]
-    fn the_reference_cache_key_changes_with_anything_that_changes_the_image() {
-        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/cornell.toml");
-        let scene = Scene::load(Path::new(path)).unwrap();
-        let (_, key) = reference_settings(&scene, 1024);
-        assert_eq!(reference_settings(&scene.clone(), 1024).1, key, "the same scene, the same key");
-        // A copy with the light twice as bright and the same name (the case that used to reuse
-        // the old reference), more spp, another seed, another size.
-        let mut brighter = scene.clone();
-        for m in &mut brighter.materials {
-            if let illum::scene::MaterialKind::Emitter { radiance } = &mut m.kind {
-                *radiance *= 2.0;
-            }
-        }
-        let mut seeded = scene.clone();
-        seeded.pathtrace.seed += 1;
-        let mut wider = scene.clone();
-        wider.camera.width += 1;
-        for (what, other) in [
-            ("emission", reference_settings(&brighter, 1024).1),
-            ("spp", reference_settings(&scene, 2048).1),
-            ("seed", reference_settings(&seeded, 1024).1),
-            ("width", reference_settings(&wider, 1024).1),
-        ] {
-            assert_ne!(other, key, "{what} changed but the key did not");
-        }
-        // The sampling of the measured rows does not change the reference (always cosine).
-        let mut uniform = scene.clone();
-        uniform.pathtrace.sampling = Sampling::Uniform;
-        assert_eq!(reference_settings(&uniform, 1024).1, key);
-    }
 }

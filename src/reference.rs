@@ -1,0 +1,144 @@
+//! The converged path-traced truth that the measuring tools (convergence, ladder) compare with:
+//! rendered once, cached as an EXR under a name derived from everything that changes it, and
+//! reused only when the cached file's full key matches.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::bail;
+use illum_gpu::GpuContext;
+use illum_image::{ExrMetadata, RgbImage32, load_exr, save_exr};
+use illum_pathtrace::PathTracer;
+use illum_scene::{Sampling, Scene};
+
+/// A reference image and what is known of its own error.
+pub struct Reference {
+    pub image: RgbImage32,
+    /// Where it is (the user's file, or the cache).
+    pub path: PathBuf,
+    /// Samples per pixel (0 if the user's file does not say).
+    pub spp: u64,
+    /// The relMSE the reference estimates for itself from its per-pixel variance (NaN if the
+    /// user's file does not carry it).
+    pub estimated_rel_mse: f64,
+}
+
+/// Loads the user's reference (which must have the scene's size).
+pub fn load_reference(path: &Path, scene: &Scene) -> anyhow::Result<Reference> {
+    let (image, attributes) = load_exr(path)?;
+    if (image.width, image.height) != (scene.camera.width, scene.camera.height) {
+        bail!(
+            "reference {} is {}x{} but the render is {}x{}: give --width/--height to match",
+            path.display(),
+            image.width,
+            image.height,
+            scene.camera.width,
+            scene.camera.height
+        );
+    }
+    let metadata = ExrMetadata::from_attributes(path, &attributes)?;
+    let field = |name: &str| metadata.as_ref().and_then(|m| m.get(name)).and_then(|v| v.parse::<f64>().ok());
+    Ok(Reference {
+        image,
+        path: path.to_path_buf(),
+        spp: field("spp").map_or(0, |v| v as u64),
+        estimated_rel_mse: field("estimated_rel_mse").unwrap_or(f64::NAN),
+    })
+}
+
+/// The cached reference of `scene` at `spp` samples per pixel in `folder`, rendered (and
+/// written) if the cache has none made with exactly these settings. `label` names the tool.
+pub fn cached_reference(
+    gpu: &GpuContext,
+    scene: &Scene,
+    spp: u32,
+    folder: &Path,
+    label: &str,
+) -> anyhow::Result<Reference> {
+    let (reference_scene, key) = reference_settings(scene, spp);
+    let path = folder.join(format!("reference-{}-{:016x}.exr", scene.name, fnv1a(key.as_bytes())));
+    if path.exists() {
+        let (image, attributes) = load_exr(&path)?;
+        let stored = ExrMetadata::from_attributes(&path, &attributes)?;
+        if stored.as_ref().and_then(|m| m.get("reference_key")) == Some(key.as_str()) {
+            println!("reusing reference {}", path.display());
+            let rel = stored.as_ref().and_then(|m| m.get("estimated_rel_mse")).and_then(|v| v.parse().ok());
+            return Ok(Reference {
+                image,
+                path,
+                spp: u64::from(spp),
+                estimated_rel_mse: rel.unwrap_or(f64::NAN),
+            });
+        }
+        println!("{} was made for other settings: rendering it again", path.display());
+    }
+    println!("rendering the reference: {spp} spp (cached as {})", path.display());
+    let mut tracer = PathTracer::new(gpu, &reference_scene)?;
+    tracer.render_to_spp(spp)?;
+    let image = tracer.accumulator().mean_image();
+    let estimated_rel_mse = tracer.accumulator().estimated_rel_mse();
+    let mut metadata = illum_pathtrace::metadata::exr_metadata(
+        &tracer,
+        tracer.wall_seconds(),
+        Some(illum_pathtrace::StopReason::SppReached),
+        label,
+    );
+    metadata.fields.push(("reference_key".into(), key));
+    metadata.fields.push(("estimated_rel_mse".into(), format!("{estimated_rel_mse:e}")));
+    save_exr(&path, &image, &metadata)?;
+    Ok(Reference { image, path, spp: u64::from(spp), estimated_rel_mse })
+}
+
+/// The scene the reference is rendered with (cosine sampling, `spp`, a seed of its own), and
+/// its cache key: everything that changes the reference image, i.e. the whole scene as loaded
+/// and overridden (geometry, materials, emission, camera, bounces, seed, spp).
+pub fn reference_settings(scene: &Scene, spp: u32) -> (Scene, String) {
+    let mut reference_scene = scene.clone();
+    reference_scene.pathtrace.sampling = Sampling::Cosine;
+    reference_scene.pathtrace.spp = spp;
+    // A seed the measured runs do not use, so reference and test noise are independent.
+    reference_scene.pathtrace.seed = scene.pathtrace.seed.wrapping_add(0x5eed);
+    let key = format!("{reference_scene:?}");
+    (reference_scene, key)
+}
+
+/// 64-bit FNV-1a: a stable hash for the cache's file name (the full key is checked on reuse).
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_reference_cache_key_changes_with_anything_that_changes_the_image() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/cornell.toml");
+        let scene = Scene::load(Path::new(path)).unwrap();
+        let (_, key) = reference_settings(&scene, 1024);
+        assert_eq!(reference_settings(&scene.clone(), 1024).1, key, "the same scene, the same key");
+        // A copy with the light twice as bright and the same name (the case that used to reuse
+        // the old reference), more spp, another seed, another size.
+        let mut brighter = scene.clone();
+        for m in &mut brighter.materials {
+            if let illum_scene::MaterialKind::Emitter { radiance } = &mut m.kind {
+                *radiance *= 2.0;
+            }
+        }
+        let mut seeded = scene.clone();
+        seeded.pathtrace.seed += 1;
+        let mut wider = scene.clone();
+        wider.camera.width += 1;
+        for (what, other) in [
+            ("emission", reference_settings(&brighter, 1024).1),
+            ("spp", reference_settings(&scene, 2048).1),
+            ("seed", reference_settings(&seeded, 1024).1),
+            ("width", reference_settings(&wider, 1024).1),
+        ] {
+            assert_ne!(other, key, "{what} changed but the key did not");
+        }
+        // The sampling of the measured rows does not change the reference (always cosine).
+        let mut uniform = scene.clone();
+        uniform.pathtrace.sampling = Sampling::Uniform;
+        assert_eq!(reference_settings(&uniform, 1024).1, key);
+    }
+}
