@@ -15,7 +15,7 @@
 #import illum::spawn::{spawn_point, spawn_error, max_abs}
 #import illum::rtcore::geometry::{NO_HIT, FAR, Surface}
 #import illum::pathtrace::scene::{Material, params, objects, materials, lights, batch_sum, batch_sum_sq}
-#import illum::pathtrace::traversal::{closest_hit, occluded, surface_at, choose_light}
+#import illum::rtcore::traversal::{closest_hit, occluded, surface_at, choose_light}
 
 const SAMPLING_COSINE: u32 = 0u;
 const UNBOUNDED: u32 = 0xffffffffu;

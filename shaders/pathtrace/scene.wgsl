@@ -5,14 +5,6 @@
 // The path tracer's scene as the GPU sees it (mirrored by gpu_scene.rs): its parameters,
 // materials, lights and bindings. Objects and ray-shape tests are in rtcore/geometry.wgsl.
 
-// A ray that hits an emitter within this relative distance of a coplanar surface sees the
-// emitter: the light's face lies exactly in the ceiling's plane and must win that tie. The two
-// distances come from different tests of the same plane (slab and quad), each within about 10
-// units of roundoff (u = 2^-24) of the exact distance, so they agree to ~20 u = 1.2e-6 relative;
-// 1e-5 (~170 u) leaves a wide margin and is still far below any gap between distinct surfaces
-// that the image could resolve.
-const EMITTER_TIE: f32 = 1.0e-5;
-
 struct Params {
     eye: vec3<f32>,
     tan_half_fov: f32,

@@ -6,12 +6,18 @@
 // pushes at most two children one level deeper and the walk always takes the top entry, so the
 // stack holds at most one pending sibling per level plus the entry in hand: depth + 2 entries,
 // MAX_STACK for the deepest recursion the scene format accepts (64).
+//
+// The traversal (closest_hit, occluded, surface_at) is the path tracer's, generated for the
+// scene with its numbers as constants (illum-pathtrace's specialise.rs): one copy of
+// intersection for both ray tracers. Its shadow rays test only the objects that can block a
+// light; a Whitted point light lies inside the area light it stands for, so the same
+// occluders serve.
 
 #import illum::spawn::spawn_point
-#import illum::rtcore::geometry::{Object, Hit, Surface, FAR, NO_HIT, KIND_AABB, KIND_BOX, KIND_QUAD, safe_inverse, hit_slabs, hit_box, hit_quad, hit_sphere, surface_aabb, surface_box, surface_quad, surface_sphere}
+#import illum::rtcore::geometry::{Object, FAR, NO_HIT}
+#import illum::rtcore::traversal::{closest_hit, occluded, surface_at}
 
 const MAX_STACK: u32 = 66u;
-const EMITTER_TIE: f32 = 1.0e-5;
 
 const MAT_LAMBERTIAN: u32 = 0u;
 const MAT_CHECKER: u32 = 1u;
@@ -34,7 +40,7 @@ struct Params {
     mirror_specular: vec4<f32>,
     // x: the mirror's weight, y: the dielectric's shininess
     shading: vec4<f32>,
-    // width, height, number of objects, first emitter
+    // width, height, unused, unused (the traversal has the objects as constants)
     sizes: vec4<u32>,
     // number of lights, depth, aa (n of n x n), unused
     counts: vec4<u32>,
@@ -77,50 +83,6 @@ struct Ray {
     depth: u32,
 }
 
-fn hit_object(o: vec3<f32>, d: vec3<f32>, inv_d: vec3<f32>, i: u32) -> f32 {
-    let obj = objects[i];
-    switch obj.kind {
-        case KIND_AABB: { return hit_slabs(o, inv_d, obj.a.xyz, obj.b.xyz); }
-        case KIND_BOX: { return hit_box(o, d, obj.a.xyz, obj.b.xyz, obj.a.w, obj.b.w, obj.c.xyz); }
-        case KIND_QUAD: { return hit_quad(o, d, obj.a.xyz, obj.b.xyz, obj.c.xyz, obj.d.xyz); }
-        default: { return hit_sphere(o, d, obj.a.xyz, obj.a.w); }
-    }
-}
-
-// The closest hit; emitters (stored last) win a tie with a coplanar surface.
-fn closest_hit(o: vec3<f32>, d: vec3<f32>) -> Hit {
-    var best = Hit(FAR, NO_HIT);
-    let inv_d = safe_inverse(d);
-    for (var i = 0u; i < params.sizes.z; i++) {
-        let t = hit_object(o, d, inv_d, i);
-        let limit = select(best.t, min(best.t * (1.0 + EMITTER_TIE), FAR), i >= params.sizes.w);
-        if (t < limit) {
-            best = Hit(t, i);
-        }
-    }
-    return best;
-}
-
-// Whether a non-emitting object lies on o + t d for 0 < t < t_max.
-fn blocked(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> bool {
-    let inv_d = safe_inverse(d);
-    for (var i = 0u; i < params.sizes.w; i++) {
-        if (hit_object(o, d, inv_d, i) < t_max) {
-            return true;
-        }
-    }
-    return false;
-}
-
-fn surface_of(obj: Object, p: vec3<f32>) -> Surface {
-    switch obj.kind {
-        case KIND_AABB: { return surface_aabb(obj, p); }
-        case KIND_BOX: { return surface_box(obj, p); }
-        case KIND_QUAD: { return surface_quad(obj, p); }
-        default: { return surface_sphere(obj, p); }
-    }
-}
-
 // Light from every light at p (normal n toward the viewer, spawn error err), for a white
 // Lambertian surface (sum E_l max(n.l, 0) V_l) and for a Blinn-Phong highlight of `shininess`
 // seen along v (sum E_l max(n.h, 0)^shininess V_l where n.l > 0).
@@ -150,7 +112,7 @@ fn light_at(p: vec3<f32>, n: vec3<f32>, err: f32, v: vec3<f32>, shininess: f32) 
             t_max = r * (1.0 - 1.0e-5);
         }
         let cos_n = dot(n, l);
-        if (cos_n <= 0.0 || all(e == vec3<f32>(0.0)) || blocked(origin, l, t_max)) {
+        if (cos_n <= 0.0 || all(e == vec3<f32>(0.0)) || occluded(origin, l, t_max)) {
             continue;
         }
         lit.diffuse += e * cos_n;
@@ -193,7 +155,7 @@ fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
         }
         let obj = objects[hit.index];
         let m = materials[obj.material];
-        let s = surface_of(obj, ray.o + hit.t * ray.d);
+        let s = surface_at(obj, ray.o + hit.t * ray.d);
         let front = dot(s.n, ray.d) < 0.0;
         let n = select(-s.n, s.n, front);
         let v = -ray.d;

@@ -3,8 +3,8 @@
 use illum_gpu::shader::{self, ShaderFile};
 use illum_gpu::{GpuContext, GpuError, readback, shader_file, wgpu};
 use illum_image::RgbImage32;
-use illum_pathtrace::gpu_scene::{ObjectRecord, ordered_objects};
-use illum_pathtrace::{GEOMETRY_MODULE, SPAWN_MODULE};
+use illum_pathtrace::gpu_scene::GpuScene;
+use illum_pathtrace::{GEOMETRY_MODULE, PathTraceError, SPAWN_MODULE, specialise};
 use illum_scene::{Scene, SceneError};
 use wgpu::util::DeviceExt;
 
@@ -25,11 +25,15 @@ pub enum WhittedError {
     Gpu(#[from] GpuError),
     #[error(transparent)]
     Scene(#[from] SceneError),
+    /// The scene's GPU encoding (shared with the path tracer) refused it.
+    #[error(transparent)]
+    Encoding(#[from] PathTraceError),
 }
 
-/// The modules the entry shader imports, in import order.
-pub fn shader_modules() -> Vec<ShaderFile> {
-    vec![SPAWN_MODULE, GEOMETRY_MODULE]
+/// The modules the entry shader imports for `scene`, in import order: ray spawning, the shared
+/// geometry, and the path tracer's traversal generated for this scene (`specialise.rs`).
+pub fn shader_modules(scene: &Scene, gpu_scene: &GpuScene) -> Vec<ShaderFile> {
+    vec![SPAWN_MODULE, GEOMETRY_MODULE, specialise::traversal_module(scene, gpu_scene)]
 }
 
 /// Whitted's algorithm on one scene, at the scene's resolution, depth and anti-aliasing.
@@ -59,11 +63,13 @@ impl WhittedTracer {
             )
             .into());
         }
-        let (objects, first_emitter) = ordered_objects(scene);
-        let records: Vec<ObjectRecord> = objects.iter().map(|(_, o)| o.record()).collect();
+        // The path tracer's encoding: objects in its order (emitters last), as the traversal and
+        // the materials index them.
+        let gpu_scene = GpuScene::new(scene)?;
+        let records = gpu_scene.object_records();
         let materials = encode::materials(scene);
         let lights = encode::lights(scene);
-        let params = encode::params(scene, records.len() as u32, first_emitter, lights.len() as u32);
+        let params = encode::params(scene, lights.len() as u32);
 
         let device = &gpu.device;
         // Storage buffers may not be empty: a scene without lights binds one unused record.
@@ -72,8 +78,13 @@ impl WhittedTracer {
         let lights_or_one = if lights.is_empty() { vec![WhittedLight::default()] } else { lights };
         let materials_or_one =
             if materials.is_empty() { vec![WhittedMaterial::default()] } else { materials };
-        let pipeline =
-            shader::compute_pipeline(gpu, &shader_modules(), &WHITTED_SHADER, &[], "whitted ray tracer")?;
+        let pipeline = shader::compute_pipeline(
+            gpu,
+            &shader_modules(scene, &gpu_scene),
+            &WHITTED_SHADER,
+            &[],
+            "whitted ray tracer",
+        )?;
         let (bind_group, image) = gpu.scoped("creating the Whitted ray tracer's buffers", || {
             let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("whitted params"),
@@ -143,17 +154,24 @@ mod tests {
     use super::*;
     use crate::encode::WhittedParams;
 
-    /// The shader composes and validates without a GPU, and the Rust records have naga's layout
-    /// of the WGSL structs.
+    /// The shader composes and validates without a GPU for every shipped scene, and the Rust
+    /// records have naga's layout of the WGSL structs.
     #[test]
     fn the_shader_validates_and_the_records_match_its_structs() {
-        let module =
-            shader::compose(&shader_modules(), &WHITTED_SHADER, &[]).unwrap_or_else(|e| panic!("{e}"));
-        let mut validator = naga::valid::Validator::new(
-            naga::valid::ValidationFlags::all(),
-            naga::valid::Capabilities::all(),
-        );
-        validator.validate(&module).unwrap_or_else(|e| panic!("whitted.wgsl: {e:?}"));
+        let mut module = None;
+        for name in ["whitted.toml", "cornell.toml"] {
+            let scene = illum_scene::testing::shipped_scene(name, 32, 32);
+            let gpu_scene = GpuScene::new(&scene).unwrap();
+            let composed = shader::compose(&shader_modules(&scene, &gpu_scene), &WHITTED_SHADER, &[])
+                .unwrap_or_else(|e| panic!("{name}: {e}"));
+            let mut validator = naga::valid::Validator::new(
+                naga::valid::ValidationFlags::all(),
+                naga::valid::Capabilities::all(),
+            );
+            validator.validate(&composed).unwrap_or_else(|e| panic!("whitted.wgsl for {name}: {e:?}"));
+            module = Some(composed);
+        }
+        let module = module.expect("two scenes");
         let wgsl = |name: &str| {
             wgsl_struct(&module, "", name).unwrap_or_else(|| panic!("no struct {name} in whitted.wgsl"))
         };
