@@ -40,9 +40,9 @@ struct Params {
     mirror_specular: vec4<f32>,
     // x: the mirror's weight, y: the dielectric's shininess
     shading: vec4<f32>,
-    // width, height, unused, unused (the traversal has the objects as constants)
+    // width, height, first emitter (objects before it can cast shadows), unused
     sizes: vec4<u32>,
-    // number of lights, depth, aa (n of n x n), unused
+    // number of lights, depth, aa (n of n x n), output (0: radiance, OUTPUT_OBJECT_IDS)
     counts: vec4<u32>,
 }
 
@@ -215,6 +215,46 @@ fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
     return colour;
 }
 
+// The object-ID image (params.counts.w = OUTPUT_OBJECT_IDS), from which the ladder cuts its
+// regions: for the ray through the pixel's centre, the index of the object it hits (NO_HIT for none), and from
+// that point toward the first light: SHADOW_LIT, SHADOW_FACING_AWAY (the surface faces away
+// from the light), or the index of the nearest object that blocks it. Indices are those of the
+// traversal (the path tracer's object order); bit-cast into the image's floats.
+const OUTPUT_OBJECT_IDS: u32 = 1u;
+const SHADOW_LIT: u32 = 0xfffffffeu;
+const SHADOW_FACING_AWAY: u32 = 0xfffffffdu;
+
+fn object_ids(eye: vec3<f32>, d: vec3<f32>) -> vec2<u32> {
+    let hit = closest_hit(eye, d);
+    if (hit.index == NO_HIT || params.counts.x == 0u) {
+        return vec2<u32>(hit.index, SHADOW_LIT);
+    }
+    let s = surface_at(objects[hit.index], eye + hit.t * d);
+    let n = select(-s.n, s.n, dot(s.n, d) < 0.0);
+    let light = lights[0];
+    var l = light.a.xyz;
+    var t_max = FAR;
+    if (light.kind != LIGHT_DIRECTIONAL) {
+        let to = light.a.xyz - s.p;
+        t_max = length(to) * (1.0 - 1.0e-5);
+        l = to / length(to);
+    }
+    if (dot(n, l) <= 0.0) {
+        return vec2<u32>(hit.index, SHADOW_FACING_AWAY);
+    }
+    let blocker = closest_hit(spawn_point(s.p, n, s.err), l);
+    let blocks = blocker.index < params.sizes.z && blocker.t < t_max;
+    return vec2<u32>(hit.index, select(SHADOW_LIT, blocker.index, blocks));
+}
+
+// The unit direction through the point (px, py) of the image, in pixels from its top-left.
+fn camera_ray(px: f32, py: f32) -> vec3<f32> {
+    let x = 2.0 * px / f32(params.sizes.x) - 1.0;
+    let y = 1.0 - 2.0 * py / f32(params.sizes.y);
+    return normalize(params.forward.xyz + x * params.right.w * params.eye.w * params.right.xyz
+        + y * params.eye.w * params.up.xyz);
+}
+
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let width = params.sizes.x;
@@ -222,18 +262,17 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if (id.x >= width || id.y >= height) {
         return;
     }
+    if (params.counts.w == OUTPUT_OBJECT_IDS) {
+        let ids = object_ids(params.eye.xyz, camera_ray(f32(id.x) + 0.5, f32(id.y) + 0.5));
+        image[id.y * width + id.x] = vec4<f32>(bitcast<f32>(ids.x), bitcast<f32>(ids.y), 0.0, 0.0);
+        return;
+    }
     let n = max(params.counts.z, 1u);
     var sum = vec3<f32>(0.0);
     for (var j = 0u; j < n; j++) {
         for (var i = 0u; i < n; i++) {
             // The cell centres of an n x n grid over the pixel.
-            let px = f32(id.x) + (f32(i) + 0.5) / f32(n);
-            let py = f32(id.y) + (f32(j) + 0.5) / f32(n);
-            let x = 2.0 * px / f32(width) - 1.0;
-            let y = 1.0 - 2.0 * py / f32(height);
-            let d = normalize(params.forward.xyz + x * params.right.w * params.eye.w * params.right.xyz
-                + y * params.eye.w * params.up.xyz);
-            sum += trace(params.eye.xyz, d);
+            sum += trace(params.eye.xyz, camera_ray(f32(id.x) + (f32(i) + 0.5) / f32(n), f32(id.y) + (f32(j) + 0.5) / f32(n)));
         }
     }
     image[id.y * width + id.x] = vec4<f32>(sum / f32(n * n), 1.0);

@@ -8,7 +8,7 @@ use illum_pathtrace::{GEOMETRY_MODULE, PathTraceError, SPAWN_MODULE, specialise}
 use illum_scene::{Scene, SceneError};
 use wgpu::util::DeviceExt;
 
-use crate::encode::{self, FEATURES_BUT, WhittedLight, WhittedMaterial};
+use crate::encode::{self, FEATURES_BUT, WhittedLight, WhittedMaterial, WhittedParams};
 
 /// The entry shader (entry point `main`).
 pub const WHITTED_SHADER: ShaderFile = shader_file!("shaders/whitted/whitted.wgsl");
@@ -36,6 +36,14 @@ pub fn shader_modules(scene: &Scene, gpu_scene: &GpuScene) -> Vec<ShaderFile> {
     vec![SPAWN_MODULE, GEOMETRY_MODULE, specialise::traversal_module(scene, gpu_scene)]
 }
 
+/// What the pipeline writes (`params.counts.w`, OUTPUT_* in the shader).
+const OUTPUT_RADIANCE: u32 = 0;
+const OUTPUT_OBJECT_IDS: u32 = 1;
+/// The shader's markers in the shadow channel of the object-ID image.
+const SHADOW_LIT: u32 = 0xffff_fffe;
+const SHADOW_FACING_AWAY: u32 = 0xffff_fffd;
+const NO_HIT: u32 = u32::MAX;
+
 /// Whitted's algorithm on one scene, at the scene's resolution, depth and anti-aliasing.
 pub struct WhittedTracer {
     gpu: GpuContext,
@@ -43,7 +51,35 @@ pub struct WhittedTracer {
     height: u32,
     pipeline: wgpu::ComputePipeline,
     bind_group: wgpu::BindGroup,
+    params: wgpu::Buffer,
+    radiance_params: WhittedParams,
     image: wgpu::Buffer,
+    /// The index in `scene.objects` of each object in the GPU's order.
+    scene_index: Vec<usize>,
+}
+
+/// Where the first light stands from the point a pixel's centre ray hits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shadow {
+    /// The light reaches the point (also for a pixel that sees no object, or a scene without
+    /// lights).
+    Lit,
+    /// The surface faces away from the light.
+    FacingAway,
+    /// This object (an index into `scene.objects`) is the nearest one blocking the light.
+    BlockedBy(usize),
+}
+
+/// The object-ID image: for the ray through each pixel's centre, the object it hits and whether
+/// the scene's first light reaches that point (the ladder's regions are cut from it).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ObjectIds {
+    pub width: u32,
+    pub height: u32,
+    /// Per pixel, row-major from the top-left: the index into `scene.objects` of the object the
+    /// centre ray hits, if any.
+    pub hit: Vec<Option<usize>>,
+    pub shadow: Vec<Shadow>,
 }
 
 impl WhittedTracer {
@@ -69,7 +105,10 @@ impl WhittedTracer {
         let records = gpu_scene.object_records();
         let materials = encode::materials(scene);
         let lights = encode::lights(scene);
-        let params = encode::params(scene, lights.len() as u32);
+        let radiance_params =
+            encode::params(scene, gpu_scene.first_emitter, lights.len() as u32, OUTPUT_RADIANCE);
+        let (ordered, _) = illum_pathtrace::gpu_scene::ordered_objects(scene);
+        let scene_index = ordered.iter().map(|(i, _)| *i).collect();
 
         let device = &gpu.device;
         // Storage buffers may not be empty: a scene without lights binds one unused record.
@@ -85,11 +124,11 @@ impl WhittedTracer {
             &[],
             "whitted ray tracer",
         )?;
-        let (bind_group, image) = gpu.scoped("creating the Whitted ray tracer's buffers", || {
+        let (bind_group, image, params) = gpu.scoped("creating the Whitted ray tracer's buffers", || {
             let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("whitted params"),
-                contents: bytemuck::bytes_of(&params),
-                usage: wgpu::BufferUsages::UNIFORM,
+                contents: bytemuck::bytes_of(&radiance_params),
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             });
             let objects = storage("whitted objects", bytemuck::cast_slice(&records));
             let materials = storage("whitted materials", bytemuck::cast_slice(&materials_or_one));
@@ -111,13 +150,59 @@ impl WhittedTracer {
                     wgpu::BindGroupEntry { binding: 4, resource: image.as_entire_binding() },
                 ],
             });
-            (bind_group, image)
+            (bind_group, image, params)
         })?;
-        Ok(WhittedTracer { gpu: gpu.clone(), width, height, pipeline, bind_group, image })
+        Ok(WhittedTracer {
+            gpu: gpu.clone(),
+            width,
+            height,
+            pipeline,
+            bind_group,
+            params,
+            radiance_params,
+            image,
+            scene_index,
+        })
     }
 
     /// Renders the image: linear radiance per pixel, row-major from the top-left.
     pub fn render(&self) -> Result<RgbImage32, WhittedError> {
+        let texels = self.run(OUTPUT_RADIANCE, "reading the Whitted image")?;
+        let mut image = RgbImage32::new(self.width, self.height);
+        for (pixel, texel) in image.pixels.iter_mut().zip(&texels) {
+            *pixel = [texel[0], texel[1], texel[2]];
+        }
+        Ok(image)
+    }
+
+    /// The object-ID image of the same camera (one ray through each pixel's centre).
+    pub fn object_ids(&self) -> Result<ObjectIds, WhittedError> {
+        let texels = self.run(OUTPUT_OBJECT_IDS, "reading the object-ID image")?;
+        let scene_object = |gpu_index: u32| self.scene_index.get(gpu_index as usize).copied();
+        let hit = texels.iter().map(|t| scene_object(t[0].to_bits())).collect();
+        let shadow = texels
+            .iter()
+            .map(|t| match t[1].to_bits() {
+                SHADOW_LIT | NO_HIT => Shadow::Lit,
+                SHADOW_FACING_AWAY => Shadow::FacingAway,
+                i => scene_object(i).map_or(Shadow::Lit, Shadow::BlockedBy),
+            })
+            .collect();
+        Ok(ObjectIds { width: self.width, height: self.height, hit, shadow })
+    }
+
+    /// One dispatch writing `output`, read back as one vec4 per pixel.
+    fn run(&self, output: u32, reading: &str) -> Result<Vec<[f32; 4]>, WhittedError> {
+        let params = WhittedParams {
+            counts: [
+                self.radiance_params.counts[0],
+                self.radiance_params.counts[1],
+                self.radiance_params.counts[2],
+                output,
+            ],
+            ..self.radiance_params
+        };
+        self.gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         let mut encoder = self
             .gpu
             .device
@@ -133,14 +218,9 @@ impl WhittedTracer {
         }
         self.gpu.queue.submit([encoder.finish()]);
         let bytes = u64::from(self.width) * u64::from(self.height) * PIXEL_BYTES;
-        let data = readback::read_buffer(&self.gpu, &self.image, 0, bytes, "reading the Whitted image")?;
+        let data = readback::read_buffer(&self.gpu, &self.image, 0, bytes, reading)?;
         self.gpu.check()?;
-        let texels: &[[f32; 4]] = bytemuck::cast_slice(&data);
-        let mut image = RgbImage32::new(self.width, self.height);
-        for (pixel, texel) in image.pixels.iter_mut().zip(texels) {
-            *pixel = [texel[0], texel[1], texel[2]];
-        }
-        Ok(image)
+        Ok(bytemuck::cast_slice(&data).to_vec())
     }
 }
 
