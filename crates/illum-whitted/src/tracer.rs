@@ -30,6 +30,12 @@ pub enum WhittedError {
     Encoding(#[from] PathTraceError),
 }
 
+/// The shader defs of the pipeline for `scene`: its ray stack's size, depth + 2 (see the
+/// shader's header).
+pub fn shader_defs(scene: &Scene) -> Vec<(&'static str, shader::Def)> {
+    vec![("WHITTED_STACK", shader::Def::UInt(scene.whitted.depth + 2))]
+}
+
 /// The modules the entry shader imports for `scene`, in import order: ray spawning, the shared
 /// geometry, and the path tracer's traversal generated for this scene (`specialise.rs`).
 pub fn shader_modules(scene: &Scene, gpu_scene: &GpuScene) -> Vec<ShaderFile> {
@@ -121,7 +127,7 @@ impl WhittedTracer {
             gpu,
             &shader_modules(scene, &gpu_scene),
             &WHITTED_SHADER,
-            &[],
+            &shader_defs(scene),
             "whitted ray tracer",
         )?;
         let (bind_group, image, params) = gpu.scoped("creating the Whitted ray tracer's buffers", || {
@@ -242,8 +248,9 @@ mod tests {
         for name in ["whitted.toml", "cornell.toml"] {
             let scene = illum_scene::testing::shipped_scene(name, 32, 32);
             let gpu_scene = GpuScene::new(&scene).unwrap();
-            let composed = shader::compose(&shader_modules(&scene, &gpu_scene), &WHITTED_SHADER, &[])
-                .unwrap_or_else(|e| panic!("{name}: {e}"));
+            let composed =
+                shader::compose(&shader_modules(&scene, &gpu_scene), &WHITTED_SHADER, &shader_defs(&scene))
+                    .unwrap_or_else(|e| panic!("{name}: {e}"));
             let mut validator = naga::valid::Validator::new(
                 naga::valid::ValidationFlags::all(),
                 naga::valid::Capabilities::all(),
