@@ -36,7 +36,7 @@ fn setup() -> &'static Setup {
     static SETUP: OnceLock<Setup> = OnceLock::new();
     SETUP.get_or_init(|| {
         let scene = scene();
-        let truth = path_traced(&scene, 4096, scene.pathtrace.bounces, 0x5eed);
+        let truth = path_traced(&scene, 4096, Bounces::Unbounded, 0x5eed);
         let regions =
             Regions::from_ids(&scene, &WhittedTracer::new(gpu(), &scene).unwrap().object_ids().unwrap());
         Setup { truth, regions }

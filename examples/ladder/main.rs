@@ -3,7 +3,7 @@
 //!
 //! ```text
 //! cargo run --release --example ladder -- [SCENE] [--width W --height H] [--truth-spp N]
-//!     [--truth FILE.exr] [--spp-list 1,4,16,64,256,1024] [--depths 1,2,8]
+//!     [--truth-bounces B] [--truth FILE.exr] [--spp-list 1,4,16,64,256,1024] [--depths 1,2,8]
 //!     [--bounce-list 0,1,2,4] [--bounce-spp 1024] [--frames 5] [--out DIR]
 //! ```
 //! Rows:
@@ -19,8 +19,8 @@
 //! tracer's wall time per image (dispatch and readback); the path tracer's wall time to render
 //! that many samples per pixel from nothing (median of up to 3 runs).
 //!
-//! The truth is a path-traced render with `--truth-spp` samples per pixel (the scene's bounces,
-//! cosine sampling, its own seed), cached in DIR under a name derived from everything that
+//! The truth is a path-traced render with `--truth-spp` samples per pixel (`--truth-bounces`,
+//! by default unbounded; cosine sampling; its own seed), cached in DIR under a name derived from everything that
 //! changes it, or the EXR given by `--truth`. The regions come from the Whitted ray tracer's
 //! object-ID image (`illum::regions`).
 //!
@@ -38,7 +38,7 @@ use illum::cli;
 use illum::gpu::GpuContext;
 use illum::image::{Encoding, RgbImage32, contact_sheet, median, save_exr, save_rgba8_png, to_rgba8};
 use illum::pathtrace::PathTracer;
-use illum::plot::{self, Line};
+use illum::plot::{self, Line, Style};
 use illum::raster::{Options, RasterRenderer, RasterScene};
 use illum::reference::{Reference, cached_reference, load_reference};
 use illum::regions::{Comparison, Regions, compare, flip_heat_map};
@@ -64,6 +64,10 @@ struct Args {
     /// Samples per pixel of the rendered (and cached) truth.
     #[arg(long, default_value_t = 16384)]
     truth_spp: u32,
+    /// Bounces of the truth: the converged solution of the rendering equation is `unbounded`
+    /// (Russian roulette); the rows at the scene's own bounce count then show that count's bias.
+    #[arg(long, default_value = "unbounded")]
+    truth_bounces: Bounces,
     /// A truth EXR (linear, the same size) instead of rendering one.
     #[arg(long)]
     truth: Option<PathBuf>,
@@ -87,9 +91,21 @@ struct Args {
     out: PathBuf,
 }
 
+/// Which of the plots' series a rung belongs to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Series {
+    Raster,
+    Whitted,
+    /// The path tracer at the scene's bounces, more samples per pixel each rung.
+    PathTraceSpp,
+    /// The path tracer at a fixed spp, more bounces each rung.
+    PathTraceBounces,
+}
+
 /// One rung: an image made by one renderer with one setting, and how long it took.
 struct Rung {
     renderer: &'static str,
+    series: Series,
     settings: String,
     /// Median wall time per frame, in milliseconds.
     wall_ms: f64,
@@ -130,7 +146,11 @@ fn run(args: Args) -> anyhow::Result<()> {
 
     let Reference { image: truth, spp: truth_spp, estimated_rel_mse: truth_error, .. } = match &args.truth {
         Some(path) => load_reference(path, &scene)?,
-        None => cached_reference(&gpu, &scene, args.truth_spp, &args.out, "ladder truth")?,
+        None => {
+            let mut truth_scene = scene.clone();
+            truth_scene.pathtrace.bounces = args.truth_bounces;
+            cached_reference(&gpu, &truth_scene, args.truth_spp, &args.out, "ladder truth")?
+        }
     };
     println!("truth: {truth_spp} spp, its own estimated relMSE {truth_error:.2e}");
     let regions = Regions::from_ids(&scene, &WhittedTracer::new(&gpu, &scene)?.object_ids()?);
@@ -142,11 +162,12 @@ fn run(args: Args) -> anyhow::Result<()> {
         print_rung(rungs.last().expect("pushed"));
     }
     for &spp in &args.spp_list {
-        rungs.push(pathtrace_rung(&gpu, &scene, spp, scene.pathtrace.bounces, args.frames.min(3))?);
+        let setting = (spp, scene.pathtrace.bounces);
+        rungs.push(pathtrace_rung(&gpu, &scene, setting, Series::PathTraceSpp, args.frames.min(3))?);
         print_rung(rungs.last().expect("pushed"));
     }
     for &bounces in args.bounce_list.iter().filter(|_| args.bounce_spp > 0) {
-        rungs.push(pathtrace_rung(&gpu, &scene, args.bounce_spp, bounces, 1)?);
+        rungs.push(pathtrace_rung(&gpu, &scene, (args.bounce_spp, bounces), Series::PathTraceBounces, 1)?);
         print_rung(rungs.last().expect("pushed"));
     }
     let rows: Vec<Row> = rungs
@@ -157,7 +178,10 @@ fn run(args: Args) -> anyhow::Result<()> {
         })
         .collect();
 
-    let header = Header { scene: &scene, adapter: &gpu.adapter_info.name, truth_spp, truth_error };
+    let truth_bounces =
+        if args.truth.is_some() { "as in the given file".to_owned() } else { args.truth_bounces.to_string() };
+    let header =
+        Header { scene: &scene, adapter: &gpu.adapter_info.name, truth_spp, truth_bounces, truth_error };
     write_outputs(&args, &header, &truth, &regions, &rows)?;
     Ok(())
 }
@@ -215,6 +239,7 @@ fn raster_rungs(gpu: &GpuContext, scene: &Scene, frames: u32, rungs: &mut Vec<Ru
         let report = illum::raster::bench_frames(gpu, &raster_scene, w, h, &options, 2, frames)?;
         rungs.push(Rung {
             renderer: "raster",
+            series: Series::Raster,
             settings: label,
             wall_ms: report.median_frame_ms(),
             gpu_ms: report.median_pass_ms().map(|t| t.total_ms()),
@@ -238,6 +263,7 @@ fn whitted_rung(gpu: &GpuContext, scene: &Scene, depth: u32, frames: u32) -> any
     }
     Ok(Rung {
         renderer: "whitted",
+        series: Series::Whitted,
         settings: format!("depth {depth}, {0}x{0} rays per pixel", scene.whitted.aa),
         wall_ms: median(&mut ms),
         gpu_ms: None,
@@ -248,8 +274,8 @@ fn whitted_rung(gpu: &GpuContext, scene: &Scene, depth: u32, frames: u32) -> any
 fn pathtrace_rung(
     gpu: &GpuContext,
     scene: &Scene,
-    spp: u32,
-    bounces: Bounces,
+    (spp, bounces): (u32, Bounces),
+    series: Series,
     runs: u32,
 ) -> anyhow::Result<Rung> {
     let mut scene = scene.clone();
@@ -266,6 +292,7 @@ fn pathtrace_rung(
     }
     Ok(Rung {
         renderer: "pathtrace",
+        series,
         settings: format!("{spp} spp, bounces {bounces}"),
         wall_ms: median(&mut ms),
         gpu_ms: None,
@@ -277,6 +304,7 @@ struct Header<'a> {
     scene: &'a Scene,
     adapter: &'a str,
     truth_spp: u64,
+    truth_bounces: String,
     truth_error: f64,
 }
 
@@ -341,7 +369,7 @@ fn write_outputs(
         s.camera.height,
         header.adapter,
         header.truth_spp,
-        s.pathtrace.bounces,
+        header.truth_bounces,
         number(header.truth_error)
     );
     let overall: Vec<Vec<String>> = rows
@@ -392,19 +420,25 @@ fn write_outputs(
         ("error-vs-time.png", "relMSE against time per frame", "relMSE", 0),
         ("flip-vs-time.png", "FLIP against time per frame", "mean FLIP", 1),
     ] {
-        let lines: Vec<Line> = ["raster", "whitted", "pathtrace"]
+        let series = [
+            ("rasterizer", Series::Raster, Style::Markers),
+            ("Whitted ray tracer", Series::Whitted, Style::Markers),
+            ("path tracer, more spp", Series::PathTraceSpp, Style::Joined),
+            ("path tracer, more bounces", Series::PathTraceBounces, Style::Joined),
+        ];
+        let lines: Vec<Line> = series
             .iter()
-            .map(|renderer| Line {
-                label: (*renderer).to_owned(),
+            .map(|&(label, series, style)| Line {
+                label: label.to_owned(),
                 points: rows
                     .iter()
-                    .filter(|r| r.rung.renderer == *renderer)
+                    .filter(|r| r.rung.series == series)
                     .map(|r| {
                         let e = &r.errors.overall;
                         (r.rung.wall_ms, if value == 0 { e.rel_mse } else { e.flip })
                     })
                     .collect(),
-                markers_only: *renderer != "pathtrace",
+                style,
             })
             .filter(|l| !l.points.is_empty())
             .collect();
