@@ -215,20 +215,11 @@ fn raster_rungs(gpu: &GpuContext, scene: &Scene, frames: u32, rungs: &mut Vec<Ru
         }
     };
     let (w, h) = (scene.camera.width, scene.camera.height);
-    type Toggle = (&'static str, fn(&mut Effects));
-    let toggles: [Toggle; 6] = [
-        ("shadows", |e| e.shadows = false),
-        ("pcf", |e| e.pcf = false),
-        ("refraction", |e| e.refraction = false),
-        ("reflection", |e| e.reflection = false),
-        ("fresnel", |e| e.fresnel = false),
-        ("msaa", |e| e.msaa = false),
-    ];
     let mut settings = vec![
         ("figure look".to_owned(), Options::all_on(Look::Figure)),
         ("enhanced look".to_owned(), Options::all_on(Look::Enhanced)),
     ];
-    for (name, off) in toggles {
+    for (name, off) in Effects::TOGGLES {
         let mut options = Options::all_on(Look::Enhanced);
         off(&mut options.effects);
         settings.push((format!("enhanced, {name} off"), options));

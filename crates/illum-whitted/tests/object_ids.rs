@@ -1,5 +1,5 @@
-//! The object-ID image against a closed form computed here in f64: each pixel's centre ray hits
-//! the nearest of the scene's shapes (ray-sphere and ray-parallelogram solved directly), and a
+//! The object-ID image against a closed form computed in f64: each pixel's centre ray hits the
+//! nearest of the scene's shapes (the oracle's intersection, which shares no code with WGSL), and a
 //! floor point lies in a ball's shadow exactly when the ball's projection along the light
 //! covers it: the line p + t L (t > 0) passes within the radius of the centre. Pixels where a
 //! silhouette or a shadow edge passes within a small margin of the centre ray may fall on the
@@ -18,34 +18,22 @@ fn gpu() -> &'static GpuContext {
     GPU.get_or_init(|| GpuContext::new().unwrap_or_else(|e| panic!("{e}")))
 }
 
-/// Distance along (o, d) to the shape, and how close the ray comes to missing it (the distance
-/// from a silhouette or an edge, in the shape's units), or None.
-fn hit(shape: &Shape, o: DVec3, d: DVec3) -> Option<(f64, f64)> {
+/// How far the ray (o, d) passes from the shape's outline: from a sphere's silhouette, or from
+/// the nearest edge of a rectangle where it crosses its plane (a small margin means f32 may
+/// decide hit or miss the other way).
+fn margin(shape: &Shape, o: DVec3, d: DVec3) -> f64 {
     match shape {
         Shape::Sphere(s) => {
-            let c = s.center.as_dvec3();
-            let r = f64::from(s.radius);
-            let oc = o - c;
-            let b = oc.dot(d);
-            let disc = b * b - (oc.length_squared() - r * r);
-            if disc < 0.0 {
-                return None;
-            }
-            let t = -b - disc.sqrt();
-            // Distance of the ray's closest approach from the silhouette.
-            let miss = r - (oc - b * d).length();
-            (t > 0.0).then_some((t, miss))
+            let oc = o - s.center.as_dvec3();
+            (f64::from(s.radius) - (oc - oc.dot(d) * d).length()).abs()
         }
         Shape::Quad(q) => {
-            let (p0, u, v) = (q.corner.as_dvec3(), q.edge_u.as_dvec3(), q.edge_v.as_dvec3());
+            let (u, v) = (q.edge_u.as_dvec3(), q.edge_v.as_dvec3());
             let n = u.cross(v);
-            let t = (p0 - o).dot(n) / d.dot(n);
-            let h = o + t * d - p0;
-            let w = n / n.length_squared();
-            let (a, b) = (w.dot(h.cross(v)), w.dot(u.cross(h)));
-            let inside = (0.0..=1.0).contains(&a) && (0.0..=1.0).contains(&b);
-            let edge = a.min(1.0 - a) * u.length().min(b.min(1.0 - b) * v.length());
-            (t > 0.0 && inside).then_some((t, edge))
+            let p = o + (q.corner.as_dvec3() - o).dot(n) / d.dot(n) * d - q.corner.as_dvec3();
+            // Rectangle coordinates along each edge, in scene units.
+            let (a, b) = (p.dot(u) / u.length(), p.dot(v) / v.length());
+            [a, u.length() - a, b, v.length() - b].into_iter().map(f64::abs).fold(f64::MAX, f64::min)
         }
         Shape::Box(_) => panic!("the Whitted scene has no boxes"),
     }
@@ -55,6 +43,8 @@ fn hit(shape: &Shape, o: DVec3, d: DVec3) -> Option<(f64, f64)> {
 fn object_ids_match_ray_casting_and_shadows_are_the_balls_projections_along_the_light() {
     let scene: Scene = illum_scene::testing::shipped_scene("whitted.toml", 160, 90);
     let ids = WhittedTracer::new(gpu(), &scene).unwrap().object_ids().unwrap();
+    let traced = illum_oracle::scene::TraceScene::new(&scene).unwrap();
+    assert_eq!(traced.surfaces.len(), scene.objects.len());
     let to_light = -scene.directional_light.expect("a sun").direction.as_dvec3().normalize();
     let scale = 1e-3 * scene.camera.eye.as_dvec3().length().max(1.0);
     let (mut checked, mut skipped, mut shadowed) = (0usize, 0usize, [0usize; 8]);
@@ -62,19 +52,22 @@ fn object_ids_match_ray_casting_and_shadows_are_the_balls_projections_along_the_
         for x in 0..ids.width {
             let i = (y * ids.width + x) as usize;
             let (o, d) = pixel_ray(&scene.camera, f64::from(x) + 0.5, f64::from(y) + 0.5);
-            let nearest = scene
-                .objects
+            // The oracle's f64 intersection (the scene has no emitters, so its surfaces are the
+            // scene's objects in order).
+            let nearest = traced
+                .surfaces
                 .iter()
                 .enumerate()
-                .filter_map(|(k, obj)| hit(&obj.shape, o, d).map(|(t, margin)| (k, t, margin)))
+                .filter_map(|(k, p)| p.surface.intersect(o, d, f64::INFINITY).map(|hit| (k, hit.t)))
                 .min_by(|a, b| a.1.total_cmp(&b.1));
+            let near_an_outline = scene.objects.iter().any(|obj| margin(&obj.shape, o, d) < scale);
             // The expected shadow: which balls' projections along the light cover the point.
             let (expected_hit, expected_shadow, near_edge) = match nearest {
-                None => (None, Shadow::Lit, false),
-                Some((k, t, margin)) => {
+                None => (None, Shadow::Lit, near_an_outline),
+                Some((k, t)) => {
                     let p = o + t * d;
                     let mut shadow = Shadow::Lit;
-                    let mut near = margin < scale;
+                    let mut near = near_an_outline;
                     if matches!(scene.objects[k].shape, Shape::Quad(_)) {
                         for (j, obj) in scene.objects.iter().enumerate() {
                             if let Shape::Sphere(s) = &obj.shape {
