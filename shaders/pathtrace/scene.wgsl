@@ -28,8 +28,9 @@ struct Params {
     first_emitter: u32,
     // Samples per invocation (one chunk); the dispatch's z dimension counts chunks.
     chunk_samples: u32,
-    // The directional light (shader def SUN): xyz = unit vector toward it, w = cos of its
-    // angular radius (1 for a delta light); its irradiance on a surface facing it.
+    // The directional light (shader def SUN): xyz = unit vector toward it, w = 1 - cos of its
+    // angular radius (0 for a delta light; see sample_uniform_cone); its irradiance on a
+    // surface facing it.
     sun: vec4<f32>,
     sun_irradiance: vec4<f32>,
     // The environment's radiance (shader def SKY).
