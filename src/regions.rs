@@ -38,7 +38,15 @@ pub struct Regions {
 enum Key {
     Nothing,
     Object(usize, Lighting),
+    /// Every region smaller than [`SMALL_REGION`] of the image, together.
+    Small,
 }
+
+/// Regions under this fraction of the image are merged into one ("other"): slivers where a
+/// pixel's centre ray meets a box's side face or a shadow's single-pixel edge carry no
+/// statistics of their own. (The Whitted scene's smallest real region, the metal sphere's
+/// shadow, is 1.2% of the image.)
+pub const SMALL_REGION: f64 = 0.005;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 enum Lighting {
@@ -68,7 +76,18 @@ impl Regions {
                 Key::Object(k, lighting)
             }
         };
-        let keys: Vec<Key> = ids.hit.iter().zip(&ids.shadow).map(|(&h, &s)| key(h, s)).collect();
+        let mut keys: Vec<Key> = ids.hit.iter().zip(&ids.shadow).map(|(&h, &s)| key(h, s)).collect();
+        let mut counts: BTreeMap<Key, usize> = BTreeMap::new();
+        for &k in &keys {
+            *counts.entry(k).or_default() += 1;
+        }
+        let total = keys.len() as f64;
+        let small = |k: &Key| (counts[k] as f64) < SMALL_REGION * total;
+        for k in &mut keys {
+            if small(k) {
+                *k = Key::Small;
+            }
+        }
         let mut order: BTreeMap<Key, usize> = keys.iter().map(|&k| (k, 0)).collect();
         let mut names = Vec::new();
         for (k, index) in order.iter_mut() {
@@ -83,6 +102,7 @@ impl Regions {
                 Key::Object(i, Lighting::ShadowOf(j)) => {
                     format!("{} in the {}'s shadow", object(i), object(j))
                 }
+                Key::Small => format!("other (regions under {}% of the image)", SMALL_REGION * 100.0),
             });
         }
         Regions { names, of_pixel: keys.iter().map(|k| order[k]).collect() }
@@ -187,6 +207,42 @@ mod tests {
 
     fn image(w: u32, h: u32, f: impl Fn(u32, u32) -> [f32; 3]) -> RgbImage32 {
         RgbImage32::from_fn(w, h, f)
+    }
+
+    /// Regions are named from the scene, sorted sky first, and slivers under 0.5% of the image
+    /// are merged into one.
+    #[test]
+    fn regions_are_named_by_what_is_seen_and_slivers_are_merged() {
+        let scene = illum_scene::testing::shipped_scene("whitted.toml", 100, 10);
+        let (floor, glass, metal) = (0, 1, 2);
+        let mut hit = vec![None; 1000];
+        let mut shadow = vec![Shadow::Lit; 1000];
+        for i in 0..400 {
+            hit[i] = Some(floor);
+        }
+        for i in 400..500 {
+            hit[i] = Some(floor);
+            shadow[i] = Shadow::BlockedBy(glass);
+        }
+        for i in 500..504 {
+            hit[i] = Some(metal); // 0.4%: merged
+        }
+        for i in 504..508 {
+            hit[i] = Some(floor);
+            shadow[i] = Shadow::FacingAway; // 0.4%: merged
+        }
+        let ids = ObjectIds { width: 100, height: 10, hit, shadow };
+        let regions = Regions::from_ids(&scene, &ids);
+        assert_eq!(
+            regions.names,
+            [
+                "sky",
+                "floor, lit",
+                "floor in the glass sphere's shadow",
+                "other (regions under 0.5% of the image)"
+            ]
+        );
+        assert_eq!(regions.sizes(), [492, 400, 100, 8]);
     }
 
     #[test]
