@@ -217,20 +217,11 @@ mod tests {
         let (floor, glass, metal) = (0, 1, 2);
         let mut hit = vec![None; 1000];
         let mut shadow = vec![Shadow::Lit; 1000];
-        for i in 0..400 {
-            hit[i] = Some(floor);
-        }
-        for i in 400..500 {
-            hit[i] = Some(floor);
-            shadow[i] = Shadow::BlockedBy(glass);
-        }
-        for i in 500..504 {
-            hit[i] = Some(metal); // 0.4%: merged
-        }
-        for i in 504..508 {
-            hit[i] = Some(floor);
-            shadow[i] = Shadow::FacingAway; // 0.4%: merged
-        }
+        hit[..500].fill(Some(floor));
+        shadow[400..500].fill(Shadow::BlockedBy(glass));
+        hit[500..504].fill(Some(metal)); // 0.4%: merged
+        hit[504..508].fill(Some(floor));
+        shadow[504..508].fill(Shadow::FacingAway); // 0.4%: merged
         let ids = ObjectIds { width: 100, height: 10, hit, shadow };
         let regions = Regions::from_ids(&scene, &ids);
         assert_eq!(
