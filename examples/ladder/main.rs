@@ -155,6 +155,13 @@ fn run(args: Args) -> anyhow::Result<()> {
         }
     };
     println!("truth: {truth_spp} spp, its own estimated relMSE {truth_error:.2e}");
+    let most = args.spp_list.iter().copied().chain([args.bounce_spp]).max().unwrap_or(0);
+    if truth_spp < 16 * u64::from(most) {
+        println!(
+            "warning: the truth has {truth_spp} spp, under 16 times the {most} spp of the largest row: \
+             that row's error includes a sixteenth or more of the truth's own"
+        );
+    }
     let regions = Regions::from_ids(&scene, &WhittedTracer::new(&gpu, &scene)?.object_ids()?);
 
     let mut rungs = Vec::new();
