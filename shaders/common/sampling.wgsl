@@ -55,6 +55,16 @@ fn to_world(n: vec3<f32>, local: vec3<f32>) -> vec3<f32> {
     return local.x * t + local.y * bt + local.z * n;
 }
 
+// A uniform point on the disc of radius `radius` about `centre`, perpendicular to the unit
+// vector `axis` (where the caustic's particles cross the light's plane): the radius
+// r = radius sqrt(u1) makes the area inside r, pi r^2, uniform in u1; phi = 2 pi u2.
+// pdf = 1 / (pi radius^2) with respect to area.
+fn sample_disc(centre: vec3<f32>, axis: vec3<f32>, radius: f32, u1: f32, u2: f32) -> vec3<f32> {
+    let r = radius * sqrt(u1);
+    let phi = TWO_PI * u2;
+    return centre + to_world(axis, vec3<f32>(r * cos(phi), r * sin(phi), 0.0));
+}
+
 // A uniform point on the parallelogram corner + s u + t v: pdf = 1 / area with respect to area.
 fn sample_parallelogram(corner: vec3<f32>, edge_u: vec3<f32>, edge_v: vec3<f32>, u1: f32, u2: f32) -> vec3<f32> {
     return corner + u1 * edge_u + u2 * edge_v;

@@ -16,6 +16,13 @@
 #import illum::rtcore::geometry::{NO_HIT, FAR, Surface}
 #import illum::pathtrace::scene::{Material, params, objects, materials, lights, batch_sum, batch_sum_sq}
 #import illum::rtcore::traversal::{closest_hit, occluded, surface_at, choose_light}
+#import illum::pathtrace::surfaces::{MATERIAL_CHECKER, MATERIAL_DIELECTRIC, MATERIAL_MIRROR}
+#ifdef SPECULAR
+#import illum::pathtrace::surfaces::fresnel
+#endif
+#ifdef CHECKER
+#import illum::pathtrace::surfaces::checker_albedo
+#endif
 
 const SAMPLING_COSINE: u32 = 0u;
 const UNBOUNDED: u32 = 0xffffffffu;
@@ -72,10 +79,6 @@ fn max3(v: vec3<f32>) -> f32 {
     return max(max(v.x, v.y), v.z);
 }
 
-const MATERIAL_CHECKER: u32 = 1u;
-const MATERIAL_DIELECTRIC: u32 = 2u;
-const MATERIAL_MIRROR: u32 = 3u;
-
 #ifdef SUN
 // Next-event estimation toward the directional light from s (rays leave from `origin`): its
 // contribution to the integral of incoming radiance x cos(theta_x), divided by its pdf. A delta
@@ -111,40 +114,22 @@ fn sun_radiance() -> vec3<f32> {
 
 // What a ray leaving the scene along d sees: the sky, and a sun disc where light straight from
 // it counts (camera and specular rays: next-event estimation already counted it for diffuse
-// ones). A delta sun is never seen.
-fn escaped(d: vec3<f32>, direct_counts: bool) -> vec3<f32> {
+// ones), unless the caustic's light tracer owns the path (`caustic_owned`: E D S+ L with D the
+// camera ray's own hit, see caustic.wgsl). A delta sun is never seen.
+fn escaped(d: vec3<f32>, direct_counts: bool, caustic_owned: bool) -> vec3<f32> {
     var l = vec3<f32>(0.0);
 #ifdef SKY
     l += params.sky.xyz;
 #endif
 #ifdef SUN_DISC
-    if (direct_counts && 1.0 - dot(d, params.sun.xyz) <= params.sun.w) {
+    if (direct_counts && !caustic_owned && 1.0 - dot(d, params.sun.xyz) <= params.sun.w) {
         l += sun_radiance();
     }
 #endif
     return l;
 }
 
-#ifdef CHECKER
-// The checker's albedo at p on quad obj: tile (i, j) counted from its corner along its edges.
-fn checker_albedo(obj_index: u32, m: Material, p: vec3<f32>) -> vec3<f32> {
-    let obj = objects[obj_index];
-    let q = p - obj.a.xyz;
-    let i = floor(dot(q, obj.b.xyz) / length(obj.b.xyz) / m.emission.w);
-    let j = floor(dot(q, obj.c.xyz) / length(obj.c.xyz) / m.emission.w);
-    return select(m.albedo.rgb, m.emission.rgb, (i32(i) + i32(j)) % 2 != 0);
-}
-#endif
 
-#ifdef SPECULAR
-// Exact unpolarised Fresnel reflectance for cosines of incidence and transmission and
-// eta = n_from / n_to.
-fn fresnel(cos_i: f32, cos_t: f32, eta: f32) -> f32 {
-    let rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    return 0.5 * (rs * rs + rp * rp);
-}
-#endif
 
 // One path's radiance estimate along the camera ray (o, d).
 //
@@ -161,10 +146,13 @@ fn radiance(origin: vec3<f32>, direction: vec3<f32>, sampler: ptr<function, Samp
     var throughput = vec3<f32>(1.0);
     var depth = 0u;
     var direct_counts = true;
+    // Set at the camera ray's own diffuse hit when the caustic estimator is on, kept through
+    // specular scattering: the path E D S+ L it would complete belongs to the light tracer.
+    var caustic_owned = false;
     loop {
         let hit = closest_hit(o, d);
         if (hit.index == NO_HIT) {
-            radiance += throughput * escaped(d, direct_counts);
+            radiance += throughput * escaped(d, direct_counts, caustic_owned);
             break;
         }
         let obj = objects[hit.index];
@@ -253,6 +241,9 @@ fn radiance(origin: vec3<f32>, direction: vec3<f32>, sampler: ptr<function, Samp
         }
         o = spawned;
         direct_counts = false;
+#ifdef CAUSTIC
+        caustic_owned = depth == 0u;
+#endif
         depth += 1u;
     }
     return radiance;

@@ -2,6 +2,8 @@
 //! lavapipe. (One binary, not one per file: each test binary links wgpu, and a dozen of them
 //! filled the CI machine's disk.)
 //!
+//! - `caustic`: the caustic's light tracer against the oracle, a closed form (an index-1 ball
+//!   vanishes), the error estimate with two estimators, extremes and its fixed point;
 //! - `closed_form`: direct light at floor points against Lambert's polygon formula;
 //! - `statistics`: the samplers agree, cosine sampling is less noisy, seeds, batching, no NaN;
 //! - `reference`: a small Cornell box against checked-in converged references, per pixel;
@@ -22,6 +24,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod caustic;
 mod closed_form;
 mod display_sum;
 mod error_estimate;

@@ -26,7 +26,7 @@ fn run_on_gpu(expression: &str, seed: u32) -> Vec<DVec3> {
     let gpu = common::gpu();
     let source = format!(
         "#import illum::rng::{{rng_seed, rng_f32}}
-#import illum::sampling::{{sample_cosine_hemisphere, sample_uniform_hemisphere, sample_uniform_cone, to_world, sample_parallelogram}}
+#import illum::sampling::{{sample_cosine_hemisphere, sample_uniform_hemisphere, sample_uniform_cone, to_world, sample_parallelogram, sample_disc}}
 @group(0) @binding(0) var<storage, read_write> samples: array<vec4<f32>>;
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {{
@@ -230,6 +230,38 @@ fn rectangular_light_sampling_is_uniform_over_area() {
     }
     // pdf = 1/A over area: every cell of the (s, t) grid has the same area, so p = 1/256.
     chi_square_test("rectangle", &counts, &vec![1.0 / (BINS * BINS) as f64; BINS * BINS]);
+}
+
+#[test]
+fn caustic_emission_is_uniform_over_its_disc() {
+    // The caustic's particles cross the plane perpendicular to the light on a disc about a
+    // specular object's centre: here radius 1.5 about (4.2, 2.6, -4.2), perpendicular to the
+    // Whitted scene's light direction.
+    let centre = DVec3::new(4.2, 2.6, -4.2);
+    let axis = DVec3::new(-10.0, -13.0, 2.0).normalize();
+    let samples = run_on_gpu(
+        &format!(
+            "sample_disc(vec3<f32>(4.2, 2.6, -4.2), vec3<f32>({:?}, {:?}, {:?}), 1.5, u1, u2)",
+            axis.x as f32, axis.y as f32, axis.z as f32
+        ),
+        8,
+    );
+    let (t, b) = frame(axis);
+    const BINS: usize = 16;
+    let mut counts = vec![0u64; BINS * BINS];
+    for p in &samples {
+        let h = *p - centre;
+        assert!(h.dot(axis).abs() < 1e-5, "sample {p} is off the disc's plane");
+        let (x, y) = (h.dot(t) / 1.5, h.dot(b) / 1.5);
+        let r2 = x * x + y * y;
+        assert!(r2 <= 1.0 + 1e-5, "sample {p} outside the disc");
+        // Cells of equal area: r^2 in 16 equal steps times 16 equal angles.
+        let i = ((r2 * BINS as f64) as usize).min(BINS - 1);
+        let phi = y.atan2(x).rem_euclid(std::f64::consts::TAU);
+        let j = ((phi / std::f64::consts::TAU * BINS as f64) as usize).min(BINS - 1);
+        counts[i * BINS + j] += 1;
+    }
+    chi_square_test("disc", &counts, &vec![1.0 / (BINS * BINS) as f64; BINS * BINS]);
 }
 
 #[test]

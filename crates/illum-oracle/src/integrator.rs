@@ -34,22 +34,22 @@ use crate::whitted::{reflect, refract};
 const EMITTER_TIE: f64 = 1e-9;
 /// A new ray starts this far (relative to the point's largest coordinate, at least 1e-9) off
 /// the surface along the facing normal. f64 hit points carry errors ~1e-16 |p|.
-const SPAWN_OFFSET: f64 = 1e-9;
+pub(crate) const SPAWN_OFFSET: f64 = 1e-9;
 /// Shadow rays end this fraction short of the light point, so the light's own plane (and a
 /// surface coplanar with it) does not shadow it.
 const SHADOW_SHORTEN: f64 = 1e-8;
 /// Continuation rays taken without Russian roulette in unbounded mode.
-const ROULETTE_AFTER: u32 = 3;
-const ROULETTE_MAX_SURVIVAL: f64 = 0.95;
+pub(crate) const ROULETTE_AFTER: u32 = 3;
+pub(crate) const ROULETTE_MAX_SURVIVAL: f64 = 0.95;
 /// A safety limit for unbounded paths; reaching it has probability below 0.95^100000.
 const UNBOUNDED_LIMIT: u32 = 100_000;
 
 /// What a ray hit: the primitive, distance and geometric normal.
 #[derive(Clone, Copy, Debug)]
-struct Hit<'a> {
-    primitive: &'a Primitive,
-    t: f64,
-    normal: DVec3,
+pub(crate) struct Hit<'a> {
+    pub(crate) primitive: &'a Primitive,
+    pub(crate) t: f64,
+    pub(crate) normal: DVec3,
 }
 
 /// Nearest hit with t in (0, inf) among `list`.
@@ -67,22 +67,36 @@ fn nearest_in(list: &[Primitive], o: DVec3, d: DVec3) -> Option<Hit<'_>> {
 /// A scene prepared for tracing with the settings of one estimate.
 #[derive(Clone, Debug)]
 pub struct Oracle {
-    scene: TraceScene,
+    pub(crate) scene: TraceScene,
     pub camera: PinholeCamera,
     pub bounces: Bounces,
     pub sampling: Sampling,
+    /// The light tracer of the caustic (`caustic.rs`), when on and the scene can have one.
+    pub(crate) caustic: Option<crate::caustic::Emitter>,
 }
 
 impl Oracle {
     /// Prepares `scene` with its own path-tracer settings (`scene.pathtrace.bounces` and
     /// `.sampling`), or says which feature of the scene the oracle does not implement.
     pub fn new(scene: &Scene) -> Result<Oracle, illum_scene::SceneError> {
-        Ok(Oracle {
+        let oracle = Oracle {
             scene: TraceScene::new(scene)?,
             camera: PinholeCamera::new(&scene.camera),
             bounces: scene.pathtrace.bounces,
             sampling: scene.pathtrace.sampling,
-        })
+            caustic: None,
+        };
+        Ok(oracle.with_caustics(scene.pathtrace.caustics))
+    }
+
+    /// Turns the caustic's light tracer on or off (on has an effect only with a directional
+    /// light and a mirror or dielectric).
+    pub fn with_caustics(mut self, on: bool) -> Oracle {
+        self.caustic = None;
+        if on {
+            self.caustic = crate::caustic::Emitter::new(&self);
+        }
+        self
     }
 
     pub fn with_bounces(mut self, bounces: Bounces) -> Oracle {
@@ -102,7 +116,7 @@ impl Oracle {
 
     /// Nearest hit along o + t d (d unit) with t in (0, inf); an emitter wins a tie with a
     /// surface up to the relative distance EMITTER_TIE behind it.
-    fn closest_hit(&self, o: DVec3, d: DVec3) -> Option<Hit<'_>> {
+    pub(crate) fn closest_hit(&self, o: DVec3, d: DVec3) -> Option<Hit<'_>> {
         let surface = nearest_in(&self.scene.surfaces, o, d);
         let emitter = nearest_in(&self.scene.emitters, o, d);
         match (surface, emitter) {
@@ -141,7 +155,7 @@ impl Oracle {
     }
 
     /// Whether the path may take continuation ray number `taken + 1`, given `taken` so far.
-    fn may_continue(&self, taken: u32) -> bool {
+    pub(crate) fn may_continue(&self, taken: u32) -> bool {
         match self.bounces {
             Bounces::Fixed(n) => taken < n,
             Bounces::Unbounded => taken < UNBOUNDED_LIMIT,
@@ -173,9 +187,14 @@ impl Oracle {
     /// What a ray leaving the scene along d sees: the sky, and the sun's disc where it counts
     /// (camera and specular rays only: next-event estimation already counted it for diffuse
     /// ones). A delta sun is never seen.
-    fn escaped(&self, d: DVec3, direct_counts: bool) -> DVec3 {
+    fn escaped(&self, d: DVec3, direct_counts: bool, caustic_owned: bool) -> DVec3 {
         let sun = match self.scene.sun {
-            Some(sun) if direct_counts && !sun.is_delta() && d.dot(sun.to_light) >= sun.cos_max => {
+            Some(sun)
+                if direct_counts
+                    && !caustic_owned
+                    && !sun.is_delta()
+                    && d.dot(sun.to_light) >= sun.cos_max =>
+            {
                 sun.radiance()
             }
             _ => DVec3::ZERO,
@@ -209,9 +228,12 @@ impl Oracle {
         // the camera ray and after specular scattering, which next-event estimation cannot
         // follow; not after a diffuse bounce, whose point already sampled the lights.
         let mut direct_counts = true;
+        // Whether the path so far is E D S* with D the camera ray's own hit: its end at the sun
+        // disc (E D S+ L) belongs to the caustic's light tracer when that is on (caustic.rs).
+        let mut caustic_owned = false;
         loop {
             let Some(hit) = self.closest_hit(o, d) else {
-                sum += throughput * self.escaped(d, direct_counts);
+                sum += throughput * self.escaped(d, direct_counts, caustic_owned);
                 break;
             };
             if hit.primitive.emitter {
@@ -299,6 +321,7 @@ impl Oracle {
                     d = local_to_world(n, local).normalize();
                     o = x_off;
                     direct_counts = false;
+                    caustic_owned = taken == 0 && self.caustic.is_some();
                 }
                 MaterialKind::Emitter { .. } => unreachable!("emitters are handled above"),
             }

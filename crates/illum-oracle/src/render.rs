@@ -45,16 +45,34 @@ impl Moments {
 }
 
 impl Oracle {
-    /// `spp` samples (indices 0..spp) of pixel (x, y) under `seed`.
+    /// `spp` samples (indices 0..spp) of pixel (x, y) under `seed`. With the caustic on, sample
+    /// k is the camera path's estimate plus the pixel's share of caustic frame k (`caustic.rs`):
+    /// the two are independent, so the sample variance below estimates the sum of their
+    /// variances. (One pixel then costs spp whole frames of particles: [`Self::render`] traces
+    /// each frame once for all pixels.)
     ///
     /// # Panics
     /// If `spp` is 0.
     pub fn pixel(&self, x: u32, y: u32, spp: u32, seed: u64) -> PixelEstimate {
+        let index = y as usize * self.camera.width as usize + x as usize;
+        self.pixel_with(x, y, spp, seed, |k| {
+            if self.caustics() { self.caustic_frame(seed, k)[index] } else { DVec3::ZERO }
+        })
+    }
+
+    fn pixel_with(
+        &self,
+        x: u32,
+        y: u32,
+        spp: u32,
+        seed: u64,
+        caustic: impl Fn(u32) -> DVec3,
+    ) -> PixelEstimate {
         assert!(spp > 0, "illum-oracle: spp must be at least 1");
         let mut moments = Moments::default();
         let mut dropped = 0;
         for sample in 0..spp {
-            let l = self.pixel_sample(x, y, seed, sample);
+            let l = self.pixel_sample(x, y, seed, sample) + caustic(sample);
             if l.is_finite() {
                 moments.add(l);
             } else {
@@ -68,6 +86,33 @@ impl Oracle {
         }
     }
 
+    /// The caustic frames 0..spp (empty when the caustic is off), on `threads` threads.
+    pub fn caustic_frames(&self, spp: u32, seed: u64, threads: usize) -> Vec<Vec<DVec3>> {
+        if !self.caustics() {
+            return Vec::new();
+        }
+        let next = AtomicU32::new(0);
+        let mut frames: Vec<(u32, Vec<DVec3>)> = std::thread::scope(|scope| {
+            let workers: Vec<_> = (0..threads.clamp(1, spp as usize))
+                .map(|_| {
+                    scope.spawn(|| {
+                        let mut done = Vec::new();
+                        loop {
+                            let k = next.fetch_add(1, Ordering::Relaxed);
+                            if k >= spp {
+                                break done;
+                            }
+                            done.push((k, self.caustic_frame(seed, k)));
+                        }
+                    })
+                })
+                .collect();
+            workers.into_iter().flat_map(|w| w.join().expect("oracle worker panicked")).collect()
+        });
+        frames.sort_unstable_by_key(|(k, _)| *k);
+        frames.into_iter().map(|(_, f)| f).collect()
+    }
+
     /// The whole image on `threads` threads (at least one), which take rows one at a time.
     /// The result does not depend on `threads`: every sample's random numbers are keyed by
     /// (seed, pixel, sample index).
@@ -77,7 +122,11 @@ impl Oracle {
     pub fn render(&self, spp: u32, seed: u64, threads: usize) -> OracleImage {
         assert!(spp > 0, "illum-oracle: spp must be at least 1");
         let (width, height) = (self.camera.width, self.camera.height);
-        let pixels = rows_in_parallel(width, height, threads, |x, y| self.pixel(x, y, spp, seed));
+        let frames = self.caustic_frames(spp, seed, threads);
+        let pixels = rows_in_parallel(width, height, threads, |x, y| {
+            let index = y as usize * width as usize + x as usize;
+            self.pixel_with(x, y, spp, seed, |k| frames.get(k as usize).map_or(DVec3::ZERO, |f| f[index]))
+        });
         let mut image = OracleImage {
             width,
             height,

@@ -193,6 +193,48 @@ impl Accumulator {
         }
     }
 
+    /// Folds, beside a camera chunk just folded with [`Self::fold`] (`camera`: its sums as the
+    /// shader wrote them), a second, independent estimator's values for the same samples: per
+    /// pixel the true-radiance sum `sum` and sum of squares `sum_sq` of its `frames` values,
+    /// one per sample index of the chunk (the caustic's light tracer, `tracer/caustic.rs`).
+    /// Sample k of the pixel is then c_k + s_k: the sums gain S1 and the sums of squares
+    /// S2 + 2 C S1 / n (C the camera sum of n samples), whose expectation is that of the paired
+    /// sum of (c_k + s_k)^2 since the two are independent; so the sample variance estimates
+    /// var(c) + var(s). When some camera samples of the chunk were dropped (n < frames), S1
+    /// and S2 are scaled by n / frames, the expected share of the kept samples.
+    pub fn fold_independent(
+        &mut self,
+        first_pixel: usize,
+        camera: &[[f32; 4]],
+        sum: &[[f64; 3]],
+        sum_sq: &[[f64; 3]],
+        frames: u32,
+    ) {
+        if frames == 0 {
+            return;
+        }
+        let scale = self.sum_scale;
+        let frames = f64::from(frames);
+        for (i, chunk) in camera.iter().enumerate() {
+            let n = f64::from(chunk[3]);
+            if n == 0.0 {
+                continue;
+            }
+            let p = first_pixel + i;
+            let share = n / frames;
+            for c in 0..3 {
+                self.sum[p][c] += sum[i][c] * share;
+                self.sum_sq[p][c] +=
+                    sum_sq[i][c] * share + 2.0 * f64::from(chunk[c]) * scale * sum[i][c] / frames;
+            }
+        }
+    }
+
+    /// Counts `n` more dropped values (the caustic's particles too bright for its fixed point).
+    pub fn add_dropped(&mut self, n: u64) {
+        self.dropped += n;
+    }
+
     /// Samples dropped because they were NaN or Inf.
     pub fn dropped_samples(&self) -> u64 {
         self.dropped

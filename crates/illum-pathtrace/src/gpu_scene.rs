@@ -336,6 +336,9 @@ impl GpuScene {
         if kinds().any(|k| matches!(k, MaterialKind::Checker(_))) {
             defs.push("CHECKER");
         }
+        if scene.pathtrace.caustics && scene.directional_light.is_some() && defs.contains(&"SPECULAR") {
+            defs.push("CAUSTIC");
+        }
         let objects = objects.into_iter().map(|(_, object)| object).collect();
         Ok(Self { objects, materials, lights, light_area, first_emitter, defs, radiance_exponent })
     }
@@ -376,7 +379,8 @@ pub fn ordered_objects(scene: &Scene) -> (Vec<(usize, GpuObject)>, u32) {
 
 impl GpuScene {
     /// naga_oil shader defs for the features the scene uses: AREA_LIGHTS, SUN, SUN_DISC, SKY,
-    /// SPECULAR (a mirror or a dielectric), CHECKER. The Cornell box compiles with
+    /// SPECULAR (a mirror or a dielectric), CHECKER, and CAUSTIC (`caustics = true` with a
+    /// directional light and a specular object: the light tracer, see tracer/caustic.rs). The Cornell box compiles with
     /// AREA_LIGHTS alone: none of the other features' code is in its pipeline.
     pub fn shader_defs(&self) -> Vec<(&'static str, illum_gpu::shader::Def)> {
         self.defs.iter().map(|&d| (d, illum_gpu::shader::Def::Bool(true))).collect()

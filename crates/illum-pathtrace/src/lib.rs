@@ -40,4 +40,4 @@ pub use shaders::{
     GENERIC_TRAVERSAL, GEOMETRY_MODULE, PATHTRACE_SHADER, SAMPLING_MODULES, SCENE_MODULE, SPAWN_MODULE,
     shader_modules,
 };
-pub use tracer::{PathTracer, StepReport};
+pub use tracer::{CausticParams, PathTracer, StepReport, bounding_sphere, fixed_point};

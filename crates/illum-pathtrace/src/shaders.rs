@@ -18,6 +18,10 @@ use crate::{PathTraceError, specialise};
 pub const PATHTRACE_SHADER: ShaderFile = shader_file!("shaders/pathtrace/pathtrace.wgsl");
 /// Scene layout, bindings and ray-shape tests.
 pub const SCENE_MODULE: ShaderFile = shader_file!("shaders/pathtrace/scene.wgsl");
+/// Material kinds and the functions both estimators use to read them.
+pub const SURFACES_MODULE: ShaderFile = shader_file!("shaders/pathtrace/surfaces.wgsl");
+/// The caustic's light tracer (entry point `main`; shader def CAUSTIC).
+pub const CAUSTIC_SHADER: ShaderFile = shader_file!("shaders/pathtrace/caustic.wgsl");
 /// The generic traversal (a loop over the object buffer).
 pub const GENERIC_TRAVERSAL: ShaderFile = shader_file!("shaders/pathtrace/traversal.wgsl");
 
@@ -46,6 +50,7 @@ pub fn shader_modules(scene: &Scene, gpu_scene: &GpuScene, traversal: Traversal)
         Traversal::Generic => GENERIC_TRAVERSAL,
         Traversal::Specialised => specialise::traversal_module(scene, gpu_scene),
     });
+    modules.push(SURFACES_MODULE);
     modules
 }
 
@@ -59,11 +64,25 @@ pub(crate) fn pathtrace_pipeline(
     options: TracerOptions,
 ) -> Result<(wgpu::ComputePipeline, String), PathTraceError> {
     let modules = shader_modules(scene, gpu_scene, options.traversal);
-    let traversal_source = modules.last().expect("a traversal").source.to_string();
+    let traversal_source = modules[modules.len() - 2].source.to_string();
     let mut defs = options.shader_defs();
     defs.extend(gpu_scene.shader_defs());
     let pipeline = shader::compute_pipeline(gpu, &modules, &PATHTRACE_SHADER, &defs, "path-tracing")?;
     Ok((pipeline, traversal_source))
+}
+
+/// The caustic's light-tracing pipeline for `scene` (one with shader def CAUSTIC), built from
+/// the same modules and defs as its path-tracing pipeline.
+pub(crate) fn caustic_pipeline(
+    gpu: &GpuContext,
+    scene: &Scene,
+    gpu_scene: &GpuScene,
+    options: TracerOptions,
+) -> Result<wgpu::ComputePipeline, PathTraceError> {
+    let modules = shader_modules(scene, gpu_scene, options.traversal);
+    let mut defs = options.shader_defs();
+    defs.extend(gpu_scene.shader_defs());
+    Ok(shader::compute_pipeline(gpu, &modules, &CAUSTIC_SHADER, &defs, "caustic light-tracing")?)
 }
 
 #[cfg(test)]
@@ -136,6 +155,15 @@ mod tests {
                         &PATHTRACE_SHADER,
                         &defs,
                     );
+                    if gpu_scene.defs.contains(&"CAUSTIC") {
+                        let mut all = defs.clone();
+                        all.extend(gpu_scene.shader_defs());
+                        compose_and_validate(
+                            &shader_modules(&scene, &gpu_scene, traversal),
+                            &CAUSTIC_SHADER,
+                            &all,
+                        );
+                    }
                 }
             }
         }
@@ -176,6 +204,25 @@ mod tests {
                 &members!(ObjectRecord: kind, material, emitter, padding, a, b, c, d),
             );
         wgsl("Material").assert_matches(size_of::<GpuMaterial>(), &members!(GpuMaterial: albedo, emission));
+        // The caustic's parameters, in a scene that has the light tracer.
+        let whitted =
+            path_tracer_scenes().into_iter().find(|s| s.name == "whitted").expect("scenes/whitted.toml");
+        let gpu_scene = GpuScene::new(&whitted).unwrap_or_else(|e| panic!("{e}"));
+        assert!(
+            gpu_scene.defs.contains(&"CAUSTIC"),
+            "whitted.toml turns the caustic on: {:?}",
+            gpu_scene.defs
+        );
+        let module = compose_and_validate(
+            &shader_modules(&whitted, &gpu_scene, Traversal::Generic),
+            &CAUSTIC_SHADER,
+            &gpu_scene.shader_defs(),
+        );
+        wgsl_struct(&module, "", "CausticParams").expect("struct CausticParams in caustic.wgsl").assert_matches(
+            size_of::<crate::CausticParams>(),
+            &members!(crate::CausticParams: particles, row_stride, frame_base, frame_count, num_discs, seed,
+                pixel_area, area_per_particle, scene_centre, scene_radius, fixed_scale, fixed_cap, disc_area, padding),
+        );
         wgsl("Light").assert_matches(
             size_of::<GpuLight>(),
             &members!(GpuLight: corner, edge_u, edge_v, normal, emission),

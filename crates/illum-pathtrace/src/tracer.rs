@@ -17,7 +17,10 @@ use crate::options::{TracerOptions, Traversal};
 use crate::planner::{BatchPlanner, DEFAULT_TARGET_SECONDS, PassPlan};
 use crate::{Accumulator, PathTraceError, limits, shaders, specialise};
 
+mod caustic;
 mod submit;
+
+pub use caustic::{CausticParams, bounding_sphere, fixed_point};
 
 const TIMED_PASS: &str = "pathtrace";
 
@@ -78,6 +81,8 @@ pub struct PathTracer {
     chunk_aligned: bool,
     /// 2^-k scale of the uploaded emission (see `accumulator::radiance_exponent`).
     radiance_exponent: i32,
+    /// The caustic's light tracer, when the scene asks for it and can have a caustic.
+    caustic: Option<caustic::CausticTracer>,
     /// Wall and GPU seconds spent on submissions since the last reset.
     wall_seconds: f64,
     gpu_seconds: f64,
@@ -162,6 +167,13 @@ impl PathTracer {
                     ),
                 )
             })?;
+        let caustic = caustic::CausticTracer::new(
+            gpu,
+            scene,
+            &gpu_scene,
+            options,
+            [&params_buffer, &objects_buffer, &materials_buffer],
+        )?;
 
         Ok(Self {
             gpu: gpu.clone(),
@@ -188,6 +200,7 @@ impl PathTracer {
             sample_offset: 0,
             chunk_aligned: false,
             radiance_exponent: gpu_scene.radiance_exponent,
+            caustic,
             wall_seconds: 0.0,
             gpu_seconds: 0.0,
         })
@@ -195,6 +208,17 @@ impl PathTracer {
 
     pub fn scene(&self) -> &Scene {
         &self.scene
+    }
+
+    /// Whether the caustic's light tracer runs (`[pathtrace] caustics = true` on a scene with a
+    /// directional light and a mirror or dielectric).
+    pub fn caustics(&self) -> bool {
+        self.caustic.is_some()
+    }
+
+    /// The caustic's shader parameters (fixed-point scale and cap, discs), when it runs.
+    pub fn caustic_params(&self) -> Option<CausticParams> {
+        self.caustic.as_ref().map(|c| c.params())
     }
 
     /// Whether `self` and `other` run the very same compiled pipeline: the context's cache found
@@ -302,8 +326,10 @@ impl PathTracer {
                 ),
             });
         }
-        let resized =
-            (scene.camera.width, scene.camera.height) != (self.scene.camera.width, self.scene.camera.height);
+        // Another resolution, or the caustic turned on or off (another pipeline), builds anew.
+        let resized = (scene.camera.width, scene.camera.height)
+            != (self.scene.camera.width, self.scene.camera.height)
+            || scene.pathtrace.caustics != self.scene.pathtrace.caustics;
         if resized {
             let mut resized = Self::with_options(&self.gpu, scene, self.options)?;
             // What the caller chose and the planner learnt (the cost of a sample) carry over:
@@ -320,6 +346,14 @@ impl PathTracer {
         }
         let gpu_scene = GpuScene::new(scene)?;
         self.base_params = gpu_scene::params(scene, &gpu_scene);
+        // The caustic's parameters follow the camera and the seed.
+        self.caustic = caustic::CausticTracer::new(
+            &self.gpu,
+            scene,
+            &gpu_scene,
+            self.options,
+            [&self.params_buffer, &self.objects_buffer, &self.materials_buffer],
+        )?;
         self.scene = scene.clone();
         self.reset();
         Ok(())
@@ -409,6 +443,9 @@ impl PathTracer {
     /// Discards everything accumulated; the next step starts again at sample 0.
     pub fn reset(&mut self) {
         self.accumulator.reset();
+        if let Some(caustic) = &mut self.caustic {
+            caustic.discard_pass();
+        }
         if let Some(display) = &self.display_sum {
             display.clear(&self.gpu);
         }

@@ -45,6 +45,8 @@
 //! seed = 0
 //! sampling = "cosine"              # or "uniform"
 //! sequence = "independent"         # or "low-discrepancy"
+//! caustics = false                 # true: light tracing from the directional light through
+//!                                  # mirrors and glass onto diffuse surfaces (the caustic)
 //! [raster]                         # the rasterizer
 //! look = "figure"                  # or "enhanced"
 //! pcf_radius = 0.05                # half-width of the soft shadow edge
@@ -141,6 +143,7 @@ pub(crate) struct RawPathTrace {
     pub seed: Int,
     pub sampling: String,
     pub sequence: String,
+    pub caustics: bool,
 }
 
 impl Default for RawPathTrace {
@@ -152,6 +155,7 @@ impl Default for RawPathTrace {
             seed: Int(0),
             sampling: "cosine".to_owned(),
             sequence: "independent".to_owned(),
+            caustics: false,
         }
     }
 }

@@ -2,7 +2,7 @@
 //!
 //! | section | renderer | what |
 //! |---|---|---|
-//! | `[pathtrace]` | path tracer | [`PathTraceSettings`]: spp, bounces, seed, sampling, sequence |
+//! | `[pathtrace]` | path tracer | [`PathTraceSettings`]: spp, bounces, seed, sampling, sequence, caustics |
 //! | `[raster]` | rasterizer | [`RasterSettings`]: look, effect toggles, PCF radius, cube-map size, the figure look's glass mix |
 //! | `[whitted]` | Whitted ray tracer | [`WhittedSettings`]: recursion depth, anti-aliasing pattern |
 //! | `[shading]` | rasterizer and Whitted ray tracer | [`Shading`]: the local Phong model (ambient, highlights, mirror weight) |
@@ -84,6 +84,11 @@ pub struct PathTraceSettings {
     pub seed: u32,
     pub sampling: Sampling,
     pub sequence: Sequence,
+    /// Light tracing for the caustic (`caustics = true`): particles from the directional light
+    /// through mirrors and dielectrics to the first diffuse surface, connected to the camera.
+    /// It covers the paths L S+ D E that next-event estimation cannot find (see
+    /// docs/caustics.md); off by default.
+    pub caustics: bool,
 }
 
 /// The two looks of the rasterizer.

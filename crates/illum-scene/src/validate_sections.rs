@@ -100,7 +100,7 @@ impl Check<'_> {
         let sequence: Sequence = raw.sequence.parse().map_err(|e: crate::ParseValueError| {
             self.invalid("pathtrace.sequence", format!("{:?}", raw.sequence), e.allowed)
         })?;
-        Ok(PathTraceSettings { spp, bounces, seed, sampling, sequence })
+        Ok(PathTraceSettings { spp, bounces, seed, sampling, sequence, caustics: raw.caustics })
     }
 
     /// `bounces` is an integer in 0..=MAX_BOUNCES or exactly the string "unbounded".

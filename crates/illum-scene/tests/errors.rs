@@ -631,3 +631,14 @@ fn overrides_are_validated_and_leave_the_scene_unchanged_on_error() {
         assert_eq!(s, base, "{field}: scene changed despite the error");
     }
 }
+
+#[test]
+fn caustics_is_a_boolean_off_by_default() {
+    assert!(!parse(BASE).unwrap().pathtrace.caustics, "off unless the file turns it on");
+    let s = parse(&edit("seed = 7\n", "seed = 7\ncaustics = true\n")).unwrap();
+    assert!(s.pathtrace.caustics);
+    // A string is a type error at the value, naming what was expected.
+    let text = edit("seed = 7\n", "seed = 7\ncaustics = \"yes\"\n");
+    let (line, column) = position_of(&text, "\"yes\"");
+    expect_syntax(&text, line, column, "expected a boolean");
+}

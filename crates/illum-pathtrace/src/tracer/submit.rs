@@ -22,6 +22,11 @@ impl PathTracer {
         // check_row_fits guarantees max_slots >= width, so at least one chunk fits.
         let max_chunks = u64::from(self.max_chunks).min(self.max_slots / width).max(1);
         let spp = u64::from(plan.spp.max(1)).min(max_chunks * chunk);
+        // The caustic's statistics of one pass must fit their host memory.
+        let spp = match &self.caustic {
+            Some(caustic) => spp.min(u64::from(caustic.max_pass_spp(self.chunk_samples))),
+            None => spp,
+        };
         let chunks = spp.div_ceil(chunk);
         let max_rows = (self.max_slots / (width * chunks)).max(1);
         let rows = u64::from(plan.rows).clamp(1, max_rows);
@@ -69,6 +74,11 @@ impl PathTracer {
         params.sample_count = spp;
         params.chunk_samples = chunk;
         self.gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&params));
+        // The caustic's frames of this pass (traced once, at its first band; after the params
+        // above, whose camera they read).
+        if let Some(caustic) = &mut self.caustic {
+            caustic.prepare_pass(&self.gpu, self.sample_offset + sample_base, spp, chunk)?;
+        }
 
         let bytes = slots * SLOT_BYTES;
         let staging_size = 2 * bytes + self.timer.result_size();
@@ -123,8 +133,15 @@ impl PathTracer {
             self.accumulator.fold(
                 row_offset as usize * width as usize,
                 &sums[range.clone()],
-                &sums_sq[range],
+                &sums_sq[range.clone()],
             );
+            if let Some(caustic) = &self.caustic {
+                caustic.fold(&mut self.accumulator, k, row_offset as usize * width as usize, &sums[range]);
+            }
+        }
+        // The display pass added the camera's samples only: show the accumulator's image.
+        if let (Some(display), Some(_)) = (&self.display_sum, &self.caustic) {
+            display.seed(&self.gpu, &self.accumulator, self.radiance_exponent);
         }
         let gpu_seconds = self.timer.decode(&data[(2 * bytes) as usize..]).map(|timings| timings[0].1 * 1e-3);
 
@@ -134,6 +151,9 @@ impl PathTracer {
         if pass_completed {
             self.spp_done += spp;
             self.pass = None;
+            if let Some(caustic) = &mut self.caustic {
+                caustic.finish_pass(&mut self.accumulator);
+            }
         }
         let wall_seconds = started.elapsed().as_secs_f64();
         self.wall_seconds += wall_seconds;

@@ -1,0 +1,456 @@
+//! The caustic's light tracer on the host (shader `shaders/pathtrace/caustic.wgsl`; the
+//! estimator and its path space are in docs/caustics.md).
+//!
+//! Frame k, N = width x height particles, pairs with sample index k of every pixel: pixel p's
+//! sample k is the camera path's estimate plus frame k's splat at p. Rather than adding the two
+//! per sample on the GPU, each pass traces its frames first (in dispatches of up to
+//! `frames_per_dispatch`), reads each frame back and keeps, per chunk of the pass (the same
+//! groups of sample indices as the camera's f32 chunk sums) and pixel, the f64 sum S1 and sum
+//! of squares S2 of the frames' values. Folding a camera chunk (sum C of n samples) then adds
+//!     sum += S1,   sum of squares += S2 + 2 C S1 / n.
+//! The last term replaces sum_k c_k s_k by its mean over the pairings of the chunk's camera and
+//! caustic values, which has the same expectation n^2 mu_c mu_s / n as the paired sum because
+//! the two estimators are independent. So the accumulator's mean is exactly the two
+//! estimators' sum, and its sample variance is an unbiased estimate of var(c) + var(s): the
+//! error estimate stays honest, and checkpoints, resume, merge and the stop rules work
+//! unchanged. Frames depend only on (seed, particle, frame index), and integer atomics add in
+//! any order to the same result, so the image does not depend on how a render is batched.
+//!
+//! Fixed point: see [`fixed_point`].
+
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+use illum_gpu::{GpuContext, readback, wgpu};
+use illum_scene::{MaterialKind, Scene};
+
+use crate::accumulator::Accumulator;
+use crate::gpu_scene::{GpuScene, GpuShape};
+use crate::options::TracerOptions;
+use crate::{PathTraceError, shaders};
+
+/// Mirrors `struct CausticParams` in caustic.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct CausticParams {
+    pub particles: u32,
+    pub row_stride: u32,
+    pub frame_base: u32,
+    pub frame_count: u32,
+    pub num_discs: u32,
+    pub seed: u32,
+    pub pixel_area: f32,
+    pub area_per_particle: f32,
+    pub scene_centre: [f32; 3],
+    pub scene_radius: f32,
+    pub fixed_scale: f32,
+    pub fixed_cap: f32,
+    pub disc_area: f32,
+    pub padding: u32,
+}
+
+/// Mixed into the scene's seed for the particles, so that particle i of frame k never draws
+/// the random numbers of sample k of pixel i.
+const PARTICLE_SEED_KEY: u32 = 0x5ca0_571c;
+const WORKGROUP: u32 = 64;
+/// Words per pixel of a frame: (lo, hi) for each of three channels.
+const WORDS_PER_PIXEL: u64 = 6;
+/// The most bytes one dispatch's frames take (and the most host memory one pass's chunk
+/// statistics may take, below).
+const SPLAT_BYTES: u64 = 64 << 20;
+/// Host bytes per pixel and chunk of a pass: S1 and S2, three f64 each.
+pub(crate) const PASS_BYTES_PER_PIXEL_CHUNK: u64 = 48;
+/// The most host memory one pass's caustic statistics may take.
+pub(crate) const PASS_BYTES: u64 = 256 << 20;
+
+/// The bounding sphere (centre, radius) of a shape, in f32 (what the GPU tests against).
+pub fn bounding_sphere(shape: &GpuShape) -> (Vec3, f32) {
+    match *shape {
+        GpuShape::Aabb { min, max } => (0.5 * (min + max), 0.5 * (max - min).length()),
+        GpuShape::Box { local_min, local_max, cos, sin, offset } => {
+            let c = 0.5 * (local_min + local_max);
+            let centre = Vec3::new(cos * c.x + sin * c.z, c.y, -sin * c.x + cos * c.z) + offset;
+            (centre, 0.5 * (local_max - local_min).length())
+        }
+        GpuShape::Quad { corner, edge_u, edge_v } => {
+            let radius = 0.5 * (edge_u + edge_v).length().max((edge_u - edge_v).length());
+            (corner + 0.5 * (edge_u + edge_v), radius)
+        }
+        GpuShape::Sphere { center, radius } => (center, radius),
+    }
+}
+
+/// The fixed-point scale S (a power of two) and cap for frames of `particles` particles whose
+/// typical splat is `reference` (in the GPU's scaled radiance).
+///
+/// Each particle adds to one pixel once, as q = round(v S) < cap, cap = 2^(64 - ceil(log2 N))
+/// (particles at or above it are dropped and counted). A frame's pixel sum is then below
+/// N cap <= 2^64: the two-word (64-bit) sum cannot overflow, for any scene, sun or particle.
+/// S puts the reference splat at cap / 2^24: a particle may be 2^24 times brighter than the
+/// reference (the floor 4096 times nearer the eye, say) before it is dropped, and the reference
+/// splat has 64 - ceil(log2 N) - 24 bits (22 at 512 x 512: relative rounding 2^-23, below f32's
+/// own). The scale follows the sun's irradiance, so a very bright sun changes nothing but S.
+pub fn fixed_point(particles: u64, reference: f64) -> (f32, f32) {
+    let bits = 64 - (particles.max(1) as f64).log2().ceil() as i32;
+    let cap = 2f64.powi(bits);
+    let exponent = if reference > 0.0 && reference.is_finite() {
+        ((cap / 2f64.powi(24) / reference).log2().floor() as i32).clamp(-120, 120)
+    } else {
+        0
+    };
+    (2f32.powi(exponent), cap as f32)
+}
+
+/// One pass's caustic statistics: per chunk and pixel, S1 and S2 of its frames.
+struct CausticPass {
+    first_sample: u32,
+    spp: u32,
+    chunk: u32,
+    sum: Vec<[f64; 3]>,
+    sum_sq: Vec<[f64; 3]>,
+    dropped: u64,
+}
+
+pub(crate) struct CausticTracer {
+    pipeline: wgpu::ComputePipeline,
+    params_buffer: wgpu::Buffer,
+    splat: wgpu::Buffer,
+    staging: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+    base: CausticParams,
+    frames_per_dispatch: u32,
+    groups: (u32, u32),
+    pixels: usize,
+    /// What a fixed-point unit is worth in true radiance: 2^radiance_exponent / S.
+    unit: f64,
+    pass: Option<CausticPass>,
+}
+
+impl CausticTracer {
+    /// The light tracer for `scene`, or `None` when its pipeline has no CAUSTIC def (caustics
+    /// off, no directional light or no specular object).
+    pub(crate) fn new(
+        gpu: &GpuContext,
+        scene: &Scene,
+        gpu_scene: &GpuScene,
+        options: TracerOptions,
+        scene_buffers: [&wgpu::Buffer; 3],
+    ) -> Result<Option<Self>, PathTraceError> {
+        if !gpu_scene.defs.contains(&"CAUSTIC") {
+            return Ok(None);
+        }
+        let sun = scene.directional_light.expect("CAUSTIC needs a directional light");
+        let camera = scene.camera;
+        let pixels = camera.width as usize * camera.height as usize;
+        let particles = pixels as u64;
+        let frame_bytes = WORDS_PER_PIXEL * 4 * particles + 4;
+        let limits = gpu.device.limits();
+        let max_binding = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+        if frame_bytes > max_binding {
+            return Err(PathTraceError::Unsupported {
+                scene: scene.name.clone(),
+                message: format!(
+                    "pathtrace.caustics = true at camera.width x camera.height = {} x {}: one frame of the caustic \
+                     (24 bytes per pixel) needs {frame_bytes} bytes, over the device's storage binding limit of \
+                     {max_binding}; render smaller or set caustics = false",
+                    camera.width, camera.height
+                ),
+            });
+        }
+        let frames_per_dispatch =
+            (SPLAT_BYTES.min(max_binding) / frame_bytes).clamp(1, crate::CHUNK_SAMPLES as u64) as u32;
+
+        let specular = |material: u32| {
+            matches!(
+                scene.materials[material as usize].kind,
+                MaterialKind::Mirror { .. } | MaterialKind::Dielectric { .. }
+            )
+        };
+        let discs: Vec<[f32; 4]> = gpu_scene
+            .objects
+            .iter()
+            .filter(|o| !o.emitter && specular(o.material))
+            .map(|o| {
+                let (c, r) = bounding_sphere(&o.shape);
+                [c.x, c.y, c.z, r]
+            })
+            .collect();
+        let disc_area: f32 = discs.iter().map(|d| std::f32::consts::PI * d[3] * d[3]).sum();
+        let spheres: Vec<(Vec3, f32)> = gpu_scene.objects.iter().map(|o| bounding_sphere(&o.shape)).collect();
+        let scene_centre = spheres.iter().map(|s| s.0).sum::<Vec3>() / spheres.len() as f32;
+        let scene_radius = spheres.iter().map(|(c, r)| (*c - scene_centre).length() + r).fold(0.0, f32::max);
+
+        let basis = scene.camera.basis();
+        let pixel_area = (2.0 * basis.aspect * basis.tan_half_fov / camera.width as f32)
+            * (2.0 * basis.tan_half_fov / camera.height as f32);
+        // The reference splat: a particle of the brightest channel's flux landing at the
+        // distance of the nearest specular object, facing the eye on the axis.
+        let scale = 2f64.powi(-gpu_scene.radiance_exponent);
+        let flux_density = f64::from(sun.irradiance.max_element()) * scale;
+        let nearest = discs
+            .iter()
+            .map(|d| {
+                f64::from((Vec3::new(d[0], d[1], d[2]) - scene.camera.eye).length()).max(f64::from(d[3]))
+            })
+            .fold(f64::INFINITY, f64::min);
+        let reference = flux_density * f64::from(disc_area)
+            / particles as f64
+            / std::f64::consts::PI
+            / (f64::from(pixel_area) * nearest * nearest);
+        let (fixed_scale, fixed_cap) = fixed_point(particles, reference);
+
+        let groups_total = (particles as u32).div_ceil(WORKGROUP);
+        let gx = groups_total.min(limits.max_compute_workgroups_per_dimension);
+        let gy = groups_total.div_ceil(gx);
+        let base = CausticParams {
+            particles: particles as u32,
+            row_stride: gx * WORKGROUP,
+            frame_base: 0,
+            frame_count: 0,
+            num_discs: discs.len() as u32,
+            seed: scene.pathtrace.seed ^ PARTICLE_SEED_KEY,
+            pixel_area,
+            area_per_particle: disc_area / particles as f32,
+            scene_centre: scene_centre.to_array(),
+            scene_radius,
+            fixed_scale,
+            fixed_cap,
+            disc_area,
+            padding: 0,
+        };
+        let pipeline = shaders::caustic_pipeline(gpu, scene, gpu_scene, options)?;
+        let device = &gpu.device;
+        let splat_size = frame_bytes * u64::from(frames_per_dispatch);
+        let (params_buffer, discs_buffer, splat, staging) =
+            gpu.scoped("allocating the caustic's buffers", || {
+                (
+                    device.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some("caustic params"),
+                        size: std::mem::size_of::<CausticParams>() as u64,
+                        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                        mapped_at_creation: false,
+                    }),
+                    illum_gpu::buffers::storage_buffer(device, "caustic discs", bytemuck::cast_slice(&discs)),
+                    device.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some("caustic splats"),
+                        size: splat_size,
+                        usage: wgpu::BufferUsages::STORAGE
+                            | wgpu::BufferUsages::COPY_SRC
+                            | wgpu::BufferUsages::COPY_DST,
+                        mapped_at_creation: false,
+                    }),
+                    device.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some("caustic staging"),
+                        size: splat_size,
+                        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                        mapped_at_creation: false,
+                    }),
+                )
+            })?;
+        let layout = pipeline.get_bind_group_layout(0);
+        let [params, objects, materials] = scene_buffers;
+        let bind_group = gpu.scoped("binding the caustic's buffers", || {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("caustic"),
+                layout: &layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: objects.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 2, resource: materials.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 6, resource: params_buffer.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 7, resource: discs_buffer.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 8, resource: splat.as_entire_binding() },
+                ],
+            })
+        })?;
+        Ok(Some(CausticTracer {
+            pipeline,
+            params_buffer,
+            splat,
+            staging,
+            bind_group,
+            base,
+            frames_per_dispatch,
+            groups: (gx, gy),
+            pixels,
+            unit: 2f64.powi(gpu_scene.radiance_exponent) / f64::from(fixed_scale),
+            pass: None,
+        }))
+    }
+
+    /// The parameters the shader gets (for the layout test and the overflow tests).
+    pub(crate) fn params(&self) -> CausticParams {
+        self.base
+    }
+
+    /// The most samples per pixel one pass may have so that its chunk statistics fit
+    /// [`PASS_BYTES`] (at least one chunk).
+    pub(crate) fn max_pass_spp(&self, chunk: u32) -> u32 {
+        let chunks = (PASS_BYTES / (PASS_BYTES_PER_PIXEL_CHUNK * self.pixels as u64)).max(1);
+        (chunks * u64::from(chunk)).min(u64::from(u32::MAX)) as u32
+    }
+
+    /// Traces the frames of the pass of `spp` samples from absolute sample index `first_sample`
+    /// (chunks of `chunk`), unless they are the ones already held.
+    pub(crate) fn prepare_pass(
+        &mut self,
+        gpu: &GpuContext,
+        first_sample: u32,
+        spp: u32,
+        chunk: u32,
+    ) -> Result<(), PathTraceError> {
+        if self.pass.as_ref().is_some_and(|p| (p.first_sample, p.spp, p.chunk) == (first_sample, spp, chunk))
+        {
+            return Ok(());
+        }
+        self.pass = None;
+        let chunks = spp.div_ceil(chunk) as usize;
+        let mut pass = CausticPass {
+            first_sample,
+            spp,
+            chunk,
+            sum: vec![[0.0; 3]; chunks * self.pixels],
+            sum_sq: vec![[0.0; 3]; chunks * self.pixels],
+            dropped: 0,
+        };
+        let words_per_frame = WORDS_PER_PIXEL as usize * self.pixels;
+        let mut done = 0u32;
+        while done < spp {
+            let count = self.frames_per_dispatch.min(spp - done);
+            let params = CausticParams { frame_base: first_sample + done, frame_count: count, ..self.base };
+            gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&params));
+            let bytes = (words_per_frame as u64 + 1) * 4 * u64::from(count);
+            let mut encoder = gpu
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("caustic frames") });
+            encoder.clear_buffer(&self.splat, 0, Some(bytes));
+            {
+                let mut compute = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("caustic"),
+                    timestamp_writes: None,
+                });
+                compute.set_pipeline(&self.pipeline);
+                compute.set_bind_group(0, &self.bind_group, &[]);
+                compute.dispatch_workgroups(self.groups.0, self.groups.1, count);
+            }
+            encoder.copy_buffer_to_buffer(&self.splat, 0, &self.staging, 0, bytes);
+            gpu.queue.submit([encoder.finish()]);
+            let data = readback::read_mapped(gpu, &self.staging, bytes, "reading back caustic frames")?;
+            let words: &[u32] = bytemuck::cast_slice(&data);
+            for f in 0..count as usize {
+                let relative = done as usize + f;
+                let offset = (relative / chunk as usize) * self.pixels;
+                let frame = &words[f * words_per_frame..(f + 1) * words_per_frame];
+                for (p, w) in frame.chunks_exact(WORDS_PER_PIXEL as usize).enumerate() {
+                    for c in 0..3 {
+                        let q = (u64::from(w[2 * c + 1]) << 32) | u64::from(w[2 * c]);
+                        if q != 0 {
+                            let v = q as f64 * self.unit;
+                            pass.sum[offset + p][c] += v;
+                            pass.sum_sq[offset + p][c] += v * v;
+                        }
+                    }
+                }
+                pass.dropped += u64::from(words[count as usize * words_per_frame + f]);
+            }
+            done += count;
+        }
+        self.pass = Some(pass);
+        Ok(())
+    }
+
+    /// Adds the held pass's chunk `k` for the band's pixels `first_pixel..` to the accumulator,
+    /// beside the camera's chunk sums `camera` just folded for them (see the module
+    /// documentation for the cross term).
+    pub(crate) fn fold(
+        &self,
+        accumulator: &mut Accumulator,
+        k: usize,
+        first_pixel: usize,
+        camera: &[[f32; 4]],
+    ) {
+        let pass = self.pass.as_ref().expect("prepare_pass before fold");
+        let frames = (pass.chunk * (k as u32 + 1)).min(pass.spp) - pass.chunk * k as u32;
+        let range = k * self.pixels + first_pixel..k * self.pixels + first_pixel + camera.len();
+        accumulator.fold_independent(
+            first_pixel,
+            camera,
+            &pass.sum[range.clone()],
+            &pass.sum_sq[range],
+            frames,
+        );
+    }
+
+    /// Forgets the held pass (its frames belong to a render that was reset).
+    pub(crate) fn discard_pass(&mut self) {
+        self.pass = None;
+    }
+
+    /// Ends the held pass: its dropped particles are counted once, and its memory freed.
+    pub(crate) fn finish_pass(&mut self, accumulator: &mut Accumulator) {
+        if let Some(pass) = self.pass.take() {
+            accumulator.add_dropped(pass.dropped);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The no-overflow argument: N particles, each below the cap, sum below 2^64; the reference
+    /// splat sits 2^24 below the cap (within a factor 2, S being a power of two), for one pixel
+    /// up to 2^28 particles and references from a dim to a blinding sun.
+    #[test]
+    fn the_fixed_point_cannot_overflow_and_keeps_headroom() {
+        for particles in [1u64, 2, 3, 1000, 512 * 512, 1 << 24, (1 << 28) - 1] {
+            for reference in [1e-30, 1e-6, 0.37, 3.0, 1e6, 1e20] {
+                let (scale, cap) = fixed_point(particles, reference);
+                assert_eq!(scale.to_bits() & 0x007f_ffff, 0, "{scale} is a power of two");
+                assert_eq!(cap.to_bits() & 0x007f_ffff, 0, "{cap} is a power of two");
+                // N cap <= 2^64: the largest total of a frame's pixel fits the two words.
+                assert!(particles as f64 * f64::from(cap) <= 2f64.powi(64), "N {particles}, cap {cap}");
+                // Every q below the cap splits exactly into two words.
+                assert!(f64::from(cap) <= 2f64.powi(64));
+                let q = reference * f64::from(scale);
+                let target = f64::from(cap) / 2f64.powi(24);
+                // (S is an f32: beyond 2^120 it stops growing, and a light of 1e-30 keeps
+                // fewer bits, still about 20.)
+                let clamped = scale == 2f32.powi(120);
+                assert!(
+                    q <= target && (q > 0.5 * target || clamped),
+                    "N {particles}, reference {reference}: q {q}, target {target}"
+                );
+            }
+        }
+        // A reference of zero (no light) or not a number gives scale 1, not infinity.
+        assert_eq!(fixed_point(100, 0.0).0, 1.0);
+        assert_eq!(fixed_point(100, f64::NAN).0, 1.0);
+    }
+
+    #[test]
+    fn bounding_spheres_contain_their_shapes() {
+        let quad = GpuShape::Quad {
+            corner: Vec3::ZERO,
+            edge_u: Vec3::new(2.0, 0.0, 0.0),
+            edge_v: Vec3::new(1.0, 0.0, 3.0),
+        };
+        let (c, r) = bounding_sphere(&quad);
+        for p in [Vec3::ZERO, Vec3::new(2.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 3.0), Vec3::new(3.0, 0.0, 3.0)] {
+            assert!((p - c).length() <= r * (1.0 + 1e-6), "{p} outside ({c}, {r})");
+        }
+        let (cos, sin) = (0.5f32.sqrt(), 0.5f32.sqrt());
+        let boxed = GpuShape::Box {
+            local_min: Vec3::ZERO,
+            local_max: Vec3::new(1.0, 2.0, 3.0),
+            cos,
+            sin,
+            offset: Vec3::new(5.0, 0.0, 1.0),
+        };
+        let (c, r) = bounding_sphere(&boxed);
+        for i in 0..8 {
+            let l = Vec3::new((i & 1) as f32, 2.0 * ((i >> 1) & 1) as f32, 3.0 * ((i >> 2) & 1) as f32);
+            let p = Vec3::new(cos * l.x + sin * l.z, l.y, -sin * l.x + cos * l.z) + Vec3::new(5.0, 0.0, 1.0);
+            assert!((p - c).length() <= r * (1.0 + 1e-6), "corner {p} outside ({c}, {r})");
+        }
+    }
+}

@@ -1,0 +1,286 @@
+// The caustic estimator (shader def CAUSTIC): light tracing from the directional light for the
+// paths L S+ D E that the camera path tracer cannot find with a delta sun. One invocation traces
+// one particle of one frame; frame k pairs with sample index k of every pixel (tracer/caustic.rs
+// folds it in). The mathematics is in docs/caustics.md; in short:
+//
+// Emission: a disc of radius R_k about the centre of each specular object's bounding sphere,
+// perpendicular to the light's direction w, covers every line of light that can meet it. A
+// particle picks disc k with probability A_k / A (A = sum of the disc areas), a point x uniform
+// on it, so its density on the plane is c(x) / A (c(x) = number of discs covering x), and
+// carries the flux (irradiance across the plane) x A / (c(x) N), N particles per frame. A sun
+// disc first draws w uniform in its cone: irradiance across the plane L 2 pi (1 - cos_max).
+//
+// Transport: a mirror multiplies the flux by its reflectance; a dielectric reflects with
+// probability F (exact Fresnel), else refracts, weight 1, no eta^2 factor: flux is the adjoint
+// quantity of radiance, and the power an interface passes on is (1 - F) of what arrives
+// whatever the indices (Veach 1997, 5.2). A particle whose first hit is diffuse is discarded:
+// it carries an L D path, which next-event estimation counts.
+//
+// Connection at the first diffuse point x (albedo rho, normal n toward the particle's side)
+// to the pinhole at the eye: the pixel's value is the mean radiance over its rectangle of area
+// A_p on the image plane at distance 1, so a particle of flux Phi adds
+//     Phi rho / pi x cos(theta_x) / (A_p cos^3(theta) r^2)
+// (the pinhole's importance 1 / (A_p cos^4 theta) times the geometry term cos theta cos theta_x
+// / r^2) to the pixel through which the eye sees x, if nothing hides x from the eye.
+//
+// Splatting: WGSL has no float atomics, so each value is rounded to a 64-bit fixed-point
+// integer q = round(v S) (S = caustic.fixed_scale, a power of two) added as two u32 words with
+// an explicit carry: exact integer addition, in any order, so the image does not depend on the
+// scheduling. A particle whose q would reach caustic.fixed_cap = 2^64 / 2^ceil(log2 N) is
+// dropped and counted instead; with at most N particles per frame, each adding to one pixel
+// once, no pixel's sum can then reach 2^64 (the proof is in docs/caustics.md).
+
+#import illum::constants::{PI, TWO_PI, INV_PI}
+#import illum::sampler::{Sampler, sampler_new, sample_1d}
+#import illum::sampling::{sample_uniform_cone, sample_disc, to_world}
+#import illum::spawn::spawn_point
+#import illum::rtcore::geometry::{NO_HIT, Surface}
+#import illum::pathtrace::scene::{params, objects, materials}
+#import illum::rtcore::traversal::{closest_hit, surface_at}
+#import illum::pathtrace::surfaces::{MATERIAL_CHECKER, MATERIAL_DIELECTRIC, MATERIAL_MIRROR, fresnel}
+#ifdef CHECKER
+#import illum::pathtrace::surfaces::checker_albedo
+#endif
+
+const UNBOUNDED: u32 = 0xffffffffu;
+// Russian roulette as the camera paths have it (pathtrace.wgsl).
+const RR_START: u32 = 3u;
+const RR_MAX_SURVIVAL: f32 = 0.95;
+const UNBOUNDED_DEPTH_CAP: u32 = 1024u;
+const TWO_POW_32: f32 = 4294967296.0;
+
+// Mirrored by tracer/caustic.rs's CausticParams.
+struct CausticParams {
+    // Particles per frame (N) and the invocations per row of the dispatch.
+    particles: u32,
+    row_stride: u32,
+    // The sample index of frame 0 of this dispatch, and how many frames it traces.
+    frame_base: u32,
+    frame_count: u32,
+    num_discs: u32,
+    seed: u32,
+    // A_p: a pixel's area on the image plane at distance 1.
+    pixel_area: f32,
+    // A / N: the plane area each particle stands for (times 1 / c(x)).
+    area_per_particle: f32,
+    // The whole scene's bounding sphere: particles start outside it.
+    scene_centre: vec3<f32>,
+    scene_radius: f32,
+    fixed_scale: f32,
+    fixed_cap: f32,
+    // A: the discs' total area.
+    disc_area: f32,
+    padding: u32,
+}
+
+@group(0) @binding(6) var<uniform> caustic: CausticParams;
+// Per specular object: the centre and radius of its bounding sphere.
+@group(0) @binding(7) var<storage, read> discs: array<vec4<f32>>;
+// Frame f's pixel p, channel c: words (lo, hi) at 6 (f N_pixels + p) + 2 c; after the frames,
+// one counter of dropped particles per frame.
+@group(0) @binding(8) var<storage, read_write> splat: array<atomic<u32>>;
+
+fn max3(v: vec3<f32>) -> f32 {
+    return max(max(v.x, v.y), v.z);
+}
+
+// Adds value v >= 0 to pixel `pixel` of frame `frame` in fixed point; false if too large
+// (or not a number) to be added safely.
+fn fits(v: vec3<f32>) -> bool {
+    let q = floor(v * caustic.fixed_scale + 0.5);
+    return all(q < vec3<f32>(caustic.fixed_cap));
+}
+
+fn splat_add(frame: u32, pixel: u32, v: vec3<f32>) {
+    let pixels = params.width * params.height;
+    let base = 6u * (frame * pixels + pixel);
+    for (var c = 0u; c < 3u; c++) {
+        let q = floor(v[c] * caustic.fixed_scale + 0.5);
+        // q < 2^64 is an integer in f32: its high word is exact, and so is the remainder
+        // q - hi 2^32 (a multiple of q's ulp below 2^32 <= q, or q itself when q < 2^32).
+        let hi = u32(floor(q / TWO_POW_32));
+        let lo = u32(q - f32(hi) * TWO_POW_32);
+        if (lo != 0u) {
+            let old = atomicAdd(&splat[base + 2u * c], lo);
+            // old + lo wrapped past 2^32 exactly when old > 2^32 - 1 - lo: carry one.
+            let carry = select(0u, 1u, old > 0xffffffffu - lo);
+            if (hi + carry != 0u) {
+                atomicAdd(&splat[base + 2u * c + 1u], hi + carry);
+            }
+        } else if (hi != 0u) {
+            atomicAdd(&splat[base + 2u * c + 1u], hi);
+        }
+    }
+}
+
+fn drop_particle(frame: u32) {
+    atomicAdd(&splat[6u * caustic.frame_count * params.width * params.height + frame], 1u);
+}
+
+// The particle of outgoing factor `weight` (flux rho / pi) at surface s, seen from the eye.
+fn connect(frame: u32, s: Surface, weight: vec3<f32>) {
+    let to_eye = params.eye - s.p;
+    let r2 = dot(to_eye, to_eye);
+    let w = to_eye / sqrt(r2);
+    let cos_x = dot(s.n, w);
+    let cos_theta = -dot(w, params.forward);
+    if (!(cos_x > 0.0 && cos_theta > 0.0)) {
+        return;
+    }
+    // Where the eye's ray toward x crosses the image plane at distance 1, in pixels.
+    let sx = -dot(w, params.right) / cos_theta;
+    let sy = -dot(w, params.up) / cos_theta;
+    let px = (sx / (params.aspect * params.tan_half_fov) + 1.0) * 0.5 * f32(params.width);
+    let py = (1.0 - sy / params.tan_half_fov) * 0.5 * f32(params.height);
+    if (!(px >= 0.0 && px < f32(params.width) && py >= 0.0 && py < f32(params.height))) {
+        return;
+    }
+    let ix = min(u32(px), params.width - 1u);
+    let iy = min(u32(py), params.height - 1u);
+    // Visibility: the nearest surface (emitters included: a camera ray would see them) from x
+    // toward the eye must lie beyond it.
+    let origin = spawn_point(s.p, s.n, s.err);
+    let segment = params.eye - origin;
+    let distance = length(segment);
+    let hit = closest_hit(origin, segment / distance);
+    if (hit.index != NO_HIT && hit.t < distance) {
+        return;
+    }
+    let v = weight * (cos_x / (caustic.pixel_area * cos_theta * cos_theta * cos_theta * r2));
+    if (!fits(v)) {
+        drop_particle(frame);
+        return;
+    }
+    splat_add(frame, iy * params.width + ix, v);
+}
+
+// Whether a particle that has scattered `scatterings` times may scatter again with `weight`:
+// the camera path E D S^k L it mirrors takes k + 1 continuation rays, so with `bounces` = n
+// a particle may scatter k <= n - 1 times. Unbounded: Russian roulette from RR_START on.
+fn may_scatter(scatterings: u32, throughput: ptr<function, vec3<f32>>, weight: vec3<f32>, sampler: ptr<function, Sampler>) -> bool {
+    if (params.bounces != UNBOUNDED) {
+        if (scatterings + 2u > params.bounces) {
+            return false;
+        }
+    } else {
+        if (scatterings >= UNBOUNDED_DEPTH_CAP) {
+            return false;
+        }
+        if (scatterings >= RR_START) {
+            let q = min(max3(*throughput * weight), RR_MAX_SURVIVAL);
+            if (!(sample_1d(sampler) < q)) {
+                return false;
+            }
+            *throughput /= q;
+        }
+    }
+    *throughput *= weight;
+    return max3(*throughput) > 0.0;
+}
+
+@compute @workgroup_size(64, 1, 1)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let particle = gid.y * caustic.row_stride + gid.x;
+    let frame = gid.z;
+    if (particle >= caustic.particles || frame >= caustic.frame_count) {
+        return;
+    }
+    var sampler = sampler_new(caustic.seed, particle, caustic.frame_base + frame);
+    let u1 = sample_1d(&sampler);
+    let u2 = sample_1d(&sampler);
+#ifdef SUN_DISC
+    let one_minus_cos_max = params.sun.w;
+    let to_light = normalize(to_world(params.sun.xyz, sample_uniform_cone(one_minus_cos_max, u1, u2)));
+    // L 2 pi (1 - cos_max) with L = E / (pi (1 - cos_max^2)): 2 E / (1 + cos_max), finite for
+    // any disc (params.sun.w is 1 - cos_max, see sample_uniform_cone).
+    let flux_density = params.sun_irradiance.xyz * (2.0 / (2.0 - one_minus_cos_max));
+#else
+    let to_light = params.sun.xyz;
+    let flux_density = params.sun_irradiance.xyz;
+#endif
+    let d0 = -to_light;
+    // A disc with probability proportional to its area, a point uniform on it.
+    let pick = sample_1d(&sampler) * caustic.disc_area;
+    var k = 0u;
+    var acc = 0.0;
+    for (; k + 1u < caustic.num_discs; k++) {
+        acc += PI * discs[k].w * discs[k].w;
+        if (pick < acc) {
+            break;
+        }
+    }
+    let u3 = sample_1d(&sampler);
+    let u4 = sample_1d(&sampler);
+    let x = sample_disc(discs[k].xyz, d0, discs[k].w, u3, u4);
+    var covering = 0u;
+    for (var j = 0u; j < caustic.num_discs; j++) {
+        let m = x - discs[j].xyz;
+        let across = m - d0 * dot(m, d0);
+        covering += select(0u, 1u, dot(across, across) <= discs[j].w * discs[j].w);
+    }
+    var throughput = flux_density * (caustic.area_per_particle / f32(max(covering, 1u)));
+    var o = x + d0 * (dot(caustic.scene_centre - x, d0) - caustic.scene_radius - 1.0);
+    var d = d0;
+    var scatterings = 0u;
+    loop {
+        let hit = closest_hit(o, d);
+        if (hit.index == NO_HIT) {
+            return;
+        }
+        let obj = objects[hit.index];
+        if (obj.emitter != 0u) {
+            return;
+        }
+        var s = surface_at(obj, o + hit.t * d);
+        let front = dot(s.n, d) < 0.0;
+        if (!front) {
+            s.n = -s.n;
+        }
+        let m = materials[obj.material];
+        let kind = u32(m.albedo.w);
+        if (kind == MATERIAL_MIRROR) {
+            if (!may_scatter(scatterings, &throughput, m.albedo.xyz, &sampler)) {
+                return;
+            }
+            d = reflect(d, s.n);
+            o = spawn_point(s.p, s.n, s.err);
+        } else if (kind == MATERIAL_DIELECTRIC) {
+            if (!may_scatter(scatterings, &throughput, vec3<f32>(1.0), &sampler)) {
+                return;
+            }
+            let ior = m.emission.w;
+            let eta = select(ior, 1.0 / ior, front);
+            let cos_i = -dot(d, s.n);
+            let k2 = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+            var reflects = k2 < 0.0;
+            if (!reflects) {
+                let cos_t = sqrt(k2);
+                reflects = sample_1d(&sampler) < fresnel(cos_i, cos_t, eta);
+                if (!reflects) {
+                    // Flux crosses without an eta^2 factor (see the top of this file).
+                    d = normalize(eta * d + (eta * cos_i - cos_t) * s.n);
+                    o = spawn_point(s.p, -s.n, s.err);
+                }
+            }
+            if (reflects) {
+                d = reflect(d, s.n);
+                o = spawn_point(s.p, s.n, s.err);
+            }
+        } else {
+            if (scatterings == 0u) {
+                return;
+            }
+#ifdef CHECKER
+            var albedo = m.albedo.xyz;
+            if (kind == MATERIAL_CHECKER) {
+                albedo = checker_albedo(hit.index, m, s.p);
+            }
+#else
+            let albedo = m.albedo.xyz;
+#endif
+            connect(frame, s, throughput * albedo * INV_PI);
+            return;
+        }
+        scatterings += 1u;
+    }
+}
