@@ -10,9 +10,10 @@
 //! - the rasterizer (if it can draw the scene): the `figure` look, the `enhanced` look, and the
 //!   enhanced look with each effect off in turn;
 //! - the Whitted ray tracer at each depth of `--depths`;
-//! - the path tracer at each spp of `--spp-list` (the scene's bounces), and at each bounce
-//!   count of `--bounce-list` with `--bounce-spp` samples (on the Cornell box this is the
-//!   classic "Whitted against path tracing, bounce by bounce").
+//! - the path tracer at each spp of `--spp-list` (the scene's bounces), without and (where the
+//!   scene has a caustic: a sun and a mirror or glass) with the caustic estimator, and at each
+//!   bounce count of `--bounce-list` with `--bounce-spp` samples (on the Cornell box this is
+//!   the classic "Whitted against path tracing, bounce by bounce").
 //!
 //! Each row's time is the median of `--frames` frames: the rasterizer's wall time per frame as
 //! a viewer pays it (no readback) and its GPU time from timestamp queries; the Whitted ray
@@ -22,7 +23,8 @@
 //! 0.06 to 0.08 ms whatever the work, 1 or 16 spp, so they do not measure it.)
 //!
 //! The truth is a path-traced render with `--truth-spp` samples per pixel (`--truth-bounces`,
-//! by default unbounded; cosine sampling; its own seed), cached in DIR under a name derived from everything that
+//! by default unbounded; the caustic estimator where the scene has a caustic; cosine sampling;
+//! its own seed), cached in DIR under a name derived from everything that
 //! changes it, or the EXR given by `--truth`. The regions come from the Whitted ray tracer's
 //! object-ID image (`illum::regions`).
 //!
@@ -45,7 +47,7 @@ use illum::raster::{Options, RasterRenderer, RasterScene};
 use illum::reference::{Reference, cached_reference, load_reference};
 use illum::regions::{Comparison, Regions, compare, flip_heat_map};
 use illum::report::{csv_text, markdown_table, write_text};
-use illum::scene::{Bounces, Effects, Look, MAX_WHITTED_DEPTH, Scene};
+use illum::scene::{Bounces, Effects, Look, MAX_WHITTED_DEPTH, MaterialKind, Scene};
 use illum::whitted::WhittedTracer;
 
 #[derive(Parser, Debug)]
@@ -98,8 +100,11 @@ struct Args {
 enum Series {
     Raster,
     Whitted,
-    /// The path tracer at the scene's bounces, more samples per pixel each rung.
+    /// The path tracer at the scene's bounces, more samples per pixel each rung, without the
+    /// caustic estimator.
     PathTraceSpp,
+    /// The same with the caustic estimator (light tracing, `[pathtrace] caustics`).
+    PathTraceCaustics,
     /// The path tracer at a fixed spp, more bounces each rung.
     PathTraceBounces,
 }
@@ -151,6 +156,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         None => {
             let mut truth_scene = scene.clone();
             truth_scene.pathtrace.bounces = args.truth_bounces;
+            truth_scene.pathtrace.caustics = has_caustic(&scene);
             cached_reference(&gpu, &truth_scene, args.truth_spp, &args.out, "ladder truth")?
         }
     };
@@ -170,13 +176,24 @@ fn run(args: Args) -> anyhow::Result<()> {
         rungs.push(whitted_rung(&gpu, &scene, depth, args.frames)?);
         print_rung(rungs.last().expect("pushed"));
     }
-    for &spp in &args.spp_list {
-        let setting = (spp, scene.pathtrace.bounces);
-        rungs.push(pathtrace_rung(&gpu, &scene, setting, Series::PathTraceSpp, args.frames.min(3))?);
-        print_rung(rungs.last().expect("pushed"));
+    // Without and with the caustic estimator, where the scene has a caustic (a sun and a mirror
+    // or glass to focus it); the truth has it.
+    let caustic_options: &[bool] = if has_caustic(&scene) { &[false, true] } else { &[false] };
+    for &caustics in caustic_options {
+        let mut variant = scene.clone();
+        variant.pathtrace.caustics = caustics;
+        let series = if caustics { Series::PathTraceCaustics } else { Series::PathTraceSpp };
+        for &spp in &args.spp_list {
+            let setting = (spp, scene.pathtrace.bounces);
+            rungs.push(pathtrace_rung(&gpu, &variant, setting, series, args.frames.min(3))?);
+            print_rung(rungs.last().expect("pushed"));
+        }
     }
+    let mut with_caustic = scene.clone();
+    with_caustic.pathtrace.caustics = has_caustic(&scene);
     for &bounces in args.bounce_list.iter().filter(|_| args.bounce_spp > 0) {
-        rungs.push(pathtrace_rung(&gpu, &scene, (args.bounce_spp, bounces), Series::PathTraceBounces, 1)?);
+        let setting = (args.bounce_spp, bounces);
+        rungs.push(pathtrace_rung(&gpu, &with_caustic, setting, Series::PathTraceBounces, 1)?);
         print_rung(rungs.last().expect("pushed"));
     }
     let rows: Vec<Row> = rungs
@@ -193,6 +210,16 @@ fn run(args: Args) -> anyhow::Result<()> {
         Header { scene: &scene, adapter: &gpu.adapter_info.name, truth_spp, truth_bounces, truth_error };
     write_outputs(&args, &header, &truth, &regions, &rows)?;
     Ok(())
+}
+
+/// Whether the scene has a caustic for the light tracer: a directional light and a mirror or
+/// glass that can focus it.
+fn has_caustic(scene: &Scene) -> bool {
+    let specular = scene
+        .materials
+        .iter()
+        .any(|m| matches!(m.kind, MaterialKind::Dielectric { .. } | MaterialKind::Mirror { .. }));
+    scene.directional_light.is_some() && specular
 }
 
 /// The scene's aspect with 320 pixels on the longer side, unless the flags say otherwise.
@@ -293,7 +320,10 @@ fn pathtrace_rung(
     Ok(Rung {
         renderer: "pathtrace",
         series,
-        settings: format!("{spp} spp, bounces {bounces}"),
+        settings: format!(
+            "{spp} spp, bounces {bounces}{}",
+            if scene.pathtrace.caustics { ", caustic estimator" } else { "" }
+        ),
         wall_ms: median(&mut ms),
         gpu_ms: None,
         image: tracer.accumulator().mean_image(),
@@ -424,6 +454,7 @@ fn write_outputs(
             ("rasterizer", Series::Raster, Style::Markers),
             ("Whitted ray tracer", Series::Whitted, Style::Markers),
             ("path tracer, more spp", Series::PathTraceSpp, Style::Joined),
+            ("path tracer + caustic estimator, more spp", Series::PathTraceCaustics, Style::Joined),
             ("path tracer, more bounces", Series::PathTraceBounces, Style::Joined),
         ];
         let lines: Vec<Line> = series
