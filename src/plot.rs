@@ -121,7 +121,7 @@ pub fn log_log(path: &Path, title: &str, x_label: &str, y_label: &str, lines: &[
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .label_font(("sans-serif", 14))
-            .position(SeriesLabelPosition::UpperRight)
+            .position(SeriesLabelPosition::LowerLeft)
             .draw()?;
         root.present()?;
     }
