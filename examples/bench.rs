@@ -20,7 +20,7 @@ use illum::cli::{self, SceneArgs};
 use illum::image::median;
 use illum::pathtrace::{PathTracer, TracerOptions, Traversal};
 use illum::raster::RasterScene;
-use illum::raster::{Look, Options, bench_frames};
+use illum::raster::{Look, Motion, Options, bench_frames};
 use illum::scene::{Bounces, Scene};
 
 #[derive(Parser, Debug)]
@@ -130,23 +130,26 @@ fn bench_raster(gpu: &illum::gpu::GpuContext, runs: usize) -> anyhow::Result<()>
     let path = cli::resolve_scene_path(std::path::Path::new("scenes/whitted.toml"));
     let scene = RasterScene::load(&path)?;
     let options = Options::all_on(Look::Enhanced);
-    let report = bench_frames(gpu, &scene, 1280, 720, &options, 5, (12 * runs.max(1)) as u32)?;
     println!();
     println!(
-        "| Whitted look-alike, 1280x720, every effect on | median frame (ms) | fps | shadow (ms) | cube maps (ms) | main (ms) |"
+        "| Whitted look-alike, 1280x720, enhanced, every effect on | median frame (ms) | fps | shadow (ms) | cube maps (ms) | main (ms) |"
     );
     println!("|---|---|---|---|---|---|");
-    let passes = report.median_pass_ms();
-    let pass = |f: fn(&illum::raster::PassTimes) -> f64| {
-        passes.as_ref().map_or("n/a".to_owned(), |p| format!("{:.2}", f(p)))
-    };
-    println!(
-        "| enhanced look | {:.2} | {:.1} | {} | {} | {} |",
-        report.median_frame_ms(),
-        report.fps(),
-        pass(|p| p.shadow_ms),
-        pass(|p| p.cube_ms),
-        pass(|p| p.main_ms),
-    );
+    for motion in [Motion::CameraOrbit, Motion::SceneChange] {
+        let report = bench_frames(gpu, &scene, 1280, 720, &options, motion, 5, (12 * runs.max(1)) as u32)?;
+        let passes = report.median_pass_ms();
+        let pass = |f: fn(&illum::raster::PassTimes) -> f64| {
+            passes.as_ref().map_or("n/a".to_owned(), |p| format!("{:.2}", f(p)))
+        };
+        println!(
+            "| {} | {:.2} | {:.1} | {} | {} | {} |",
+            motion.describe(),
+            report.median_frame_ms(),
+            report.fps(),
+            pass(|p| p.shadow_ms),
+            pass(|p| p.cube_ms),
+            pass(|p| p.main_ms),
+        );
+    }
     Ok(())
 }

@@ -6,7 +6,9 @@
 //! ```
 //! Renders `frames` frames (after `warmup` untimed ones) without reading them back and prints the
 //! median frame time, frames per second, and the median GPU time of each pass (shadow map, the
-//! twelve cube-map faces together, main pass with MSAA resolve) from timestamp queries. With no
+//! cube-map faces together, main pass with MSAA resolve) from timestamp queries, twice: with the
+//! camera orbiting an unchanged scene (a viewer's steady state: the shadow and cube maps are
+//! reused) and with the scene changing every frame (every map made again). With no
 //! flags: `scenes/whitted.toml` at 1280 x 720, enhanced look, every effect on. Timings are never
 //! asserted in tests; the figures are in docs/performance-raster.md.
 
@@ -16,7 +18,7 @@ use anyhow::Context;
 use clap::Parser;
 use illum::cli;
 use illum::raster::RasterScene;
-use illum::raster::{Look, bench_frames};
+use illum::raster::{Look, Motion, bench_frames};
 use illum::raster_cli::RasterArgs;
 
 #[derive(Parser, Debug)]
@@ -62,14 +64,28 @@ fn run(args: Args) -> anyhow::Result<()> {
     }
     anyhow::ensure!(args.frames >= 1, "--frames = 0: must be at least 1");
     let gpu = cli::gpu()?;
-    let report = bench_frames(&gpu, &scene, args.width, args.height, &options, args.warmup, args.frames)
+    for motion in [Motion::CameraOrbit, Motion::SceneChange] {
+        bench_one(&gpu, &scene, &args, &options, motion)?;
+    }
+    Ok(())
+}
+
+fn bench_one(
+    gpu: &illum::gpu::GpuContext,
+    scene: &RasterScene,
+    args: &Args,
+    options: &illum::raster::Options,
+    motion: Motion,
+) -> anyhow::Result<()> {
+    let report = bench_frames(gpu, scene, args.width, args.height, options, motion, args.warmup, args.frames)
         .context("benchmarking the rasterizer")?;
     println!(
-        "{} {}x{} look {} (shadow map {}^2, cube faces {}^2, {} frames): median frame {:.2} ms = {:.1} fps (min {:.2}, max {:.2})",
+        "{} {}x{} look {}, {} (shadow map {}^2, cube faces {}^2, {} frames): median frame {:.2} ms = {:.1} fps (min {:.2}, max {:.2})",
         scene.name,
         report.width,
         report.height,
         report.options.look,
+        motion.describe(),
         report.shadow_map_size,
         report.cube_size,
         report.frame_ms.len(),

@@ -263,7 +263,9 @@ fn raster_rungs(gpu: &GpuContext, scene: &Scene, frames: u32, rungs: &mut Vec<Ru
     let mut renderer = RasterRenderer::new(gpu, &raster_scene, w, h)?;
     for (label, options) in settings {
         let image = renderer.render(&options)?;
-        let report = illum::raster::bench_frames(gpu, &raster_scene, w, h, &options, 2, frames)?;
+        // The whole frame, every map made again: what the ray tracers pay too.
+        let motion = illum::raster::Motion::SceneChange;
+        let report = illum::raster::bench_frames(gpu, &raster_scene, w, h, &options, motion, 2, frames)?;
         rungs.push(Rung {
             renderer: "raster",
             series: Series::Raster,

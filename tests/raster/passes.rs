@@ -134,3 +134,38 @@ fn a_metal_that_mirrors_nothing_looks_as_without_reflection() {
     assert_eq!(count(&names, "cube metal"), 6, "{names:?}");
     assert!(differing(&mirrored, &switched_off) > 40, "the mirror shows nothing");
 }
+
+/// The shadow map and the cube maps do not depend on the camera: the frame after a camera move
+/// reuses them (it records the main pass alone) and is the same picture, value for value, as a
+/// fresh renderer's frame from that camera. Moving a sphere records the captures again, and
+/// that frame too equals a fresh renderer's.
+#[test]
+fn a_camera_move_reuses_shadow_and_cube_maps_and_changes_nothing_else() {
+    let gpu = common::gpu();
+    let options = Options::all_on(Look::Enhanced);
+    let s = scene();
+    let mut r = illum::raster::RasterRenderer::new(gpu, &s, WIDTH, HEIGHT).unwrap();
+    assert!(r.plan(&options).passes().len() > 1, "the first frame makes its maps");
+    r.render(&options).unwrap();
+    assert_eq!(r.plan(&options).pass_names(), ["main"], "an unchanged scene reuses them");
+
+    let fresh = |scene: &RasterScene| {
+        illum::raster::RasterRenderer::new(gpu, scene, WIDTH, HEIGHT).unwrap().render(&options).unwrap()
+    };
+    let mut moved = s.clone();
+    moved.camera.eye += glam::Vec3::new(0.4, 0.5, -0.3);
+    r.set_scene(&moved).unwrap();
+    assert_eq!(r.plan(&options).pass_names(), ["main"], "a camera move reuses them");
+    let reused = r.render(&options).unwrap();
+    assert_eq!(reused.pixels, fresh(&moved).pixels, "reused maps changed the picture");
+    assert!(differing(&reused, &fresh(&s)) > 100, "the camera move changed nothing: no test");
+
+    let mut shifted = moved.clone();
+    shifted.metal.as_mut().expect("a metal sphere").center.y += 0.25;
+    r.set_scene(&shifted).unwrap();
+    assert!(r.plan(&options).pass_names().len() > 1, "a moved sphere needs new maps");
+    assert_eq!(r.render(&options).unwrap().pixels, fresh(&shifted).pixels);
+    // Other options are other maps (the figure look has no metal cube map).
+    let figure = Options::all_on(Look::Figure);
+    assert!(r.plan(&figure).pass_names().len() > 1);
+}

@@ -1,8 +1,10 @@
 //! Frame timing for the benchmark: wall time per frame and GPU time per pass.
 //!
-//! A frame is timed from the start of recording to the moment the GPU reports it finished (its
-//! pass times are mapped back), without reading the image back: what an interactive viewer
-//! pays per frame. Warm-up frames first absorb pipeline and allocation costs.
+//! A frame is timed from the change that starts it (a camera step, a moved sphere) to the moment
+//! the GPU reports it finished (its pass times are mapped back), without reading the image
+//! back: what an interactive viewer pays per frame. Warm-up frames first absorb pipeline and
+//! allocation costs. [`Motion`] says what changes between frames: the camera alone (a viewer
+//! being dragged: the shadow and cube maps are reused) or the scene too (every map made again).
 
 use std::time::Instant;
 
@@ -12,12 +14,49 @@ use illum_image::median;
 
 use crate::{Options, PassTimes, RasterError, RasterRenderer};
 
+/// What changes from one frame to the next.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Motion {
+    /// The camera orbits its target by half a degree a frame; the scene stays.
+    CameraOrbit,
+    /// The camera orbits and the metal sphere (or else the glass one) moves up and down: the
+    /// shadow map and every cube map are made again each frame.
+    SceneChange,
+}
+
+impl Motion {
+    pub fn describe(self) -> &'static str {
+        match self {
+            Motion::CameraOrbit => "camera moving, scene unchanged",
+            Motion::SceneChange => "scene changing every frame",
+        }
+    }
+
+    /// `scene` at frame `i`.
+    fn frame(self, scene: &RasterScene, i: u32) -> RasterScene {
+        let mut s = scene.clone();
+        let angle = (i as f32 * 0.5).to_radians();
+        let offset = s.camera.eye - s.camera.target;
+        s.camera.eye = s.camera.target + glam::Quat::from_rotation_y(angle) * offset;
+        if self == Motion::SceneChange {
+            let bob = 0.05 * (i as f32 * 0.3).sin() + 0.06;
+            if let Some(metal) = &mut s.metal {
+                metal.center.y += bob;
+            } else if let Some(glass) = &mut s.glass {
+                glass.center.y += bob;
+            }
+        }
+        s
+    }
+}
+
 /// What [`bench_frames`] measured.
 #[derive(Clone, Debug)]
 pub struct BenchReport {
     pub width: u32,
     pub height: u32,
     pub options: Options,
+    pub motion: Motion,
     /// Wall time of each measured frame, in milliseconds, in the order they ran.
     pub frame_ms: Vec<f64>,
     /// Per-frame pass times (empty without timestamp queries).
@@ -52,24 +91,29 @@ impl BenchReport {
     }
 }
 
-/// Renders `warmup` untimed frames, then `frames` timed ones, of `scene` at `width` x `height`.
+/// Renders `warmup` untimed frames, then `frames` timed ones, of `scene` at `width` x `height`,
+/// changing it between frames as `motion` says.
+#[allow(clippy::too_many_arguments)]
 pub fn bench_frames(
     gpu: &GpuContext,
     scene: &RasterScene,
     width: u32,
     height: u32,
     options: &Options,
+    motion: Motion,
     warmup: u32,
     frames: u32,
 ) -> Result<BenchReport, RasterError> {
     let mut renderer = RasterRenderer::new(gpu, scene, width, height)?;
-    for _ in 0..warmup {
+    for i in 0..warmup {
+        renderer.set_scene(&motion.frame(scene, i))?;
         renderer.draw(options)?;
     }
     let mut frame_ms = Vec::with_capacity(frames as usize);
     let mut pass_ms = Vec::with_capacity(frames as usize);
-    for _ in 0..frames {
+    for i in warmup..warmup + frames {
         let started = Instant::now();
+        renderer.set_scene(&motion.frame(scene, i))?;
         let times = renderer.draw(options)?;
         frame_ms.push(started.elapsed().as_secs_f64() * 1e3);
         pass_ms.extend(times);
@@ -78,6 +122,7 @@ pub fn bench_frames(
         width,
         height,
         options: *options,
+        motion,
         frame_ms,
         pass_ms,
         shadow_map_size: renderer.shadow_map_resolution().0,

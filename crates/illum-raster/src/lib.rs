@@ -47,7 +47,7 @@ pub mod uniforms;
 pub mod variants;
 pub mod views;
 
-pub use bench::{BenchReport, bench_frames};
+pub use bench::{BenchReport, Motion, bench_frames};
 pub use error::RasterError;
 pub use illum_scene::{Effects, Look};
 pub use limits::check_device_limits;

@@ -7,6 +7,9 @@
 //! - The glass sphere's cube maps (fine and coarse) exist for the glass alone: no glass, none.
 //! - The metal sphere's cube map is read only by its mirror: the enhanced look with reflection on
 //!   and a mirror fraction above zero.
+//! - The shadow map and the cube maps do not depend on the camera: when the previous frame made
+//!   them for the same scene and options, the frame reuses them ([`FramePlan::reuse_views`]),
+//!   so a viewer whose camera moves over an unchanged scene draws the main pass alone.
 
 use illum_scene::Look;
 
@@ -74,6 +77,9 @@ pub struct FramePlan {
     pub metal_shadowed: bool,
     /// The metal sphere's cube map is captured and mirrored.
     pub metal_cube: bool,
+    /// The shadow map and cube maps of the previous frame are this frame's (same scene but for
+    /// the camera, same options): their passes are not recorded.
+    pub reuse_views: bool,
 }
 
 impl FramePlan {
@@ -90,21 +96,23 @@ impl FramePlan {
             glass_shadowed: shadow_pass && fit.glass_shadowed,
             metal_shadowed: shadow_pass && fit.metal_shadowed,
             metal_cube,
+            reuse_views: false,
         }
     }
 
     /// The passes of the frame, in recording order: the shadow pass, the glass sphere's cube
     /// map and its coarse level, the metal sphere's cube map, the main pass; each only when the
-    /// frame needs it. The frame walks this list.
+    /// frame needs it, and only the main pass when the frame reuses the others' results. The
+    /// frame walks this list.
     pub fn passes(&self) -> Vec<Pass> {
         let mut passes = Vec::new();
-        if self.shadow_pass {
+        if self.shadow_pass && !self.reuse_views {
             passes.push(Pass::Shadow);
         }
-        if self.glass {
+        if self.glass && !self.reuse_views {
             passes.extend([Pass::Capture(Cube::Glass), Pass::Capture(Cube::GlassCoarse)]);
         }
-        if self.metal_cube {
+        if self.metal_cube && !self.reuse_views {
             passes.push(Pass::Capture(Cube::Metal));
         }
         passes.push(Pass::Main);
@@ -208,5 +216,10 @@ mod tests {
         assert!(!p.draws(Pass::Capture(Cube::Glass)).glass && p.draws(Pass::Capture(Cube::Glass)).metal);
         assert!(p.draws(Pass::Capture(Cube::Metal)).glass && !p.draws(Pass::Capture(Cube::Metal)).metal);
         assert_eq!(p.pass_names().len(), 1 + 3 * 6 + 1);
+        // Reusing the views leaves the main pass alone, still reading the shadow map.
+        let reused = FramePlan { reuse_views: true, ..p };
+        assert_eq!(reused.passes(), [Pass::Main]);
+        assert_eq!(reused.pass_names(), ["main"]);
+        assert_eq!(reused.draws(Pass::Main), p.draws(Pass::Main));
     }
 }

@@ -53,6 +53,33 @@ pub struct RasterRenderer {
     timer: PassTimer,
     timer_plan: Option<FramePlan>,
     staging: Option<wgpu::Buffer>,
+    /// What the shadow map and cube maps hold now, if a recorded frame made them (see
+    /// [`ViewsKey`]).
+    views: Option<ViewsKey>,
+}
+
+/// Everything the shadow map and the cube maps depend on: the scene but for its camera (the
+/// captures are made from the light and the spheres' centres, with their own clip planes) and
+/// the frame's options and plan.
+#[derive(Clone, Debug, PartialEq)]
+struct ViewsKey {
+    scene: RasterScene,
+    options: Options,
+    plan: FramePlan,
+}
+
+impl ViewsKey {
+    fn new(scene: &RasterScene, options: &Options, plan: FramePlan) -> Self {
+        let camera = illum_scene::Camera {
+            eye: glam::Vec3::ZERO,
+            target: glam::Vec3::ZERO,
+            up: glam::Vec3::ZERO,
+            vfov_deg: 0.0,
+            width: 0,
+            height: 0,
+        };
+        ViewsKey { scene: RasterScene { camera, ..scene.clone() }, options: *options, plan }
+    }
 }
 
 impl RasterRenderer {
@@ -84,6 +111,7 @@ impl RasterRenderer {
             timer: PassTimer::new(gpu, &[]),
             timer_plan: None,
             staging: None,
+            views: None,
         })
     }
 
@@ -125,9 +153,11 @@ impl RasterRenderer {
         let cube_size = scene.quality.cube_size;
         if fit.size != self.shadow_map.size {
             self.shadow_map = ShadowMap::new(&self.gpu, fit.size)?;
+            self.views = None;
         }
         if cube_size != self.cubes.glass.size {
             self.cubes = CubeSet::new(&self.gpu, cube_size)?;
+            self.views = None;
         }
         self.texture_groups = TextureGroups::new(
             &self.gpu,
@@ -141,9 +171,13 @@ impl RasterRenderer {
         Ok(())
     }
 
-    /// The passes a frame with `options` records (see [`FramePlan`]).
+    /// The passes the next frame with `options` records (see [`FramePlan`]): without the shadow
+    /// and capture passes when the last frame made their results for this scene (camera aside)
+    /// and these options.
     pub fn plan(&self, options: &Options) -> FramePlan {
-        FramePlan::new(&self.scene, options, &self.shadow_fit)
+        let fresh = FramePlan::new(&self.scene, options, &self.shadow_fit);
+        let reuse_views = self.views.as_ref() == Some(&ViewsKey::new(&self.scene, options, fresh));
+        FramePlan { reuse_views, ..fresh }
     }
 
     /// Changes the output size (checked against the device's limits).
@@ -243,6 +277,7 @@ impl RasterRenderer {
         }
         let main = Target::Main { samples };
         let plan = self.plan(options);
+        let views = ViewsKey::new(&self.scene, options, FramePlan { reuse_views: false, ..plan });
         if self.timer_plan != Some(plan) {
             let names = plan.pass_names();
             let name_refs: Vec<&str> = names.iter().map(String::as_str).collect();
@@ -314,6 +349,7 @@ impl RasterRenderer {
             background: self.scene.background.to_array(),
         };
         resources.record(&mut encoder);
+        self.views = Some(views);
         Ok(encoder)
     }
 

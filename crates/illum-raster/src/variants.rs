@@ -137,6 +137,7 @@ mod tests {
             glass_shadowed: shadow_pass && shadowed,
             metal_shadowed: shadow_pass && shadowed,
             metal_cube: options.look == Look::Enhanced && options.effects.reflection,
+            reuse_views: false,
         }
     }
 
