@@ -132,7 +132,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         return render_whitted(&WhittedRequest {
             scene: &args.scene,
             settings: &args.settings,
-            whitted: &args.whitted,
+            args: &args.whitted,
             outputs: &args.outputs,
             encoding: args.encoding,
             exposure: args.exposure,
@@ -142,24 +142,21 @@ fn run(args: Args) -> anyhow::Result<()> {
     let whitted_flags = args.whitted.given();
     if !whitted_flags.is_empty() {
         anyhow::bail!(
-            "{}: {} only to the Whitted ray tracer (--renderer whitted)",
+            "{}: {} {} only to the Whitted ray tracer (--renderer whitted)",
             args.scene.display(),
-            if whitted_flags.len() == 1 {
-                format!("{} applies", whitted_flags[0])
-            } else {
-                format!("{} apply", whitted_flags.join(", "))
-            }
+            whitted_flags.join(", "),
+            cli::verb(whitted_flags.len())
         );
     }
     if renderer == RendererKind::Raster {
         return render_raster(&RasterRequest {
             scene: &args.scene,
             settings: &args.settings,
-            raster: &args.raster,
+            args: &args.raster,
             outputs: &args.outputs,
             encoding: args.encoding,
             exposure: args.exposure,
-            path_tracer_flags: path_tracer_only,
+            other_flags: path_tracer_only,
         });
     }
     args.raster.reject_for_path_tracer(&args.scene)?;

@@ -4,6 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use clap::Args;
+use illum_image::{Encoding, ExrMetadata, RgbImage32, save_exr, save_png};
 pub use illum_scene::resolve_scene_path;
 use illum_scene::{Bounces, Overrides, Sampling, Scene};
 
@@ -34,6 +35,16 @@ pub struct SceneArgs {
 }
 
 impl SceneArgs {
+    /// The path tracer's flags among these that were given: an error for the other renderers.
+    pub fn path_tracer_flags(&self) -> Vec<&'static str> {
+        given_flags(&[
+            (self.spp.is_some(), "--spp"),
+            (self.bounces.is_some(), "--bounces"),
+            (self.seed.is_some(), "--seed"),
+            (self.sampling.is_some(), "--sampling"),
+        ])
+    }
+
     pub fn overrides(&self) -> Overrides {
         Overrides {
             spp: self.spp,
@@ -97,6 +108,76 @@ pub fn given_flags(flags: &[(bool, &'static str)]) -> Vec<&'static str> {
     flags.iter().filter_map(|&(given, flag)| given.then_some(flag)).collect()
 }
 
+/// "applies" for one flag, "apply" for several.
+pub fn verb(flags: usize) -> &'static str {
+    if flags == 1 { "applies" } else { "apply" }
+}
+
+/// What the `render` example passes to the path of a renderer that draws one image (the
+/// rasterizer, the Whitted ray tracer): the scene, the shared flags, the renderer's own flags
+/// `A`, the outputs and the PNG settings.
+pub struct RenderRequest<'a, A> {
+    pub scene: &'a Path,
+    pub settings: &'a SceneArgs,
+    /// The renderer's own flags.
+    pub args: &'a A,
+    /// Output files; empty: `out/NAME-SUFFIX.png` (see [`RenderRequest::checked_outputs`]).
+    pub outputs: &'a [PathBuf],
+    /// PNG encoding; `None`: linear, as the assignment's figure 1 was written.
+    pub encoding: Option<Encoding>,
+    /// PNG exposure in stops; `None`: 0.
+    pub exposure: Option<f32>,
+    /// Flags of the other renderers that were given (e.g. "--target-error", "--look"): an error.
+    pub other_flags: Vec<&'static str>,
+}
+
+impl<A> RenderRequest<'_, A> {
+    /// The flags this renderer refuses that were given: the path tracer's scene settings, then
+    /// `other_flags`.
+    pub fn refused_flags(&self) -> Vec<&'static str> {
+        let mut flags = self.settings.path_tracer_flags();
+        flags.extend(&self.other_flags);
+        flags
+    }
+
+    /// The outputs (`out/NAME-SUFFIX.png` when none is given), each checked before any
+    /// rendering (see [`check_outputs`]).
+    pub fn checked_outputs(&self, name: &str, suffix: &str) -> anyhow::Result<Vec<PathBuf>> {
+        let outputs = if self.outputs.is_empty() {
+            vec![PathBuf::from(format!("out/{name}-{suffix}.png"))]
+        } else {
+            self.outputs.to_vec()
+        };
+        let png_flags =
+            given_flags(&[(self.encoding.is_some(), "--encoding"), (self.exposure.is_some(), "--exposure")]);
+        check_outputs(&outputs, &png_flags)?;
+        Ok(outputs)
+    }
+
+    /// Writes `image` to every output (PNG with the request's exposure and encoding, linear by
+    /// default; EXR with `metadata`), then prints `summary` and the files written.
+    pub fn write(
+        &self,
+        outputs: &[PathBuf],
+        image: &RgbImage32,
+        metadata: &ExrMetadata,
+        summary: &str,
+    ) -> anyhow::Result<()> {
+        let (exposure, encoding) = (self.exposure.unwrap_or(0.0), self.encoding.unwrap_or(Encoding::Linear));
+        for output in outputs {
+            match output_format(output)? {
+                OutputFormat::Png => save_png(output, image, exposure, encoding)?,
+                OutputFormat::Exr => save_exr(output, image, metadata)?,
+            }
+        }
+        println!("{summary}");
+        for output in outputs {
+            println!("wrote {}", output.display());
+        }
+        Ok(())
+    }
+}
+
 /// Parses `--sample-range A..B`: sample indices A to B-1, A < B.
 pub fn sample_range_arg(text: &str) -> Result<std::ops::Range<u32>, String> {
     let (a, b) = text
@@ -125,8 +206,9 @@ pub fn check_outputs(outputs: &[PathBuf], png_flags: &[&str]) -> anyhow::Result<
     }
     if !any_png && !png_flags.is_empty() {
         anyhow::bail!(
-            "{} only to PNG output (EXR files are linear and never scaled), and no -o file is a .png",
-            png_flags.join(", ").to_owned() + if png_flags.len() == 1 { " applies" } else { " apply" }
+            "{} {} only to PNG output (EXR files are linear and never scaled), and no -o file is a .png",
+            png_flags.join(", "),
+            verb(png_flags.len())
         );
     }
     for output in outputs {

@@ -9,11 +9,10 @@ use anyhow::bail;
 use clap::Args;
 use illum_gpu::GpuContext;
 
-use crate::cli::{OutputFormat, output_format};
-use illum_image::{Encoding, ExrMetadata, save_exr, save_png};
+use illum_image::ExrMetadata;
 use illum_raster::{Look, Options, PassTimes, RasterRenderer, RasterScene};
 
-use crate::cli::{self, SceneArgs};
+use crate::cli::{self, RenderRequest};
 
 /// Flags that apply to rasterizer scenes only. Each effect is on unless the scene file or one of
 /// these flags turns it off.
@@ -46,7 +45,7 @@ pub struct RasterArgs {
 impl RasterArgs {
     /// The flags given, as typed.
     pub fn given(&self) -> Vec<&'static str> {
-        [
+        cli::given_flags(&[
             (self.look.is_some(), "--look"),
             (self.no_shadows, "--no-shadows"),
             (self.no_pcf, "--no-pcf"),
@@ -54,10 +53,7 @@ impl RasterArgs {
             (self.no_reflection, "--no-reflection"),
             (self.no_fresnel, "--no-fresnel"),
             (self.no_msaa, "--no-msaa"),
-        ]
-        .into_iter()
-        .filter_map(|(given, flag)| given.then_some(flag))
-        .collect()
+        ])
     }
 
     /// The scene file's look and effects, changed by the flags.
@@ -85,49 +81,21 @@ impl RasterArgs {
                  scenes/whitted.toml); this render uses the path tracer",
                 scene.display(),
                 given.join(", "),
-                verb(given.len())
+                cli::verb(given.len())
             );
         }
         Ok(())
     }
 }
 
-/// "applies" for one flag, "apply" for several.
-fn verb(flags: usize) -> &'static str {
-    if flags == 1 { "applies" } else { "apply" }
-}
-
 /// Everything the `render` example passes for a rasterizer scene.
-pub struct RasterRequest<'a> {
-    pub scene: &'a Path,
-    pub settings: &'a SceneArgs,
-    pub raster: &'a RasterArgs,
-    /// Output files; empty: `out/NAME-LOOK.png`.
-    pub outputs: &'a [PathBuf],
-    /// PNG encoding; `None`: linear, as the assignment's figure was written.
-    pub encoding: Option<Encoding>,
-    /// PNG exposure in stops; `None`: 0.
-    pub exposure: Option<f32>,
-    /// Path-tracer-only flags of the example that were given (e.g. "--target-error"): an error.
-    pub path_tracer_flags: Vec<&'static str>,
-}
-
-/// The path tracer's flags in [`SceneArgs`] that were given.
-fn path_tracer_settings(settings: &SceneArgs) -> Vec<&'static str> {
-    cli::given_flags(&[
-        (settings.spp.is_some(), "--spp"),
-        (settings.bounces.is_some(), "--bounces"),
-        (settings.seed.is_some(), "--seed"),
-        (settings.sampling.is_some(), "--sampling"),
-    ])
-}
+pub type RasterRequest<'a> = RenderRequest<'a, RasterArgs>;
 
 /// Loads the scene, applies `--width` / `--height`, and checks every flag and output name,
 /// before any GPU work.
 fn prepare(request: &RasterRequest) -> anyhow::Result<(RasterScene, Options, Vec<PathBuf>)> {
     let path = cli::resolve_scene_path(request.scene);
-    let mut flags = path_tracer_settings(request.settings);
-    flags.extend(&request.path_tracer_flags);
+    let flags = request.refused_flags();
     if !flags.is_empty() {
         bail!(
             "{}: {} {} only to the path tracer; this render uses the rasterizer (--renderer raster), \
@@ -135,22 +103,13 @@ fn prepare(request: &RasterRequest) -> anyhow::Result<(RasterScene, Options, Vec
              --no-fresnel, --no-msaa, --width, --height, --encoding, --exposure, -o",
             request.scene.display(),
             flags.join(", "),
-            verb(flags.len())
+            cli::verb(flags.len())
         );
     }
     let mut scene = RasterScene::load(&path)?;
     scene.set_resolution(request.settings.width, request.settings.height, "command line")?;
-    let options = request.raster.options(&scene);
-    let outputs = if request.outputs.is_empty() {
-        vec![PathBuf::from(format!("out/{}-{}.png", scene.name, options.look))]
-    } else {
-        request.outputs.to_vec()
-    };
-    let png_flags = cli::given_flags(&[
-        (request.encoding.is_some(), "--encoding"),
-        (request.exposure.is_some(), "--exposure"),
-    ]);
-    cli::check_outputs(&outputs, &png_flags)?;
+    let options = request.args.options(&scene);
+    let outputs = request.checked_outputs(&scene.name, options.look.as_str())?;
     Ok((scene, options, outputs))
 }
 
@@ -199,7 +158,6 @@ fn render_prepared(
     let mut renderer = RasterRenderer::new(gpu, scene, width, height)?;
     let frame = renderer.render_timed(options)?;
     let seconds = started.elapsed().as_secs_f64();
-    let encoding = request.encoding.unwrap_or(Encoding::Linear);
     let times = frame.pass_times.map(|t: PassTimes| {
         format!(
             "GPU ms of this first (cold) frame: shadow {:.2}, cube {:.2}, main {:.2} (warm figures: raster_bench)",
@@ -218,21 +176,12 @@ fn render_prepared(
             ("adapter".into(), gpu.adapter_info.name.clone()),
         ],
     };
-    for output in outputs {
-        match output_format(output)? {
-            OutputFormat::Png => save_png(output, &frame.image, request.exposure.unwrap_or(0.0), encoding)?,
-            OutputFormat::Exr => save_exr(output, &frame.image, &metadata)?,
-        }
-    }
-    println!(
+    let summary = format!(
         "{}: {width}x{height}, {}, {:.2} s including setup{}",
         scene.name,
         describe(options),
         seconds,
         times.map(|t| format!(", {t}")).unwrap_or_default()
     );
-    for output in outputs {
-        println!("wrote {}", output.display());
-    }
-    Ok(())
+    request.write(outputs, &frame.image, &metadata, &summary)
 }

@@ -1,16 +1,16 @@
 //! The `render` example's path for the Whitted ray tracer (`--renderer whitted`): its flags, and
 //! rendering to PNG / EXR with the same error quality as the other renderers' paths.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::bail;
 use clap::Args;
-use illum_image::{Encoding, ExrMetadata, save_exr, save_png};
+use illum_image::ExrMetadata;
 use illum_scene::{MAX_WHITTED_AA, MAX_WHITTED_DEPTH, Overrides, Scene};
 use illum_whitted::WhittedTracer;
 
-use crate::cli::{self, OutputFormat, SceneArgs, given_flags, output_format};
+use crate::cli::{self, RenderRequest, given_flags};
 
 /// Flags that apply to the Whitted ray tracer only; each overrides the scene's `[whitted]`.
 #[derive(Args, Clone, Debug, Default)]
@@ -33,18 +33,7 @@ impl WhittedArgs {
 }
 
 /// Everything the `render` example passes for the Whitted ray tracer.
-pub struct WhittedRequest<'a> {
-    pub scene: &'a Path,
-    pub settings: &'a SceneArgs,
-    pub whitted: &'a WhittedArgs,
-    /// Output files; empty: `out/NAME-whitted.png`.
-    pub outputs: &'a [PathBuf],
-    /// PNG encoding; `None`: linear, like the rasterizer's (the assignment's figure 1 is linear).
-    pub encoding: Option<Encoding>,
-    pub exposure: Option<f32>,
-    /// Flags of the other renderers that were given (e.g. "--spp", "--look"): an error.
-    pub other_flags: Vec<&'static str>,
-}
+pub type WhittedRequest<'a> = RenderRequest<'a, WhittedArgs>;
 
 /// Checks a flag's value against `min..=max`, in the words of the scene file's errors.
 fn in_range(flag: &str, value: Option<u32>, min: u32, max: u32) -> anyhow::Result<Option<u32>> {
@@ -58,13 +47,7 @@ fn in_range(flag: &str, value: Option<u32>, min: u32, max: u32) -> anyhow::Resul
 
 /// Loads the scene with the flags applied and checks every output, before any GPU work.
 fn prepare(request: &WhittedRequest) -> anyhow::Result<(Scene, Vec<PathBuf>)> {
-    let mut flags = given_flags(&[
-        (request.settings.spp.is_some(), "--spp"),
-        (request.settings.bounces.is_some(), "--bounces"),
-        (request.settings.seed.is_some(), "--seed"),
-        (request.settings.sampling.is_some(), "--sampling"),
-    ]);
-    flags.extend(&request.other_flags);
+    let flags = request.refused_flags();
     if !flags.is_empty() {
         bail!(
             "{}: {} {} to the other renderers; this render uses the Whitted ray tracer \
@@ -72,27 +55,18 @@ fn prepare(request: &WhittedRequest) -> anyhow::Result<(Scene, Vec<PathBuf>)> {
              --exposure, -o",
             request.scene.display(),
             flags.join(", "),
-            if flags.len() == 1 { "applies" } else { "apply" }
+            cli::verb(flags.len())
         );
     }
-    let depth = in_range("--depth", request.whitted.depth, 0, MAX_WHITTED_DEPTH)?;
-    let aa = in_range("--aa", request.whitted.aa, 1, MAX_WHITTED_AA)?;
+    let depth = in_range("--depth", request.args.depth, 0, MAX_WHITTED_DEPTH)?;
+    let aa = in_range("--aa", request.args.aa, 1, MAX_WHITTED_AA)?;
     let mut scene = Scene::load(&cli::resolve_scene_path(request.scene))?;
     let sizes =
         Overrides { width: request.settings.width, height: request.settings.height, ..Default::default() };
     scene.apply_overrides(&sizes, "command line")?;
     scene.whitted.depth = depth.unwrap_or(scene.whitted.depth);
     scene.whitted.aa = aa.unwrap_or(scene.whitted.aa);
-    let outputs = if request.outputs.is_empty() {
-        vec![PathBuf::from(format!("out/{}-whitted.png", scene.name))]
-    } else {
-        request.outputs.to_vec()
-    };
-    let png_flags = given_flags(&[
-        (request.encoding.is_some(), "--encoding"),
-        (request.exposure.is_some(), "--exposure"),
-    ]);
-    cli::check_outputs(&outputs, &png_flags)?;
+    let outputs = request.checked_outputs(&scene.name, "whitted")?;
     Ok((scene, outputs))
 }
 
@@ -113,24 +87,10 @@ pub fn render_whitted(request: &WhittedRequest) -> anyhow::Result<()> {
             ("adapter".into(), gpu.adapter_info.name.clone()),
         ],
     };
-    for output in &outputs {
-        match output_format(output)? {
-            OutputFormat::Png => save_png(
-                output,
-                &image,
-                request.exposure.unwrap_or(0.0),
-                request.encoding.unwrap_or(Encoding::Linear),
-            )?,
-            OutputFormat::Exr => save_exr(output, &image, &metadata)?,
-        }
-    }
     let (w, h) = (scene.camera.width, scene.camera.height);
-    println!(
+    let summary = format!(
         "{}: {w}x{h}, Whitted ray tracer, depth {}, {} x {} rays per pixel, {seconds:.2} s including setup",
         scene.name, scene.whitted.depth, scene.whitted.aa, scene.whitted.aa
     );
-    for output in &outputs {
-        println!("wrote {}", output.display());
-    }
-    Ok(())
+    request.write(&outputs, &image, &metadata, &summary)
 }

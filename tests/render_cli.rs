@@ -33,6 +33,15 @@ fn run(args: &[&str]) -> Output {
     render(args).output().expect("the render example starts")
 }
 
+/// Runs the example with `flags` (words separated by spaces) and `-o` for each of `outputs`.
+fn run_to(flags: &str, outputs: &[&Path]) -> Output {
+    let mut args: Vec<&str> = flags.split_whitespace().collect();
+    for output in outputs {
+        args.extend(["-o", output.to_str().expect("a UTF-8 path")]);
+    }
+    run(&args)
+}
+
 fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()
 }
@@ -106,18 +115,7 @@ fn bad_stop_rules_and_exposures_are_clear_errors() {
 fn a_negative_exposure_is_accepted_as_typed() {
     let dir = tempfile::tempdir().unwrap();
     let png = dir.path().join("dark.png");
-    let out = run(&[
-        "--width",
-        "8",
-        "--height",
-        "8",
-        "--spp",
-        "1",
-        "--exposure",
-        "-1",
-        "-o",
-        png.to_str().unwrap(),
-    ]);
+    let out = run_to("--width 8 --height 8 --spp 1 --exposure -1", &[&png]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     assert!(png.exists());
 }
@@ -147,18 +145,7 @@ fn outputs_are_checked_before_rendering() {
     let plain = dir.path().join("plain");
     std::fs::write(&plain, b"x").unwrap();
     for bad in [directory, plain.join("x.png")] {
-        let out = run(&[
-            "--width",
-            "8",
-            "--height",
-            "8",
-            "--spp",
-            "1",
-            "-o",
-            good.to_str().unwrap(),
-            "-o",
-            bad.to_str().unwrap(),
-        ]);
+        let out = run_to("--width 8 --height 8 --spp 1", &[&good, &bad]);
         assert_no_panic(&out);
         let stderr = text(&out.stderr);
         assert_eq!(out.status.code(), Some(1), "{} was accepted: {stderr}", bad.display());
@@ -175,7 +162,7 @@ fn a_read_only_output_is_refused_and_left_as_it_was() {
     let png = dir.path().join("keep.png");
     std::fs::write(&png, b"precious").unwrap();
     std::fs::set_permissions(&png, std::fs::Permissions::from_mode(0o444)).unwrap();
-    let out = run(&["--width", "8", "--height", "8", "--spp", "1", "-o", png.to_str().unwrap()]);
+    let out = run_to("--width 8 --height 8 --spp 1", &[&png]);
     assert_eq!(out.status.code(), Some(1));
     assert!(text(&out.stderr).contains("read-only"), "{}", text(&out.stderr));
     assert_eq!(std::fs::read(&png).unwrap(), b"precious");
@@ -194,16 +181,7 @@ fn raster_scenes_refuse_path_tracer_flags_and_write_their_own_metadata() {
 
     let dir = tempfile::tempdir().unwrap();
     let exr = dir.path().join("w.exr");
-    let out = run(&[
-        "scenes/whitted.toml",
-        "--width",
-        "32",
-        "--height",
-        "18",
-        "--no-msaa",
-        "-o",
-        exr.to_str().unwrap(),
-    ]);
+    let out = run_to("scenes/whitted.toml --width 32 --height 18 --no-msaa", &[&exr]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     let meta = metadata(&exr);
     assert_eq!(meta.renderer, "raster");
@@ -576,23 +554,10 @@ fn the_whitted_ray_tracer_renders_both_scenes_and_refuses_the_other_renderers_fl
     let dir = tempfile::tempdir().unwrap();
     let exr = dir.path().join("w.exr");
     let png = dir.path().join("w.png");
-    let out = run(&[
-        "scenes/whitted.toml",
-        "--renderer",
-        "whitted",
-        "--width",
-        "32",
-        "--height",
-        "18",
-        "--depth",
-        "3",
-        "--aa",
-        "1",
-        "-o",
-        exr.to_str().unwrap(),
-        "-o",
-        png.to_str().unwrap(),
-    ]);
+    let out = run_to(
+        "scenes/whitted.toml --renderer whitted --width 32 --height 18 --depth 3 --aa 1",
+        &[&exr, &png],
+    );
     assert!(out.status.success(), "{}", text(&out.stderr));
     assert!(png.exists());
     let meta = metadata(&exr);
@@ -600,17 +565,7 @@ fn the_whitted_ray_tracer_renders_both_scenes_and_refuses_the_other_renderers_fl
     assert_eq!((field(&meta, "depth"), field(&meta, "aa")), ("3".to_owned(), "1".to_owned()));
     // The Cornell box too (its light as a point light).
     let cornell = dir.path().join("c.png");
-    let out = run(&[
-        "scenes/cornell.toml",
-        "--renderer",
-        "whitted",
-        "--width",
-        "16",
-        "--height",
-        "16",
-        "-o",
-        cornell.to_str().unwrap(),
-    ]);
+    let out = run_to("scenes/cornell.toml --renderer whitted --width 16 --height 16", &[&cornell]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     // Flags of the other renderers, and out-of-range values, are refused before rendering.
     for (args, expected) in [

@@ -8,7 +8,7 @@
 // already drew and fills in only the rest. A CPU rasterizer pays for a shader's every texture
 // tap on every pixel it shades, so the taps are spent only where a shadow can be.
 
-#import illum::raster::scene::{scene, view, quad_corner, Switches}
+#import illum::raster::scene::{scene, view, quad_corner, Switches, WorldVertex, world_vertex}
 #import illum::raster::lighting::shade_floor
 
 // Set per pipeline (see Switches in scene.wgsl). RECEIVER: draw the receiver parallelogram with
@@ -16,13 +16,8 @@
 override RECEIVER: bool = true;
 override PCF: bool = true;
 
-struct VertexOut {
-    @builtin(position) position: vec4<f32>,
-    @location(0) world: vec3<f32>,
-}
-
 @vertex
-fn vs_main(@builtin(vertex_index) vertex: u32) -> VertexOut {
+fn vs_main(@builtin(vertex_index) vertex: u32) -> WorldVertex {
     let corner = 0.5 * quad_corner(vertex) + vec2<f32>(0.5);
     var xz: vec2<f32>;
     if RECEIVER {
@@ -31,14 +26,11 @@ fn vs_main(@builtin(vertex_index) vertex: u32) -> VertexOut {
         xz = mix(scene.floor_rect.xy, scene.floor_rect.zw, corner);
     }
     let world = vec3<f32>(xz.x, scene.floor_params.x, xz.y);
-    var out: VertexOut;
-    out.position = view.view_proj * vec4<f32>(world, 1.0);
-    out.world = world;
-    return out;
+    return world_vertex(world);
 }
 
 @fragment
-fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
+fn fs_main(in: WorldVertex) -> @location(0) vec4<f32> {
     let tile_coord = (in.world.xz - scene.floor_rect.xy) / scene.floor_params.y;
     // The pixel's footprint in tiles, from screen-space derivatives (taken here, in uniform
     // control flow): it sets the width of the checker's box filter.

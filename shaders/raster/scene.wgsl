@@ -78,6 +78,20 @@ struct View {
 @group(0) @binding(0) var<uniform> scene: Scene;
 @group(0) @binding(1) var<uniform> view: View;
 
+// What the floor's and the spheres' vertex shaders pass on: a world point (on the floor, or on
+// a sphere's billboard) and its clip position in the view.
+struct WorldVertex {
+    @builtin(position) position: vec4<f32>,
+    @location(0) world: vec3<f32>,
+}
+
+fn world_vertex(world: vec3<f32>) -> WorldVertex {
+    var out: WorldVertex;
+    out.position = view.view_proj * vec4<f32>(world, 1.0);
+    out.world = world;
+    return out;
+}
+
 // Centre (xyz) and radius (w) of sphere `index` (SPHERE_GLASS or SPHERE_METAL).
 fn sphere_of(index: u32) -> vec4<f32> {
     if index == SPHERE_GLASS {

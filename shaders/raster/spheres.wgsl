@@ -2,7 +2,7 @@
 // and by the cube-map captures; each pipeline draws one sphere, so a capture leaves out the
 // sphere it is taken from by drawing only the other.
 
-#import illum::raster::scene::{view, sphere_of, view_depth, quad_corner, Switches, SPHERE_GLASS}
+#import illum::raster::scene::{view, sphere_of, view_depth, quad_corner, Switches, SPHERE_GLASS, WorldVertex, world_vertex}
 #import illum::raster::sphere::{billboard_perspective, coverage_mask, visible_point}
 #import illum::raster::lighting::{shade_glass, shade_metal}
 
@@ -17,18 +17,10 @@ override REFLECTION: bool = true;
 override FRESNEL: bool = true;
 override METAL_ENV: bool = false;
 
-struct VertexOut {
-    @builtin(position) position: vec4<f32>,
-    @location(0) world: vec3<f32>,
-}
-
 @vertex
-fn vs_main(@builtin(vertex_index) vertex: u32) -> VertexOut {
+fn vs_main(@builtin(vertex_index) vertex: u32) -> WorldVertex {
     let world = billboard_perspective(sphere_of(SPHERE), view.eye.xyz, quad_corner(vertex));
-    var out: VertexOut;
-    out.position = view.view_proj * vec4<f32>(world, 1.0);
-    out.world = world;
-    return out;
+    return world_vertex(world);
 }
 
 struct FragmentOut {
@@ -41,7 +33,7 @@ struct FragmentOut {
 }
 
 @fragment
-fn fs_main(in: VertexOut) -> FragmentOut {
+fn fs_main(in: WorldVertex) -> FragmentOut {
     let dx = dpdx(in.world);
     let dy = dpdy(in.world);
     let sphere = sphere_of(SPHERE);

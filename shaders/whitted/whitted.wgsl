@@ -53,9 +53,7 @@ struct Params {
 // or dielectric ior); b: checker odd.
 struct Material {
     kind: u32,
-    pad0: u32,
-    pad1: u32,
-    pad2: u32,
+    pad: array<u32, 3>,
     a: vec4<f32>,
     b: vec4<f32>,
 }
@@ -65,9 +63,7 @@ struct Material {
 // power = (radiance x area, 0).
 struct Light {
     kind: u32,
-    pad0: u32,
-    pad1: u32,
-    pad2: u32,
+    pad: array<u32, 3>,
     a: vec4<f32>,
     normal: vec4<f32>,
     power: vec4<f32>,

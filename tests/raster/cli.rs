@@ -11,11 +11,11 @@ fn request<'a>(settings: &'a SceneArgs, raster: &'a RasterArgs, outputs: &'a [Pa
     RasterRequest {
         scene: Path::new("scenes/whitted.toml"),
         settings,
-        raster,
+        args: raster,
         outputs,
         encoding: None,
         exposure: None,
-        path_tracer_flags: Vec::new(),
+        other_flags: Vec::new(),
     }
 }
 
@@ -69,7 +69,7 @@ fn path_tracer_flags_and_bad_outputs_are_refused_before_rendering() {
     assert!(error.contains("--spp applies only to the path tracer"), "{error}");
     let settings = SceneArgs::default();
     let mut req = request(&settings, &raster, &out);
-    req.path_tracer_flags = vec!["--target-error"];
+    req.other_flags = vec!["--target-error"];
     assert!(error_of(&req).contains("--target-error"));
     let bad = vec![PathBuf::from("x.jpg")];
     let error = error_of(&request(&settings, &raster, &bad));

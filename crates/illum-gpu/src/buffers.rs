@@ -1,4 +1,4 @@
-//! Buffers and layouts every renderer creates the same way.
+//! Buffers, layouts, bind groups and compute dispatches every renderer makes the same way.
 
 /// A uniform buffer of `size` bytes that the queue writes (`UNIFORM | COPY_DST`), zeroed.
 pub fn uniform_buffer(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
@@ -33,4 +33,34 @@ pub fn pipeline_layout(
         bind_group_layouts: &groups,
         immediate_size: 0,
     })
+}
+
+/// A bind group of whole buffers, each bound at its binding number.
+pub fn buffer_bind_group(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    buffers: &[(u32, &wgpu::Buffer)],
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry> = buffers
+        .iter()
+        .map(|&(binding, buffer)| wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries })
+}
+
+/// Records one compute pass of `pipeline`, with `bind_group` at group 0, over `workgroups`
+/// (x, y, z), untimed.
+pub fn dispatch(
+    encoder: &mut wgpu::CommandEncoder,
+    label: &str,
+    pipeline: &wgpu::ComputePipeline,
+    bind_group: &wgpu::BindGroup,
+    workgroups: [u32; 3],
+) {
+    let mut pass = encoder
+        .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes: None });
+    pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, bind_group, &[]);
+    pass.dispatch_workgroups(workgroups[0], workgroups[1], workgroups[2]);
 }

@@ -4,7 +4,7 @@
 //!   honours `WGPU_BACKEND` / `WGPU_ADAPTER_NAME`, and turns "no adapter", device loss and
 //!   validation errors into [`GpuError`]s instead of panics or hangs.
 //! - [`policy`]: the backends, adapter choice, features and limits, shared with the viewer.
-//! - [`buffers`]: buffers every renderer allocates alike (uniforms).
+//! - [`buffers`]: buffers, bind groups and compute dispatches every renderer makes alike.
 //! - [`readback`]: copy a GPU buffer back to the CPU.
 //! - [`timing`]: GPU pass timing with timestamp queries, where the adapter has them.
 //! - [`shader`]: WGSL composition (naga_oil) and validation.

@@ -242,8 +242,10 @@ pub fn median(values: &mut [f64]) -> f64 {
 mod tests {
     use super::*;
 
-    fn close(a: f64, b: f64, tol: f64) -> bool {
-        (a - b).abs() <= tol
+    /// Asserts `|got - expected| <= tol`, naming `what` and both values when it fails.
+    #[track_caller]
+    fn assert_close(what: impl std::fmt::Display, got: f64, expected: f64, tol: f64) {
+        assert!((got - expected).abs() <= tol, "{what}: {got}, expected {expected} within {tol}");
     }
 
     #[test]
@@ -260,11 +262,11 @@ mod tests {
         ];
         for (p, x) in known {
             let got = inverse_normal_cdf(p);
-            assert!(close(got, x, 1e-6 * x.abs().max(1.0)), "Φ⁻¹({p}) = {got}, expected {x}");
+            assert_close(format!("Φ⁻¹({p})"), got, x, 1e-6 * x.abs().max(1.0));
         }
         // Symmetry Φ⁻¹(1 - p) = -Φ⁻¹(p) across branches.
         for p in [1e-5, 0.02, 0.03, 0.2, 0.4] {
-            assert!(close(inverse_normal_cdf(1.0 - p), -inverse_normal_cdf(p), 1e-8), "{p}");
+            assert_close(format!("Φ⁻¹(1 - {p})"), inverse_normal_cdf(1.0 - p), -inverse_normal_cdf(p), 1e-8);
         }
         assert_eq!(inverse_normal_cdf(0.0), f64::NEG_INFINITY);
         assert_eq!(inverse_normal_cdf(1.0), f64::INFINITY);
@@ -282,7 +284,7 @@ mod tests {
     fn rmse_by_hand() {
         let (a, r) = pair();
         // Differences 0, 1, 2, 0, 0, -2: squares sum to 9 over 6 values.
-        assert!(close(rmse(&a, &r).unwrap(), 1.5f64.sqrt(), 1e-12));
+        assert_close("rmse", rmse(&a, &r).unwrap(), 1.5f64.sqrt(), 1e-12);
         assert_eq!(rmse(&r, &r).unwrap(), 0.0);
     }
 
@@ -291,12 +293,12 @@ mod tests {
         let (a, r) = pair();
         // Non-zero terms: 1/(1 + 0.01), 4/(1 + 0.01), 4/(4 + 0.01); divided by 6 values.
         let expected = (1.0 / 1.01 + 4.0 / 1.01 + 4.0 / 4.01) / 6.0; // = 0.991333...
-        assert!(close(rel_mse(&a, &r).unwrap(), expected, 1e-12));
-        assert!(close(expected, 0.991_333_6, 1e-6));
+        assert_close("rel_mse", rel_mse(&a, &r).unwrap(), expected, 1e-12);
+        assert_close("the relMSE worked by hand", expected, 0.991_333_6, 1e-6);
         // A black reference pixel: error 0.1 counts as 0.01 / 0.01 = 1.
         let z = RgbImage32::new(1, 1);
         let e = RgbImage32::filled(1, 1, [0.1; 3]);
-        assert!(close(rel_mse(&e, &z).unwrap(), 1.0, 1e-6));
+        assert_close("rel_mse against zero", rel_mse(&e, &z).unwrap(), 1.0, 1e-6);
     }
 
     #[test]
@@ -305,7 +307,7 @@ mod tests {
         // mean(a) = (0.5, 1, 1.5): Y = 0.1063 + 0.7152 + 0.1083 = 0.9298
         // mean(r) = (0.5, 0.5, 1.5): Y = 0.1063 + 0.3576 + 0.1083 = 0.5722
         let expected = (0.9298 - 0.5722) / 0.5722;
-        assert!(close(mean_luminance_bias(&a, &r).unwrap(), expected, 1e-12));
+        assert_close("mean_luminance_bias", mean_luminance_bias(&a, &r).unwrap(), expected, 1e-12);
         let black = RgbImage32::new(2, 1);
         assert_eq!(mean_luminance_bias(&a, &black), Err(MetricsError::DegenerateReference(0.0)));
     }
@@ -361,46 +363,30 @@ mod tests {
         assert_eq!(z_test_pass_fraction(&a, &v, &b, &v, 0.01).unwrap(), 0.5);
     }
 
-    /// SplitMix64: a small, well-mixed deterministic generator for test data.
-    struct SplitMix64(u64);
-    impl SplitMix64 {
-        fn next_f64(&mut self) -> f64 {
-            self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = self.0;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            z ^= z >> 31;
-            (z >> 11) as f64 / (1u64 << 53) as f64
-        }
-    }
-
     /// A Monte Carlo "render": each pixel channel is the mean of `n` exponential samples
     /// (skewed, like path-tracing radiance) with true mean `truth(x, y) * scale`. Returns the
     /// mean image and the variance-of-the-mean image (sample variance / n).
     fn mc_render(seed: u64, n: usize, scale: f64) -> (RgbImage32, RgbImage32) {
-        let mut rng = SplitMix64(seed);
-        let (w, h) = (64u32, 64u32);
-        let mut mean = RgbImage32::new(w, h);
-        let mut var = RgbImage32::new(w, h);
-        for y in 0..h {
-            for x in 0..w {
-                let mut m = [0.0f32; 3];
-                let mut v = [0.0f32; 3];
-                for c in 0..3 {
-                    let truth = scale * (0.1 + f64::from(x + 2 * y + 7 * c as u32) / 200.0);
-                    let (mut s, mut s2) = (0.0, 0.0);
-                    for _ in 0..n {
-                        let sample = -truth * (1.0 - rng.next_f64()).ln();
-                        s += sample;
-                        s2 += sample * sample;
-                    }
-                    let mu = s / n as f64;
-                    let sample_var = (s2 - n as f64 * mu * mu) / (n as f64 - 1.0);
-                    m[c] = mu as f32;
-                    v[c] = (sample_var / n as f64) as f32;
-                }
-                mean.set(x, y, m);
-                var.set(x, y, v);
+        let mut rng = illum_oracle::Rng::from_state(seed);
+        // (mean, variance of the mean) of one channel's n samples of true mean `truth`.
+        let mut channel = |truth: f64| {
+            let (mut s, mut s2) = (0.0, 0.0);
+            for _ in 0..n {
+                let sample = -truth * (1.0 - rng.uniform()).ln();
+                s += sample;
+                s2 += sample * sample;
+            }
+            let mu = s / n as f64;
+            let sample_var = (s2 - n as f64 * mu * mu) / (n as f64 - 1.0);
+            (mu as f32, (sample_var / n as f64) as f32)
+        };
+        let w = 64u32;
+        let (mut mean, mut var) = (RgbImage32::new(w, w), RgbImage32::new(w, w));
+        // Row-major, as the pixels are stored.
+        for (i, (m, v)) in mean.pixels.iter_mut().zip(&mut var.pixels).enumerate() {
+            let (x, y) = (i as u32 % w, i as u32 / w);
+            for c in 0..3 {
+                (m[c], v[c]) = channel(scale * (0.1 + f64::from(x + 2 * y + 7 * c as u32) / 200.0));
             }
         }
         (mean, var)

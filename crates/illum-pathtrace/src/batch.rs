@@ -5,6 +5,7 @@
 //! (rgb) with their count (w), and their sum of squares (rgb) with the count of dropped NaN/Inf
 //! samples (w). The slots of a band are laid out chunk by chunk, `rows x width` slots each.
 
+use illum_gpu::buffers::buffer_bind_group;
 use illum_gpu::{GpuContext, GpuError, wgpu};
 use illum_scene::Scene;
 
@@ -52,22 +53,12 @@ impl BatchBuffers {
             let sum = buffer("pathtrace batch sum");
             let sum_sq = buffer("pathtrace batch sum of squares");
             let [params, objects, materials, lights] = scene_buffers;
-            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("pathtrace"),
-                layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: objects.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 2, resource: materials.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 3, resource: lights.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 4, resource: sum.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 5, resource: sum_sq.as_entire_binding() },
-                ]
-                .iter()
-                .filter(|e| bind_lights || e.binding != 3)
-                .cloned()
-                .collect::<Vec<_>>(),
-            });
+            let bound: Vec<(u32, &wgpu::Buffer)> =
+                [(0, params), (1, objects), (2, materials), (3, lights), (4, &sum), (5, &sum_sq)]
+                    .into_iter()
+                    .filter(|&(binding, _)| bind_lights || binding != 3)
+                    .collect();
+            let bind_group = buffer_bind_group(device, "pathtrace", layout, &bound);
             BatchBuffers { slots, sum, sum_sq, bind_group }
         })
     }

@@ -15,6 +15,7 @@
 //! display sum is never read back by illum itself.
 
 use bytemuck::{Pod, Zeroable};
+use illum_gpu::buffers::{buffer_bind_group, dispatch};
 use illum_gpu::shader::{self, ShaderFile};
 use illum_gpu::{GpuContext, shader_file, wgpu};
 
@@ -161,25 +162,17 @@ impl DisplaySum {
         // Queue writes land before the next submission, which is this band's.
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         if self.bound.as_ref().is_none_or(|(bound, _)| bound != batch_sum) {
-            let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("pathtrace display sum"),
-                layout: &self.pipeline.get_bind_group_layout(0),
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: self.params.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: batch_sum.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 2, resource: self.buffer.as_entire_binding() },
-                ],
-            });
+            let bind_group = buffer_bind_group(
+                &gpu.device,
+                "pathtrace display sum",
+                &self.pipeline.get_bind_group_layout(0),
+                &[(0, &self.params), (1, batch_sum), (2, &self.buffer)],
+            );
             self.bound = Some((batch_sum.clone(), bind_group));
         }
         let (_, bind_group) = self.bound.as_ref().expect("bound above");
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("pathtrace display sum"),
-            timestamp_writes: None,
-        });
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, bind_group, &[]);
-        pass.dispatch_workgroups(self.width.div_ceil(WORKGROUP), rows.div_ceil(WORKGROUP), 1);
+        let workgroups = [self.width.div_ceil(WORKGROUP), rows.div_ceil(WORKGROUP), 1];
+        dispatch(encoder, "pathtrace display sum", &self.pipeline, bind_group, workgroups);
     }
 }
 

@@ -13,7 +13,7 @@ use glam::{Vec2, Vec3};
 use illum_gpu::wgpu;
 use illum_raster::scene::FEATURES;
 use illum_raster::{Effects, Look, RasterScene, check_device_limits};
-use illum_scene::testing::{check_invalid, edit_once as edit_text, without};
+use illum_scene::testing::{Edits, check_invalid, edit_once as edit_text, without};
 use illum_scene::{Feature, RendererKind, Scene, SceneError};
 
 const FILE: &str = "scenes/w.toml";
@@ -33,9 +33,12 @@ const METAL_OBJECT: &str = "[[objects]]\nname = \"metal sphere\"\nmaterial = \"m
 const FLOOR_QUAD: &str =
     "quad = { corner = [-23.0, 0.0, -7.5], edge_u = [0.0, 0.0, 15.0], edge_v = [30.0, 0.0, 0.0] }";
 
+/// What the tests edit: `BASE`, loaded as the rasterizer sees it.
+const SCENE: Edits<RasterScene> = Edits { base: BASE, file: FILE, load: RasterScene::from_toml_str };
+
 /// `BASE` with `from` replaced by `to`; `from` must occur exactly once.
 fn edit(from: &str, to: &str) -> String {
-    edit_text(BASE, from, to)
+    SCENE.edit(from, to)
 }
 
 /// `BASE` with `table` (TOML text ending in a newline) appended after the last object.
@@ -44,14 +47,11 @@ fn with_object(table: &str) -> String {
 }
 
 fn parse(text: &str) -> Result<RasterScene, SceneError> {
-    RasterScene::from_toml_str(text, FILE)
+    SCENE.parse(text)
 }
 
 fn expect_invalid(text: &str, field: &str, value: &str, allowed: &str) {
-    match parse(text) {
-        Ok(_) => panic!("expected an error on {field} = {value}, but the scene loaded"),
-        Err(e) => check_invalid(&e, FILE, field, value, allowed),
-    }
+    SCENE.expect_invalid(text, field, value, allowed);
 }
 
 /// Asserts `text` is a valid scene that the rasterizer refuses because `place` uses `feature`.
@@ -231,155 +231,144 @@ fn non_finite_numbers_are_rejected() {
 
 #[test]
 fn camera_rules_are_the_path_tracers() {
-    expect_invalid(&edit("vfov = 60.0", "vfov = 180.0"), "camera.vfov", "180", "open interval (0, 180)");
-    expect_invalid(&edit("width = 64", "width = 0"), "camera.width", "0", "at least 1");
-    expect_invalid(&edit("height = 36", "height = -3"), "camera.height", "-3", "at least 1");
-    expect_invalid(
-        &edit("target = [4.2, 2.3, -4.2]", "target = [7.5, 2.3, -4.2]"),
-        "camera.target",
-        "[7.5, 2.3, -4.2]",
-        "must differ from camera.eye",
-    );
-    expect_invalid(
-        &edit("up = [0.0, 1.0, 0.0]", "up = [-1.0, 0.0, 0.0]"),
-        "camera.up",
-        "[-1, 0, 0]",
-        "not parallel",
-    );
-    expect_invalid(&edit("near = 0.1", "near = 0.0"), "camera.near", "0", "must be > 0");
-    expect_invalid(&edit("far = 3000.0", "far = 0.1"), "camera.far", "0.1", "greater than camera.near = 0.1");
+    SCENE.expect_invalid_edits(&[
+        ("vfov = 60.0", "vfov = 180.0", "camera.vfov", "180", "open interval (0, 180)"),
+        ("width = 64", "width = 0", "camera.width", "0", "at least 1"),
+        ("height = 36", "height = -3", "camera.height", "-3", "at least 1"),
+        (
+            "target = [4.2, 2.3, -4.2]",
+            "target = [7.5, 2.3, -4.2]",
+            "camera.target",
+            "[7.5, 2.3, -4.2]",
+            "must differ from camera.eye",
+        ),
+        ("up = [0.0, 1.0, 0.0]", "up = [-1.0, 0.0, 0.0]", "camera.up", "[-1, 0, 0]", "not parallel"),
+        ("near = 0.1", "near = 0.0", "camera.near", "0", "must be > 0"),
+        ("far = 3000.0", "far = 0.1", "camera.far", "0.1", "greater than camera.near = 0.1"),
+    ]);
 }
 
 #[test]
 fn geometry_and_material_ranges() {
-    expect_invalid(
-        &edit("center = [4.2, 2.6, -4.2], radius = 1.0", "center = [4.2, 2.6, -4.2], radius = 0.0"),
-        "objects[1] (\"glass sphere\").sphere.radius",
-        "0",
-        "must be > 0",
-    );
-    expect_invalid(
-        &edit("center = [2.0, 1.9, -2.5], radius = 1.0", "center = [2.0, 1.9, -2.5], radius = -1"),
-        "objects[2] (\"metal sphere\").sphere.radius",
-        "-1",
-        "must be > 0",
-    );
-    // The old `floor.size[0] = 0` is a floor quad with a zero edge.
-    expect_invalid(
-        &edit("edge_v = [30.0, 0.0, 0.0]", "edge_v = [0.0, 0.0, 0.0]"),
-        "objects[0] (\"floor\").quad",
-        "{ edge_u = [0, 0, 15], edge_v = [0, 0, 0] }",
-        "must be non-zero and not parallel",
-    );
-    expect_invalid(&edit("tile = 1.0", "tile = 0.0"), "materials.floor.checker.tile", "0", "must be > 0");
-    // 2^-15 is exact in f32, so the value is shown as written: 30 / 2^-15 = 983040 tiles.
-    expect_invalid(
-        &edit("tile = 1.0", "tile = 0.000030517578125"),
-        "materials.floor.checker.tile",
-        "0.000030517578125",
-        "at most 100000 tiles along each edge of a quad it is on (this quad gives 983040)",
-    );
     // 30 / 3e-4 = 100000 tiles exactly (in f64 of the f32 tile: just under), the limit itself.
     parse(&edit("tile = 1.0", "tile = 0.0003")).unwrap();
-    expect_invalid(
-        &edit("odd = [0.8, 0.0, 0.0]", "odd = [1.5, 0.0, 0.0]"),
-        "materials.floor.checker.odd",
-        "[1.5, 0, 0]",
-        "every channel must be in [0, 1]",
-    );
-    expect_invalid(
-        &edit("reflectance = [0.792, 0.863, 0.851]", "reflectance = [0.792, -0.1, 0.851]"),
-        "materials.metal.mirror.reflectance",
-        "[0.792, -0.1, 0.851]",
-        "every channel must be in [0, 1]",
-    );
-    // The old `refraction_ratio = 0` is ior 0, refused by the scene for every renderer.
-    expect_invalid(&edit("ior = 1.4285715", "ior = 0"), "materials.glass.dielectric.ior", "0", "must be > 0");
-    expect_invalid(
-        &edit("ior = 1.4285715", "ior = -1.5"),
-        "materials.glass.dielectric.ior",
-        "-1.5",
-        "must be > 0",
-    );
-    expect_invalid(
-        &edit("glass_reflectivity = 0.9", "glass_reflectivity = 1.1"),
-        "raster.glass_reflectivity",
-        "1.1",
-        "[0, 1]",
-    );
-    expect_invalid(
-        &edit("glass_color = [1.0, 1.0, 1.0]", "glass_color = [1.0, 2.0, 1.0]"),
-        "raster.glass_color",
-        "[1, 2, 1]",
-        "[0, 1]",
-    );
-    expect_invalid(&edit("weight = 0.6", "weight = -0.1"), "shading.mirror.weight", "-0.1", "[0, 1]");
-    expect_invalid(
-        &edit("shininess = 30.0", "shininess = 0"),
-        "shading.mirror.shininess",
-        "0",
-        "must be > 0",
-    );
-    expect_invalid(
-        &edit("shininess = 200.0", "shininess = -2"),
-        "shading.dielectric.shininess",
-        "-2",
-        "must be > 0",
-    );
-    expect_invalid(
-        &edit("specular = [1.0, 1.0, 1.0]", "specular = [1.0, 1.0, 1.5]"),
-        "shading.mirror.specular",
-        "[1, 1, 1.5]",
-        "[0, 1]",
-    );
-    expect_invalid(
-        &edit("ambient = [0.23, 0.23, 0.23]", "ambient = [0.23, -0.23, 0.23]"),
-        "shading.ambient",
-        "[0.23, -0.23, 0.23]",
-        ">= 0",
-    );
-    // The old `background.color` is the environment's radiance.
-    expect_invalid(
-        &edit("radiance = [0.3, 0.5, 0.9]", "radiance = [0.3, -0.5, 0.9]"),
-        "environment.radiance",
-        "[0.3, -0.5, 0.9]",
-        ">= 0",
-    );
-    // The old `light.intensity = -1` is a negative irradiance.
-    expect_invalid(
-        &edit("irradiance = [3.14159265, 3.14159265, 3.14159265]", "irradiance = [-1.0, 1.0, 1.0]"),
-        "directional_light.irradiance",
-        "[-1, 1, 1]",
-        ">= 0",
-    );
-    // The old `light.target == light.position` is a zero direction.
-    expect_invalid(
-        &edit("direction = [-10.0, -13.0, 2.0]", "direction = [0.0, 0.0, 0.0]"),
-        "directional_light.direction",
-        "[0, 0, 0]",
-        "must be non-zero",
-    );
-    expect_invalid(&edit("cube_size = 128", "cube_size = 0"), "raster.cube_size", "0", "at least 1");
-    expect_invalid(
-        &edit("cube_size = 128", "cube_size = 4294967296"),
-        "raster.cube_size",
-        "4294967296",
-        "at most 4294967295",
-    );
-    expect_invalid(&edit("pcf_radius = 0.05", "pcf_radius = 0"), "raster.pcf_radius", "0", "must be > 0");
-    expect_invalid(
-        &edit("look = \"enhanced\"", "look = \"photo\""),
-        "raster.look",
-        "\"photo\"",
-        "\"figure\" or \"enhanced\"",
-    );
-    // The old format's second look was "whitted"; the word now names the Whitted ray tracer.
-    expect_invalid(
-        &edit("look = \"enhanced\"", "look = \"whitted\""),
-        "raster.look",
-        "\"whitted\"",
-        "\"figure\" or \"enhanced\"",
-    );
+    SCENE.expect_invalid_edits(&[
+        (
+            "center = [4.2, 2.6, -4.2], radius = 1.0",
+            "center = [4.2, 2.6, -4.2], radius = 0.0",
+            "objects[1] (\"glass sphere\").sphere.radius",
+            "0",
+            "must be > 0",
+        ),
+        (
+            "center = [2.0, 1.9, -2.5], radius = 1.0",
+            "center = [2.0, 1.9, -2.5], radius = -1",
+            "objects[2] (\"metal sphere\").sphere.radius",
+            "-1",
+            "must be > 0",
+        ),
+        // The old `floor.size[0] = 0` is a floor quad with a zero edge.
+        (
+            "edge_v = [30.0, 0.0, 0.0]",
+            "edge_v = [0.0, 0.0, 0.0]",
+            "objects[0] (\"floor\").quad",
+            "{ edge_u = [0, 0, 15], edge_v = [0, 0, 0] }",
+            "must be non-zero and not parallel",
+        ),
+        ("tile = 1.0", "tile = 0.0", "materials.floor.checker.tile", "0", "must be > 0"),
+        // 2^-15 is exact in f32, so the value is shown as written: 30 / 2^-15 = 983040 tiles.
+        (
+            "tile = 1.0",
+            "tile = 0.000030517578125",
+            "materials.floor.checker.tile",
+            "0.000030517578125",
+            "at most 100000 tiles along each edge of a quad it is on (this quad gives 983040)",
+        ),
+        (
+            "odd = [0.8, 0.0, 0.0]",
+            "odd = [1.5, 0.0, 0.0]",
+            "materials.floor.checker.odd",
+            "[1.5, 0, 0]",
+            "every channel must be in [0, 1]",
+        ),
+        (
+            "reflectance = [0.792, 0.863, 0.851]",
+            "reflectance = [0.792, -0.1, 0.851]",
+            "materials.metal.mirror.reflectance",
+            "[0.792, -0.1, 0.851]",
+            "every channel must be in [0, 1]",
+        ),
+        // The old `refraction_ratio = 0` is ior 0, refused by the scene for every renderer.
+        ("ior = 1.4285715", "ior = 0", "materials.glass.dielectric.ior", "0", "must be > 0"),
+        ("ior = 1.4285715", "ior = -1.5", "materials.glass.dielectric.ior", "-1.5", "must be > 0"),
+        (
+            "glass_reflectivity = 0.9",
+            "glass_reflectivity = 1.1",
+            "raster.glass_reflectivity",
+            "1.1",
+            "[0, 1]",
+        ),
+        (
+            "glass_color = [1.0, 1.0, 1.0]",
+            "glass_color = [1.0, 2.0, 1.0]",
+            "raster.glass_color",
+            "[1, 2, 1]",
+            "[0, 1]",
+        ),
+        ("weight = 0.6", "weight = -0.1", "shading.mirror.weight", "-0.1", "[0, 1]"),
+        ("shininess = 30.0", "shininess = 0", "shading.mirror.shininess", "0", "must be > 0"),
+        ("shininess = 200.0", "shininess = -2", "shading.dielectric.shininess", "-2", "must be > 0"),
+        (
+            "specular = [1.0, 1.0, 1.0]",
+            "specular = [1.0, 1.0, 1.5]",
+            "shading.mirror.specular",
+            "[1, 1, 1.5]",
+            "[0, 1]",
+        ),
+        (
+            "ambient = [0.23, 0.23, 0.23]",
+            "ambient = [0.23, -0.23, 0.23]",
+            "shading.ambient",
+            "[0.23, -0.23, 0.23]",
+            ">= 0",
+        ),
+        // The old `background.color` is the environment's radiance.
+        (
+            "radiance = [0.3, 0.5, 0.9]",
+            "radiance = [0.3, -0.5, 0.9]",
+            "environment.radiance",
+            "[0.3, -0.5, 0.9]",
+            ">= 0",
+        ),
+        // The old `light.intensity = -1` is a negative irradiance.
+        (
+            "irradiance = [3.14159265, 3.14159265, 3.14159265]",
+            "irradiance = [-1.0, 1.0, 1.0]",
+            "directional_light.irradiance",
+            "[-1, 1, 1]",
+            ">= 0",
+        ),
+        // The old `light.target == light.position` is a zero direction.
+        (
+            "direction = [-10.0, -13.0, 2.0]",
+            "direction = [0.0, 0.0, 0.0]",
+            "directional_light.direction",
+            "[0, 0, 0]",
+            "must be non-zero",
+        ),
+        ("cube_size = 128", "cube_size = 0", "raster.cube_size", "0", "at least 1"),
+        ("cube_size = 128", "cube_size = 4294967296", "raster.cube_size", "4294967296", "at most 4294967295"),
+        ("pcf_radius = 0.05", "pcf_radius = 0", "raster.pcf_radius", "0", "must be > 0"),
+        ("look = \"enhanced\"", "look = \"photo\"", "raster.look", "\"photo\"", "\"figure\" or \"enhanced\""),
+        // The old format's second look was "whitted"; the word now names the Whitted ray tracer.
+        (
+            "look = \"enhanced\"",
+            "look = \"whitted\"",
+            "raster.look",
+            "\"whitted\"",
+            "\"figure\" or \"enhanced\"",
+        ),
+    ]);
 }
 
 #[test]
@@ -435,25 +424,30 @@ fn the_ior_refusal_names_the_field_as_validation_does() {
 
 #[test]
 fn the_camera_must_be_outside_the_spheres_and_the_spheres_apart() {
-    expect_invalid(
-        &edit("eye = [7.5, 2.3, -4.2]", "eye = [4.5, 2.6, -4.2]"),
-        "camera.eye",
-        "[4.5, 2.6, -4.2]",
-        "must lie outside objects[1] (\"glass sphere\") (centre [4.2, 2.6, -4.2], radius 1",
-    );
-    expect_invalid(
-        &edit("center = [2.0, 1.9, -2.5]", "center = [3.5, 2.6, -4.2]"),
-        "objects[2] (\"metal sphere\").sphere.center",
-        "[3.5, 2.6, -4.2]",
-        "must not touch or overlap",
-    );
-    // Touching counts: centres exactly 2 apart along X, radii 1 + 1.
-    expect_invalid(
-        &edit("center = [2.0, 1.9, -2.5]", "center = [2.2, 2.6, -4.2]"),
-        "objects[2] (\"metal sphere\").sphere.center",
-        "[2.2, 2.6, -4.2]",
-        "must not touch or overlap",
-    );
+    SCENE.expect_invalid_edits(&[
+        (
+            "eye = [7.5, 2.3, -4.2]",
+            "eye = [4.5, 2.6, -4.2]",
+            "camera.eye",
+            "[4.5, 2.6, -4.2]",
+            "must lie outside objects[1] (\"glass sphere\") (centre [4.2, 2.6, -4.2], radius 1",
+        ),
+        (
+            "center = [2.0, 1.9, -2.5]",
+            "center = [3.5, 2.6, -4.2]",
+            "objects[2] (\"metal sphere\").sphere.center",
+            "[3.5, 2.6, -4.2]",
+            "must not touch or overlap",
+        ),
+        // Touching counts: centres exactly 2 apart along X, radii 1 + 1.
+        (
+            "center = [2.0, 1.9, -2.5]",
+            "center = [2.2, 2.6, -4.2]",
+            "objects[2] (\"metal sphere\").sphere.center",
+            "[2.2, 2.6, -4.2]",
+            "must not touch or overlap",
+        ),
+    ]);
 }
 
 #[test]
@@ -570,20 +564,24 @@ fn at_most_one_glass_and_one_metal_sphere() {
 fn the_floor_is_one_horizontal_quad_facing_up_from_its_minimum_corner() {
     let allowed = "horizontal rectangle facing up (+Y)";
     let field = "objects[0] (\"floor\").quad";
-    // Tilted: edge_v climbs.
-    expect_invalid(
-        &edit("edge_v = [30.0, 0.0, 0.0]", "edge_v = [30.0, 1.0, 0.0]"),
-        field,
-        "{ corner = [-23, 0, -7.5], edge_u = [0, 0, 15], edge_v = [30, 1, 0] }",
-        allowed,
-    );
-    // Horizontal but its edges not along X and Z.
-    expect_invalid(
-        &edit("edge_v = [30.0, 0.0, 0.0]", "edge_v = [30.0, 0.0, 1.0]"),
-        field,
-        "{ corner = [-23, 0, -7.5], edge_u = [0, 0, 15], edge_v = [30, 0, 1] }",
-        allowed,
-    );
+    SCENE.expect_invalid_edits(&[
+        // Tilted: edge_v climbs.
+        (
+            "edge_v = [30.0, 0.0, 0.0]",
+            "edge_v = [30.0, 1.0, 0.0]",
+            field,
+            "{ corner = [-23, 0, -7.5], edge_u = [0, 0, 15], edge_v = [30, 1, 0] }",
+            allowed,
+        ),
+        // Horizontal but its edges not along X and Z.
+        (
+            "edge_v = [30.0, 0.0, 0.0]",
+            "edge_v = [30.0, 0.0, 1.0]",
+            field,
+            "{ corner = [-23, 0, -7.5], edge_u = [0, 0, 15], edge_v = [30, 0, 1] }",
+            allowed,
+        ),
+    ]);
     // Facing down: the edges swapped, edge_u x edge_v = -Y.
     let down = "quad = { corner = [-23.0, 0.0, -7.5], edge_u = [30.0, 0.0, 0.0], edge_v = [0.0, 0.0, 15.0] }";
     Scene::from_toml_str(&edit(FLOOR_QUAD, down), FILE).expect("a valid quad, facing down");
@@ -620,18 +618,22 @@ fn the_floor_is_checkered_or_plain() {
     let plain = parse(&edit("material = \"floor\"", "material = \"grey\"")).unwrap();
     assert_eq!(plain.floor.colors, [Vec3::splat(0.5); 2], "a Lambertian floor is one colour");
     assert_eq!(plain.floor.tile, 30.0, "one tile covers it");
-    expect_invalid(
-        &edit("material = \"floor\"", "material = \"glass\""),
-        "objects[0] (\"floor\").material",
-        "dielectric",
-        "floor needs a Lambertian or checker material",
-    );
-    expect_invalid(
-        &edit("material = \"floor\"", "material = \"metal\""),
-        "objects[0] (\"floor\").material",
-        "mirror",
-        "floor needs a Lambertian or checker material",
-    );
+    SCENE.expect_invalid_edits(&[
+        (
+            "material = \"floor\"",
+            "material = \"glass\"",
+            "objects[0] (\"floor\").material",
+            "dielectric",
+            "floor needs a Lambertian or checker material",
+        ),
+        (
+            "material = \"floor\"",
+            "material = \"metal\"",
+            "objects[0] (\"floor\").material",
+            "mirror",
+            "floor needs a Lambertian or checker material",
+        ),
+    ]);
 }
 
 #[test]
@@ -645,8 +647,10 @@ fn clip_planes_and_a_delta_light_are_required() {
         "the rasterizer needs the camera's clip planes near and far",
     );
     // One without the other is refused by the scene itself.
-    expect_invalid(&edit("near = 0.1\n", ""), "camera.near", "(missing)", "must be given with camera.far");
-    expect_invalid(&edit("far = 3000.0\n", ""), "camera.far", "(missing)", "must be given with camera.near");
+    SCENE.expect_invalid_edits(&[
+        ("near = 0.1\n", "", "camera.near", "(missing)", "must be given with camera.far"),
+        ("far = 3000.0\n", "", "camera.far", "(missing)", "must be given with camera.near"),
+    ]);
 
     let no_light = edit(
         "[directional_light]\ndirection = [-10.0, -13.0, 2.0]\n\

@@ -15,10 +15,11 @@ pub(crate) fn bounces_allowed() -> String {
     format!("must be an integer in 0..={MAX_BOUNCES} or \"{UNBOUNDED}\"")
 }
 
-/// `as_str` (the name used in files and on the command line), `FromStr` and `Display` for an
-/// enum of fixed words, and the constant `$allowed` (its text given) that error messages show.
+/// For each enum of fixed words: `as_str` (the name used in files and on the command line),
+/// `FromStr` and `Display`, and the constant `$allowed` (its text given) that error messages
+/// show.
 macro_rules! named_words {
-    ($ty:ident, $allowed:ident = $allowed_text:expr, $($variant:ident => $word:literal),+ $(,)?) => {
+    ($($ty:ident, $allowed:ident = $allowed_text:expr, { $($variant:ident => $word:literal),+ $(,)? };)+) => {$(
         #[doc = concat!("What a `", stringify!($ty), "` accepts, for error messages.")]
         pub(crate) const $allowed: &str = $allowed_text;
 
@@ -47,24 +48,19 @@ macro_rules! named_words {
                 f.write_str(self.as_str())
             }
         }
-    };
+    )+};
 }
 
-named_words!(Sampling, SAMPLING_ALLOWED = "must be \"cosine\" or \"uniform\"", Cosine => "cosine", Uniform => "uniform");
-named_words!(
-    Sequence,
-    SEQUENCE_ALLOWED = "must be \"independent\" or \"low-discrepancy\"",
-    Independent => "independent",
-    LowDiscrepancy => "low-discrepancy",
-);
-named_words!(Look, LOOK_ALLOWED = "must be \"figure\" or \"enhanced\"", Figure => "figure", Enhanced => "enhanced");
-named_words!(
-    RendererKind,
-    RENDERER_ALLOWED = "must be \"raster\", \"pathtrace\" or \"whitted\"",
-    Raster => "raster",
-    PathTrace => "pathtrace",
-    Whitted => "whitted",
-);
+named_words! {
+    Sampling, SAMPLING_ALLOWED = "must be \"cosine\" or \"uniform\"",
+        { Cosine => "cosine", Uniform => "uniform" };
+    Sequence, SEQUENCE_ALLOWED = "must be \"independent\" or \"low-discrepancy\"",
+        { Independent => "independent", LowDiscrepancy => "low-discrepancy" };
+    Look, LOOK_ALLOWED = "must be \"figure\" or \"enhanced\"",
+        { Figure => "figure", Enhanced => "enhanced" };
+    RendererKind, RENDERER_ALLOWED = "must be \"raster\", \"pathtrace\" or \"whitted\"",
+        { Raster => "raster", PathTrace => "pathtrace", Whitted => "whitted" };
+}
 
 impl Look {
     pub const ALL: [Look; 2] = [Look::Figure, Look::Enhanced];

@@ -41,3 +41,61 @@ pub fn shipped_scene(name: &str, width: u32, height: u32) -> crate::Scene {
     scene.camera.height = height;
     scene
 }
+
+/// A refusal an error test expects: `(from, to, field, value, allowed)`, the base scene with
+/// `from` replaced by `to` must fail on `field`, showing `value`, allowing `allowed` (see
+/// [`check_invalid`]).
+pub type InvalidEdit<'a> = (&'a str, &'a str, &'a str, &'a str, &'a str);
+
+/// A refusal of one value: `(value, shown, allowed)`, written in place of a line's value (see
+/// [`Edits::expect_invalid_values`]).
+pub type InvalidValue<'a> = (&'a str, &'a str, &'a str);
+
+/// What an error test edits and how it loads the result: a valid scene text, the file label
+/// its errors name, and the loader (`Scene::from_toml_str`, or a renderer's view of a scene).
+/// The error tests of every crate share it, so that each checks a rule the same way.
+pub struct Edits<T> {
+    /// The valid scene every edit starts from.
+    pub base: &'static str,
+    /// The file label given to the loader, which every error must name.
+    pub file: &'static str,
+    /// Loads a scene text under a file label.
+    pub load: fn(&str, &str) -> Result<T, SceneError>,
+}
+
+impl<T: std::fmt::Debug> Edits<T> {
+    /// The base with `from` replaced by `to`; `from` must occur exactly once (see [`edit_once`]).
+    pub fn edit(&self, from: &str, to: &str) -> String {
+        edit_once(self.base, from, to)
+    }
+
+    /// `text` loaded under the file label.
+    pub fn parse(&self, text: &str) -> Result<T, SceneError> {
+        (self.load)(text, self.file)
+    }
+
+    /// Asserts `text` fails validation on `field` with the shown `value`, and that the allowed
+    /// text contains `allowed`; the displayed message must contain all four parts.
+    pub fn expect_invalid(&self, text: &str, field: &str, value: &str, allowed: &str) {
+        match self.parse(text) {
+            Ok(_) => panic!("expected an error on {field} = {value}, but the scene loaded"),
+            Err(e) => check_invalid(&e, self.file, field, value, allowed),
+        }
+    }
+
+    /// [`Edits::expect_invalid`] for each edit of the base in `cases`.
+    pub fn expect_invalid_edits(&self, cases: &[InvalidEdit]) {
+        for &(from, to, field, value, allowed) in cases {
+            self.expect_invalid(&self.edit(from, to), field, value, allowed);
+        }
+    }
+
+    /// `line` is a `KEY = VALUE` line of the base; for each `(value, shown, allowed)` in `cases`,
+    /// the base with `KEY = value` in its place must fail on `field`.
+    pub fn expect_invalid_values(&self, line: &str, field: &str, cases: &[InvalidValue]) {
+        let (key, _) = line.split_once(" = ").unwrap_or_else(|| panic!("{line:?} is not KEY = VALUE"));
+        for &(value, shown, allowed) in cases {
+            self.expect_invalid(&self.edit(line, &format!("{key} = {value}")), field, shown, allowed);
+        }
+    }
+}

@@ -5,7 +5,7 @@
 //! Long (one test per rule) but one concept: every error of the file format and its overrides.
 
 use glam::Vec3;
-use illum_scene::testing::{check_invalid, edit_once as edit_text};
+use illum_scene::testing::{Edits, check_invalid, edit_once as edit_text};
 use illum_scene::{Bounces, MAX_BOUNCES, MaterialKind, Overrides, Sampling, Scene, SceneError, Shape};
 
 const FILE: &str = "scenes/test.toml";
@@ -13,24 +13,21 @@ const FILE: &str = "scenes/test.toml";
 /// A valid scene using every construct of the format once.
 const BASE: &str = include_str!("scenes/test.toml");
 
+/// What the tests edit: `BASE`, loaded as a [`Scene`].
+const SCENE: Edits<Scene> = Edits { base: BASE, file: FILE, load: Scene::from_toml_str };
+
 /// `BASE` with `from` replaced by `to`; `from` must occur exactly once, so a typo in a test
 /// fails loudly instead of silently testing the unedited scene.
 fn edit(from: &str, to: &str) -> String {
-    edit_text(BASE, from, to)
+    SCENE.edit(from, to)
 }
 
 fn parse(text: &str) -> Result<Scene, SceneError> {
-    Scene::from_toml_str(text, FILE)
+    SCENE.parse(text)
 }
 
-/// Asserts `text` fails validation on `field` with the shown `value`, and that the allowed text
-/// contains `allowed`; the displayed message must contain all four parts.
 fn expect_invalid(text: &str, field: &str, value: &str, allowed: &str) {
-    let err = match parse(text) {
-        Ok(_) => panic!("expected an error on {field} = {value}, but the scene loaded"),
-        Err(e) => e,
-    };
-    check_invalid(&err, FILE, field, value, allowed);
+    SCENE.expect_invalid(text, field, value, allowed);
 }
 
 /// Asserts a syntax error at 1-based (line, column) whose message contains `needle`.
@@ -222,32 +219,34 @@ fn non_finite_numbers_are_rejected_in_every_field() {
 
 #[test]
 fn box_half_extent_must_be_positive() {
-    for (bad, shown) in [("[1.0, 0.0, 1.0]", "[1, 0, 1]"), ("[-1.0, 1.0, 1.0]", "[-1, 1, 1]")] {
-        expect_invalid(
-            &edit("half_extent = [1.0, 1.0, 1.0]", &format!("half_extent = {bad}")),
-            "objects[0] (\"block\").box.half_extent",
-            shown,
-            "every component must be > 0",
-        );
-    }
+    let allowed = "every component must be > 0";
+    SCENE.expect_invalid_values(
+        "half_extent = [1.0, 1.0, 1.0]",
+        "objects[0] (\"block\").box.half_extent",
+        &[("[1.0, 0.0, 1.0]", "[1, 0, 1]", allowed), ("[-1.0, 1.0, 1.0]", "[-1, 1, 1]", allowed)],
+    );
 }
 
 #[test]
 fn box_max_must_exceed_min() {
-    // y equal to min: a flat box.
-    expect_invalid(
-        &edit("max = [2.0, -0.5, 2.0]", "max = [2.0, -1.0, 2.0]"),
-        "objects[1] (\"slab\").box.max",
-        "[2, -1, 2]",
-        "must be greater than objects[1] (\"slab\").box.min = [-2, -1, -2] on every axis",
-    );
-    // x below min.
-    expect_invalid(
-        &edit("max = [2.0, -0.5, 2.0]", "max = [-3.0, -0.5, 2.0]"),
-        "objects[1] (\"slab\").box.max",
-        "[-3, -0.5, 2]",
-        "on every axis",
-    );
+    SCENE.expect_invalid_edits(&[
+        // y equal to min: a flat box.
+        (
+            "max = [2.0, -0.5, 2.0]",
+            "max = [2.0, -1.0, 2.0]",
+            "objects[1] (\"slab\").box.max",
+            "[2, -1, 2]",
+            "must be greater than objects[1] (\"slab\").box.min = [-2, -1, -2] on every axis",
+        ),
+        // x below min.
+        (
+            "max = [2.0, -0.5, 2.0]",
+            "max = [-3.0, -0.5, 2.0]",
+            "objects[1] (\"slab\").box.max",
+            "[-3, -0.5, 2]",
+            "on every axis",
+        ),
+    ]);
 }
 
 #[test]
@@ -271,14 +270,12 @@ fn box_needs_one_corner_form() {
 
 #[test]
 fn sphere_radius_must_be_positive() {
-    for (bad, shown) in [("0.0", "0"), ("-2.5", "-2.5")] {
-        expect_invalid(
-            &edit("radius = 0.5", &format!("radius = {bad}")),
-            "objects[3].sphere.radius",
-            shown,
-            "must be > 0",
-        );
-    }
+    let allowed = "must be > 0";
+    SCENE.expect_invalid_values(
+        "radius = 0.5",
+        "objects[3].sphere.radius",
+        &[("0.0", "0", allowed), ("-2.5", "-2.5", allowed)],
+    );
 }
 
 #[test]
@@ -349,27 +346,27 @@ fn camera_up_must_be_nonzero_and_not_parallel_to_the_view() {
 
 #[test]
 fn camera_vfov_must_be_in_the_open_interval() {
-    for (bad, shown) in [("0.0", "0"), ("180.0", "180"), ("-10.0", "-10"), ("200", "200")] {
-        expect_invalid(
-            &edit("vfov = 45.0", &format!("vfov = {bad}")),
-            "camera.vfov",
-            shown,
-            "must be in the open interval (0, 180) degrees",
-        );
-    }
+    let allowed = "must be in the open interval (0, 180) degrees";
+    SCENE.expect_invalid_values(
+        "vfov = 45.0",
+        "camera.vfov",
+        &[
+            ("0.0", "0", allowed),
+            ("180.0", "180", allowed),
+            ("-10.0", "-10", allowed),
+            ("200", "200", allowed),
+        ],
+    );
 }
 
 #[test]
 fn camera_resolution_must_be_positive() {
-    expect_invalid(&edit("width = 64", "width = 0"), "camera.width", "0", "must be at least 1");
-    expect_invalid(&edit("height = 32", "height = 0"), "camera.height", "0", "must be at least 1");
-    expect_invalid(&edit("width = 64", "width = -640"), "camera.width", "-640", "must be at least 1");
-    expect_invalid(
-        &edit("height = 32", "height = 4294967296"),
-        "camera.height",
-        "4294967296",
-        "must be at most 4294967295",
-    );
+    SCENE.expect_invalid_edits(&[
+        ("width = 64", "width = 0", "camera.width", "0", "must be at least 1"),
+        ("height = 32", "height = 0", "camera.height", "0", "must be at least 1"),
+        ("width = 64", "width = -640", "camera.width", "-640", "must be at least 1"),
+        ("height = 32", "height = 4294967296", "camera.height", "4294967296", "must be at most 4294967295"),
+    ]);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -420,14 +417,12 @@ fn sampling_must_be_cosine_or_uniform() {
 
 #[test]
 fn albedo_channels_must_be_in_unit_range() {
-    for (bad, shown) in [("[0.5, 1.2, 0.5]", "[0.5, 1.2, 0.5]"), ("[-0.1, 0.5, 0.5]", "[-0.1, 0.5, 0.5]")] {
-        expect_invalid(
-            &edit("albedo = [0.5, 0.5, 0.5]", &format!("albedo = {bad}")),
-            "materials.grey.albedo",
-            shown,
-            "every channel must be in [0, 1]",
-        );
-    }
+    let allowed = "every channel must be in [0, 1]";
+    SCENE.expect_invalid_values(
+        "albedo = [0.5, 0.5, 0.5]",
+        "materials.grey.albedo",
+        &[("[0.5, 1.2, 0.5]", "[0.5, 1.2, 0.5]", allowed), ("[-0.1, 0.5, 0.5]", "[-0.1, 0.5, 0.5]", allowed)],
+    );
     // The bounds themselves are allowed.
     parse(&edit("albedo = [0.5, 0.5, 0.5]", "albedo = [0.0, 1.0, 1.0]")).unwrap();
 }
@@ -513,37 +508,40 @@ fn a_scene_needs_objects() {
 // ---------------------------------------------------------------------------------------------
 // Syntax and shape errors.
 
+/// Asserts that `BASE` with `from` replaced by `to` is a syntax error at the first occurrence of
+/// `at` in the edited text, whose message contains `needle`; returns the edited text.
+fn expect_syntax_at(from: &str, to: &str, at: &str, needle: &str) -> String {
+    let text = edit(from, to);
+    let (line, column) = position_of(&text, at);
+    expect_syntax(&text, line, column, needle);
+    text
+}
+
 #[test]
 fn unknown_keys_are_named_at_their_position() {
-    let text = edit("vfov = 45.0", "fov = 45.0");
-    let (line, column) = position_of(&text, "fov = 45.0");
-    expect_syntax(&text, line, column, "unknown field `fov`");
-
-    let text = edit("rotate_y = 30.0", "rotate_z = 30.0");
-    let (line, column) = position_of(&text, "rotate_z");
-    expect_syntax(&text, line, column, "unknown field `rotate_z`");
-
-    let text = edit("[pathtrace]", "[render]");
-    let (line, column) = position_of(&text, "render]");
-    expect_syntax(&text, line, column, "unknown field `render`");
-
-    let text = edit("albedo = [0.5, 0.5, 0.5]", "albedo = [0.5, 0.5, 0.5]\nroughness = 0.2");
-    let (line, column) = position_of(&text, "roughness");
-    expect_syntax(&text, line, column, "unknown field `roughness`");
+    // (from, to, where the error points, message)
+    for (from, to, at, needle) in [
+        ("vfov = 45.0", "fov = 45.0", "fov = 45.0", "unknown field `fov`"),
+        ("rotate_y = 30.0", "rotate_z = 30.0", "rotate_z", "unknown field `rotate_z`"),
+        ("[pathtrace]", "[render]", "render]", "unknown field `render`"),
+        (
+            "albedo = [0.5, 0.5, 0.5]",
+            "albedo = [0.5, 0.5, 0.5]\nroughness = 0.2",
+            "roughness",
+            "unknown field `roughness`",
+        ),
+    ] {
+        expect_syntax_at(from, to, at, needle);
+    }
 }
 
 #[test]
 fn malformed_toml_reports_line_and_column() {
     // An unterminated array. TOML arrays may span lines, so the parser only notices at the next
     // line, where `vfov` is neither a value nor a comma nor the closing bracket.
-    let text = edit("up = [0.0, 1.0, 0.0]", "up = [0.0, 1.0, 0.0");
-    let (line, column) = position_of(&text, "vfov = 45.0");
-    expect_syntax(&text, line, column, "missing comma");
-
+    expect_syntax_at("up = [0.0, 1.0, 0.0]", "up = [0.0, 1.0, 0.0", "vfov = 45.0", "missing comma");
     // A bare word as a value.
-    let text = edit("seed = 7", "seed = seven");
-    let (line, column) = position_of(&text, "seven");
-    expect_syntax(&text, line, column, "must be quoted");
+    expect_syntax_at("seed = 7", "seed = seven", "seven", "must be quoted");
 
     // A key without a value: reported just after the `=`, at the end of the line.
     let text = edit("seed = 7", "seed =");
@@ -553,18 +551,10 @@ fn malformed_toml_reports_line_and_column() {
 
 #[test]
 fn wrong_types_point_at_the_value_and_quote_the_line() {
-    let text = edit("spp = 4", "spp = \"16\"");
-    let (line, column) = position_of(&text, "\"16\"");
-    expect_syntax(&text, line, column, "expected an integer");
+    let text = expect_syntax_at("spp = 4", "spp = \"16\"", "\"16\"", "expected an integer");
     assert!(parse(&text).unwrap_err().to_string().contains("spp = \"16\""));
-
-    let text = edit("spp = 4", "spp = 1.5");
-    let (line, column) = position_of(&text, "1.5");
-    expect_syntax(&text, line, column, "expected an integer");
-
-    let text = edit("eye = [0.0, 1.0, -5.0]", "eye = [0.0, 1.0]");
-    let (line, column) = position_of(&text, "[0.0, 1.0]");
-    expect_syntax(&text, line, column, "array of three numbers");
+    expect_syntax_at("spp = 4", "spp = 1.5", "1.5", "expected an integer");
+    expect_syntax_at("eye = [0.0, 1.0, -5.0]", "eye = [0.0, 1.0]", "[0.0, 1.0]", "array of three numbers");
 }
 
 #[test]

@@ -38,9 +38,7 @@ pub struct WhittedParams {
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct WhittedMaterial {
     pub kind: u32,
-    pub pad0: u32,
-    pub pad1: u32,
-    pub pad2: u32,
+    pub pad: [u32; 3],
     pub a: [f32; 4],
     pub b: [f32; 4],
 }
@@ -49,9 +47,7 @@ pub struct WhittedMaterial {
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct WhittedLight {
     pub kind: u32,
-    pub pad0: u32,
-    pub pad1: u32,
-    pub pad2: u32,
+    pub pad: [u32; 3],
     pub a: [f32; 4],
     pub normal: [f32; 4],
     pub power: [f32; 4],
@@ -73,7 +69,7 @@ pub(crate) fn materials(scene: &Scene) -> Vec<WhittedMaterial> {
                 MaterialKind::Mirror { reflectance } => (MAT_MIRROR, v4(reflectance, 0.0), [0.0; 4]),
                 MaterialKind::Emitter { radiance } => (MAT_EMITTER, v4(radiance, 0.0), [0.0; 4]),
             };
-            WhittedMaterial { kind, pad0: 0, pad1: 0, pad2: 0, a, b }
+            WhittedMaterial { kind, pad: [0; 3], a, b }
         })
         .collect()
 }
@@ -84,9 +80,7 @@ pub(crate) fn lights(scene: &Scene) -> Vec<WhittedLight> {
     if let Some(sun) = &scene.directional_light {
         lights.push(WhittedLight {
             kind: LIGHT_DIRECTIONAL,
-            pad0: 0,
-            pad1: 0,
-            pad2: 0,
+            pad: [0; 3],
             a: v4(sun.to_light(), 0.0),
             normal: [0.0; 4],
             power: v4(sun.irradiance / PI, 0.0),
@@ -97,9 +91,7 @@ pub(crate) fn lights(scene: &Scene) -> Vec<WhittedLight> {
         let centre = quad.corner + 0.5 * (quad.edge_u + quad.edge_v);
         lights.push(WhittedLight {
             kind: LIGHT_POINT,
-            pad0: 0,
-            pad1: 0,
-            pad2: 0,
+            pad: [0; 3],
             a: v4(centre, 1.0),
             normal: v4(quad.normal(), 0.0),
             power: v4(scene.material_of(object).emission() * quad.area(), 0.0),

@@ -1,5 +1,6 @@
 //! The Whitted ray tracer's GPU side: buffers, the compute pipeline, one dispatch, readback.
 
+use illum_gpu::buffers::{buffer_bind_group, dispatch};
 use illum_gpu::shader::{self, ShaderFile};
 use illum_gpu::{GpuContext, GpuError, readback, shader_file, wgpu};
 use illum_image::RgbImage32;
@@ -145,17 +146,12 @@ impl WhittedTracer {
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             });
-            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("whitted"),
-                layout: &pipeline.get_bind_group_layout(0),
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: objects.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 2, resource: materials.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 3, resource: lights.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 4, resource: image.as_entire_binding() },
-                ],
-            });
+            let bind_group = buffer_bind_group(
+                device,
+                "whitted",
+                &pipeline.get_bind_group_layout(0),
+                &[(0, &params), (1, &objects), (2, &materials), (3, &lights), (4, &image)],
+            );
             (bind_group, image, params)
         })?;
         Ok(WhittedTracer {
@@ -213,15 +209,8 @@ impl WhittedTracer {
             .gpu
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("whitted") });
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("whitted"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &self.bind_group, &[]);
-            pass.dispatch_workgroups(self.width.div_ceil(WORKGROUP), self.height.div_ceil(WORKGROUP), 1);
-        }
+        let workgroups = [self.width.div_ceil(WORKGROUP), self.height.div_ceil(WORKGROUP), 1];
+        dispatch(&mut encoder, "whitted", &self.pipeline, &self.bind_group, workgroups);
         self.gpu.queue.submit([encoder.finish()]);
         let bytes = u64::from(self.width) * u64::from(self.height) * PIXEL_BYTES;
         let data = readback::read_buffer(&self.gpu, &self.image, 0, bytes, reading)?;
@@ -267,13 +256,9 @@ mod tests {
             &members!(WhittedParams: eye, right, up, forward, background, ambient, mirror_specular, shading,
                 sizes, counts),
         );
-        wgsl("Material").assert_matches(
-            size_of::<WhittedMaterial>(),
-            &members!(WhittedMaterial: kind, pad0, pad1, pad2, a, b),
-        );
-        wgsl("Light").assert_matches(
-            size_of::<WhittedLight>(),
-            &members!(WhittedLight: kind, pad0, pad1, pad2, a, normal, power),
-        );
+        wgsl("Material")
+            .assert_matches(size_of::<WhittedMaterial>(), &members!(WhittedMaterial: kind, pad, a, b));
+        wgsl("Light")
+            .assert_matches(size_of::<WhittedLight>(), &members!(WhittedLight: kind, pad, a, normal, power));
     }
 }
