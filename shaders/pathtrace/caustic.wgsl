@@ -32,12 +32,12 @@
 
 #import illum::constants::{PI, TWO_PI, INV_PI}
 #import illum::sampler::{Sampler, sampler_new, sample_1d}
-#import illum::sampling::{sample_uniform_cone, sample_disc, to_world}
+#import illum::sampling::sample_disc
 #import illum::spawn::spawn_point
 #import illum::rtcore::geometry::{NO_HIT, Surface}
 #import illum::pathtrace::scene::{params, objects, materials}
 #import illum::rtcore::traversal::{closest_hit, surface_at}
-#import illum::pathtrace::surfaces::{MATERIAL_CHECKER, MATERIAL_DIELECTRIC, MATERIAL_MIRROR, fresnel}
+#import illum::pathtrace::surfaces::{MATERIAL_CHECKER, MATERIAL_DIELECTRIC, MATERIAL_MIRROR, fresnel, sample_sun}
 #ifdef CHECKER
 #import illum::pathtrace::surfaces::checker_albedo
 #endif
@@ -188,16 +188,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var sampler = sampler_new(caustic.seed, particle, caustic.frame_base + frame);
     let u1 = sample_1d(&sampler);
     let u2 = sample_1d(&sampler);
-#ifdef SUN_DISC
-    let one_minus_cos_max = params.sun.w;
-    let to_light = normalize(to_world(params.sun.xyz, sample_uniform_cone(one_minus_cos_max, u1, u2)));
-    // L 2 pi (1 - cos_max) with L = E / (pi (1 - cos_max^2)): 2 E / (1 + cos_max), finite for
-    // any disc (params.sun.w is 1 - cos_max, see sample_uniform_cone).
-    let flux_density = params.sun_irradiance.xyz * (2.0 / (2.0 - one_minus_cos_max));
-#else
-    let to_light = params.sun.xyz;
-    let flux_density = params.sun_irradiance.xyz;
-#endif
+    // The flux density across the plane normal to the sun: L 2 pi (1 - cos_max) for a disc,
+    // the irradiance for a delta sun (surfaces.wgsl's sample_sun).
+    let sun = sample_sun(u1, u2);
+    let to_light = sun.w;
+    let flux_density = sun.weight;
     let d0 = -to_light;
     // A disc with probability proportional to its area, a point uniform on it.
     let pick = sample_1d(&sampler) * caustic.disc_area;

@@ -11,12 +11,15 @@
 
 #import illum::constants::{PI, TWO_PI, INV_PI}
 #import illum::sampler::{Sampler, sampler_new, sample_1d}
-#import illum::sampling::{sample_cosine_hemisphere, sample_uniform_hemisphere, sample_uniform_cone, to_world, sample_parallelogram}
+#import illum::sampling::{sample_cosine_hemisphere, sample_uniform_hemisphere, to_world, sample_parallelogram}
 #import illum::spawn::{spawn_point, spawn_error, max_abs}
 #import illum::rtcore::geometry::{NO_HIT, FAR, Surface}
 #import illum::pathtrace::scene::{Material, params, objects, materials, lights, batch_sum, batch_sum_sq}
 #import illum::rtcore::traversal::{closest_hit, occluded, surface_at, choose_light}
 #import illum::pathtrace::surfaces::{MATERIAL_CHECKER, MATERIAL_DIELECTRIC, MATERIAL_MIRROR}
+#ifdef SUN
+#import illum::pathtrace::surfaces::sample_sun
+#endif
 #ifdef SPECULAR
 #import illum::pathtrace::surfaces::fresnel
 #endif
@@ -81,21 +84,19 @@ fn max3(v: vec3<f32>) -> f32 {
 
 #ifdef SUN
 // Next-event estimation toward the directional light from s (rays leave from `origin`): its
-// contribution to the integral of incoming radiance x cos(theta_x), divided by its pdf. A delta
-// light: irradiance x cos. A disc of half-angle a: one direction uniform in its cone (pdf
-// 1 / (2 pi (1 - cos a))) with radiance L = irradiance / (pi sin^2 a), so radiance / pdf =
-// irradiance x 2 / (1 + cos a), finite however small the disc. Every object blocks it.
+// contribution to the integral of incoming radiance x cos(theta_x), divided by its pdf (see
+// surfaces.wgsl's sample_sun). A sun disc draws two numbers; a delta sun none. Every object
+// blocks it.
 fn sun_light(s: Surface, origin: vec3<f32>, sampler: ptr<function, Sampler>) -> vec3<f32> {
 #ifdef SUN_DISC
     let u1 = sample_1d(sampler);
     let u2 = sample_1d(sampler);
-    let one_minus_cos_max = params.sun.w;
-    let w = normalize(to_world(params.sun.xyz, sample_uniform_cone(one_minus_cos_max, u1, u2)));
-    let weight = params.sun_irradiance.xyz * (2.0 / (2.0 - one_minus_cos_max));
+    let sun = sample_sun(u1, u2);
 #else
-    let w = params.sun.xyz;
-    let weight = params.sun_irradiance.xyz;
+    let sun = sample_sun(0.0, 0.0);
 #endif
+    let w = sun.w;
+    let weight = sun.weight;
     let cos_x = dot(s.n, w);
     if (cos_x > 0.0 && !occluded(origin, w, FAR)) {
         return weight * cos_x;

@@ -1,9 +1,34 @@
 #define_import_path illum::pathtrace::surfaces
 
 // What the path tracer's two estimators (pathtrace.wgsl from the camera, caustic.wgsl from the
-// sun) both need to know about surfaces: the material kinds and the functions that read them.
+// sun) both need to know about surfaces and the sun: the material kinds, the functions that
+// read them, and the sun's sampled direction.
 
-#import illum::pathtrace::scene::{Material, objects}
+#import illum::sampling::{sample_uniform_cone, to_world}
+#import illum::pathtrace::scene::{Material, params, objects}
+
+#ifdef SUN
+// A direction toward the directional light and its weight, radiance / pdf. A delta light: its
+// direction and irradiance (u1, u2 unused). A disc of half-angle a: a direction uniform in its
+// cone (pdf 1 / (2 pi (1 - cos a))) of radiance L = irradiance / (pi sin^2 a), so L / pdf =
+// irradiance x 2 / (1 + cos a), finite however small the disc; params.sun.w holds 1 - cos a
+// (see sample_uniform_cone). Next-event estimation weighs a surface's cos by it; the caustic's
+// light tracer uses it as the flux density crossing the plane across the sun's direction.
+struct SunSample {
+    w: vec3<f32>,
+    weight: vec3<f32>,
+}
+
+fn sample_sun(u1: f32, u2: f32) -> SunSample {
+#ifdef SUN_DISC
+    let one_minus_cos_max = params.sun.w;
+    let w = normalize(to_world(params.sun.xyz, sample_uniform_cone(one_minus_cos_max, u1, u2)));
+    return SunSample(w, params.sun_irradiance.xyz * (2.0 / (2.0 - one_minus_cos_max)));
+#else
+    return SunSample(params.sun.xyz, params.sun_irradiance.xyz);
+#endif
+}
+#endif
 
 const MATERIAL_CHECKER: u32 = 1u;
 const MATERIAL_DIELECTRIC: u32 = 2u;
