@@ -48,6 +48,18 @@ else
 fi
 
 echo
+echo "== The ladder (docs/ladder-whitted.md, docs/ladder-cornell.md, the README's ladder table)"
+"$bin/ladder" --out "$out/ladder"
+cp "$out/ladder/ladder.md" docs/ladder-whitted.md
+cp "$out/ladder/error-vs-time.png" docs/images/ladder-error-vs-time.png
+cp "$out/ladder/flip-vs-time.png" docs/images/ladder-flip-vs-time.png
+cp "$out/ladder/contact-sheet.png" docs/images/ladder-contact-sheet.png
+"$bin/ladder" scenes/cornell.toml --width 256 --height 256 --truth-spp 8192 --spp-list 1,4,16,64,256 \
+    --bounce-list 0,1,2,4,8 --out "$out/ladder-cornell"
+cp "$out/ladder-cornell/ladder.md" docs/ladder-cornell.md
+cp "$out/ladder-cornell/contact-sheet.png" docs/images/ladder-cornell-contact-sheet.png
+
+echo
 echo "== 'reaches 1% estimated relative error at about N spp' (512 x 512, the default scene)"
 "$bin/render" --target-error 0.01 -o "$out/cornell-1pct.exr"
 echo

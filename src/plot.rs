@@ -8,8 +8,18 @@ use plotters::prelude::*;
 pub struct Line {
     pub label: String,
     pub points: Vec<(f64, f64)>,
-    /// Drawn as markers only (for estimates), not joined.
-    pub markers_only: bool,
+    pub style: Style,
+}
+
+/// How a [`Line`] is drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Style {
+    /// Points joined by a line, in a colour of its own.
+    Joined,
+    /// Crosses, not joined, in a colour of their own (single measurements).
+    Markers,
+    /// Crosses in the previous line's colour (estimates of that line's values).
+    MarkersOfPrevious,
 }
 
 const COLOURS: [RGBColor; 6] = [
@@ -86,12 +96,12 @@ pub fn log_log(path: &Path, title: &str, x_label: &str, y_label: &str, lines: &[
             .draw()?;
         let mut colour_index = 0;
         for (i, line) in lines.iter().enumerate() {
-            if !line.markers_only && i > 0 {
+            if line.style != Style::MarkersOfPrevious && i > 0 {
                 colour_index += 1;
             }
             let colour = COLOURS[colour_index % COLOURS.len()];
             let pts: Vec<(f64, f64)> = line.points.iter().copied().filter(|p| plottable(p)).collect();
-            if line.markers_only {
+            if line.style != Style::Joined {
                 chart
                     .draw_series(pts.iter().map(|&p| Cross::new(p, 5, colour.stroke_width(2))))?
                     .label(line.label.clone())

@@ -34,7 +34,7 @@ use illum::image::{RgbImage32, mean_luminance_bias, rel_mse, rmse};
 use illum::pathtrace::{
     PathTracer, Sequence, StopRules, TracerOptions, parse_time_budget, render_progressive,
 };
-use illum::plot::{self, Line};
+use illum::plot::{self, Line, Style};
 use illum::reference::{Reference, cached_reference, load_reference};
 use illum::report::{csv_text, write_text};
 use illum::scene::{Bounces, Sampling, Scene};
@@ -331,12 +331,12 @@ fn plot_rows(out: &Path, rows: &[Row]) -> anyhow::Result<()> {
                     Line {
                         label: format!("{name}: relMSE"),
                         points: series(rows, name, time, measured),
-                        markers_only: false,
+                        style: Style::Joined,
                     },
                     Line {
                         label: format!("{name}: estimated"),
                         points: series(rows, name, time, estimated),
-                        markers_only: true,
+                        style: Style::MarkersOfPrevious,
                     },
                 ]
             })
@@ -354,7 +354,7 @@ fn plot_rows(out: &Path, rows: &[Row]) -> anyhow::Result<()> {
         .map(|v| Line {
             label: v.name.to_owned(),
             points: series(rows, v.name, spp, measured),
-            markers_only: false,
+            style: Style::Joined,
         })
         .collect();
     // The 1/N line through the first baseline point: Monte Carlo's convergence rate.
@@ -363,7 +363,7 @@ fn plot_rows(out: &Path, rows: &[Row]) -> anyhow::Result<()> {
         lines.push(Line {
             label: "1/N (relMSE of an O(1/sqrt N) error)".into(),
             points: vec![(n0, e0), (last, e0 * n0 / last)],
-            markers_only: false,
+            style: Style::Joined,
         });
     }
     plot::log_log(&out.join("error-vs-spp.png"), "Error against samples per pixel", "spp", "relMSE", &lines)
@@ -418,6 +418,6 @@ fn bounce_table(gpu: &GpuContext, scene: &Scene, spp: u32, out: &Path) -> anyhow
         "Light added by each bounce",
         "bounce index + 1",
         "added mean luminance",
-        &[Line { label: "increment".into(), points, markers_only: false }],
+        &[Line { label: "increment".into(), points, style: Style::Joined }],
     )
 }

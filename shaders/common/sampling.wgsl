@@ -26,12 +26,16 @@ fn sample_uniform_hemisphere(u1: f32, u2: f32) -> vec3<f32> {
     return vec3<f32>(r * cos(phi), r * sin(phi), z);
 }
 
-// A direction uniform over the cone of half-angle acos(cos_max) around +z (a sun disc seen from
-// the scene): solid angle is linear in cos(theta), so cos(theta) = 1 - u1 (1 - cos_max);
-// pdf = 1 / (2 pi (1 - cos_max)). Local frame, like the hemispheres above.
-fn sample_uniform_cone(cos_max: f32, u1: f32, u2: f32) -> vec3<f32> {
-    let cos_t = 1.0 - u1 * (1.0 - cos_max);
-    let sin_t = sqrt(max(1.0 - cos_t * cos_t, 0.0));
+// A direction uniform over the cone of half-angle a around +z (a sun disc seen from the scene),
+// given one_minus_cos_max = 1 - cos(a): solid angle is linear in cos(theta), so 1 - cos(theta) =
+// u1 (1 - cos a); pdf = 1 / (2 pi (1 - cos a)). The cone is given by 1 - cos a, not cos a: for a
+// disc below about 0.02 degrees cos a rounds to 1 in f32 (the pdf's denominator would be 0), while
+// 1 - cos a = 2 sin^2(a / 2) keeps its precision; sin(theta) is computed from it for the same
+// reason, as sqrt((1 - cos) (1 + cos)). Local frame, like the hemispheres above.
+fn sample_uniform_cone(one_minus_cos_max: f32, u1: f32, u2: f32) -> vec3<f32> {
+    let one_minus_cos = u1 * one_minus_cos_max;
+    let cos_t = 1.0 - one_minus_cos;
+    let sin_t = sqrt(max(one_minus_cos * (2.0 - one_minus_cos), 0.0));
     let phi = TWO_PI * u2;
     return vec3<f32>(sin_t * cos(phi), sin_t * sin(phi), cos_t);
 }

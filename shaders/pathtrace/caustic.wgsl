@@ -36,7 +36,7 @@
 #import illum::spawn::spawn_point
 #import illum::rtcore::geometry::{NO_HIT, Surface}
 #import illum::pathtrace::scene::{params, objects, materials}
-#import illum::pathtrace::traversal::{closest_hit, surface_at}
+#import illum::rtcore::traversal::{closest_hit, surface_at}
 #import illum::pathtrace::surfaces::{MATERIAL_CHECKER, MATERIAL_DIELECTRIC, MATERIAL_MIRROR, fresnel}
 #ifdef CHECKER
 #import illum::pathtrace::surfaces::checker_albedo
@@ -189,11 +189,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let u1 = sample_1d(&sampler);
     let u2 = sample_1d(&sampler);
 #ifdef SUN_DISC
-    let cos_max = params.sun.w;
-    let to_light = normalize(to_world(params.sun.xyz, sample_uniform_cone(cos_max, u1, u2)));
-    // L 2 pi (1 - cos_max) with L = E / (pi (1 - cos_max^2)): 2 E / (1 + cos_max), a form
-    // that stays finite when a tiny disc's cos_max rounds to 1 in f32.
-    let flux_density = params.sun_irradiance.xyz * (2.0 / (1.0 + cos_max));
+    let one_minus_cos_max = params.sun.w;
+    let to_light = normalize(to_world(params.sun.xyz, sample_uniform_cone(one_minus_cos_max, u1, u2)));
+    // L 2 pi (1 - cos_max) with L = E / (pi (1 - cos_max^2)): 2 E / (1 + cos_max), finite for
+    // any disc (params.sun.w is 1 - cos_max, see sample_uniform_cone).
+    let flux_density = params.sun_irradiance.xyz * (2.0 / (2.0 - one_minus_cos_max));
 #else
     let to_light = params.sun.xyz;
     let flux_density = params.sun_irradiance.xyz;

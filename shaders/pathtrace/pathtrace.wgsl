@@ -15,7 +15,7 @@
 #import illum::spawn::{spawn_point, spawn_error, max_abs}
 #import illum::rtcore::geometry::{NO_HIT, FAR, Surface}
 #import illum::pathtrace::scene::{Material, params, objects, materials, lights, batch_sum, batch_sum_sq}
-#import illum::pathtrace::traversal::{closest_hit, occluded, surface_at, choose_light}
+#import illum::rtcore::traversal::{closest_hit, occluded, surface_at, choose_light}
 #import illum::pathtrace::surfaces::{MATERIAL_CHECKER, MATERIAL_DIELECTRIC, MATERIAL_MIRROR}
 #ifdef SPECULAR
 #import illum::pathtrace::surfaces::fresnel
@@ -83,16 +83,15 @@ fn max3(v: vec3<f32>) -> f32 {
 // Next-event estimation toward the directional light from s (rays leave from `origin`): its
 // contribution to the integral of incoming radiance x cos(theta_x), divided by its pdf. A delta
 // light: irradiance x cos. A disc of half-angle a: one direction uniform in its cone (pdf
-// 1 / (2 pi (1 - cos a))) with radiance L = irradiance / (pi sin^2 a). Every object blocks it.
+// 1 / (2 pi (1 - cos a))) with radiance L = irradiance / (pi sin^2 a), so radiance / pdf =
+// irradiance x 2 / (1 + cos a), finite however small the disc. Every object blocks it.
 fn sun_light(s: Surface, origin: vec3<f32>, sampler: ptr<function, Sampler>) -> vec3<f32> {
 #ifdef SUN_DISC
     let u1 = sample_1d(sampler);
     let u2 = sample_1d(sampler);
-    let cos_max = params.sun.w;
-    let w = normalize(to_world(params.sun.xyz, sample_uniform_cone(cos_max, u1, u2)));
-    // L 2 pi (1 - cos_max) = 2 E / (1 + cos_max): finite even when a disc of 0.01 degrees has
-    // cos_max = 1 in f32 (where L itself is E / 0).
-    let weight = params.sun_irradiance.xyz * (2.0 / (1.0 + cos_max));
+    let one_minus_cos_max = params.sun.w;
+    let w = normalize(to_world(params.sun.xyz, sample_uniform_cone(one_minus_cos_max, u1, u2)));
+    let weight = params.sun_irradiance.xyz * (2.0 / (2.0 - one_minus_cos_max));
 #else
     let w = params.sun.xyz;
     let weight = params.sun_irradiance.xyz;
@@ -106,9 +105,10 @@ fn sun_light(s: Surface, origin: vec3<f32>, sampler: ptr<function, Sampler>) -> 
 #endif
 
 #ifdef SUN_DISC
+// irradiance / (pi sin^2 a), with sin^2 a = (1 - cos a)(1 + cos a).
 fn sun_radiance() -> vec3<f32> {
-    let cos_max = params.sun.w;
-    return params.sun_irradiance.xyz / (PI * (1.0 - cos_max * cos_max));
+    let one_minus_cos_max = params.sun.w;
+    return params.sun_irradiance.xyz / (PI * one_minus_cos_max * (2.0 - one_minus_cos_max));
 }
 #endif
 
@@ -122,8 +122,7 @@ fn escaped(d: vec3<f32>, direct_counts: bool, caustic_owned: bool) -> vec3<f32> 
     l += params.sky.xyz;
 #endif
 #ifdef SUN_DISC
-    // (A disc too small for f32, cos_max = 1, is never hit: next-event estimation has it all.)
-    if (direct_counts && !caustic_owned && params.sun.w < 1.0 && dot(d, params.sun.xyz) >= params.sun.w) {
+    if (direct_counts && !caustic_owned && 1.0 - dot(d, params.sun.xyz) <= params.sun.w) {
         l += sun_radiance();
     }
 #endif

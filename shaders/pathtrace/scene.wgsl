@@ -5,14 +5,6 @@
 // The path tracer's scene as the GPU sees it (mirrored by gpu_scene.rs): its parameters,
 // materials, lights and bindings. Objects and ray-shape tests are in rtcore/geometry.wgsl.
 
-// A ray that hits an emitter within this relative distance of a coplanar surface sees the
-// emitter: the light's face lies exactly in the ceiling's plane and must win that tie. The two
-// distances come from different tests of the same plane (slab and quad), each within about 10
-// units of roundoff (u = 2^-24) of the exact distance, so they agree to ~20 u = 1.2e-6 relative;
-// 1e-5 (~170 u) leaves a wide margin and is still far below any gap between distinct surfaces
-// that the image could resolve.
-const EMITTER_TIE: f32 = 1.0e-5;
-
 struct Params {
     eye: vec3<f32>,
     tan_half_fov: f32,
@@ -36,8 +28,9 @@ struct Params {
     first_emitter: u32,
     // Samples per invocation (one chunk); the dispatch's z dimension counts chunks.
     chunk_samples: u32,
-    // The directional light (shader def SUN): xyz = unit vector toward it, w = cos of its
-    // angular radius (1 for a delta light); its irradiance on a surface facing it.
+    // The directional light (shader def SUN): xyz = unit vector toward it, w = 1 - cos of its
+    // angular radius (0 for a delta light; see sample_uniform_cone); its irradiance on a
+    // surface facing it.
     sun: vec4<f32>,
     sun_irradiance: vec4<f32>,
     // The environment's radiance (shader def SKY).

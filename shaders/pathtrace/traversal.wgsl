@@ -1,10 +1,11 @@
-#define_import_path illum::pathtrace::traversal
+#define_import_path illum::rtcore::traversal
 
-// Generic traversal: loops over the object buffer, so one pipeline serves every scene.
-// (The specialised pipeline replaces this module with code generated from the scene.)
+// Generic traversal: loops over the path tracer's object buffer, so one pipeline serves every
+// scene. (The specialised pipelines, the path tracer's by default and the Whitted ray
+// tracer's always, replace this module with code generated from the scene: specialise.rs.)
 
-#import illum::rtcore::geometry::{Hit, Object, FAR, NO_HIT, KIND_AABB, KIND_BOX, KIND_QUAD, safe_inverse, hit_slabs, hit_box, hit_quad, hit_sphere, Surface, surface_aabb, surface_box, surface_quad, surface_sphere}
-#import illum::pathtrace::scene::{EMITTER_TIE, params, objects, lights}
+#import illum::rtcore::geometry::{Hit, Object, FAR, NO_HIT, EMITTER_TIE, KIND_AABB, KIND_BOX, KIND_QUAD, safe_inverse, hit_slabs, hit_box, hit_quad, hit_sphere, Surface, surface_aabb, surface_box, surface_quad, surface_sphere}
+#import illum::pathtrace::scene::{params, objects, lights}
 
 // Closest hit over all objects. `d` must be unit length. Only the fields a shape's test needs are
 // loaded: on a CPU driver each storage-buffer read is a per-lane memory access.

@@ -5,6 +5,9 @@
 // What every compute ray tracer of illum shares: the objects as the GPU stores them (mirrored
 // by illum-pathtrace's gpu_scene.rs), the ray-shape tests, and the surface at a hit point made
 // precise for spawning the next ray. No bindings: each renderer binds its own object buffer.
+// The traversal over a scene's objects (closest_hit, occluded, surface_at) is the module
+// illum::rtcore::traversal, generated per scene by illum-pathtrace's specialise.rs and imported
+// by both the path tracer and the Whitted ray tracer.
 
 const KIND_BOX: u32 = 0u;
 const KIND_QUAD: u32 = 1u;
@@ -12,6 +15,14 @@ const KIND_SPHERE: u32 = 2u;
 const KIND_AABB: u32 = 3u;
 const NO_HIT: u32 = 0xffffffffu;
 const FAR: f32 = 3.0e38;
+
+// A ray that hits an emitter within this relative distance of a coplanar surface sees the
+// emitter: the light's face lies exactly in the ceiling's plane and must win that tie. The two
+// distances come from different tests of the same plane (slab and quad), each within about 10
+// units of roundoff (u = 2^-24) of the exact distance, so they agree to ~20 u = 1.2e-6 relative;
+// 1e-5 (~170 u) leaves a wide margin and is still far below any gap between distinct surfaces
+// that the image could resolve.
+const EMITTER_TIE: f32 = 1.0e-5;
 
 // Box: a = (local min, cos), b = (local max, sin), c = (offset, 0): world = R_y local + offset.
 // Axis-aligned box (a box without rotation): a = world min, b = world max.

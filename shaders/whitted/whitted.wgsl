@@ -4,14 +4,23 @@
 // The ray tree is walked depth-first with an explicit stack (WGSL has no recursion): a hit on a
 // mirror or a dielectric pushes its reflected and refracted rays with their weights. Each entry
 // pushes at most two children one level deeper and the walk always takes the top entry, so the
-// stack holds at most one pending sibling per level plus the entry in hand: depth + 2 entries,
-// MAX_STACK for the deepest recursion the scene format accepts (64).
+// stack holds at most one pending sibling per level plus the entry in hand: depth + 2 entries.
+// The pipeline is built for the scene's depth (shader def WHITTED_STACK = depth + 2, at most 66
+// for the deepest recursion the scene format accepts): WGSL zero-fills a function's arrays on
+// every call, and a stack sized for depth 64 made a depth-1 frame four times slower (160 x 90,
+// 2 x 2 rays per pixel, lavapipe: 80 against 21 ms).
+//
+// The traversal (closest_hit, occluded, surface_at) is the path tracer's, generated for the
+// scene with its numbers as constants (illum-pathtrace's specialise.rs): one copy of
+// intersection for both ray tracers. Its shadow rays test only the objects that can block a
+// light; a Whitted point light lies inside the area light it stands for, so the same
+// occluders serve.
 
 #import illum::spawn::spawn_point
-#import illum::rtcore::geometry::{Object, Hit, Surface, FAR, NO_HIT, KIND_AABB, KIND_BOX, KIND_QUAD, safe_inverse, hit_slabs, hit_box, hit_quad, hit_sphere, surface_aabb, surface_box, surface_quad, surface_sphere}
+#import illum::rtcore::geometry::{Object, FAR, NO_HIT}
+#import illum::rtcore::traversal::{closest_hit, occluded, surface_at}
 
-const MAX_STACK: u32 = 66u;
-const EMITTER_TIE: f32 = 1.0e-5;
+const MAX_STACK: u32 = #{WHITTED_STACK}u;
 
 const MAT_LAMBERTIAN: u32 = 0u;
 const MAT_CHECKER: u32 = 1u;
@@ -34,9 +43,9 @@ struct Params {
     mirror_specular: vec4<f32>,
     // x: the mirror's weight, y: the dielectric's shininess
     shading: vec4<f32>,
-    // width, height, number of objects, first emitter
+    // width, height, first emitter (objects before it can cast shadows), unused
     sizes: vec4<u32>,
-    // number of lights, depth, aa (n of n x n), unused
+    // number of lights, depth, aa (n of n x n), output (0: radiance, OUTPUT_OBJECT_IDS)
     counts: vec4<u32>,
 }
 
@@ -77,50 +86,6 @@ struct Ray {
     depth: u32,
 }
 
-fn hit_object(o: vec3<f32>, d: vec3<f32>, inv_d: vec3<f32>, i: u32) -> f32 {
-    let obj = objects[i];
-    switch obj.kind {
-        case KIND_AABB: { return hit_slabs(o, inv_d, obj.a.xyz, obj.b.xyz); }
-        case KIND_BOX: { return hit_box(o, d, obj.a.xyz, obj.b.xyz, obj.a.w, obj.b.w, obj.c.xyz); }
-        case KIND_QUAD: { return hit_quad(o, d, obj.a.xyz, obj.b.xyz, obj.c.xyz, obj.d.xyz); }
-        default: { return hit_sphere(o, d, obj.a.xyz, obj.a.w); }
-    }
-}
-
-// The closest hit; emitters (stored last) win a tie with a coplanar surface.
-fn closest_hit(o: vec3<f32>, d: vec3<f32>) -> Hit {
-    var best = Hit(FAR, NO_HIT);
-    let inv_d = safe_inverse(d);
-    for (var i = 0u; i < params.sizes.z; i++) {
-        let t = hit_object(o, d, inv_d, i);
-        let limit = select(best.t, min(best.t * (1.0 + EMITTER_TIE), FAR), i >= params.sizes.w);
-        if (t < limit) {
-            best = Hit(t, i);
-        }
-    }
-    return best;
-}
-
-// Whether a non-emitting object lies on o + t d for 0 < t < t_max.
-fn blocked(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> bool {
-    let inv_d = safe_inverse(d);
-    for (var i = 0u; i < params.sizes.w; i++) {
-        if (hit_object(o, d, inv_d, i) < t_max) {
-            return true;
-        }
-    }
-    return false;
-}
-
-fn surface_of(obj: Object, p: vec3<f32>) -> Surface {
-    switch obj.kind {
-        case KIND_AABB: { return surface_aabb(obj, p); }
-        case KIND_BOX: { return surface_box(obj, p); }
-        case KIND_QUAD: { return surface_quad(obj, p); }
-        default: { return surface_sphere(obj, p); }
-    }
-}
-
 // Light from every light at p (normal n toward the viewer, spawn error err), for a white
 // Lambertian surface (sum E_l max(n.l, 0) V_l) and for a Blinn-Phong highlight of `shininess`
 // seen along v (sum E_l max(n.h, 0)^shininess V_l where n.l > 0).
@@ -150,7 +115,7 @@ fn light_at(p: vec3<f32>, n: vec3<f32>, err: f32, v: vec3<f32>, shininess: f32) 
             t_max = r * (1.0 - 1.0e-5);
         }
         let cos_n = dot(n, l);
-        if (cos_n <= 0.0 || all(e == vec3<f32>(0.0)) || blocked(origin, l, t_max)) {
+        if (cos_n <= 0.0 || all(e == vec3<f32>(0.0)) || occluded(origin, l, t_max)) {
             continue;
         }
         lit.diffuse += e * cos_n;
@@ -193,7 +158,7 @@ fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
         }
         let obj = objects[hit.index];
         let m = materials[obj.material];
-        let s = surface_of(obj, ray.o + hit.t * ray.d);
+        let s = surface_at(obj, ray.o + hit.t * ray.d);
         let front = dot(s.n, ray.d) < 0.0;
         let n = select(-s.n, s.n, front);
         let v = -ray.d;
@@ -253,6 +218,46 @@ fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
     return colour;
 }
 
+// The object-ID image (params.counts.w = OUTPUT_OBJECT_IDS), from which the ladder cuts its
+// regions: for the ray through the pixel's centre, the index of the object it hits (NO_HIT for none), and from
+// that point toward the first light: SHADOW_LIT, SHADOW_FACING_AWAY (the surface faces away
+// from the light), or the index of the nearest object that blocks it. Indices are those of the
+// traversal (the path tracer's object order); bit-cast into the image's floats.
+const OUTPUT_OBJECT_IDS: u32 = 1u;
+const SHADOW_LIT: u32 = 0xfffffffeu;
+const SHADOW_FACING_AWAY: u32 = 0xfffffffdu;
+
+fn object_ids(eye: vec3<f32>, d: vec3<f32>) -> vec2<u32> {
+    let hit = closest_hit(eye, d);
+    if (hit.index == NO_HIT || params.counts.x == 0u) {
+        return vec2<u32>(hit.index, SHADOW_LIT);
+    }
+    let s = surface_at(objects[hit.index], eye + hit.t * d);
+    let n = select(-s.n, s.n, dot(s.n, d) < 0.0);
+    let light = lights[0];
+    var l = light.a.xyz;
+    var t_max = FAR;
+    if (light.kind != LIGHT_DIRECTIONAL) {
+        let to = light.a.xyz - s.p;
+        t_max = length(to) * (1.0 - 1.0e-5);
+        l = to / length(to);
+    }
+    if (dot(n, l) <= 0.0) {
+        return vec2<u32>(hit.index, SHADOW_FACING_AWAY);
+    }
+    let blocker = closest_hit(spawn_point(s.p, n, s.err), l);
+    let blocks = blocker.index < params.sizes.z && blocker.t < t_max;
+    return vec2<u32>(hit.index, select(SHADOW_LIT, blocker.index, blocks));
+}
+
+// The unit direction through the point (px, py) of the image, in pixels from its top-left.
+fn camera_ray(px: f32, py: f32) -> vec3<f32> {
+    let x = 2.0 * px / f32(params.sizes.x) - 1.0;
+    let y = 1.0 - 2.0 * py / f32(params.sizes.y);
+    return normalize(params.forward.xyz + x * params.right.w * params.eye.w * params.right.xyz
+        + y * params.eye.w * params.up.xyz);
+}
+
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let width = params.sizes.x;
@@ -260,18 +265,17 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if (id.x >= width || id.y >= height) {
         return;
     }
+    if (params.counts.w == OUTPUT_OBJECT_IDS) {
+        let ids = object_ids(params.eye.xyz, camera_ray(f32(id.x) + 0.5, f32(id.y) + 0.5));
+        image[id.y * width + id.x] = vec4<f32>(bitcast<f32>(ids.x), bitcast<f32>(ids.y), 0.0, 0.0);
+        return;
+    }
     let n = max(params.counts.z, 1u);
     var sum = vec3<f32>(0.0);
     for (var j = 0u; j < n; j++) {
         for (var i = 0u; i < n; i++) {
             // The cell centres of an n x n grid over the pixel.
-            let px = f32(id.x) + (f32(i) + 0.5) / f32(n);
-            let py = f32(id.y) + (f32(j) + 0.5) / f32(n);
-            let x = 2.0 * px / f32(width) - 1.0;
-            let y = 1.0 - 2.0 * py / f32(height);
-            let d = normalize(params.forward.xyz + x * params.right.w * params.eye.w * params.right.xyz
-                + y * params.eye.w * params.up.xyz);
-            sum += trace(params.eye.xyz, d);
+            sum += trace(params.eye.xyz, camera_ray(f32(id.x) + (f32(i) + 0.5) / f32(n), f32(id.y) + (f32(j) + 0.5) / f32(n)));
         }
     }
     image[id.y * width + id.x] = vec4<f32>(sum / f32(n * n), 1.0);

@@ -15,7 +15,9 @@
 //! - `specialisation`: each scene's pipeline holds what it uses, is cached, refuses others,
 //!   and keeps the caller's submission size across a resize;
 //! - `overflow`: lights up to f32::MAX keep a finite image, error estimate and display sum;
-//! - `random_scenes`: a few hundred random valid scenes render without NaN or dropped samples.
+//! - `random_scenes`: a few hundred random valid scenes render without NaN or dropped samples;
+//! - `whitted_extremes`: the Whitted scene's sun at extreme elevations and sizes against the
+//!   floor's closed form, and albedo 1 with unbounded bounces.
 //!
 //! naga validates the shaders without a GPU in each crate's own tests (see tests/shaders.rs).
 
@@ -35,3 +37,4 @@ mod reference;
 mod sampling;
 mod specialisation;
 mod statistics;
+mod whitted_extremes;

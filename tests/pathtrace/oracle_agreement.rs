@@ -143,6 +143,22 @@ fn the_whitted_scene_agrees_with_the_oracle_at_bounces_0_1_8() {
     }
 }
 
+/// Glass barely denser than air (1.0001: grazing refraction, reflectance near 0) and far denser
+/// (4: the critical angle is 14.5 degrees, so rays bounce inside by total internal reflection
+/// many times).
+#[test]
+fn extreme_indices_of_refraction_agree_with_the_oracle() {
+    for ior in [1.0001f32, 4.0] {
+        let mut s = scene("whitted", 8);
+        for m in &mut s.materials {
+            if let illum::scene::MaterialKind::Dielectric { ior: value } = &mut m.kind {
+                *value = ior;
+            }
+        }
+        compare_scene(&format!("whitted, ior {ior}, bounces 8"), &s);
+    }
+}
+
 #[test]
 fn a_sun_disc_agrees_with_the_oracle() {
     let mut s = scene("whitted", 1);

@@ -148,24 +148,40 @@ fn uniform_hemisphere_sampling_follows_one_over_two_pi() {
 
 #[test]
 fn sun_disc_sampling_is_uniform_over_its_cone() {
-    // A cone of half-angle 20 degrees around a tilted axis (the sun's next-event estimation).
+    // Cones of half-angle 20 and 0.05 degrees around a tilted axis (the sun's next-event
+    // estimation). At 0.05 degrees cos(theta_max) is 1 - 3.8e-7 in f32, a few float steps from
+    // 1: the routine takes 1 - cos(theta_max), which keeps its precision there.
+    for degrees in [20.0f64, 0.05] {
+        check_cone(degrees);
+    }
+}
+
+fn check_cone(degrees: f64) {
     let (n, n_wgsl) = tilted_normal();
-    let theta_max = 20f64.to_radians();
-    let cos_max = theta_max.cos() as f32;
-    let samples =
-        run_on_gpu(&format!("normalize(to_world({n_wgsl}, sample_uniform_cone({cos_max:?}, u1, u2)))"), 6);
+    let theta_max = degrees.to_radians();
+    let half = theta_max / 2.0;
+    let one_minus_cos_max = (2.0 * half.sin() * half.sin()) as f32;
+    let samples = run_on_gpu(
+        &format!("normalize(to_world({n_wgsl}, sample_uniform_cone({one_minus_cos_max:?}, u1, u2)))"),
+        6,
+    );
     let (t, b) = frame(n);
     let mut counts = vec![0u64; THETA_BINS * PHI_BINS];
     for d in &samples {
-        let theta = d.dot(n).clamp(-1.0, 1.0).acos();
-        assert!(theta <= theta_max + 1e-4, "direction {d} outside the cone ({theta} rad)");
+        // atan2 of sin and cos: acos of a dot product near 1 would lose the small angles.
+        let theta = d.cross(n).length().atan2(d.dot(n));
+        assert!(
+            theta <= theta_max * 1.001,
+            "{degrees} degrees: direction {d} outside the cone ({theta} rad)"
+        );
         let phi = d.dot(b).atan2(d.dot(t)).rem_euclid(2.0 * PI);
         let i = ((theta / theta_max * THETA_BINS as f64) as usize).min(THETA_BINS - 1);
         let j = ((phi / (2.0 * PI) * PHI_BINS as f64) as usize).min(PHI_BINS - 1);
         counts[i * PHI_BINS + j] += 1;
     }
-    // Uniform over the cone's solid angle: the theta CDF is (1 - cos theta) / (1 - cos theta_max).
-    let cdf = |theta: f64| (1.0 - theta.cos()) / (1.0 - theta_max.cos());
+    // Uniform over the cone's solid angle: the theta CDF is (1 - cos theta) / (1 - cos theta_max)
+    // = sin^2(theta / 2) / sin^2(theta_max / 2).
+    let cdf = |theta: f64| (theta / 2.0).sin().powi(2) / half.sin().powi(2);
     let mut p = Vec::new();
     for i in 0..THETA_BINS {
         let (t0, t1) =
@@ -174,7 +190,7 @@ fn sun_disc_sampling_is_uniform_over_its_cone() {
             p.push((cdf(t1) - cdf(t0)) / PHI_BINS as f64);
         }
     }
-    chi_square_test("sun cone", &counts, &p);
+    chi_square_test(&format!("sun cone of {degrees} degrees"), &counts, &p);
 }
 
 #[test]

@@ -22,9 +22,6 @@ fn changed(a: &RgbImage32, b: &RgbImage32) -> Vec<(u32, u32)> {
     out
 }
 
-/// Turns one effect off.
-type Toggle = fn(&mut Effects);
-
 /// `look` with every effect on but what `change` turns off.
 pub(crate) fn with(look: Look, change: impl FnOnce(&mut Effects)) -> Options {
     let mut options = Options::all_on(look);
@@ -37,15 +34,7 @@ fn each_toggle_changes_the_picture_or_is_documented_not_to() {
     let s = scene();
     for look in Look::ALL {
         let all = render(&s, &Options::all_on(look));
-        let toggles: [(&str, Toggle); 6] = [
-            ("shadows", |e| e.shadows = false),
-            ("pcf", |e| e.pcf = false),
-            ("refraction", |e| e.refraction = false),
-            ("reflection", |e| e.reflection = false),
-            ("fresnel", |e| e.fresnel = false),
-            ("msaa", |e| e.msaa = false),
-        ];
-        for (name, off) in toggles {
+        for (name, off) in Effects::TOGGLES {
             let n = changed(&all, &render(&s, &with(look, off))).len();
             // The figure has no reflections and no Fresnel: those toggles belong to the enhanced look.
             let inert = look == Look::Figure && (name == "reflection" || name == "fresnel");

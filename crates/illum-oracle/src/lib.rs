@@ -46,12 +46,12 @@ mod camera;
 mod caustic;
 pub mod chi_square;
 pub mod closed_form;
-mod geometry;
+pub mod geometry;
 mod integrator;
 mod render;
 mod rng;
 mod sampling;
-mod scene;
+pub mod scene;
 pub mod whitted;
 
 pub use camera::PinholeCamera;

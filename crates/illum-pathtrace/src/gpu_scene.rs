@@ -236,6 +236,13 @@ pub struct GpuScene {
     pub radiance_exponent: i32,
 }
 
+/// 1 - cos(a) for a sun of angular radius `degrees`, as 2 sin^2(a / 2) in f64: exact to f32
+/// precision for any radius (cos a itself rounds to 1 in f32 below about 0.02 degrees).
+fn one_minus_cos(degrees: f32) -> f32 {
+    let half = f64::from(degrees).to_radians() / 2.0;
+    (2.0 * half.sin() * half.sin()) as f32
+}
+
 fn v4(v: Vec3, w: f32) -> [f32; 4] {
     [v.x, v.y, v.z, w]
 }
@@ -433,7 +440,7 @@ pub fn params(scene: &Scene, gpu_scene: &GpuScene) -> GpuParams {
         chunk_samples: crate::batch::CHUNK_SAMPLES,
         sun: scene
             .directional_light
-            .map_or([0.0; 4], |l| v4(l.to_light(), l.angular_radius_deg.to_radians().cos())),
+            .map_or([0.0; 4], |l| v4(l.to_light(), one_minus_cos(l.angular_radius_deg))),
         sun_irradiance: scene.directional_light.map_or([0.0; 4], |l| v4(l.irradiance * scale, 1.0)),
         sky: scene.environment.map_or([0.0; 4], |e| v4(e.radiance * scale, 1.0)),
     }

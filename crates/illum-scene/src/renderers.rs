@@ -123,10 +123,23 @@ pub struct Effects {
     pub msaa: bool,
 }
 
+/// Turns one effect off.
+pub type EffectOff = fn(&mut Effects);
+
 impl Effects {
     /// Every effect on (the default).
     pub const ALL_ON: Effects =
         Effects { shadows: true, pcf: true, refraction: true, reflection: true, fresnel: true, msaa: true };
+
+    /// Each effect's name (its key in `[raster.effects]`) and how to turn it off.
+    pub const TOGGLES: [(&'static str, EffectOff); 6] = [
+        ("shadows", |e| e.shadows = false),
+        ("pcf", |e| e.pcf = false),
+        ("refraction", |e| e.refraction = false),
+        ("reflection", |e| e.reflection = false),
+        ("fresnel", |e| e.fresnel = false),
+        ("msaa", |e| e.msaa = false),
+    ];
 }
 
 impl Default for Effects {

@@ -1,6 +1,8 @@
 //! The application: the mode switch, opening scene files, and the layout (top bar, the mode's
-//! panel on the left, the image filling the rest). Each mode keeps its own settings, camera
-//! and renderer, so switching away and back finds them as they were.
+//! panel on the left, the image filling the rest). Each mode keeps its own settings and
+//! renderer, so switching away and back finds them as they were. The camera follows a switch
+//! between two modes that show the same scene file, so one view can be flipped between the
+//! three renderers.
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -9,6 +11,7 @@ use std::str::FromStr;
 use illum_gpu::GpuContext;
 use illum_scene::RendererKind;
 
+use crate::camera::OrbitCamera;
 use crate::frame_rate::FrameRate;
 use crate::pathtrace_panel::PathTraceMode;
 use crate::raster_panel::RasterMode;
@@ -133,10 +136,49 @@ impl ViewerApp {
 
     /// The scene file of the mode shown, as it was given.
     fn current_scene_path(&self) -> Option<String> {
-        match self.mode {
+        self.scene_path_of(self.mode)
+    }
+
+    /// The scene file of `mode`, as it was given.
+    fn scene_path_of(&self, mode: Mode) -> Option<String> {
+        match mode {
             Mode::Raster => self.raster.as_ref().ok().map(|m| m.scene_path().display().to_string()),
             Mode::PathTrace => self.pathtrace.as_ref().ok().map(|m| m.scene_path().display().to_string()),
             Mode::Whitted => self.whitted.as_ref().ok().map(|m| m.scene_path().display().to_string()),
+        }
+    }
+
+    /// The orbit camera of `mode`, when it has a scene.
+    fn camera_of(&mut self, mode: Mode) -> Option<&mut OrbitCamera> {
+        match mode {
+            Mode::Raster => self.raster.as_mut().ok().map(|m| &mut m.camera),
+            Mode::PathTrace => self.pathtrace.as_mut().ok().map(|m| &mut m.camera),
+            Mode::Whitted => self.whitted.as_mut().ok().map(|m| &mut m.camera),
+        }
+    }
+
+    /// Gives the mode now shown the camera of `from` if both show the same scene file (the
+    /// renderer then draws the same view; each one redraws when its camera changes).
+    fn carry_camera(&mut self, from: Mode) {
+        let same_scene =
+            self.scene_path_of(from).is_some() && self.scene_path_of(from) == self.current_scene_path();
+        let Some(camera) = self.camera_of(from).copied() else { return };
+        if let (true, Some(to)) = (same_scene, self.camera_of(self.mode)) {
+            *to = camera;
+        }
+    }
+
+    /// Switches to `mode` as the top bar's buttons do (the camera follows, see
+    /// [`Self::carry_camera`]).
+    pub fn switch_to(&mut self, mode: Mode) {
+        let before = std::mem::replace(&mut self.mode, mode);
+        if mode != before {
+            self.carry_camera(before);
+            if let Some(current) = self.current_scene_path() {
+                // The field follows the mode: it names the scene now shown.
+                self.scene_field = current;
+                self.open_error = None;
+            }
         }
     }
 
@@ -199,17 +241,11 @@ impl ViewerApp {
             if ui.button(panel_button).clicked() {
                 self.show_panel = !self.show_panel;
             }
-            let before = self.mode;
-            ui.selectable_value(&mut self.mode, Mode::Raster, "Raster");
-            ui.selectable_value(&mut self.mode, Mode::PathTrace, "Path tracer");
-            ui.selectable_value(&mut self.mode, Mode::Whitted, "Whitted");
-            if self.mode != before
-                && let Some(current) = self.current_scene_path()
-            {
-                // The field follows the mode: it names the scene now shown.
-                self.scene_field = current;
-                self.open_error = None;
-            }
+            let mut chosen = self.mode;
+            ui.selectable_value(&mut chosen, Mode::Raster, "Raster");
+            ui.selectable_value(&mut chosen, Mode::PathTrace, "Path tracer");
+            ui.selectable_value(&mut chosen, Mode::Whitted, "Whitted");
+            self.switch_to(chosen);
             ui.separator();
             let label = ui.label("Scene");
             let field = ui
@@ -278,12 +314,7 @@ impl ViewerApp {
             Some(id) => ui.add(egui::Image::new(egui::load::SizedTexture::new(id, size)).sense(sense)),
             None => ui.allocate_response(size, sense),
         };
-        let camera = match self.mode {
-            Mode::Raster => self.raster.as_mut().ok().map(|m| &mut m.camera),
-            Mode::PathTrace => self.pathtrace.as_mut().ok().map(|m| &mut m.camera),
-            Mode::Whitted => self.whitted.as_mut().ok().map(|m| &mut m.camera),
-        };
-        if let Some(camera) = camera
+        if let Some(camera) = self.camera_of(self.mode)
             && camera.handle(ui, &response)
         {
             ui.ctx().request_repaint();

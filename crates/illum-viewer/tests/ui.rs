@@ -33,14 +33,15 @@ fn shared_device() -> egui_wgpu::WgpuSetupExisting {
 }
 
 fn harness(mode: Mode) -> Harness<'static, ViewerApp> {
+    harness_with("scenes/cornell.toml", mode)
+}
+
+fn harness_with(scene: &'static str, mode: Mode) -> Harness<'static, ViewerApp> {
     Harness::builder()
         .with_size(egui::vec2(900.0, 560.0))
         .wgpu_setup(egui_wgpu::WgpuSetup::Existing(shared_device()))
         .build_eframe(move |cc| {
-            ViewerApp::new(
-                cc,
-                StartOptions { scene: "scenes/cornell.toml".into(), mode: Some(mode), screenshot: None },
-            )
+            ViewerApp::new(cc, StartOptions { scene: scene.into(), mode: Some(mode), screenshot: None })
         })
 }
 
@@ -251,7 +252,43 @@ fn dragging_orbits_the_camera_and_reset_camera_restores_it() {
     assert!(spp(&harness) > 0);
     // Paused, so that the restart caused by the camera change stays visible as 0 spp.
     click(&mut harness, "Pause");
-    // The image fills the central panel, right of the settings panel.
+    drag_across_the_image(&mut harness);
+    assert!(!harness.state().pathtrace().unwrap().camera.is_home(), "the drag did not move the camera");
+    assert_eq!(spp(&harness), 0, "a camera change restarts the accumulation");
+    harness.get_by_label("Reset camera").click();
+    harness.run_steps(2);
+    assert!(harness.state().pathtrace().unwrap().camera.is_home());
+}
+
+/// The view flips between the three renderers: a camera moved in one mode is the camera of
+/// the next mode shown, when both show the same scene file; a mode showing another file keeps
+/// its own.
+#[test]
+fn switching_modes_keeps_the_camera_on_the_same_scene() {
+    let mut harness = harness_with("scenes/whitted.toml", Mode::Whitted);
+    harness.run_steps(2);
+    drag_across_the_image(&mut harness);
+    let moved = harness.state().whitted().unwrap().camera;
+    assert!(!moved.is_home(), "the drag did not move the camera");
+    click(&mut harness, "Path tracer");
+    harness.run_steps(1);
+    assert_eq!(harness.state().mode(), Mode::PathTrace);
+    assert_eq!(harness.state().pathtrace().unwrap().camera, moved);
+    click(&mut harness, "Raster");
+    harness.run_steps(1);
+    assert_eq!(harness.state().raster().unwrap().camera, moved);
+
+    // The Cornell box opened in the path tracer only (the rasterizer cannot draw it): the
+    // raster keeps the Whitted scene and its camera, and the box starts from its own.
+    harness.state_mut().open(std::path::Path::new("scenes/cornell.toml")).unwrap();
+    click(&mut harness, "Path tracer");
+    assert!(harness.state().pathtrace().unwrap().camera.is_home());
+    assert_eq!(harness.state().raster().unwrap().camera, moved);
+}
+
+/// A left drag across the middle of the image, in steps (the image fills the central panel,
+/// right of the settings panel).
+fn drag_across_the_image(harness: &mut Harness<'_, ViewerApp>) {
     let start = egui::pos2(600.0, 300.0);
     harness.event(egui::Event::PointerMoved(start));
     harness.event(egui::Event::PointerButton {
@@ -273,11 +310,6 @@ fn dragging_orbits_the_camera_and_reset_camera_restores_it() {
         modifiers: egui::Modifiers::NONE,
     });
     harness.run_steps(2);
-    assert!(!harness.state().pathtrace().unwrap().camera.is_home(), "the drag did not move the camera");
-    assert_eq!(spp(&harness), 0, "a camera change restarts the accumulation");
-    harness.get_by_label("Reset camera").click();
-    harness.run_steps(2);
-    assert!(harness.state().pathtrace().unwrap().camera.is_home());
 }
 
 #[test]

@@ -108,7 +108,7 @@ pub(crate) fn lights(scene: &Scene) -> Vec<WhittedLight> {
     lights
 }
 
-pub(crate) fn params(scene: &Scene, num_objects: u32, first_emitter: u32, num_lights: u32) -> WhittedParams {
+pub(crate) fn params(scene: &Scene, first_emitter: u32, num_lights: u32, output: u32) -> WhittedParams {
     let b = scene.camera.basis();
     let mirror = scene.shading.mirror;
     WhittedParams {
@@ -120,7 +120,7 @@ pub(crate) fn params(scene: &Scene, num_objects: u32, first_emitter: u32, num_li
         ambient: v4(scene.shading.ambient, 0.0),
         mirror_specular: v4(mirror.specular, mirror.shininess),
         shading: [mirror.weight, scene.shading.dielectric.shininess, 0.0, 0.0],
-        sizes: [scene.camera.width, scene.camera.height, num_objects, first_emitter],
-        counts: [num_lights, scene.whitted.depth, scene.whitted.aa, 0],
+        sizes: [scene.camera.width, scene.camera.height, first_emitter, 0],
+        counts: [num_lights, scene.whitted.depth, scene.whitted.aa, output],
     }
 }

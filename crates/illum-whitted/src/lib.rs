@@ -28,4 +28,6 @@ mod encode;
 mod tracer;
 
 pub use encode::FEATURES_BUT;
-pub use tracer::{WHITTED_SHADER, WhittedError, WhittedTracer, shader_modules};
+pub use tracer::{
+    ObjectIds, Shadow, WHITTED_SHADER, WhittedError, WhittedTracer, shader_defs, shader_modules,
+};

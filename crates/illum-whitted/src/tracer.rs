@@ -3,12 +3,12 @@
 use illum_gpu::shader::{self, ShaderFile};
 use illum_gpu::{GpuContext, GpuError, readback, shader_file, wgpu};
 use illum_image::RgbImage32;
-use illum_pathtrace::gpu_scene::{ObjectRecord, ordered_objects};
-use illum_pathtrace::{GEOMETRY_MODULE, SPAWN_MODULE};
+use illum_pathtrace::gpu_scene::GpuScene;
+use illum_pathtrace::{GEOMETRY_MODULE, PathTraceError, SPAWN_MODULE, specialise};
 use illum_scene::{Scene, SceneError};
 use wgpu::util::DeviceExt;
 
-use crate::encode::{self, FEATURES_BUT, WhittedLight, WhittedMaterial};
+use crate::encode::{self, FEATURES_BUT, WhittedLight, WhittedMaterial, WhittedParams};
 
 /// The entry shader (entry point `main`).
 pub const WHITTED_SHADER: ShaderFile = shader_file!("shaders/whitted/whitted.wgsl");
@@ -25,12 +25,30 @@ pub enum WhittedError {
     Gpu(#[from] GpuError),
     #[error(transparent)]
     Scene(#[from] SceneError),
+    /// The scene's GPU encoding (shared with the path tracer) refused it.
+    #[error(transparent)]
+    Encoding(#[from] PathTraceError),
 }
 
-/// The modules the entry shader imports, in import order.
-pub fn shader_modules() -> Vec<ShaderFile> {
-    vec![SPAWN_MODULE, GEOMETRY_MODULE]
+/// The shader defs of the pipeline for `scene`: its ray stack's size, depth + 2 (see the
+/// shader's header).
+pub fn shader_defs(scene: &Scene) -> Vec<(&'static str, shader::Def)> {
+    vec![("WHITTED_STACK", shader::Def::UInt(scene.whitted.depth + 2))]
 }
+
+/// The modules the entry shader imports for `scene`, in import order: ray spawning, the shared
+/// geometry, and the path tracer's traversal generated for this scene (`specialise.rs`).
+pub fn shader_modules(scene: &Scene, gpu_scene: &GpuScene) -> Vec<ShaderFile> {
+    vec![SPAWN_MODULE, GEOMETRY_MODULE, specialise::traversal_module(scene, gpu_scene)]
+}
+
+/// What the pipeline writes (`params.counts.w`, OUTPUT_* in the shader).
+const OUTPUT_RADIANCE: u32 = 0;
+const OUTPUT_OBJECT_IDS: u32 = 1;
+/// The shader's markers in the shadow channel of the object-ID image.
+const SHADOW_LIT: u32 = 0xffff_fffe;
+const SHADOW_FACING_AWAY: u32 = 0xffff_fffd;
+const NO_HIT: u32 = u32::MAX;
 
 /// Whitted's algorithm on one scene, at the scene's resolution, depth and anti-aliasing.
 pub struct WhittedTracer {
@@ -39,7 +57,35 @@ pub struct WhittedTracer {
     height: u32,
     pipeline: wgpu::ComputePipeline,
     bind_group: wgpu::BindGroup,
+    params: wgpu::Buffer,
+    radiance_params: WhittedParams,
     image: wgpu::Buffer,
+    /// The index in `scene.objects` of each object in the GPU's order.
+    scene_index: Vec<usize>,
+}
+
+/// Where the first light stands from the point a pixel's centre ray hits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shadow {
+    /// The light reaches the point (also for a pixel that sees no object, or a scene without
+    /// lights).
+    Lit,
+    /// The surface faces away from the light.
+    FacingAway,
+    /// This object (an index into `scene.objects`) is the nearest one blocking the light.
+    BlockedBy(usize),
+}
+
+/// The object-ID image: for the ray through each pixel's centre, the object it hits and whether
+/// the scene's first light reaches that point (the ladder's regions are cut from it).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ObjectIds {
+    pub width: u32,
+    pub height: u32,
+    /// Per pixel, row-major from the top-left: the index into `scene.objects` of the object the
+    /// centre ray hits, if any.
+    pub hit: Vec<Option<usize>>,
+    pub shadow: Vec<Shadow>,
 }
 
 impl WhittedTracer {
@@ -59,11 +105,16 @@ impl WhittedTracer {
             )
             .into());
         }
-        let (objects, first_emitter) = ordered_objects(scene);
-        let records: Vec<ObjectRecord> = objects.iter().map(|(_, o)| o.record()).collect();
+        // The path tracer's encoding: objects in its order (emitters last), as the traversal and
+        // the materials index them.
+        let gpu_scene = GpuScene::new(scene)?;
+        let records = gpu_scene.object_records();
         let materials = encode::materials(scene);
         let lights = encode::lights(scene);
-        let params = encode::params(scene, records.len() as u32, first_emitter, lights.len() as u32);
+        let radiance_params =
+            encode::params(scene, gpu_scene.first_emitter, lights.len() as u32, OUTPUT_RADIANCE);
+        let (ordered, _) = illum_pathtrace::gpu_scene::ordered_objects(scene);
+        let scene_index = ordered.iter().map(|(i, _)| *i).collect();
 
         let device = &gpu.device;
         // Storage buffers may not be empty: a scene without lights binds one unused record.
@@ -72,13 +123,18 @@ impl WhittedTracer {
         let lights_or_one = if lights.is_empty() { vec![WhittedLight::default()] } else { lights };
         let materials_or_one =
             if materials.is_empty() { vec![WhittedMaterial::default()] } else { materials };
-        let pipeline =
-            shader::compute_pipeline(gpu, &shader_modules(), &WHITTED_SHADER, &[], "whitted ray tracer")?;
-        let (bind_group, image) = gpu.scoped("creating the Whitted ray tracer's buffers", || {
+        let pipeline = shader::compute_pipeline(
+            gpu,
+            &shader_modules(scene, &gpu_scene),
+            &WHITTED_SHADER,
+            &shader_defs(scene),
+            "whitted ray tracer",
+        )?;
+        let (bind_group, image, params) = gpu.scoped("creating the Whitted ray tracer's buffers", || {
             let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("whitted params"),
-                contents: bytemuck::bytes_of(&params),
-                usage: wgpu::BufferUsages::UNIFORM,
+                contents: bytemuck::bytes_of(&radiance_params),
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             });
             let objects = storage("whitted objects", bytemuck::cast_slice(&records));
             let materials = storage("whitted materials", bytemuck::cast_slice(&materials_or_one));
@@ -100,13 +156,59 @@ impl WhittedTracer {
                     wgpu::BindGroupEntry { binding: 4, resource: image.as_entire_binding() },
                 ],
             });
-            (bind_group, image)
+            (bind_group, image, params)
         })?;
-        Ok(WhittedTracer { gpu: gpu.clone(), width, height, pipeline, bind_group, image })
+        Ok(WhittedTracer {
+            gpu: gpu.clone(),
+            width,
+            height,
+            pipeline,
+            bind_group,
+            params,
+            radiance_params,
+            image,
+            scene_index,
+        })
     }
 
     /// Renders the image: linear radiance per pixel, row-major from the top-left.
     pub fn render(&self) -> Result<RgbImage32, WhittedError> {
+        let texels = self.run(OUTPUT_RADIANCE, "reading the Whitted image")?;
+        let mut image = RgbImage32::new(self.width, self.height);
+        for (pixel, texel) in image.pixels.iter_mut().zip(&texels) {
+            *pixel = [texel[0], texel[1], texel[2]];
+        }
+        Ok(image)
+    }
+
+    /// The object-ID image of the same camera (one ray through each pixel's centre).
+    pub fn object_ids(&self) -> Result<ObjectIds, WhittedError> {
+        let texels = self.run(OUTPUT_OBJECT_IDS, "reading the object-ID image")?;
+        let scene_object = |gpu_index: u32| self.scene_index.get(gpu_index as usize).copied();
+        let hit = texels.iter().map(|t| scene_object(t[0].to_bits())).collect();
+        let shadow = texels
+            .iter()
+            .map(|t| match t[1].to_bits() {
+                SHADOW_LIT | NO_HIT => Shadow::Lit,
+                SHADOW_FACING_AWAY => Shadow::FacingAway,
+                i => scene_object(i).map_or(Shadow::Lit, Shadow::BlockedBy),
+            })
+            .collect();
+        Ok(ObjectIds { width: self.width, height: self.height, hit, shadow })
+    }
+
+    /// One dispatch writing `output`, read back as one vec4 per pixel.
+    fn run(&self, output: u32, reading: &str) -> Result<Vec<[f32; 4]>, WhittedError> {
+        let params = WhittedParams {
+            counts: [
+                self.radiance_params.counts[0],
+                self.radiance_params.counts[1],
+                self.radiance_params.counts[2],
+                output,
+            ],
+            ..self.radiance_params
+        };
+        self.gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         let mut encoder = self
             .gpu
             .device
@@ -122,14 +224,9 @@ impl WhittedTracer {
         }
         self.gpu.queue.submit([encoder.finish()]);
         let bytes = u64::from(self.width) * u64::from(self.height) * PIXEL_BYTES;
-        let data = readback::read_buffer(&self.gpu, &self.image, 0, bytes, "reading the Whitted image")?;
+        let data = readback::read_buffer(&self.gpu, &self.image, 0, bytes, reading)?;
         self.gpu.check()?;
-        let texels: &[[f32; 4]] = bytemuck::cast_slice(&data);
-        let mut image = RgbImage32::new(self.width, self.height);
-        for (pixel, texel) in image.pixels.iter_mut().zip(texels) {
-            *pixel = [texel[0], texel[1], texel[2]];
-        }
-        Ok(image)
+        Ok(bytemuck::cast_slice(&data).to_vec())
     }
 }
 
@@ -143,17 +240,25 @@ mod tests {
     use super::*;
     use crate::encode::WhittedParams;
 
-    /// The shader composes and validates without a GPU, and the Rust records have naga's layout
-    /// of the WGSL structs.
+    /// The shader composes and validates without a GPU for every shipped scene, and the Rust
+    /// records have naga's layout of the WGSL structs.
     #[test]
     fn the_shader_validates_and_the_records_match_its_structs() {
-        let module =
-            shader::compose(&shader_modules(), &WHITTED_SHADER, &[]).unwrap_or_else(|e| panic!("{e}"));
-        let mut validator = naga::valid::Validator::new(
-            naga::valid::ValidationFlags::all(),
-            naga::valid::Capabilities::all(),
-        );
-        validator.validate(&module).unwrap_or_else(|e| panic!("whitted.wgsl: {e:?}"));
+        let mut module = None;
+        for name in ["whitted.toml", "cornell.toml"] {
+            let scene = illum_scene::testing::shipped_scene(name, 32, 32);
+            let gpu_scene = GpuScene::new(&scene).unwrap();
+            let composed =
+                shader::compose(&shader_modules(&scene, &gpu_scene), &WHITTED_SHADER, &shader_defs(&scene))
+                    .unwrap_or_else(|e| panic!("{name}: {e}"));
+            let mut validator = naga::valid::Validator::new(
+                naga::valid::ValidationFlags::all(),
+                naga::valid::Capabilities::all(),
+            );
+            validator.validate(&composed).unwrap_or_else(|e| panic!("whitted.wgsl for {name}: {e:?}"));
+            module = Some(composed);
+        }
+        let module = module.expect("two scenes");
         let wgsl = |name: &str| {
             wgsl_struct(&module, "", name).unwrap_or_else(|| panic!("no struct {name} in whitted.wgsl"))
         };

@@ -1,0 +1,111 @@
+//! The object-ID image against a closed form computed in f64: each pixel's centre ray hits the
+//! nearest of the scene's shapes (the oracle's intersection, which shares no code with WGSL), and a
+//! floor point lies in a ball's shadow exactly when the ball's projection along the light
+//! covers it: the line p + t L (t > 0) passes within the radius of the centre. Pixels where a
+//! silhouette or a shadow edge passes within a small margin of the centre ray may fall on the
+//! other side in f32; they are skipped and counted (under 2% of the image).
+
+use std::sync::OnceLock;
+
+use glam::DVec3;
+use illum_gpu::GpuContext;
+use illum_oracle::closed_form::pixel_ray;
+use illum_scene::{Scene, Shape};
+use illum_whitted::{Shadow, WhittedTracer};
+
+fn gpu() -> &'static GpuContext {
+    static GPU: OnceLock<GpuContext> = OnceLock::new();
+    GPU.get_or_init(|| GpuContext::new().unwrap_or_else(|e| panic!("{e}")))
+}
+
+/// How far the ray (o, d) passes from the shape's outline: from a sphere's silhouette, or from
+/// the nearest edge of a rectangle where it crosses its plane (a small margin means f32 may
+/// decide hit or miss the other way).
+fn margin(shape: &Shape, o: DVec3, d: DVec3) -> f64 {
+    match shape {
+        Shape::Sphere(s) => {
+            let oc = o - s.center.as_dvec3();
+            (f64::from(s.radius) - (oc - oc.dot(d) * d).length()).abs()
+        }
+        Shape::Quad(q) => {
+            let (u, v) = (q.edge_u.as_dvec3(), q.edge_v.as_dvec3());
+            let n = u.cross(v);
+            let p = o + (q.corner.as_dvec3() - o).dot(n) / d.dot(n) * d - q.corner.as_dvec3();
+            // Rectangle coordinates along each edge, in scene units.
+            let (a, b) = (p.dot(u) / u.length(), p.dot(v) / v.length());
+            [a, u.length() - a, b, v.length() - b].into_iter().map(f64::abs).fold(f64::MAX, f64::min)
+        }
+        Shape::Box(_) => panic!("the Whitted scene has no boxes"),
+    }
+}
+
+#[test]
+fn object_ids_match_ray_casting_and_shadows_are_the_balls_projections_along_the_light() {
+    let scene: Scene = illum_scene::testing::shipped_scene("whitted.toml", 160, 90);
+    let ids = WhittedTracer::new(gpu(), &scene).unwrap().object_ids().unwrap();
+    let traced = illum_oracle::scene::TraceScene::new(&scene).unwrap();
+    assert_eq!(traced.surfaces.len(), scene.objects.len());
+    let to_light = -scene.directional_light.expect("a sun").direction.as_dvec3().normalize();
+    let scale = 1e-3 * scene.camera.eye.as_dvec3().length().max(1.0);
+    let (mut checked, mut skipped, mut shadowed) = (0usize, 0usize, [0usize; 8]);
+    for y in 0..ids.height {
+        for x in 0..ids.width {
+            let i = (y * ids.width + x) as usize;
+            let (o, d) = pixel_ray(&scene.camera, f64::from(x) + 0.5, f64::from(y) + 0.5);
+            // The oracle's f64 intersection (the scene has no emitters, so its surfaces are the
+            // scene's objects in order).
+            let nearest = traced
+                .surfaces
+                .iter()
+                .enumerate()
+                .filter_map(|(k, p)| p.surface.intersect(o, d, f64::INFINITY).map(|hit| (k, hit.t)))
+                .min_by(|a, b| a.1.total_cmp(&b.1));
+            let near_an_outline = scene.objects.iter().any(|obj| margin(&obj.shape, o, d) < scale);
+            // The expected shadow: which balls' projections along the light cover the point.
+            let (expected_hit, expected_shadow, near_edge) = match nearest {
+                None => (None, Shadow::Lit, near_an_outline),
+                Some((k, t)) => {
+                    let p = o + t * d;
+                    let mut shadow = Shadow::Lit;
+                    let mut near = near_an_outline;
+                    if matches!(scene.objects[k].shape, Shape::Quad(_)) {
+                        for (j, obj) in scene.objects.iter().enumerate() {
+                            if let Shape::Sphere(s) = &obj.shape {
+                                let cp = s.center.as_dvec3() - p;
+                                let along = cp.dot(to_light);
+                                let off_axis = (cp - along * to_light).length();
+                                let r = f64::from(s.radius);
+                                near |= (off_axis - r).abs() < scale;
+                                if along > 0.0 && off_axis < r {
+                                    shadow = Shadow::BlockedBy(j);
+                                }
+                            }
+                        }
+                    }
+                    (Some(k), shadow, near)
+                }
+            };
+            if near_edge {
+                skipped += 1;
+                continue;
+            }
+            checked += 1;
+            assert_eq!(ids.hit[i], expected_hit, "pixel ({x}, {y}): the object hit");
+            if expected_hit.is_some_and(|k| matches!(scene.objects[k].shape, Shape::Quad(_))) {
+                assert_eq!(ids.shadow[i], expected_shadow, "pixel ({x}, {y}): the floor's shadow");
+                if let Shadow::BlockedBy(j) = expected_shadow {
+                    shadowed[j] += 1;
+                }
+            }
+        }
+    }
+    let total = (ids.width * ids.height) as usize;
+    assert!(skipped * 50 < total, "{skipped} of {total} pixels lie on an edge");
+    // Both balls cast a shadow onto the visible floor, so both kinds of region exist.
+    let balls: Vec<usize> =
+        (0..scene.objects.len()).filter(|&j| matches!(scene.objects[j].shape, Shape::Sphere(_))).collect();
+    for j in balls {
+        assert!(shadowed[j] > 20, "{}: shadow covers only {} pixels", scene.object_label(j), shadowed[j]);
+    }
+    assert!(checked + skipped == total);
+}
