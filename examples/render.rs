@@ -4,6 +4,7 @@
 //! cargo run --release --example render -- [SCENE] [--spp N] [--bounces B|unbounded] [--seed S]
 //!     [--width W --height H] [--sampling cosine|uniform] [-o FILE.png|FILE.exr]...
 //!     [--target-error X] [--time-budget SECONDS] [--encoding gamma2.2|srgb] [--exposure STOPS]
+//!     [--caustics on|off]
 //! ```
 //! With no arguments it renders `scenes/cornell.toml` to `out/cornell.png` and `out/cornell.exr`.
 //! `--renderer raster|pathtrace` picks the renderer; the default is the scene file's `renderer`
@@ -84,6 +85,11 @@ struct Args {
     /// needed: see docs/accuracy.md).
     #[arg(long)]
     sequence: Option<Sequence>,
+    /// Path-tracer scenes: the caustic's light tracer `on` or `off` (default: the file's
+    /// `[pathtrace] caustics`). It runs only on a scene with a directional light and a mirror
+    /// or glass object (docs/caustics.md).
+    #[arg(long, value_name = "on|off", value_parser = cli::on_off_arg)]
+    caustics: Option<bool>,
     /// PNG exposure in stops, e.g. -1 or 2 (EXR output is never scaled). Default 0.
     #[arg(long, allow_negative_numbers = true, value_parser = cli::exposure_arg)]
     exposure: Option<f32>,
@@ -122,6 +128,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         (args.target_error.is_some(), "--target-error"),
         (args.time_budget.is_some(), "--time-budget"),
         (args.sequence.is_some(), "--sequence"),
+        (args.caustics.is_some(), "--caustics"),
         (args.resume.is_some(), "--resume"),
         (args.sample_range.is_some(), "--sample-range"),
         (args.checkpoint_seconds.is_some(), "--checkpoint-seconds"),
@@ -163,6 +170,9 @@ fn run(args: Args) -> anyhow::Result<()> {
     let mut scene = cli::load_scene(&args.scene, &args.settings)?;
     if let Some(sequence) = args.sequence {
         scene.pathtrace.sequence = sequence;
+    }
+    if let Some(caustics) = args.caustics {
+        scene.pathtrace.caustics = caustics;
     }
     // Read the checkpoint first: a bad file is refused before anything is rendered or written.
     let resumed: Option<Checkpoint> = match &args.resume {
@@ -303,7 +313,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         }
     }
     println!(
-        "{}: {}x{}, {} spp ({}), bounces {}, {} sampling, {:.2} s, {:.2} Msamples/s (wall clock), estimated relative error {:.4}, dropped samples {}",
+        "{}: {}x{}, {} spp ({}), bounces {}, {} sampling, caustics {}, {:.2} s, {:.2} Msamples/s (wall clock), estimated relative error {:.4}, dropped samples {}",
         scene.name,
         scene.camera.width,
         scene.camera.height,
@@ -316,6 +326,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         },
         scene.pathtrace.bounces,
         scene.pathtrace.sampling,
+        illum::pathtrace::gpu_scene::caustics_label(&scene),
         seconds,
         status.samples_per_second() * 1e-6,
         accumulator.estimated_relative_error(),

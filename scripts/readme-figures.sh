@@ -25,6 +25,17 @@ echo "== Pictures"
 "$bin/render" scenes/whitted.toml --renderer whitted --width 640 --height 360 -o docs/images/whitted-raytraced.png
 "$bin/render" scenes/whitted.toml --renderer pathtrace --width 640 --height 360 --spp 1024 --encoding linear \
     -o docs/images/whitted-pathtraced.png
+cp docs/images/whitted-pathtraced.png docs/images/whitted-caustic.png
+"$bin/render" scenes/whitted.toml --renderer pathtrace --width 640 --height 360 --spp 1024 --encoding linear \
+    --caustics off -o docs/images/whitted-no-caustic.png
+# docs/caustics.md: the caustic measured (scripts/caustic-measure.py reads these).
+for caustics in on off; do
+    "$bin/render" scenes/whitted.toml --renderer pathtrace --width 320 --height 180 --spp 1024 \
+        --encoding linear --exposure -1 --caustics $caustics -o out/m-$caustics.png
+    "$bin/render" scenes/whitted.toml --renderer pathtrace --width 320 --height 180 --spp 64 --seed 7 \
+        --encoding linear --exposure -1 --caustics $caustics -o out/m-${caustics}64.png
+done
+python3 scripts/caustic-measure.py
 "$bin/figures" --out "$out/figures"
 cp "$out/figures/contact-sheet.png" docs/images/figures.png
 if command -v xvfb-run > /dev/null; then

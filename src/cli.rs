@@ -82,6 +82,15 @@ pub fn main_with<A: clap::Parser>(run: impl FnOnce(A) -> anyhow::Result<()>) {
     }
 }
 
+/// Parses `on` or `off` (for `--caustics`).
+pub fn on_off_arg(text: &str) -> Result<bool, String> {
+    match text.trim() {
+        "on" => Ok(true),
+        "off" => Ok(false),
+        other => Err(format!("{other:?} is neither on nor off")),
+    }
+}
+
 /// Parses a number of stops for `--exposure`: any finite number, negative ones as typed
 /// (`--exposure -1`; declare the flag with `allow_negative_numbers`).
 pub fn exposure_arg(text: &str) -> Result<f32, String> {

@@ -585,3 +585,54 @@ fn the_whitted_ray_tracer_renders_both_scenes_and_refuses_the_other_renderers_fl
         assert!(!never.exists());
     }
 }
+
+#[test]
+fn caustics_on_off_is_recorded_and_a_checkpoint_of_the_other_setting_is_refused() {
+    let whitted = ["scenes/whitted.toml", "--renderer", "pathtrace", "--spp", "16"];
+    let on = render_16_exr(&whitted);
+    assert_eq!(field(&on, "caustics"), "on", "scenes/whitted.toml turns it on");
+    let mut off_flags = whitted.to_vec();
+    off_flags.extend(["--caustics", "off"]);
+    assert_eq!(field(&render_16_exr(&off_flags), "caustics"), "off");
+    // The Cornell box has neither a sun nor glass: nothing to light-trace, even when asked.
+    assert_eq!(field(&render_16_exr(&["--spp", "16", "--caustics", "on"]), "caustics"), "off");
+
+    // A render with the caustic cannot be continued without it.
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("w.exr");
+    let mut args = whitted.to_vec();
+    args.extend(["--width", "16", "--height", "16", "-o", exr.to_str().unwrap()]);
+    assert!(run(&args).status.success());
+    let out = run(&[
+        "scenes/whitted.toml",
+        "--renderer",
+        "pathtrace",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--caustics",
+        "off",
+        "--resume",
+        exr.to_str().unwrap(),
+        "--spp",
+        "32",
+    ]);
+    assert!(!out.status.success());
+    assert!(text(&out.stderr).contains("caustics: on in the file, off now"), "{}", text(&out.stderr));
+
+    // A bad value and the raster renderer are refused by name.
+    let out = run(&["scenes/whitted.toml", "--renderer", "pathtrace", "--caustics", "maybe"]);
+    assert!(
+        !out.status.success() && text(&out.stderr).contains("neither on nor off"),
+        "{}",
+        text(&out.stderr)
+    );
+    let out = run(&["scenes/whitted.toml", "--caustics", "on", "-o", "target/never.png"]);
+    assert!(!out.status.success());
+    assert!(
+        text(&out.stderr).contains("--caustics applies only to the path tracer"),
+        "{}",
+        text(&out.stderr)
+    );
+}

@@ -1,8 +1,8 @@
 //! Every WGSL file under shaders/ belongs to some crate's list of shaders, so that the crate's
 //! own naga test validates it without a GPU:
 //! - illum-pathtrace (`shaders.rs`): the sampling modules, the shared geometry module
-//!   (`shaders/rtcore/`), the scene module, both traversals,
-//!   the integrator and the display-sum pass, for every scene file;
+//!   (`shaders/rtcore/`), the scene module, both traversals, the surfaces module,
+//!   the integrator, the caustic's light tracer and the display-sum pass, for every scene file;
 //! - illum-raster (`shaders.rs`): its modules and entry files;
 //! - illum-whitted (`tracer.rs`): its entry shader, composed with the spawn and geometry modules;
 //! - illum-viewer (`display.rs`): its display pass.
@@ -13,7 +13,8 @@ use std::collections::BTreeSet;
 use std::path::PathBuf;
 
 use illum::pathtrace::{
-    self, GENERIC_TRAVERSAL, GEOMETRY_MODULE, PATHTRACE_SHADER, SAMPLING_MODULES, SCENE_MODULE,
+    self, CAUSTIC_SHADER, GENERIC_TRAVERSAL, GEOMETRY_MODULE, PATHTRACE_SHADER, SAMPLING_MODULES,
+    SCENE_MODULE, SURFACES_MODULE,
 };
 
 /// The viewer's shader, validated by illum-viewer's own test (the facade does not depend on the
@@ -30,6 +31,8 @@ fn every_wgsl_file_is_validated_by_its_crate() {
             &SCENE_MODULE,
             &GENERIC_TRAVERSAL,
             &PATHTRACE_SHADER,
+            &SURFACES_MODULE,
+            &CAUSTIC_SHADER,
             &pathtrace::DISPLAY_SUM_SHADER,
         ])
         .chain(illum::raster::shaders::MODULES)

@@ -5,6 +5,10 @@
 //! Both are relMSE with the same epsilon: the estimate is mean(Var[mean] / (mean^2 + 0.01)), the
 //! truth mean((mean - ref)^2 / (ref^2 + 0.01)). The reference (tests/reference, 16384 spp) has
 //! its own variance, 1/16 of the test's at 1024 spp; it is subtracted from the measured error.
+//!
+//! With two estimators (camera paths plus the caustic's light tracer, whose variances add) the
+//! same check runs against an exact closed form in `caustic.rs`
+//! (`an_index_1_ball_vanishes_and_the_error_estimate_of_both_estimators_is_honest`).
 
 use illum::image::{load_exr, rel_mse};
 use illum::pathtrace::PathTracer;

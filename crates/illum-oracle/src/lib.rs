@@ -20,7 +20,8 @@
 //!   (next-event estimation uniform in its cone, and seen directly by camera and specular rays
 //!   only); a constant environment seen by every escaping ray (no next-event estimation, so no
 //!   double counting). Light that a delta light sends through glass onto a diffuse surface
-//!   (the caustic, paths L S+ D E) is not found by this estimator;
+//!   (the caustic, paths L S+ D E) is found by a second estimator with `caustics = true`:
+//!   light tracing from the sun, paired sample by sample with the camera paths (`caustic.rs`);
 //! - next-event estimation at every diffuse hit with a point uniform on the union of the lights
 //!   by area; `Bounces::Fixed(n)` continuation rays (specular ones count) or unbounded with
 //!   Russian roulette; cosine or uniform hemisphere sampling (`Sampling`).

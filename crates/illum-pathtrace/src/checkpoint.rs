@@ -201,6 +201,7 @@ pub fn image_settings(scene: &Scene, options: TracerOptions) -> Vec<(&'static st
         ("seed", scene.pathtrace.seed.to_string()),
         ("sampling", scene.pathtrace.sampling.to_string()),
         ("sequence", options.sequence.to_string()),
+        ("caustics", crate::gpu_scene::caustics_label(scene).to_owned()),
     ]
 }
 
@@ -210,13 +211,15 @@ impl Checkpoint {
         match key {
             "width" => Some(self.accumulator.width.to_string()),
             "height" => Some(self.accumulator.height.to_string()),
+            // Files from before the caustic's light tracer existed rendered without it.
+            "caustics" => Some(self.metadata.get(key).unwrap_or("off").to_owned()),
             _ => self.metadata.get(key).map(str::to_owned),
         }
     }
 
     /// Checks that this checkpoint was rendered from `scene` with `options`: an error naming
     /// every difference (scene name, content hash, resolution, bounces, seed, sampling,
-    /// sequence), with both values.
+    /// sequence, caustics), with both values.
     pub fn check_matches(&self, path: &Path, scene: &Scene, options: TracerOptions) -> Result<(), String> {
         let mut differences = Vec::new();
         if self.metadata.scene != scene.name {
@@ -246,8 +249,8 @@ impl Checkpoint {
 }
 
 /// The keys two partial renders must agree on to be merged.
-const MERGE_KEYS: [&str; 8] =
-    ["scene", "scene_hash", "width", "height", "bounces", "seed", "sampling", "sequence"];
+const MERGE_KEYS: [&str; 9] =
+    ["scene", "scene_hash", "width", "height", "bounces", "seed", "sampling", "sequence", "caustics"];
 
 impl Checkpoint {
     /// The sample indices this file holds: `sample_start .. sample_start + spp_done`.

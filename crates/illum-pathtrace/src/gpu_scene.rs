@@ -336,12 +336,27 @@ impl GpuScene {
         if kinds().any(|k| matches!(k, MaterialKind::Checker(_))) {
             defs.push("CHECKER");
         }
-        if scene.pathtrace.caustics && scene.directional_light.is_some() && defs.contains(&"SPECULAR") {
+        if caustics_active(scene) {
             defs.push("CAUSTIC");
         }
         let objects = objects.into_iter().map(|(_, object)| object).collect();
         Ok(Self { objects, materials, lights, light_area, first_emitter, defs, radiance_exponent })
     }
+}
+
+/// Whether the caustic's light tracer runs for `scene`: `[pathtrace] caustics = true`, a
+/// directional light, and a mirror or dielectric object that can send its light onward.
+pub fn caustics_active(scene: &Scene) -> bool {
+    scene.pathtrace.caustics
+        && scene.directional_light.is_some()
+        && scene.objects.iter().any(|o| {
+            matches!(scene.material_of(o).kind, MaterialKind::Mirror { .. } | MaterialKind::Dielectric { .. })
+        })
+}
+
+/// `on` or `off`: [`caustics_active`] as EXR metadata and checkpoints store it.
+pub fn caustics_label(scene: &Scene) -> &'static str {
+    if caustics_active(scene) { "on" } else { "off" }
 }
 
 /// The shape as the shader tests it: a box without rotation as world bounds, a rotated box by

@@ -1,7 +1,9 @@
 //! illum-pathtrace: the Cornell box path tracer (the assignment's task 2).
 //!
 //! A WGSL compute shader (`shaders/pathtrace/pathtrace.wgsl`) traces paths over the scene's
-//! analytic boxes, quads and spheres with next-event estimation on rectangular lights. The host
+//! analytic boxes, quads and spheres with next-event estimation on rectangular lights and the
+//! sun; a second compute shader (`caustic.wgsl`, only with `[pathtrace] caustics = true`) traces
+//! the caustic from the sun (`tracer/caustic.rs`, docs/caustics.md). The host
 //! side here uploads the scene ([`gpu_scene`]), composes the pipeline ([`shaders`], with a
 //! traversal generated per scene by [`specialise`]), checks the device's limits ([`limits`]),
 //! plans short GPU submissions ([`planner`]), and folds each batch's f32 sums into f64
@@ -37,7 +39,7 @@ pub use progressive::{
     parse_time_budget, render_progressive,
 };
 pub use shaders::{
-    GENERIC_TRAVERSAL, GEOMETRY_MODULE, PATHTRACE_SHADER, SAMPLING_MODULES, SCENE_MODULE, SPAWN_MODULE,
-    shader_modules,
+    CAUSTIC_SHADER, GENERIC_TRAVERSAL, GEOMETRY_MODULE, PATHTRACE_SHADER, SAMPLING_MODULES, SCENE_MODULE,
+    SPAWN_MODULE, SURFACES_MODULE, shader_modules,
 };
 pub use tracer::{CausticParams, PathTracer, StepReport, bounding_sphere, fixed_point};

@@ -15,7 +15,8 @@ pub const RENDERER: &str = "pathtrace";
 ///   (wall-clock time, see [`crate::progressive::RenderClock`]);
 /// - `spp`: samples per pixel of the completed passes (every pixel has at least this many
 ///   paths; an interrupted pass may have added more to some rows), `bounces`, `seed`,
-///   `sampling`, `sequence`: the settings;
+///   `sampling`, `sequence`: the settings; `caustics`: `on` when the caustic's light tracer
+///   ran (`[pathtrace] caustics = true` on a scene with a sun and a mirror or glass), else `off`;
 /// - `estimated_relative_error`: [`crate::Accumulator::estimated_relative_error`] (`inf` below
 ///   2 spp); `dropped_samples`: NaN/Inf samples left out;
 /// - `stopped_by`: the stop rule that ended the render (`spp`, `target_error`, `time_budget`,
@@ -39,6 +40,7 @@ pub fn exr_metadata(
         ("seed", scene.pathtrace.seed.to_string()),
         ("sampling", scene.pathtrace.sampling.to_string()),
         ("sequence", tracer.options().sequence.to_string()),
+        ("caustics", crate::gpu_scene::caustics_label(scene).to_owned()),
         ("estimated_relative_error", accumulator.estimated_relative_error().to_string()),
         ("dropped_samples", accumulator.dropped_samples().to_string()),
         ("stopped_by", stopped_by.map_or("none", StopReason::name).to_owned()),
