@@ -13,6 +13,7 @@
 //! - `specialisation`: each scene's pipeline holds what it uses, is cached, refuses others,
 //!   and keeps the caller's submission size across a resize;
 //! - `overflow`: lights up to f32::MAX keep a finite image, error estimate and display sum;
+//! - `polled`: the web viewer's polled readback folds the same samples as the blocking one;
 //! - `random_scenes`: a few hundred random valid scenes render without NaN or dropped samples.
 //!
 //! naga validates the shaders without a GPU in each crate's own tests (see tests/shaders.rs).
@@ -27,6 +28,7 @@ mod extremes;
 mod furnace;
 mod oracle_agreement;
 mod overflow;
+mod polled;
 mod random_scenes;
 mod reference;
 mod sampling;

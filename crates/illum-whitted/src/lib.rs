@@ -28,4 +28,4 @@ mod encode;
 mod tracer;
 
 pub use encode::FEATURES_BUT;
-pub use tracer::{WHITTED_SHADER, WhittedError, WhittedTracer, shader_modules};
+pub use tracer::{PendingImage, WHITTED_SHADER, WhittedError, WhittedTracer, shader_modules};

@@ -107,6 +107,42 @@ impl WhittedTracer {
 
     /// Renders the image: linear radiance per pixel, row-major from the top-left.
     pub fn render(&self) -> Result<RgbImage32, WhittedError> {
+        self.dispatch();
+        let bytes = u64::from(self.width) * u64::from(self.height) * PIXEL_BYTES;
+        let data = readback::read_buffer(&self.gpu, &self.image, 0, bytes, "reading the Whitted image")?;
+        self.gpu.check()?;
+        Ok(self.decode(&data))
+    }
+
+    /// [`Self::render`] without waiting (what a web page needs): submits the frame and starts
+    /// its readback; [`PendingImage::poll`] on later frames returns the image.
+    pub fn render_polled(&self) -> PendingImage {
+        self.dispatch();
+        let bytes = u64::from(self.width) * u64::from(self.height) * PIXEL_BYTES;
+        let staging = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("whitted staging"),
+            size: bytes,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = self
+            .gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("whitted readback") });
+        encoder.copy_buffer_to_buffer(&self.image, 0, &staging, 0, bytes);
+        self.gpu.queue.submit([encoder.finish()]);
+        PendingImage {
+            read: readback::PendingRead::start(staging, bytes, "reading the Whitted image"),
+            width: self.width,
+            height: self.height,
+        }
+    }
+
+    fn decode(&self, data: &[u8]) -> RgbImage32 {
+        decode_image(self.width, self.height, data)
+    }
+
+    fn dispatch(&self) {
         let mut encoder = self
             .gpu
             .device
@@ -121,16 +157,37 @@ impl WhittedTracer {
             pass.dispatch_workgroups(self.width.div_ceil(WORKGROUP), self.height.div_ceil(WORKGROUP), 1);
         }
         self.gpu.queue.submit([encoder.finish()]);
-        let bytes = u64::from(self.width) * u64::from(self.height) * PIXEL_BYTES;
-        let data = readback::read_buffer(&self.gpu, &self.image, 0, bytes, "reading the Whitted image")?;
-        self.gpu.check()?;
-        let texels: &[[f32; 4]] = bytemuck::cast_slice(&data);
-        let mut image = RgbImage32::new(self.width, self.height);
-        for (pixel, texel) in image.pixels.iter_mut().zip(texels) {
-            *pixel = [texel[0], texel[1], texel[2]];
-        }
-        Ok(image)
     }
+}
+
+/// A Whitted frame whose readback is under way ([`WhittedTracer::render_polled`]).
+pub struct PendingImage {
+    read: readback::PendingRead,
+    width: u32,
+    height: u32,
+}
+
+impl PendingImage {
+    /// `None` while the image is still being read back; never waits.
+    pub fn poll(&self, gpu: &GpuContext) -> Option<Result<RgbImage32, WhittedError>> {
+        let data = self.read.poll(gpu)?;
+        Some(data.map_err(WhittedError::from).and_then(|data| {
+            gpu.check()?;
+            Ok(decode_image(self.width, self.height, &data))
+        }))
+    }
+}
+
+/// The image buffer's RGBA f32 texels as linear RGB.
+fn decode_image(width: u32, height: u32, data: &[u8]) -> RgbImage32 {
+    // The mapped copy has no alignment guarantee, so read the floats one by one.
+    let floats: Vec<f32> =
+        data.chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().expect("4 bytes"))).collect();
+    let mut image = RgbImage32::new(width, height);
+    for (pixel, texel) in image.pixels.iter_mut().zip(floats.chunks_exact(4)) {
+        *pixel = [texel[0], texel[1], texel[2]];
+    }
+    image
 }
 
 #[cfg(test)]

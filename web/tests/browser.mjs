@@ -1,0 +1,138 @@
+// Drives the web viewer in headless Chromium (Playwright, the system's chromium) and writes
+// what it saw for the Rust test (crates/illum-viewer/tests/web.rs) to check:
+//   <out>/<case>.png     a screenshot of the page's canvas
+//   <out>/<case>.status  the page's #illum-status data-* attributes, one "name=value" a line
+// Usage: node browser.mjs URL OUT_DIR
+// Env: CHROMIUM (default /usr/bin/chromium), WEB_TEST_TIMEOUT_S (per wait, default 300).
+// This script waits for the page's state but asserts nothing itself beyond "it got there".
+import { chromium } from 'playwright-core';
+import { mkdirSync, writeFileSync } from 'node:fs';
+import { join } from 'node:path';
+
+const [url, out] = process.argv.slice(2);
+if (!url || !out) {
+  console.error('usage: node browser.mjs URL OUT_DIR');
+  process.exit(2);
+}
+mkdirSync(out, { recursive: true });
+const executablePath = process.env.CHROMIUM || '/usr/bin/chromium';
+const timeout = 1000 * Number(process.env.WEB_TEST_TIMEOUT_S || 300);
+
+// Never reach out to the network, never share a profile (Playwright gives each launch a
+// fresh one).
+const quiet = ['--no-sandbox', '--disable-background-networking', '--disable-component-update',
+  '--disable-sync', '--no-first-run', '--disable-quic', '--headless=new'];
+// WebGPU on SwiftShader, Chromium's CPU Vulkan: works without a GPU or a display.
+const webgpu = ['--enable-unsafe-webgpu', '--enable-features=Vulkan', '--use-vulkan=swiftshader',
+  '--use-angle=swiftshader'];
+
+async function statusOf(page) {
+  return page.evaluate(() => ({ ...document.getElementById('illum-status').dataset }));
+}
+
+function save(name, status) {
+  const lines = Object.entries(status).map(([k, v]) => `${k}=${String(v).replace(/\n/g, ' ')}`);
+  writeFileSync(join(out, `${name}.status`), lines.join('\n') + '\n');
+  console.log(`[${name}] ` + JSON.stringify(status));
+}
+
+// Waits until `predicate(status)` holds; on a timeout saves what the page had and fails.
+async function waitFor(page, name, what, predicate) {
+  const started = Date.now();
+  for (;;) {
+    const status = await statusOf(page);
+    if (status.failure) {
+      save(name, status);
+      throw new Error(`${name}: the viewer failed: ${status.failure}`);
+    }
+    if (predicate(status)) return status;
+    if (Date.now() - started > timeout) {
+      save(name, status);
+      await page.screenshot({ path: join(out, `${name}-timeout.png`) });
+      throw new Error(`${name}: timed out after ${timeout / 1000} s waiting for ${what}`);
+    }
+    await page.waitForTimeout(250);
+  }
+}
+
+// Lets the page draw `n` more frames (so the canvas shows the latest state).
+async function frames(page, n) {
+  await page.evaluate((n) => new Promise((done) => {
+    const step = (left) => (left === 0 ? done() : requestAnimationFrame(() => step(left - 1)));
+    step(n);
+  }), n);
+}
+
+async function shoot(page, name, status) {
+  await frames(page, 5);
+  await page.locator('#illum-canvas').screenshot({ path: join(out, `${name}.png`) });
+  save(name, status ?? await statusOf(page));
+}
+
+async function open(browser, query) {
+  const page = await browser.newPage({ viewport: { width: 960, height: 600 }, deviceScaleFactor: 1 });
+  page.on('console', (m) => { if (m.type() === 'error') console.log(`  console: ${m.text()}`); });
+  page.on('pageerror', (e) => console.log(`  page error: ${e}`));
+  await page.goto(url + query);
+  return page;
+}
+
+// 1. A browser without WebGPU (no --enable-unsafe-webgpu on Linux): the explanation page.
+{
+  const browser = await chromium.launch({ executablePath, headless: true, args: quiet });
+  const page = await open(browser, '');
+  const status = await waitFor(page, 'no-webgpu', 'the WebGPU check', (s) => s.webgpu);
+  status.messageVisible = String(await page.locator('#no-webgpu').isVisible());
+  status.messageText = (await page.locator('#no-webgpu').innerText()).replace(/\s+/g, ' ');
+  save('no-webgpu', status);
+  await browser.close();
+}
+
+// 2. With WebGPU (SwiftShader): each mode, and a bad scene file.
+const browser = await chromium.launch({ executablePath, headless: true, args: [...quiet, ...webgpu] });
+try {
+  {
+    // The path tracer on the Cornell box, to 8 spp.
+    const page = await open(browser, '?scene=scenes/cornell.toml&mode=pathtrace&spp=8');
+    const status = await waitFor(page, 'pathtrace', 'the path tracer to reach its spp',
+      (s) => s.pathtraceStopped === 'spp' && s.pathtraceMean);
+    await shoot(page, 'pathtrace', status);
+
+    // A bad scene file dropped on the window: its error shows and the Cornell box stays.
+    const transfer = await page.evaluateHandle(() => {
+      const t = new DataTransfer();
+      t.items.add(new File(['[camera]\nvfov = "wide"\n'], 'bad.toml', { type: 'text/plain' }));
+      return t;
+    });
+    for (const type of ['dragenter', 'dragover', 'drop']) {
+      await page.dispatchEvent('#illum-canvas', type, { dataTransfer: transfer });
+    }
+    const bad = await waitFor(page, 'bad-scene', 'the dropped file\'s error', (s) => s.openError);
+    await shoot(page, 'bad-scene', bad);
+    await page.close();
+  }
+  {
+    // A scene the page does not have, named in the address: an error, the default scene stays.
+    const page = await open(browser, '?scene=scenes/nope.toml');
+    const status = await waitFor(page, 'missing-scene', 'the error', (s) => s.openError);
+    save('missing-scene', status);
+    await page.close();
+  }
+  {
+    // The rasterizer on the Whitted scene, figure look (the file's).
+    const page = await open(browser, '?scene=scenes/whitted.toml&mode=raster');
+    const status = await waitFor(page, 'raster', 'raster frames', (s) => Number(s.windowFps) > 0);
+    await shoot(page, 'raster', status);
+    await page.close();
+  }
+  {
+    // The Whitted ray tracer on the Whitted scene.
+    const page = await open(browser, '?scene=scenes/whitted.toml&mode=whitted');
+    const status = await waitFor(page, 'whitted', 'a Whitted frame', (s) => Number(s.whittedFrames) >= 1);
+    await shoot(page, 'whitted', status);
+    await page.close();
+  }
+} finally {
+  await browser.close();
+}
+console.log('browser run complete');
