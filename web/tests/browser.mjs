@@ -20,7 +20,7 @@ const timeout = 1000 * Number(process.env.WEB_TEST_TIMEOUT_S || 300);
 
 // Never reach out to the network, never share a profile (Playwright gives each launch a
 // fresh one).
-const quiet = ['--no-sandbox', '--disable-background-networking', '--disable-component-update',
+const quiet = ['--no-sandbox', '--disable-dev-shm-usage', '--disable-background-networking', '--disable-component-update',
   '--disable-sync', '--no-first-run', '--disable-quic', '--headless=new'];
 // WebGPU on SwiftShader, Chromium's CPU Vulkan: works without a GPU or a display.
 const webgpu = ['--enable-unsafe-webgpu', '--enable-features=Vulkan', '--use-vulkan=swiftshader',
@@ -97,6 +97,15 @@ try {
     const status = await waitFor(page, 'pathtrace', 'the path tracer to reach its spp',
       (s) => s.pathtraceStopped === 'spp' && s.pathtraceMean);
     await shoot(page, 'pathtrace', status);
+
+    // Save EXR (the button's place in this 960 x 600 layout, left panel): a download.
+    const [download] = await Promise.all([
+      page.waitForEvent('download', { timeout }),
+      page.mouse.click(118, 512),
+    ]);
+    await download.saveAs(join(out, 'download.exr'));
+    writeFileSync(join(out, 'download.name'), download.suggestedFilename());
+    console.log(`[download] ${download.suggestedFilename()}`);
 
     // A bad scene file dropped on the window: its error shows and the Cornell box stays.
     const transfer = await page.evaluateHandle(() => {

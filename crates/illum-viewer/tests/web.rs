@@ -8,6 +8,7 @@
 //!   scene, size, seed and spp (the samples depend only on seed, pixel and sample index);
 //! - the raster's figure look shows the assignment's exact colours (background, lit and
 //!   shadowed tiles), and the Whitted ray tracer draws a picture with its sky;
+//! - Save EXR downloads a checkpoint of those 8 spp that the desktop's loader reads;
 //! - a bad scene file dropped on the page shows the desktop's error and keeps the scene.
 //!
 //! Prerequisites (`.ci/run` installs them): `rustup target add wasm32-unknown-unknown`,
@@ -255,6 +256,21 @@ fn the_web_viewer_works_in_headless_chromium() {
         samples / gpu_seconds.max(1e-9),
         get(&pt, "windowFps")
     );
+
+    // Save EXR downloads the checkpoint the desktop writes: the same f64 statistics, 8 spp.
+    let name = std::fs::read_to_string(out.join("download.name")).expect("the download's name");
+    assert_eq!(name, "viewer-cornell.exr");
+    let saved = illum_pathtrace::checkpoint::load_checkpoint(&out.join("download.exr"))
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(saved.spp_done, SPP);
+    assert_eq!(saved.metadata.get("spp"), Some(SPP.to_string().as_str()), "{:?}", saved.metadata);
+    let saved_mean = saved.accumulator.mean_image().mean();
+    for c in 0..3 {
+        assert!(
+            (saved_mean[c] - web[c]).abs() <= 1e-6 * web[c],
+            "the saved EXR's mean {saved_mean:?} vs the page's {web:?}"
+        );
+    }
 
     // A bad file dropped on the page: the desktop's message; the Cornell box stays.
     let bad = status(&out, "bad-scene");
