@@ -95,7 +95,14 @@ impl ViewerApp {
     pub fn new(cc: &eframe::CreationContext<'_>, options: StartOptions) -> Self {
         let gpu = match &cc.wgpu_render_state {
             Some(rs) => {
-                let gpu = GpuContext::from_device(rs.device.clone(), rs.queue.clone(), rs.adapter.get_info());
+                #[allow(unused_mut)]
+                let mut info = rs.adapter.get_info();
+                // Browsers do not tell WebGPU's adapter name to wgpu; the page asked for it.
+                #[cfg(target_arch = "wasm32")]
+                if info.name.is_empty() {
+                    info.name = crate::web::adapter_description();
+                }
+                let gpu = GpuContext::from_device(rs.device.clone(), rs.queue.clone(), info);
                 log::info!("viewer adapter: {} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend);
                 Ok((gpu, rs.clone()))
             }

@@ -91,6 +91,17 @@ pub fn publish_status(status: &[(&'static str, String)]) {
     let _ = element.set_attribute("data-running", "yes");
 }
 
+/// The WebGPU adapter as the page's script described it (vendor, architecture, description,
+/// from `GPUAdapter.info`): wgpu's adapter info has no name in the browser.
+pub fn adapter_description() -> String {
+    document()
+        .ok()
+        .and_then(|d| d.get_element_by_id(STATUS_ID))
+        .and_then(|e| e.get_attribute("data-webgpu-adapter"))
+        .filter(|name| !name.is_empty())
+        .unwrap_or_else(|| "WebGPU adapter".to_owned())
+}
+
 /// Starts a download of `bytes` as a file called `name`.
 pub fn download(name: &str, bytes: &[u8], mime: &str) -> Result<(), String> {
     let failed = |e: JsValue| format!("the download of {name} could not start: {}", js_text(&e));

@@ -214,8 +214,10 @@ fn the_web_viewer_works_in_headless_chromium() {
     // The path tracer: an adapter, 8 spp, a picture, and the native render's image mean.
     let pt = status(&out, "pathtrace");
     let adapter = get(&pt, "adapter");
-    assert!(adapter.contains("BrowserWebGpu") && !get(&pt, "webgpuAdapter").is_empty(), "no adapter: {pt:?}");
-    println!("WebGPU adapter: {adapter} ({})", get(&pt, "webgpuAdapter"));
+    let described = get(&pt, "webgpuAdapter");
+    assert!(!described.is_empty(), "the page found no adapter: {pt:?}");
+    assert_eq!(adapter, format!("{described} (BrowserWebGpu)"), "the viewer's adapter: {pt:?}");
+    println!("WebGPU adapter: {adapter}");
     assert_eq!(get(&pt, "pathtraceSpp"), SPP.to_string(), "{pt:?}");
     let shot = screenshot(&out, "pathtrace");
     assert!(
@@ -264,6 +266,7 @@ fn the_web_viewer_works_in_headless_chromium() {
         .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(saved.spp_done, SPP);
     assert_eq!(saved.metadata.get("spp"), Some(SPP.to_string().as_str()), "{:?}", saved.metadata);
+    assert_eq!(saved.metadata.get("adapter"), Some(described), "{:?}", saved.metadata);
     let saved_mean = saved.accumulator.mean_image().mean();
     for c in 0..3 {
         assert!(
