@@ -6,7 +6,7 @@
 // Env: CHROMIUM (default /usr/bin/chromium), WEB_TEST_TIMEOUT_S (per wait, default 300).
 // This script waits for the page's state but asserts nothing itself beyond "it got there".
 import { chromium } from 'playwright-core';
-import { mkdirSync, writeFileSync } from 'node:fs';
+import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import { join } from 'node:path';
 
 const [url, out] = process.argv.slice(2);
@@ -69,6 +69,16 @@ async function shoot(page, name, status) {
   save(name, status ?? await statusOf(page));
 }
 
+// Clicks like a person: move, press, release a moment later, so that egui (drawing a few
+// frames a second here) sees the pointer over the button and the press before the release.
+async function click(page, x, y) {
+  await page.mouse.move(x, y);
+  await page.waitForTimeout(300);
+  await page.mouse.down();
+  await page.waitForTimeout(300);
+  await page.mouse.up();
+}
+
 async function open(browser, query) {
   const page = await browser.newPage({ viewport: { width: 960, height: 600 }, deviceScaleFactor: 1 });
   page.on('console', (m) => { if (m.type() === 'error') console.log(`  console: ${m.text()}`); });
@@ -101,7 +111,7 @@ try {
     // Save EXR (the button's place in this 960 x 600 layout, left panel): a download.
     const [download] = await Promise.all([
       page.waitForEvent('download', { timeout }),
-      page.mouse.click(118, 512),
+      click(page, 118, 512),
     ]);
     await download.saveAs(join(out, 'download.exr'));
     writeFileSync(join(out, 'download.name'), download.suggestedFilename());
@@ -125,6 +135,17 @@ try {
     const page = await open(browser, '?scene=scenes/nope.toml');
     const status = await waitFor(page, 'missing-scene', 'the error', (s) => s.openError);
     save('missing-scene', status);
+
+    // "Open file..." (top bar, this layout): the browser's file picker, given the Whitted
+    // scene under another name; it opens in its file's mode, the raster.
+    const [chooser] = await Promise.all([
+      page.waitForEvent('filechooser', { timeout }),
+      click(page, 875, 12),
+    ]);
+    const text = readFileSync(new URL('../../scenes/whitted.toml', import.meta.url));
+    await chooser.setFiles({ name: 'picked.toml', mimeType: 'text/plain', buffer: text });
+    const picked = await waitFor(page, 'picked-scene', 'the picked scene', (s) => s.scene === 'picked.toml');
+    save('picked-scene', picked);
     await page.close();
   }
   {

@@ -8,6 +8,7 @@
 //!   scene, size, seed and spp (the samples depend only on seed, pixel and sample index);
 //! - the raster's figure look shows the assignment's exact colours (background, lit and
 //!   shadowed tiles), and the Whitted ray tracer draws a picture with its sky;
+//! - "Open file..." opens a scene through the browser's file picker;
 //! - Save EXR downloads a checkpoint of those 8 spp that the desktop's loader reads;
 //! - a bad scene file dropped on the page shows the desktop's error and keeps the scene.
 //!
@@ -288,6 +289,14 @@ fn the_web_viewer_works_in_headless_chromium() {
     let error = get(&missing_scene, "openError");
     assert!(error.contains("scenes/nope.toml") && error.contains("built into this page"), "{error}");
     assert_eq!(get(&missing_scene, "scene"), "scenes/cornell.toml", "{missing_scene:?}");
+    // "Open file...": the browser's file picker, given the Whitted scene as picked.toml; it
+    // opens in its file's mode and the error goes.
+    let picked = status(&out, "picked-scene");
+    assert_eq!(
+        (get(&picked, "scene"), get(&picked, "mode"), get(&picked, "openError")),
+        ("picked.toml", "raster", ""),
+        "{picked:?}"
+    );
 
     // The raster's figure look: the assignment's exact colours (docs/scenes.md).
     let raster = screenshot(&out, "raster");
