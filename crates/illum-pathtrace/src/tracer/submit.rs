@@ -155,15 +155,14 @@ impl PathTracer {
         encoder.copy_buffer_to_buffer(&batch.sum_sq, 0, staging, bytes, bytes);
         self.timer.copy_results(&mut encoder, staging, 2 * bytes);
         self.gpu.queue.submit([encoder.finish()]);
-        Ok(Band { started, row_offset, rows, spp, chunks, band_pixels, bytes, staging_size })
+        Ok(Band { started, row_offset, rows, spp, chunk, chunks, band_pixels, bytes, staging_size })
     }
 
     /// Checks and folds a band's read-back bytes, and moves the pass on.
     fn finish_band(&mut self, band: &Band, data: &[u8]) -> Result<StepReport, PathTraceError> {
-        let Band { started, row_offset, rows, spp, chunks, band_pixels, bytes, .. } = *band;
+        let Band { started, row_offset, rows, spp, chunk, chunks, band_pixels, bytes, .. } = *band;
         let width = self.scene.camera.width;
         let height = self.scene.camera.height;
-        let chunk = self.chunk_samples;
         let floats = batch::decode_slots(&data[..(2 * bytes) as usize]);
         let (sums, sums_sq) = floats.split_at(floats.len() / 2);
         if let Err(error) = batch::check_complete(sums, sums_sq, spp, chunk, band_pixels) {
@@ -210,6 +209,8 @@ pub(super) struct Band {
     row_offset: u32,
     rows: u32,
     spp: u32,
+    /// Samples per chunk when it was recorded (a later `set_chunk_samples` must not change it).
+    chunk: u32,
     chunks: u32,
     band_pixels: usize,
     /// Bytes of each of the two slot arrays (sums, sums of squares) in the staging buffer.
