@@ -95,6 +95,14 @@ async function open(browser, query) {
   status.messageVisible = String(await page.locator('#no-webgpu').isVisible());
   status.messageText = (await page.locator('#no-webgpu').innerText()).replace(/\s+/g, ' ');
   save('no-webgpu', status);
+
+  // A browser with no WebGPU API at all (navigator.gpu removed before the page runs).
+  const bare = await browser.newPage();
+  await bare.addInitScript(() => { delete Navigator.prototype.gpu; });
+  await bare.goto(url);
+  const noApi = await waitFor(bare, 'no-webgpu-api', 'the WebGPU check', (s) => s.webgpu);
+  noApi.messageVisible = String(await bare.locator('#no-webgpu').isVisible());
+  save('no-webgpu-api', noApi);
   await browser.close();
 }
 

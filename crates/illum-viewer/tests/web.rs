@@ -2,7 +2,8 @@
 //! 127.0.0.1, drives headless Chromium on WebGPU (SwiftShader) with `web/tests/browser.mjs`
 //! (Playwright), and checks what the page showed and reported:
 //!
-//! - a browser without WebGPU gets the page that says so and how to enable it;
+//! - a browser without WebGPU (no adapter, or no API at all) gets the page that says so and how
+//!   to enable it;
 //! - a WebGPU adapter was found (which one is printed);
 //! - the path tracer's Cornell box at 8 spp has the image mean of a native render of the same
 //!   scene, size, seed and spp (the samples depend only on seed, pixel and sample index);
@@ -212,6 +213,9 @@ fn the_web_viewer_works_in_headless_chromium() {
     assert_eq!(get(&none, "messageVisible"), "true", "{none:?}");
     let text = get(&none, "messageText");
     assert!(text.contains("illum needs WebGPU") && text.contains("enable-unsafe-webgpu"), "{text}");
+    let no_api = status(&out, "no-webgpu-api");
+    assert_eq!((get(&no_api, "webgpu"), get(&no_api, "messageVisible")), ("missing", "true"), "{no_api:?}");
+    assert!(get(&no_api, "webgpuReason").contains("navigator.gpu is missing"), "{no_api:?}");
 
     // The path tracer: an adapter, 8 spp, a picture, and the native render's image mean.
     let pt = status(&out, "pathtrace");
