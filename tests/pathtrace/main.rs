@@ -15,6 +15,7 @@
 //! - `specialisation`: each scene's pipeline holds what it uses, is cached, refuses others,
 //!   and keeps the caller's submission size across a resize;
 //! - `overflow`: lights up to f32::MAX keep a finite image, error estimate and display sum;
+//! - `polled`: the web viewer's polled readback folds the same samples as the blocking one;
 //! - `random_scenes`: a few hundred random valid scenes render without NaN or dropped samples;
 //! - `whitted_extremes`: the Whitted scene's sun at extreme elevations and sizes against the
 //!   floor's closed form, and albedo 1 with unbounded bounces.
@@ -32,6 +33,7 @@ mod extremes;
 mod furnace;
 mod oracle_agreement;
 mod overflow;
+mod polled;
 mod random_scenes;
 mod reference;
 mod sampling;

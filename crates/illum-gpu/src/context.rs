@@ -110,6 +110,20 @@ impl GpuContext {
 
     /// Runs `f` inside validation and out-of-memory error scopes, returning the first error raised.
     /// Used around pipeline and buffer creation, where wgpu reports errors asynchronously.
+    ///
+    /// In the browser the scopes' results arrive only after control returns to the page, which
+    /// cannot be waited for; there `f` runs without scopes and its errors, if any, reach
+    /// [`GpuContext::check`] through the uncaptured-error handler a frame later.
+    #[cfg(target_arch = "wasm32")]
+    pub fn scoped<T>(&self, _context: &str, f: impl FnOnce() -> T) -> Result<T, GpuError> {
+        let value = f();
+        self.check()?;
+        Ok(value)
+    }
+
+    /// Runs `f` inside validation and out-of-memory error scopes, returning the first error raised.
+    /// Used around pipeline and buffer creation, where wgpu reports errors asynchronously.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn scoped<T>(&self, context: &str, f: impl FnOnce() -> T) -> Result<T, GpuError> {
         let oom = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
         let validation = self.device.push_error_scope(wgpu::ErrorFilter::Validation);

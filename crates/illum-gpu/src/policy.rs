@@ -6,9 +6,17 @@ use crate::error::GpuError;
 
 /// The backends illum tries: `WGPU_BACKEND` when set, else Vulkan, Metal and DX12. GL is left
 /// out because the path tracer needs compute shaders.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn backends() -> wgpu::Backends {
     wgpu::Backends::from_env()
         .unwrap_or(wgpu::Backends::VULKAN | wgpu::Backends::METAL | wgpu::Backends::DX12)
+}
+
+/// In the browser: WebGPU only. WebGL has no compute shaders, so a browser without WebGPU gets
+/// the page's explanation instead of a half-working viewer.
+#[cfg(target_arch = "wasm32")]
+pub fn backends() -> wgpu::Backends {
+    wgpu::Backends::BROWSER_WEBGPU
 }
 
 /// Whether to prefer a software adapter (lavapipe) over a hardware one: under CI (`CI` set), so

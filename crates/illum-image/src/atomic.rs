@@ -87,6 +87,7 @@ where
     let path = path.as_ref();
     // From here on, dropping `tmp` (on any early return) deletes the temporary file.
     let mut tmp = temporary_next_to(path)?;
+    #[cfg(unix)]
     let (dir, _) = target_parts(path)?;
 
     write(tmp.as_file_mut())?;

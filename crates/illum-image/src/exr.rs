@@ -207,12 +207,38 @@ pub fn save_exr_with_layers(
     metadata: &ExrMetadata,
     layers: &[U32Layer],
 ) -> Result<(), ImageError> {
-    use exr::prelude::{AnyChannel, AnyChannels, FlatSamples};
     let path = path.as_ref();
     if layers.is_empty() {
         return save_exr(path, image, metadata);
     }
     check_writable(path, image)?;
+    write_atomically(path, |file| encode_with_layers(path, image, metadata, layers, file))
+}
+
+/// [`save_exr_with_layers`] into memory: the EXR file's bytes (for a download in the browser).
+/// `name` labels errors, as a path would.
+pub fn exr_bytes_with_layers(
+    name: &str,
+    image: &RgbImage32,
+    metadata: &ExrMetadata,
+    layers: &[U32Layer],
+) -> Result<Vec<u8>, ImageError> {
+    let path = Path::new(name);
+    check_writable(path, image)?;
+    let mut out = std::io::Cursor::new(Vec::new());
+    encode_with_layers(path, image, metadata, layers, &mut out)?;
+    Ok(out.into_inner())
+}
+
+/// Encodes the RGB image and the extra layers (at least one) into `out`. `path` labels errors.
+fn encode_with_layers<W: std::io::Write + std::io::Seek>(
+    path: &Path,
+    image: &RgbImage32,
+    metadata: &ExrMetadata,
+    layers: &[U32Layer],
+    out: W,
+) -> Result<(), ImageError> {
+    use exr::prelude::{AnyChannel, AnyChannels, FlatSamples};
     let attributes = metadata.to_attributes();
     check_attribute_names(path, &attributes)?;
     let pixels = image.width as usize * image.height as usize;
@@ -266,12 +292,10 @@ pub fn save_exr_with_layers(
         exr::prelude::ImageAttributes::new(exr::prelude::IntegerBounds::from_dimensions(size)),
         all,
     );
-    write_atomically(path, |file| {
-        exr_image.write().to_unbuffered(file).map_err(|e| ImageError::Encode {
-            path: path.to_path_buf(),
-            format: "EXR",
-            source: Box::new(e),
-        })
+    exr_image.write().to_unbuffered(out).map_err(|e| ImageError::Encode {
+        path: path.to_path_buf(),
+        format: "EXR",
+        source: Box::new(e),
     })
 }
 

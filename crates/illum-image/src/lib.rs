@@ -25,11 +25,13 @@ use std::path::PathBuf;
 pub use atomic::{check_output, write_atomically};
 pub use contact_sheet::contact_sheet;
 pub use diff::{DiffImages, save_diff_images};
-pub use exr::{ExrMetadata, U32Layer, load_exr, load_u32_layer, save_exr, save_exr_with_layers};
+pub use exr::{
+    ExrMetadata, U32Layer, exr_bytes_with_layers, load_exr, load_u32_layer, save_exr, save_exr_with_layers,
+};
 pub use metrics::{
     MetricsError, inverse_normal_cdf, mean_luminance_bias, median, rel_mse, rmse, z_test_pass_fraction,
 };
-pub use png::{save_png, save_rgba8_png};
+pub use png::{png_bytes, save_png, save_rgba8_png};
 pub use rgb_image::{RgbImage32, luminance};
 pub use tonemap::{Encoding, ParseEncodingError, encode_8bit, to_rgb8, to_rgba8};
 

@@ -48,6 +48,24 @@ pub fn save_png(
     write_png_bytes(path, rgb.as_raw(), rgb.width(), rgb.height(), image::ExtendedColorType::Rgb8)
 }
 
+/// [`save_png`] into memory: the PNG file's bytes (for a download in the browser). `name`
+/// labels errors, as a path would.
+pub fn png_bytes(
+    name: &str,
+    image: &RgbImage32,
+    exposure: f32,
+    encoding: Encoding,
+) -> Result<Vec<u8>, ImageError> {
+    let path = Path::new(name);
+    check_writable(path, image)?;
+    let rgb = to_rgb8(image, exposure, encoding);
+    let mut out = Vec::new();
+    PngEncoder::new(&mut out)
+        .write_image(rgb.as_raw(), rgb.width(), rgb.height(), image::ExtendedColorType::Rgb8)
+        .map_err(|e| ImageError::Encode { path: path.to_path_buf(), format: "PNG", source: Box::new(e) })?;
+    Ok(out)
+}
+
 /// Writes an 8-bit RGBA image (a contact sheet, a diff picture) as PNG, atomically.
 pub fn save_rgba8_png(path: impl AsRef<Path>, image: &image::RgbaImage) -> Result<(), ImageError> {
     let path = path.as_ref();

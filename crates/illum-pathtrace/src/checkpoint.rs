@@ -102,6 +102,19 @@ pub fn save_statistics(path: &Path, accumulator: &Accumulator, metadata: &ExrMet
         .map_err(|e| with_causes(&e))
 }
 
+/// [`save_checkpoint`] into memory: the EXR file's bytes (the web viewer's download). `name`
+/// labels errors.
+pub fn checkpoint_bytes(name: &str, tracer: &PathTracer, metadata: &ExrMetadata) -> Result<Vec<u8>, String> {
+    let accumulator = tracer.accumulator();
+    illum_image::exr_bytes_with_layers(
+        name,
+        &accumulator.mean_image(),
+        metadata,
+        &[statistics_layer(accumulator)],
+    )
+    .map_err(|e| with_causes(&e))
+}
+
 /// A render read back from a checkpoint file.
 #[derive(Clone, Debug)]
 pub struct Checkpoint {

@@ -14,7 +14,9 @@
 //! read better whole, since each rule's meaning is defined by how the loop checks it.
 
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::{Duration, Instant};
+use std::time::Duration;
+
+use web_time::Instant;
 
 use crate::{PathTraceError, PathTracer};
 

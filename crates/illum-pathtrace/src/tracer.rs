@@ -86,6 +86,10 @@ pub struct PathTracer {
     /// Wall and GPU seconds spent on submissions since the last reset.
     wall_seconds: f64,
     gpu_seconds: f64,
+    /// Whether [`Self::render_step`] polls its readback instead of waiting (see
+    /// [`Self::set_polled_readback`]), and the band it is waiting for.
+    polled_readback: bool,
+    in_flight: Option<submit::InFlightBand>,
 }
 
 /// The placeholder record bound when a scene has no area light.
@@ -203,6 +207,8 @@ impl PathTracer {
             caustic,
             wall_seconds: 0.0,
             gpu_seconds: 0.0,
+            polled_readback: false,
+            in_flight: None,
         })
     }
 
@@ -338,6 +344,7 @@ impl PathTracer {
             resized.chunk_samples = self.chunk_samples;
             resized.sample_offset = self.sample_offset;
             resized.chunk_aligned = self.chunk_aligned;
+            resized.polled_readback = self.polled_readback;
             if self.display_sum.is_some() {
                 resized.enable_display_sum()?;
             }
@@ -442,6 +449,7 @@ impl PathTracer {
 
     /// Discards everything accumulated; the next step starts again at sample 0.
     pub fn reset(&mut self) {
+        self.in_flight = None;
         self.accumulator.reset();
         if let Some(caustic) = &mut self.caustic {
             caustic.discard_pass();
@@ -459,6 +467,9 @@ impl PathTracer {
     /// [`Self::set_target_seconds`]) toward `target_spp` samples per pixel (`None`: no limit).
     /// Returns a report with `samples == 0` once the target is reached. Progressive renderers
     /// call it in a loop, between frames or checks of their stop rules.
+    ///
+    /// With [`Self::set_polled_readback`] it never waits: a call submits a band, and later calls
+    /// report `samples == 0` until its results are back, then fold it and report it.
     pub fn render_step(&mut self, target_spp: Option<u32>) -> Result<StepReport, PathTraceError> {
         let camera = self.scene.camera;
         if self.pass.is_none() {
@@ -473,9 +484,31 @@ impl PathTracer {
             }
             self.pass = Some(ActivePass { plan, sample_base: self.spp_done, next_row: 0 });
         }
-        let report = self.submit_band()?;
-        self.planner.record(report.samples, report.wall_seconds);
+        let report = if self.polled_readback {
+            match self.poll_band()? {
+                Some(report) => report,
+                None => return Ok(StepReport::default()),
+            }
+        } else {
+            self.submit_band()?
+        };
+        // A polled band's wall time includes the frames drawn while it was read back; its GPU
+        // time (timestamp queries), where the adapter has them, is what it cost.
+        let seconds = if self.polled_readback {
+            report.gpu_seconds.unwrap_or(report.wall_seconds)
+        } else {
+            report.wall_seconds
+        };
+        self.planner.record(report.samples, seconds);
         Ok(report)
+    }
+
+    /// Makes [`Self::render_step`] poll for each band's results instead of waiting for them:
+    /// what a web page needs, since the browser maps buffers only between frames. The samples,
+    /// the f64 fold and the statistics are the same; only the waiting differs.
+    /// [`Self::render_to_spp`] and [`Self::add_samples_in_one_pass`] always wait.
+    pub fn set_polled_readback(&mut self, polled: bool) {
+        self.polled_readback = polled;
     }
 
     /// Renders until every pixel has `spp` samples in all (those already taken count), in

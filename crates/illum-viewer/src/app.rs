@@ -89,13 +89,23 @@ pub struct ViewerApp {
     screenshot: Option<ScreenshotJob>,
     /// How often the window repaints (shown in the top bar, printed after a screenshot run).
     frame_rate: FrameRate,
+    /// The browser's file picker ("Open file..."), which delivers a file a few frames later.
+    #[cfg(target_arch = "wasm32")]
+    picker: crate::web::FilePicker,
 }
 
 impl ViewerApp {
     pub fn new(cc: &eframe::CreationContext<'_>, options: StartOptions) -> Self {
         let gpu = match &cc.wgpu_render_state {
             Some(rs) => {
-                let gpu = GpuContext::from_device(rs.device.clone(), rs.queue.clone(), rs.adapter.get_info());
+                #[allow(unused_mut)]
+                let mut info = rs.adapter.get_info();
+                // Browsers do not tell WebGPU's adapter name to wgpu; the page asked for it.
+                #[cfg(target_arch = "wasm32")]
+                if info.name.is_empty() {
+                    info.name = crate::web::adapter_description();
+                }
+                let gpu = GpuContext::from_device(rs.device.clone(), rs.queue.clone(), info);
                 log::info!("viewer adapter: {} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend);
                 Ok((gpu, rs.clone()))
             }
@@ -112,6 +122,8 @@ impl ViewerApp {
             open_error: None,
             screenshot: options.screenshot,
             frame_rate: FrameRate::default(),
+            #[cfg(target_arch = "wasm32")]
+            picker: crate::web::FilePicker::default(),
         };
         // Each mode starts on its default scene; the given file then replaces its mode's.
         app.pathtrace = load_pathtrace(Path::new(DEFAULT_PATHTRACE_SCENE));
@@ -211,8 +223,46 @@ impl ViewerApp {
     /// nothing changes and the loader's message is returned.
     pub fn open(&mut self, path: &Path) -> Result<Mode, String> {
         // The path as given names the scene in the UI and in saved metadata.
-        let given = path.to_path_buf();
         let loaded = scene_file::load(path)?;
+        Ok(self.install(path.to_path_buf(), loaded))
+    }
+
+    /// As [`Self::open`], for the text of a file dropped on the window or picked in the
+    /// browser; `name` (its file name) names it in errors and in the UI.
+    pub fn open_text(&mut self, name: &str, text: &str) -> Result<Mode, String> {
+        let loaded = scene_file::load_text(name, text)?;
+        Ok(self.install(PathBuf::from(name), loaded))
+    }
+
+    /// Opens a scene file dropped on the window like the Open button (natively: its path; in
+    /// the browser its bytes arrive a few frames later, through the file picker's inbox).
+    fn open_dropped(&mut self, ctx: &egui::Context, file: egui::DroppedFileHandle) {
+        #[cfg(not(target_arch = "wasm32"))]
+        {
+            let _ = ctx;
+            let result = self.open(file.path());
+            self.opened(result);
+        }
+        #[cfg(target_arch = "wasm32")]
+        self.picker.read_dropped(ctx, file);
+    }
+
+    /// Shows the outcome of opening a scene from the UI: its mode and name, or the error.
+    fn opened(&mut self, result: Result<Mode, String>) {
+        match result {
+            Ok(mode) => {
+                self.mode = mode;
+                self.open_error = None;
+                if let Some(current) = self.current_scene_path() {
+                    self.scene_field = current;
+                }
+            }
+            Err(e) => self.open_error = Some(e),
+        }
+    }
+
+    /// Puts a loaded scene into every mode that can render it; returns the mode to show.
+    fn install(&mut self, given: PathBuf, loaded: scene_file::LoadedScene) -> Mode {
         let mode = loaded.mode();
         if let Ok(scene) = loaded.pathtrace {
             match &mut self.pathtrace {
@@ -232,7 +282,46 @@ impl ViewerApp {
                 Err(_) => self.whitted = Ok(WhittedMode::new(given, scene)),
             }
         }
-        Ok(mode)
+        mode
+    }
+
+    /// What the window shows, as (name, value) pairs: the mode, the scene, the last open
+    /// error, the adapter, and each mode's progress. The web page publishes them on the page
+    /// (`data-*` attributes of `#illum-status`) for scripts and browser tests.
+    pub fn status(&self) -> Vec<(&'static str, String)> {
+        // Every name every time (empty when it does not apply), so that a value never outlives
+        // what it describes.
+        let text = |value: Option<String>| value.unwrap_or_default();
+        let pathtrace = self.pathtrace();
+        let stats = pathtrace.map(PathTraceMode::stats);
+        let image = pathtrace.and_then(PathTraceMode::image_mean);
+        let seconds = pathtrace.and_then(PathTraceMode::submission_seconds);
+        vec![
+            ("mode", self.mode.to_string()),
+            ("scene", text(self.current_scene_path())),
+            ("open-error", text(self.open_error.clone())),
+            ("window-fps", text(self.frame_rate.fps().map(|f| format!("{f:.1}")))),
+            (
+                "adapter",
+                text(
+                    self.gpu.as_ref().ok().map(|(gpu, _)| {
+                        format!("{} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend)
+                    }),
+                ),
+            ),
+            ("pathtrace-spp", text(stats.map(|s| s.spp.to_string()))),
+            ("pathtrace-samples-per-second", text(stats.map(|s| format!("{:.0}", s.samples_per_second)))),
+            ("pathtrace-stopped", text(pathtrace.and_then(|p| p.stop_reason()).map(|r| r.name().to_owned()))),
+            ("pathtrace-size", text(image.map(|(_, [w, h])| format!("{w}x{h}")))),
+            ("pathtrace-mean", text(image.map(|(m, _)| format!("{} {} {}", m[0], m[1], m[2])))),
+            ("pathtrace-submission-seconds", text(seconds.map(|(wall, _)| format!("{wall:.3}")))),
+            ("pathtrace-gpu-seconds", text(seconds.map(|(_, gpu)| format!("{gpu:.3}")))),
+            ("pathtrace-message", text(pathtrace.and_then(|p| p.message.clone()))),
+            ("raster-message", text(self.raster().and_then(|r| r.message.clone()))),
+            ("whitted-frames", text(self.whitted().map(|w| w.frames.to_string()))),
+            ("whitted-ms", text(self.whitted().and_then(|w| w.frame_ms).map(|ms| format!("{ms:.0}")))),
+            ("whitted-message", text(self.whitted().and_then(|w| w.message.clone()))),
+        ]
     }
 
     fn top_bar(&mut self, ui: &mut egui::Ui) {
@@ -262,6 +351,8 @@ impl ViewerApp {
                     Err(e) => self.open_error = Some(e),
                 }
             }
+            #[cfg(target_arch = "wasm32")]
+            self.web_open_buttons(ui);
             if let Some(current) = self.current_scene_path() {
                 ui.weak(format!("showing {current}"));
             }
@@ -324,8 +415,9 @@ impl ViewerApp {
         let busy = match self.mode {
             Mode::Raster => self.raster.is_ok(),
             Mode::PathTrace => self.pathtrace.as_ref().is_ok_and(PathTraceMode::is_rendering),
-            // Whitted redraws only when the view changes (handled above).
-            Mode::Whitted => false,
+            // Whitted redraws only when the view changes (handled above), and while its
+            // frame is being read back (in the browser).
+            Mode::Whitted => self.whitted.as_ref().is_ok_and(WhittedMode::is_busy),
         };
         if busy {
             ui.ctx().request_repaint();
@@ -348,6 +440,11 @@ fn load_whitted(path: &Path) -> Result<WhittedMode, String> {
 impl eframe::App for ViewerApp {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         self.frame_rate.tick();
+        // A scene file dropped on the window opens like one named in the Scene field.
+        let dropped = ui.ctx().input(|i| i.raw.dropped_files.clone());
+        for file in dropped {
+            self.open_dropped(ui.ctx(), file);
+        }
         // The path tracer's wall clock runs only while its mode is shown.
         let showing_pathtrace = self.mode == Mode::PathTrace;
         if let Ok(pathtrace) = &mut self.pathtrace {
@@ -366,6 +463,38 @@ impl eframe::App for ViewerApp {
         egui::CentralPanel::default().show(ui, |ui| self.view(ui));
         if let Some(job) = &mut self.screenshot {
             job.tick(ui.ctx(), self.frame_rate.fps());
+        }
+        #[cfg(target_arch = "wasm32")]
+        {
+            let picked = self.picker.take();
+            if let Some((name, text)) = picked {
+                let result = text.and_then(|text| self.open_text(&name, &text));
+                self.opened(result);
+            }
+            crate::web::publish_status(&self.status());
+        }
+    }
+}
+
+/// The browser's extra ways to open a scene: the scenes built into the page, and a file from
+/// the user's disk through the browser's file picker (the desktop types a path instead).
+#[cfg(target_arch = "wasm32")]
+impl ViewerApp {
+    fn web_open_buttons(&mut self, ui: &mut egui::Ui) {
+        ui.menu_button("Built-in scenes", |ui| {
+            for (name, _) in crate::platform::BUILT_IN_SCENES {
+                if ui.button(*name).clicked() {
+                    self.scene_field = (*name).to_owned();
+                    let result = self.open(Path::new(name));
+                    self.opened(result);
+                    ui.close();
+                }
+            }
+        });
+        if ui.button("Open file...").clicked()
+            && let Err(e) = self.picker.open(ui.ctx())
+        {
+            self.open_error = Some(e);
         }
     }
 }

@@ -1,7 +1,7 @@
 //! Frames per second over a sliding window of recent frames.
 
 use std::collections::VecDeque;
-use std::time::Instant;
+use web_time::Instant;
 
 /// Frames averaged.
 const WINDOW: usize = 30;

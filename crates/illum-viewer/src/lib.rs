@@ -9,7 +9,9 @@
 //! - [`gpu_setup`]: how eframe creates the device the renderers share;
 //! - [`frame_rate`]: frames per second over recent frames;
 //! - [`scene_file`]: opening scene files of either kind, with errors as text;
-//! - [`cli`] and [`screenshot`]: the command line, and `--screenshot FILE --frames N`.
+//! - [`cli`] and [`screenshot`]: the command line, and `--screenshot FILE --frames N`;
+//! - [`platform`]: what differs between the desktop and the browser (readback, scene files,
+//!   saving), and `web` (wasm32 only): the browser's start, downloads, file picker and status.
 
 pub mod app;
 pub mod camera;
@@ -18,9 +20,12 @@ pub mod display;
 pub mod frame_rate;
 pub mod gpu_setup;
 pub mod pathtrace_panel;
+pub mod platform;
 pub mod raster_panel;
 pub mod scene_file;
 pub mod screenshot;
+#[cfg(target_arch = "wasm32")]
+pub mod web;
 pub mod whitted_panel;
 
 pub use app::{Mode, StartOptions, ViewerApp};

@@ -1,59 +1,78 @@
 //! `cargo run --release -p illum-viewer -- [SCENE] [--mode raster|pathtrace|whitted]
 //! [--screenshot FILE --frames N]`
+//!
+//! Built for `wasm32-unknown-unknown` it is the web viewer instead (`scripts/build-web.sh`):
+//! `main` starts it on the page's canvas.
 
-use std::sync::Arc;
-
-use clap::Parser;
-use illum_viewer::cli::Args;
-use illum_viewer::gpu_setup::wgpu_setup;
-use illum_viewer::screenshot::{Outcome, ScreenshotJob};
-use illum_viewer::{StartOptions, ViewerApp};
-
+#[cfg(not(target_arch = "wasm32"))]
 fn main() {
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
-    let args = Args::parse();
-    // A screenshot run is a check (the smoke test's): a scene that does not open must fail it,
-    // not draw a window with the error in it and exit 0. Without --screenshot the window opens
-    // and shows the error, so that another file can be opened.
-    if args.screenshot.is_some()
-        && let Err(e) = illum_viewer::scene_file::load(&args.scene)
-    {
-        eprintln!("error: {e}");
-        std::process::exit(1);
-    }
-    let outcome: Outcome = Arc::default();
-    let screenshot =
-        args.screenshot.clone().map(|path| ScreenshotJob::new(path, args.frames, outcome.clone()));
-    let start = StartOptions { scene: args.scene.clone(), mode: args.mode, screenshot };
+    native::main();
+}
 
-    let mut native = eframe::NativeOptions {
-        viewport: egui::ViewportBuilder::default()
-            .with_title("illum viewer")
-            .with_inner_size([args.width, args.height]),
-        ..Default::default()
-    };
-    // Under CI (as in the tests) prefer lavapipe, as illum_gpu::GpuContext::new does.
-    native.wgpu_options.wgpu_setup = wgpu_setup(illum_gpu::policy::prefer_software_from_env());
-    // No vsync: the frame rate is bounded by the work (path-tracing slices, raster frames), and
-    // on software drivers FIFO presentation adds a wait to every frame.
-    native.wgpu_options.surface.present_mode = egui_wgpu::wgpu::PresentMode::AutoNoVsync;
+#[cfg(target_arch = "wasm32")]
+fn main() {
+    illum_viewer::web::start();
+}
 
-    let result =
-        eframe::run_native("illum viewer", native, Box::new(|cc| Ok(Box::new(ViewerApp::new(cc, start)))));
-    if let Err(e) = result {
-        eprintln!("error: the window could not run: {e}");
-        std::process::exit(1);
-    }
-    if args.screenshot.is_some() {
-        match outcome.lock().unwrap_or_else(|p| p.into_inner()).take() {
-            Some(Ok(path)) => println!("screenshot saved to {}", path.display()),
-            Some(Err(e)) => {
-                eprintln!("error: {e}");
-                std::process::exit(1);
-            }
-            None => {
-                eprintln!("error: the window closed before the screenshot was taken");
-                std::process::exit(1);
+#[cfg(not(target_arch = "wasm32"))]
+mod native {
+    use std::sync::Arc;
+
+    use clap::Parser;
+    use illum_viewer::cli::Args;
+    use illum_viewer::gpu_setup::wgpu_setup;
+    use illum_viewer::screenshot::{Outcome, ScreenshotJob};
+    use illum_viewer::{StartOptions, ViewerApp};
+
+    pub fn main() {
+        env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+        let args = Args::parse();
+        // A screenshot run is a check (the smoke test's): a scene that does not open must fail it,
+        // not draw a window with the error in it and exit 0. Without --screenshot the window opens
+        // and shows the error, so that another file can be opened.
+        if args.screenshot.is_some()
+            && let Err(e) = illum_viewer::scene_file::load(&args.scene)
+        {
+            eprintln!("error: {e}");
+            std::process::exit(1);
+        }
+        let outcome: Outcome = Arc::default();
+        let screenshot =
+            args.screenshot.clone().map(|path| ScreenshotJob::new(path, args.frames, outcome.clone()));
+        let start = StartOptions { scene: args.scene.clone(), mode: args.mode, screenshot };
+
+        let mut native = eframe::NativeOptions {
+            viewport: egui::ViewportBuilder::default()
+                .with_title("illum viewer")
+                .with_inner_size([args.width, args.height]),
+            ..Default::default()
+        };
+        // Under CI (as in the tests) prefer lavapipe, as illum_gpu::GpuContext::new does.
+        native.wgpu_options.wgpu_setup = wgpu_setup(illum_gpu::policy::prefer_software_from_env());
+        // No vsync: the frame rate is bounded by the work (path-tracing slices, raster frames), and
+        // on software drivers FIFO presentation adds a wait to every frame.
+        native.wgpu_options.surface.present_mode = egui_wgpu::wgpu::PresentMode::AutoNoVsync;
+
+        let result = eframe::run_native(
+            "illum viewer",
+            native,
+            Box::new(|cc| Ok(Box::new(ViewerApp::new(cc, start)))),
+        );
+        if let Err(e) = result {
+            eprintln!("error: the window could not run: {e}");
+            std::process::exit(1);
+        }
+        if args.screenshot.is_some() {
+            match outcome.lock().unwrap_or_else(|p| p.into_inner()).take() {
+                Some(Ok(path)) => println!("screenshot saved to {}", path.display()),
+                Some(Err(e)) => {
+                    eprintln!("error: {e}");
+                    std::process::exit(1);
+                }
+                None => {
+                    eprintln!("error: the window closed before the screenshot was taken");
+                    std::process::exit(1);
+                }
             }
         }
     }

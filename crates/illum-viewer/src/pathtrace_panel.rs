@@ -21,7 +21,7 @@
 use std::path::{Path, PathBuf};
 
 use illum_gpu::GpuContext;
-use illum_image::{Encoding, RgbImage32, save_png};
+use illum_image::{Encoding, RgbImage32};
 use illum_pathtrace::{PathTracer, Progressive, StopReason, StopRules};
 use illum_scene::{Bounces, Sampling, Scene};
 
@@ -161,6 +161,22 @@ impl PathTraceMode {
         self.stats
     }
 
+    /// Wall-clock and GPU seconds of the tracer's submissions since the last reset (the GPU's
+    /// where the adapter has timestamp queries, else 0).
+    pub fn submission_seconds(&self) -> Option<(f64, f64)> {
+        self.tracer.as_ref().map(|t| (t.wall_seconds(), t.gpu_seconds()))
+    }
+
+    /// The mean of the f64 image over all pixels (linear RGB) and the resolution it was
+    /// rendered at, once something was rendered: a summary that a check can compare with a
+    /// headless render of the same scene.
+    pub fn image_mean(&self) -> Option<([f64; 3], [u32; 2])> {
+        let tracer = self.tracer.as_ref()?;
+        let accumulator = tracer.accumulator();
+        (accumulator.total_samples() > 0)
+            .then(|| (accumulator.mean_image().mean(), [accumulator.width, accumulator.height]))
+    }
+
     pub fn paused(&self) -> bool {
         self.paused
     }
@@ -294,7 +310,8 @@ impl PathTraceMode {
             Some(tracer) => tracer.update_scene(wanted).map_err(|e| e.to_string())?,
             None => {
                 let mut tracer = PathTracer::new(gpu, wanted).map_err(|e| e.to_string())?;
-                tracer.set_target_seconds(FRAME_BUDGET);
+                tracer.set_target_seconds(crate::platform::submission_seconds(FRAME_BUDGET));
+                tracer.set_polled_readback(crate::platform::POLLED_READBACK);
                 // The window shows the GPU-resident sum; it follows resets and resizes itself.
                 tracer.enable_display_sum().map_err(|e| e.to_string())?;
                 self.tracer = Some(tracer);
@@ -332,21 +349,40 @@ impl PathTraceMode {
         if path.as_os_str().is_empty() || path.file_stem().is_none() {
             return Err(format!("{:?} is not a file name", self.save_path));
         }
-        if extension == "exr" {
-            let metadata = illum_pathtrace::metadata::exr_metadata(
+        let metadata = || {
+            illum_pathtrace::metadata::exr_metadata(
                 tracer,
                 self.progressive.clock().elapsed().as_secs_f64(),
                 self.progressive.stopped(),
                 "illum-viewer",
-            );
+            )
+        };
+        #[cfg(not(target_arch = "wasm32"))]
+        if extension == "exr" {
             // With the statistics layer, so that `render --resume` can continue it (at the size
             // the viewer rendered).
-            illum_pathtrace::checkpoint::save_checkpoint(&path, tracer, &metadata)?;
+            illum_pathtrace::checkpoint::save_checkpoint(&path, tracer, &metadata())?;
         } else {
             // The PNG is the image as rendered: gamma 2.2, no display exposure.
             let image: RgbImage32 = tracer.accumulator().mean_image();
-            save_png(&path, &image, 0.0, Encoding::Gamma22).map_err(|e| error_chain(&e))?;
+            illum_image::save_png(&path, &image, 0.0, Encoding::Gamma22).map_err(|e| error_chain(&e))?;
         }
+        // In the browser the same file, made in memory, is downloaded under the field's file name.
+        #[cfg(target_arch = "wasm32")]
+        {
+            let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+            let (bytes, mime) = if extension == "exr" {
+                (illum_pathtrace::checkpoint::checkpoint_bytes(&name, tracer, &metadata())?, "image/x-exr")
+            } else {
+                let image: RgbImage32 = tracer.accumulator().mean_image();
+                let bytes = illum_image::png_bytes(&name, &image, 0.0, Encoding::Gamma22)
+                    .map_err(|e| error_chain(&e))?;
+                (bytes, "image/png")
+            };
+            crate::web::download(&name, &bytes, mime)?;
+            Ok(PathBuf::from(name))
+        }
+        #[cfg(not(target_arch = "wasm32"))]
         Ok(path)
     }
 
@@ -431,7 +467,7 @@ impl PathTraceMode {
             for (button, extension) in [("Save PNG", "png"), ("Save EXR", "exr")] {
                 if ui.button(button).clicked() {
                     self.message = Some(match self.save(extension) {
-                        Ok(path) => format!("saved {}", path.display()),
+                        Ok(path) => format!("{} {}", crate::platform::SAVED, path.display()),
                         Err(e) => format!("not saved: {e}"),
                     });
                 }

@@ -136,7 +136,11 @@ impl RasterMode {
             if self.failed.as_ref() == Some(&attempt) {
                 return Err(self.message.clone().unwrap_or_default());
             }
-            match RasterRenderer::new(gpu, scene, width, height) {
+            // The raster reads its pass times back with a blocking wait, which a web page cannot
+            // do: there it runs without them (as on an adapter without timestamp queries).
+            let mut gpu = gpu.clone();
+            gpu.timestamps &= !crate::platform::POLLED_READBACK;
+            match RasterRenderer::new(&gpu, scene, width, height) {
                 Ok(renderer) => self.renderer = Some(RasterState { renderer, texture: None }),
                 Err(e) => {
                     self.failed = Some(attempt);

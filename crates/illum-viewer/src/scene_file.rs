@@ -41,9 +41,25 @@ impl LoadedScene {
 }
 
 /// Loads a scene file for every mode. An error when the file does not load, or when no mode
-/// can render it (with each renderer's reason).
+/// can render it (with each renderer's reason). In the browser the path names one of the
+/// scenes built into the page ([`crate::platform::read_scene`]).
 pub fn load(path: &Path) -> Result<LoadedScene, String> {
-    let scene = Scene::load(&resolve_scene_path(path)).map_err(|e| e.to_string())?;
+    split(crate::platform::read_scene(path)?)
+}
+
+/// Loads scene text that did not come from a path the viewer can read (a file dropped on the
+/// window or picked in the browser). `label` names it in errors, as a path would.
+pub fn load_text(label: &str, text: &str) -> Result<LoadedScene, String> {
+    split(Scene::from_toml_str(text, label).map_err(|e| e.to_string())?)
+}
+
+/// Reads a scene file from disk (native), with the loader's message on failure.
+pub fn read_from_disk(path: &Path) -> Result<Scene, String> {
+    Scene::load(&resolve_scene_path(path)).map_err(|e| e.to_string())
+}
+
+/// The scene as each mode sees it.
+fn split(scene: Scene) -> Result<LoadedScene, String> {
     let pathtrace = scene
         .require(RendererKind::PathTrace, illum_pathtrace::FEATURES)
         .map(|()| scene.clone())
@@ -87,5 +103,20 @@ mod tests {
         std::fs::write(&bad, "[camera]\nvfov = \"wide\"\n").unwrap();
         let message = load(&bad).unwrap_err();
         assert!(message.contains("bad.toml"), "{message}");
+    }
+
+    /// Text from a dropped or picked file gives the same messages as the file read from disk,
+    /// naming it by its label.
+    #[test]
+    fn text_loads_like_the_file() {
+        let text = "[camera]\nvfov = \"wide\"\n";
+        let from_text = load_text("dropped/bad.toml", text).unwrap_err();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("bad.toml");
+        std::fs::write(&path, text).unwrap();
+        let from_disk = load(&path).unwrap_err();
+        assert_eq!(from_text, from_disk.replace(&path.display().to_string(), "dropped/bad.toml"));
+        let cornell = include_str!("../../../scenes/cornell.toml");
+        assert_eq!(load_text("cornell.toml", cornell).unwrap().mode(), Mode::PathTrace);
     }
 }

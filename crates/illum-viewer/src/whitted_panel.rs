@@ -5,13 +5,15 @@
 //! egui texture, in linear values like the rasterizer's (the assignment's figure 1 is linear).
 
 use std::path::{Path, PathBuf};
-use std::time::Instant;
+use web_time::Instant;
 
 use illum_gpu::GpuContext;
+use illum_image::RgbImage32;
 use illum_scene::{MAX_WHITTED_AA, MAX_WHITTED_DEPTH, Scene};
-use illum_whitted::WhittedTracer;
+use illum_whitted::{PendingImage, WhittedTracer};
 
 use crate::camera::OrbitCamera;
+use crate::platform;
 
 /// What a frame depends on: when it is unchanged, the last image stands.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -35,6 +37,8 @@ pub struct WhittedMode {
     /// Frames rendered since the scene was opened.
     pub frames: u64,
     pub message: Option<String>,
+    /// A frame being read back (polled readback, in the browser): its key, start and image.
+    pending: Option<(FrameKey, Instant, PendingImage)>,
 }
 
 impl WhittedMode {
@@ -50,6 +54,7 @@ impl WhittedMode {
             frame_ms: None,
             frames: 0,
             message: None,
+            pending: None,
         }
     }
 
@@ -72,39 +77,76 @@ impl WhittedMode {
         // pixel than the rasterizer.
         let (width, height) = ((view_pixels[0] / 2).max(1), (view_pixels[1] / 2).max(1));
         let key = FrameKey { camera: self.camera.camera(width, height), depth: self.depth, aa: self.aa };
+        if let Some((pending_key, started, pending)) = &self.pending {
+            match pending.poll(gpu) {
+                None => return self.texture.as_ref().map(egui::TextureHandle::id),
+                Some(result) => {
+                    let (pending_key, started) = (*pending_key, *started);
+                    self.pending = None;
+                    self.show(ctx, pending_key, started, result);
+                }
+            }
+        }
         if self.drawn != Some(key) {
             let mut scene = self.scene.clone();
             scene.camera = key.camera;
             scene.whitted.depth = key.depth;
             scene.whitted.aa = key.aa;
             let started = Instant::now();
-            match WhittedTracer::new(gpu, &scene).and_then(|t| t.render()) {
-                Ok(image) => {
-                    let pixels: Vec<egui::Color32> = image
-                        .pixels
-                        .iter()
-                        .map(|p| {
-                            let [r, g, b] = p.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8);
-                            egui::Color32::from_rgb(r, g, b)
-                        })
-                        .collect();
-                    let color = egui::ColorImage::new([width as usize, height as usize], pixels);
-                    match &mut self.texture {
-                        Some(handle) => handle.set(color, egui::TextureOptions::LINEAR),
-                        None => {
-                            self.texture =
-                                Some(ctx.load_texture("whitted", color, egui::TextureOptions::LINEAR))
-                        }
+            let tracer = WhittedTracer::new(gpu, &scene);
+            if platform::POLLED_READBACK {
+                match tracer {
+                    Ok(tracer) => {
+                        self.pending = Some((key, started, tracer.render_polled()));
+                        self.drawn = Some(key);
                     }
-                    self.frame_ms = Some(started.elapsed().as_secs_f64() * 1e3);
-                    self.frames += 1;
-                    self.message = None;
+                    Err(e) => self.show(ctx, key, started, Err(e)),
                 }
-                Err(e) => self.message = Some(e.to_string()),
+            } else {
+                self.show(ctx, key, started, tracer.and_then(|t| t.render()));
             }
-            self.drawn = Some(key);
         }
         self.texture.as_ref().map(egui::TextureHandle::id)
+    }
+
+    /// True while a frame is being read back (the window must keep repainting to finish it).
+    pub fn is_busy(&self) -> bool {
+        self.pending.is_some()
+    }
+
+    /// Shows a rendered frame (or its error) and records it as drawn.
+    fn show(
+        &mut self,
+        ctx: &egui::Context,
+        key: FrameKey,
+        started: Instant,
+        result: Result<RgbImage32, illum_whitted::WhittedError>,
+    ) {
+        match result {
+            Ok(image) => {
+                let pixels: Vec<egui::Color32> = image
+                    .pixels
+                    .iter()
+                    .map(|p| {
+                        let [r, g, b] = p.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8);
+                        egui::Color32::from_rgb(r, g, b)
+                    })
+                    .collect();
+                let size = [image.width as usize, image.height as usize];
+                let color = egui::ColorImage::new(size, pixels);
+                match &mut self.texture {
+                    Some(handle) => handle.set(color, egui::TextureOptions::LINEAR),
+                    None => {
+                        self.texture = Some(ctx.load_texture("whitted", color, egui::TextureOptions::LINEAR))
+                    }
+                }
+                self.frame_ms = Some(started.elapsed().as_secs_f64() * 1e3);
+                self.frames += 1;
+                self.message = None;
+            }
+            Err(e) => self.message = Some(e.to_string()),
+        }
+        self.drawn = Some(key);
     }
 
     /// The panel's controls.

@@ -29,5 +29,5 @@ mod tracer;
 
 pub use encode::FEATURES_BUT;
 pub use tracer::{
-    ObjectIds, Shadow, WHITTED_SHADER, WhittedError, WhittedTracer, shader_defs, shader_modules,
+    ObjectIds, PendingImage, Shadow, WHITTED_SHADER, WhittedError, WhittedTracer, shader_defs, shader_modules,
 };

@@ -169,22 +169,24 @@ impl WhittedTracer {
 
     /// Renders the image: linear radiance per pixel, row-major from the top-left.
     pub fn render(&self) -> Result<RgbImage32, WhittedError> {
-        let texels = self.run(OUTPUT_RADIANCE, "reading the Whitted image")?;
-        let mut image = RgbImage32::new(self.width, self.height);
-        for (pixel, texel) in image.pixels.iter_mut().zip(&texels) {
-            *pixel = [texel[0], texel[1], texel[2]];
-        }
-        Ok(image)
+        self.dispatch(OUTPUT_RADIANCE);
+        let data = self.read("reading the Whitted image")?;
+        Ok(self.decode(&data))
     }
 
     /// The object-ID image of the same camera (one ray through each pixel's centre).
     pub fn object_ids(&self) -> Result<ObjectIds, WhittedError> {
-        let texels = self.run(OUTPUT_OBJECT_IDS, "reading the object-ID image")?;
+        self.dispatch(OUTPUT_OBJECT_IDS);
+        let data = self.read("reading the object-ID image")?;
+        // Two u32 per pixel, in a vec4 of f32 bits (the copy has no alignment guarantee).
+        let words: Vec<u32> =
+            data.chunks_exact(4).map(|c| u32::from_le_bytes(c.try_into().expect("4 bytes"))).collect();
+        let texels: Vec<&[u32]> = words.chunks_exact(4).collect();
         let scene_object = |gpu_index: u32| self.scene_index.get(gpu_index as usize).copied();
-        let hit = texels.iter().map(|t| scene_object(t[0].to_bits())).collect();
+        let hit = texels.iter().map(|t| scene_object(t[0])).collect();
         let shadow = texels
             .iter()
-            .map(|t| match t[1].to_bits() {
+            .map(|t| match t[1] {
                 SHADOW_LIT | NO_HIT => Shadow::Lit,
                 SHADOW_FACING_AWAY => Shadow::FacingAway,
                 i => scene_object(i).map_or(Shadow::Lit, Shadow::BlockedBy),
@@ -193,17 +195,46 @@ impl WhittedTracer {
         Ok(ObjectIds { width: self.width, height: self.height, hit, shadow })
     }
 
-    /// One dispatch writing `output`, read back as one vec4 per pixel.
-    fn run(&self, output: u32, reading: &str) -> Result<Vec<[f32; 4]>, WhittedError> {
-        let params = WhittedParams {
-            counts: [
-                self.radiance_params.counts[0],
-                self.radiance_params.counts[1],
-                self.radiance_params.counts[2],
-                output,
-            ],
-            ..self.radiance_params
-        };
+    /// [`Self::render`] without waiting (what a web page needs): submits the frame and starts
+    /// its readback; [`PendingImage::poll`] on later frames returns the image.
+    pub fn render_polled(&self) -> PendingImage {
+        self.dispatch(OUTPUT_RADIANCE);
+        let bytes = u64::from(self.width) * u64::from(self.height) * PIXEL_BYTES;
+        let staging = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("whitted staging"),
+            size: bytes,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = self
+            .gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("whitted readback") });
+        encoder.copy_buffer_to_buffer(&self.image, 0, &staging, 0, bytes);
+        self.gpu.queue.submit([encoder.finish()]);
+        PendingImage {
+            read: readback::PendingRead::start(staging, bytes, "reading the Whitted image"),
+            width: self.width,
+            height: self.height,
+        }
+    }
+
+    fn decode(&self, data: &[u8]) -> RgbImage32 {
+        decode_image(self.width, self.height, data)
+    }
+
+    /// The image buffer, read back with a wait (one vec4 per pixel).
+    fn read(&self, reading: &str) -> Result<Vec<u8>, WhittedError> {
+        let bytes = u64::from(self.width) * u64::from(self.height) * PIXEL_BYTES;
+        let data = readback::read_buffer(&self.gpu, &self.image, 0, bytes, reading)?;
+        self.gpu.check()?;
+        Ok(data)
+    }
+
+    /// Submits one dispatch writing `output` (OUTPUT_RADIANCE or OUTPUT_OBJECT_IDS).
+    fn dispatch(&self, output: u32) {
+        let [lights, depth, aa, _] = self.radiance_params.counts;
+        let params = WhittedParams { counts: [lights, depth, aa, output], ..self.radiance_params };
         self.gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         let mut encoder = self
             .gpu
@@ -212,11 +243,37 @@ impl WhittedTracer {
         let workgroups = [self.width.div_ceil(WORKGROUP), self.height.div_ceil(WORKGROUP), 1];
         dispatch(&mut encoder, "whitted", &self.pipeline, &self.bind_group, workgroups);
         self.gpu.queue.submit([encoder.finish()]);
-        let bytes = u64::from(self.width) * u64::from(self.height) * PIXEL_BYTES;
-        let data = readback::read_buffer(&self.gpu, &self.image, 0, bytes, reading)?;
-        self.gpu.check()?;
-        Ok(bytemuck::cast_slice(&data).to_vec())
     }
+}
+
+/// A Whitted frame whose readback is under way ([`WhittedTracer::render_polled`]).
+pub struct PendingImage {
+    read: readback::PendingRead,
+    width: u32,
+    height: u32,
+}
+
+impl PendingImage {
+    /// `None` while the image is still being read back; never waits.
+    pub fn poll(&self, gpu: &GpuContext) -> Option<Result<RgbImage32, WhittedError>> {
+        let data = self.read.poll(gpu)?;
+        Some(data.map_err(WhittedError::from).and_then(|data| {
+            gpu.check()?;
+            Ok(decode_image(self.width, self.height, &data))
+        }))
+    }
+}
+
+/// The image buffer's RGBA f32 texels as linear RGB.
+fn decode_image(width: u32, height: u32, data: &[u8]) -> RgbImage32 {
+    // The mapped copy has no alignment guarantee, so read the floats one by one.
+    let floats: Vec<f32> =
+        data.chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().expect("4 bytes"))).collect();
+    let mut image = RgbImage32::new(width, height);
+    for (pixel, texel) in image.pixels.iter_mut().zip(floats.chunks_exact(4)) {
+        *pixel = [texel[0], texel[1], texel[2]];
+    }
+    image
 }
 
 #[cfg(test)]

@@ -1,9 +1,13 @@
 //! One submission of the path tracer: a band of rows of the current pass traced on the GPU,
 //! read back, checked for lost samples and folded into the f64 accumulator.
+//!
+//! The readback is either a blocking wait ([`PathTracer::submit_band`], native tools) or polled
+//! ([`PathTracer::poll_band`], the web viewer, which cannot wait): the band is submitted and its
+//! mapping started, and later calls fold it once the browser has mapped it.
 
-use std::time::Instant;
-
+use illum_gpu::readback::PendingRead;
 use illum_gpu::{readback, wgpu};
+use web_time::Instant;
 
 use super::{PathTracer, StepReport, TIMED_PASS};
 use crate::PathTraceError;
@@ -52,7 +56,53 @@ impl PathTracer {
         Ok(())
     }
 
+    /// Traces one band and folds it, waiting for the readback.
     pub(super) fn submit_band(&mut self) -> Result<StepReport, PathTraceError> {
+        let band = self.begin_band()?;
+        let staging = self.staging.as_ref().expect("allocated by begin_band");
+        let data = readback::read_mapped(
+            &self.gpu,
+            staging,
+            band.staging_size,
+            "reading back a path-tracing batch",
+        )?;
+        self.finish_band(&band, &data)
+    }
+
+    /// The polled form of [`Self::submit_band`]: submits a band when none is in flight, and
+    /// folds the one in flight once its mapping is done. `None` while it is not; never waits.
+    pub(super) fn poll_band(&mut self) -> Result<Option<StepReport>, PathTraceError> {
+        if self.in_flight.is_none() {
+            self.launch_band()?;
+        }
+        let Some(result) = self.in_flight.as_ref().and_then(|f| f.read.poll(&self.gpu)) else {
+            return Ok(None);
+        };
+        let flight = self.in_flight.take().expect("polled above");
+        let data = result?;
+        self.staging = Some(flight.read.into_buffer());
+        let report = self.finish_band(&flight.band, &data)?;
+        // The next band of this pass goes to the GPU now, so that it works while the page
+        // draws its next frame (a new pass waits for the next call, which checks the target).
+        if self.pass.is_some() {
+            self.launch_band()?;
+        }
+        Ok(Some(report))
+    }
+
+    /// Submits a band and starts its polled readback.
+    fn launch_band(&mut self) -> Result<(), PathTraceError> {
+        let band = self.begin_band()?;
+        // The staging buffer travels with the band: nothing may copy into it while mapped.
+        let staging = self.staging.take().expect("allocated by begin_band");
+        let read = PendingRead::start(staging, band.staging_size, "reading back a path-tracing batch");
+        self.in_flight = Some(InFlightBand { band, read });
+        Ok(())
+    }
+
+    /// Records and submits one band of the active pass (trace, display sum, copies into the
+    /// staging buffer).
+    fn begin_band(&mut self) -> Result<Band, PathTraceError> {
         let started = Instant::now();
         let width = self.scene.camera.width;
         let height = self.scene.camera.height;
@@ -115,9 +165,14 @@ impl PathTracer {
         encoder.copy_buffer_to_buffer(&batch.sum_sq, 0, staging, bytes, bytes);
         self.timer.copy_results(&mut encoder, staging, 2 * bytes);
         self.gpu.queue.submit([encoder.finish()]);
+        Ok(Band { started, row_offset, rows, spp, chunk, chunks, band_pixels, bytes, staging_size })
+    }
 
-        let data =
-            readback::read_mapped(&self.gpu, staging, staging_size, "reading back a path-tracing batch")?;
+    /// Checks and folds a band's read-back bytes, and moves the pass on.
+    fn finish_band(&mut self, band: &Band, data: &[u8]) -> Result<StepReport, PathTraceError> {
+        let Band { started, row_offset, rows, spp, chunk, chunks, band_pixels, bytes, .. } = *band;
+        let width = self.scene.camera.width;
+        let height = self.scene.camera.height;
         let floats = batch::decode_slots(&data[..(2 * bytes) as usize]);
         let (sums, sums_sq) = floats.split_at(floats.len() / 2);
         if let Err(error) = batch::check_complete(sums, sums_sq, spp, chunk, band_pixels) {
@@ -165,4 +220,26 @@ impl PathTracer {
             pass_completed,
         })
     }
+}
+
+/// What a submitted band covers, for folding it when its bytes are back.
+#[derive(Clone, Copy)]
+pub(super) struct Band {
+    started: Instant,
+    row_offset: u32,
+    rows: u32,
+    spp: u32,
+    /// Samples per chunk when it was recorded (a later `set_chunk_samples` must not change it).
+    chunk: u32,
+    chunks: u32,
+    band_pixels: usize,
+    /// Bytes of each of the two slot arrays (sums, sums of squares) in the staging buffer.
+    bytes: u64,
+    staging_size: u64,
+}
+
+/// A band submitted with polled readback, whose staging buffer is being mapped.
+pub(super) struct InFlightBand {
+    band: Band,
+    read: PendingRead,
 }

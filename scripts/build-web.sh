@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# Builds the web viewer into web/dist/ (index.html, illum_viewer.js, illum_viewer_bg.wasm).
+# With --serve, then serves it on http://127.0.0.1:8000/ (PORT=... to change).
+#
+# Needs: rustup target add wasm32-unknown-unknown
+#        cargo install wasm-bindgen-cli --version <the wasm-bindgen version in Cargo.lock>
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+target_dir="${CARGO_TARGET_DIR:-$PWD/target}"
+dist="web/dist"
+
+# wasm-bindgen-cli must be exactly the wasm-bindgen crate's version.
+wanted=$(awk '/^name = "wasm-bindgen"$/ { getline; gsub(/"/, "", $3); print $3 }' Cargo.lock)
+if ! command -v wasm-bindgen >/dev/null; then
+    echo "error: wasm-bindgen is not installed; install it with: cargo install wasm-bindgen-cli --version $wanted" >&2
+    exit 1
+fi
+have=$(wasm-bindgen --version | awk '{ print $2 }')
+if [ "$have" != "$wanted" ]; then
+    echo "error: wasm-bindgen $have is installed but Cargo.lock has wasm-bindgen $wanted; install the same: cargo install wasm-bindgen-cli --version $wanted" >&2
+    exit 1
+fi
+if command -v rustup >/dev/null && ! rustup target list --installed | grep -qx wasm32-unknown-unknown; then
+    echo "error: the wasm32-unknown-unknown target is missing; add it with: rustup target add wasm32-unknown-unknown" >&2
+    exit 1
+fi
+
+cargo build --release --target wasm32-unknown-unknown -p illum-viewer --bin illum-viewer
+rm -rf "$dist"
+mkdir -p "$dist"
+wasm-bindgen --target web --no-typescript --out-name illum_viewer --out-dir "$dist" \
+    "$target_dir/wasm32-unknown-unknown/release/illum-viewer.wasm"
+cp web/index.html "$dist/"
+echo "built $dist: $(du -sh "$dist" | cut -f1)"
+
+if [ "${1:-}" = "--serve" ]; then
+    port="${PORT:-8000}"
+    echo "serving on http://127.0.0.1:$port/ (Ctrl-C stops)"
+    exec python3 -m http.server "$port" --bind 127.0.0.1 --directory "$dist"
+fi

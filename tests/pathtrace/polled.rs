@@ -1,0 +1,69 @@
+//! Polled readback (what the web viewer uses, `PathTracer::set_polled_readback`): the same
+//! samples reach the same f64 fold as with the blocking readback, and a reset while a band is
+//! in flight never folds that band.
+
+use illum::pathtrace::PathTracer;
+use illum::scene::{Bounces, Sampling};
+
+use crate::common;
+
+const SPP: u32 = 8;
+
+/// Renders to `SPP` with `render_step`, polling or waiting; `reset_after_first_step` resets the
+/// tracer after its first step (a band is then in flight when polling).
+fn render(polled: bool, reset_after_first_step: bool) -> PathTracer {
+    let scene = common::cornell(24, SPP, Bounces::Fixed(2), Sampling::Cosine, 5);
+    let mut tracer = PathTracer::new(common::gpu(), &scene).expect("path tracer builds");
+    // One sample per chunk: each sample reaches the f64 fold as its own f32 value, so how the
+    // samples were grouped into bands changes only the f64 rounding of the sums.
+    tracer.set_chunk_samples(1);
+    tracer.set_polled_readback(polled);
+    let mut steps_without_samples = 0u64;
+    if reset_after_first_step {
+        tracer.render_step(Some(SPP)).expect("a step");
+        tracer.reset();
+    }
+    while tracer.spp_done() < SPP {
+        let report = tracer.render_step(Some(SPP)).expect("a step");
+        if report.samples == 0 {
+            steps_without_samples += 1;
+            std::thread::yield_now();
+        }
+    }
+    println!("polled {polled}: {steps_without_samples} steps returned before their band was back");
+    tracer
+}
+
+fn assert_same_image(a: &PathTracer, b: &PathTracer, what: &str) {
+    let (a, b) = (a.accumulator(), b.accumulator());
+    assert_eq!(a.total_samples(), b.total_samples(), "{what}: sample counts differ");
+    assert_eq!(a.dropped_samples(), b.dropped_samples(), "{what}: dropped samples differ");
+    for pixel in 0..(a.width * a.height) as usize {
+        assert_eq!(a.pixel_count(pixel), b.pixel_count(pixel), "{what}: pixel {pixel}'s count");
+        let (sa, sb) = (a.pixel_sum(pixel), b.pixel_sum(pixel));
+        for c in 0..3 {
+            let scale = sa[c].abs().max(sb[c].abs()).max(1e-30);
+            assert!(
+                (sa[c] - sb[c]).abs() / scale < 1e-12,
+                "{what}: pixel {pixel} channel {c}: {} vs {}",
+                sa[c],
+                sb[c]
+            );
+        }
+    }
+}
+
+#[test]
+fn polled_readback_folds_the_same_samples_as_waiting() {
+    let waited = render(false, false);
+    let polled = render(true, false);
+    assert_same_image(&waited, &polled, "polled against waited");
+    assert_eq!(polled.spp_done(), SPP);
+}
+
+#[test]
+fn a_reset_while_a_band_is_in_flight_drops_that_band() {
+    let waited = render(false, false);
+    let reset = render(true, true);
+    assert_same_image(&waited, &reset, "reset mid-flight against a fresh render");
+}
