@@ -37,7 +37,7 @@
 #import illum::rtcore::geometry::{NO_HIT, Surface}
 #import illum::pathtrace::scene::{params, objects, materials}
 #import illum::rtcore::traversal::{closest_hit, surface_at}
-#import illum::pathtrace::surfaces::{MATERIAL_CHECKER, MATERIAL_DIELECTRIC, MATERIAL_MIRROR, fresnel, sample_sun}
+#import illum::pathtrace::surfaces::{MATERIAL_CHECKER, MATERIAL_DIELECTRIC, MATERIAL_MIRROR, scatter_dielectric, sample_sun}
 #ifdef CHECKER
 #import illum::pathtrace::surfaces::checker_albedo
 #endif
@@ -243,24 +243,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             if (!may_scatter(scatterings, &throughput, vec3<f32>(1.0), &sampler)) {
                 return;
             }
-            let ior = m.emission.w;
-            let eta = select(ior, 1.0 / ior, front);
-            let cos_i = -dot(d, s.n);
-            let k2 = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
-            var reflects = k2 < 0.0;
-            if (!reflects) {
-                let cos_t = sqrt(k2);
-                reflects = sample_1d(&sampler) < fresnel(cos_i, cos_t, eta);
-                if (!reflects) {
-                    // Flux crosses without an eta^2 factor (see the top of this file).
-                    d = normalize(eta * d + (eta * cos_i - cos_t) * s.n);
-                    o = spawn_point(s.p, -s.n, s.err);
-                }
-            }
-            if (reflects) {
-                d = reflect(d, s.n);
-                o = spawn_point(s.p, s.n, s.err);
-            }
+            // Flux crosses without an eta^2 factor (see the top of this file).
+            let next = scatter_dielectric(s, d, m.emission.w, front, &sampler);
+            o = next.o;
+            d = next.d;
         } else {
             if (scatterings == 0u) {
                 return;

@@ -21,7 +21,7 @@
 #import illum::pathtrace::surfaces::sample_sun
 #endif
 #ifdef SPECULAR
-#import illum::pathtrace::surfaces::fresnel
+#import illum::pathtrace::surfaces::scatter_dielectric
 #endif
 #ifdef CHECKER
 #import illum::pathtrace::surfaces::checker_albedo
@@ -184,23 +184,9 @@ fn radiance(origin: vec3<f32>, direction: vec3<f32>, sampler: ptr<function, Samp
                 d = reflect(d, s.n);
                 o = spawn_point(s.p, s.n, s.err);
             } else {
-                let ior = m.emission.w;
-                let eta = select(ior, 1.0 / ior, front);
-                let cos_i = -dot(d, s.n);
-                let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
-                var reflects = k < 0.0;
-                if (!reflects) {
-                    let cos_t = sqrt(k);
-                    reflects = sample_1d(sampler) < fresnel(cos_i, cos_t, eta);
-                    if (!reflects) {
-                        d = normalize(eta * d + (eta * cos_i - cos_t) * s.n);
-                        o = spawn_point(s.p, -s.n, s.err);
-                    }
-                }
-                if (reflects) {
-                    d = reflect(d, s.n);
-                    o = spawn_point(s.p, s.n, s.err);
-                }
+                let next = scatter_dielectric(s, d, m.emission.w, front, sampler);
+                o = next.o;
+                d = next.d;
             }
             direct_counts = true;
             if (!roulette(depth, &throughput, sampler)) {

@@ -4,7 +4,10 @@
 // sun) both need to know about surfaces and the sun: the material kinds, the functions that
 // read them, and the sun's sampled direction.
 
+#import illum::sampler::{Sampler, sample_1d}
 #import illum::sampling::{sample_uniform_cone, to_world}
+#import illum::spawn::spawn_point
+#import illum::rtcore::geometry::Surface
 #import illum::pathtrace::scene::{Material, params, objects}
 
 #ifdef SUN
@@ -52,5 +55,30 @@ fn fresnel(cos_i: f32, cos_t: f32, eta: f32) -> f32 {
     let rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
     let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
     return 0.5 * (rs * rs + rp * rp);
+}
+
+// A ray leaving a smooth surface: its origin and direction.
+struct Scattered {
+    o: vec3<f32>,
+    d: vec3<f32>,
+}
+
+// The smooth dielectric of index `ior` (inside; 1 outside) met by direction d at s, whose
+// normal s.n faces d (`front`: d enters). Reflect or refract, chosen with the Fresnel
+// probability (one number from the sampler, none under total internal reflection, where
+// everything reflects). No weight: choosing by the reflectance makes it 1 for radiance from
+// the camera and for flux from the light alike; radiance's eta^2 across the interface cancels
+// over the two crossings every path through a closed dielectric makes (docs/caustics.md).
+fn scatter_dielectric(s: Surface, d: vec3<f32>, ior: f32, front: bool, sampler: ptr<function, Sampler>) -> Scattered {
+    let eta = select(ior, 1.0 / ior, front);
+    let cos_i = -dot(d, s.n);
+    let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+    if (k >= 0.0) {
+        let cos_t = sqrt(k);
+        if (sample_1d(sampler) >= fresnel(cos_i, cos_t, eta)) {
+            return Scattered(spawn_point(s.p, -s.n, s.err), normalize(eta * d + (eta * cos_i - cos_t) * s.n));
+        }
+    }
+    return Scattered(spawn_point(s.p, s.n, s.err), reflect(d, s.n));
 }
 #endif
