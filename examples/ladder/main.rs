@@ -9,7 +9,8 @@
 //! Rows:
 //! - the rasterizer (if it can draw the scene): the `figure` look, the `enhanced` look, and the
 //!   enhanced look with each effect off in turn;
-//! - the Whitted ray tracer at each depth of `--depths`;
+//! - the Whitted ray tracer at each depth of `--depths` (the first alone in a scene without a
+//!   mirror or glass, where depth changes nothing);
 //! - the path tracer at each spp of `--spp-list` (the scene's bounces), without and (where the
 //!   scene has a caustic: a sun and a mirror or glass) with the caustic estimator, and at each
 //!   bounce count of `--bounce-list` with `--bounce-spp` samples (on the Cornell box this is
@@ -172,7 +173,14 @@ fn run(args: Args) -> anyhow::Result<()> {
 
     let mut rungs = Vec::new();
     raster_rungs(&gpu, &scene, args.frames, &mut rungs)?;
-    for &depth in &args.depths {
+    // Without a mirror or glass no ray is ever reflected or refracted: every depth gives the
+    // same image, so only the first is rendered.
+    let depths =
+        if has_specular(&scene) { &args.depths[..] } else { &args.depths[..args.depths.len().min(1)] };
+    if depths.len() < args.depths.len() {
+        println!("no mirror or glass: the Whitted ray tracer's depth changes nothing, one row only");
+    }
+    for &depth in depths {
         rungs.push(whitted_rung(&gpu, &scene, depth, args.frames)?);
         print_rung(rungs.last().expect("pushed"));
     }
@@ -212,14 +220,18 @@ fn run(args: Args) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Whether the scene has a mirror or glass.
+fn has_specular(scene: &Scene) -> bool {
+    scene
+        .materials
+        .iter()
+        .any(|m| matches!(m.kind, MaterialKind::Dielectric { .. } | MaterialKind::Mirror { .. }))
+}
+
 /// Whether the scene has a caustic for the light tracer: a directional light and a mirror or
 /// glass that can focus it.
 fn has_caustic(scene: &Scene) -> bool {
-    let specular = scene
-        .materials
-        .iter()
-        .any(|m| matches!(m.kind, MaterialKind::Dielectric { .. } | MaterialKind::Mirror { .. }));
-    scene.directional_light.is_some() && specular
+    scene.directional_light.is_some() && has_specular(scene)
 }
 
 /// The scene's aspect with 320 pixels on the longer side, unless the flags say otherwise.
