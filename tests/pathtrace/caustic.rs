@@ -183,16 +183,7 @@ fn a_very_bright_sun_scales_the_image_and_nothing_overflows() {
 
 #[test]
 fn extremes_stay_finite_with_nothing_dropped() {
-    for (material, sun) in [
-        ("dielectric = { ior = 1.0001 }", "direction = [-1.0, -1.0, 0.0]"),
-        ("dielectric = { ior = 4.0 }", "direction = [-1.0, -1.0, 0.0]"),
-        // 0.1 and 89.9 degrees of elevation.
-        ("dielectric = { ior = 1.5 }", "direction = [-1.0, -0.0017453, 0.0]"),
-        ("dielectric = { ior = 1.5 }", "direction = [-0.0017453, -1.0, 0.0]"),
-        ("dielectric = { ior = 1.5 }", "direction = [-1.0, -1.0, 0.0]\nangular_radius = 20.0"),
-        ("dielectric = { ior = 1.5 }", "direction = [-1.0, -1.0, 0.0]\nangular_radius = 0.01"),
-        ("mirror = { reflectance = [1.0, 1.0, 1.0] }", "direction = [-1.0, -1.0, 0.0]"),
-    ] {
+    for (material, sun) in illum_oracle::caustic::EXTREME_CASES {
         for bounces in ["8", "\"unbounded\""] {
             let mut s = ball_scene(material, sun, 3.0, SKY, bounces);
             s.pathtrace.spp = 8;

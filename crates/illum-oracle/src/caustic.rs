@@ -298,3 +298,18 @@ impl Oracle {
         image
     }
 }
+
+/// The caustic's extreme cases, shared by the oracle's tests and the GPU's
+/// (`tests/pathtrace/caustic.rs`): a ball's material and the `[directional_light]` lines that
+/// go with it. Indices of refraction 1.0001 (grazing refraction, almost no reflection) and 4
+/// (total internal reflection chains), the sun at 0.1 and 89.9 degrees of elevation, a sun disc
+/// of 20 and of 0.01 degrees, and a perfect mirror.
+pub const EXTREME_CASES: [(&str, &str); 7] = [
+    ("dielectric = { ior = 1.0001 }", "direction = [-1.0, -1.0, 0.0]"),
+    ("dielectric = { ior = 4.0 }", "direction = [-1.0, -1.0, 0.0]"),
+    ("dielectric = { ior = 1.5 }", "direction = [-1.0, -0.0017453, 0.0]"),
+    ("dielectric = { ior = 1.5 }", "direction = [-0.0017453, -1.0, 0.0]"),
+    ("dielectric = { ior = 1.5 }", "direction = [-1.0, -1.0, 0.0]\nangular_radius = 20.0"),
+    ("dielectric = { ior = 1.5 }", "direction = [-1.0, -1.0, 0.0]\nangular_radius = 0.01"),
+    ("mirror = { reflectance = [1.0, 1.0, 1.0] }", "direction = [-1.0, -1.0, 0.0]"),
+];

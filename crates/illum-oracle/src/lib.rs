@@ -43,7 +43,7 @@
 //! polygon formula and an empty room lit through its ceiling).
 
 mod camera;
-mod caustic;
+pub mod caustic;
 pub mod chi_square;
 pub mod closed_form;
 pub mod geometry;

@@ -180,16 +180,7 @@ fn bounce_limits_count_the_specular_scatterings_as_the_camera_path_would() {
 
 #[test]
 fn extremes_stay_finite() {
-    for (material, sun) in [
-        ("dielectric = { ior = 1.0001 }", "direction = [-1.0, -1.0, 0.0]"),
-        ("dielectric = { ior = 4.0 }", "direction = [-1.0, -1.0, 0.0]"),
-        // 0.1 and 89.9 degrees of elevation.
-        ("dielectric = { ior = 1.5 }", "direction = [-1.0, -0.0017453, 0.0]"),
-        ("dielectric = { ior = 1.5 }", "direction = [-0.0017453, -1.0, 0.0]"),
-        ("dielectric = { ior = 1.5 }", "direction = [-1.0, -1.0, 0.0]\nangular_radius = 20.0"),
-        ("dielectric = { ior = 1.5 }", "direction = [-1.0, -1.0, 0.0]\nangular_radius = 0.01"),
-        ("mirror = { reflectance = [1.0, 1.0, 1.0] }", "direction = [-1.0, -1.0, 0.0]"),
-    ] {
+    for (material, sun) in illum_oracle::caustic::EXTREME_CASES {
         let s = ball_scene(material, sun);
         for bounces in [Bounces::Fixed(8), Bounces::Unbounded] {
             let image = render(&s, bounces, true, 4, 6);
