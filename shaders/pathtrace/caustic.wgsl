@@ -37,16 +37,11 @@
 #import illum::rtcore::geometry::{NO_HIT, Surface}
 #import illum::pathtrace::scene::{params, objects, materials}
 #import illum::rtcore::traversal::{closest_hit, surface_at}
-#import illum::pathtrace::surfaces::{MATERIAL_CHECKER, MATERIAL_DIELECTRIC, MATERIAL_MIRROR, scatter_dielectric, sample_sun}
+#import illum::pathtrace::surfaces::{MATERIAL_CHECKER, MATERIAL_DIELECTRIC, MATERIAL_MIRROR, UNBOUNDED, RR_START, RR_MAX_SURVIVAL, UNBOUNDED_DEPTH_CAP, max3, scatter_dielectric, sample_sun}
 #ifdef CHECKER
 #import illum::pathtrace::surfaces::checker_albedo
 #endif
 
-const UNBOUNDED: u32 = 0xffffffffu;
-// Russian roulette as the camera paths have it (pathtrace.wgsl).
-const RR_START: u32 = 3u;
-const RR_MAX_SURVIVAL: f32 = 0.95;
-const UNBOUNDED_DEPTH_CAP: u32 = 1024u;
 const TWO_POW_32: f32 = 4294967296.0;
 
 // Mirrored by tracer/caustic.rs's CausticParams.
@@ -80,9 +75,6 @@ struct CausticParams {
 // one counter of dropped particles per frame.
 @group(0) @binding(8) var<storage, read_write> splat: array<atomic<u32>>;
 
-fn max3(v: vec3<f32>) -> f32 {
-    return max(max(v.x, v.y), v.z);
-}
 
 // Adds value v >= 0 to pixel `pixel` of frame `frame` in fixed point; false if too large
 // (or not a number) to be added safely.

@@ -16,7 +16,7 @@
 #import illum::rtcore::geometry::{NO_HIT, FAR, Surface}
 #import illum::pathtrace::scene::{Material, params, objects, materials, lights, batch_sum, batch_sum_sq}
 #import illum::rtcore::traversal::{closest_hit, occluded, surface_at, choose_light}
-#import illum::pathtrace::surfaces::{MATERIAL_CHECKER, MATERIAL_DIELECTRIC, MATERIAL_MIRROR}
+#import illum::pathtrace::surfaces::{MATERIAL_CHECKER, MATERIAL_DIELECTRIC, MATERIAL_MIRROR, UNBOUNDED, RR_START, RR_MAX_SURVIVAL, UNBOUNDED_DEPTH_CAP, max3}
 #ifdef SUN
 #import illum::pathtrace::surfaces::sample_sun
 #endif
@@ -28,14 +28,6 @@
 #endif
 
 const SAMPLING_COSINE: u32 = 0u;
-const UNBOUNDED: u32 = 0xffffffffu;
-// Russian roulette starts after this many bounces; survival is capped below 1 so that even an
-// albedo-1 closed box terminates (expected extra length <= 1 / (1 - 0.95) = 20 bounces).
-const RR_START: u32 = 3u;
-const RR_MAX_SURVIVAL: f32 = 0.95;
-// A safety net for `unbounded`: reaching it needs 0.95^1000 ~ 5e-23 survival odds, so the bias it
-// introduces is far below f32 resolution.
-const UNBOUNDED_DEPTH_CAP: u32 = 1024u;
 // Shadow rays end this fraction of their length short of the light (on top of the light's own
 // error band, see direct_light). It covers rounding only: the computed length of the segment and
 // the distance at which the slab or quad test finds a surface lying in the light's plane each
@@ -76,10 +68,6 @@ fn direct_light(s: Surface, origin: vec3<f32>, sampler: ptr<function, Sampler>) 
         }
     }
     return vec3<f32>(0.0);
-}
-
-fn max3(v: vec3<f32>) -> f32 {
-    return max(max(v.x, v.y), v.z);
 }
 
 #ifdef SUN

@@ -33,6 +33,20 @@ fn sample_sun(u1: f32, u2: f32) -> SunSample {
 }
 #endif
 
+// How long paths get, for the camera's paths and the caustic's particles alike: `bounces` or
+// UNBOUNDED, where Russian roulette starts after RR_START bounces with survival capped below 1
+// so that even an albedo-1 closed box terminates (expected extra length <= 1 / (1 - 0.95) = 20
+// bounces), and UNBOUNDED_DEPTH_CAP is a safety net whose 0.95^1000 ~ 5e-23 survival odds bias
+// nothing f32 can resolve.
+const UNBOUNDED: u32 = 0xffffffffu;
+const RR_START: u32 = 3u;
+const RR_MAX_SURVIVAL: f32 = 0.95;
+const UNBOUNDED_DEPTH_CAP: u32 = 1024u;
+
+fn max3(v: vec3<f32>) -> f32 {
+    return max(max(v.x, v.y), v.z);
+}
+
 const MATERIAL_CHECKER: u32 = 1u;
 const MATERIAL_DIELECTRIC: u32 = 2u;
 const MATERIAL_MIRROR: u32 = 3u;
