@@ -25,7 +25,7 @@ use illum::scene::{Bounces, Scene};
 
 #[derive(Parser, Debug)]
 #[command(about = "Measure path-tracer throughput (samples/s, rays/s, GPU time per submission; generic \
-             against specialised pipelines) and the Whitted look-alike's frame time")]
+             against specialised pipelines) and the rasterizer's frame time")]
 struct Args {
     /// Scene to benchmark.
     #[arg(default_value = cli::DEFAULT_SCENE)]
@@ -124,7 +124,7 @@ fn run(args: Args) -> anyhow::Result<()> {
     bench_raster(&gpu, args.runs)
 }
 
-/// The Whitted look-alike at 1280 x 720, enhanced look, every effect on: frames per second and
+/// The rasterizer on the Whitted scene at 1280 x 720, enhanced look, every effect on: frames per second and
 /// the GPU time of each pass (more options: `--example raster_bench`).
 fn bench_raster(gpu: &illum::gpu::GpuContext, runs: usize) -> anyhow::Result<()> {
     let path = cli::resolve_scene_path(std::path::Path::new("scenes/whitted.toml"));
@@ -132,7 +132,7 @@ fn bench_raster(gpu: &illum::gpu::GpuContext, runs: usize) -> anyhow::Result<()>
     let options = Options::all_on(Look::Enhanced);
     println!();
     println!(
-        "| Whitted look-alike, 1280x720, enhanced, every effect on | median frame (ms) | fps | shadow (ms) | cube maps (ms) | main (ms) |"
+        "| Rasterizer, Whitted scene, 1280x720, enhanced, every effect on | median frame (ms) | fps | shadow (ms) | cube maps (ms) | main (ms) |"
     );
     println!("|---|---|---|---|---|---|");
     for motion in [Motion::CameraOrbit, Motion::SceneChange] {

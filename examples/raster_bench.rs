@@ -1,4 +1,4 @@
-//! Frame-rate benchmark of the Whitted look-alike rasterizer.
+//! Frame-rate benchmark of the rasterizer (which fakes Whitted's look).
 //!
 //! ```text
 //! cargo run --release --example raster_bench -- [SCENE] [--width 1280 --height 720]
@@ -22,7 +22,7 @@ use illum::raster::{Look, Motion, bench_frames};
 use illum::raster_cli::RasterArgs;
 
 #[derive(Parser, Debug)]
-#[command(about = "Measure the Whitted look-alike's frame rate and the GPU time of each pass (shadow, \
+#[command(about = "Measure the rasterizer's frame rate and the GPU time of each pass (shadow, \
              cube capture, main)")]
 struct Args {
     /// Rasterizer scene file.

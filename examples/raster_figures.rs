@@ -1,5 +1,5 @@
-//! Renders the pictures of docs/theory-whitted.md: both looks of the Whitted look-alike, and a
-//! contact sheet of the effect toggles.
+//! Renders the pictures of docs/theory-whitted.md: both looks of the rasterizer (which fakes
+//! Whitted's look), and a contact sheet of the effect toggles.
 //!
 //! ```text
 //! cargo run --release --example raster_figures -- [--out out/raster-figures]
@@ -18,7 +18,7 @@ use illum::image::{Encoding, contact_sheet, save_png, save_rgba8_png, to_rgba8};
 use illum::raster::{Effects, Look, Options, RasterRenderer, RasterScene};
 
 #[derive(Parser, Debug)]
-#[command(about = "Render the Whitted look-alike's pictures: both looks, and a contact sheet of the \
+#[command(about = "Render the rasterizer's pictures: both looks, and a contact sheet of the \
              effect toggles (use --out docs/images to update the docs' copies)")]
 struct Args {
     /// Output folder.

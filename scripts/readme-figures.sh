@@ -69,5 +69,5 @@ echo
 echo "== 'The pipeline generated for each scene is about N times faster than the generic one'"
 "$bin/bench" --quick
 echo
-echo "== 'Whitted look-alike: 1280 x 720 with every effect on, median frame about N ms' (camera moving; scene changing)"
+echo "== 'Rasterizer, enhanced look: 1280 x 720 with every effect on, median frame about N ms' (camera moving; scene changing)"
 "$bin/raster_bench" --look enhanced

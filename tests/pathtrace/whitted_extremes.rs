@@ -1,6 +1,6 @@
-//! The Whitted scene's physics where its inputs run out (issue: the path tracer renders the
-//! Whitted scene): the sun at 0.1 and 89.9 degrees of elevation and of radius 0.01 and 20
-//! degrees against the floor's closed form, and albedo 1 everywhere with unbounded bounces.
+//! The path tracer on the Whitted scene where the scene's inputs run out: the sun at 0.1 and 89.9
+//! degrees of elevation and of radius 0.01 and 20 degrees against the floor's closed form, and
+//! albedo 1 everywhere with unbounded bounces.
 //! (Indices of refraction 1.0001 and 4, with their grazing rays and total-internal-reflection
 //! chains, are checked against the oracle in `oracle_agreement`.)
 //!

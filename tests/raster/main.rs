@@ -1,4 +1,4 @@
-//! GPU tests of the Whitted look-alike rasterizer (one test binary, one device, on lavapipe).
+//! GPU tests of the rasterizer (one test binary, one device, on lavapipe).
 //!
 //! - `reference`: both looks against checked-in 320 x 180 references, with a stated tolerance;
 //! - `figure`: checks of the figure look that need no reference: the floor's Lambert shading,

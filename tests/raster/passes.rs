@@ -58,18 +58,18 @@ fn each_scene_records_only_the_passes_it_needs() {
     };
     let no_glass = RasterScene { glass: None, ..s.clone() };
     let no_spheres = RasterScene { glass: None, metal: None, ..s.clone() };
-    let (figure, whitted) = (Options::all_on(Look::Figure), Options::all_on(Look::Enhanced));
+    let (figure, enhanced) = (Options::all_on(Look::Figure), Options::all_on(Look::Enhanced));
     let shadows_off = with(Look::Enhanced, |e| e.shadows = false);
     // (case, scene, options, shadow pass, glass faces (fine + coarse), metal faces)
     let cases: [(&str, &RasterScene, Options, bool, usize, usize); 8] = [
         ("assignment, figure", &s, figure, true, 12, 0),
-        ("assignment, whitted", &s, whitted, true, 12, 6),
+        ("assignment, enhanced", &s, enhanced, true, 12, 6),
         ("shadows switched off", &s, shadows_off, false, 12, 6),
         ("shadows off in the file", &no_cast, Options::from_scene(&no_cast), false, 12, 6),
-        ("metal mirrors nothing", &no_mirror, whitted, true, 12, 0),
-        ("no glass, whitted", &no_glass, whitted, true, 0, 6),
+        ("metal mirrors nothing", &no_mirror, enhanced, true, 12, 0),
+        ("no glass, enhanced", &no_glass, enhanced, true, 0, 6),
         ("no glass, figure", &no_glass, figure, true, 0, 0),
-        ("no spheres", &no_spheres, whitted, false, 0, 0),
+        ("no spheres", &no_spheres, enhanced, false, 0, 0),
     ];
     for (case, scene, options, shadow, glass_faces, metal_faces) in cases {
         let (names, times, _) = frame(scene, &options);
@@ -123,14 +123,14 @@ fn a_metal_that_mirrors_nothing_looks_as_without_reflection() {
     let metal_only = RasterScene { glass: None, ..scene() };
     let mut matte = metal_only.clone();
     matte.metal.as_mut().unwrap().mirror = 0.0;
-    let whitted = Options::all_on(Look::Enhanced);
+    let enhanced = Options::all_on(Look::Enhanced);
     let no_reflection = with(Look::Enhanced, |e| e.reflection = false);
-    let (names, _, skipped) = frame(&matte, &whitted);
+    let (names, _, skipped) = frame(&matte, &enhanced);
     assert_eq!(count(&names, "cube"), 0, "{names:?}");
     let (_, _, switched_off) = frame(&matte, &no_reflection);
     assert_eq!(differing(&skipped, &switched_off), 0);
     // With its mirror the metal's cube map is captured and shows.
-    let (names, _, mirrored) = frame(&metal_only, &whitted);
+    let (names, _, mirrored) = frame(&metal_only, &enhanced);
     assert_eq!(count(&names, "cube metal"), 6, "{names:?}");
     assert!(differing(&mirrored, &switched_off) > 40, "the mirror shows nothing");
 }

@@ -78,15 +78,15 @@ fn figure_matches_its_reference() {
 }
 
 #[test]
-fn whitted_matches_its_reference() {
+fn enhanced_matches_its_reference() {
     check(Look::Enhanced);
 }
 
 #[test]
 fn the_tolerance_tells_the_looks_and_missing_effects_apart() {
     let figure = render(&scene(), &Options::all_on(Look::Figure));
-    let whitted_reference = load_reference(Look::Enhanced);
-    assert!(!within_tolerance(difference(&figure, &whitted_reference)), "the looks are indistinguishable");
+    let enhanced_reference = load_reference(Look::Enhanced);
+    assert!(!within_tolerance(difference(&figure, &enhanced_reference)), "the looks are indistinguishable");
     let mut no_shadows = Options::all_on(Look::Figure);
     no_shadows.effects.shadows = false;
     let shadowless = render(&scene(), &no_shadows);

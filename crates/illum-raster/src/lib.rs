@@ -1,5 +1,5 @@
-//! illum-raster: the Whitted look-alike (the assignment's task 1), drawn with wgpu render
-//! pipelines only.
+//! illum-raster: the rasterizer, which fakes the look of Whitted's scene (the assignment's task
+//! 1), drawn with wgpu render pipelines only.
 //!
 //! Each frame ([`frame`] has the order and why):
 //! - a **shadow map** from the directional light, fitted to the spheres ([`shadow_fit`]), read

@@ -34,7 +34,7 @@ struct Keys {
 /// Bytes per output pixel (RGBA8) and the row alignment of texture-to-buffer copies.
 const BYTES_PER_PIXEL: u32 = 4;
 
-/// The Whitted look-alike renderer: a scene, a fixed output size and the GPU resources for them.
+/// The rasterizer (Whitted's look, faked): a scene, a fixed output size and the GPU resources for them.
 pub struct RasterRenderer {
     gpu: GpuContext,
     scene: RasterScene,
