@@ -10,7 +10,8 @@
 //!
 //! ```toml
 //! name = "cornell"                 # default: the file's stem
-//! renderer = "pathtrace"           # the renderer tools use by default: "pathtrace" or "raster"
+//! renderer = "pathtrace"           # the renderer tools use by default: "pathtrace", "raster"
+//!                                  # or "whitted"
 //! [camera]                         # pinhole camera
 //! eye = [278.0, 278.0, -724.26]
 //! target = [278.0, 278.0, 0.0]
