@@ -7,7 +7,10 @@ use clap::Parser;
 use crate::app::Mode;
 
 #[derive(Parser, Debug, Clone)]
-#[command(name = "illum-viewer", about = "Interactive viewer for illum's three renderers: the rasterizer, the Whitted ray tracer and the path tracer")]
+#[command(
+    name = "illum-viewer",
+    about = "Interactive viewer for illum's three renderers: the rasterizer, the Whitted ray tracer and the path tracer"
+)]
 pub struct Args {
     /// Scene file (TOML). It opens in every mode that can render it and is shown in the mode of
     /// its `renderer`; a mode that cannot render it keeps its default scene.
