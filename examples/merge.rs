@@ -5,14 +5,14 @@
 //! ```
 //! Each input is an EXR written by `render --sample-range A..B` (or a merge of such files): the
 //! same scene and settings, sample ranges that together cover one range with no overlap and no
-//! gap. The output holds the union, as one render of it would (within 1e-12 relative per pixel
-//! for ranges on multiples of 16: see `illum_pathtrace::checkpoint`), and can itself be resumed
+//! gap, each starting on a multiple of 16. The output holds the union, as one render of it would
+//! (within 1e-12 relative per pixel: see `illum_pathtrace::checkpoint`), and can itself be resumed
 //! (`render --resume`) or merged again. A mismatch is refused, naming the files and what differs.
 
 use std::path::PathBuf;
 
 use clap::Parser;
-use illum::pathtrace::checkpoint::{load_checkpoint, merge_checkpoints, save_statistics};
+use illum::pathtrace::checkpoint::{load_checkpoint, merge_checkpoints, save_loaded};
 
 #[derive(Parser, Debug)]
 #[command(about = "Merge partial path-traced renders (render --sample-range A..B) into one EXR")]
@@ -43,7 +43,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         .map(|(p, c)| format!("{} ({}..{})", p.display(), c.sample_range().start, c.sample_range().end))
         .collect();
     let merged = merge_checkpoints(inputs).map_err(anyhow::Error::msg)?;
-    save_statistics(&args.output, &merged.accumulator, &merged.metadata).map_err(anyhow::Error::msg)?;
+    save_loaded(&args.output, &merged).map_err(anyhow::Error::msg)?;
     println!(
         "merged {}: samples {}..{} ({} spp), estimated relative error {:.4}, dropped samples {}",
         ranges.join(", "),

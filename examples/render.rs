@@ -94,18 +94,19 @@ struct Args {
     #[arg(long, allow_negative_numbers = true, value_parser = cli::exposure_arg)]
     exposure: Option<f32>,
     /// Continue the path-traced render saved in this EXR (a checkpoint) to --spp N samples per
-    /// pixel. The scene and every setting that changes the image must be the file's. Default
-    /// output: the same file.
+    /// pixel (or to the end of --sample-range). Give the same scene file; the settings that
+    /// change the image (size, bounces, seed, sampling, sequence, caustics) default to the
+    /// file's, and one given that differs is refused. Default output: the same file.
     #[arg(long, value_name = "FILE.exr")]
     resume: Option<PathBuf>,
     /// Render only sample indices A to B-1 of every pixel (B - A spp), for the merge example
-    /// to combine with other ranges. Boundaries on multiples of 16 make the merge match one
-    /// render within 1e-12.
+    /// to combine with other ranges. A must be a multiple of 16 (the chunk the GPU sums in), so
+    /// that merged ranges give the image of one render.
     #[arg(long, value_name = "A..B", value_parser = cli::sample_range_arg)]
     sample_range: Option<std::ops::Range<u32>>,
     /// Write the EXR outputs (checkpoints, see --resume) every this many seconds while
     /// rendering. Default 60.
-    #[arg(long, value_name = "SECONDS", value_parser = cli::time_budget_arg)]
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = cli::checkpoint_seconds_arg)]
     checkpoint_seconds: Option<Duration>,
 }
 
@@ -117,6 +118,24 @@ const DEFAULT_CHECKPOINT: Duration = Duration::from_secs(60);
 
 fn main() {
     illum::cli::main_with(run);
+}
+
+/// Fills the image-changing settings not given on the command line from a checkpoint's
+/// metadata, so that `--resume FILE` needs only the scene file and the new target.
+fn fill_from_checkpoint(
+    checkpoint: &Checkpoint,
+    settings: &mut cli::SceneArgs,
+    sequence: &mut Option<Sequence>,
+    caustics: &mut Option<bool>,
+) {
+    let get = |key: &str| checkpoint.metadata.get(key);
+    settings.width = settings.width.or(Some(checkpoint.accumulator.width));
+    settings.height = settings.height.or(Some(checkpoint.accumulator.height));
+    settings.bounces = settings.bounces.or_else(|| get("bounces")?.parse().ok());
+    settings.seed = settings.seed.or_else(|| get("seed")?.parse().ok());
+    settings.sampling = settings.sampling.or_else(|| get("sampling")?.parse().ok());
+    *sequence = sequence.or_else(|| get("sequence")?.parse().ok());
+    *caustics = caustics.or_else(|| cli::on_off_arg(get("caustics")?).ok());
 }
 
 fn run(args: Args) -> anyhow::Result<()> {
@@ -167,17 +186,26 @@ fn run(args: Args) -> anyhow::Result<()> {
         });
     }
     args.raster.reject_for_path_tracer(&args.scene)?;
-    let mut scene = cli::load_scene(&args.scene, &args.settings)?;
-    if let Some(sequence) = args.sequence {
+    // Read the checkpoint first: a bad file is refused before anything is rendered or written,
+    // and the settings not given on the command line are the file's.
+    let checkpoint = match &args.resume {
+        Some(path) => Some(load_checkpoint(path).map_err(anyhow::Error::msg)?),
+        None => None,
+    };
+    let mut settings = args.settings.clone();
+    let (mut sequence, mut caustics) = (args.sequence, args.caustics);
+    if let Some(checkpoint) = &checkpoint {
+        fill_from_checkpoint(checkpoint, &mut settings, &mut sequence, &mut caustics);
+    }
+    let mut scene = cli::load_scene(&args.scene, &settings)?;
+    if let Some(sequence) = sequence {
         scene.pathtrace.sequence = sequence;
     }
-    if let Some(caustics) = args.caustics {
+    if let Some(caustics) = caustics {
         scene.pathtrace.caustics = caustics;
     }
-    // Read the checkpoint first: a bad file is refused before anything is rendered or written.
-    let resumed: Option<Checkpoint> = match &args.resume {
-        Some(path) => {
-            let checkpoint = load_checkpoint(path).map_err(anyhow::Error::msg)?;
+    let resumed: Option<Checkpoint> = match (&args.resume, checkpoint) {
+        (Some(path), Some(checkpoint)) => {
             let options = TracerOptions { sequence: scene.pathtrace.sequence, ..Default::default() };
             checkpoint.check_matches(path, &scene, options).map_err(anyhow::Error::msg)?;
             if let Some(range) = &args.sample_range
@@ -191,12 +219,38 @@ fn run(args: Args) -> anyhow::Result<()> {
                     checkpoint.sample_start
                 );
             }
+            let target = args.sample_range.as_ref().map(|r| r.end - r.start).or(args.settings.spp);
+            if let Some(target) = target
+                && target < checkpoint.spp_done
+            {
+                anyhow::bail!(
+                    "{} already holds {} spp, more than the {target} asked for: nothing to continue (give a \
+                     larger --spp{})",
+                    path.display(),
+                    checkpoint.spp_done,
+                    if args.sample_range.is_some() { " or a longer --sample-range" } else { "" }
+                );
+            }
+            if checkpoint.sample_start != 0 && args.sample_range.is_none() {
+                anyhow::bail!(
+                    "{} is a part of a split render (samples from index {}): continue it with --sample-range {}..END",
+                    path.display(),
+                    checkpoint.sample_start,
+                    checkpoint.sample_start
+                );
+            }
             Some(checkpoint)
         }
-        None => None,
+        _ => None,
     };
     if args.sample_range.is_some() && args.settings.spp.is_some() {
         anyhow::bail!("--sample-range A..B renders B - A spp; give it or --spp, not both");
+    }
+    if args.sample_range.is_some() && (args.target_error.is_some() || args.time_budget.is_some()) {
+        anyhow::bail!(
+            "--sample-range A..B renders exactly samples A to B-1 so that the parts merge into one render; \
+             --target-error and --time-budget would stop it short (a part stopped short cannot be merged)"
+        );
     }
     let outputs = if args.outputs.is_empty() {
         if let Some(path) = &args.resume {
@@ -234,7 +288,32 @@ fn run(args: Args) -> anyhow::Result<()> {
                 .partial_pass
                 .map_or(String::new(), |(spp, rows)| format!(", and {rows} rows of a pass of {spp} spp"))
         );
-        tracer.restore(checkpoint.accumulator, checkpoint.spp_done, checkpoint.partial_pass)?;
+        match checkpoint.aligned_prefix {
+            // The samples end inside a chunk: start again from the last chunk boundary, so that
+            // the chunk is summed whole, as a straight render sums it (illum_pathtrace::checkpoint).
+            Some((prefix, spp)) if checkpoint.partial_pass.is_none() => {
+                println!(
+                    "  (going on from {spp} spp, the last chunk boundary, so that the result equals a straight render)"
+                );
+                tracer.restore(prefix, spp, None, None)?
+            }
+            prefix => {
+                let chunk = illum::pathtrace::CHUNK_SAMPLES;
+                if prefix.is_none() && !(checkpoint.sample_start + checkpoint.spp_done).is_multiple_of(chunk)
+                {
+                    println!(
+                        "  (the file ends inside a chunk of {chunk} samples and has no copy of its statistics at the \
+                         chunk boundary: the result will differ from a straight render by f32 rounding, about 1e-7)"
+                    );
+                }
+                tracer.restore(
+                    checkpoint.accumulator,
+                    checkpoint.spp_done,
+                    checkpoint.partial_pass,
+                    prefix,
+                )?
+            }
+        }
     } else if let Some(start) = range_start {
         tracer.set_sample_offset(start);
     }

@@ -108,8 +108,17 @@ pub fn target_error_arg(text: &str) -> Result<f64, String> {
 
 /// Parses `--time-budget` in seconds (see [`illum_pathtrace::parse_time_budget`]).
 pub fn time_budget_arg(text: &str) -> Result<std::time::Duration, String> {
+    seconds_arg("--time-budget", text)
+}
+
+/// Parses `--checkpoint-seconds` (a positive, finite number of seconds, as `--time-budget`).
+pub fn checkpoint_seconds_arg(text: &str) -> Result<std::time::Duration, String> {
+    seconds_arg("--checkpoint-seconds", text)
+}
+
+fn seconds_arg(flag: &str, text: &str) -> Result<std::time::Duration, String> {
     let value = text.trim().parse::<f64>().map_err(|_| format!("{text:?} is not a number of seconds"))?;
-    illum_pathtrace::parse_time_budget("--time-budget", value)
+    illum_pathtrace::parse_time_budget(flag, value)
 }
 
 /// The names of the flags that were given, from (given, name) pairs, in order.
@@ -200,6 +209,14 @@ pub fn sample_range_arg(text: &str) -> Result<std::ops::Range<u32>, String> {
     let (a, b) = (parse(a, "start")?, parse(b, "end")?);
     if a >= b {
         return Err(format!("{text:?}: the range is empty; the end must be above the start"));
+    }
+    let chunk = illum_pathtrace::CHUNK_SAMPLES;
+    if !a.is_multiple_of(chunk) {
+        return Err(format!(
+            "{text:?}: the start must be a multiple of {chunk} (the GPU sums samples in chunks of {chunk}; ranges \
+             that start on a chunk merge into exactly the image of one render), for example {}..{b}",
+            a / chunk * chunk
+        ));
     }
     Ok(a..b)
 }

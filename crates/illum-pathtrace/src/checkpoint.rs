@@ -18,6 +18,15 @@
 //! arithmetic: the result is bit-identical. A merge adds whole partial sums instead
 //! ((a + b) + c against a + (b + c) per pixel), so it differs from one render only by f64
 //! rounding: within 1e-12 relative for ranges on chunk boundaries (multiples of 16).
+//!
+//! A render whose spp is not a multiple of the chunk ends inside a chunk: its last f32 chunk sum
+//! holds fewer samples than a longer render's would. Continuing from there would split that
+//! chunk in two and differ by f32 rounding (about 1e-7 relative). So such a file also stores the
+//! statistics at its last chunk boundary (layer [`ALIGNED_LAYER`], spp `aligned_spp`), and a
+//! resumed render starts again from that boundary: the few samples after it are traced again,
+//! with the same random numbers, and the result is bit-identical to a straight render. For the
+//! same reason `--sample-range A..B` must start on a chunk boundary, so only the last of a set of
+//! ranges can end inside a chunk.
 
 use std::path::Path;
 
@@ -28,6 +37,10 @@ use crate::{Accumulator, PathTracer, TracerOptions};
 
 /// Name of the EXR layer with the exact per-pixel statistics.
 pub const STATISTICS_LAYER: &str = "illum.statistics";
+
+/// Name of the layer with the statistics at the last chunk boundary, in files whose samples end
+/// inside a chunk (its spp: metadata `aligned_spp`).
+pub const ALIGNED_LAYER: &str = "illum.statistics.aligned";
 
 const CHANNELS: [&str; 3] = ["R", "G", "B"];
 
@@ -76,6 +89,10 @@ fn join(hi: u32, lo: u32) -> u64 {
 
 /// The statistics layer of `accumulator`.
 pub fn statistics_layer(accumulator: &Accumulator) -> U32Layer {
+    layer_named(STATISTICS_LAYER, accumulator)
+}
+
+fn layer_named(name: &str, accumulator: &Accumulator) -> U32Layer {
     let state = accumulator.state();
     let mut channels = Vec::new();
     for (prefix, data) in [("sum", state.sum), ("sum_sq", state.sum_sq)] {
@@ -88,31 +105,49 @@ pub fn statistics_layer(accumulator: &Accumulator) -> U32Layer {
     let (hi, lo): (Vec<u32>, Vec<u32>) = state.count.iter().map(|&n| split(n)).unzip();
     channels.push(("count.hi".to_owned(), hi));
     channels.push(("count.lo".to_owned(), lo));
-    U32Layer { name: STATISTICS_LAYER.to_owned(), channels }
+    U32Layer { name: name.to_owned(), channels }
+}
+
+/// The layers and metadata of a checkpoint of `accumulator`: the statistics, and where the
+/// samples end inside a chunk, the statistics at the last chunk boundary (`aligned`: them and
+/// their spp) with `aligned_spp` added to the metadata.
+fn checkpoint_layers(
+    accumulator: &Accumulator,
+    aligned: Option<(&Accumulator, u32)>,
+    metadata: &ExrMetadata,
+) -> (ExrMetadata, Vec<U32Layer>) {
+    let mut metadata = metadata.clone();
+    metadata.fields.retain(|(k, _)| k != "aligned_spp");
+    let mut layers = vec![statistics_layer(accumulator)];
+    if let Some((prefix, spp)) = aligned {
+        metadata.fields.push(("aligned_spp".to_owned(), spp.to_string()));
+        layers.push(layer_named(ALIGNED_LAYER, prefix));
+    }
+    (metadata, layers)
 }
 
 /// Writes the tracer's mean image, `metadata` and the statistics layer to `path`, atomically.
 pub fn save_checkpoint(path: &Path, tracer: &PathTracer, metadata: &ExrMetadata) -> Result<(), String> {
-    save_statistics(path, tracer.accumulator(), metadata)
+    let (metadata, layers) = checkpoint_layers(tracer.accumulator(), tracer.aligned_prefix(), metadata);
+    save_exr_with_layers(path, &tracer.accumulator().mean_image(), &metadata, &layers)
+        .map_err(|e| with_causes(&e))
 }
 
-/// Writes `accumulator`'s mean image, `metadata` and its statistics layer to `path`, atomically.
-pub fn save_statistics(path: &Path, accumulator: &Accumulator, metadata: &ExrMetadata) -> Result<(), String> {
-    save_exr_with_layers(path, &accumulator.mean_image(), metadata, &[statistics_layer(accumulator)])
+/// Writes a checkpoint read back or merged: its mean image, metadata and statistics layers, to
+/// `path`, atomically.
+pub fn save_loaded(path: &Path, checkpoint: &Checkpoint) -> Result<(), String> {
+    let aligned = checkpoint.aligned_prefix.as_ref().map(|(a, spp)| (a, *spp));
+    let (metadata, layers) = checkpoint_layers(&checkpoint.accumulator, aligned, &checkpoint.metadata);
+    save_exr_with_layers(path, &checkpoint.accumulator.mean_image(), &metadata, &layers)
         .map_err(|e| with_causes(&e))
 }
 
 /// [`save_checkpoint`] into memory: the EXR file's bytes (the web viewer's download). `name`
 /// labels errors.
 pub fn checkpoint_bytes(name: &str, tracer: &PathTracer, metadata: &ExrMetadata) -> Result<Vec<u8>, String> {
-    let accumulator = tracer.accumulator();
-    illum_image::exr_bytes_with_layers(
-        name,
-        &accumulator.mean_image(),
-        metadata,
-        &[statistics_layer(accumulator)],
-    )
-    .map_err(|e| with_causes(&e))
+    let (metadata, layers) = checkpoint_layers(tracer.accumulator(), tracer.aligned_prefix(), metadata);
+    illum_image::exr_bytes_with_layers(name, &tracer.accumulator().mean_image(), &metadata, &layers)
+        .map_err(|e| with_causes(&e))
 }
 
 /// A render read back from a checkpoint file.
@@ -126,14 +161,21 @@ pub struct Checkpoint {
     pub sample_start: u32,
     /// A pass stopped inside: (its spp, rows done from row 0).
     pub partial_pass: Option<(u32, u32)>,
+    /// Where the samples end inside a chunk: the statistics at the last chunk boundary and their
+    /// spp, from which a resumed render starts again (see the module's documentation).
+    pub aligned_prefix: Option<(Accumulator, u32)>,
 }
 
-/// Reads a checkpoint. Every failure names the file and what is wrong with it: not an EXR or
-/// truncated (the decoder's error), not illum's, not the path tracer's, no statistics layer, or a
-/// missing or unparsable key.
+/// Reads a checkpoint. Every failure names the file and what is wrong with it: not an EXR,
+/// truncated or corrupt (with the decoder's error), not illum's, not the path tracer's, no
+/// statistics layer, a missing or unparsable key, or statistics that do not add up to the spp
+/// the metadata claims.
 pub fn load_checkpoint(path: &Path) -> Result<Checkpoint, String> {
     let at = |reason: String| format!("{}: {reason}", path.display());
-    let (image, attributes) = load_exr(path).map_err(|e| with_causes(&e))?;
+    let unreadable = |e: &dyn std::error::Error| {
+        at(format!("cannot be read as an EXR (truncated or corrupt?): {}", with_causes(e)))
+    };
+    let (image, attributes) = load_exr(path).map_err(|e| unreadable(&e))?;
     let metadata = ExrMetadata::from_attributes(path, &attributes)
         .map_err(|e| e.to_string())?
         .ok_or_else(|| at("not written by illum (no illum.* metadata), so it cannot be continued".into()))?;
@@ -150,21 +192,61 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint, String> {
     let spp_done = number("spp")?;
     let sample_start = number("sample_start")?;
     let partial = (number("partial_pass_spp")?, number("partial_pass_rows")?);
-    let layer = load_u32_layer(path, STATISTICS_LAYER).map_err(|e| with_causes(&e))?.ok_or_else(|| {
+    let partial_pass = (partial.0 > 0 && partial.1 > 0).then_some(partial);
+    let dropped = match metadata.get("dropped_samples") {
+        Some(text) => {
+            text.parse().map_err(|_| at(format!("illum.dropped_samples = {text:?} is not a count")))?
+        }
+        None => 0,
+    };
+    let (width, height) = (image.width, image.height);
+    let read = |name: &str| -> Result<Option<Accumulator>, String> {
+        let Some(layer) = load_u32_layer(path, name).map_err(|e| unreadable(&e))? else {
+            return Ok(None);
+        };
+        statistics_from_layer(&layer, width, height, dropped).map(Some).map_err(at)
+    };
+    let accumulator = read(STATISTICS_LAYER)?.ok_or_else(|| {
         at(format!(
             "has no {STATISTICS_LAYER} layer (written without the statistics a render continues from)"
         ))
     })?;
-    let pixels = image.width as usize * image.height as usize;
+    check_counts(&accumulator, spp_done, partial_pass).map_err(at)?;
+    let aligned_prefix = match read(ALIGNED_LAYER)? {
+        Some(prefix) => {
+            let spp = number("aligned_spp")?;
+            if spp > spp_done || !(sample_start + spp).is_multiple_of(crate::CHUNK_SAMPLES) {
+                return Err(at(format!(
+                    "illum.aligned_spp = {spp}: must be a chunk boundary (sample_start + it a multiple of {}) \
+                     at most illum.spp = {spp_done}",
+                    crate::CHUNK_SAMPLES
+                )));
+            }
+            check_counts(&prefix, spp, None).map_err(|e| at(format!("layer {ALIGNED_LAYER}: {e}")))?;
+            Some((prefix, spp))
+        }
+        None => None,
+    };
+    Ok(Checkpoint { metadata, accumulator, spp_done, sample_start, partial_pass, aligned_prefix })
+}
+
+/// Rebuilds an accumulator from a statistics layer of a `width x height` image.
+fn statistics_from_layer(
+    layer: &U32Layer,
+    width: u32,
+    height: u32,
+    dropped: u64,
+) -> Result<Accumulator, String> {
+    let pixels = width as usize * height as usize;
     let channel = |name: String| -> Result<&Vec<u32>, String> {
         let values = layer
             .channels
             .iter()
             .find(|(n, _)| *n == name)
             .map(|(_, v)| v)
-            .ok_or_else(|| at(format!("layer {STATISTICS_LAYER} has no channel {name}")))?;
+            .ok_or_else(|| format!("layer {} has no channel {name}", layer.name))?;
         if values.len() != pixels {
-            return Err(at(format!("channel {name} has {} values for {pixels} pixels", values.len())));
+            return Err(format!("channel {name} has {} values for {pixels} pixels", values.len()));
         }
         Ok(values)
     };
@@ -184,23 +266,39 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint, String> {
     let (hi, lo) = (channel("count.hi".into())?, channel("count.lo".into())?);
     let count: Vec<u64> = hi.iter().zip(lo).map(|(&h, &l)| join(h, l)).collect();
     if sum.iter().chain(&sum_sq).flatten().any(|v| !v.is_finite()) {
-        return Err(at("the statistics hold a NaN or infinite sum: the file is corrupt".into()));
+        return Err("the statistics hold a NaN or infinite sum: the file is corrupt".into());
     }
-    let dropped = match metadata.get("dropped_samples") {
-        Some(text) => {
-            text.parse().map_err(|_| at(format!("illum.dropped_samples = {text:?} is not a count")))?
+    Accumulator::from_state(width, height, sum, sum_sq, count, dropped)
+}
+
+/// Checks that the per-pixel sample counts are what `spp_done` complete passes and a pass
+/// stopped inside (`partial`: its spp and the rows done from row 0) give: no pixel has more,
+/// and the samples missing in all are at most the dropped (NaN or infinite) ones.
+fn check_counts(accumulator: &Accumulator, spp_done: u32, partial: Option<(u32, u32)>) -> Result<(), String> {
+    let width = accumulator.width as usize;
+    let mut missing = 0u64;
+    for p in 0..width * accumulator.height as usize {
+        let row = (p / width) as u32;
+        let expected = u64::from(spp_done)
+            + partial.filter(|&(_, rows)| row < rows).map_or(0, |(spp, _)| u64::from(spp));
+        let count = accumulator.pixel_count(p);
+        if count > expected {
+            return Err(format!(
+                "pixel ({}, {row}) has {count} samples, more than the {expected} the metadata's spp gives: the file is \
+                 corrupt or was edited",
+                p % width
+            ));
         }
-        None => 0,
-    };
-    let accumulator =
-        Accumulator::from_state(image.width, image.height, sum, sum_sq, count, dropped).map_err(at)?;
-    Ok(Checkpoint {
-        metadata,
-        accumulator,
-        spp_done,
-        sample_start,
-        partial_pass: (partial.0 > 0 && partial.1 > 0).then_some(partial),
-    })
+        missing += expected - count;
+    }
+    if missing > accumulator.dropped_samples() {
+        return Err(format!(
+            "the statistics hold {missing} samples fewer than illum.spp = {spp_done} gives, and only {} were dropped: \
+             the file is corrupt or was edited",
+            accumulator.dropped_samples()
+        ));
+    }
+    Ok(())
 }
 
 /// The settings that change the image, as stored in a checkpoint and as `scene` and `options`
@@ -290,18 +388,43 @@ pub fn merge_checkpoints(inputs: Vec<(std::path::PathBuf, Checkpoint)>) -> Resul
         return Err("nothing to merge: give at least one EXR file".to_owned());
     }
     for (path, c) in &inputs {
+        let range = c.sample_range();
+        let resume = || {
+            format!(
+                "finish it first with `render SCENE.toml --resume {} --sample-range {}..END` (END: the end of its range)",
+                path.display(),
+                range.start
+            )
+        };
         if let Some((spp, rows)) = c.partial_pass {
             return Err(format!(
-                "{}: stopped inside a pass ({rows} rows of {spp} spp done after {} complete spp); finish it first with \
-                 `render --resume {} --spp {}`",
+                "{}: stopped inside a pass ({rows} rows of {spp} spp done after {} complete spp); {}",
                 path.display(),
                 c.spp_done,
-                path.display(),
-                c.spp_done + spp
+                resume()
             ));
         }
         if c.spp_done == 0 {
             return Err(format!("{}: holds no complete pass", path.display()));
+        }
+        if let Some(reason @ ("cancelled" | "time_budget")) = c.metadata.get("stopped_by") {
+            return Err(format!(
+                "{}: stopped early (illum.stopped_by = {reason}) at sample {} of its range, so it may not hold the \
+                 whole range; {}",
+                path.display(),
+                range.end,
+                resume()
+            ));
+        }
+        if !range.start.is_multiple_of(u64::from(crate::CHUNK_SAMPLES)) {
+            return Err(format!(
+                "{}: its samples start at index {}, not a multiple of {} (the chunk the GPU sums in), so merged it \
+                 would differ from one render by f32 rounding; render the ranges with starts on multiples of {}",
+                path.display(),
+                range.start,
+                crate::CHUNK_SAMPLES,
+                crate::CHUNK_SAMPLES
+            ));
         }
     }
     let (first_path, first) = &inputs[0];
@@ -356,6 +479,18 @@ pub fn merge_checkpoints(inputs: Vec<(std::path::PathBuf, Checkpoint)>) -> Resul
     let total = inputs.iter().map(|(_, c)| u64::from(c.spp_done)).sum::<u64>();
     let spp_done = u32::try_from(total)
         .map_err(|_| format!("the merged render would have {total} spp, above {}", u32::MAX))?;
+    // Every range but the last ends where the next starts, on a chunk boundary; the last may
+    // end inside a chunk, and then its statistics at its last boundary, added to the others',
+    // are the merged render's (what `render --resume` goes on from).
+    let last = inputs.len() - 1;
+    let aligned_prefix = inputs[last].1.aligned_prefix.as_ref().map(|(prefix, spp)| {
+        // The same order of additions as the merge below: the ranges in sample order.
+        let mut parts = inputs[..last].iter().map(|(_, c)| &c.accumulator).chain([prefix]);
+        let mut merged = parts.next().expect("at least the prefix").clone();
+        parts.for_each(|part| merged.merge(part));
+        let earlier = inputs[..last].iter().map(|(_, c)| c.spp_done).sum::<u32>();
+        (merged, earlier + spp)
+    });
     let mut iter = inputs.into_iter();
     let (_, mut merged) = iter.next().expect("not empty");
     for (_, c) in iter {
@@ -363,6 +498,7 @@ pub fn merge_checkpoints(inputs: Vec<(std::path::PathBuf, Checkpoint)>) -> Resul
         merged.metadata.render_seconds += c.metadata.render_seconds;
     }
     merged.spp_done = spp_done;
+    merged.aligned_prefix = aligned_prefix;
     let accumulator = &merged.accumulator;
     for (key, value) in [
         ("spp", spp_done.to_string()),

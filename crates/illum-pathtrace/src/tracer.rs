@@ -79,6 +79,12 @@ pub struct PathTracer {
     /// Whether [`Self::render_step`] ends passes on multiples of the chunk (see
     /// [`Self::set_chunk_aligned_passes`]).
     chunk_aligned: bool,
+    /// With chunk-aligned passes, the statistics at the last chunk boundary before a pass that
+    /// ends inside a chunk (the last pass of a render whose spp is not a multiple of the chunk),
+    /// and their spp. A checkpoint stores them so that a resumed render can start again from that
+    /// boundary: splitting the final chunk's f32 sum in two would differ from a straight render
+    /// by f32 rounding.
+    aligned_prefix: Option<(Accumulator, u32)>,
     /// 2^-k scale of the uploaded emission (see `accumulator::radiance_exponent`).
     radiance_exponent: i32,
     /// The caustic's light tracer, when the scene asks for it and can have a caustic.
@@ -203,6 +209,7 @@ impl PathTracer {
             spp_done: 0,
             sample_offset: 0,
             chunk_aligned: false,
+            aligned_prefix: None,
             radiance_exponent: gpu_scene.radiance_exponent,
             caustic,
             wall_seconds: 0.0,
@@ -412,14 +419,27 @@ impl PathTracer {
         self.pass.as_ref().map(|p| (p.plan.spp, p.next_row))
     }
 
+    /// The statistics at the last chunk boundary and their spp, when the samples taken so far
+    /// (or the pass in progress) end inside a chunk: what a checkpoint stores so that a resumed
+    /// render can go on from that boundary (see [`Self::set_chunk_aligned_passes`]).
+    pub fn aligned_prefix(&self) -> Option<(&Accumulator, u32)> {
+        let chunk = self.chunk_samples.max(1);
+        let end = self.sample_offset + self.spp_done + self.pass.as_ref().map_or(0, |p| p.plan.spp);
+        let (accumulator, spp) = self.aligned_prefix.as_ref()?;
+        (!end.is_multiple_of(chunk) && *spp <= self.spp_done).then_some((accumulator, *spp))
+    }
+
     /// Continues from a checkpoint: the accumulator, the spp of the completed passes, and a pass
     /// stopped inside (its spp and the rows done), which the next steps finish first. The
-    /// accumulator must have this tracer's resolution.
+    /// accumulator must have this tracer's resolution. `aligned_prefix`: the checkpoint's
+    /// statistics at its last chunk boundary (see [`Self::aligned_prefix`]), kept for the next
+    /// checkpoint when the pass in progress ends inside a chunk.
     pub fn restore(
         &mut self,
         mut accumulator: Accumulator,
         spp_done: u32,
         partial_pass: Option<(u32, u32)>,
+        aligned_prefix: Option<(Accumulator, u32)>,
     ) -> Result<(), PathTraceError> {
         let camera = self.scene.camera;
         if (accumulator.width, accumulator.height) != (camera.width, camera.height) {
@@ -435,6 +455,10 @@ impl PathTracer {
         self.reset();
         self.accumulator = accumulator;
         self.spp_done = spp_done;
+        self.aligned_prefix = aligned_prefix.map(|(mut prefix, spp)| {
+            prefix.set_radiance_exponent(self.radiance_exponent);
+            (prefix, spp)
+        });
         self.pass =
             partial_pass.filter(|&(_, rows)| rows > 0 && rows < camera.height).map(|(spp, next_row)| {
                 let planned = self.planner.plan(camera.width, camera.height, spp);
@@ -459,6 +483,7 @@ impl PathTracer {
         }
         self.pass = None;
         self.spp_done = 0;
+        self.aligned_prefix = None;
         self.wall_seconds = 0.0;
         self.gpu_seconds = 0.0;
     }
@@ -480,7 +505,24 @@ impl PathTracer {
             };
             let mut plan = self.fit(self.planner.plan(camera.width, camera.height, remaining));
             if self.chunk_aligned {
-                plan = align_pass(plan, self.sample_offset + self.spp_done, remaining, self.chunk_samples);
+                let start = self.sample_offset + self.spp_done;
+                plan = align_pass(plan, start, remaining, self.chunk_samples);
+                let chunk = self.chunk_samples.max(1);
+                if start.is_multiple_of(chunk) {
+                    // The last pass of a render that ends inside a chunk: keep the statistics
+                    // at this boundary (see `aligned_prefix`), if the host has the memory for a
+                    // copy (at 16384 x 16384 it has not: such a render, resumed, then differs
+                    // from a straight one by f32 rounding, and says so).
+                    let copy_fits = || {
+                        let bytes = self.accumulator.width as u64
+                            * self.accumulator.height as u64
+                            * crate::accumulator::STATISTICS_BYTES_PER_PIXEL;
+                        crate::accumulator::available_host_memory()
+                            .is_none_or(|available| bytes < available / 2)
+                    };
+                    self.aligned_prefix = (!(start + plan.spp).is_multiple_of(chunk) && copy_fits())
+                        .then(|| (self.accumulator.clone(), self.spp_done));
+                }
             }
             self.pass = Some(ActivePass { plan, sample_base: self.spp_done, next_row: 0 });
         }
@@ -549,12 +591,49 @@ impl PathTracer {
 /// chunk more when the plan would end inside the first chunk, fewer when it ends past a chunk
 /// boundary. The rows shrink or grow with the spp so that a submission keeps its size.
 fn align_pass(plan: PassPlan, start: u32, remaining: u32, chunk: u32) -> PassPlan {
-    if plan.spp >= remaining {
-        return PassPlan { spp: remaining, ..plan };
-    }
     let chunk = chunk.max(1);
+    if plan.spp >= remaining {
+        // The last pass. Where the render ends inside a chunk, the whole chunks come first and
+        // the rest in a pass of its own, so that the statistics at the last chunk boundary can be
+        // kept for a resumed render (see `PathTracer::aligned_prefix`).
+        let end = start.saturating_add(remaining);
+        let boundary = end / chunk * chunk;
+        let spp = if !end.is_multiple_of(chunk) && boundary > start { boundary - start } else { remaining };
+        return PassPlan { spp, ..plan };
+    }
     let end = start.saturating_add(plan.spp) / chunk * chunk;
     let spp = if end > start { end - start } else { chunk - start % chunk }.min(remaining);
     let rows = (u64::from(plan.rows) * u64::from(plan.spp) / u64::from(spp)).clamp(1, u64::from(u32::MAX));
     PassPlan { spp, rows: rows as u32 }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every pass ends on a chunk boundary or at the render's end, and a render that ends inside
+    /// a chunk gets its whole chunks first and the rest in a last pass of its own.
+    #[test]
+    fn passes_end_on_chunk_boundaries_and_the_tail_comes_alone() {
+        let ends = |start: u32, target: u32, plan_spp: u32| {
+            let mut ends = Vec::new();
+            let mut at = start;
+            while at < target {
+                let plan = align_pass(PassPlan { spp: plan_spp, rows: 8 }, at, target - at, 16);
+                assert!(plan.spp >= 1 && plan.rows >= 1);
+                at += plan.spp;
+                ends.push(at);
+            }
+            ends
+        };
+        assert_eq!(ends(0, 50, 1000), [48, 50]);
+        assert_eq!(ends(0, 50, 20), [16, 32, 48, 50]);
+        assert_eq!(ends(0, 10, 1000), [10]);
+        assert_eq!(ends(0, 64, 1000), [64]);
+        assert_eq!(ends(16, 100, 1000), [96, 100]);
+        assert_eq!(ends(0, 100, 1), [16, 32, 48, 64, 80, 96, 100]);
+        // A resumed render going on from an unaligned count reaches the next boundary first.
+        assert_eq!(ends(50, 100, 1000), [96, 100]);
+        assert_eq!(ends(50, 100, 4), [64, 80, 96, 100]);
+    }
 }
