@@ -16,6 +16,9 @@ use crate::frame_rate::FrameRate;
 use crate::pathtrace_panel::PathTraceMode;
 use crate::raster_panel::RasterMode;
 use crate::scene_file::{self, DEFAULT_PATHTRACE_SCENE, DEFAULT_RASTER_SCENE};
+
+/// Below this window width (in points) the top bar is compact (see `ViewerApp::top_bar`).
+const COMPACT_BELOW_POINTS: f32 = 520.0;
 use crate::screenshot::ScreenshotJob;
 use crate::whitted_panel::WhittedMode;
 
@@ -86,6 +89,8 @@ pub struct ViewerApp {
     pub show_panel: bool,
     /// The last open attempt's error (the current scenes stay).
     pub open_error: Option<String>,
+    /// The scene file opened last and, for each mode that cannot render it, why.
+    refused: Option<(PathBuf, Vec<(Mode, String)>)>,
     screenshot: Option<ScreenshotJob>,
     /// How often the window repaints (shown in the top bar, printed after a screenshot run).
     frame_rate: FrameRate,
@@ -120,6 +125,7 @@ impl ViewerApp {
             scene_field: options.scene.display().to_string(),
             show_panel: true,
             open_error: None,
+            refused: None,
             screenshot: options.screenshot,
             frame_rate: FrameRate::default(),
             #[cfg(target_arch = "wasm32")]
@@ -262,26 +268,33 @@ impl ViewerApp {
     }
 
     /// Puts a loaded scene into every mode that can render it; returns the mode to show.
+    /// The modes that cannot render it keep their scene, and their reasons are kept for the
+    /// top bar ([`Self::refusal_of`]).
     fn install(&mut self, given: PathBuf, loaded: scene_file::LoadedScene) -> Mode {
         let mode = loaded.mode();
-        if let Ok(scene) = loaded.pathtrace {
-            match &mut self.pathtrace {
+        let mut refusals = Vec::new();
+        match loaded.pathtrace {
+            Ok(scene) => match &mut self.pathtrace {
                 Ok(mode) => mode.set_scene(given.clone(), scene),
                 Err(_) => self.pathtrace = Ok(PathTraceMode::new(given.clone(), scene)),
-            }
+            },
+            Err(reason) => refusals.push((Mode::PathTrace, reason)),
         }
-        if let Ok(scene) = loaded.raster {
-            match &mut self.raster {
+        match loaded.raster {
+            Ok(scene) => match &mut self.raster {
                 Ok(mode) => mode.set_scene(given.clone(), scene),
                 Err(_) => self.raster = Ok(RasterMode::new(given.clone(), scene)),
-            }
+            },
+            Err(reason) => refusals.push((Mode::Raster, reason)),
         }
-        if let Ok(scene) = loaded.whitted {
-            match &mut self.whitted {
-                Ok(mode) => mode.set_scene(given, scene),
-                Err(_) => self.whitted = Ok(WhittedMode::new(given, scene)),
-            }
+        match loaded.whitted {
+            Ok(scene) => match &mut self.whitted {
+                Ok(mode) => mode.set_scene(given.clone(), scene),
+                Err(_) => self.whitted = Ok(WhittedMode::new(given.clone(), scene)),
+            },
+            Err(reason) => refusals.push((Mode::Whitted, reason)),
         }
+        self.refused = (!refusals.is_empty()).then_some((given, refusals));
         mode
     }
 
@@ -300,6 +313,7 @@ impl ViewerApp {
             ("mode", self.mode.to_string()),
             ("scene", text(self.current_scene_path())),
             ("open-error", text(self.open_error.clone())),
+            ("mode-refusal", text(self.refusal_of(self.mode))),
             ("window-fps", text(self.frame_rate.fps().map(|f| format!("{f:.1}")))),
             (
                 "adapter",
@@ -325,21 +339,47 @@ impl ViewerApp {
     }
 
     fn top_bar(&mut self, ui: &mut egui::Ui) {
+        // A narrow window gets a compact bar (the modes in a drop-down, no status text), so
+        // that the bar stays about two lines high and the image keeps most of the window.
+        let compact = ui.available_width() < COMPACT_BELOW_POINTS;
         ui.horizontal_wrapped(|ui| {
-            let panel_button = if self.show_panel { "Hide settings" } else { "Show settings" };
-            if ui.button(panel_button).clicked() {
-                self.show_panel = !self.show_panel;
+            if compact {
+                ui.toggle_value(&mut self.show_panel, "Settings");
+            } else {
+                let panel_button = if self.show_panel { "Hide settings" } else { "Show settings" };
+                if ui.button(panel_button).clicked() {
+                    self.show_panel = !self.show_panel;
+                }
             }
             let mut chosen = self.mode;
-            ui.selectable_value(&mut chosen, Mode::Raster, "Raster");
-            ui.selectable_value(&mut chosen, Mode::PathTrace, "Path tracer");
-            ui.selectable_value(&mut chosen, Mode::Whitted, "Whitted");
+            let modes =
+                [(Mode::Raster, "Raster"), (Mode::PathTrace, "Path tracer"), (Mode::Whitted, "Whitted")];
+            if compact {
+                let shown = modes.iter().find(|(m, _)| *m == chosen).map_or("", |(_, name)| name);
+                egui::ComboBox::from_id_salt("mode").selected_text(shown).show_ui(ui, |ui| {
+                    for (mode, name) in modes {
+                        ui.selectable_value(&mut chosen, mode, name);
+                    }
+                });
+            } else {
+                for (mode, name) in modes {
+                    ui.selectable_value(&mut chosen, mode, name);
+                }
+                ui.separator();
+            }
             self.switch_to(chosen);
-            ui.separator();
-            let label = ui.label("Scene");
-            let field = ui
-                .add(egui::TextEdit::singleline(&mut self.scene_field).desired_width(280.0))
-                .labelled_by(label.id);
+            let field = if compact {
+                // The field on a line of its own, as wide as the window allows, its label inside.
+                ui.end_row();
+                let width = (ui.available_width() - 72.0).clamp(40.0, 280.0);
+                ui.add(
+                    egui::TextEdit::singleline(&mut self.scene_field).desired_width(width).hint_text("Scene"),
+                )
+            } else {
+                let label = ui.label("Scene");
+                ui.add(egui::TextEdit::singleline(&mut self.scene_field).desired_width(280.0))
+                    .labelled_by(label.id)
+            };
             let entered = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
             if ui.button("Open").clicked() || entered {
                 let path = PathBuf::from(self.scene_field.trim());
@@ -353,6 +393,9 @@ impl ViewerApp {
             }
             #[cfg(target_arch = "wasm32")]
             self.web_open_buttons(ui);
+            if compact {
+                return;
+            }
             if let Some(current) = self.current_scene_path() {
                 ui.weak(format!("showing {current}"));
             }
@@ -363,6 +406,21 @@ impl ViewerApp {
         if let Some(error) = &self.open_error {
             ui.colored_label(ui.visuals().error_fg_color, format!("Could not open the scene: {error}"));
         }
+        if let Some(refusal) = self.refusal_of(self.mode) {
+            ui.colored_label(ui.visuals().warn_fg_color, refusal);
+        }
+    }
+
+    /// Why the mode shown is not showing the scene file opened last (it keeps its own scene),
+    /// as a sentence for the top bar.
+    pub fn refusal_of(&self, mode: Mode) -> Option<String> {
+        let (opened, refusals) = self.refused.as_ref()?;
+        let (_, reason) = refusals.iter().find(|(m, _)| *m == mode)?;
+        let showing = self.scene_path_of(mode).map_or(String::new(), |p| format!("; showing {p}"));
+        // The reason names the file when it comes from the file's validation; else say which.
+        let file = opened.display().to_string();
+        let named = if reason.contains(&file) { String::new() } else { format!("{file}: ") };
+        Some(format!("{named}{reason}{showing}"))
     }
 
     fn side_panel(&mut self, ui: &mut egui::Ui) {

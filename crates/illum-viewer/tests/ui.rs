@@ -240,7 +240,7 @@ fn the_window_shows_what_save_png_writes() {
 
 #[test]
 fn snapshot_raster() {
-    let mut harness = harness(Mode::Raster);
+    let mut harness = harness_with("scenes/whitted.toml", Mode::Raster);
     harness.run_steps(4);
     harness.snapshot("viewer_raster");
 }
@@ -338,6 +338,27 @@ fn the_scene_field_follows_the_mode() {
 }
 
 #[test]
+fn a_mode_that_cannot_render_the_opened_scene_says_why() {
+    // The Cornell box has boxes and an area light: the rasterizer keeps its own scene and says so.
+    let mut harness = harness(Mode::Raster);
+    harness.run_steps(1);
+    let refusal = harness.state().refusal_of(Mode::Raster).expect("a refusal for the raster");
+    assert!(
+        refusal.contains("cornell.toml: objects[0]")
+            && refusal.contains("cannot render")
+            && refusal.ends_with("showing scenes/whitted.toml"),
+        "{refusal}"
+    );
+    harness.get_by_label_contains("cannot render");
+    assert_eq!(harness.state().refusal_of(Mode::PathTrace), None);
+    // A scene every mode renders clears it.
+    harness.state_mut().scene_field = "scenes/whitted.toml".into();
+    harness.run_steps(1);
+    click(&mut harness, "Open");
+    assert_eq!(harness.state().refusal_of(Mode::Raster), None);
+}
+
+#[test]
 fn a_small_window_still_shows_the_image_and_the_panel_hides() {
     let mut harness = harness(Mode::PathTrace);
     harness.set_size(egui::vec2(200.0, 150.0));
@@ -345,13 +366,21 @@ fn a_small_window_still_shows_the_image_and_the_panel_hides() {
     let with_panel = harness.state().pathtrace().unwrap().stats();
     // The panel takes at most half the width: the image keeps the other half (x 0.5 scale).
     assert!(with_panel.width >= 40, "the settings panel covers the image: {with_panel:?}");
-    harness.get_by_label("Hide settings").click();
+    // The top bar is compact (two lines): the image keeps most of the height.
+    assert!(with_panel.height * 2 >= 80, "the top bar covers the image: {with_panel:?}");
+    // The compact bar's toggle.
+    harness.get_by_label("Settings").click();
     harness.run_steps(3);
     assert!(!harness.state().show_panel);
     let without = harness.state().pathtrace().unwrap().stats();
     assert!(without.width > with_panel.width, "{with_panel:?} -> {without:?}");
-    click(&mut harness, "Show settings");
+    click(&mut harness, "Settings");
     assert!(harness.state().show_panel);
+    // A wide window has the full bar again.
+    harness.set_size(egui::vec2(900.0, 560.0));
+    harness.run_steps(1);
+    click(&mut harness, "Hide settings");
+    assert!(!harness.state().show_panel);
 }
 
 #[test]
