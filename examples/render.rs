@@ -90,8 +90,9 @@ struct Args {
     /// or glass object (docs/caustics.md).
     #[arg(long, value_name = "on|off", value_parser = cli::on_off_arg)]
     caustics: Option<bool>,
-    /// PNG exposure in stops, e.g. -1 or 2 (EXR output is never scaled). Default 0.
-    #[arg(long, allow_negative_numbers = true, value_parser = cli::exposure_arg)]
+    /// PNG exposure in stops, e.g. -1 or 2, at most 64 either way (EXR output is never
+    /// scaled). Default 0.
+    #[arg(long, allow_hyphen_values = true, value_parser = cli::exposure_arg)]
     exposure: Option<f32>,
     /// Continue the path-traced render saved in this EXR (a checkpoint) to --spp N samples per
     /// pixel (or to the end of --sample-range). Give the same scene file; the settings that
@@ -269,6 +270,9 @@ fn run(args: Args) -> anyhow::Result<()> {
     cli::check_outputs(&outputs, &png_flags)?;
     let sequence = scene.pathtrace.sequence;
 
+    // Installed before the GPU is set up, so that Ctrl-C during the (slow on lavapipe) pipeline
+    // compilation is handled like one during the render: a message and status 130.
+    let interrupt = Interrupt::install()?;
     let gpu = cli::gpu()?;
     let mut tracer =
         PathTracer::with_options(&gpu, &scene, TracerOptions { sequence, ..Default::default() })?;
@@ -317,7 +321,6 @@ fn run(args: Args) -> anyhow::Result<()> {
     } else if let Some(start) = range_start {
         tracer.set_sample_offset(start);
     }
-    let interrupt = Interrupt::install()?;
     let no_stop_flag = args.settings.spp.is_none()
         && args.target_error.is_none()
         && args.time_budget.is_none()

@@ -91,11 +91,20 @@ pub fn on_off_arg(text: &str) -> Result<bool, String> {
     }
 }
 
-/// Parses a number of stops for `--exposure`: any finite number, negative ones as typed
-/// (`--exposure -1`; declare the flag with `allow_negative_numbers`).
+/// Largest `--exposure` in stops either way: 2^64 (about 1.8e19) scales any radiance the
+/// scene model gives from black to white or back; beyond it the scale factor only overflows.
+pub const MAX_EXPOSURE_STOPS: f32 = 64.0;
+
+/// Parses a number of stops for `--exposure`: a finite number within +-[`MAX_EXPOSURE_STOPS`],
+/// negative ones as typed (`--exposure -1`; declare the flag with `allow_hyphen_values`, so that
+/// `-inf` reaches this parser too).
 pub fn exposure_arg(text: &str) -> Result<f32, String> {
     match text.trim().parse::<f32>() {
-        Ok(v) if v.is_finite() => Ok(v),
+        Ok(v) if v.is_finite() && v.abs() <= MAX_EXPOSURE_STOPS => Ok(v),
+        Ok(v) if v.is_finite() => Err(format!(
+            "{text:?}: at most {MAX_EXPOSURE_STOPS} stops either way (a factor of 2^{MAX_EXPOSURE_STOPS}); {v} \
+             would turn every pixel black or white"
+        )),
         _ => Err(format!("{text:?} is not a finite number of stops (for example -1, 0 or 2.5)")),
     }
 }

@@ -73,7 +73,12 @@ pub fn cached_reference(
     }
     println!("rendering the reference: {spp} spp (cached as {})", path.display());
     let mut tracer = PathTracer::new(gpu, &reference_scene)?;
-    tracer.render_to_spp(spp)?;
+    // A long render (minutes for the Whitted scene's caustic): a progress bar on a terminal.
+    let rules = illum_pathtrace::StopRules { spp: Some(spp), target_error: None, time_budget: None };
+    let progress = crate::progress::RenderProgress::new();
+    let never = std::sync::atomic::AtomicBool::new(false);
+    illum_pathtrace::render_progressive(&mut tracer, &rules, &never, |t, p| progress.update(t, p))?;
+    progress.finish();
     let image = tracer.accumulator().mean_image();
     let estimated_rel_mse = tracer.accumulator().estimated_rel_mse();
     let mut metadata = illum_pathtrace::metadata::exr_metadata(

@@ -102,6 +102,9 @@ fn bad_stop_rules_and_exposures_are_clear_errors() {
         (&["--target-error", "-0.5"][..], "above 0"),
         (&["--exposure", "nan"][..], "not a finite number of stops"),
         (&["--exposure", "inf"][..], "not a finite number of stops"),
+        (&["--exposure", "-inf"][..], "not a finite number of stops"),
+        (&["--exposure", "1e10"][..], "at most 64 stops"),
+        (&["--exposure", "-65"][..], "at most 64 stops"),
     ] {
         let out = run(args);
         assert_no_panic(&out);

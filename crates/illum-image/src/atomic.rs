@@ -41,6 +41,24 @@ fn target_parts(path: &Path) -> Result<(PathBuf, &std::ffi::OsStr), ImageError> 
     Ok((dir, file_name))
 }
 
+/// The file a write to `path` should replace: `path` itself, or where it points if it is a
+/// symbolic link (renaming onto the link would replace the link by a regular file and leave
+/// the file it points to as it was). A dangling link gives the file it names.
+fn resolve_link(path: &Path) -> PathBuf {
+    let is_link = std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink());
+    if !is_link {
+        return path.to_path_buf();
+    }
+    if let Ok(target) = std::fs::canonicalize(path) {
+        return target;
+    }
+    match std::fs::read_link(path) {
+        Ok(target) if target.is_relative() => path.parent().map_or(target.clone(), |dir| dir.join(&target)),
+        Ok(target) => target,
+        Err(_) => path.to_path_buf(),
+    }
+}
+
 /// Creates the temporary file next to `path` that [`write_atomically`] writes into (creating
 /// the folder if it is missing).
 fn temporary_next_to(path: &Path) -> Result<tempfile::NamedTempFile, ImageError> {
@@ -72,19 +90,21 @@ fn temporary_next_to(path: &Path) -> Result<tempfile::NamedTempFile, ImageError>
 /// names a file that is not a directory and not read-only, and a file can be created in its
 /// folder (which is created if it is missing). Nothing is left behind but the folder.
 pub fn check_output(path: impl AsRef<Path>) -> Result<(), ImageError> {
-    temporary_next_to(path.as_ref()).map(drop)
+    temporary_next_to(&resolve_link(path.as_ref())).map(drop)
 }
 
 /// Writes `path` atomically. `write` receives the temporary file (seekable, as some encoders
 /// need); it should write the whole content and may return any [`ImageError`], which is
 /// passed on after the temporary file has been removed. The parent directory is created if
 /// it is missing. An existing file is replaced and keeps its permissions; a read-only one is
-/// refused, and so is a directory.
+/// refused, and so is a directory. A symbolic link is followed: the file it points to is
+/// replaced and the link stays.
 pub fn write_atomically<F>(path: impl AsRef<Path>, write: F) -> Result<(), ImageError>
 where
     F: FnOnce(&mut File) -> Result<(), ImageError>,
 {
-    let path = path.as_ref();
+    let resolved = resolve_link(path.as_ref());
+    let path = resolved.as_path();
     // From here on, dropping `tmp` (on any early return) deletes the temporary file.
     let mut tmp = temporary_next_to(path)?;
     #[cfg(unix)]
@@ -122,6 +142,31 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Writing through a symbolic link replaces the file it points to and keeps the link.
+    #[cfg(unix)]
+    #[test]
+    fn a_symbolic_link_is_followed_not_replaced() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("target.png");
+        std::fs::write(&target, b"old").unwrap();
+        let link = dir.path().join("link.png");
+        std::os::unix::fs::symlink("target.png", &link).unwrap();
+        write_atomically(&link, |f| f.write_all(b"new").map_err(|e| ImageError::io(&link, "writing", e)))
+            .unwrap();
+        assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink(), "the link was replaced");
+        assert_eq!(std::fs::read(&target).unwrap(), b"new");
+        // A dangling link: the file it names is created.
+        let dangling = dir.path().join("dangling.png");
+        std::os::unix::fs::symlink("made.png", &dangling).unwrap();
+        check_output(&dangling).unwrap();
+        write_atomically(&dangling, |f| {
+            f.write_all(b"x").map_err(|e| ImageError::io(&dangling, "writing", e))
+        })
+        .unwrap();
+        assert_eq!(std::fs::read(dir.path().join("made.png")).unwrap(), b"x");
+        assert!(std::fs::symlink_metadata(&dangling).unwrap().file_type().is_symlink());
+    }
 
     fn entries(dir: &Path) -> Vec<String> {
         let mut v: Vec<String> = std::fs::read_dir(dir)
