@@ -31,13 +31,25 @@ pub fn read_buffer(
 }
 
 /// Maps the first `size` bytes of a `MAP_READ` buffer, copies them out and unmaps it.
-#[cfg(not(target_arch = "wasm32"))]
 pub fn read_mapped(
     gpu: &GpuContext,
     buffer: &wgpu::Buffer,
     size: u64,
     context: &str,
 ) -> Result<Vec<u8>, GpuError> {
+    with_mapped(gpu, buffer, size, context, <[u8]>::to_vec)
+}
+
+/// Maps the first `size` bytes of a `MAP_READ` buffer, gives them to `read` where they lie (no
+/// copy: a large batch is folded straight from the mapping) and unmaps it.
+#[cfg(not(target_arch = "wasm32"))]
+pub fn with_mapped<R>(
+    gpu: &GpuContext,
+    buffer: &wgpu::Buffer,
+    size: u64,
+    context: &str,
+    read: impl FnOnce(&[u8]) -> R,
+) -> Result<R, GpuError> {
     use crate::DEFAULT_GPU_TIMEOUT;
     let (sender, receiver) = std::sync::mpsc::channel();
     buffer.map_async(wgpu::MapMode::Read, 0..size, move |result| {
@@ -62,18 +74,26 @@ pub fn read_mapped(
         }
     };
     result.map_err(|e| GpuError::Map { context: context.to_owned(), message: e.to_string() })?;
-    copy_out(buffer, size, context)
+    let value = {
+        let view = buffer
+            .get_mapped_range(0..size)
+            .map_err(|e| GpuError::Map { context: context.to_owned(), message: e.to_string() })?;
+        read(&view)
+    };
+    buffer.unmap();
+    Ok(value)
 }
 
 /// In the browser a blocking read would never finish (the page must return to the browser for
 /// the mapping to happen), so it is an error that names the caller; use [`PendingRead`].
 #[cfg(target_arch = "wasm32")]
-pub fn read_mapped(
+pub fn with_mapped<R>(
     _gpu: &GpuContext,
     _buffer: &wgpu::Buffer,
     _size: u64,
     context: &str,
-) -> Result<Vec<u8>, GpuError> {
+    _read: impl FnOnce(&[u8]) -> R,
+) -> Result<R, GpuError> {
     Err(GpuError::BlockingOnTheWeb { context: context.to_owned() })
 }
 

@@ -87,7 +87,16 @@ pub(crate) fn check_row_fits(scene: &Scene, max_slots: u64) -> Result<(), PathTr
     Ok(())
 }
 
-/// The slots read back from the GPU (little-endian f32 vec4s).
+/// The slots read back from the GPU (little-endian f32 vec4s), where they lie when the bytes
+/// are aligned for f32 on a little-endian host (a mapped buffer is), else decoded into a copy.
+pub(crate) fn slots(bytes: &[u8]) -> std::borrow::Cow<'_, [[f32; 4]]> {
+    match bytemuck::try_cast_slice::<u8, [f32; 4]>(bytes) {
+        Ok(slots) if cfg!(target_endian = "little") => std::borrow::Cow::Borrowed(slots),
+        _ => std::borrow::Cow::Owned(decode_slots(bytes)),
+    }
+}
+
+/// The slots read back from the GPU (little-endian f32 vec4s), decoded into a copy.
 pub(crate) fn decode_slots(bytes: &[u8]) -> Vec<[f32; 4]> {
     bytes
         .chunks_exact(SLOT_BYTES as usize)
@@ -142,5 +151,11 @@ mod tests {
         let bytes: Vec<u8> =
             [1.0f32, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0].iter().flat_map(|f| f.to_le_bytes()).collect();
         assert_eq!(decode_slots(&bytes), [[1.0, 2.0, 3.0, 4.0], [5.0, 6.0, 7.0, 8.0]]);
+        // Aligned or not, `slots` reads the same values (borrowed where it can).
+        let aligned: Vec<[f32; 4]> = vec![[1.0, 2.0, 3.0, 4.0], [5.0, 6.0, 7.0, 8.0]];
+        assert!(matches!(slots(bytemuck::cast_slice(&aligned)), std::borrow::Cow::Borrowed(_)));
+        let mut shifted = vec![0u8];
+        shifted.extend_from_slice(&bytes);
+        assert_eq!(&*slots(&shifted[1..]), &aligned[..]);
     }
 }

@@ -47,6 +47,17 @@ impl BatchPlanner {
         }
     }
 
+    /// Rows per band for a pass of `spp` samples per pixel over a `width` x `height` image:
+    /// what the learnt cost of a sample allows in one submission (at least one row, at most
+    /// the image). Before any measurement: the probe's size.
+    pub fn rows_for(&self, width: u32, height: u32, spp: u32) -> u32 {
+        let budget = match self.seconds_per_sample {
+            None => PROBE_PIXELS,
+            Some(cost) => (self.target_seconds / cost).max(1.0) as u64,
+        };
+        (budget / (u64::from(width) * u64::from(spp.max(1)))).clamp(1, u64::from(height)) as u32
+    }
+
     /// Records that `samples` paths took `seconds` of wall time.
     pub fn record(&mut self, samples: u64, seconds: f64) {
         if samples == 0 || seconds.is_nan() || seconds <= 0.0 {
@@ -89,5 +100,17 @@ mod tests {
         assert_eq!(p, PassPlan { spp: 1, rows: 2 });
         planner.record(1, 10.0);
         assert_eq!(planner.plan(50, 40, 16).rows, 1);
+    }
+
+    /// The rows of a band follow the learnt cost: a pass planned before the first measurement
+    /// (one row of 16 spp at 1024 wide) gets bands of the submission's size once it is known.
+    #[test]
+    fn band_rows_follow_the_learnt_cost() {
+        let mut planner = BatchPlanner::new(0.1);
+        assert_eq!(planner.rows_for(1024, 1024, 16), 1);
+        planner.record(1_000_000, 0.1); // 1e6 samples per submission
+        assert_eq!(planner.rows_for(1024, 1024, 16), 61);
+        assert_eq!(planner.rows_for(1024, 40, 1), 40);
+        assert_eq!(planner.rows_for(100_000, 10, 64), 1);
     }
 }

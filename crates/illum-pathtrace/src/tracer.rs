@@ -542,6 +542,17 @@ impl PathTracer {
             report.wall_seconds
         };
         self.planner.record(report.samples, seconds);
+        // Later bands of the pass follow what the planner has learnt: a pass planned before
+        // the first measurement (at 1024 x 1024 with chunk-aligned passes, bands of one row)
+        // would otherwise be a thousand tiny submissions, each paying the driver's fixed cost.
+        // Bands are rows, so their size never changes which samples a pixel's chunks hold.
+        if let Some(spp) = self.pass.as_ref().map(|p| p.plan.spp) {
+            let rows = self.planner.rows_for(camera.width, camera.height, spp);
+            let fitted = self.fit(PassPlan { spp, rows });
+            if let Some(pass) = self.pass.as_mut().filter(|_| fitted.spp == spp) {
+                pass.plan.rows = fitted.rows;
+            }
+        }
         Ok(report)
     }
 

@@ -59,14 +59,16 @@ impl PathTracer {
     /// Traces one band and folds it, waiting for the readback.
     pub(super) fn submit_band(&mut self) -> Result<StepReport, PathTraceError> {
         let band = self.begin_band()?;
-        let staging = self.staging.as_ref().expect("allocated by begin_band");
-        let data = readback::read_mapped(
-            &self.gpu,
-            staging,
-            band.staging_size,
-            "reading back a path-tracing batch",
-        )?;
-        self.finish_band(&band, &data)
+        // Folded straight from the mapping: at 1024 x 1024 a band is many megabytes, and
+        // copying it out first (allocating and faulting in fresh pages) cost time for nothing.
+        let staging = self.staging.take().expect("allocated by begin_band");
+        let context = "reading back a path-tracing batch";
+        let gpu = self.gpu.clone();
+        let folded = readback::with_mapped(&gpu, &staging, band.staging_size, context, |data| {
+            self.finish_band(&band, data)
+        });
+        self.staging = Some(staging);
+        folded?
     }
 
     /// The polled form of [`Self::submit_band`]: submits a band when none is in flight, and
@@ -173,7 +175,7 @@ impl PathTracer {
         let Band { started, row_offset, rows, spp, chunk, chunks, band_pixels, bytes, .. } = *band;
         let width = self.scene.camera.width;
         let height = self.scene.camera.height;
-        let floats = batch::decode_slots(&data[..(2 * bytes) as usize]);
+        let floats = batch::slots(&data[..(2 * bytes) as usize]);
         let (sums, sums_sq) = floats.split_at(floats.len() / 2);
         if let Err(error) = batch::check_complete(sums, sums_sq, spp, chunk, band_pixels) {
             // The accumulator drops this band, but the display pass already added it: set the
