@@ -63,6 +63,9 @@ echo
 echo "== 'reaches 1% estimated relative error at about N spp' (512 x 512, the default scene)"
 "$bin/render" --target-error 0.01 -o "$out/cornell-1pct.exr"
 echo
+echo "== 'With no stop-rule flag ... (on this project's 2-core machine: N spp, X% error, in T s)'"
+"$bin/render" -o "$out/cornell-default.exr"
+echo
 echo "== 'A relMSE of 10^-2 (10% RMS error) takes about N spp'"
 "$bin/render" --target-error 0.1 -o "$out/cornell-10pct.exr"
 echo

@@ -91,26 +91,7 @@ impl Oracle {
         if !self.caustics() {
             return Vec::new();
         }
-        let next = AtomicU32::new(0);
-        let mut frames: Vec<(u32, Vec<DVec3>)> = std::thread::scope(|scope| {
-            let workers: Vec<_> = (0..threads.clamp(1, spp as usize))
-                .map(|_| {
-                    scope.spawn(|| {
-                        let mut done = Vec::new();
-                        loop {
-                            let k = next.fetch_add(1, Ordering::Relaxed);
-                            if k >= spp {
-                                break done;
-                            }
-                            done.push((k, self.caustic_frame(seed, k)));
-                        }
-                    })
-                })
-                .collect();
-            workers.into_iter().flat_map(|w| w.join().expect("oracle worker panicked")).collect()
-        });
-        frames.sort_unstable_by_key(|(k, _)| *k);
-        frames.into_iter().map(|(_, f)| f).collect()
+        in_parallel(spp, threads, |k| self.caustic_frame(seed, k))
     }
 
     /// The whole image on `threads` threads (at least one), which take rows one at a time.
@@ -153,27 +134,36 @@ pub(crate) fn rows_in_parallel<T: Send>(
     threads: usize,
     pixel: impl Fn(u32, u32) -> T + Sync,
 ) -> Vec<T> {
-    let next_row = AtomicU32::new(0);
-    let threads = threads.clamp(1, height.max(1) as usize);
-    let mut rows: Vec<(u32, Vec<T>)> = std::thread::scope(|scope| {
+    in_parallel(height, threads, |y| (0..width).map(|x| pixel(x, y)).collect::<Vec<T>>())
+        .into_iter()
+        .flatten()
+        .collect()
+}
+
+/// `item(i)` for i in 0..count, in that order, computed on `threads` threads (at least one)
+/// that take the next index one at a time; the result does not depend on `threads`.
+fn in_parallel<T: Send>(count: u32, threads: usize, item: impl Fn(u32) -> T + Sync) -> Vec<T> {
+    let next = AtomicU32::new(0);
+    let threads = threads.clamp(1, count.max(1) as usize);
+    let mut items: Vec<(u32, T)> = std::thread::scope(|scope| {
         let workers: Vec<_> = (0..threads)
             .map(|_| {
                 scope.spawn(|| {
                     let mut done = Vec::new();
                     loop {
-                        let y = next_row.fetch_add(1, Ordering::Relaxed);
-                        if y >= height {
+                        let i = next.fetch_add(1, Ordering::Relaxed);
+                        if i >= count {
                             break done;
                         }
-                        done.push((y, (0..width).map(|x| pixel(x, y)).collect()));
+                        done.push((i, item(i)));
                     }
                 })
             })
             .collect();
         workers.into_iter().flat_map(|w| w.join().expect("oracle worker panicked")).collect()
     });
-    rows.sort_unstable_by_key(|(y, _)| *y);
-    rows.into_iter().flat_map(|(_, row)| row).collect()
+    items.sort_unstable_by_key(|(i, _)| *i);
+    items.into_iter().map(|(_, item)| item).collect()
 }
 
 /// A rendered estimate: per pixel, row-major from the top-left, the mean radiance and the

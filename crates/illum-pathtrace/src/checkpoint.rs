@@ -129,7 +129,7 @@ fn checkpoint_layers(
 /// Writes the tracer's mean image, `metadata` and the statistics layer to `path`, atomically.
 pub fn save_checkpoint(path: &Path, tracer: &PathTracer, metadata: &ExrMetadata) -> Result<(), String> {
     let (metadata, layers) = checkpoint_layers(tracer.accumulator(), tracer.aligned_prefix(), metadata);
-    save_exr_with_layers(path, &tracer.accumulator().mean_image(), &metadata, &layers)
+    save_exr_with_layers(path, &tracer.accumulator().mean_image(), &metadata, layers)
         .map_err(|e| with_causes(&e))
 }
 
@@ -138,7 +138,7 @@ pub fn save_checkpoint(path: &Path, tracer: &PathTracer, metadata: &ExrMetadata)
 pub fn save_loaded(path: &Path, checkpoint: &Checkpoint) -> Result<(), String> {
     let aligned = checkpoint.aligned_prefix.as_ref().map(|(a, spp)| (a, *spp));
     let (metadata, layers) = checkpoint_layers(&checkpoint.accumulator, aligned, &checkpoint.metadata);
-    save_exr_with_layers(path, &checkpoint.accumulator.mean_image(), &metadata, &layers)
+    save_exr_with_layers(path, &checkpoint.accumulator.mean_image(), &metadata, layers)
         .map_err(|e| with_causes(&e))
 }
 
@@ -146,7 +146,7 @@ pub fn save_loaded(path: &Path, checkpoint: &Checkpoint) -> Result<(), String> {
 /// labels errors.
 pub fn checkpoint_bytes(name: &str, tracer: &PathTracer, metadata: &ExrMetadata) -> Result<Vec<u8>, String> {
     let (metadata, layers) = checkpoint_layers(tracer.accumulator(), tracer.aligned_prefix(), metadata);
-    illum_image::exr_bytes_with_layers(name, &tracer.accumulator().mean_image(), &metadata, &layers)
+    illum_image::exr_bytes_with_layers(name, &tracer.accumulator().mean_image(), &metadata, layers)
         .map_err(|e| with_causes(&e))
 }
 

@@ -510,15 +510,16 @@ impl PathTracer {
                 let chunk = self.chunk_samples.max(1);
                 if start.is_multiple_of(chunk) {
                     // The last pass of a render that ends inside a chunk: keep the statistics
-                    // at this boundary (see `aligned_prefix`), if the host has the memory for a
-                    // copy (at 16384 x 16384 it has not: such a render, resumed, then differs
-                    // from a straight one by f32 rounding, and says so).
+                    // at this boundary (see `aligned_prefix`), if the host has the memory for
+                    // the copy with a fifth to spare (at 8192 x 8192 on 24 GB it has not: such
+                    // a render, resumed, then differs from a straight one by f32 rounding, and
+                    // the resume says so).
                     let copy_fits = || {
-                        let bytes = self.accumulator.width as u64
-                            * self.accumulator.height as u64
-                            * crate::accumulator::STATISTICS_BYTES_PER_PIXEL;
+                        use crate::accumulator::{ALIGNED_COPY_BYTES_PER_PIXEL, RENDER_HOST_BYTES_PER_PIXEL};
+                        let pixels = u64::from(self.accumulator.width) * u64::from(self.accumulator.height);
+                        let peak = pixels * (RENDER_HOST_BYTES_PER_PIXEL + ALIGNED_COPY_BYTES_PER_PIXEL);
                         crate::accumulator::available_host_memory()
-                            .is_none_or(|available| bytes < available / 2)
+                            .is_none_or(|available| peak <= available / 5 * 4)
                     };
                     self.aligned_prefix = (!(start + plan.spp).is_multiple_of(chunk) && copy_fits())
                         .then(|| (self.accumulator.clone(), self.spp_done));
