@@ -41,8 +41,9 @@ pub fn read_mapped(
 }
 
 /// Maps the first `size` bytes of a `MAP_READ` buffer, gives them to `read` where they lie (no
-/// copy: a large batch is folded straight from the mapping) and unmaps it.
-#[cfg(not(target_arch = "wasm32"))]
+/// copy: a large batch is folded straight from the mapping) and unmaps it. In the browser a
+/// blocking read would never finish (the page must return to the browser for the mapping to
+/// happen), so there it is an error that names the caller; use [`PendingRead`].
 pub fn with_mapped<R>(
     gpu: &GpuContext,
     buffer: &wgpu::Buffer,
@@ -50,6 +51,26 @@ pub fn with_mapped<R>(
     context: &str,
     read: impl FnOnce(&[u8]) -> R,
 ) -> Result<R, GpuError> {
+    #[cfg(target_arch = "wasm32")]
+    {
+        let _ = (gpu, buffer, size, read);
+        Err(GpuError::BlockingOnTheWeb { context: context.to_owned() })
+    }
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        wait_for_mapping(gpu, buffer, size, context)?;
+        read_and_unmap(buffer, size, context, read)
+    }
+}
+
+/// Asks for the first `size` bytes of `buffer` to be mapped and waits until they are.
+#[cfg(not(target_arch = "wasm32"))]
+fn wait_for_mapping(
+    gpu: &GpuContext,
+    buffer: &wgpu::Buffer,
+    size: u64,
+    context: &str,
+) -> Result<(), GpuError> {
     use crate::DEFAULT_GPU_TIMEOUT;
     let (sender, receiver) = std::sync::mpsc::channel();
     buffer.map_async(wgpu::MapMode::Read, 0..size, move |result| {
@@ -74,6 +95,16 @@ pub fn with_mapped<R>(
         }
     };
     result.map_err(|e| GpuError::Map { context: context.to_owned(), message: e.to_string() })?;
+    Ok(())
+}
+
+/// Gives the mapped first `size` bytes of `buffer` to `read`, then unmaps it.
+fn read_and_unmap<R>(
+    buffer: &wgpu::Buffer,
+    size: u64,
+    context: &str,
+    read: impl FnOnce(&[u8]) -> R,
+) -> Result<R, GpuError> {
     let value = {
         let view = buffer
             .get_mapped_range(0..size)
@@ -84,29 +115,9 @@ pub fn with_mapped<R>(
     Ok(value)
 }
 
-/// In the browser a blocking read would never finish (the page must return to the browser for
-/// the mapping to happen), so it is an error that names the caller; use [`PendingRead`].
-#[cfg(target_arch = "wasm32")]
-pub fn with_mapped<R>(
-    _gpu: &GpuContext,
-    _buffer: &wgpu::Buffer,
-    _size: u64,
-    context: &str,
-    _read: impl FnOnce(&[u8]) -> R,
-) -> Result<R, GpuError> {
-    Err(GpuError::BlockingOnTheWeb { context: context.to_owned() })
-}
-
 /// Copies the first `size` bytes out of a mapped buffer and unmaps it.
 fn copy_out(buffer: &wgpu::Buffer, size: u64, context: &str) -> Result<Vec<u8>, GpuError> {
-    let bytes = {
-        let view = buffer
-            .get_mapped_range(0..size)
-            .map_err(|e| GpuError::Map { context: context.to_owned(), message: e.to_string() })?;
-        view.to_vec()
-    };
-    buffer.unmap();
-    Ok(bytes)
+    read_and_unmap(buffer, size, context, <[u8]>::to_vec)
 }
 
 /// A readback that does not wait: [`PendingRead::start`] asks for the buffer to be mapped, and
