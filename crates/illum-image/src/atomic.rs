@@ -143,29 +143,29 @@ where
 mod tests {
     use super::*;
 
-    /// Writing through a symbolic link replaces the file it points to and keeps the link.
+    /// Writing through a symbolic link replaces the file it points to and keeps the link; a
+    /// dangling link gets the file it names.
     #[cfg(unix)]
     #[test]
     fn a_symbolic_link_is_followed_not_replaced() {
         let dir = tempfile::tempdir().unwrap();
-        let target = dir.path().join("target.png");
-        std::fs::write(&target, b"old").unwrap();
-        let link = dir.path().join("link.png");
-        std::os::unix::fs::symlink("target.png", &link).unwrap();
-        write_atomically(&link, |f| f.write_all(b"new").map_err(|e| ImageError::io(&link, "writing", e)))
+        let at = |name: &str| dir.path().join(name);
+        std::fs::write(at("target.png"), b"old").unwrap();
+        for (link, points_to, content) in
+            [("link.png", "target.png", b"new"), ("dangling.png", "made.png", b"xyz")]
+        {
+            std::os::unix::fs::symlink(points_to, at(link)).unwrap();
+            check_output(at(link)).unwrap();
+            write_atomically(at(link), |f| {
+                f.write_all(content).map_err(|e| ImageError::io(at(link), "writing", e))
+            })
             .unwrap();
-        assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink(), "the link was replaced");
-        assert_eq!(std::fs::read(&target).unwrap(), b"new");
-        // A dangling link: the file it names is created.
-        let dangling = dir.path().join("dangling.png");
-        std::os::unix::fs::symlink("made.png", &dangling).unwrap();
-        check_output(&dangling).unwrap();
-        write_atomically(&dangling, |f| {
-            f.write_all(b"x").map_err(|e| ImageError::io(&dangling, "writing", e))
-        })
-        .unwrap();
-        assert_eq!(std::fs::read(dir.path().join("made.png")).unwrap(), b"x");
-        assert!(std::fs::symlink_metadata(&dangling).unwrap().file_type().is_symlink());
+            assert!(
+                std::fs::symlink_metadata(at(link)).unwrap().file_type().is_symlink(),
+                "{link} was replaced"
+            );
+            assert_eq!(std::fs::read(at(points_to)).unwrap(), content);
+        }
     }
 
     fn entries(dir: &Path) -> Vec<String> {
