@@ -205,6 +205,27 @@ fn run(args: Args) -> anyhow::Result<()> {
     if let Some(caustics) = caustics {
         scene.pathtrace.caustics = caustics;
     }
+    let no_stop_flag = args.settings.spp.is_none()
+        && args.target_error.is_none()
+        && args.time_budget.is_none()
+        && args.sample_range.is_none()
+        && args.resume.is_none();
+    let rules = if no_stop_flag {
+        println!(
+            "no stop rule given: rendering until the estimated error is {}% or for {} s, whichever comes first \
+             (--spp N, --target-error X or --time-budget S choose another)",
+            DEFAULT_TARGET_ERROR * 100.0,
+            DEFAULT_TIME_BUDGET.as_secs()
+        );
+        StopRules {
+            spp: None,
+            target_error: Some(DEFAULT_TARGET_ERROR),
+            time_budget: Some(DEFAULT_TIME_BUDGET),
+        }
+    } else {
+        let spp = args.sample_range.as_ref().map(|r| r.end - r.start).or(args.settings.spp);
+        StopRules::from_command_line(scene.pathtrace.spp, spp, args.target_error, args.time_budget)
+    };
     let resumed: Option<Checkpoint> = match (&args.resume, checkpoint) {
         (Some(path), Some(checkpoint)) => {
             let options = TracerOptions { sequence: scene.pathtrace.sequence, ..Default::default() };
@@ -220,13 +241,17 @@ fn run(args: Args) -> anyhow::Result<()> {
                     checkpoint.sample_start
                 );
             }
-            let target = args.sample_range.as_ref().map(|r| r.end - r.start).or(args.settings.spp);
-            if let Some(target) = target
+            if let Some(target) = rules.spp
                 && target < checkpoint.spp_done
             {
+                let asked = if args.sample_range.is_some() || args.settings.spp.is_some() {
+                    "asked for"
+                } else {
+                    "of the scene file's [pathtrace] spp"
+                };
                 anyhow::bail!(
-                    "{} already holds {} spp, more than the {target} asked for: nothing to continue (give a \
-                     larger --spp{})",
+                    "{} already holds {} spp, more than the {target} {asked}: nothing to continue (give a larger \
+                     --spp{})",
                     path.display(),
                     checkpoint.spp_done,
                     if args.sample_range.is_some() { " or a longer --sample-range" } else { "" }
@@ -292,10 +317,13 @@ fn run(args: Args) -> anyhow::Result<()> {
                 .partial_pass
                 .map_or(String::new(), |(spp, rows)| format!(", and {rows} rows of a pass of {spp} spp"))
         );
+        // Going on past the file's spp, to an spp target.
+        let continues = rules.spp.is_some_and(|target| target > checkpoint.spp_done);
         match checkpoint.aligned_prefix {
             // The samples end inside a chunk: start again from the last chunk boundary, so that
             // the chunk is summed whole, as a straight render sums it (illum_pathtrace::checkpoint).
-            Some((prefix, spp)) if checkpoint.partial_pass.is_none() => {
+            // Only when the render goes on to more spp: otherwise nothing may be taken away.
+            Some((prefix, spp)) if checkpoint.partial_pass.is_none() && continues => {
                 println!(
                     "  (going on from {spp} spp, the last chunk boundary, so that the result equals a straight render)"
                 );
@@ -303,7 +331,9 @@ fn run(args: Args) -> anyhow::Result<()> {
             }
             prefix => {
                 let chunk = illum::pathtrace::CHUNK_SAMPLES;
-                if prefix.is_none() && !(checkpoint.sample_start + checkpoint.spp_done).is_multiple_of(chunk)
+                if continues
+                    && prefix.is_none()
+                    && !(checkpoint.sample_start + checkpoint.spp_done).is_multiple_of(chunk)
                 {
                     println!(
                         "  (the file ends inside a chunk of {chunk} samples and has no copy of its statistics at the \
@@ -321,27 +351,6 @@ fn run(args: Args) -> anyhow::Result<()> {
     } else if let Some(start) = range_start {
         tracer.set_sample_offset(start);
     }
-    let no_stop_flag = args.settings.spp.is_none()
-        && args.target_error.is_none()
-        && args.time_budget.is_none()
-        && args.sample_range.is_none()
-        && args.resume.is_none();
-    let rules = if no_stop_flag {
-        println!(
-            "no stop rule given: rendering until the estimated error is {}% or for {} s, whichever comes first \
-             (--spp N, --target-error X or --time-budget S choose another)",
-            DEFAULT_TARGET_ERROR * 100.0,
-            DEFAULT_TIME_BUDGET.as_secs()
-        );
-        StopRules {
-            spp: None,
-            target_error: Some(DEFAULT_TARGET_ERROR),
-            time_budget: Some(DEFAULT_TIME_BUDGET),
-        }
-    } else {
-        let spp = args.sample_range.as_ref().map(|r| r.end - r.start).or(args.settings.spp);
-        StopRules::from_command_line(scene.pathtrace.spp, spp, args.target_error, args.time_budget)
-    };
     let exr_outputs: Vec<PathBuf> =
         outputs.iter().filter(|o| matches!(output_format(o), Ok(OutputFormat::Exr))).cloned().collect();
     let every = args.checkpoint_seconds.unwrap_or(DEFAULT_CHECKPOINT);

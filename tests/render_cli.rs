@@ -492,6 +492,22 @@ fn a_render_ending_inside_a_chunk_resumes_and_merges_like_one_render() {
     let p = |name: &str| dir.path().join(name).to_str().unwrap().to_owned();
     render_ok(&["--spp", "50", "-o", &p("fifty.exr")]);
     assert_eq!(field(&metadata(Path::new(&p("fifty.exr"))), "aligned_spp"), "48");
+    // Nothing to continue (the scene file's 16 spp), or a target the file already meets: the
+    // file keeps all of its 50 spp (going back to the chunk boundary would drop 2).
+    let before = statistics_bits(Path::new(&p("fifty.exr")));
+    let out = run(&["--resume", &p("fifty.exr")]);
+    assert!(
+        !out.status.success()
+            && text(&out.stderr).contains("already holds 50 spp, more than the 16 of the scene file"),
+        "{}",
+        text(&out.stderr)
+    );
+    render_ok(&["--resume", &p("fifty.exr"), "--target-error", "0.9"]);
+    assert_eq!(field(&metadata(Path::new(&p("fifty.exr"))), "spp"), "50");
+    assert!(
+        statistics_bits(Path::new(&p("fifty.exr"))) == before,
+        "a resume that had nothing to do changed the file"
+    );
     let resumed = render_ok(&["--resume", &p("fifty.exr"), "--spp", "100"]);
     assert!(text(&resumed.stdout).contains("going on from 48 spp"), "{}", text(&resumed.stdout));
     render_ok(&["--spp", "100", "-o", &p("straight.exr")]);

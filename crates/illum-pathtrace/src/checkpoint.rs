@@ -175,6 +175,9 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint, String> {
     let unreadable = |e: &dyn std::error::Error| {
         at(format!("cannot be read as an EXR (truncated or corrupt?): {}", with_causes(e)))
     };
+    if !path.exists() {
+        return Err(at("no such file".into()));
+    }
     let (image, attributes) = load_exr(path).map_err(|e| unreadable(&e))?;
     let metadata = ExrMetadata::from_attributes(path, &attributes)
         .map_err(|e| e.to_string())?

@@ -87,6 +87,8 @@ pub struct ViewerApp {
     pub scene_field: String,
     /// Whether the settings panel is shown (the top bar's "Hide settings" / "Show settings").
     pub show_panel: bool,
+    /// Whether the first frame has chosen `show_panel` for the window's width.
+    panel_fitted: bool,
     /// The last open attempt's error (the current scenes stay).
     pub open_error: Option<String>,
     /// The scene file opened last and, for each mode that cannot render it, why.
@@ -124,6 +126,7 @@ impl ViewerApp {
             whitted: Err("no Whitted scene loaded".to_owned()),
             scene_field: options.scene.display().to_string(),
             show_panel: true,
+            panel_fitted: false,
             open_error: None,
             refused: None,
             screenshot: options.screenshot,
@@ -407,7 +410,13 @@ impl ViewerApp {
             ui.colored_label(ui.visuals().error_fg_color, format!("Could not open the scene: {error}"));
         }
         if let Some(refusal) = self.refusal_of(self.mode) {
-            ui.colored_label(ui.visuals().warn_fg_color, refusal);
+            let text = egui::RichText::new(&refusal).color(ui.visuals().warn_fg_color);
+            if compact {
+                // One line in a narrow window; the whole sentence on hover.
+                ui.add(egui::Label::new(text).truncate()).on_hover_text(refusal);
+            } else {
+                ui.label(text);
+            }
         }
     }
 
@@ -507,6 +516,14 @@ impl eframe::App for ViewerApp {
         let showing_pathtrace = self.mode == Mode::PathTrace;
         if let Ok(pathtrace) = &mut self.pathtrace {
             pathtrace.set_active(showing_pathtrace);
+        }
+        // A window that starts narrow starts with the settings hidden, so that the image has
+        // the window (the top bar's Settings toggle shows them).
+        if !self.panel_fitted {
+            self.panel_fitted = true;
+            if ui.available_width() < COMPACT_BELOW_POINTS {
+                self.show_panel = false;
+            }
         }
         egui::Panel::top("top bar").show(ui, |ui| self.top_bar(ui));
         if self.show_panel {

@@ -37,8 +37,12 @@ fn harness(mode: Mode) -> Harness<'static, ViewerApp> {
 }
 
 fn harness_with(scene: &'static str, mode: Mode) -> Harness<'static, ViewerApp> {
+    harness_sized(scene, mode, egui::vec2(900.0, 560.0))
+}
+
+fn harness_sized(scene: &'static str, mode: Mode, size: egui::Vec2) -> Harness<'static, ViewerApp> {
     Harness::builder()
-        .with_size(egui::vec2(900.0, 560.0))
+        .with_size(size)
         .wgpu_setup(egui_wgpu::WgpuSetup::Existing(shared_device()))
         .build_eframe(move |cc| {
             ViewerApp::new(cc, StartOptions { scene: scene.into(), mode: Some(mode), screenshot: None })
@@ -360,27 +364,27 @@ fn a_mode_that_cannot_render_the_opened_scene_says_why() {
 
 #[test]
 fn a_small_window_still_shows_the_image_and_the_panel_hides() {
-    let mut harness = harness(Mode::PathTrace);
-    harness.set_size(egui::vec2(200.0, 150.0));
+    let mut harness = harness_sized("scenes/cornell.toml", Mode::PathTrace, egui::vec2(200.0, 150.0));
     harness.run_steps(3);
-    let with_panel = harness.state().pathtrace().unwrap().stats();
-    // The panel takes at most half the width: the image keeps the other half (x 0.5 scale).
-    assert!(with_panel.width >= 40, "the settings panel covers the image: {with_panel:?}");
-    // The top bar is compact (two lines): the image keeps most of the height.
-    assert!(with_panel.height * 2 >= 80, "the top bar covers the image: {with_panel:?}");
-    // The compact bar's toggle.
-    harness.get_by_label("Settings").click();
-    harness.run_steps(3);
+    // A window that starts narrow starts with the settings hidden: the image has the window
+    // below a compact, two-line top bar (x 0.5 render scale).
     assert!(!harness.state().show_panel);
     let without = harness.state().pathtrace().unwrap().stats();
+    assert!(without.width * 2 >= 180 && without.height * 2 >= 80, "the image is too small: {without:?}");
+    // The compact bar's toggle shows them; the panel takes at most half the width.
+    harness.get_by_label("Settings").click();
+    harness.run_steps(3);
+    assert!(harness.state().show_panel);
+    let with_panel = harness.state().pathtrace().unwrap().stats();
+    assert!(with_panel.width >= 40, "the settings panel covers the image: {with_panel:?}");
     assert!(without.width > with_panel.width, "{with_panel:?} -> {without:?}");
     click(&mut harness, "Settings");
-    assert!(harness.state().show_panel);
+    assert!(!harness.state().show_panel);
     // A wide window has the full bar again.
     harness.set_size(egui::vec2(900.0, 560.0));
     harness.run_steps(1);
-    click(&mut harness, "Hide settings");
-    assert!(!harness.state().show_panel);
+    click(&mut harness, "Show settings");
+    assert!(harness.state().show_panel);
 }
 
 #[test]
