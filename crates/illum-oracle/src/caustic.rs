@@ -58,7 +58,7 @@ use crate::integrator::{Oracle, ROULETTE_AFTER, ROULETTE_MAX_SURVIVAL, SPAWN_OFF
 use crate::rng::Rng;
 use crate::sampling::{local_to_world, uniform_cone};
 use crate::scene::Primitive;
-use crate::whitted::{reflect, refract};
+use crate::whitted::{reflect, scatter_dielectric};
 
 /// Key mixed into the particles' seed so that particle i of frame k never shares its random
 /// numbers with sample k of pixel i.
@@ -181,21 +181,8 @@ impl Oracle {
                     if !self.may_scatter(scatterings, &mut throughput, DVec3::ONE, rng) {
                         return None;
                     }
-                    let eta = if front { 1.0 / f64::from(ior) } else { f64::from(ior) };
-                    let cos_i = -d.dot(nrm);
-                    match refract(d, nrm, eta)
-                        .filter(|t| rng.uniform() >= crate::whitted::fresnel(cos_i, -t.dot(nrm), eta))
-                    {
-                        // Flux, not radiance: no eta^2 (see the module documentation).
-                        Some(t) => {
-                            d = t;
-                            o = p - nrm * lift;
-                        }
-                        None => {
-                            d = reflect(d, nrm);
-                            o = p + nrm * lift;
-                        }
-                    }
+                    // Flux, not radiance: no eta^2 (see the module documentation).
+                    (o, d) = scatter_dielectric(d, nrm, p, front, ior, lift, rng);
                 }
                 MaterialKind::Lambertian { .. } | MaterialKind::Checker(_) => {
                     // A particle whose first hit is diffuse carries an L D path: not ours.

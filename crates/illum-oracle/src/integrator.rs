@@ -27,7 +27,7 @@ use crate::geometry::Surface;
 use crate::rng::Rng;
 use crate::sampling::{cosine_hemisphere, local_to_world, uniform_cone, uniform_hemisphere};
 use crate::scene::{Primitive, TraceScene};
-use crate::whitted::{reflect, refract};
+use crate::whitted::{reflect, scatter_dielectric};
 
 /// Relative distance by which an emitter may lie behind the nearest other surface and still
 /// be the one that is hit: lights set into a coplanar ceiling win the tie.
@@ -269,22 +269,7 @@ impl Oracle {
                     if !self.may_continue(taken) || !self.roulette(taken, throughput, &mut throughput, rng) {
                         break;
                     }
-                    let eta = if front { 1.0 / f64::from(ior) } else { f64::from(ior) };
-                    let cos_i = -d.dot(n);
-                    let refracted = refract(d, n, eta).filter(|t| {
-                        let f = crate::whitted::fresnel(cos_i, -t.dot(n), eta);
-                        rng.uniform() >= f
-                    });
-                    match refracted {
-                        Some(t) => {
-                            d = t;
-                            o = x - n * lift;
-                        }
-                        None => {
-                            d = reflect(d, n);
-                            o = x + n * lift;
-                        }
-                    }
+                    (o, d) = scatter_dielectric(d, n, x, front, ior, lift, rng);
                     direct_counts = true;
                 }
                 MaterialKind::Lambertian { .. } | MaterialKind::Checker(_) => {

@@ -311,6 +311,29 @@ pub(crate) fn refract(d: DVec3, n: DVec3, eta: f64) -> Option<DVec3> {
     Some((eta * d + (eta * cos_i - cos_t) * n).normalize())
 }
 
+/// One stochastic step through a smooth dielectric at point `p`, for the path tracer and the
+/// caustic's light tracer alike: `n` faces the incoming unit ray `d`, `front` says whether the
+/// ray arrives from outside (eta = 1 / ior) or inside (eta = ior). Reflect with probability F
+/// (the exact Fresnel reflectance; 1 under total internal reflection), else refract, so the
+/// weight is F / F = (1 - F) / (1 - F) = 1. The new origin is `lift` off the surface on the
+/// side the ray leaves to. Returns (origin, direction).
+pub(crate) fn scatter_dielectric(
+    d: DVec3,
+    n: DVec3,
+    p: DVec3,
+    front: bool,
+    ior: f32,
+    lift: f64,
+    rng: &mut crate::rng::Rng,
+) -> (DVec3, DVec3) {
+    let eta = if front { 1.0 / f64::from(ior) } else { f64::from(ior) };
+    let cos_i = -d.dot(n);
+    match refract(d, n, eta).filter(|t| rng.uniform() >= fresnel(cos_i, -t.dot(n), eta)) {
+        Some(t) => (p - n * lift, t),
+        None => (p + n * lift, reflect(d, n)),
+    }
+}
+
 /// The exact unpolarised Fresnel reflectance of a dielectric interface: the mean of the s- and
 /// p-polarised reflectances, for cosines of incidence `cos_i` and transmission `cos_t` and
 /// eta = n_from / n_to.

@@ -426,7 +426,7 @@ impl PathTracer {
         let chunk = self.chunk_samples.max(1);
         let end = self.sample_offset + self.spp_done + self.pass.as_ref().map_or(0, |p| p.plan.spp);
         let (accumulator, spp) = self.aligned_prefix.as_ref()?;
-        (!end.is_multiple_of(chunk) && *spp <= self.spp_done).then_some((accumulator, *spp))
+        (!end.is_multiple_of(chunk)).then_some((accumulator, *spp))
     }
 
     /// Continues from a checkpoint: the accumulator, the spp of the completed passes, and a pass
