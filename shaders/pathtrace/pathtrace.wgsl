@@ -14,8 +14,9 @@
 #import illum::sampling::{sample_cosine_hemisphere, sample_uniform_hemisphere, to_world, sample_parallelogram}
 #import illum::spawn::{spawn_point, spawn_error, max_abs}
 #import illum::rtcore::geometry::{NO_HIT, FAR, Surface}
-#import illum::pathtrace::scene::{Material, params, objects, materials, lights, batch_sum, batch_sum_sq}
-#import illum::rtcore::traversal::{closest_hit, occluded, surface_at, choose_light}
+#import illum::pathtrace::scene::{Material, params, lights, batch_sum, batch_sum_sq}
+#import illum::pathtrace::materials::material_at
+#import illum::rtcore::traversal::{closest_hit, occluded, surface_at, choose_light, object_at}
 #import illum::pathtrace::surfaces::{MATERIAL_CHECKER, MATERIAL_DIELECTRIC, MATERIAL_MIRROR, UNBOUNDED, RR_START, RR_MAX_SURVIVAL, UNBOUNDED_DEPTH_CAP, max3}
 #ifdef SUN
 #import illum::pathtrace::surfaces::sample_sun
@@ -27,7 +28,6 @@
 #import illum::pathtrace::surfaces::checker_albedo
 #endif
 
-const SAMPLING_COSINE: u32 = 0u;
 // Shadow rays end this fraction of their length short of the light (on top of the light's own
 // error band, see direct_light). It covers rounding only: the computed length of the segment and
 // the distance at which the slab or quad test finds a surface lying in the light's plane each
@@ -144,23 +144,26 @@ fn radiance(origin: vec3<f32>, direction: vec3<f32>, sampler: ptr<function, Samp
             radiance += throughput * escaped(d, direct_counts, caustic_owned);
             break;
         }
-        let obj = objects[hit.index];
+        // object_at and material_at: literals in a specialised pipeline (see specialise.rs).
+        let obj = object_at(hit.index);
+        // One reconstruction for both uses below: lavapipe (Mesa 22) runs the body of every
+        // `if` for all lanes under a mask, so a second one inside the emitter's branch would be
+        // paid on every hit.
+        var s = surface_at(obj, o + hit.t * d);
+        let front = dot(s.n, d) < 0.0;
         if (obj.emitter != 0u) {
             if (direct_counts) {
                 // One-sided emitter: visible only from its front.
-                let facing = dot(surface_at(obj, o + hit.t * d).n, d) < 0.0;
-                radiance += select(vec3<f32>(0.0), throughput * materials[obj.material].emission.xyz, facing);
+                radiance += select(vec3<f32>(0.0), throughput * material_at(obj.material).emission.xyz, front);
             }
             break;
         }
-        var s = surface_at(obj, o + hit.t * d);
-        let front = dot(s.n, d) < 0.0;
         if (!front) {
             s.n = -s.n;
         }
         let last = (params.bounces != UNBOUNDED && depth >= params.bounces) || depth >= UNBOUNDED_DEPTH_CAP;
 #ifdef SPECULAR
-        let m = materials[obj.material];
+        let m = material_at(obj.material);
         let kind = u32(m.albedo.w);
         if (kind == MATERIAL_MIRROR || kind == MATERIAL_DIELECTRIC) {
             // Its only continuation is the bounce it may not take.
@@ -185,13 +188,13 @@ fn radiance(origin: vec3<f32>, direction: vec3<f32>, sampler: ptr<function, Samp
         }
 #endif
 #ifdef CHECKER
-        let checker = materials[obj.material];
+        let checker = material_at(obj.material);
         var albedo = checker.albedo.xyz;
         if (u32(checker.albedo.w) == MATERIAL_CHECKER) {
             albedo = checker_albedo(hit.index, checker, s.p);
         }
 #else
-        let albedo = materials[obj.material].albedo.xyz;
+        let albedo = material_at(obj.material).albedo.xyz;
 #endif
         // Every ray leaving this point (shadow and bounce) starts here, off the surface.
         let spawned = spawn_point(s.p, s.n, s.err);
@@ -202,15 +205,16 @@ fn radiance(origin: vec3<f32>, direction: vec3<f32>, sampler: ptr<function, Samp
         let u1 = sample_1d(sampler);
         let u2 = sample_1d(sampler);
         // Lambertian f = albedo / pi. Cosine pdf cos/pi: f cos / pdf = albedo.
-        // Uniform pdf 1/(2 pi): f cos / pdf = 2 albedo cos.
-        if (params.sampling == SAMPLING_COSINE) {
-            d = to_world(s.n, sample_cosine_hemisphere(u1, u2));
-            throughput *= albedo;
-        } else {
-            let local = sample_uniform_hemisphere(u1, u2);
-            d = to_world(s.n, local);
-            throughput *= albedo * (2.0 * local.z);
-        }
+        // Uniform pdf 1/(2 pi): f cos / pdf = 2 albedo cos. A shader def, not a branch on
+        // params: lavapipe would run both samplers (and their sin and cos) for every lane.
+#ifdef UNIFORM_SAMPLING
+        let local = sample_uniform_hemisphere(u1, u2);
+        d = to_world(s.n, local);
+        throughput *= albedo * (2.0 * local.z);
+#else
+        d = to_world(s.n, sample_cosine_hemisphere(u1, u2));
+        throughput *= albedo;
+#endif
         if (!roulette(depth, &throughput, sampler)) {
             break;
         }
@@ -236,17 +240,20 @@ fn direct(s: Surface, origin: vec3<f32>, sampler: ptr<function, Sampler>) -> vec
     return l;
 }
 
-// Russian roulette in unbounded mode from bounce RR_START on: survive with probability
+// Russian roulette in unbounded mode (shader def UNBOUNDED_BOUNCES; compiled out otherwise, as
+// lavapipe would run its body for every lane) from bounce RR_START on: survive with probability
 // q = min(max channel, 0.95) and divide by q, so E[throughput] is unchanged. False: the path
 // ends (also when nothing more can be added).
 fn roulette(depth: u32, throughput: ptr<function, vec3<f32>>, sampler: ptr<function, Sampler>) -> bool {
-    if (params.bounces == UNBOUNDED && depth >= RR_START) {
+#ifdef UNBOUNDED_BOUNCES
+    if (depth >= RR_START) {
         let q = min(max3(*throughput), RR_MAX_SURVIVAL);
         if (sample_1d(sampler) >= q) {
             return false;
         }
         *throughput /= q;
     }
+#endif
     return max3(*throughput) > 0.0;
 }
 

@@ -8,7 +8,8 @@
 #import illum::sampling::{sample_uniform_cone, to_world}
 #import illum::spawn::spawn_point
 #import illum::rtcore::geometry::Surface
-#import illum::pathtrace::scene::{Material, params, objects}
+#import illum::pathtrace::scene::{Material, params}
+#import illum::rtcore::traversal::object_at
 
 #ifdef SUN
 // A direction toward the directional light and its weight, radiance / pdf. A delta light: its
@@ -54,7 +55,7 @@ const MATERIAL_MIRROR: u32 = 3u;
 #ifdef CHECKER
 // The checker's albedo at p on quad obj: tile (i, j) counted from its corner along its edges.
 fn checker_albedo(obj_index: u32, m: Material, p: vec3<f32>) -> vec3<f32> {
-    let obj = objects[obj_index];
+    let obj = object_at(obj_index);
     let q = p - obj.a.xyz;
     let i = floor(dot(q, obj.b.xyz) / length(obj.b.xyz) / m.emission.w);
     let j = floor(dot(q, obj.c.xyz) / length(obj.c.xyz) / m.emission.w);

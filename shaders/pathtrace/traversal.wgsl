@@ -24,6 +24,11 @@ fn closest_hit(o: vec3<f32>, d: vec3<f32>) -> Hit {
     return best;
 }
 
+// The object at `index`.
+fn object_at(index: u32) -> Object {
+    return objects[index];
+}
+
 fn hit_object_at(o: vec3<f32>, d: vec3<f32>, inv_d: vec3<f32>, i: u32) -> f32 {
     switch objects[i].kind {
         case KIND_AABB: { return hit_slabs(o, inv_d, objects[i].a.xyz, objects[i].b.xyz); }

@@ -32,13 +32,16 @@ pub(crate) struct BatchBuffers {
 impl BatchBuffers {
     /// Allocates buffers of `slots` slots each and binds them, after the scene's buffers
     /// (`scene_buffers`: params, objects, materials, lights), to `layout`. The lights are bound
-    /// only with `bind_lights`: a pipeline without area lights does not declare them.
+    /// only with `bind_lights` (a pipeline without area lights does not declare them), the
+    /// objects and materials only with `bind_scene_data` (a specialised pipeline holds them as
+    /// literals).
     pub(crate) fn new(
         gpu: &GpuContext,
         slots: u64,
         layout: &wgpu::BindGroupLayout,
         scene_buffers: [&wgpu::Buffer; 4],
         bind_lights: bool,
+        bind_scene_data: bool,
     ) -> Result<Self, GpuError> {
         let device = &gpu.device;
         gpu.scoped("allocating path-tracer batch buffers", || {
@@ -56,7 +59,9 @@ impl BatchBuffers {
             let bound: Vec<(u32, &wgpu::Buffer)> =
                 [(0, params), (1, objects), (2, materials), (3, lights), (4, &sum), (5, &sum_sq)]
                     .into_iter()
-                    .filter(|&(binding, _)| bind_lights || binding != 3)
+                    .filter(|&(binding, _)| {
+                        (bind_lights || binding != 3) && (bind_scene_data || !(1..=2).contains(&binding))
+                    })
                     .collect();
             let bind_group = buffer_bind_group(device, "pathtrace", layout, &bound);
             BatchBuffers { slots, sum, sum_sq, bind_group }

@@ -339,6 +339,14 @@ impl GpuScene {
         if caustics_active(scene) {
             defs.push("CAUSTIC");
         }
+        // Render settings that choose code rather than numbers: lavapipe runs both sides of a
+        // branch on a uniform parameter for every lane, so the unused side costs its full price.
+        if scene.pathtrace.sampling == Sampling::Uniform {
+            defs.push("UNIFORM_SAMPLING");
+        }
+        if scene.pathtrace.bounces == Bounces::Unbounded {
+            defs.push("UNBOUNDED_BOUNCES");
+        }
         let objects = objects.into_iter().map(|(_, object)| object).collect();
         Ok(Self { objects, materials, lights, light_area, first_emitter, defs, radiance_exponent })
     }
@@ -395,8 +403,10 @@ pub fn ordered_objects(scene: &Scene) -> (Vec<(usize, GpuObject)>, u32) {
 impl GpuScene {
     /// naga_oil shader defs for the features the scene uses: AREA_LIGHTS, SUN, SUN_DISC, SKY,
     /// SPECULAR (a mirror or a dielectric), CHECKER, and CAUSTIC (`caustics = true` with a
-    /// directional light and a specular object: the light tracer, see tracer/caustic.rs). The Cornell box compiles with
-    /// AREA_LIGHTS alone: none of the other features' code is in its pipeline.
+    /// directional light and a specular object: the light tracer, see tracer/caustic.rs); and
+    /// for two render settings, UNIFORM_SAMPLING (`sampling = "uniform"`) and UNBOUNDED_BOUNCES
+    /// (Russian roulette). The Cornell box at its defaults compiles with AREA_LIGHTS alone: none
+    /// of the other features' code is in its pipeline.
     pub fn shader_defs(&self) -> Vec<(&'static str, illum_gpu::shader::Def)> {
         self.defs.iter().map(|&d| (d, illum_gpu::shader::Def::Bool(true))).collect()
     }

@@ -22,6 +22,8 @@ pub const SCENE_MODULE: ShaderFile = shader_file!("shaders/pathtrace/scene.wgsl"
 pub const SURFACES_MODULE: ShaderFile = shader_file!("shaders/pathtrace/surfaces.wgsl");
 /// The caustic's light tracer (entry point `main`; shader def CAUSTIC).
 pub const CAUSTIC_SHADER: ShaderFile = shader_file!("shaders/pathtrace/caustic.wgsl");
+/// The generic material lookup (a read of the material buffer).
+pub const GENERIC_MATERIALS: ShaderFile = shader_file!("shaders/pathtrace/materials.wgsl");
 /// The generic traversal (a loop over the object buffer).
 pub const GENERIC_TRAVERSAL: ShaderFile = shader_file!("shaders/pathtrace/traversal.wgsl");
 
@@ -46,6 +48,10 @@ pub fn shader_modules(scene: &Scene, gpu_scene: &GpuScene, traversal: Traversal)
     let mut modules = SAMPLING_MODULES.to_vec();
     modules.push(GEOMETRY_MODULE);
     modules.push(SCENE_MODULE);
+    modules.push(match traversal {
+        Traversal::Generic => GENERIC_MATERIALS,
+        Traversal::Specialised => specialise::materials_module(scene, gpu_scene),
+    });
     modules.push(match traversal {
         Traversal::Generic => GENERIC_TRAVERSAL,
         Traversal::Specialised => specialise::traversal_module(scene, gpu_scene),

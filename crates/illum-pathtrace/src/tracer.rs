@@ -339,10 +339,13 @@ impl PathTracer {
                 ),
             });
         }
-        // Another resolution, or the caustic turned on or off (another pipeline), builds anew.
+        // Another resolution, or settings that choose another pipeline (the caustic on or off,
+        // the hemisphere sampling, bounded or unbounded paths: shader defs), build anew.
+        let pipeline_changes = GpuScene::new(scene)?.defs != GpuScene::new(&self.scene)?.defs;
         let resized = (scene.camera.width, scene.camera.height)
             != (self.scene.camera.width, self.scene.camera.height)
-            || scene.pathtrace.caustics != self.scene.pathtrace.caustics;
+            || scene.pathtrace.caustics != self.scene.pathtrace.caustics
+            || pipeline_changes;
         if resized {
             let mut resized = Self::with_options(&self.gpu, scene, self.options)?;
             // What the caller chose and the planner learnt (the cost of a sample) carry over:

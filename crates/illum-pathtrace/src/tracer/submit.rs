@@ -12,6 +12,7 @@ use web_time::Instant;
 use super::{PathTracer, StepReport, TIMED_PASS};
 use crate::PathTraceError;
 use crate::batch::{self, BatchBuffers, SLOT_BYTES};
+use crate::options::Traversal;
 use crate::planner::PassPlan;
 
 const WORKGROUP: u32 = 8;
@@ -52,7 +53,10 @@ impl PathTracer {
         let scene_buffers =
             [&self.params_buffer, &self.objects_buffer, &self.materials_buffer, &self.lights_buffer];
         let bind_lights = self.base_params.num_lights > 0;
-        self.batch = Some(BatchBuffers::new(&self.gpu, slots, &layout, scene_buffers, bind_lights)?);
+        // A specialised pipeline has its objects and materials as literals (specialise.rs).
+        let bind_scene_data = self.options.traversal == Traversal::Generic;
+        self.batch =
+            Some(BatchBuffers::new(&self.gpu, slots, &layout, scene_buffers, bind_lights, bind_scene_data)?);
         Ok(())
     }
 
