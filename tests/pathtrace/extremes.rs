@@ -817,10 +817,20 @@ fn render_capped(scene: &Scene, bytes: Option<u64>) -> (PathTracer, usize) {
         tracer.limit_batch_bytes(bytes).expect("one row fits");
     }
     let mut submissions = 0;
+    let started = std::time::Instant::now();
     while tracer.spp_done() < scene.pathtrace.spp {
         tracer.render_step(Some(scene.pathtrace.spp)).expect("renders");
         submissions += 1;
     }
+    // Each band is submitted while the one before it is folded; their wall times must still
+    // add up to no more than the time that passed (a band counted from its own launch would
+    // count the overlap twice).
+    let elapsed = started.elapsed().as_secs_f64();
+    assert!(
+        tracer.wall_seconds() <= elapsed,
+        "bands counted {} s of wall time in {elapsed} s",
+        tracer.wall_seconds()
+    );
     (tracer, submissions)
 }
 

@@ -328,10 +328,15 @@ impl Accumulator {
         self.estimated_rel_mse().sqrt()
     }
 
+    /// Starts over (same size and radiance scale). Zeroes the statistics in place: fresh
+    /// vectors would come from the system as untouched pages, and the first fold after a reset
+    /// (a viewer's camera move) paid a page fault per 4 KiB, about 40 ms at 1024 x 1024.
     pub fn reset(&mut self) {
-        let scale = self.sum_scale;
-        *self = Self::new(self.width, self.height);
-        self.sum_scale = scale;
+        self.sum.fill([0.0; 3]);
+        self.sum_sq.fill([0.0; 3]);
+        self.count.fill(0);
+        self.total = 0;
+        self.dropped = 0;
     }
 }
 
@@ -361,6 +366,25 @@ mod tests {
         // Sample variance of 1..5 is 2.5; of the mean, 2.5 / 5 = 0.5.
         let v = acc.pixel_variance_of_mean(0);
         assert!((v[0] - 0.5).abs() < 1e-12, "{v:?}");
+    }
+
+    #[test]
+    fn reset_starts_over_and_keeps_the_radiance_scale() {
+        let mut acc = Accumulator::new(2, 1);
+        acc.set_radiance_exponent(3);
+        acc.fold(
+            0,
+            &[[1.0, 1.0, 1.0, 1.0], [2.0, 2.0, 2.0, 1.0]],
+            &[[1.0, 1.0, 1.0, 1.0], [4.0, 4.0, 4.0, 0.0]],
+        );
+        acc.reset();
+        let state = acc.state();
+        assert!(state.sum.iter().chain(state.sum_sq).all(|v| *v == [0.0; 3]));
+        assert!(state.count.iter().all(|&c| c == 0));
+        assert_eq!((acc.total_samples(), acc.dropped_samples()), (0, 0));
+        // Still scaled by 2^3 after the reset: one sample of 1 folds to a mean of 8.
+        acc.fold(0, &[[1.0, 1.0, 1.0, 1.0]], &[[1.0, 1.0, 1.0, 0.0]]);
+        assert_eq!(acc.pixel_mean(0), [8.0; 3]);
     }
 
     #[test]

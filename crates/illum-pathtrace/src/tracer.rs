@@ -40,7 +40,16 @@ pub struct StepReport {
 struct ActivePass {
     plan: PassPlan,
     sample_base: u32,
+    /// Rows folded so far (from row 0).
     next_row: u32,
+    /// Rows submitted so far: `next_row` plus a band launched ahead (see `submit.rs`).
+    launched_row: u32,
+}
+
+impl ActivePass {
+    fn new(plan: PassPlan, sample_base: u32, next_row: u32) -> Self {
+        ActivePass { plan, sample_base, next_row, launched_row: next_row }
+    }
 }
 
 pub struct PathTracer {
@@ -59,6 +68,11 @@ pub struct PathTracer {
     /// up to `max_slots`.
     batch: Option<BatchBuffers>,
     staging: Option<wgpu::Buffer>,
+    /// The next band of the pass, submitted before the current one was folded, and the staging
+    /// buffer it copies into (see `submit.rs`).
+    ahead: Option<submit::AheadBand>,
+    /// When the last band was folded: a band launched ahead counts its wall time from there.
+    last_fold: Option<web_time::Instant>,
     /// Samples per invocation.
     chunk_samples: u32,
     /// Most slots one batch buffer may hold: the device's storage binding limit (or a lower cap
@@ -198,6 +212,8 @@ impl PathTracer {
             lights_buffer,
             batch: None,
             staging: None,
+            ahead: None,
+            last_fold: None,
             chunk_samples: CHUNK_SAMPLES,
             max_slots,
             max_chunks: limits.max_compute_workgroups_per_dimension,
@@ -466,7 +482,7 @@ impl PathTracer {
             partial_pass.filter(|&(_, rows)| rows > 0 && rows < camera.height).map(|(spp, next_row)| {
                 let planned = self.planner.plan(camera.width, camera.height, spp);
                 let rows = if planned.spp >= spp { camera.height } else { planned.rows.max(1) };
-                ActivePass { plan: self.fit(PassPlan { spp, rows }), sample_base: spp_done, next_row }
+                ActivePass::new(self.fit(PassPlan { spp, rows }), spp_done, next_row)
             });
         if let Some(display) = &self.display_sum {
             display.seed(&self.gpu, &self.accumulator, self.radiance_exponent);
@@ -477,6 +493,8 @@ impl PathTracer {
     /// Discards everything accumulated; the next step starts again at sample 0.
     pub fn reset(&mut self) {
         self.in_flight = None;
+        self.ahead = None;
+        self.last_fold = None;
         self.accumulator.reset();
         if let Some(caustic) = &mut self.caustic {
             caustic.discard_pass();
@@ -528,7 +546,7 @@ impl PathTracer {
                         .then(|| (self.accumulator.clone(), self.spp_done));
                 }
             }
-            self.pass = Some(ActivePass { plan, sample_base: self.spp_done, next_row: 0 });
+            self.pass = Some(ActivePass::new(plan, self.spp_done, 0));
         }
         let report = if self.polled_readback {
             match self.poll_band()? {
@@ -591,7 +609,7 @@ impl PathTracer {
             let planned = self.planner.plan(camera.width, camera.height, remaining);
             let rows = if planned.spp >= remaining { camera.height } else { planned.rows.max(1) };
             let plan = self.fit(PassPlan { spp: remaining, rows });
-            self.pass = Some(ActivePass { plan, sample_base: self.spp_done, next_row: 0 });
+            self.pass = Some(ActivePass::new(plan, self.spp_done, 0));
             while self.pass.is_some() {
                 let report = self.submit_band()?;
                 self.planner.record(report.samples, report.wall_seconds);

@@ -4,6 +4,11 @@
 //! The readback is either a blocking wait ([`PathTracer::submit_band`], native tools) or polled
 //! ([`PathTracer::poll_band`], the web viewer, which cannot wait): the band is submitted and its
 //! mapping started, and later calls fold it once the browser has mapped it.
+//!
+//! The blocking form keeps the GPU busy while the CPU folds: once a band's results are mapped,
+//! the next band of the same pass is submitted (into a second staging buffer) before the fold
+//! begins. At 1024 x 1024 the fold of one band (a pass over 88 MB of statistics and 32 MB of
+//! results) took 5 to 6 ms, during which the GPU had nothing to do.
 
 use illum_gpu::readback::PendingRead;
 use illum_gpu::{readback, wgpu};
@@ -60,19 +65,48 @@ impl PathTracer {
         Ok(())
     }
 
-    /// Traces one band and folds it, waiting for the readback.
+    /// Traces one band and folds it, waiting for the readback (the band launched ahead by the
+    /// previous call, if there is one), and launches the pass's next band before folding.
     pub(super) fn submit_band(&mut self) -> Result<StepReport, PathTraceError> {
-        let band = self.begin_band()?;
+        let AheadBand { band, staging } = match self.ahead.take() {
+            Some(ahead) => ahead,
+            None => {
+                let band = self.begin_band()?;
+                AheadBand { band, staging: self.staging.take().expect("allocated by begin_band") }
+            }
+        };
         // Folded straight from the mapping: at 1024 x 1024 a band is many megabytes, and
         // copying it out first (allocating and faulting in fresh pages) cost time for nothing.
-        let staging = self.staging.take().expect("allocated by begin_band");
         let context = "reading back a path-tracing batch";
         let gpu = self.gpu.clone();
         let folded = readback::with_mapped(&gpu, &staging, band.staging_size, context, |data| {
-            self.finish_band(&band, data)
+            let launched = self.launch_ahead(&band);
+            launched.and_then(|()| self.finish_band(&band, data))
         });
+        // The buffer just read becomes the one the next band (launched later) copies into.
         self.staging = Some(staging);
-        folded?
+        let folded = folded.map_err(PathTraceError::from).and_then(|r| r);
+        if folded.is_err() {
+            // This band's rows were not folded: the band ahead of it may not be either.
+            self.ahead = None;
+            if let Some(pass) = self.pass.as_mut() {
+                pass.launched_row = pass.next_row;
+            }
+        }
+        folded
+    }
+
+    /// Submits the pass's next band, if `band` is not its last, into the spare staging buffer
+    /// (the caustic's passes fold frames traced per pass and are left serial).
+    fn launch_ahead(&mut self, band: &Band) -> Result<(), PathTraceError> {
+        let height = self.scene.camera.height;
+        if self.caustic.is_some() || band.row_offset + band.rows >= height {
+            return Ok(());
+        }
+        let band = self.begin_band()?;
+        let staging = self.staging.take().expect("allocated by begin_band");
+        self.ahead = Some(AheadBand { band, staging });
+        Ok(())
     }
 
     /// The polled form of [`Self::submit_band`]: submits a band when none is in flight, and
@@ -112,9 +146,10 @@ impl PathTracer {
         let started = Instant::now();
         let width = self.scene.camera.width;
         let height = self.scene.camera.height;
-        let pass = self.pass.as_ref().expect("submit_band needs an active pass");
-        let row_offset = pass.next_row;
+        let pass = self.pass.as_mut().expect("submit_band needs an active pass");
+        let row_offset = pass.launched_row;
         let rows = pass.plan.rows.min(height - row_offset);
+        pass.launched_row += rows;
         let spp = pass.plan.spp;
         let sample_base = pass.sample_base;
         let chunk = self.chunk_samples;
@@ -216,7 +251,12 @@ impl PathTracer {
                 caustic.finish_pass(&mut self.accumulator);
             }
         }
-        let wall_seconds = started.elapsed().as_secs_f64();
+        // A band launched ahead ran while the previous one was folded: its wall time starts
+        // where that fold ended, so that the bands' times add up to the elapsed time.
+        let now = Instant::now();
+        let from = self.last_fold.filter(|&t| t > started).unwrap_or(started);
+        let wall_seconds = now.duration_since(from).as_secs_f64();
+        self.last_fold = Some(now);
         self.wall_seconds += wall_seconds;
         self.gpu_seconds += gpu_seconds.unwrap_or(0.0);
         Ok(StepReport {
@@ -242,6 +282,12 @@ pub(super) struct Band {
     /// Bytes of each of the two slot arrays (sums, sums of squares) in the staging buffer.
     bytes: u64,
     staging_size: u64,
+}
+
+/// A band submitted while the one before it is folded, and the staging buffer it copies into.
+pub(super) struct AheadBand {
+    band: Band,
+    staging: wgpu::Buffer,
 }
 
 /// A band submitted with polled readback, whose staging buffer is being mapped.
