@@ -46,6 +46,16 @@ fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()
 }
 
+/// Asserts that a run of `case` (what the test tried, for the failure message) failed and that
+/// its message names every one of `expected`; the message is shown when either does not hold.
+fn assert_refused(out: &Output, case: &str, expected: &[&str]) {
+    let stderr = text(&out.stderr);
+    assert!(!out.status.success(), "{case}: accepted, expected a refusal naming {expected:?}: {stderr}");
+    for part in expected {
+        assert!(stderr.contains(part), "{case}: the refusal lacks {part:?}: {stderr}");
+    }
+}
+
 /// The `illum.*` metadata of an EXR the example wrote.
 fn metadata(path: &Path) -> illum::image::ExrMetadata {
     let (_, attributes) = illum::image::load_exr(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
@@ -108,9 +118,7 @@ fn bad_stop_rules_and_exposures_are_clear_errors() {
     ] {
         let out = run(args);
         assert_no_panic(&out);
-        assert!(!out.status.success(), "{args:?} was accepted");
-        let stderr = text(&out.stderr);
-        assert!(stderr.contains(args[0]) && stderr.contains(expected), "{args:?}: {stderr}");
+        assert_refused(&out, &format!("{args:?}"), &[args[0], expected]);
     }
 }
 
@@ -131,9 +139,11 @@ fn png_only_flags_without_a_png_are_refused() {
         let mut args = vec!["--width", "8", "--height", "8", "--spp", "1", "-o", exr.to_str().unwrap()];
         args.extend(flags);
         let out = run(&args);
-        assert!(!out.status.success(), "{flags:?} with only an EXR output was accepted");
-        let stderr = text(&out.stderr);
-        assert!(stderr.contains(flags[0]) && stderr.contains("only to PNG output"), "{stderr}");
+        assert_refused(
+            &out,
+            &format!("{flags:?} with only an EXR output"),
+            &[flags[0], "only to PNG output"],
+        );
         assert!(!exr.exists());
     }
 }
@@ -175,12 +185,7 @@ fn a_read_only_output_is_refused_and_left_as_it_was() {
 #[test]
 fn raster_scenes_refuse_path_tracer_flags_and_write_their_own_metadata() {
     let out = run(&["scenes/whitted.toml", "--sequence", "low-discrepancy", "-o", "target/never.png"]);
-    assert!(!out.status.success());
-    assert!(
-        text(&out.stderr).contains("--sequence applies only to the path tracer"),
-        "{}",
-        text(&out.stderr)
-    );
+    assert_refused(&out, "--sequence on a raster scene", &["--sequence applies only to the path tracer"]);
 
     let dir = tempfile::tempdir().unwrap();
     let exr = dir.path().join("w.exr");
@@ -496,12 +501,7 @@ fn a_render_ending_inside_a_chunk_resumes_and_merges_like_one_render() {
     // file keeps all of its 50 spp (going back to the chunk boundary would drop 2).
     let before = statistics_bits(Path::new(&p("fifty.exr")));
     let out = run(&["--resume", &p("fifty.exr")]);
-    assert!(
-        !out.status.success()
-            && text(&out.stderr).contains("already holds 50 spp, more than the 16 of the scene file"),
-        "{}",
-        text(&out.stderr)
-    );
+    assert_refused(&out, "--resume fifty.exr", &["already holds 50 spp, more than the 16 of the scene file"]);
     render_ok(&["--resume", &p("fifty.exr"), "--target-error", "0.9"]);
     assert_eq!(field(&metadata(Path::new(&p("fifty.exr"))), "spp"), "50");
     assert!(
@@ -529,13 +529,7 @@ fn a_render_ending_inside_a_chunk_resumes_and_merges_like_one_render() {
 
     // A range that starts inside a chunk could not merge exactly: refused, with a start that can.
     let out = run(&["--sample-range", "50..100", "-o", &p("never.exr")]);
-    assert!(
-        !out.status.success()
-            && text(&out.stderr).contains("must be a multiple of 16")
-            && text(&out.stderr).contains("48..100"),
-        "{}",
-        text(&out.stderr)
-    );
+    assert_refused(&out, "--sample-range 50..100", &["must be a multiple of 16", "48..100"]);
     assert!(!Path::new(&p("never.exr")).exists());
 }
 
@@ -599,11 +593,7 @@ fn mismatched_corrupt_and_overlapping_inputs_are_refused_by_name() {
         args.extend(["-o", &out_path]);
         let out = merge(&args);
         assert_no_panic(&out);
-        assert!(
-            !out.status.success() && text(&out.stderr).contains(expected),
-            "{args:?}: {}",
-            text(&out.stderr)
-        );
+        assert_refused(&out, &format!("{args:?}"), &[expected]);
         assert!(!Path::new(&out_path).exists());
     }
 
@@ -620,11 +610,7 @@ fn mismatched_corrupt_and_overlapping_inputs_are_refused_by_name() {
         args.extend(["--resume", &a, "--spp", "64"]);
         args.extend(flags);
         let out = run(&args);
-        assert!(
-            !out.status.success() && text(&out.stderr).contains(expected),
-            "{flags:?}: {}",
-            text(&out.stderr)
-        );
+        assert_refused(&out, &format!("{flags:?}"), &[expected]);
     }
     let edited = dir.path().join("edited.toml");
     let scene =
@@ -640,12 +626,12 @@ fn mismatched_corrupt_and_overlapping_inputs_are_refused_by_name() {
     // A truncated file and a file without statistics: refused, nothing written.
     std::fs::write(p("truncated.exr"), &original[..original.len() / 2]).unwrap();
     let out = run(&["--resume", &p("truncated.exr"), "--spp", "64", "-o", &p("t.exr")]);
-    assert!(!out.status.success() && text(&out.stderr).contains("truncated.exr"), "{}", text(&out.stderr));
+    assert_refused(&out, "--resume truncated.exr", &["truncated.exr"]);
     assert!(!Path::new(&p("t.exr")).exists());
     let plain = illum::image::ExrMetadata { renderer: "pathtrace".into(), ..Default::default() };
     illum::image::save_exr(p("plain.exr"), &illum::image::RgbImage32::new(2, 2), &plain).unwrap();
     let out = run(&["--resume", &p("plain.exr"), "--spp", "64"]);
-    assert!(!out.status.success() && text(&out.stderr).contains("plain.exr"), "{}", text(&out.stderr));
+    assert_refused(&out, "--resume plain.exr", &["plain.exr"]);
 }
 
 #[test]
@@ -717,21 +703,11 @@ fn caustics_on_off_is_recorded_and_a_checkpoint_of_the_other_setting_is_refused(
         "--spp",
         "32",
     ]);
-    assert!(!out.status.success());
-    assert!(text(&out.stderr).contains("caustics: on in the file, off now"), "{}", text(&out.stderr));
+    assert_refused(&out, "--caustics off on a resume", &["caustics: on in the file, off now"]);
 
     // A bad value and the raster renderer are refused by name.
     let out = run(&["scenes/whitted.toml", "--renderer", "pathtrace", "--caustics", "maybe"]);
-    assert!(
-        !out.status.success() && text(&out.stderr).contains("neither on nor off"),
-        "{}",
-        text(&out.stderr)
-    );
+    assert_refused(&out, "--caustics maybe", &["neither on nor off"]);
     let out = run(&["scenes/whitted.toml", "--caustics", "on", "-o", "target/never.png"]);
-    assert!(!out.status.success());
-    assert!(
-        text(&out.stderr).contains("--caustics applies only to the path tracer"),
-        "{}",
-        text(&out.stderr)
-    );
+    assert_refused(&out, "--caustics on a raster scene", &["--caustics applies only to the path tracer"]);
 }

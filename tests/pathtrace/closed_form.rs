@@ -61,27 +61,25 @@ fn check_point(label: &str, x: DVec3) {
     );
 }
 
-// The floor's inner face is y = 1.
-#[test]
-fn floor_under_the_light_centre() {
-    check_point("centre", DVec3::new(278.0, 1.0, 278.0));
-}
-
-#[test]
-fn floor_under_the_light_edge() {
-    check_point("edge", DVec3::new(342.0, 1.0, 329.0));
-}
-
-#[test]
-fn floor_far_from_the_light() {
-    check_point("far corner", DVec3::new(20.0, 1.0, 20.0));
-}
-
-#[test]
-fn floor_at_grazing_incidence() {
+/// The floor points checked, each with the label its messages give (the floor's inner face is
+/// y = 1): one table instead of a test body per point, since every point is checked alike.
+const FLOOR_POINTS: [(&str, DVec3); 4] = [
+    // Under the light's centre.
+    ("centre", DVec3::new(278.0, 1.0, 278.0)),
+    // Under the light's edge.
+    ("edge", DVec3::new(342.0, 1.0, 329.0)),
+    // Far from the light.
+    ("far corner", DVec3::new(20.0, 1.0, 20.0)),
     // Far across the room, near the back wall: the light is seen at about 63 degrees from the
-    // floor's normal and its edges subtend small, nearly parallel angles.
-    check_point("grazing", DVec3::new(545.0, 1.0, 545.0));
+    // floor's normal and its edges subtend small, nearly parallel angles (grazing incidence).
+    ("grazing", DVec3::new(545.0, 1.0, 545.0)),
+];
+
+#[test]
+fn floor_points_match_lamberts_closed_form() {
+    for (label, x) in FLOOR_POINTS {
+        check_point(label, x);
+    }
 }
 
 #[test]

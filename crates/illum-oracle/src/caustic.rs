@@ -54,7 +54,7 @@ use glam::DVec3;
 use illum_scene::{Bounces, MaterialKind};
 
 use crate::geometry::Surface;
-use crate::integrator::{Oracle, ROULETTE_AFTER, ROULETTE_MAX_SURVIVAL, SPAWN_OFFSET};
+use crate::integrator::{Contact, Oracle, ROULETTE_AFTER, ROULETTE_MAX_SURVIVAL};
 use crate::rng::Rng;
 use crate::sampling::{local_to_world, uniform_cone};
 use crate::scene::Primitive;
@@ -165,10 +165,7 @@ impl Oracle {
             if hit.primitive.emitter {
                 return None;
             }
-            let p = o + hit.t * d;
-            let front = hit.normal.dot(d) < 0.0;
-            let nrm = if front { hit.normal } else { -hit.normal };
-            let lift = SPAWN_OFFSET * p.abs().max_element().max(1.0);
+            let Contact { point: p, front, normal: nrm, lift } = hit.contact(o, d);
             match hit.primitive.material {
                 MaterialKind::Mirror { reflectance } => {
                     if !self.may_scatter(scatterings, &mut throughput, reflectance.as_dvec3(), rng) {
@@ -189,13 +186,7 @@ impl Oracle {
                     if scatterings == 0 {
                         return None;
                     }
-                    let albedo = match (hit.primitive.material, hit.primitive.surface) {
-                        (MaterialKind::Checker(c), Surface::Parallelogram(quad)) => {
-                            crate::whitted::checker_albedo(&quad, c, p)
-                        }
-                        _ => hit.primitive.albedo,
-                    };
-                    return self.connect(p, nrm, lift, throughput * albedo * FRAC_1_PI);
+                    return self.connect(p, nrm, lift, throughput * hit.diffuse_albedo(p) * FRAC_1_PI);
                 }
                 MaterialKind::Emitter { .. } => unreachable!("emitters are handled above"),
             }

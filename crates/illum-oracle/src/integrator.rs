@@ -52,6 +52,41 @@ pub(crate) struct Hit<'a> {
     pub(crate) normal: DVec3,
 }
 
+/// Where a ray meets the surface it hit, as both estimators (the camera's paths here and the
+/// caustic's light tracer) scatter from it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Contact {
+    /// The hit point.
+    pub(crate) point: DVec3,
+    /// Whether the ray meets the front side (against the geometric normal).
+    pub(crate) front: bool,
+    /// The geometric normal turned to face the arriving ray.
+    pub(crate) normal: DVec3,
+    /// How far along `normal` a new ray starts (see [`SPAWN_OFFSET`]).
+    pub(crate) lift: f64,
+}
+
+impl Hit<'_> {
+    /// This hit as the ray `o + t d` meets it.
+    pub(crate) fn contact(&self, o: DVec3, d: DVec3) -> Contact {
+        let point = o + self.t * d;
+        let front = self.normal.dot(d) < 0.0;
+        let normal = if front { self.normal } else { -self.normal };
+        Contact { point, front, normal, lift: SPAWN_OFFSET * point.abs().max_element().max(1.0) }
+    }
+
+    /// The diffuse albedo at `point` of this (Lambertian or checker) hit: a checker's tile
+    /// colour there, else the material's albedo.
+    pub(crate) fn diffuse_albedo(&self, point: DVec3) -> DVec3 {
+        match (self.primitive.material, self.primitive.surface) {
+            (MaterialKind::Checker(c), Surface::Parallelogram(quad)) => {
+                crate::whitted::checker_albedo(&quad, c, point)
+            }
+            _ => self.primitive.albedo,
+        }
+    }
+}
+
 /// Nearest hit with t in (0, inf) among `list`.
 fn nearest_in(list: &[Primitive], o: DVec3, d: DVec3) -> Option<Hit<'_>> {
     let mut best: Option<Hit<'_>> = None;
@@ -243,10 +278,7 @@ impl Oracle {
                 }
                 break;
             }
-            let x = o + hit.t * d;
-            let front = hit.normal.dot(d) < 0.0;
-            let n = if front { hit.normal } else { -hit.normal };
-            let lift = SPAWN_OFFSET * x.abs().max_element().max(1.0);
+            let Contact { point: x, front, normal: n, lift } = hit.contact(o, d);
             match hit.primitive.material {
                 MaterialKind::Mirror { reflectance } => {
                     // A smooth mirror: one direction, weight = its reflectance.
@@ -273,12 +305,7 @@ impl Oracle {
                     direct_counts = true;
                 }
                 MaterialKind::Lambertian { .. } | MaterialKind::Checker(_) => {
-                    let albedo = match (hit.primitive.material, hit.primitive.surface) {
-                        (MaterialKind::Checker(c), Surface::Parallelogram(quad)) => {
-                            crate::whitted::checker_albedo(&quad, c, x)
-                        }
-                        _ => hit.primitive.albedo,
-                    };
+                    let albedo = hit.diffuse_albedo(x);
                     let x_off = x + n * lift;
                     sum += throughput
                         * albedo

@@ -19,6 +19,7 @@
 //! its stepping and saving), which reads better whole than split between widgets and state.
 
 use std::path::{Path, PathBuf};
+use std::time::Duration;
 
 use illum_gpu::GpuContext;
 use illum_image::{Encoding, RgbImage32};
@@ -40,19 +41,20 @@ pub const DEFAULT_SCALE: f32 = 0.5;
 /// Everything the user sets in the path-tracer panel.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PathTraceSettings {
+    /// Bounces of indirect light (the scene's `[pathtrace] bounces` to start with).
     pub bounces: Bounces,
-    /// Samples per pixel to stop at; `None`: keep going.
-    pub spp_target: Option<u32>,
+    /// Hemisphere sampling of the bounces.
     pub sampling: Sampling,
+    /// Random seed.
     pub seed: u32,
     /// Render resolution = view size in pixels x this.
     pub resolution_scale: f32,
     /// Display-only exposure in stops (the saved files are not scaled).
     pub exposure: f32,
-    /// Stop once the estimated relative error falls to this.
-    pub target_error: Option<f64>,
-    /// Stop after this many seconds of wall-clock time spent rendering.
-    pub time_budget: Option<f64>,
+    /// When to stop: the `render` example's own rules, set from the panel (`spp`: the spp
+    /// target, `None` to keep going). Held as the tracer's type, not a copy of its fields, so
+    /// that the panel and the command line cannot drift apart.
+    pub stop: StopRules,
 }
 
 impl PathTraceSettings {
@@ -60,25 +62,11 @@ impl PathTraceSettings {
     pub fn from_scene(scene: &Scene) -> Self {
         PathTraceSettings {
             bounces: scene.pathtrace.bounces,
-            spp_target: None,
             sampling: scene.pathtrace.sampling,
             seed: scene.pathtrace.seed,
             resolution_scale: DEFAULT_SCALE,
             exposure: 0.0,
-            target_error: None,
-            time_budget: None,
-        }
-    }
-}
-
-impl PathTraceSettings {
-    /// The stop rules these settings ask for. A time budget that a `Duration` cannot hold is
-    /// no budget (the UI offers at most a day).
-    pub fn stop_rules(&self) -> StopRules {
-        StopRules {
-            spp: self.spp_target,
-            target_error: self.target_error,
-            time_budget: self.time_budget.and_then(|s| std::time::Duration::try_from_secs_f64(s).ok()),
+            stop: StopRules::default(),
         }
     }
 }
@@ -127,7 +115,7 @@ impl PathTraceMode {
         let stem = scene.name.clone();
         let settings = PathTraceSettings::from_scene(&scene);
         PathTraceMode {
-            progressive: Progressive::new(settings.stop_rules()),
+            progressive: Progressive::new(settings.stop),
             settings,
             camera: OrbitCamera::new(scene.camera),
             scene_path,
@@ -238,7 +226,7 @@ impl PathTraceMode {
         scene.pathtrace.bounces = self.settings.bounces;
         scene.pathtrace.sampling = self.settings.sampling;
         scene.pathtrace.seed = self.settings.seed;
-        if let Some(spp) = self.settings.spp_target {
+        if let Some(spp) = self.settings.stop.spp {
             scene.pathtrace.spp = spp.max(1);
         }
         scene
@@ -264,7 +252,7 @@ impl PathTraceMode {
         let Some(tracer) = self.tracer.as_mut() else { return };
         // The rules follow the panel (a changed spp target restarts the accumulation through
         // the scene; a changed error target or budget applies from now on).
-        self.progressive.rules = self.settings.stop_rules();
+        self.progressive.rules = self.settings.stop;
         if !self.paused
             && let Err(e) = self.progressive.step(tracer)
         {
@@ -401,13 +389,13 @@ impl PathTraceMode {
             s.bounces = if unbounded { Bounces::Unbounded } else { Bounces::Fixed(fixed) };
         });
         ui.horizontal(|ui| {
-            let mut unlimited = s.spp_target.is_none();
-            let mut spp = s.spp_target.unwrap_or(self.scene.pathtrace.spp.max(1));
+            let mut unlimited = s.stop.spp.is_none();
+            let mut spp = s.stop.spp.unwrap_or(self.scene.pathtrace.spp.max(1));
             let label = ui.label("spp target");
             ui.add_enabled(!unlimited, egui::DragValue::new(&mut spp).range(1..=1_000_000).speed(1.0))
                 .labelled_by(label.id);
             ui.checkbox(&mut unlimited, "Unlimited");
-            s.spp_target = if unlimited { None } else { Some(spp) };
+            s.stop.spp = if unlimited { None } else { Some(spp) };
         });
         ui.horizontal(|ui| {
             ui.label("Sampling");
@@ -424,23 +412,25 @@ impl PathTraceMode {
         ui.separator();
         ui.label("Stop rules");
         ui.horizontal(|ui| {
-            let mut on = s.target_error.is_some();
-            let mut value = s.target_error.unwrap_or(0.01);
+            let mut on = s.stop.target_error.is_some();
+            let mut value = s.stop.target_error.unwrap_or(0.01);
             let check = ui.checkbox(&mut on, "At relative error");
             ui.add_enabled(on, egui::DragValue::new(&mut value).range(0.0001..=1.0).speed(0.001))
                 .labelled_by(check.id);
-            s.target_error = on.then_some(value);
+            s.stop.target_error = on.then_some(value);
         });
         ui.horizontal(|ui| {
-            let mut on = s.time_budget.is_some();
-            let mut value = s.time_budget.unwrap_or(10.0);
+            let mut on = s.stop.time_budget.is_some();
+            // Edited in seconds; Duration rounds to the nearest nanosecond, so the round trip
+            // each frame is stable (a budget of at most a day is far inside f64's precision).
+            let mut value = s.stop.time_budget.map_or(10.0, |d| d.as_secs_f64());
             let check = ui.checkbox(&mut on, "After time budget");
             ui.add_enabled(
                 on,
                 egui::DragValue::new(&mut value).range(0.1..=86_400.0).speed(0.5).suffix(" s"),
             )
             .labelled_by(check.id);
-            s.time_budget = on.then_some(value);
+            s.stop.time_budget = if on { Duration::try_from_secs_f64(value).ok() } else { None };
         });
 
         ui.separator();

@@ -47,7 +47,7 @@ async fn run() -> Result<(), String> {
             Box::new(move |cc| {
                 let mut app = ViewerApp::new(cc, options);
                 if let (Some(spp), Some(pathtrace)) = (spp, app.pathtrace_mut()) {
-                    pathtrace.settings.spp_target = Some(spp);
+                    pathtrace.settings.stop.spp = Some(spp);
                 }
                 if let Some(error) = url_error {
                     app.open_error = Some(error);

@@ -182,7 +182,7 @@ fn a_bad_scene_file_shows_its_error_and_keeps_the_scene() {
 /// The path-tracer window run until its spp target stops it (within 200 frames).
 fn stopped_at(spp_target: u32) -> Harness<'static, ViewerApp> {
     let mut harness = harness(Mode::PathTrace);
-    harness.state_mut().pathtrace_mut().unwrap().settings.spp_target = Some(spp_target);
+    harness.state_mut().pathtrace_mut().unwrap().settings.stop.spp = Some(spp_target);
     for _ in 0..200 {
         harness.run_steps(1);
         if harness.state().pathtrace().unwrap().stop_reason().is_some() {
