@@ -8,7 +8,11 @@
 //! tracing. The generated module also contains only what the scene uses:
 //! - surface reconstruction only for the kinds of shape present;
 //! - no light-selection code when there is one light;
-//! - shadow rays test only the objects that can block a light (see [`can_block_light`]).
+//! - shadow rays test only the objects that can block a light (see [`can_block_light`]);
+//! - the object and material at a hit come from literals (`object_at`, and `material_at` in
+//!   the separate module [`materials_module`]), not from storage buffers: a specialised
+//!   pipeline binds neither buffer. On lavapipe a read at a per-lane index costs a scalar load
+//!   per lane and component, which made the Cornell box 29% slower at 2 bounces.
 //!
 //! The module (`illum::rtcore::traversal`) is shared: the Whitted ray tracer imports the same
 //! `closest_hit`, `occluded` and `surface_at` (`choose_light` is the path tracer's alone).
