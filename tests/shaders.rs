@@ -1,7 +1,8 @@
 //! Every WGSL file under shaders/ belongs to some crate's list of shaders, so that the crate's
 //! own naga test validates it without a GPU:
 //! - illum-pathtrace (`shaders.rs`): the sampling modules, the shared geometry module
-//!   (`shaders/rtcore/`), the scene module, both traversals, the surfaces module,
+//!   (`shaders/rtcore/`), the scene module, both material lookups and both traversals (the
+//!   specialised ones generated), the surfaces module,
 //!   the integrator, the caustic's light tracer and the display-sum pass, for every scene file;
 //! - illum-raster (`shaders.rs`): its modules and entry files;
 //! - illum-whitted (`tracer.rs`): its entry shader, composed with the spawn and geometry modules;
@@ -13,8 +14,8 @@ use std::collections::BTreeSet;
 use std::path::PathBuf;
 
 use illum::pathtrace::{
-    self, CAUSTIC_SHADER, GENERIC_TRAVERSAL, GEOMETRY_MODULE, PATHTRACE_SHADER, SAMPLING_MODULES,
-    SCENE_MODULE, SURFACES_MODULE,
+    self, CAUSTIC_SHADER, GENERIC_MATERIALS, GENERIC_TRAVERSAL, GEOMETRY_MODULE, PATHTRACE_SHADER,
+    SAMPLING_MODULES, SCENE_MODULE, SURFACES_MODULE,
 };
 
 /// The viewer's shader, validated by illum-viewer's own test (the facade does not depend on the
@@ -29,6 +30,7 @@ fn every_wgsl_file_is_validated_by_its_crate() {
         .chain([
             &GEOMETRY_MODULE,
             &SCENE_MODULE,
+            &GENERIC_MATERIALS,
             &GENERIC_TRAVERSAL,
             &PATHTRACE_SHADER,
             &SURFACES_MODULE,

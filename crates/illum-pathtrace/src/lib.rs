@@ -39,7 +39,7 @@ pub use progressive::{
     parse_time_budget, render_progressive,
 };
 pub use shaders::{
-    CAUSTIC_SHADER, GENERIC_TRAVERSAL, GEOMETRY_MODULE, PATHTRACE_SHADER, SAMPLING_MODULES, SCENE_MODULE,
-    SPAWN_MODULE, SURFACES_MODULE, shader_modules,
+    CAUSTIC_SHADER, GENERIC_MATERIALS, GENERIC_TRAVERSAL, GEOMETRY_MODULE, PATHTRACE_SHADER,
+    SAMPLING_MODULES, SCENE_MODULE, SPAWN_MODULE, SURFACES_MODULE, shader_modules,
 };
 pub use tracer::{CausticParams, PathTracer, StepReport, bounding_sphere, fixed_point};

@@ -81,7 +81,9 @@ impl PathTracer {
         let gpu = self.gpu.clone();
         let folded = readback::with_mapped(&gpu, &staging, band.staging_size, context, |data| {
             let launched = self.launch_ahead(&band);
-            launched.and_then(|()| self.finish_band(&band, data))
+            // Folded even when the next band could not be launched: its error comes after.
+            let folded = self.finish_band(&band, data);
+            folded.and_then(|report| launched.map(|()| report))
         });
         // The buffer just read becomes the one the next band (launched later) copies into.
         self.staging = Some(staging);
@@ -146,10 +148,9 @@ impl PathTracer {
         let started = Instant::now();
         let width = self.scene.camera.width;
         let height = self.scene.camera.height;
-        let pass = self.pass.as_mut().expect("submit_band needs an active pass");
+        let pass = self.pass.as_ref().expect("submit_band needs an active pass");
         let row_offset = pass.launched_row;
         let rows = pass.plan.rows.min(height - row_offset);
-        pass.launched_row += rows;
         let spp = pass.plan.spp;
         let sample_base = pass.sample_base;
         let chunk = self.chunk_samples;
@@ -206,6 +207,9 @@ impl PathTracer {
         encoder.copy_buffer_to_buffer(&batch.sum_sq, 0, staging, bytes, bytes);
         self.timer.copy_results(&mut encoder, staging, 2 * bytes);
         self.gpu.queue.submit([encoder.finish()]);
+        if let Some(pass) = self.pass.as_mut() {
+            pass.launched_row = row_offset + rows;
+        }
         Ok(Band { started, row_offset, rows, spp, chunk, chunks, band_pixels, bytes, staging_size })
     }
 
