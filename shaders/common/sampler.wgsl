@@ -4,38 +4,74 @@
 //
 // Independent (default): a PCG stream seeded from (seed, pixel, sample index).
 //
-// LOW_DISCREPANCY: the first LD_DIMENSIONS dimensions come from the Kronecker sequence R_d of
-// Roberts ("The unreasonable effectiveness of quasirandom sequences", 2018):
-//     x_i,j = frac(s_j + i alpha_j),  alpha_j = (1 / phi_d)^(j+1),
-// phi_d the positive root of x^(d+1) = x + 1, with d = LD_DIMENSIONS. The shift s_j is a random
-// number per (seed, pixel, dimension) (a Cranley-Patterson rotation): every sample is then
-// uniform on [0, 1)^d, so the estimator stays unbiased, while the points of one pixel are
-// spread more evenly than independent ones. Arithmetic is in 32-bit fixed point (alpha_j
-// scaled by 2^32, wrapping), so it is exact for any sample index. Later dimensions fall back
-// to the PCG stream.
+// LOW_DISCREPANCY: dimensions come in pairs (2k, 2k + 1), and each pair is its own copy of the
+// two-dimensional Kronecker sequence R_2 of Roberts ("The unreasonable effectiveness of
+// quasirandom sequences", 2018):
+//     x_j = frac(s + j (1 / phi, 1 / phi^2)),  phi = 1.3247... the plastic number (phi^3 = phi + 1),
+// whose points spread evenly over the unit square for any number of samples. Per pixel:
+//   - each dimension gets a random shift s (a Cranley-Patterson rotation), independent between
+//     pairs: every sample is then uniform over all its dimensions, and the estimator unbiased;
+//   - each pair visits the points in its own order j = shuffle(i) ("padding"), a nested random
+//     permutation of the sample index (see `shuffle`). It maps the first 2^m indices onto one
+//     aligned block of 2^m consecutive ones, and a run of consecutive points of a Kronecker
+//     sequence is the sequence shifted: each pair's first 2^m samples stay evenly spread, while
+//     different pairs (a path's light sample, its bounce direction, the next bounce) are
+//     paired at random rather than in lockstep.
+// Callers draw two-dimensional integrands (pixel, light point, direction) with sample_2d, which
+// starts on an even dimension so that the two numbers are one pair.
+//
+// Why not one sequence of many dimensions (R_d, as before): its quality hangs on how the
+// dimensions' steps relate. With R_16 the Cornell box at 1024 spp had a relMSE of 2.2e-5, but
+// R_15 4.0e-5 and R_20 4.9e-4 (3 times independent numbers' 1.5e-4), and on the Whitted scene
+// R_16 itself was worse than independent numbers (6.6e-4 against 4.1e-4 at 256 spp), where
+// these pairs have 6.4e-5 (docs/performance.md). Arithmetic is in 32-bit fixed point (wrapping),
+// exact for any sample index; any number of dimensions is as good as the first.
 
 #import illum::rng::{pcg_hash, rng_seed, rng_f32}
 
-const LD_DIMENSIONS: u32 = 16u;
-// 1 / phi_16, phi_16 = 1.0429177323017866 the positive root of x^17 = x + 1; checked by the
-// Rust test `ld_alpha_matches_roberts_definition` in crates/illum-pathtrace/src/tracer.rs.
-// alpha_j = (1/phi)^(j+1) is formed by repeated multiplication as dimensions are drawn (a
-// constant table indexed at run time is copied to local memory on every call by some drivers).
-const LD_INV_PHI: f32 = 0.958848401;
+// 1 / phi and 1 / phi^2 times 2^32, rounded; checked by the Rust test
+// `r2_steps_match_the_plastic_number` in crates/illum-pathtrace/src/shaders.rs.
+const R2_STEP_X: u32 = 3242174889u;
+const R2_STEP_Y: u32 = 2447445414u;
 
 struct Sampler {
-    // PCG state for the independent stream (and the fallback dimensions).
+    // PCG state for the independent stream.
     state: u32,
-    // Hash of (seed, pixel), the source of the per-dimension shifts.
+    // Hash of (seed, pixel), the source of the pairs' shuffles and shifts.
     pixel_key: u32,
     sample_index: u32,
     dimension: u32,
-    // alpha of the next low-discrepancy dimension.
-    alpha: f32,
 }
 
 fn sampler_new(seed: u32, pixel: u32, sample_index: u32) -> Sampler {
-    return Sampler(rng_seed(seed, pixel, sample_index), pcg_hash(seed ^ pcg_hash(pixel)), sample_index, 0u, LD_INV_PHI);
+    return Sampler(rng_seed(seed, pixel, sample_index), pcg_hash(seed ^ pcg_hash(pixel)), sample_index, 0u);
+}
+
+// A nested random permutation of the sample index: Owen scrambling in base 2, the way Burley
+// ("Practical Hash-based Owen Scrambling", JCGT 2020) shuffles a padded sequence. Bit b of the
+// result is bit b of i flipped by a function of the bits above it (and of the seed): so indices
+// that agree above bit m stay together, and [0, 2^m) maps onto one aligned block. The flips are
+// the Laine-Karras permutation of the reversed bits: adding the seed, and XOR with the product
+// by an even constant, change each bit only as a function of the bits below it.
+fn shuffle(i: u32, seed: u32) -> u32 {
+    var x = reverseBits(i);
+    x += seed;
+    x ^= x * 0x6c50b47cu;
+    x ^= x * 0xb82f1e52u;
+    x ^= x * 0xc7afe638u;
+    x ^= x * 0x8d22f6e6u;
+    return reverseBits(x);
+}
+
+// Dimensions 2k and 2k + 1 of the sample, in [0, 1)^2 (only the components asked for are used).
+fn pair_values(s: ptr<function, Sampler>, k: u32) -> vec2<f32> {
+    // The pair's seed: the pixel key plus the pair times an odd constant, mixed. The two
+    // dimensions' shifts: that seed hashed once more, differently for each.
+    let seed = pcg_hash((*s).pixel_key + k * 0x9e3779b9u);
+    let j = shuffle((*s).sample_index, seed);
+    let shift = vec2<u32>(pcg_hash(seed ^ 0x68e31da4u), pcg_hash(seed ^ 0xb5297a4du));
+    let x = shift + j * vec2<u32>(R2_STEP_X, R2_STEP_Y);
+    return vec2<f32>(x >> vec2<u32>(8u)) * 5.9604644775390625e-8;
 }
 
 // The next dimension's value, in [0, 1).
@@ -43,20 +79,27 @@ fn sample_1d(s: ptr<function, Sampler>) -> f32 {
 #ifdef LOW_DISCREPANCY
     let d = (*s).dimension;
     (*s).dimension = d + 1u;
-    if (d < LD_DIMENSIONS) {
-        // One hash per (pixel, dimension): the key times an odd constant spreads the
-        // dimensions apart before the permutation mixes them.
-        let shift = pcg_hash((*s).pixel_key + d * 0x9e3779b9u);
-        // alpha in 32-bit fixed point: an f32 in (0, 1) times 2^32 is an exact integer.
-        let alpha = u32((*s).alpha * 4294967296.0);
-        (*s).alpha *= LD_INV_PHI;
-        let x = shift + (*s).sample_index * alpha;
-        return f32(x >> 8u) * 5.9604644775390625e-8;
-    }
-#endif
+    let values = pair_values(s, d >> 1u);
+    return select(values.x, values.y, (d & 1u) == 1u);
+#else
     // Through a local: naga's SPIR-V writer mishandles a pointer to a field of a pointee.
     var state = (*s).state;
     let value = rng_f32(&state);
     (*s).state = state;
     return value;
+#endif
+}
+
+// The next two dimensions' values, for a two-dimensional integrand: with LOW_DISCREPANCY, one
+// pair of the sequence (a dimension left odd by a sample_1d is skipped), its index shuffled once.
+fn sample_2d(s: ptr<function, Sampler>) -> vec2<f32> {
+#ifdef LOW_DISCREPANCY
+    let k = ((*s).dimension + 1u) >> 1u;
+    (*s).dimension = 2u * k + 2u;
+    return pair_values(s, k);
+#else
+    let u = sample_1d(s);
+    let v = sample_1d(s);
+    return vec2<f32>(u, v);
+#endif
 }

@@ -10,7 +10,7 @@
 // A camera ray that hits a light sees its emitted radiance.
 
 #import illum::constants::{PI, TWO_PI, INV_PI}
-#import illum::sampler::{Sampler, sampler_new, sample_1d}
+#import illum::sampler::{Sampler, sampler_new, sample_1d, sample_2d}
 #import illum::sampling::{sample_cosine_hemisphere, sample_uniform_hemisphere, to_world, sample_parallelogram}
 #import illum::spawn::{spawn_point, spawn_error, max_abs}
 #import illum::rtcore::geometry::{NO_HIT, FAR, Surface}
@@ -41,11 +41,14 @@ const SHADOW_SHORTEN: f32 = 9.5367431640625e-7;
 // (1 / A_total) and multiplied by cos(theta_x); the caller multiplies by albedo / pi. The
 // geometry uses the surface point itself; only visibility is tested from the spawned origin.
 fn direct_light(s: Surface, origin: vec3<f32>, sampler: ptr<function, Sampler>) -> vec3<f32> {
-    let pick = sample_1d(sampler) * params.light_area;
-    let u1 = sample_1d(sampler);
-    let u2 = sample_1d(sampler);
-    let light = lights[choose_light(pick)];
-    let y = sample_parallelogram(light.corner.xyz, light.edge_u.xyz, light.edge_v.xyz, u1, u2);
+#ifdef LIGHT_CHOICE
+    let light = lights[choose_light(sample_1d(sampler) * params.light_area)];
+#else
+    // One light: nothing to choose, and no number drawn for it.
+    let light = lights[0];
+#endif
+    let u = sample_2d(sampler);
+    let y = sample_parallelogram(light.corner.xyz, light.edge_u.xyz, light.edge_v.xyz, u.x, u.y);
     let to_light = y - s.p;
     let dist2 = dot(to_light, to_light);
     let wi = to_light / sqrt(dist2);
@@ -77,9 +80,8 @@ fn direct_light(s: Surface, origin: vec3<f32>, sampler: ptr<function, Sampler>) 
 // blocks it.
 fn sun_light(s: Surface, origin: vec3<f32>, sampler: ptr<function, Sampler>) -> vec3<f32> {
 #ifdef SUN_DISC
-    let u1 = sample_1d(sampler);
-    let u2 = sample_1d(sampler);
-    let sun = sample_sun(u1, u2);
+    let u = sample_2d(sampler);
+    let sun = sample_sun(u.x, u.y);
 #else
     let sun = sample_sun(0.0, 0.0);
 #endif
@@ -202,8 +204,9 @@ fn radiance(origin: vec3<f32>, direction: vec3<f32>, sampler: ptr<function, Samp
         if (last) {
             break;
         }
-        let u1 = sample_1d(sampler);
-        let u2 = sample_1d(sampler);
+        let u = sample_2d(sampler);
+        let u1 = u.x;
+        let u2 = u.y;
         // Lambertian f = albedo / pi. Cosine pdf cos/pi: f cos / pdf = albedo.
         // Uniform pdf 1/(2 pi): f cos / pdf = 2 albedo cos. A shader def, not a branch on
         // params: lavapipe would run both samplers (and their sin and cos) for every lane.
@@ -289,8 +292,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     for (var i = 0u; i < count; i++) {
         var sampler = sampler_new(params.seed, pixel, params.sample_base + first + i);
         // Jitter uniformly inside the pixel; row 0 is the top of the image.
-        let sx = (2.0 * (f32(x) + sample_1d(&sampler)) * inv_width - 1.0) * params.aspect * params.tan_half_fov;
-        let sy = (1.0 - 2.0 * (f32(y) + sample_1d(&sampler)) * inv_height) * params.tan_half_fov;
+        let jitter = sample_2d(&sampler);
+        let sx = (2.0 * (f32(x) + jitter.x) * inv_width - 1.0) * params.aspect * params.tan_half_fov;
+        let sy = (1.0 - 2.0 * (f32(y) + jitter.y) * inv_height) * params.tan_half_fov;
         let d = normalize(params.forward + sx * params.right + sy * params.up);
         let l = radiance(params.eye, d, &sampler);
         if (is_finite3(l)) {

@@ -320,6 +320,9 @@ impl GpuScene {
         if !lights.is_empty() {
             defs.push("AREA_LIGHTS");
         }
+        if lights.len() > 1 {
+            defs.push("LIGHT_CHOICE");
+        }
         if let Some(sun) = &scene.directional_light {
             defs.push("SUN");
             if !sun.is_delta() {
@@ -401,7 +404,8 @@ pub fn ordered_objects(scene: &Scene) -> (Vec<(usize, GpuObject)>, u32) {
 }
 
 impl GpuScene {
-    /// naga_oil shader defs for the features the scene uses: AREA_LIGHTS, SUN, SUN_DISC, SKY,
+    /// naga_oil shader defs for the features the scene uses: AREA_LIGHTS (and LIGHT_CHOICE with
+    /// more than one area light), SUN, SUN_DISC, SKY,
     /// SPECULAR (a mirror or a dielectric), CHECKER, and CAUSTIC (`caustics = true` with a
     /// directional light and a specular object: the light tracer, see tracer/caustic.rs); and
     /// for two render settings, UNIFORM_SAMPLING (`sampling = "uniform"`) and UNBOUNDED_BOUNCES
