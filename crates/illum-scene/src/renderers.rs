@@ -71,7 +71,8 @@ pub enum Sequence {
     /// Independent uniform numbers from a PCG stream per (seed, pixel, sample index).
     #[default]
     Independent,
-    /// A randomly shifted Kronecker (R_d) low-discrepancy sequence for the first 16 dimensions.
+    /// Low-discrepancy numbers: each pair of dimensions a randomly shifted R_2 sequence, visited
+    /// in its own shuffled order per pixel (see shaders/common/sampler.wgsl).
     LowDiscrepancy,
 }
 
