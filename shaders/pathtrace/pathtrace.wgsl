@@ -205,17 +205,15 @@ fn radiance(origin: vec3<f32>, direction: vec3<f32>, sampler: ptr<function, Samp
             break;
         }
         let u = sample_2d(sampler);
-        let u1 = u.x;
-        let u2 = u.y;
         // Lambertian f = albedo / pi. Cosine pdf cos/pi: f cos / pdf = albedo.
         // Uniform pdf 1/(2 pi): f cos / pdf = 2 albedo cos. A shader def, not a branch on
         // params: lavapipe would run both samplers (and their sin and cos) for every lane.
 #ifdef UNIFORM_SAMPLING
-        let local = sample_uniform_hemisphere(u1, u2);
+        let local = sample_uniform_hemisphere(u.x, u.y);
         d = to_world(s.n, local);
         throughput *= albedo * (2.0 * local.z);
 #else
-        d = to_world(s.n, sample_cosine_hemisphere(u1, u2));
+        d = to_world(s.n, sample_cosine_hemisphere(u.x, u.y));
         throughput *= albedo;
 #endif
         if (!roulette(depth, &throughput, sampler)) {

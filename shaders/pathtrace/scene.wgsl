@@ -22,7 +22,9 @@ struct Params {
     sample_count: u32,
     seed: u32,
     bounces: u32,
-    sampling: u32,
+    // Unused: keeps the members after it at the offsets gpu_scene.rs gives them (the
+    // hemisphere sampling is the shader def UNIFORM_SAMPLING).
+    padding: u32,
     num_lights: u32,
     // Objects [first_emitter, num_objects) are the emitters.
     first_emitter: u32,

@@ -202,7 +202,9 @@ pub struct GpuParams {
     pub sample_count: u32,
     pub seed: u32,
     pub bounces: u32,
-    pub sampling: u32,
+    /// Unused: keeps the members after it where the WGSL struct has them (the hemisphere
+    /// sampling is a shader def, UNIFORM_SAMPLING, not a parameter).
+    pub padding: u32,
     pub num_lights: u32,
     pub first_emitter: u32,
     /// Samples per invocation: each invocation traces one chunk of a pixel's samples and writes
@@ -445,10 +447,7 @@ pub fn params(scene: &Scene, gpu_scene: &GpuScene) -> GpuParams {
             Bounces::Fixed(n) => n,
             Bounces::Unbounded => UNBOUNDED,
         },
-        sampling: match scene.pathtrace.sampling {
-            Sampling::Cosine => 0,
-            Sampling::Uniform => 1,
-        },
+        padding: 0,
         num_lights: gpu_scene.lights.len() as u32,
         first_emitter: gpu_scene.first_emitter,
         chunk_samples: crate::batch::CHUNK_SAMPLES,

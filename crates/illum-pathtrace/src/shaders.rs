@@ -200,7 +200,7 @@ mod tests {
         wgsl("Params").assert_matches(
             size_of::<GpuParams>(),
             &members!(GpuParams: eye, tan_half_fov, right, aspect, up, light_area, forward, num_objects,
-                width, height, row_offset, rows, sample_base, sample_count, seed, bounces, sampling,
+                width, height, row_offset, rows, sample_base, sample_count, seed, bounces, padding,
                 num_lights, first_emitter, chunk_samples, sun, sun_irradiance, sky),
         );
         wgsl_struct(&module, "illum::rtcore::geometry", "Object")

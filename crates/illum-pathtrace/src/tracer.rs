@@ -332,8 +332,8 @@ impl PathTracer {
     /// other object data) is refused with an error naming what changed; build a new
     /// `PathTracer` for it. The resolution may change (the buffers are reallocated).
     pub fn update_scene(&mut self, scene: &Scene) -> Result<(), PathTraceError> {
+        let gpu_scene = GpuScene::new(scene)?;
         if scene.objects != self.scene.objects || scene.materials != self.scene.materials {
-            let gpu_scene = GpuScene::new(scene)?;
             let needed = specialise::specialise(scene, &gpu_scene);
             let what = if self.options.traversal == Traversal::Specialised
                 && needed.source != self.traversal_source
@@ -355,14 +355,12 @@ impl PathTracer {
                 ),
             });
         }
-        // Another resolution, or settings that choose another pipeline (the caustic on or off,
-        // the hemisphere sampling, bounded or unbounded paths: shader defs), build anew.
-        let pipeline_changes = GpuScene::new(scene)?.defs != GpuScene::new(&self.scene)?.defs;
-        let resized = (scene.camera.width, scene.camera.height)
+        // Another resolution, or settings that choose another pipeline (shader defs: the
+        // caustic on or off, the hemisphere sampling, bounded or unbounded paths), build anew.
+        let rebuild = (scene.camera.width, scene.camera.height)
             != (self.scene.camera.width, self.scene.camera.height)
-            || scene.pathtrace.caustics != self.scene.pathtrace.caustics
-            || pipeline_changes;
-        if resized {
+            || gpu_scene.defs != GpuScene::new(&self.scene)?.defs;
+        if rebuild {
             let mut resized = Self::with_options(&self.gpu, scene, self.options)?;
             // What the caller chose and the planner learnt (the cost of a sample) carry over:
             // a viewer that set short submissions keeps them after the window is resized.
@@ -377,7 +375,6 @@ impl PathTracer {
             *self = resized;
             return Ok(());
         }
-        let gpu_scene = GpuScene::new(scene)?;
         self.base_params = gpu_scene::params(scene, &gpu_scene);
         // The caustic's parameters follow the camera and the seed.
         self.caustic = caustic::CausticTracer::new(
