@@ -1,6 +1,7 @@
-//! Polled readback (what the web viewer uses, `PathTracer::set_polled_readback`): the same
-//! samples reach the same f64 fold as with the blocking readback, and a reset while a band is
-//! in flight never folds that band.
+//! The ways a band comes back to the CPU fold the same samples: polled readback (what the web
+//! viewer uses, `PathTracer::set_polled_readback`) as the blocking one, and a reset while a band
+//! is in flight never folds that band; batch buffers mapped where the GPU wrote them (a device
+//! that shares the host's memory) as the staging copy a discrete GPU needs.
 
 use illum::pathtrace::PathTracer;
 use illum::scene::{Bounces, Sampling};
@@ -66,4 +67,28 @@ fn a_reset_while_a_band_is_in_flight_drops_that_band() {
     let waited = render(false, false);
     let reset = render(true, true);
     assert_same_image(&waited, &reset, "reset mid-flight against a fresh render");
+}
+
+/// Mapped readback, the default on lavapipe, against the staging copy, over passes split into
+/// bands of 5 rows: each band is traced while the one before it is folded, so the mapped form
+/// alternates between its two sets of batch buffers.
+#[test]
+fn mapped_readback_folds_the_same_samples_as_the_staging_copy() {
+    let render = |mapped: bool| {
+        let scene = common::cornell(24, SPP, Bounces::Fixed(2), Sampling::Cosine, 5);
+        let mut tracer = PathTracer::new(common::gpu(), &scene).expect("path tracer builds");
+        tracer.set_chunk_samples(1);
+        tracer.set_mapped_readback(mapped);
+        tracer.limit_batch_bytes(5 * 24 * 16).expect("five rows of one chunk fit");
+        tracer.render_to_spp(SPP).expect("renders");
+        tracer
+    };
+    let mapped = render(true);
+    if common::gpu().adapter_info.device_type == illum::gpu::wgpu::DeviceType::Cpu {
+        assert!(mapped.mapped_readback(), "a software driver shares the host's memory: bands are mapped");
+    }
+    let copied = render(false);
+    assert!(!copied.mapped_readback());
+    assert_same_image(&mapped, &copied, "mapped against copied");
+    assert_eq!(mapped.spp_done(), SPP);
 }

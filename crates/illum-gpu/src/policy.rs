@@ -26,12 +26,18 @@ pub fn prefer_software_from_env() -> bool {
 }
 
 /// What illum asks of a device on `adapter`: timestamp queries where the adapter has them (GPU
-/// time per pass), and the adapter's own limits (large storage buffers are what let big
+/// time per pass), mappable storage buffers where the GPU shares the host's memory (see
+/// [`shares_host_memory`]), and the adapter's own limits (large storage buffers are what let big
 /// renders proceed in few bands; the resolution checks report against these same limits).
 pub fn device_descriptor(adapter: &wgpu::Adapter, label: &'static str) -> wgpu::DeviceDescriptor<'static> {
     let mut required_features = wgpu::Features::empty();
     if adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY) {
         required_features |= wgpu::Features::TIMESTAMP_QUERY;
+    }
+    if shares_host_memory(adapter.get_info().device_type)
+        && adapter.features().contains(wgpu::Features::MAPPABLE_PRIMARY_BUFFERS)
+    {
+        required_features |= wgpu::Features::MAPPABLE_PRIMARY_BUFFERS;
     }
     wgpu::DeviceDescriptor {
         label: Some(label),
@@ -41,6 +47,15 @@ pub fn device_descriptor(adapter: &wgpu::Adapter, label: &'static str) -> wgpu::
         memory_hints: wgpu::MemoryHints::Performance,
         trace: wgpu::Trace::Off,
     }
+}
+
+/// Whether a device of this type computes in the host's own memory (a software driver such as
+/// lavapipe, or an integrated GPU). There the path tracer maps the buffers its shader wrote
+/// instead of copying them into a staging buffer first (`MAPPABLE_PRIMARY_BUFFERS`): at 1024 x
+/// 1024 that copy is 32 MB per band. On a discrete GPU mappable storage buffers would live in
+/// slow host-visible memory, so there the copy stays.
+pub fn shares_host_memory(device_type: wgpu::DeviceType) -> bool {
+    matches!(device_type, wgpu::DeviceType::Cpu | wgpu::DeviceType::IntegratedGpu)
 }
 
 /// Picks the adapter. `WGPU_ADAPTER_NAME` picks one by case-insensitive substring. Otherwise a

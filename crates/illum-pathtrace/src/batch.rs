@@ -26,6 +26,9 @@ pub(crate) struct BatchBuffers {
     pub(crate) slots: u64,
     pub(crate) sum: wgpu::Buffer,
     pub(crate) sum_sq: wgpu::Buffer,
+    /// Where the band's timestamps are copied, when the batch buffers are read where they lie
+    /// (`mappable`) and the device has timestamp queries.
+    pub(crate) timestamps: Option<wgpu::Buffer>,
     pub(crate) bind_group: wgpu::BindGroup,
 }
 
@@ -34,7 +37,9 @@ impl BatchBuffers {
     /// (`scene_buffers`: params, objects, materials, lights), to `layout`. The lights are bound
     /// only with `bind_lights` (a pipeline without area lights does not declare them), the
     /// objects and materials only with `bind_scene_data` (a specialised pipeline holds them as
-    /// literals).
+    /// literals). `mapped_readback`: `Some(timestamp bytes)` when the CPU maps the sums where the
+    /// shader wrote them (a device with `MAPPABLE_PRIMARY_BUFFERS`); that many bytes of mappable
+    /// buffer then take the band's timestamps.
     pub(crate) fn new(
         gpu: &GpuContext,
         slots: u64,
@@ -42,19 +47,33 @@ impl BatchBuffers {
         scene_buffers: [&wgpu::Buffer; 4],
         bind_lights: bool,
         bind_scene_data: bool,
+        mapped_readback: Option<u64>,
     ) -> Result<Self, GpuError> {
         let device = &gpu.device;
         gpu.scoped("allocating path-tracer batch buffers", || {
+            let read = if mapped_readback.is_some() {
+                wgpu::BufferUsages::MAP_READ
+            } else {
+                wgpu::BufferUsages::empty()
+            };
             let buffer = |label: &str| {
                 device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some(label),
                     size: slots * SLOT_BYTES,
-                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | read,
                     mapped_at_creation: false,
                 })
             };
             let sum = buffer("pathtrace batch sum");
             let sum_sq = buffer("pathtrace batch sum of squares");
+            let timestamps = mapped_readback.filter(|&bytes| bytes > 0).map(|size| {
+                device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("pathtrace batch timestamps"),
+                    size,
+                    usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                })
+            });
             let [params, objects, materials, lights] = scene_buffers;
             let bound: Vec<(u32, &wgpu::Buffer)> =
                 [(0, params), (1, objects), (2, materials), (3, lights), (4, &sum), (5, &sum_sq)]
@@ -64,7 +83,7 @@ impl BatchBuffers {
                     })
                     .collect();
             let bind_group = buffer_bind_group(device, "pathtrace", layout, &bound);
-            BatchBuffers { slots, sum, sum_sq, bind_group }
+            BatchBuffers { slots, sum, sum_sq, timestamps, bind_group }
         })
     }
 }

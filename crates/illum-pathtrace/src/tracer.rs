@@ -67,9 +67,15 @@ pub struct PathTracer {
     /// The batch buffers (sum, sum of squares) and the bind group that uses them; grown on demand
     /// up to `max_slots`.
     batch: Option<BatchBuffers>,
+    /// With mapped readback, the other set of batch buffers: bands alternate between the two, so
+    /// that the next band is traced while the CPU folds the last one from its mapping.
+    spare_batch: Option<BatchBuffers>,
+    /// Whether the CPU reads the batch buffers where the GPU wrote them (a device that shares the
+    /// host's memory, see `illum_gpu::policy::shares_host_memory`) instead of from a staging copy.
+    mapped_readback: bool,
     staging: Option<wgpu::Buffer>,
-    /// The next band of the pass, submitted before the current one was folded, and the staging
-    /// buffer it copies into (see `submit.rs`).
+    /// The next band of the pass, submitted before the current one was folded (see
+    /// `submit.rs`).
     ahead: Option<submit::AheadBand>,
     /// When the last band was folded: a band launched ahead counts its wall time from there.
     last_fold: Option<web_time::Instant>,
@@ -211,6 +217,8 @@ impl PathTracer {
             materials_buffer,
             lights_buffer,
             batch: None,
+            spare_batch: None,
+            mapped_readback: gpu.device.features().contains(wgpu::Features::MAPPABLE_PRIMARY_BUFFERS),
             staging: None,
             ahead: None,
             last_fold: None,
@@ -369,6 +377,7 @@ impl PathTracer {
             resized.sample_offset = self.sample_offset;
             resized.chunk_aligned = self.chunk_aligned;
             resized.polled_readback = self.polled_readback;
+            resized.mapped_readback = self.mapped_readback;
             if self.display_sum.is_some() {
                 resized.enable_display_sum()?;
             }
@@ -573,6 +582,20 @@ impl PathTracer {
             }
         }
         Ok(report)
+    }
+
+    /// With `false`, reads every band back through a staging copy even on a device whose batch
+    /// buffers can be mapped where the GPU wrote them (the default there; elsewhere, and for
+    /// polled readback, the copy is the only way). The samples and statistics are the same bit
+    /// for bit; tests use it to check that, on a software driver, for the path discrete GPUs take.
+    pub fn set_mapped_readback(&mut self, mapped: bool) {
+        self.mapped_readback =
+            mapped && self.gpu.device.features().contains(wgpu::Features::MAPPABLE_PRIMARY_BUFFERS);
+    }
+
+    /// Whether bands are read where the GPU wrote them (see [`Self::set_mapped_readback`]).
+    pub fn mapped_readback(&self) -> bool {
+        self.mapped_readback
     }
 
     /// Makes [`Self::render_step`] poll for each band's results instead of waiting for them:

@@ -6,9 +6,13 @@
 //! mapping started, and later calls fold it once the browser has mapped it.
 //!
 //! The blocking form keeps the GPU busy while the CPU folds: once a band's results are mapped,
-//! the next band of the same pass is submitted (into a second staging buffer) before the fold
-//! begins. At 1024 x 1024 the fold of one band (a pass over 88 MB of statistics and 32 MB of
-//! results) took 5 to 6 ms, during which the GPU had nothing to do.
+//! the next band of the same pass is submitted (into a second staging buffer, or the second set
+//! of batch buffers) before the fold begins. At 1024 x 1024 the fold of one band (a pass over
+//! 88 MB of statistics and 32 MB of results) took 5 to 6 ms, during which the GPU had nothing
+//! to do.
+//!
+//! Where the GPU computes in the host's memory (lavapipe, integrated GPUs) the results are not
+//! copied at all: the CPU maps the batch buffers the shader wrote ([`Readback::Mapped`]).
 
 use illum_gpu::readback::PendingRead;
 use illum_gpu::{readback, wgpu};
@@ -46,7 +50,10 @@ impl PathTracer {
     /// Makes sure the batch buffers hold at least `slots` slots (growing them, within
     /// `max_slots`, and rebinding).
     fn ensure_batch_capacity(&mut self, slots: u64) -> Result<(), PathTraceError> {
-        if self.batch.as_ref().is_some_and(|b| b.slots >= slots) {
+        // Buffers made before `set_mapped_readback(true)` cannot be mapped: made anew.
+        let mappable =
+            |b: &BatchBuffers| !self.mapped_readback || b.sum.usage().contains(wgpu::BufferUsages::MAP_READ);
+        if self.batch.as_ref().is_some_and(|b| b.slots >= slots && mappable(b)) {
             return Ok(());
         }
         // Grow geometrically (within max_slots) so that passes of slowly rising spp do not
@@ -60,33 +67,56 @@ impl PathTracer {
         let bind_lights = self.base_params.num_lights > 0;
         // A specialised pipeline has its objects and materials as literals (specialise.rs).
         let bind_scene_data = self.options.traversal == Traversal::Generic;
-        self.batch =
-            Some(BatchBuffers::new(&self.gpu, slots, &layout, scene_buffers, bind_lights, bind_scene_data)?);
+        let mapped_readback = self.mapped_readback.then(|| self.timer.result_size());
+        self.batch = Some(BatchBuffers::new(
+            &self.gpu,
+            slots,
+            &layout,
+            scene_buffers,
+            bind_lights,
+            bind_scene_data,
+            mapped_readback,
+        )?);
         Ok(())
     }
 
     /// Traces one band and folds it, waiting for the readback (the band launched ahead by the
     /// previous call, if there is one), and launches the pass's next band before folding.
     pub(super) fn submit_band(&mut self) -> Result<StepReport, PathTraceError> {
-        let AheadBand { band, staging } = match self.ahead.take() {
+        let AheadBand { band } = match self.ahead.take() {
             Some(ahead) => ahead,
-            None => {
-                let band = self.begin_band()?;
-                AheadBand { band, staging: self.staging.take().expect("allocated by begin_band") }
-            }
+            None => AheadBand { band: self.begin_band(self.mapped_readback)? },
         };
         // Folded straight from the mapping: at 1024 x 1024 a band is many megabytes, and
         // copying it out first (allocating and faulting in fresh pages) cost time for nothing.
         let context = "reading back a path-tracing batch";
         let gpu = self.gpu.clone();
-        let folded = readback::with_mapped(&gpu, &staging, band.staging_size, context, |data| {
-            let launched = self.launch_ahead(&band);
-            // Folded even when the next band could not be launched: its error comes after.
-            let folded = self.finish_band(&band, data);
-            folded.and_then(|report| launched.map(|()| report))
-        });
-        // The buffer just read becomes the one the next band (launched later) copies into.
-        self.staging = Some(staging);
+        let bytes = band.bytes;
+        let folded = match &band.readback {
+            Readback::Staging(staging) => {
+                readback::with_mapped(&gpu, staging, band.staging_size, context, |data| {
+                    let (sums, rest) = data.split_at(bytes as usize);
+                    let (sums_sq, timestamps) = rest.split_at(bytes as usize);
+                    self.launch_ahead_and_finish(&band, sums, sums_sq, timestamps)
+                })
+            }
+            Readback::Mapped { sum, sum_sq, timestamps } => {
+                readback::with_mapped(&gpu, sum, bytes, context, |sums| {
+                    readback::with_mapped(&gpu, sum_sq, bytes, context, |sums_sq| match timestamps {
+                        Some(t) => readback::with_mapped(&gpu, t, t.size(), context, |timestamps| {
+                            self.launch_ahead_and_finish(&band, sums, sums_sq, timestamps)
+                        }),
+                        None => Ok(self.launch_ahead_and_finish(&band, sums, sums_sq, &[])),
+                    })
+                })
+                .and_then(|mapped| mapped)
+                .and_then(|mapped| mapped)
+            }
+        };
+        // The staging buffer just read becomes the one the next band (launched later) copies into.
+        if let Readback::Staging(staging) = band.readback {
+            self.staging = Some(staging);
+        }
         let folded = folded.map_err(PathTraceError::from).and_then(|r| r);
         if folded.is_err() {
             // This band's rows were not folded: the band ahead of it may not be either.
@@ -98,6 +128,20 @@ impl PathTracer {
         folded
     }
 
+    /// Launches the pass's next band, then folds `band` from its read-back bytes.
+    fn launch_ahead_and_finish(
+        &mut self,
+        band: &Band,
+        sums: &[u8],
+        sums_sq: &[u8],
+        timestamps: &[u8],
+    ) -> Result<StepReport, PathTraceError> {
+        let launched = self.launch_ahead(band);
+        // Folded even when the next band could not be launched: its error comes after.
+        let folded = self.finish_band(band, sums, sums_sq, timestamps);
+        folded.and_then(|report| launched.map(|()| report))
+    }
+
     /// Submits the pass's next band, if `band` is not its last, into the spare staging buffer
     /// (the caustic's passes fold frames traced per pass and are left serial).
     fn launch_ahead(&mut self, band: &Band) -> Result<(), PathTraceError> {
@@ -105,9 +149,7 @@ impl PathTracer {
         if self.caustic.is_some() || band.row_offset + band.rows >= height {
             return Ok(());
         }
-        let band = self.begin_band()?;
-        let staging = self.staging.take().expect("allocated by begin_band");
-        self.ahead = Some(AheadBand { band, staging });
+        self.ahead = Some(AheadBand { band: self.begin_band(self.mapped_readback)? });
         Ok(())
     }
 
@@ -123,7 +165,9 @@ impl PathTracer {
         let flight = self.in_flight.take().expect("polled above");
         let data = result?;
         self.staging = Some(flight.read.into_buffer());
-        let report = self.finish_band(&flight.band, &data)?;
+        let bytes = flight.band.bytes as usize;
+        let report =
+            self.finish_band(&flight.band, &data[..bytes], &data[bytes..2 * bytes], &data[2 * bytes..])?;
         // The next band of this pass goes to the GPU now, so that it works while the page
         // draws its next frame (a new pass waits for the next call, which checks the target).
         if self.pass.is_some() {
@@ -134,17 +178,20 @@ impl PathTracer {
 
     /// Submits a band and starts its polled readback.
     fn launch_band(&mut self) -> Result<(), PathTraceError> {
-        let band = self.begin_band()?;
-        // The staging buffer travels with the band: nothing may copy into it while mapped.
-        let staging = self.staging.take().expect("allocated by begin_band");
+        // Through a staging copy: the polled read maps one buffer.
+        let band = self.begin_band(false)?;
+        let Readback::Staging(staging) = band.readback.clone() else {
+            unreachable!("begun with a staging copy")
+        };
         let read = PendingRead::start(staging, band.staging_size, "reading back a path-tracing batch");
         self.in_flight = Some(InFlightBand { band, read });
         Ok(())
     }
 
-    /// Records and submits one band of the active pass (trace, display sum, copies into the
-    /// staging buffer).
-    fn begin_band(&mut self) -> Result<Band, PathTraceError> {
+    /// Records and submits one band of the active pass (trace, display sum, and with `mapped`
+    /// false the copies into the staging buffer; with `mapped` true the band takes the other set
+    /// of batch buffers, and the CPU will map them).
+    fn begin_band(&mut self, mapped: bool) -> Result<Band, PathTraceError> {
         let started = Instant::now();
         let width = self.scene.camera.width;
         let height = self.scene.camera.height;
@@ -157,6 +204,10 @@ impl PathTracer {
         let chunks = spp.div_ceil(chunk);
         let band_pixels = rows as usize * width as usize;
         let slots = band_pixels as u64 * u64::from(chunks);
+        if mapped {
+            // The set the previous band wrote may still be mapped, or about to be.
+            std::mem::swap(&mut self.batch, &mut self.spare_batch);
+        }
         self.ensure_batch_capacity(slots)?;
 
         let mut params = self.base_params;
@@ -173,8 +224,8 @@ impl PathTracer {
         }
 
         let bytes = slots * SLOT_BYTES;
-        let staging_size = 2 * bytes + self.timer.result_size();
-        if self.staging.as_ref().is_none_or(|s| s.size() < staging_size) {
+        let staging_size = if mapped { 0 } else { 2 * bytes + self.timer.result_size() };
+        if !mapped && self.staging.as_ref().is_none_or(|s| s.size() < staging_size) {
             self.staging = Some(self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("pathtrace staging"),
                 size: staging_size,
@@ -182,7 +233,6 @@ impl PathTracer {
                 mapped_at_creation: false,
             }));
         }
-        let staging = self.staging.as_ref().expect("allocated above");
         let batch = self.batch.as_ref().expect("allocated above");
 
         let mut encoder = self
@@ -203,23 +253,44 @@ impl PathTracer {
         if let Some(display) = &mut self.display_sum {
             display.record(&self.gpu, &mut encoder, &batch.sum, rows, row_offset, chunks);
         }
-        encoder.copy_buffer_to_buffer(&batch.sum, 0, staging, 0, bytes);
-        encoder.copy_buffer_to_buffer(&batch.sum_sq, 0, staging, bytes, bytes);
-        self.timer.copy_results(&mut encoder, staging, 2 * bytes);
+        let readback = if mapped {
+            if let Some(timestamps) = &batch.timestamps {
+                self.timer.copy_results(&mut encoder, timestamps, 0);
+            }
+            Readback::Mapped {
+                sum: batch.sum.clone(),
+                sum_sq: batch.sum_sq.clone(),
+                timestamps: batch.timestamps.clone(),
+            }
+        } else {
+            // Taken: the band holds it until its bytes are read (nothing may copy into it then).
+            let staging = self.staging.take().expect("allocated above");
+            encoder.copy_buffer_to_buffer(&batch.sum, 0, &staging, 0, bytes);
+            encoder.copy_buffer_to_buffer(&batch.sum_sq, 0, &staging, bytes, bytes);
+            self.timer.copy_results(&mut encoder, &staging, 2 * bytes);
+            Readback::Staging(staging)
+        };
         self.gpu.queue.submit([encoder.finish()]);
         if let Some(pass) = self.pass.as_mut() {
             pass.launched_row = row_offset + rows;
         }
-        Ok(Band { started, row_offset, rows, spp, chunk, chunks, band_pixels, bytes, staging_size })
+        Ok(Band { started, row_offset, rows, spp, chunk, chunks, band_pixels, bytes, staging_size, readback })
     }
 
-    /// Checks and folds a band's read-back bytes, and moves the pass on.
-    fn finish_band(&mut self, band: &Band, data: &[u8]) -> Result<StepReport, PathTraceError> {
-        let Band { started, row_offset, rows, spp, chunk, chunks, band_pixels, bytes, .. } = *band;
+    /// Checks and folds a band's read-back bytes (its sums, sums of squares and timestamps), and
+    /// moves the pass on.
+    fn finish_band(
+        &mut self,
+        band: &Band,
+        sums: &[u8],
+        sums_sq: &[u8],
+        timestamps: &[u8],
+    ) -> Result<StepReport, PathTraceError> {
+        let Band { started, row_offset, rows, spp, chunk, chunks, band_pixels, .. } = *band;
         let width = self.scene.camera.width;
         let height = self.scene.camera.height;
-        let floats = batch::slots(&data[..(2 * bytes) as usize]);
-        let (sums, sums_sq) = floats.split_at(floats.len() / 2);
+        let (sums, sums_sq) = (batch::slots(sums), batch::slots(sums_sq));
+        let (sums, sums_sq) = (&sums[..], &sums_sq[..]);
         if let Err(error) = batch::check_complete(sums, sums_sq, spp, chunk, band_pixels) {
             // The accumulator drops this band, but the display pass already added it: set the
             // display sum back to the accumulator's samples.
@@ -243,7 +314,7 @@ impl PathTracer {
         if let (Some(display), Some(_)) = (&self.display_sum, &self.caustic) {
             display.seed(&self.gpu, &self.accumulator, self.radiance_exponent);
         }
-        let gpu_seconds = self.timer.decode(&data[(2 * bytes) as usize..]).map(|timings| timings[0].1 * 1e-3);
+        let gpu_seconds = self.timer.decode(timestamps).map(|timings| timings[0].1 * 1e-3);
 
         let pass = self.pass.as_mut().expect("still active");
         pass.next_row += rows;
@@ -273,7 +344,6 @@ impl PathTracer {
 }
 
 /// What a submitted band covers, for folding it when its bytes are back.
-#[derive(Clone, Copy)]
 pub(super) struct Band {
     started: Instant,
     row_offset: u32,
@@ -283,15 +353,26 @@ pub(super) struct Band {
     chunk: u32,
     chunks: u32,
     band_pixels: usize,
-    /// Bytes of each of the two slot arrays (sums, sums of squares) in the staging buffer.
+    /// Bytes of each of the two slot arrays (sums, sums of squares).
     bytes: u64,
+    /// Bytes of the staging copy (0 when mapped where the GPU wrote them).
     staging_size: u64,
+    readback: Readback,
 }
 
-/// A band submitted while the one before it is folded, and the staging buffer it copies into.
+/// Where a band's results are read.
+#[derive(Clone)]
+pub(super) enum Readback {
+    /// A staging buffer they were copied into: the sums, then the sums of squares, then the
+    /// timestamps.
+    Staging(wgpu::Buffer),
+    /// The batch buffers the shader wrote, and the band's timestamps (when timed).
+    Mapped { sum: wgpu::Buffer, sum_sq: wgpu::Buffer, timestamps: Option<wgpu::Buffer> },
+}
+
+/// A band submitted while the one before it is folded.
 pub(super) struct AheadBand {
     band: Band,
-    staging: wgpu::Buffer,
 }
 
 /// A band submitted with polled readback, whose staging buffer is being mapped.
