@@ -1,9 +1,11 @@
 //! The path tracer: a scene's buffers on the GPU, and the submit-readback-fold loop that renders
 //! it progressively, band by band, into the f64 accumulator.
 //!
-//! The pipeline comes from `shaders.rs`, the batch buffers and their decoding from `batch.rs`,
-//! the size of each submission from `planner.rs`; one submission (a band traced, read back and
-//! folded) is `tracer/submit.rs`.
+//! This file builds a tracer for a scene (and rebuilds it when the scene changes) and holds its
+//! settings. The pipeline comes from `shaders.rs`, the batch buffers and their decoding from
+//! `batch.rs`, the size of each submission from `planner.rs`; the passes of a render (planned,
+//! reset, restored from a checkpoint) are `tracer/passes.rs`, and one submission (a band
+//! traced, read back and folded) is `tracer/submit.rs`.
 
 use illum_gpu::timing::PassTimer;
 use illum_gpu::{GpuContext, wgpu};
@@ -18,6 +20,7 @@ use crate::planner::{BatchPlanner, DEFAULT_TARGET_SECONDS, PassPlan};
 use crate::{Accumulator, PathTraceError, limits, shaders, specialise};
 
 mod caustic;
+mod passes;
 mod submit;
 
 pub use caustic::{CausticParams, bounding_sphere, fixed_point};
@@ -429,161 +432,6 @@ impl PathTracer {
         self.sample_offset
     }
 
-    /// With `true`, every pass [`Self::render_step`] plans ends on a multiple of the chunk size in
-    /// absolute sample indices (or where the render ends), so each pixel's chunks are always the
-    /// same samples, whatever the batching: two renders with the same seed, or one resumed from
-    /// a checkpoint, fold the same f32 chunk sums in the same order and agree bit for bit. The
-    /// first pass then has a whole chunk (16 spp) rather than the planner's 1-spp probe; the
-    /// bands shrink to keep each submission short. The `render` example turns it on.
-    pub fn set_chunk_aligned_passes(&mut self, aligned: bool) {
-        self.chunk_aligned = aligned;
-    }
-
-    /// The pass in progress, if a render stopped inside one: (its spp, rows done from row 0).
-    pub fn partial_pass(&self) -> Option<(u32, u32)> {
-        self.pass.as_ref().map(|p| (p.plan.spp, p.next_row))
-    }
-
-    /// The statistics at the last chunk boundary and their spp, when the samples taken so far
-    /// (or the pass in progress) end inside a chunk: what a checkpoint stores so that a resumed
-    /// render can go on from that boundary (see [`Self::set_chunk_aligned_passes`]).
-    pub fn aligned_prefix(&self) -> Option<(&Accumulator, u32)> {
-        let chunk = self.chunk_samples.max(1);
-        let end = self.sample_offset + self.spp_done + self.pass.as_ref().map_or(0, |p| p.plan.spp);
-        let (accumulator, spp) = self.aligned_prefix.as_ref()?;
-        (!end.is_multiple_of(chunk)).then_some((accumulator, *spp))
-    }
-
-    /// Continues from a checkpoint: the accumulator, the spp of the completed passes, and a pass
-    /// stopped inside (its spp and the rows done), which the next steps finish first. The
-    /// accumulator must have this tracer's resolution. `aligned_prefix`: the checkpoint's
-    /// statistics at its last chunk boundary (see [`Self::aligned_prefix`]), kept for the next
-    /// checkpoint when the pass in progress ends inside a chunk.
-    pub fn restore(
-        &mut self,
-        mut accumulator: Accumulator,
-        spp_done: u32,
-        partial_pass: Option<(u32, u32)>,
-        aligned_prefix: Option<(Accumulator, u32)>,
-    ) -> Result<(), PathTraceError> {
-        let camera = self.scene.camera;
-        if (accumulator.width, accumulator.height) != (camera.width, camera.height) {
-            return Err(PathTraceError::Unsupported {
-                scene: self.scene.name.clone(),
-                message: format!(
-                    "a checkpoint of {} x {} pixels cannot continue a {} x {} render",
-                    accumulator.width, accumulator.height, camera.width, camera.height
-                ),
-            });
-        }
-        accumulator.set_radiance_exponent(self.radiance_exponent);
-        self.reset();
-        self.accumulator = accumulator;
-        self.spp_done = spp_done;
-        self.aligned_prefix = aligned_prefix.map(|(mut prefix, spp)| {
-            prefix.set_radiance_exponent(self.radiance_exponent);
-            (prefix, spp)
-        });
-        self.pass =
-            partial_pass.filter(|&(_, rows)| rows > 0 && rows < camera.height).map(|(spp, next_row)| {
-                let planned = self.planner.plan(camera.width, camera.height, spp);
-                let rows = if planned.spp >= spp { camera.height } else { planned.rows.max(1) };
-                ActivePass::new(self.fit(PassPlan { spp, rows }), spp_done, next_row)
-            });
-        if let Some(display) = &self.display_sum {
-            display.seed(&self.gpu, &self.accumulator, self.radiance_exponent);
-        }
-        Ok(())
-    }
-
-    /// Discards everything accumulated; the next step starts again at sample 0.
-    pub fn reset(&mut self) {
-        self.in_flight = None;
-        self.ahead = None;
-        self.last_fold = None;
-        self.accumulator.reset();
-        if let Some(caustic) = &mut self.caustic {
-            caustic.discard_pass();
-        }
-        if let Some(display) = &self.display_sum {
-            display.clear(&self.gpu);
-        }
-        self.pass = None;
-        self.spp_done = 0;
-        self.aligned_prefix = None;
-        self.wall_seconds = 0.0;
-        self.gpu_seconds = 0.0;
-    }
-
-    /// Runs one short submission (one band of rows of the current pass; about 0.15 s, see
-    /// [`Self::set_target_seconds`]) toward `target_spp` samples per pixel (`None`: no limit).
-    /// Returns a report with `samples == 0` once the target is reached. Progressive renderers
-    /// call it in a loop, between frames or checks of their stop rules.
-    ///
-    /// With [`Self::set_polled_readback`] it never waits: a call submits a band, and later calls
-    /// report `samples == 0` until its results are back, then fold it and report it.
-    pub fn render_step(&mut self, target_spp: Option<u32>) -> Result<StepReport, PathTraceError> {
-        let camera = self.scene.camera;
-        if self.pass.is_none() {
-            let remaining = match target_spp {
-                Some(t) if t <= self.spp_done => return Ok(StepReport::default()),
-                Some(t) => t - self.spp_done,
-                None => u32::MAX - self.spp_done,
-            };
-            let mut plan = self.fit(self.planner.plan(camera.width, camera.height, remaining));
-            if self.chunk_aligned {
-                let start = self.sample_offset + self.spp_done;
-                plan = align_pass(plan, start, remaining, self.chunk_samples);
-                let chunk = self.chunk_samples.max(1);
-                if start.is_multiple_of(chunk) {
-                    // The last pass of a render that ends inside a chunk: keep the statistics
-                    // at this boundary (see `aligned_prefix`), if the host has the memory for
-                    // the copy with a fifth to spare (at 8192 x 8192 on 24 GB it has not: such
-                    // a render, resumed, then differs from a straight one by f32 rounding, and
-                    // the resume says so).
-                    let copy_fits = || {
-                        use crate::accumulator::{ALIGNED_COPY_BYTES_PER_PIXEL, RENDER_HOST_BYTES_PER_PIXEL};
-                        let pixels = u64::from(self.accumulator.width) * u64::from(self.accumulator.height);
-                        let peak = pixels * (RENDER_HOST_BYTES_PER_PIXEL + ALIGNED_COPY_BYTES_PER_PIXEL);
-                        crate::accumulator::available_host_memory()
-                            .is_none_or(|available| peak <= available / 5 * 4)
-                    };
-                    self.aligned_prefix = (!(start + plan.spp).is_multiple_of(chunk) && copy_fits())
-                        .then(|| (self.accumulator.clone(), self.spp_done));
-                }
-            }
-            self.pass = Some(ActivePass::new(plan, self.spp_done, 0));
-        }
-        let report = if self.polled_readback {
-            match self.poll_band()? {
-                Some(report) => report,
-                None => return Ok(StepReport::default()),
-            }
-        } else {
-            self.submit_band()?
-        };
-        // A polled band's wall time includes the frames drawn while it was read back; its GPU
-        // time (timestamp queries), where the adapter has them, is what it cost.
-        let seconds = if self.polled_readback {
-            report.gpu_seconds.unwrap_or(report.wall_seconds)
-        } else {
-            report.wall_seconds
-        };
-        self.planner.record(report.samples, seconds);
-        // Later bands of the pass follow what the planner has learnt: a pass planned before
-        // the first measurement (at 1024 x 1024 with chunk-aligned passes, bands of one row)
-        // would otherwise be a thousand tiny submissions, each paying the driver's fixed cost.
-        // Bands are rows, so their size never changes which samples a pixel's chunks hold.
-        if let Some(spp) = self.pass.as_ref().map(|p| p.plan.spp) {
-            let rows = self.planner.rows_for(camera.width, camera.height, spp);
-            let fitted = self.fit(PassPlan { spp, rows });
-            if let Some(pass) = self.pass.as_mut().filter(|_| fitted.spp == spp) {
-                pass.plan.rows = fitted.rows;
-            }
-        }
-        Ok(report)
-    }
-
     /// With `false`, reads every band back through a staging copy even on a device whose batch
     /// buffers can be mapped where the GPU wrote them (the default there; elsewhere, and for
     /// polled readback, the copy is the only way). The samples and statistics are the same bit
@@ -604,89 +452,5 @@ impl PathTracer {
     /// [`Self::render_to_spp`] and [`Self::add_samples_in_one_pass`] always wait.
     pub fn set_polled_readback(&mut self, polled: bool) {
         self.polled_readback = polled;
-    }
-
-    /// Renders until every pixel has `spp` samples in all (those already taken count), in
-    /// submissions sized by the measured speed.
-    pub fn render_to_spp(&mut self, spp: u32) -> Result<(), PathTraceError> {
-        while self.spp_done < spp {
-            self.render_step(Some(spp))?;
-        }
-        Ok(())
-    }
-
-    /// Adds exactly `spp` samples per pixel in one pass over the image when the device allows
-    /// (split into bands only if the image is too large for one short submission or one storage
-    /// binding, and into several passes only if one dispatch cannot carry `spp` chunks). Unlike
-    /// [`Self::render_to_spp`], the grouping of samples into f32 chunk sums then depends on the
-    /// call alone, never on measured speed: tests use it to compare renders bit for bit and to
-    /// control batching.
-    pub fn add_samples_in_one_pass(&mut self, spp: u32) -> Result<(), PathTraceError> {
-        assert!(self.pass.is_none(), "add_samples_in_one_pass called in the middle of a pass");
-        let camera = self.scene.camera;
-        let mut remaining = spp;
-        while remaining > 0 {
-            let planned = self.planner.plan(camera.width, camera.height, remaining);
-            let rows = if planned.spp >= remaining { camera.height } else { planned.rows.max(1) };
-            let plan = self.fit(PassPlan { spp: remaining, rows });
-            self.pass = Some(ActivePass::new(plan, self.spp_done, 0));
-            while self.pass.is_some() {
-                let report = self.submit_band()?;
-                self.planner.record(report.samples, report.wall_seconds);
-            }
-            remaining -= plan.spp;
-        }
-        Ok(())
-    }
-}
-/// A pass plan changed so that the pass ends on a multiple of `chunk` in absolute sample indices
-/// (`start` is the pass's first index), or at the end of the render (`remaining` samples): one
-/// chunk more when the plan would end inside the first chunk, fewer when it ends past a chunk
-/// boundary. The rows shrink or grow with the spp so that a submission keeps its size.
-fn align_pass(plan: PassPlan, start: u32, remaining: u32, chunk: u32) -> PassPlan {
-    let chunk = chunk.max(1);
-    if plan.spp >= remaining {
-        // The last pass. Where the render ends inside a chunk, the whole chunks come first and
-        // the rest in a pass of its own, so that the statistics at the last chunk boundary can be
-        // kept for a resumed render (see `PathTracer::aligned_prefix`).
-        let end = start.saturating_add(remaining);
-        let boundary = end / chunk * chunk;
-        let spp = if !end.is_multiple_of(chunk) && boundary > start { boundary - start } else { remaining };
-        return PassPlan { spp, ..plan };
-    }
-    let end = start.saturating_add(plan.spp) / chunk * chunk;
-    let spp = if end > start { end - start } else { chunk - start % chunk }.min(remaining);
-    let rows = (u64::from(plan.rows) * u64::from(plan.spp) / u64::from(spp)).clamp(1, u64::from(u32::MAX));
-    PassPlan { spp, rows: rows as u32 }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Every pass ends on a chunk boundary or at the render's end, and a render that ends inside
-    /// a chunk gets its whole chunks first and the rest in a last pass of its own.
-    #[test]
-    fn passes_end_on_chunk_boundaries_and_the_tail_comes_alone() {
-        let ends = |start: u32, target: u32, plan_spp: u32| {
-            let mut ends = Vec::new();
-            let mut at = start;
-            while at < target {
-                let plan = align_pass(PassPlan { spp: plan_spp, rows: 8 }, at, target - at, 16);
-                assert!(plan.spp >= 1 && plan.rows >= 1);
-                at += plan.spp;
-                ends.push(at);
-            }
-            ends
-        };
-        assert_eq!(ends(0, 50, 1000), [48, 50]);
-        assert_eq!(ends(0, 50, 20), [16, 32, 48, 50]);
-        assert_eq!(ends(0, 10, 1000), [10]);
-        assert_eq!(ends(0, 64, 1000), [64]);
-        assert_eq!(ends(16, 100, 1000), [96, 100]);
-        assert_eq!(ends(0, 100, 1), [16, 32, 48, 64, 80, 96, 100]);
-        // A resumed render going on from an unaligned count reaches the next boundary first.
-        assert_eq!(ends(50, 100, 1000), [96, 100]);
-        assert_eq!(ends(50, 100, 4), [64, 80, 96, 100]);
     }
 }
