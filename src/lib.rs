@@ -3,7 +3,7 @@
 //! This facade re-exports the workspace crates so that `examples/` and `tests/` can use one name,
 //! and holds the command-line pieces the examples share ([`cli`], [`interrupt`], [`progress`], and
 //! each renderer's path of the render example: [`raster_cli`], [`whitted_cli`]), and what the
-//! measuring tools share: the cached [`reference`], [`plot`]s, [`report`] tables and the
+//! measuring tools share: the cached [`reference`](mod@reference), [`plot`]s, [`report`] tables and the
 //! ladder's [`regions`] and errors.
 pub mod cli;
 pub mod interrupt;

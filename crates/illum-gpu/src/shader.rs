@@ -15,7 +15,7 @@ use naga_oil::compose::{
 use crate::{GpuContext, GpuError};
 
 /// One WGSL file: its path relative to the workspace (for error messages) and its text. Files
-/// from `shaders/` are embedded ([`shader_file!`]); generated modules own their text.
+/// from `shaders/` are embedded (`shader_file!`); generated modules own their text.
 #[derive(Clone, Debug)]
 pub struct ShaderFile {
     pub path: Cow<'static, str>,

@@ -307,7 +307,7 @@ impl Accumulator {
     }
 
     /// The relMSE of the current mean image against the (unknown) converged image, estimated from
-    /// the per-pixel variance alone: mean over pixels and channels of Var[mean] / (mean^2 + eps).
+    /// the per-pixel variance alone: mean over pixels and channels of Var(mean) / (mean^2 + eps).
     /// This is the expectation of `rel_mse(mean, truth)` when the estimator is unbiased.
     pub fn estimated_rel_mse(&self) -> f64 {
         let mut total = 0.0;

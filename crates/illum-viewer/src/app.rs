@@ -190,7 +190,7 @@ impl ViewerApp {
     }
 
     /// Switches to `mode` as the top bar's buttons do (the camera follows, see
-    /// [`Self::carry_camera`]).
+    /// `carry_camera`).
     pub fn switch_to(&mut self, mode: Mode) {
         let before = std::mem::replace(&mut self.mode, mode);
         if mode != before {
