@@ -5,6 +5,9 @@
 //! converged render), compressed with ZIP, which is lossless. The settings that produced the
 //! image travel with it as custom text attributes named `illum.<field>`, so a reference image
 //! says how it was made.
+//!
+//! Over 400 lines with its tests (about 400 of code): writing and reading share one layout of
+//! parts, channels and attributes, which reads best side by side.
 
 use std::collections::HashMap;
 use std::fs::File;

@@ -3,6 +3,9 @@
 //! The GPU returns, per pixel and batch, the f32 sum and sum of squares of its finite samples, the
 //! number of finite samples, and the number of dropped (NaN/Inf) ones. Folding those batch sums in
 //! f64 keeps 10^6 spp free of drift: f32 only ever sums one short batch.
+//!
+//! Over 400 lines with its tests (about 350 of code): the statistics, their fold and what is
+//! estimated from them (mean, variance, error) are one type.
 
 use illum_image::RgbImage32;
 // The epsilon of `illum_image::metrics::rel_mse` itself, so that the estimated and the measured

@@ -1,4 +1,7 @@
 //! The scene as the shader sees it: plain-old-data structs laid out like the WGSL ones.
+//!
+//! Over 400 lines, one concept: each struct beside the code that fills it from the scene, so a
+//! field's meaning on both sides is read in one place.
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;

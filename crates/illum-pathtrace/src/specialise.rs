@@ -16,6 +16,9 @@
 //!
 //! The module (`illum::rtcore::traversal`) is shared: the Whitted ray tracer imports the same
 //! `closest_hit`, `occluded` and `surface_at` (`choose_light` is the path tracer's alone).
+//!
+//! About 400 lines, one concept: the generator of one WGSL module, each function writing one of
+//! its functions.
 
 use std::collections::BTreeSet;
 

@@ -6,6 +6,8 @@
 //! `batch.rs`, the size of each submission from `planner.rs`; the passes of a render (planned,
 //! reset, restored from a checkpoint) are `tracer/passes.rs`, and one submission (a band
 //! traced, read back and folded) is `tracer/submit.rs`.
+//!
+//! About 450 lines, one concept: the `PathTracer` type, its fields and their settings.
 
 use illum_gpu::timing::PassTimer;
 use illum_gpu::{GpuContext, wgpu};

@@ -3,6 +3,9 @@
 //! renderer, so switching away and back finds them as they were. The camera follows a switch
 //! between two modes that show the same scene file, so one view can be flipped between the
 //! three renderers.
+//!
+//! Over 400 lines, one concept: the mode switch, the file opening and the layout all act on the
+//! one `ViewerApp` state; each mode's own panel is its own file.
 
 use std::fmt;
 use std::path::{Path, PathBuf};

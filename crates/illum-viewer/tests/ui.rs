@@ -5,10 +5,11 @@
 //! Both renderers repaint continuously while they work, so the tests step a fixed number of
 //! frames (`run_steps`) instead of waiting for the UI to settle.
 //!
-//! All harnesses share one device, as the real window has one: wgpu compares devices by their
-//! id within their own instance, so devices of separate instances (one per harness by default)
-//! can compare equal, and the path tracer's process-wide pipeline cache, keyed by device, would
-//! hand one device's pipeline to another.
+//! All harnesses share one device, as the real window has one (a device per harness would
+//! compile every pipeline again: the pipeline caches belong to each device's `GpuContext`).
+//!
+//! Over 400 lines, one concept: each test drives the same app through a different user action,
+//! and they share the harness setup above.
 
 use std::sync::OnceLock;
 

@@ -17,6 +17,9 @@
 //! any order to the same result, so the image does not depend on how a render is batched.
 //!
 //! Fixed point: see [`fixed_point`].
+//!
+//! Over 400 lines with its tests (under 400 of code): one estimator, from its parameters to its
+//! fold.
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
