@@ -1,7 +1,7 @@
 //! Throughput benchmark of the path tracer (and, where built, the raster scene).
 //!
 //! ```text
-//! cargo run --release --example bench -- [--runs N] [--quick]
+//! cargo run --release --example bench -- [--runs N] [--quick | --large [--compare-readback]]
 //! ```
 //! For `scenes/cornell.toml` at each size and bounce count it renders a fixed number of samples
 //! per pixel `runs` times and prints the median of:
@@ -9,7 +9,12 @@
 //!   included, as a user experiences it);
 //! - GPU samples/s: the same over the compute passes' timestamp-query time;
 //! - rays/s: rays traced (camera, bounce and shadow rays) per second of wall time; the count
-//!   comes from the bounce structure (see `rays_per_sample`).
+//!   comes from the bounce structure (see `rays_per_sample`);
+//! - wall / GPU: the first rate over the second (1: the host adds nothing to the GPU's time).
+//!
+//! `--large` measures only the 1024 x 1024 rows, where the host's share (readback and fold) is
+//! largest; `--compare-readback` adds each of them read through a staging copy, as on a discrete
+//! GPU, beside the default mapped readback of a device that shares the host's memory.
 //!
 //! Timings are never asserted in tests; the figures go to docs/performance.md.
 
@@ -34,8 +39,14 @@ struct Args {
     #[arg(long, default_value_t = 5)]
     runs: usize,
     /// Only the headline configuration (256 x 256, 64 spp, bounces 2 and 8).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "large")]
     quick: bool,
+    /// Only the 1024 x 1024 rows (the wall-against-GPU-clock figures), without the rasterizer.
+    #[arg(long)]
+    large: bool,
+    /// With --large: each row also read back through a staging copy (see `PathTracer::set_mapped_readback`).
+    #[arg(long, requires = "large")]
+    compare_readback: bool,
 }
 
 struct Config {
@@ -43,6 +54,8 @@ struct Config {
     spp: u32,
     bounces: u32,
     traversal: Traversal,
+    /// Read back through a staging copy even where the batch buffers can be mapped.
+    staging_copy: bool,
 }
 
 fn main() {
@@ -64,24 +77,32 @@ fn run(args: Args) -> anyhow::Result<()> {
     );
     // The headline configurations, each with the specialised (default) and generic traversal.
     let mut configs = Vec::new();
-    for bounces in [2, 8] {
-        for traversal in [Traversal::Specialised, Traversal::Generic] {
-            configs.push(Config { size: 256, spp: 64, bounces, traversal });
+    if !args.large {
+        for bounces in [2, 8] {
+            for traversal in [Traversal::Specialised, Traversal::Generic] {
+                configs.push(Config { size: 256, spp: 64, bounces, traversal, staging_copy: false });
+            }
         }
     }
     if !args.quick {
         for (size, spp) in [(256, 64), (1024, 4)] {
             for bounces in [0, 1, 2, 8] {
-                if !(size == 256 && (bounces == 2 || bounces == 8)) {
-                    configs.push(Config { size, spp, bounces, traversal: Traversal::Specialised });
+                let headline = size == 256 && (bounces == 2 || bounces == 8);
+                if headline || (args.large && size != 1024) {
+                    continue;
+                }
+                let traversal = Traversal::Specialised;
+                configs.push(Config { size, spp, bounces, traversal, staging_copy: false });
+                if args.compare_readback {
+                    configs.push(Config { size, spp, bounces, traversal, staging_copy: true });
                 }
             }
         }
     }
     println!(
-        "| size | spp | bounces | traversal | Msamples/s (wall) | Msamples/s (GPU) | Mrays/s (wall, upper) | GPU ms per submission |"
+        "| size | spp | bounces | traversal | readback | Msamples/s (wall) | Msamples/s (GPU) | wall / GPU | Mrays/s (wall, upper) | GPU ms per submission |"
     );
-    println!("|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|");
     for config in configs {
         let settings = SceneArgs {
             spp: Some(config.spp),
@@ -93,6 +114,8 @@ fn run(args: Args) -> anyhow::Result<()> {
         let scene: Scene = cli::load_scene(&args.scene, &settings)?;
         let options = TracerOptions { traversal: config.traversal, ..Default::default() };
         let mut tracer = PathTracer::with_options(&gpu, &scene, options)?;
+        tracer.set_mapped_readback(!config.staging_copy);
+        let readback = if tracer.mapped_readback() { "mapped" } else { "staging copy" };
         // Warm-up: compiles the pipeline on the driver and teaches the planner the cost.
         tracer.render_to_spp(1)?;
         let (mut wall, mut gpu_rate, mut per_submission) = (Vec::new(), Vec::new(), Vec::new());
@@ -109,17 +132,22 @@ fn run(args: Args) -> anyhow::Result<()> {
             per_submission.push(tracer.gpu_seconds() * 1e3 / submissions as f64);
         }
         let wall = median(&mut wall);
+        let gpu_rate = median(&mut gpu_rate);
         println!(
-            "| {0}x{0} | {1} | {2} | {7:?} | {3:.2} | {4:.2} | {5:.1} | {6:.0} |",
+            "| {0}x{0} | {1} | {2} | {3:?} | {readback} | {4:.2} | {5:.2} | {6:.2} | {7:.1} | {8:.0} |",
             config.size,
             config.spp,
             config.bounces,
+            config.traversal,
             wall * 1e-6,
-            median(&mut gpu_rate) * 1e-6,
+            gpu_rate * 1e-6,
+            wall / gpu_rate,
             wall * rays_per_sample(config.bounces) as f64 * 1e-6,
             median(&mut per_submission),
-            config.traversal,
         );
+    }
+    if args.large {
+        return Ok(());
     }
     bench_raster(&gpu, args.runs)
 }
