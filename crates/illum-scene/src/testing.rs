@@ -2,13 +2,22 @@
 //! crate's own, and the renderers' checks of what they refuse), so that each rule is checked
 //! the same way: a panic with the error when it does not match.
 
+use serde::Deserialize;
+
 use crate::error::SceneError;
 
 /// `text` with its one occurrence of `from` replaced by `to`; panics unless `from` occurs
 /// exactly once (an edit that silently missed would test the unedited scene).
 pub fn edit_once(text: &str, from: &str, to: &str) -> String {
-    assert_eq!(text.matches(from).count(), 1, "{from:?} must occur once");
-    text.replacen(from, to, 1)
+    edited(text, from, to).unwrap_or_else(|problem| panic!("{problem}"))
+}
+
+/// [`edit_once`], with the problem as an error instead of a panic.
+fn edited(text: &str, from: &str, to: &str) -> Result<String, String> {
+    match text.matches(from).count() {
+        1 => Ok(text.replacen(from, to, 1)),
+        n => Err(format!("{from:?} must occur once, occurs {n} times")),
+    }
 }
 
 /// `text` without each of `cuts`, each of which must occur exactly once (see [`edit_once`]).
@@ -20,16 +29,36 @@ pub fn without(text: &str, cuts: &[&str]) -> String {
 /// that what it allows contains `allowed`, and that the displayed message starts with
 /// `FILE: FIELD = VALUE: ` and contains all four parts.
 pub fn check_invalid(err: &SceneError, file: &str, field: &str, value: &str, allowed: &str) {
-    let SceneError::Invalid { file: f, field: fd, value: v, allowed: a } = err else {
-        panic!("expected Invalid on {field}, got {err:?}");
-    };
-    assert_eq!((f.as_str(), fd.as_str(), v.as_str()), (file, field, value), "{err}");
-    assert!(a.contains(allowed), "allowed {a:?} lacks {allowed:?}");
-    let shown = err.to_string();
-    for part in [file, field, value, allowed] {
-        assert!(shown.contains(part), "{shown:?} lacks {part:?}");
+    if let Err(problem) = invalid_mismatch(err, file, field, value, allowed) {
+        panic!("{problem}");
     }
-    assert!(shown.starts_with(&format!("{file}: {field} = {value}: ")), "{shown}");
+}
+
+/// What [`check_invalid`] asserts, with the first mismatch as an error.
+fn invalid_mismatch(
+    err: &SceneError,
+    file: &str,
+    field: &str,
+    value: &str,
+    allowed: &str,
+) -> Result<(), String> {
+    let SceneError::Invalid { file: f, field: fd, value: v, allowed: a } = err else {
+        return Err(format!("expected Invalid on {field}, got {err:?}"));
+    };
+    if (f.as_str(), fd.as_str(), v.as_str()) != (file, field, value) {
+        return Err(format!("expected {file}: {field} = {value}, got {err}"));
+    }
+    if !a.contains(allowed) {
+        return Err(format!("allowed {a:?} lacks {allowed:?}"));
+    }
+    let shown = err.to_string();
+    if let Some(part) = [file, field, value, allowed].into_iter().find(|part| !shown.contains(part)) {
+        return Err(format!("{shown:?} lacks {part:?}"));
+    }
+    if !shown.starts_with(&format!("{file}: {field} = {value}: ")) {
+        return Err(format!("{shown:?} does not start with {file}: {field} = {value}: "));
+    }
+    Ok(())
 }
 
 /// A shipped scene file (`scenes/NAME`, found from any crate's tests) at a test's resolution;
@@ -41,15 +70,6 @@ pub fn shipped_scene(name: &str, width: u32, height: u32) -> crate::Scene {
     scene.camera.height = height;
     scene
 }
-
-/// A refusal an error test expects: `(from, to, field, value, allowed)`, the base scene with
-/// `from` replaced by `to` must fail on `field`, showing `value`, allowing `allowed` (see
-/// [`check_invalid`]).
-pub type InvalidEdit<'a> = (&'a str, &'a str, &'a str, &'a str, &'a str);
-
-/// A refusal of one value: `(value, shown, allowed)`, written in place of a line's value (see
-/// [`Edits::expect_invalid_values`]).
-pub type InvalidValue<'a> = (&'a str, &'a str, &'a str);
 
 /// What an error test edits and how it loads the result: a valid scene text, the file label
 /// its errors name, and the loader (`Scene::from_toml_str`, or a renderer's view of a scene).
@@ -83,19 +103,88 @@ impl<T: std::fmt::Debug> Edits<T> {
         }
     }
 
-    /// [`Edits::expect_invalid`] for each edit of the base in `cases`.
-    pub fn expect_invalid_edits(&self, cases: &[InvalidEdit]) {
-        for &(from, to, field, value, allowed) in cases {
-            self.expect_invalid(&self.edit(from, to), field, value, allowed);
-        }
+    /// Checks every case of a refusals file (`cases`, the text of the TOML file `cases_file`): the
+    /// base edited as a case says must be refused as it says. The file is a list of `[[rule]]`
+    /// tables, each with a `name` and its `[[rule.case]]`s (or a `case = [...]` array). A case is
+    /// an edit of the base, `from` (text that must occur in it once) replaced by `to`, and the
+    /// error it must give: `field`, `value` and `allowed` as for [`check_invalid`], or `syntax`,
+    /// text the syntax error's message must contain. A rule's `from`, `field` and `allowed`
+    /// stand for each of its cases that does not give its own. A failure names the rule and the
+    /// edit of every failing case, not only the first.
+    pub fn expect_refusals(&self, cases: &str, cases_file: &str) {
+        let refusals: Refusals = toml::from_str(cases).unwrap_or_else(|e| panic!("{cases_file}: {e}"));
+        let cases = refusals.rule.iter().flat_map(|rule| rule.case.iter().map(move |case| (rule, case)));
+        let failures: Vec<String> = cases
+            .clone()
+            .filter_map(|(rule, case)| {
+                let problem = self.refusal(rule, case).err()?;
+                let from = case.from.as_ref().or(rule.from.as_ref());
+                Some(format!("rule {:?}, {from:?} -> {:?}: {problem}", rule.name, case.to))
+            })
+            .collect();
+        let checked = cases.count();
+        assert!(checked > 0, "{cases_file} has no cases");
+        assert!(
+            failures.is_empty(),
+            "{cases_file}: {} of {checked} cases failed:\n{}",
+            failures.len(),
+            failures.join("\n")
+        );
     }
 
-    /// `line` is a `KEY = VALUE` line of the base; for each `(value, shown, allowed)` in `cases`,
-    /// the base with `KEY = value` in its place must fail on `field`.
-    pub fn expect_invalid_values(&self, line: &str, field: &str, cases: &[InvalidValue]) {
-        let (key, _) = line.split_once(" = ").unwrap_or_else(|| panic!("{line:?} is not KEY = VALUE"));
-        for &(value, shown, allowed) in cases {
-            self.expect_invalid(&self.edit(line, &format!("{key} = {value}")), field, shown, allowed);
+    /// Checks one case of [`Edits::expect_refusals`].
+    fn refusal(&self, rule: &Rule, case: &Case) -> Result<(), String> {
+        let given = |own: &Option<String>, default: &Option<String>, key: &str| {
+            own.clone().or_else(|| default.clone()).ok_or_else(|| format!("the case gives no {key}"))
+        };
+        let text = edited(self.base, &given(&case.from, &rule.from, "from")?, &case.to)?;
+        let Err(err) = self.parse(&text) else { return Err("the scene loaded".to_owned()) };
+        match &case.syntax {
+            Some(_) if case.field.is_some() || case.value.is_some() || case.allowed.is_some() => {
+                Err("a syntax case gives a field, value or allowed text".to_owned())
+            }
+            Some(needle) => match &err {
+                SceneError::Syntax { message, .. } if message.contains(needle.as_str()) => Ok(()),
+                _ => Err(format!("expected a syntax error containing {needle:?}, got {err:?}")),
+            },
+            None => invalid_mismatch(
+                &err,
+                self.file,
+                &given(&case.field, &rule.field, "field")?,
+                &given(&case.value, &None, "value")?,
+                &given(&case.allowed, &rule.allowed, "allowed")?,
+            ),
         }
     }
+}
+
+/// A refusals file, as [`Edits::expect_refusals`] describes it.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Refusals {
+    rule: Vec<Rule>,
+}
+
+/// One rule of a [`Refusals`] file.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Rule {
+    /// What the rule is, as a failure names it.
+    name: String,
+    from: Option<String>,
+    field: Option<String>,
+    allowed: Option<String>,
+    case: Vec<Case>,
+}
+
+/// One case of a [`Rule`].
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Case {
+    from: Option<String>,
+    to: String,
+    field: Option<String>,
+    value: Option<String>,
+    allowed: Option<String>,
+    syntax: Option<String>,
 }
