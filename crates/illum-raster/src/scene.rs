@@ -16,17 +16,21 @@ use illum_scene::{
     fmt_f32, toml_key,
 };
 
-/// What the rasterizer implements.
-pub const FEATURES: &[Feature] = &[
-    Feature::QuadShape,
-    Feature::SphereShape,
-    Feature::Lambertian,
-    Feature::Checker,
-    Feature::Dielectric,
-    Feature::Mirror,
-    Feature::DeltaDirectionalLight,
-    Feature::Environment,
-];
+/// Whether the rasterizer implements `feature`. A match rather than a list, so that a feature
+/// added to the scene model does not compile until it is decided for the rasterizer.
+pub fn implements(feature: Feature) -> bool {
+    match feature {
+        Feature::QuadShape
+        | Feature::SphereShape
+        | Feature::Lambertian
+        | Feature::Checker
+        | Feature::Dielectric
+        | Feature::Mirror
+        | Feature::DeltaDirectionalLight
+        | Feature::Environment => true,
+        Feature::BoxShape | Feature::AreaLight | Feature::SunDisc => false,
+    }
+}
 
 /// A scene the rasterizer can draw.
 #[derive(Clone, Debug, PartialEq)]
@@ -161,7 +165,7 @@ impl RasterScene {
 
     /// The rasterizer's view of `scene`, or why it cannot draw it.
     pub fn from_scene(scene: &Scene) -> Result<RasterScene, SceneError> {
-        scene.require(RendererKind::Raster, FEATURES)?;
+        scene.require_where(RendererKind::Raster.noun(), implements)?;
         let file = scene.source.as_str();
         let needs = |field: &str, what: &str| {
             SceneError::invalid(file, field, "(missing)", format!("the rasterizer needs {what}"))
