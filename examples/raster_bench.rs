@@ -82,9 +82,9 @@ fn bench_one(
     println!(
         "{} {}x{} look {}, {} (shadow map {}^2, cube faces {}^2, {} frames): median frame {:.2} ms = {:.1} fps (min {:.2}, max {:.2})",
         scene.name,
-        report.width,
-        report.height,
-        report.options.look,
+        args.width,
+        args.height,
+        options.look,
         motion.describe(),
         report.shadow_map_size,
         report.cube_size,

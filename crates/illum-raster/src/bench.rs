@@ -50,13 +50,9 @@ impl Motion {
     }
 }
 
-/// What [`bench_frames`] measured.
+/// What [`bench_frames`] measured (what it was asked to render, the caller has).
 #[derive(Clone, Debug)]
 pub struct BenchReport {
-    pub width: u32,
-    pub height: u32,
-    pub options: Options,
-    pub motion: Motion,
     /// Wall time of each measured frame, in milliseconds, in the order they ran.
     pub frame_ms: Vec<f64>,
     /// Per-frame pass times (empty without timestamp queries).
@@ -123,10 +119,6 @@ pub fn bench_frames(
         pass_ms.extend(times);
     }
     Ok(BenchReport {
-        width,
-        height,
-        options: *options,
-        motion,
         frame_ms,
         pass_ms,
         shadow_map_size: renderer.shadow_map_resolution().0,
