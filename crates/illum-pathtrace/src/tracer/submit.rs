@@ -95,18 +95,19 @@ impl PathTracer {
         let folded = match &band.readback {
             Readback::Staging(staging) => {
                 readback::with_mapped(&gpu, staging, band.staging_size, context, |data| {
-                    let (sums, rest) = data.split_at(bytes as usize);
-                    let (sums_sq, timestamps) = rest.split_at(bytes as usize);
-                    self.launch_ahead_and_finish(&band, sums, sums_sq, timestamps)
+                    self.launch_ahead_and_finish(&band, BandBytes::split(data, bytes as usize))
                 })
             }
             Readback::Mapped { sum, sum_sq, timestamps } => {
                 readback::with_mapped(&gpu, sum, bytes, context, |sums| {
                     readback::with_mapped(&gpu, sum_sq, bytes, context, |sums_sq| match timestamps {
                         Some(t) => readback::with_mapped(&gpu, t, t.size(), context, |timestamps| {
-                            self.launch_ahead_and_finish(&band, sums, sums_sq, timestamps)
+                            self.launch_ahead_and_finish(&band, BandBytes { sums, sums_sq, timestamps })
                         }),
-                        None => Ok(self.launch_ahead_and_finish(&band, sums, sums_sq, &[])),
+                        None => {
+                            Ok(self
+                                .launch_ahead_and_finish(&band, BandBytes { sums, sums_sq, timestamps: &[] }))
+                        }
                     })
                 })
                 .and_then(|mapped| mapped)
@@ -132,18 +133,17 @@ impl PathTracer {
     fn launch_ahead_and_finish(
         &mut self,
         band: &Band,
-        sums: &[u8],
-        sums_sq: &[u8],
-        timestamps: &[u8],
+        bytes: BandBytes,
     ) -> Result<StepReport, PathTraceError> {
         let launched = self.launch_ahead(band);
         // Folded even when the next band could not be launched: its error comes after.
-        let folded = self.finish_band(band, sums, sums_sq, timestamps);
+        let folded = self.finish_band(band, bytes);
         folded.and_then(|report| launched.map(|()| report))
     }
 
-    /// Submits the pass's next band, if `band` is not its last, into the spare staging buffer
-    /// (the caustic's passes fold frames traced per pass and are left serial).
+    /// Submits the pass's next band, if `band` is not its last, into the spare staging buffer or,
+    /// with mapped readback, the other set of batch buffers (the caustic's passes fold frames
+    /// traced per pass and are left serial).
     fn launch_ahead(&mut self, band: &Band) -> Result<(), PathTraceError> {
         let height = self.scene.camera.height;
         if self.caustic.is_some() || band.row_offset + band.rows >= height {
@@ -166,8 +166,7 @@ impl PathTracer {
         let data = result?;
         self.staging = Some(flight.read.into_buffer());
         let bytes = flight.band.bytes as usize;
-        let report =
-            self.finish_band(&flight.band, &data[..bytes], &data[bytes..2 * bytes], &data[2 * bytes..])?;
+        let report = self.finish_band(&flight.band, BandBytes::split(&data, bytes))?;
         // The next band of this pass goes to the GPU now, so that it works while the page
         // draws its next frame (a new pass waits for the next call, which checks the target).
         if self.pass.is_some() {
@@ -279,17 +278,11 @@ impl PathTracer {
 
     /// Checks and folds a band's read-back bytes (its sums, sums of squares and timestamps), and
     /// moves the pass on.
-    fn finish_band(
-        &mut self,
-        band: &Band,
-        sums: &[u8],
-        sums_sq: &[u8],
-        timestamps: &[u8],
-    ) -> Result<StepReport, PathTraceError> {
+    fn finish_band(&mut self, band: &Band, bytes: BandBytes) -> Result<StepReport, PathTraceError> {
         let Band { started, row_offset, rows, spp, chunk, chunks, band_pixels, .. } = *band;
         let width = self.scene.camera.width;
         let height = self.scene.camera.height;
-        let (sums, sums_sq) = (batch::slots(sums), batch::slots(sums_sq));
+        let (sums, sums_sq) = (batch::slots(bytes.sums), batch::slots(bytes.sums_sq));
         let (sums, sums_sq) = (&sums[..], &sums_sq[..]);
         if let Err(error) = batch::check_complete(sums, sums_sq, spp, chunk, band_pixels) {
             // The accumulator drops this band, but the display pass already added it: set the
@@ -314,7 +307,7 @@ impl PathTracer {
         if let (Some(display), Some(_)) = (&self.display_sum, &self.caustic) {
             display.seed(&self.gpu, &self.accumulator, self.radiance_exponent);
         }
-        let gpu_seconds = self.timer.decode(timestamps).map(|timings| timings[0].1 * 1e-3);
+        let gpu_seconds = self.timer.decode(bytes.timestamps).map(|timings| timings[0].1 * 1e-3);
 
         let pass = self.pass.as_mut().expect("still active");
         pass.next_row += rows;
@@ -358,6 +351,23 @@ pub(super) struct Band {
     /// Bytes of the staging copy (0 when mapped where the GPU wrote them).
     staging_size: u64,
     readback: Readback,
+}
+
+/// A band's read-back bytes: its sums, its sums of squares (slot by slot, as the shader wrote
+/// them) and its timestamps (empty when the device has none).
+pub(super) struct BandBytes<'a> {
+    sums: &'a [u8],
+    sums_sq: &'a [u8],
+    timestamps: &'a [u8],
+}
+
+impl<'a> BandBytes<'a> {
+    /// The staging copy's layout: `bytes` of sums, `bytes` of sums of squares, the timestamps.
+    fn split(data: &'a [u8], bytes: usize) -> Self {
+        let (sums, rest) = data.split_at(bytes);
+        let (sums_sq, timestamps) = rest.split_at(bytes);
+        BandBytes { sums, sums_sq, timestamps }
+    }
 }
 
 /// Where a band's results are read.
