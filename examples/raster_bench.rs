@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! cargo run --release --example raster_bench -- [SCENE] [--width 1280 --height 720]
-//!     [--frames 60] [--warmup 5] [--look figure|enhanced] [--cube-size N] [--no-msaa] ...
+//!     [--frames 60] [--warmup 5] [--look figure|enhanced] [--cube-size N] [--no-antialiasing] ...
 //! ```
 //! Renders `frames` frames (after `warmup` untimed ones) without reading them back and prints the
 //! median frame time, frames per second, and the median GPU time of each pass (shadow map, the

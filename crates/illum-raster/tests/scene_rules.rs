@@ -85,7 +85,7 @@ fn base_scene_loads_with_the_written_values() {
     assert_eq!(s.look, Look::Enhanced);
     assert_eq!((s.camera.width, s.camera.height), (64, 36));
     assert_eq!((s.clip.near, s.clip.far), (0.1, 3000.0));
-    assert_eq!(s.effects, Effects { pcf: false, msaa: false, ..Effects::ALL_ON });
+    assert_eq!(s.effects, Effects { pcf: false, antialiasing: false, ..Effects::ALL_ON });
     assert_eq!(s.quality.cube_size, 128);
     assert_eq!(s.quality.pcf_radius, 0.05);
     assert_eq!(s.background, Vec3::new(0.3, 0.5, 0.9));
@@ -665,11 +665,25 @@ fn clip_planes_and_a_delta_light_are_required() {
 }
 
 #[test]
+fn antialiasing_is_read_under_its_name_and_its_former_one() {
+    // tests/scenes/w.toml says `msaa = false`, the key's name before edges were anti-aliased
+    // analytically; old files keep loading with the same meaning (anti-aliased edges or not).
+    for (key, on) in [("msaa = false", false), ("msaa = true", true), ("antialiasing = false", false)] {
+        let s = parse(&edit("msaa = false", key)).unwrap_or_else(|e| panic!("{key}: {e}"));
+        assert_eq!(s.effects.antialiasing, on, "{key}");
+    }
+    assert!(parse(&edit("msaa = false\n", "")).unwrap().effects.antialiasing, "on when absent");
+}
+
+#[test]
 fn unknown_and_mistyped_keys_are_syntax_errors() {
     for (from, to, needle) in [
         ("weight = 0.6 }", "weight = 0.6, roughness = 0.1 }", "unknown field `roughness`"),
         ("msaa = false", "msaa = false\nbloom = true", "unknown field `bloom`"),
         ("msaa = false", "msaa = \"no\"", "expected a boolean"),
+        ("msaa = false", "antialiasing = 4", "expected a boolean"),
+        // The former name and the new one together: one key written twice.
+        ("msaa = false", "msaa = false\nantialiasing = true", "duplicate field `antialiasing`"),
         ("cube_size = 128", "cube_size = 12.5", "expected an integer"),
         ("[raster.effects]", "[raster.effect]", "unknown field `effect`"),
         ("[shading]", "[shadng]", "unknown field `shadng`"),
