@@ -20,7 +20,8 @@ use crate::{HEIGHT, WIDTH, render, scene};
 /// Largest difference allowed on an edge pixel, in 8-bit levels. The shader's coverage is exact
 /// for a straight edge (edge_coverage in scene.wgsl); what remains: the output's rounding to 8
 /// bits, twice where a sphere blends over a floor that was itself rounded (1 level), the
-/// silhouette's curvature within a pixel (about 1 / (8 R) with R = 47 pixels here: 0.7 level),
+/// silhouette's curvature within a pixel (about 1 / (8 R), R = 50 and 27 pixels here: up to 1.2
+/// levels),
 /// and this test's sampling grid (up to 2 levels on an edge along a pixel axis). A common
 /// approximation, coverage = clamp(1/2 + distance / |gradient|), is off by up to 0.043 (11 levels) at
 /// 45 degrees, and a jagged edge by up to half the contrast.
