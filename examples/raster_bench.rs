@@ -2,11 +2,11 @@
 //!
 //! ```text
 //! cargo run --release --example raster_bench -- [SCENE] [--width 1280 --height 720]
-//!     [--frames 60] [--warmup 5] [--look figure|enhanced] [--cube-size N] [--no-msaa] ...
+//!     [--frames 60] [--warmup 5] [--look figure|enhanced] [--cube-size N] [--no-antialiasing] ...
 //! ```
 //! Renders `frames` frames (after `warmup` untimed ones) without reading them back and prints the
 //! median frame time, frames per second, and the median GPU time of each pass (shadow map, the
-//! cube-map faces together, main pass with MSAA resolve) from timestamp queries, twice: with the
+//! cube-map faces together, the main pass) from timestamp queries, twice: with the
 //! camera orbiting an unchanged scene (a viewer's steady state: the shadow and cube maps are
 //! reused) and with the scene changing every frame (every map made again). With no
 //! flags: `scenes/whitted.toml` at 1280 x 720, enhanced look, every effect on. Timings are never

@@ -55,7 +55,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         ("enhanced, no Fresnel", with(Look::Enhanced, |e| e.fresnel = false)),
         ("figure, no shadows", with(Look::Figure, |e| e.shadows = false)),
         ("figure, no PCF", with(Look::Figure, |e| e.pcf = false)),
-        ("figure, no MSAA", with(Look::Figure, |e| e.msaa = false)),
+        ("figure, no anti-aliasing", with(Look::Figure, |e| e.antialiasing = false)),
     ];
     let mut small = RasterRenderer::new(&gpu, &scene, 400, 225)?;
     let mut images = Vec::new();

@@ -9,7 +9,7 @@
 //! With no arguments it renders `scenes/cornell.toml` to `out/cornell.png` and `out/cornell.exr`.
 //! `--renderer raster|pathtrace` picks the renderer; the default is the scene file's `renderer`
 //! (`scenes/whitted.toml` says `raster`). The rasterizer takes `[--look figure|enhanced]
-//! [--no-shadows] [--no-pcf] [--no-refraction] [--no-reflection] [--no-fresnel] [--no-msaa]`
+//! [--no-shadows] [--no-pcf] [--no-refraction] [--no-reflection] [--no-fresnel] [--no-antialiasing]`
 //! (see `illum::raster_cli`). A renderer given a scene it cannot render says what it lacks.
 //!
 //! Stop rules: without `--target-error` or `--time-budget` the render stops at `--spp` (or the

@@ -37,9 +37,10 @@ pub struct RasterArgs {
     /// Rasterizer scenes (enhanced look): the glass reflects its normal-incidence fraction everywhere.
     #[arg(long)]
     pub no_fresnel: bool,
-    /// Rasterizer scenes: one sample per pixel instead of 4x MSAA.
-    #[arg(long)]
-    pub no_msaa: bool,
+    /// Rasterizer scenes: jagged edges (each pixel shows what the ray through its centre meets)
+    /// instead of edges blended by their coverage. `--no-msaa`, its former name, still works.
+    #[arg(long, alias = "no-msaa")]
+    pub no_antialiasing: bool,
 }
 
 impl RasterArgs {
@@ -52,7 +53,7 @@ impl RasterArgs {
             (self.no_refraction, "--no-refraction"),
             (self.no_reflection, "--no-reflection"),
             (self.no_fresnel, "--no-fresnel"),
-            (self.no_msaa, "--no-msaa"),
+            (self.no_antialiasing, "--no-antialiasing"),
         ])
     }
 
@@ -68,7 +69,7 @@ impl RasterArgs {
         e.refraction &= !self.no_refraction;
         e.reflection &= !self.no_reflection;
         e.fresnel &= !self.no_fresnel;
-        e.msaa &= !self.no_msaa;
+        e.antialiasing &= !self.no_antialiasing;
         options
     }
 
@@ -100,7 +101,7 @@ fn prepare(request: &RasterRequest) -> anyhow::Result<(RasterScene, Options, Vec
         bail!(
             "{}: {} {} only to the path tracer; this render uses the rasterizer (--renderer raster), \
              whose flags are --look, --no-shadows, --no-pcf, --no-refraction, --no-reflection, \
-             --no-fresnel, --no-msaa, --width, --height, --encoding, --exposure, -o",
+             --no-fresnel, --no-antialiasing, --width, --height, --encoding, --exposure, -o",
             request.scene.display(),
             flags.join(", "),
             cli::verb(flags.len())
@@ -134,7 +135,7 @@ fn describe(options: &Options) -> String {
         (e.refraction, "refraction"),
         (e.reflection && options.look == Look::Enhanced, "reflection"),
         (e.fresnel && options.look == Look::Enhanced, "fresnel"),
-        (e.msaa, "msaa"),
+        (e.antialiasing, "antialiasing"),
     ]
     .into_iter()
     .filter_map(|(on, name)| on.then_some(name))
@@ -144,6 +145,15 @@ fn describe(options: &Options) -> String {
         options.look,
         if effects.is_empty() { "none".into() } else { effects.join(" ") }
     )
+}
+
+/// The `antialiasing` metadata field: how the frame's edges were drawn.
+fn antialiasing(options: &Options) -> &'static str {
+    if options.effects.antialiasing {
+        "analytic coverage, 1 sample per pixel"
+    } else {
+        "off, 1 sample per pixel"
+    }
 }
 
 fn render_prepared(
@@ -172,7 +182,7 @@ fn render_prepared(
         fields: vec![
             ("look".into(), options.look.to_string()),
             ("options".into(), describe(options)),
-            ("msaa_samples".into(), options.samples().to_string()),
+            ("antialiasing".into(), antialiasing(options).into()),
             ("adapter".into(), gpu.adapter_info.name.clone()),
         ],
     };

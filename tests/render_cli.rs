@@ -200,6 +200,8 @@ fn raster_scenes_refuse_path_tracer_flags_and_write_their_own_metadata() {
         assert!(meta.get(key).is_none(), "a raster EXR carries the path tracer's illum.{key}: {meta:?}");
     }
     assert_eq!(field(&meta, "look"), "figure");
+    // --no-msaa is the former name of --no-antialiasing.
+    assert_eq!(field(&meta, "antialiasing"), "off, 1 sample per pixel");
 }
 
 /// Starts a long render with pass logging on, and waits until `passes` passes are complete
@@ -658,7 +660,7 @@ fn the_whitted_ray_tracer_renders_both_scenes_and_refuses_the_other_renderers_fl
     // Flags of the other renderers, and out-of-range values, are refused before rendering.
     for (args, expected) in [
         (vec!["--renderer", "whitted", "--spp", "4"], "--spp applies to the other renderers"),
-        (vec!["--renderer", "whitted", "--no-msaa"], "--no-msaa applies to the other renderers"),
+        (vec!["--renderer", "whitted", "--no-msaa"], "--no-antialiasing applies to the other renderers"),
         (vec!["--renderer", "whitted", "--depth", "65"], "--depth = 65: must be an integer in 0..=64"),
         (vec!["--renderer", "whitted", "--aa", "0"], "--aa = 0: must be an integer in 1..=16"),
         (vec!["--depth", "2"], "--depth applies only to the Whitted ray tracer"),

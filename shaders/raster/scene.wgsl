@@ -66,12 +66,18 @@ struct Scene {
     // x: the angle (radians) one texel of the glass's cube map spans at a face's centre,
     // y: log2 of the side ratio between that cube map and its coarse copy.
     env_params: vec4<f32>,
+    // Column i, xyz: the normal of the plane through the main view's eye and the floor
+    // rectangle's edge i, pointing inward (uniforms.rs floor_edges), for the floor's anti-aliased
+    // outline.
+    floor_edges: mat4x4<f32>,
 }
 
 struct View {
     // World -> clip space of this view.
     view_proj: mat4x4<f32>,
     // Perspective views: xyz = the eye. The shadow view: xyz = the light's travel direction.
+    // w: the main view: the angle one pixel spans at the image centre (2 tan(vfov / 2) / height),
+    // by which the drawn shapes grow to reach every pixel an edge partly covers; other views: 0.
     eye: vec4<f32>,
 }
 
@@ -115,3 +121,36 @@ fn quad_corner(i: u32) -> vec2<f32> {
     );
     return corners[min(i, 5u)];
 }
+
+// The fraction of a pixel's square on the positive side of a straight edge, exactly. Across the
+// pixel the edge's function is f + a u + b v (u, v in [-1/2, 1/2]: the offset from the pixel
+// centre in pixels; f the value at the centre, a and b its screen derivatives, in any one unit).
+// u and v are uniform and independent, so a u + b v has a trapezoidal density (two boxes of widths
+// |a| and |b| convolved): flat at 1 / max over the middle |a| - |b| wide, falling linearly over
+// min on either side. Its distribution function is linear on the flat part and quadratic on the
+// ramps. This is the exact box-filtered coverage of a half-plane, not the common clamp(0.5 + f /
+// |grad|), which is exact only for edges along a pixel axis (off by up to 1/8 at 45 degrees).
+fn edge_coverage(f: f32, a: f32, b: f32) -> f32 {
+    let wide = max(abs(a), abs(b));
+    let narrow = min(abs(a), abs(b));
+    if wide <= 0.0 {
+        return select(0.0, 1.0, f > 0.0);
+    }
+    let half_width = 0.5 * (wide + narrow);
+    let flat = 0.5 * (wide - narrow);
+    let y = min(abs(f), half_width);
+    var covered: f32;
+    if y <= flat {
+        covered = 0.5 + y / wide;
+    } else {
+        // On a ramp, so narrow > 0: y - flat <= narrow.
+        let g = half_width - y;
+        covered = 1.0 - g * g / (2.0 * wide * narrow);
+    }
+    return select(1.0 - covered, covered, f >= 0.0);
+}
+
+// How far, in pixels, the main view's shapes grow past their exact outline so that every pixel an
+// edge crosses gets a fragment (it needs half a pixel's diagonal, 0.71; the rest is slack for the
+// estimate of a pixel's size).
+const EDGE_REACH_PIXELS: f32 = 1.5;

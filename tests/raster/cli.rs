@@ -32,7 +32,7 @@ fn a_raster_render_writes_a_linear_png() {
     let out = vec![dir.path().join("w.png")];
     let settings = SceneArgs { width: Some(96), height: Some(54), ..Default::default() };
     let raster =
-        RasterArgs { look: Some(illum::raster::Look::Enhanced), no_msaa: true, ..Default::default() };
+        RasterArgs { look: Some(illum::raster::Look::Enhanced), no_antialiasing: true, ..Default::default() };
     render_raster_with(common::gpu(), &request(&settings, &raster, &out)).unwrap_or_else(|e| panic!("{e:#}"));
     let png = image::open(&out[0]).expect("the PNG exists").to_rgb8();
     assert_eq!(png.dimensions(), (96, 54));
@@ -78,8 +78,9 @@ fn path_tracer_flags_and_bad_outputs_are_refused_before_rendering() {
 
 #[test]
 fn raster_flags_are_refused_for_a_path_tracer_scene() {
-    let raster = RasterArgs { no_msaa: true, look: Some(illum::raster::Look::Figure), ..Default::default() };
+    let raster =
+        RasterArgs { no_antialiasing: true, look: Some(illum::raster::Look::Figure), ..Default::default() };
     let error = raster.reject_for_path_tracer(Path::new("scenes/cornell.toml")).unwrap_err().to_string();
-    assert!(error.contains("--look, --no-msaa apply only to the rasterizer"), "{error}");
+    assert!(error.contains("--look, --no-antialiasing apply only to the rasterizer"), "{error}");
     RasterArgs::default().reject_for_path_tracer(Path::new("scenes/cornell.toml")).unwrap();
 }

@@ -1,5 +1,5 @@
 //! Every effect toggle changes the picture where it should and nowhere else; shadows leave the
-//! lit spheres untouched (no acne); MSAA changes only pixels on an edge.
+//! lit spheres untouched (no acne); anti-aliasing changes only pixels on an edge.
 
 use illum::image::RgbImage32;
 use illum::raster::RasterScene;
@@ -128,20 +128,24 @@ fn shadows_leave_the_lit_metal_untouched() {
 }
 
 #[test]
-fn msaa_changes_only_pixels_on_an_edge() {
+fn antialiasing_changes_only_pixels_on_an_edge() {
     let s = scene();
     for look in Look::ALL {
         let on = render(&s, &Options::all_on(look));
-        let off = render(&s, &with(look, |e| e.msaa = false));
+        let off = render(&s, &with(look, |e| e.antialiasing = false));
         let differing = changed(&on, &off);
         let inside: Vec<_> = differing.iter().filter(|(x, y)| interior(&s, *x, *y).is_some()).collect();
         assert!(
             inside.is_empty(),
-            "look {look}: MSAA changed {} pixels away from any edge, e.g. {:?}",
+            "look {look}: anti-aliasing changed {} pixels away from any edge, e.g. {:?}",
             inside.len(),
             &inside[..inside.len().min(5)]
         );
         // Silhouettes of both spheres and the floor's far edge: a few hundred pixels at this size.
-        assert!(differing.len() > 150, "look {look}: MSAA changed only {} edge pixels", differing.len());
+        assert!(
+            differing.len() > 150,
+            "look {look}: anti-aliasing changed only {} edge pixels",
+            differing.len()
+        );
     }
 }

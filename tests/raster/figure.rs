@@ -30,7 +30,7 @@ fn shadow_margin(scene: &RasterScene, p: Vec3, (c, r): (Vec3, f32)) -> f32 {
 }
 
 /// True when the floor is hit at pixel (px, py) and at its eight neighbours: no silhouette or
-/// floor edge (where MSAA blends) is within a pixel.
+/// floor edge (where anti-aliasing blends) is within a pixel.
 fn floor_interior(scene: &RasterScene, cam: &Camera, px: u32, py: u32) -> Option<Vec3> {
     let at =
         |dx: i32, dy: i32| floor_hit(scene, cam, px as f32 + 0.5 + dx as f32, py as f32 + 0.5 + dy as f32);

@@ -3,7 +3,9 @@
 //! - `reference`: both looks against checked-in 320 x 180 references, with a stated tolerance;
 //! - `figure`: checks of the figure look that need no reference: the floor's Lambert shading,
 //!   the background value, where the shadows fall, and the glass's 0.1 white + 0.9 environment;
-//! - `effects`: every toggle does what it says (and only that), no shadow acne, MSAA on edges;
+//! - `edges`: anti-aliased edges against their exact coverage, computed in f64;
+//! - `effects`: every toggle does what it says (and only that), no shadow acne, anti-aliasing
+//!   only on edges;
 //! - `extremes`: the scene at its extremes (low and high light, near and far
 //!   planes, the horizon, refraction ratio 1, total internal reflection), tabulated in
 //!   docs/accuracy.md;
@@ -25,6 +27,7 @@ use illum::scene::Camera;
 mod common;
 
 mod cli;
+mod edges;
 mod effects;
 mod extremes;
 mod figure;

@@ -3,8 +3,8 @@
 //!
 //! Tolerance, in 8-bit levels of the (linear) PNG: the mean absolute difference over all pixels
 //! and channels at most [`MAX_MEAN_LEVELS`], and the 99th percentile of each pixel's largest
-//! channel difference at most [`MAX_P99_LEVELS`]. A driver that rounds or places MSAA samples
-//! slightly differently moves edge pixels by a few levels; a wrong shadow, reflection or
+//! channel difference at most [`MAX_P99_LEVELS`]. A driver that rounds or blends edge pixels
+//! slightly differently moves them by a few levels; a wrong shadow, reflection or
 //! refraction moves thousands of pixels by tens of levels (`the_tolerance_tells_...` shows the
 //! metric catches that). The references are this renderer's output on lavapipe, checked in once
 //! the reference-free checks (`figure`, `effects`) held; regenerate them after an intended

@@ -22,22 +22,4 @@ impl Options {
     pub fn all_on(look: Look) -> Self {
         Options { look, effects: Effects::ALL_ON }
     }
-
-    /// Samples per pixel of the main pass.
-    pub fn samples(&self) -> u32 {
-        if self.effects.msaa { crate::MSAA_SAMPLES } else { 1 }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn msaa_sets_the_main_pass_samples() {
-        let mut o = Options::all_on(Look::Enhanced);
-        assert_eq!(o.samples(), 4);
-        o.effects.msaa = false;
-        assert_eq!(o.samples(), 1);
-    }
 }

@@ -10,7 +10,7 @@ pub struct PassTimes {
     /// The cube-map faces the frame captured: the glass's and its coarse copy's (twelve), and
     /// the metal's (six more, in the enhanced look with reflection).
     pub cube_ms: f64,
-    /// The main view, including the MSAA resolve.
+    /// The main view: the floor, then the spheres blended over it by their edge coverage.
     pub main_ms: f64,
 }
 

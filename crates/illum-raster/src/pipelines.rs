@@ -66,6 +66,31 @@ fn depth_state(compare: wgpu::CompareFunction) -> wgpu::DepthStencilState {
 const FLOOR_AFTER_RECEIVER_BIAS: wgpu::DepthBiasState =
     wgpu::DepthBiasState { constant: 16, slope_scale: 1.0, clamp: 0.0 };
 
+/// Anti-aliased edges: a sphere fragment's alpha is the fraction of its pixel that the sphere
+/// covers, and the sphere goes over what is already there (the floor and the background, and the
+/// sphere behind it), `colour x alpha + behind x (1 - alpha)`. The alpha channel composes the
+/// same way and stays 1 over the opaque background.
+const COVERAGE_BLEND: wgpu::BlendState = wgpu::BlendState {
+    color: wgpu::BlendComponent {
+        src_factor: wgpu::BlendFactor::SrcAlpha,
+        dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
+        operation: wgpu::BlendOperation::Add,
+    },
+    alpha: wgpu::BlendComponent {
+        src_factor: wgpu::BlendFactor::One,
+        dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
+        operation: wgpu::BlendOperation::Add,
+    },
+};
+
+/// Whether `key`'s pipeline blends. Only the spheres in an anti-aliased main view: the floor is
+/// drawn first, over nothing but the background, a constant, so its shader mixes its outline
+/// with the background itself and writes opaque pixels. Blending costs a read of the target for
+/// every fragment, and the floor fills half the frame.
+fn blends(key: &PipelineKey) -> bool {
+    key.target.antialiased() && matches!(key.surface, Surface::Glass | Surface::Metal)
+}
+
 /// Impostor squares and the floor rectangle are drawn from either side, and cube faces use
 /// mirrored frames (views.rs), so nothing is culled by winding.
 fn primitive() -> wgpu::PrimitiveState {
@@ -109,14 +134,14 @@ fn surface_pipeline(
             } else {
                 depth_state(wgpu::CompareFunction::Less)
             }),
-            multisample: wgpu::MultisampleState { count: key.target.samples(), ..Default::default() },
+            multisample: Default::default(),
             fragment: Some(wgpu::FragmentState {
                 module,
                 entry_point: Some("fs_main"),
                 compilation_options: options,
                 targets: &[Some(wgpu::ColorTargetState {
                     format,
-                    blend: None,
+                    blend: blends(key).then_some(COVERAGE_BLEND),
                     write_mask: wgpu::ColorWrites::ALL,
                 })],
             }),

@@ -269,13 +269,12 @@ impl RasterRenderer {
 
     /// Writes the frame's uniforms and records its passes.
     fn record(&mut self, options: &Options) -> Result<wgpu::CommandEncoder, RasterError> {
-        let samples = options.samples();
-        if self.main.as_ref().is_none_or(|m| m.samples != samples) {
-            crate::targets::check_main_targets(&self.gpu.device.limits(), self.width, self.height, samples)
+        if self.main.is_none() {
+            crate::targets::check_main_targets(&self.gpu.device.limits(), self.width, self.height)
                 .map_err(RasterError::Unsupported)?;
-            self.main = Some(MainTargets::new(&self.gpu, self.width, self.height, samples)?);
+            self.main = Some(MainTargets::new(&self.gpu, self.width, self.height)?);
         }
-        let main = Target::Main { samples };
+        let main = Target::main(options);
         let plan = self.plan(options);
         let views = ViewsKey::new(&self.scene, options, FramePlan { reuse_views: false, ..plan });
         if self.timer_plan != Some(plan) {
@@ -341,9 +340,11 @@ impl RasterRenderer {
             metal_capture_textures: &self.texture_groups.metal_capture,
             main_textures: &self.texture_groups.main,
             main_floor: get(keys.main_floor).expect("the main pass draws the floor"),
-            main_glass: get(keys.main_glass),
-            main_metal: get(keys.main_metal),
-            main_multisampled: main.multisampled.as_ref(),
+            main_spheres: if self.metal_behind_glass() {
+                [get(keys.main_metal), get(keys.main_glass)]
+            } else {
+                [get(keys.main_glass), get(keys.main_metal)]
+            },
             main_output: &main.output_view,
             main_depth: &main.depth,
             background: self.scene.background.to_array(),
@@ -353,13 +354,33 @@ impl RasterRenderer {
         Ok(encoder)
     }
 
+    /// Whether the main pass draws the metal sphere before the glass ([`crate::frame::metal_behind_glass`]).
+    fn metal_behind_glass(&self) -> bool {
+        let s = &self.scene;
+        match (&s.glass, &s.metal) {
+            (Some(glass), Some(metal)) => crate::frame::metal_behind_glass(
+                s.camera.eye,
+                (glass.center, glass.radius),
+                (metal.center, metal.radius),
+            ),
+            _ => false,
+        }
+    }
+
     fn write_uniforms(&self) {
         let scene = &self.scene;
         let mut views: [ViewUniform; VIEW_COUNT] = bytemuck::Zeroable::zeroed();
         views[MAIN_VIEW] =
-            uniforms::perspective_view(main_view_proj(scene, self.width, self.height), scene.camera.eye);
+            uniforms::perspective_view(main_view_proj(scene, self.width, self.height), scene.camera.eye, {
+                // 2 tan(vfov / 2) / height: the image plane at distance 1 is 2 tan(vfov / 2) high.
+                2.0 * scene.camera.basis().tan_half_fov / self.height as f32
+            });
         let cube_view = |center: Vec3, face: usize| {
-            uniforms::perspective_view(cube_face_view_proj(center, face, capture_clip(scene, center)), center)
+            uniforms::perspective_view(
+                cube_face_view_proj(center, face, capture_clip(scene, center)),
+                center,
+                0.0,
+            )
         };
         // An absent sphere's face views stay zero: no capture uses them.
         for face in 0..6 {

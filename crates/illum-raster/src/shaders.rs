@@ -8,7 +8,7 @@ use illum_gpu::shader::{self, ShaderFile};
 
 /// Uniform layout and helpers shared by every raster pass (`illum::raster::scene`).
 pub const SCENE_MODULE: ShaderFile = illum_gpu::shader_file!("shaders/raster/scene.wgsl");
-/// Sphere impostors: billboards, ray-sphere tests, MSAA coverage (`illum::raster::sphere`).
+/// Sphere impostors: billboards, ray-sphere tests, silhouette coverage (`illum::raster::sphere`).
 pub const SPHERE_MODULE: ShaderFile = illum_gpu::shader_file!("shaders/raster/sphere.wgsl");
 /// Shadows, the filtered checker, cube-map lookups and the two looks (`illum::raster::lighting`).
 pub const LIGHTING_MODULE: ShaderFile = illum_gpu::shader_file!("shaders/raster/lighting.wgsl");

@@ -16,7 +16,6 @@ fn texture(
     gpu: &GpuContext,
     label: &str,
     size: (u32, u32, u32),
-    samples: u32,
     format: wgpu::TextureFormat,
     usage: wgpu::TextureUsages,
 ) -> wgpu::Texture {
@@ -24,7 +23,7 @@ fn texture(
         label: Some(label),
         size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: size.2 },
         mip_level_count: 1,
-        sample_count: samples,
+        sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
         format,
         usage,
@@ -45,7 +44,6 @@ impl ShadowMap {
                 gpu,
                 "raster shadow map",
                 (size, size, 1),
-                1,
                 DEPTH_FORMAT,
                 wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
             );
@@ -85,7 +83,7 @@ impl CubeMap {
         usage: wgpu::TextureUsages,
     ) -> Result<Self, GpuError> {
         gpu.scoped(label, || {
-            let t = texture(gpu, label, (size, size, 6), 1, CUBE_FORMAT, usage);
+            let t = texture(gpu, label, (size, size, 6), CUBE_FORMAT, usage);
             let cube_view = t.create_view(&wgpu::TextureViewDescriptor {
                 label: Some(label),
                 dimension: Some(wgpu::TextureViewDimension::Cube),
@@ -144,7 +142,6 @@ fn cube_depth(gpu: &GpuContext, size: u32) -> Result<wgpu::TextureView, GpuError
             gpu,
             "raster cube depth",
             (size, size, 1),
-            1,
             DEPTH_FORMAT,
             wgpu::TextureUsages::RENDER_ATTACHMENT,
         )
@@ -152,81 +149,57 @@ fn cube_depth(gpu: &GpuContext, size: u32) -> Result<wgpu::TextureView, GpuError
     })
 }
 
-/// The main view's targets: the single-sample output (what is read back or shown) and, with
-/// MSAA, the multisampled colour buffer resolved into it; plus the depth buffer.
+/// The main view's targets: the single-sample output (what is read back or shown) and the depth
+/// buffer. Edges are anti-aliased by their analytic coverage, blended into the output, so one
+/// sample per pixel suffices.
 pub struct MainTargets {
-    pub samples: u32,
     pub output: wgpu::Texture,
     pub output_view: wgpu::TextureView,
-    /// With MSAA: the multisampled colour buffer.
-    pub multisampled: Option<wgpu::TextureView>,
     pub depth: wgpu::TextureView,
 }
 
-/// Checks the main targets of a `width` x `height` frame with `samples` samples per pixel
-/// before creating them: each texture must fit the device's largest single allocation.
-/// wgpu has no limit for a texture's bytes; `max_buffer_size` is the device's allocation limit
-/// that it does report, and a multisampled 16384 x 16384 target beyond it fails on lavapipe
-/// with an unhelpful "texture is invalid". The error names the size, the bytes and the way out.
-pub fn check_main_targets(
-    limits: &wgpu::Limits,
-    width: u32,
-    height: u32,
-    samples: u32,
-) -> Result<(), String> {
-    let pixels = u64::from(width) * u64::from(height);
-    let mut textures = vec![("output", pixels * 4), ("depth buffer", pixels * 4 * u64::from(samples))];
-    if samples > 1 {
-        textures.push(("multisampled colour buffer", pixels * 4 * u64::from(samples)));
-    }
-    for (name, bytes) in textures {
-        if bytes > limits.max_buffer_size {
-            let msaa = if samples > 1 { format!(" with {samples}x MSAA") } else { String::new() };
-            let hint = if samples > 1 {
-                "turn MSAA off (--no-msaa, or [raster.effects] msaa = false) or render"
-            } else {
-                "render"
-            };
-            return Err(format!(
-                "camera.width x camera.height = {width} x {height}{msaa}: the {name} needs {:.2} GiB, more than \
-                 the {:.2} GiB the device allows in one allocation (max_buffer_size); {hint} at a smaller size",
-                bytes as f64 / (1u64 << 30) as f64,
-                limits.max_buffer_size as f64 / (1u64 << 30) as f64,
-            ));
-        }
+/// Checks the main targets of a `width` x `height` frame before creating them: each texture must
+/// fit the device's largest single allocation. wgpu has no limit for a texture's bytes;
+/// `max_buffer_size` is the device's allocation limit that it does report, and a target beyond it
+/// fails on lavapipe with an unhelpful "texture is invalid". The error names the size, the bytes
+/// and the way out.
+pub fn check_main_targets(limits: &wgpu::Limits, width: u32, height: u32) -> Result<(), String> {
+    // The output (RGBA8) and the depth buffer (32-bit float) both take 4 bytes a pixel.
+    let bytes = u64::from(width) * u64::from(height) * 4;
+    if bytes > limits.max_buffer_size {
+        return Err(format!(
+            "camera.width x camera.height = {width} x {height}: the output and the depth buffer need \
+             {:.2} GiB each, more than the {:.2} GiB the device allows in one allocation \
+             (max_buffer_size); render at a smaller size",
+            bytes as f64 / (1u64 << 30) as f64,
+            limits.max_buffer_size as f64 / (1u64 << 30) as f64,
+        ));
     }
     Ok(())
 }
 
 impl MainTargets {
-    pub fn new(gpu: &GpuContext, width: u32, height: u32, samples: u32) -> Result<Self, GpuError> {
+    pub fn new(gpu: &GpuContext, width: u32, height: u32) -> Result<Self, GpuError> {
         gpu.scoped("creating the main render targets", || {
             let output = texture(
                 gpu,
                 "raster output",
                 (width, height, 1),
-                1,
                 OUTPUT_FORMAT,
                 wgpu::TextureUsages::RENDER_ATTACHMENT
                     | wgpu::TextureUsages::COPY_SRC
                     | wgpu::TextureUsages::TEXTURE_BINDING,
             );
             let output_view = output.create_view(&Default::default());
-            let multisampled = (samples > 1).then(|| {
-                let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
-                texture(gpu, "raster multisampled colour", (width, height, 1), samples, OUTPUT_FORMAT, usage)
-                    .create_view(&Default::default())
-            });
             let depth = texture(
                 gpu,
                 "raster main depth",
                 (width, height, 1),
-                samples,
                 DEPTH_FORMAT,
                 wgpu::TextureUsages::RENDER_ATTACHMENT,
             )
             .create_view(&Default::default());
-            MainTargets { samples, output, output_view, multisampled, depth }
+            MainTargets { output, output_view, depth }
         })
     }
 }
@@ -236,12 +209,12 @@ mod tests {
     use super::*;
 
     #[test]
-    fn multisampled_targets_beyond_one_allocation_are_refused_with_the_way_out() {
-        let limits = wgpu::Limits { max_buffer_size: 2 << 30, ..wgpu::Limits::default() };
-        let err = check_main_targets(&limits, 16384, 16384, 4).unwrap_err();
-        assert!(err.contains("16384 x 16384 with 4x MSAA") && err.contains("--no-msaa"), "{err}");
-        assert!(err.contains("4.00 GiB") && err.contains("2.00 GiB"), "{err}");
-        assert!(check_main_targets(&limits, 16384, 16384, 1).is_ok());
-        assert!(check_main_targets(&limits, 1280, 720, 4).is_ok());
+    fn targets_beyond_one_allocation_are_refused_with_the_way_out() {
+        let limits = wgpu::Limits { max_buffer_size: 512 << 20, ..wgpu::Limits::default() };
+        let err = check_main_targets(&limits, 16384, 16384).unwrap_err();
+        assert!(err.contains("16384 x 16384") && err.contains("smaller size"), "{err}");
+        assert!(err.contains("1.00 GiB") && err.contains("0.50 GiB"), "{err}");
+        assert!(check_main_targets(&limits, 8192, 8192).is_ok());
+        assert!(check_main_targets(&limits, 1280, 720).is_ok());
     }
 }

@@ -34,6 +34,7 @@ pub struct SceneUniform {
     pub shadow_view_proj: [[f32; 4]; 4],
     pub shadow_params: [f32; 4],
     pub env_params: [f32; 4],
+    pub floor_edges: [[f32; 4]; 4],
 }
 
 /// Mirrors `struct View` in scene.wgsl.
@@ -115,12 +116,42 @@ pub fn scene_uniform(scene: &RasterScene, shadow: &ShadowFit) -> SceneUniform {
         shadow_view_proj: shadow.view_proj.to_cols_array_2d(),
         shadow_params: [normal_offset, SHADOW_DEPTH_BIAS, 0.0, 0.0],
         env_params: env_params(scene.quality.cube_size),
+        floor_edges: floor_edges(scene),
     }
 }
 
-/// A perspective view from `eye`.
-pub fn perspective_view(view_proj: Mat4, eye: Vec3) -> ViewUniform {
-    ViewUniform { view_proj: view_proj.to_cols_array_2d(), eye: v4(eye, 1.0) }
+/// `Scene.floor_edges`: for each edge of the floor's rectangle, the normal of the plane through
+/// the main view's eye and that edge, pointing to the rectangle's side (zero when the eye is on
+/// the edge's line). A floor point p is inside the rectangle when n . (p - eye) >= 0 for all
+/// four; divided by p's clip w (its distance along the view axis, so constant along each pixel's
+/// ray) this is an affine function of the pixel position, whose value and screen derivatives
+/// give each edge's exact coverage (floor.wgsl). Computed in f64 from the scene's numbers.
+fn floor_edges(scene: &RasterScene) -> [[f32; 4]; 4] {
+    let floor = &scene.floor;
+    let (lo, hi) = (floor.min_corner().as_dvec2(), floor.max_corner().as_dvec2());
+    let h = f64::from(floor.height());
+    let eye = scene.camera.eye.as_dvec3();
+    let corner = |x: f64, z: f64| glam::DVec3::new(x, h, z) - eye;
+    let centre = corner(0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y));
+    let edges = [
+        (corner(lo.x, lo.y), corner(lo.x, hi.y)),
+        (corner(hi.x, lo.y), corner(hi.x, hi.y)),
+        (corner(lo.x, lo.y), corner(hi.x, lo.y)),
+        (corner(lo.x, hi.y), corner(hi.x, hi.y)),
+    ];
+    edges.map(|(a, b)| {
+        let n = a.cross(b);
+        let n = if n.dot(centre) < 0.0 { -n } else { n };
+        // Scaled to unit length: only the sign and the ratio to clip w matter.
+        let n = n.normalize_or_zero().as_vec3();
+        [n.x, n.y, n.z, 0.0]
+    })
+}
+
+/// A perspective view from `eye`; `pixel_angle`: the angle one pixel spans at the image centre,
+/// by which anti-aliased shapes grow (the main view), or 0 (cube faces, drawn without).
+pub fn perspective_view(view_proj: Mat4, eye: Vec3, pixel_angle: f32) -> ViewUniform {
+    ViewUniform { view_proj: view_proj.to_cols_array_2d(), eye: v4(eye, pixel_angle) }
 }
 
 /// The light's view for the shadow pass; `eye` carries the light's travel direction.
@@ -133,12 +164,12 @@ mod tests {
     use super::*;
 
     /// The uniform structs have naga's size and member offsets of `Scene` and `View` in
-    /// scene.wgsl (16 vec4 + mat4 + 2 vec4 = 352 bytes; mat4 + vec4 = 80 bytes).
+    /// scene.wgsl (16 vec4 + mat4 + 2 vec4 + mat4 = 416 bytes; mat4 + vec4 = 80 bytes).
     #[test]
     fn layouts_match_the_wgsl_structs() {
         use illum_gpu::members;
         use std::mem::size_of;
-        assert_eq!(size_of::<SceneUniform>(), 352);
+        assert_eq!(size_of::<SceneUniform>(), 416);
         assert_eq!(size_of::<ViewUniform>(), 80);
         let module = crate::shaders::compose(&crate::shaders::FLOOR_SHADER).unwrap_or_else(|e| panic!("{e}"));
         let wgsl = |name: &str| {
@@ -149,7 +180,8 @@ mod tests {
             size_of::<SceneUniform>(),
             &members!(SceneUniform: to_light, light_radiance, ambient, background, floor_rect, floor_params,
                 receiver, receiver_v, floor_color_a, floor_color_b, glass_sphere, glass_color, glass_params,
-                metal_sphere, metal_color, metal_specular, shadow_view_proj, shadow_params, env_params),
+                metal_sphere, metal_color, metal_specular, shadow_view_proj, shadow_params, env_params,
+                floor_edges),
         );
         wgsl("View").assert_matches(size_of::<ViewUniform>(), &members!(ViewUniform: view_proj, eye));
     }

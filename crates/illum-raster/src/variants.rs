@@ -23,19 +23,24 @@ pub enum Surface {
     Metal,
 }
 
-/// The kind of target: a cube-map face (half float, one sample) or the main view.
+/// The kind of target: a cube-map face (half float) or the main view (8-bit), both one sample
+/// per pixel. `antialiased`: the main view's edges are blended by their coverage (the EDGE_AA
+/// constant of the floor and sphere shaders, and alpha blending); cube faces are never.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Target {
     Cube,
-    Main { samples: u32 },
+    Main { antialiased: bool },
 }
 
 impl Target {
-    pub fn samples(self) -> u32 {
-        match self {
-            Target::Cube => 1,
-            Target::Main { samples } => samples,
-        }
+    /// The main view's target for `options`.
+    pub fn main(options: &Options) -> Self {
+        Target::Main { antialiased: options.effects.antialiasing }
+    }
+
+    /// Whether edges are blended by their coverage.
+    pub fn antialiased(self) -> bool {
+        matches!(self, Target::Main { antialiased: true })
     }
 }
 
@@ -101,15 +106,16 @@ impl PipelineKey {
     pub fn constants(&self) -> Vec<(&'static str, f64)> {
         let s = &self.switches;
         let flag = |b: bool| if b { 1.0 } else { 0.0 };
+        let edge_aa = flag(self.target.antialiased());
         if matches!(self.surface, Surface::Floor | Surface::FloorReceiver) {
-            return vec![("RECEIVER", flag(s.shadows)), ("PCF", flag(s.pcf))];
+            return vec![("RECEIVER", flag(s.shadows)), ("PCF", flag(s.pcf)), ("EDGE_AA", edge_aa)];
         }
         let mut constants = vec![("SHADOWS", flag(s.shadows)), ("PCF", flag(s.pcf))];
         {
             let sphere = if self.surface == Surface::Glass { 0.0 } else { 1.0 };
             constants.extend([
                 ("SPHERE", sphere),
-                ("SAMPLES", f64::from(self.target.samples())),
+                ("EDGE_AA", edge_aa),
                 ("ENHANCED", flag(s.enhanced)),
                 ("REFRACTION", flag(s.refraction)),
                 ("REFLECTION", flag(s.reflection)),
@@ -148,7 +154,7 @@ mod tests {
         no_fresnel.effects.fresnel = false;
         no_fresnel.effects.reflection = false;
         for surface in [Surface::Floor, Surface::FloorReceiver, Surface::Glass, Surface::Metal] {
-            let target = Target::Main { samples: 4 };
+            let target = Target::Main { antialiased: true };
             assert_eq!(
                 PipelineKey::new(surface, target, &figure, &plan(&figure, true)),
                 PipelineKey::new(surface, target, &no_fresnel, &plan(&no_fresnel, true))
@@ -168,9 +174,14 @@ mod tests {
     fn the_metal_mirrors_only_in_the_enhanced_main_pass() {
         let enhanced = Options::all_on(Look::Enhanced);
         assert!(
-            PipelineKey::new(Surface::Metal, Target::Main { samples: 1 }, &enhanced, &plan(&enhanced, true))
-                .switches
-                .metal_env
+            PipelineKey::new(
+                Surface::Metal,
+                Target::Main { antialiased: false },
+                &enhanced,
+                &plan(&enhanced, true)
+            )
+            .switches
+            .metal_env
         );
         assert!(
             !PipelineKey::new(Surface::Metal, Target::Cube, &enhanced, &plan(&enhanced, true))
@@ -179,13 +190,19 @@ mod tests {
         );
         // A metal whose cube map the frame skips (mirror = 0) has no lookup into it.
         let unmirrored = FramePlan { metal_cube: false, ..plan(&enhanced, true) };
-        let key = PipelineKey::new(Surface::Metal, Target::Main { samples: 1 }, &enhanced, &unmirrored);
+        let key =
+            PipelineKey::new(Surface::Metal, Target::Main { antialiased: false }, &enhanced, &unmirrored);
         assert!(!key.switches.metal_env && !key.switches.reflection);
         let figure = Options::all_on(Look::Figure);
         assert!(
-            !PipelineKey::new(Surface::Metal, Target::Main { samples: 1 }, &figure, &plan(&figure, true))
-                .switches
-                .metal_env
+            !PipelineKey::new(
+                Surface::Metal,
+                Target::Main { antialiased: false },
+                &figure,
+                &plan(&figure, true)
+            )
+            .switches
+            .metal_env
         );
     }
 
@@ -193,7 +210,7 @@ mod tests {
     fn a_sphere_out_of_reach_of_the_other_has_no_shadow_lookup() {
         let options = Options::all_on(Look::Enhanced);
         for surface in [Surface::Glass, Surface::Metal] {
-            let target = Target::Main { samples: 4 };
+            let target = Target::Main { antialiased: true };
             assert!(PipelineKey::new(surface, target, &options, &plan(&options, true)).switches.shadows);
             let key = PipelineKey::new(surface, target, &options, &plan(&options, false));
             assert!(!key.switches.shadows && !key.switches.pcf);
@@ -204,21 +221,24 @@ mod tests {
     fn constants_name_the_overrides_of_each_entry() {
         let key = PipelineKey::new(
             Surface::Glass,
-            Target::Main { samples: 4 },
+            Target::Main { antialiased: true },
             &Options::all_on(Look::Enhanced),
             &plan(&Options::all_on(Look::Enhanced), true),
         );
         let c = key.constants();
         assert!(
-            c.contains(&("SPHERE", 0.0)) && c.contains(&("SAMPLES", 4.0)) && c.contains(&("ENHANCED", 1.0))
+            c.contains(&("SPHERE", 0.0)) && c.contains(&("EDGE_AA", 1.0)) && c.contains(&("ENHANCED", 1.0))
         );
         let enhanced = Options::all_on(Look::Enhanced);
         let receiver =
             PipelineKey::new(Surface::FloorReceiver, Target::Cube, &enhanced, &plan(&enhanced, true))
                 .constants();
-        assert_eq!(receiver, vec![("RECEIVER", 1.0), ("PCF", 1.0)]);
+        assert_eq!(receiver, vec![("RECEIVER", 1.0), ("PCF", 1.0), ("EDGE_AA", 0.0)]);
         let floor =
             PipelineKey::new(Surface::Floor, Target::Cube, &enhanced, &plan(&enhanced, true)).constants();
-        assert_eq!(floor, vec![("RECEIVER", 0.0), ("PCF", 0.0)]);
+        assert_eq!(floor, vec![("RECEIVER", 0.0), ("PCF", 0.0), ("EDGE_AA", 0.0)]);
+        let main_floor =
+            PipelineKey::new(Surface::Floor, Target::main(&enhanced), &enhanced, &plan(&enhanced, true));
+        assert_eq!(main_floor.constants(), vec![("RECEIVER", 0.0), ("PCF", 0.0), ("EDGE_AA", 1.0)]);
     }
 }

@@ -87,7 +87,7 @@ fn base_scene_loads_with_the_written_values() {
     assert_eq!(s.look, Look::Enhanced);
     assert_eq!((s.camera.width, s.camera.height), (64, 36));
     assert_eq!((s.clip.near, s.clip.far), (0.1, 3000.0));
-    assert_eq!(s.effects, Effects { pcf: false, msaa: false, ..Effects::ALL_ON });
+    assert_eq!(s.effects, Effects { pcf: false, antialiasing: false, ..Effects::ALL_ON });
     assert_eq!(s.quality.cube_size, 128);
     assert_eq!(s.quality.pcf_radius, 0.05);
     assert_eq!(s.background, Vec3::new(0.3, 0.5, 0.9));
@@ -325,6 +325,17 @@ fn clip_planes_and_a_light_are_optional_for_the_scene() {
     let dark =
         parse(&edit("irradiance = [3.14159265, 3.14159265, 3.14159265]", "irradiance = [0, 0, 0]")).unwrap();
     assert_eq!(dark.light.radiance(), Vec3::ZERO);
+}
+
+#[test]
+fn antialiasing_is_read_under_its_name_and_its_former_one() {
+    // tests/scenes/w.toml says `msaa = false`, the key's name before edges were anti-aliased
+    // analytically; old files keep loading with the same meaning (anti-aliased edges or not).
+    for (key, on) in [("msaa = false", false), ("msaa = true", true), ("antialiasing = false", false)] {
+        let s = parse(&edit("msaa = false", key)).unwrap_or_else(|e| panic!("{key}: {e}"));
+        assert_eq!(s.effects.antialiasing, on, "{key}");
+    }
+    assert!(parse(&edit("msaa = false\n", "")).unwrap().effects.antialiasing, "on when absent");
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -63,7 +63,8 @@
 //! refraction = true
 //! reflection = true
 //! fresnel = true
-//! msaa = true
+//! antialiasing = true             # anti-aliased edges at one sample per pixel (analytic
+//!                                  # coverage); `msaa`, the key's former name, is still read
 //! [whitted]                        # the Whitted ray tracer
 //! depth = 8                        # recursion depth, 0..=64
 //! aa = 2                           # n x n rays per pixel, 1..=16

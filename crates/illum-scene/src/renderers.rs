@@ -120,8 +120,12 @@ pub struct Effects {
     /// Enhanced look: Schlick's Fresnel weight between reflection and refraction on the glass;
     /// off: the normal-incidence weight everywhere.
     pub fresnel: bool,
-    /// 4x multisample anti-aliasing of edges.
-    pub msaa: bool,
+    /// Anti-aliased edges: the spheres' silhouettes and the floor's outline are blended by the
+    /// fraction of each pixel they cover, computed analytically, at one sample per pixel; off:
+    /// each pixel shows what the ray through its centre meets (jagged edges). In a file the key
+    /// is `antialiasing`; `msaa`, its name when the edges were 4x multisampled, is still read.
+    #[serde(alias = "msaa")]
+    pub antialiasing: bool,
 }
 
 /// Turns one effect off.
@@ -129,8 +133,14 @@ pub type EffectOff = fn(&mut Effects);
 
 impl Effects {
     /// Every effect on (the default).
-    pub const ALL_ON: Effects =
-        Effects { shadows: true, pcf: true, refraction: true, reflection: true, fresnel: true, msaa: true };
+    pub const ALL_ON: Effects = Effects {
+        shadows: true,
+        pcf: true,
+        refraction: true,
+        reflection: true,
+        fresnel: true,
+        antialiasing: true,
+    };
 
     /// Each effect's name (its key in `[raster.effects]`) and how to turn it off.
     pub const TOGGLES: [(&'static str, EffectOff); 6] = [
@@ -139,7 +149,7 @@ impl Effects {
         ("refraction", |e| e.refraction = false),
         ("reflection", |e| e.reflection = false),
         ("fresnel", |e| e.fresnel = false),
-        ("msaa", |e| e.msaa = false),
+        ("antialiasing", |e| e.antialiasing = false),
     ];
 }
 

@@ -105,7 +105,7 @@ impl RasterMode {
         self.frame_rate.tick();
         let view = state.renderer.output_view()?;
         let mut renderer = render_state.renderer.write();
-        // The output texture is recreated on resize and when MSAA is toggled, so the egui
+        // The output texture is recreated on resize, so the egui
         // texture is pointed at the current view every frame (this only rebuilds a bind group).
         let id = match state.texture {
             Some(id) => {
@@ -175,7 +175,7 @@ impl RasterMode {
         let enhanced = self.options.look == Look::Enhanced;
         ui.add_enabled(enhanced, egui::Checkbox::new(&mut e.reflection, "Reflection"));
         ui.add_enabled(enhanced, egui::Checkbox::new(&mut e.fresnel, "Fresnel"));
-        ui.checkbox(&mut e.msaa, "MSAA 4x");
+        ui.checkbox(&mut e.antialiasing, "Anti-aliasing");
         if ui.add_enabled(!self.camera.is_home(), egui::Button::new("Reset camera")).clicked() {
             self.camera.reset();
         }

@@ -70,7 +70,7 @@ fn switching_modes_keeps_each_modes_settings() {
     harness.run_steps(2);
     assert_eq!(harness.state().mode(), Mode::Raster);
     harness.get_by_label("enhanced").click();
-    harness.get_by_label("MSAA 4x").click();
+    harness.get_by_label("Anti-aliasing").click();
     harness.run_steps(2);
 
     harness.get_by_label("Path tracer").click();
@@ -83,7 +83,7 @@ fn switching_modes_keeps_each_modes_settings() {
     harness.run_steps(2);
     let options = harness.state().raster().unwrap().options;
     assert_eq!(options.look, illum_raster::Look::Enhanced);
-    assert!(!options.effects.msaa);
+    assert!(!options.effects.antialiasing);
 }
 
 #[test]
