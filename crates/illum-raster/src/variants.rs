@@ -172,38 +172,19 @@ mod tests {
 
     #[test]
     fn the_metal_mirrors_only_in_the_enhanced_main_pass() {
+        let main = Target::Main { antialiased: false };
+        let metal_env = |target, options: &Options, plan: &FramePlan| {
+            PipelineKey::new(Surface::Metal, target, options, plan).switches.metal_env
+        };
         let enhanced = Options::all_on(Look::Enhanced);
-        assert!(
-            PipelineKey::new(
-                Surface::Metal,
-                Target::Main { antialiased: false },
-                &enhanced,
-                &plan(&enhanced, true)
-            )
-            .switches
-            .metal_env
-        );
-        assert!(
-            !PipelineKey::new(Surface::Metal, Target::Cube, &enhanced, &plan(&enhanced, true))
-                .switches
-                .metal_env
-        );
+        assert!(metal_env(main, &enhanced, &plan(&enhanced, true)));
+        assert!(!metal_env(Target::Cube, &enhanced, &plan(&enhanced, true)));
         // A metal whose cube map the frame skips (mirror = 0) has no lookup into it.
         let unmirrored = FramePlan { metal_cube: false, ..plan(&enhanced, true) };
-        let key =
-            PipelineKey::new(Surface::Metal, Target::Main { antialiased: false }, &enhanced, &unmirrored);
+        let key = PipelineKey::new(Surface::Metal, main, &enhanced, &unmirrored);
         assert!(!key.switches.metal_env && !key.switches.reflection);
         let figure = Options::all_on(Look::Figure);
-        assert!(
-            !PipelineKey::new(
-                Surface::Metal,
-                Target::Main { antialiased: false },
-                &figure,
-                &plan(&figure, true)
-            )
-            .switches
-            .metal_env
-        );
+        assert!(!metal_env(main, &figure, &plan(&figure, true)));
     }
 
     #[test]
