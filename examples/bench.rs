@@ -35,9 +35,9 @@ struct Args {
     /// Scene to benchmark.
     #[arg(default_value = cli::DEFAULT_SCENE)]
     scene: PathBuf,
-    /// Repetitions per configuration (the median is reported).
-    #[arg(long, default_value_t = 5)]
-    runs: usize,
+    /// Repetitions per configuration (the median is reported), 1 to 1000.
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    runs: u32,
     /// Only the headline configuration (256 x 256, 64 spp, bounces 2 and 8).
     #[arg(long, conflicts_with = "large")]
     quick: bool,
@@ -119,7 +119,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         // Warm-up: compiles the pipeline on the driver and teaches the planner the cost.
         tracer.render_to_spp(1)?;
         let (mut wall, mut gpu_rate, mut per_submission) = (Vec::new(), Vec::new(), Vec::new());
-        for _ in 0..args.runs.max(1) {
+        for _ in 0..args.runs {
             tracer.reset();
             let mut submissions = 0u32;
             while tracer.spp_done() < config.spp {
@@ -154,7 +154,7 @@ fn run(args: Args) -> anyhow::Result<()> {
 
 /// The rasterizer on the Whitted scene at 1280 x 720, enhanced look, every effect on: frames per second and
 /// the GPU time of each pass (more options: `--example raster_bench`).
-fn bench_raster(gpu: &illum::gpu::GpuContext, runs: usize) -> anyhow::Result<()> {
+fn bench_raster(gpu: &illum::gpu::GpuContext, runs: u32) -> anyhow::Result<()> {
     let path = cli::resolve_scene_path(std::path::Path::new("scenes/whitted.toml"));
     let scene = RasterScene::load(&path)?;
     let options = Options::all_on(Look::Enhanced);
@@ -164,7 +164,7 @@ fn bench_raster(gpu: &illum::gpu::GpuContext, runs: usize) -> anyhow::Result<()>
     );
     println!("|---|---|---|---|---|---|");
     for motion in [Motion::CameraOrbit, Motion::SceneChange] {
-        let report = bench_frames(gpu, &scene, 1280, 720, &options, motion, 5, (12 * runs.max(1)) as u32)?;
+        let report = bench_frames(gpu, &scene, 1280, 720, &options, motion, 5, 12 * runs)?;
         let passes = report.median_pass_ms();
         let pass = |f: fn(&illum::raster::PassTimes) -> f64| {
             passes.as_ref().map_or("n/a".to_owned(), |p| format!("{:.2}", f(p)))

@@ -329,6 +329,23 @@ fn every_examples_help_says_what_it_does_and_documents_each_flag() {
     assert!(help.contains("--spp-list") && help.contains("--bounces"), "{help}");
 }
 
+/// The benchmarks refuse repetition counts that measure nothing (0) or would run for days, with
+/// the flag, the value and the range, before touching the GPU.
+#[test]
+fn benchmarks_refuse_absurd_repetition_counts() {
+    for (name, flag, value, range) in [
+        ("bench", "--runs", "0", "1..=1000"),
+        ("bench", "--runs", "1000000", "1..=1000"),
+        ("raster_bench", "--frames", "0", "1..=100000"),
+        ("raster_bench", "--frames", "100000000", "1..=100000"),
+        ("raster_bench", "--warmup", "20000", "0..=10000"),
+    ] {
+        let out = Command::new(example_binary(name)).args([flag, value]).output().expect("runs");
+        let case = format!("{name} {flag} {value}");
+        assert_refused(&out, &case, &[flag, value, range]);
+    }
+}
+
 /// Every picture the README shows exists, every `--example NAME` it names is an example, and
 /// every flag on a line that runs an example is one that example's `--help` lists. (The numbers
 /// it quotes are re-measured by `scripts/readme-figures.sh`; timings cannot be asserted.)
