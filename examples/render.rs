@@ -109,6 +109,12 @@ struct Args {
     /// that merged ranges give the image of one render.
     #[arg(long, value_name = "A..B", value_parser = cli::sample_range_arg)]
     sample_range: Option<std::ops::Range<u32>>,
+    /// Path-tracer scenes: adaptive sampling. A pilot of 16 spp (another seed, then discarded)
+    /// measures the noise of every 8 x 8 block of pixels, and the --spp budget is spread over
+    /// the blocks in proportion to it: the spp is then the mean over the image (docs/adaptive.md).
+    /// Needs --spp; not with --resume, --sample-range or the caustic's light tracer.
+    #[arg(long)]
+    adaptive: bool,
     /// Write the EXR outputs (checkpoints, see --resume) every this many seconds while
     /// rendering. Default 60.
     #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = cli::checkpoint_seconds_arg)]
@@ -156,6 +162,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         (args.resume.is_some(), "--resume"),
         (args.sample_range.is_some(), "--sample-range"),
         (args.checkpoint_seconds.is_some(), "--checkpoint-seconds"),
+        (args.adaptive, "--adaptive"),
     ]);
     if renderer == RendererKind::Whitted {
         let mut other_flags = path_tracer_only.clone();
@@ -282,6 +289,22 @@ fn run(args: Args) -> anyhow::Result<()> {
              --target-error and --time-budget would stop it short (a part stopped short cannot be merged)"
         );
     }
+    if args.adaptive {
+        let conflicting = cli::given_flags(&[
+            (args.resume.is_some(), "--resume"),
+            (args.sample_range.is_some(), "--sample-range"),
+        ]);
+        if !conflicting.is_empty() {
+            anyhow::bail!(
+                "--adaptive spreads one render's samples unevenly over the image, so it cannot be combined with {}: \
+                 a resumed or merged render needs the same samples in every pixel",
+                conflicting.join(" or ")
+            );
+        }
+        if args.settings.spp.is_none() {
+            anyhow::bail!("--adaptive needs --spp N: the mean samples per pixel it spreads over the image");
+        }
+    }
     let outputs = if args.outputs.is_empty() {
         if let Some(path) = &args.resume {
             vec![path.clone()]
@@ -310,6 +333,17 @@ fn run(args: Args) -> anyhow::Result<()> {
     tracer.set_chunk_aligned_passes(true);
     let range_start = args.sample_range.as_ref().map(|r| r.start);
     let mut earlier_seconds = 0.0;
+    let mut rules = rules;
+    if args.adaptive {
+        let budget = rules.spp.expect("--adaptive needs --spp (checked above)");
+        let pilot = std::time::Instant::now();
+        let allocation = illum::pathtrace::allocation::plan_adaptive(&mut tracer, budget)?;
+        // The pilot is part of the render's time.
+        earlier_seconds = pilot.elapsed().as_secs_f64();
+        println!("adaptive sampling: {} ({:.2} s)", allocation.describe(), earlier_seconds);
+        // Done when every block is: at the largest count.
+        rules.spp = Some(allocation.max());
+    }
     if let Some(checkpoint) = resumed {
         tracer.set_sample_offset(checkpoint.sample_start);
         earlier_seconds = checkpoint.metadata.render_seconds;
@@ -407,12 +441,21 @@ fn run(args: Args) -> anyhow::Result<()> {
             OutputFormat::Exr => save_checkpoint(output, &tracer, &metadata).map_err(anyhow::Error::msg)?,
         }
     }
+    let spp = match tracer.sample_allocation() {
+        // Mean over the image of what each pixel holds (the blocks' counts, or fewer if stopped early).
+        Some(_) => format!(
+            "{:.1} spp on average (adaptive)",
+            accumulator.total_samples() as f64
+                / (f64::from(scene.camera.width) * f64::from(scene.camera.height))
+        ),
+        None => format!("{} spp", status.spp_done),
+    };
     println!(
-        "{}: {}x{}, {} spp ({}), bounces {}, {} sampling, caustics {}, {:.2} s, {:.2} Msamples/s (wall clock), estimated relative error {:.4}, dropped samples {}",
+        "{}: {}x{}, {} ({}), bounces {}, {} sampling, caustics {}, {:.2} s, {:.2} Msamples/s (wall clock), estimated relative error {:.4}, dropped samples {}",
         scene.name,
         scene.camera.width,
         scene.camera.height,
-        status.spp_done,
+        spp,
         match reason {
             StopReason::SppReached => "spp target reached",
             StopReason::ErrorReached => "stopped at the error target",

@@ -736,3 +736,66 @@ fn caustics_on_off_is_recorded_and_a_checkpoint_of_the_other_setting_is_refused(
     let out = run(&["scenes/whitted.toml", "--caustics", "on", "-o", "target/never.png"]);
     assert_refused(&out, "--caustics on a raster scene", &["--caustics applies only to the path tracer"]);
 }
+
+/// `--adaptive`: the EXR records its allocation (and a uniform render `off`), and what cannot
+/// combine with uneven sample counts is refused by name: no budget, a resume or a sample range,
+/// the caustic's light tracer, and continuing or merging an adaptive file.
+#[test]
+fn adaptive_renders_record_their_allocation_and_refuse_what_cannot_combine() {
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("adaptive.exr");
+    let path = exr.to_str().unwrap();
+    let out = render_ok(&["--spp", "64", "--adaptive", "-o", path]);
+    assert!(text(&out.stdout).contains("adaptive sampling: 8x8 blocks"), "{}", text(&out.stdout));
+    assert!(text(&out.stdout).contains("spp on average (adaptive)"), "{}", text(&out.stdout));
+    let adaptive = field(&metadata(&exr), "adaptive");
+    assert!(adaptive.starts_with("8x8 blocks, ") && adaptive.contains("mean 6"), "{adaptive}");
+    assert_eq!(field(&render_16_exr(&["--spp", "16"]), "adaptive"), "off");
+
+    let small = |extra: &[&str]| {
+        let mut args = SMALL.to_vec();
+        args.extend(extra);
+        run(&args)
+    };
+    assert_refused(&small(&["--adaptive"]), "no budget", &["--adaptive needs --spp N"]);
+    assert_refused(
+        &small(&["--adaptive", "--sample-range", "0..32"]),
+        "a sample range",
+        &["--adaptive", "--sample-range", "same samples in every pixel"],
+    );
+    let uniform = dir.path().join("uniform.exr");
+    render_ok(&["--spp", "16", "-o", uniform.to_str().unwrap()]);
+    assert_refused(
+        &small(&["--adaptive", "--spp", "32", "--resume", uniform.to_str().unwrap()]),
+        "a resume",
+        &["--adaptive", "--resume"],
+    );
+    assert_refused(
+        &run(&["--resume", path, "--spp", "128"]),
+        "continuing an adaptive file",
+        &["adaptive.exr", "illum.adaptive", "cannot be continued"],
+    );
+    let merged = dir.path().join("merged.exr");
+    let out = merge(&[path, uniform.to_str().unwrap(), "-o", merged.to_str().unwrap()]);
+    assert_refused(&out, "merging an adaptive file", &["illum.adaptive"]);
+    assert!(!merged.exists());
+    assert_refused(
+        &run(&[
+            "scenes/whitted.toml",
+            "--renderer",
+            "pathtrace",
+            "--caustics",
+            "on",
+            "--adaptive",
+            "--spp",
+            "16",
+            "--width",
+            "32",
+            "--height",
+            "18",
+        ]),
+        "the caustic",
+        &["adaptive sampling is not available with the caustic"],
+    );
+    assert_no_panic(&small(&["--adaptive", "--spp", "0"]));
+}

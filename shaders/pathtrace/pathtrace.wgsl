@@ -15,6 +15,9 @@
 #import illum::spawn::{spawn_point, spawn_error, max_abs}
 #import illum::rtcore::geometry::{NO_HIT, FAR, Surface}
 #import illum::pathtrace::scene::{Material, params, lights, batch_sum, batch_sum_sq}
+#ifdef ADAPTIVE
+#import illum::pathtrace::scene::block_samples
+#endif
 #import illum::pathtrace::materials::material_at
 #import illum::rtcore::traversal::{closest_hit, occluded, surface_at, choose_light, object_at}
 #import illum::pathtrace::surfaces::{MATERIAL_CHECKER, MATERIAL_DIELECTRIC, MATERIAL_MIRROR, UNBOUNDED, RR_START, RR_MAX_SURVIVAL, UNBOUNDED_DEPTH_CAP, max3}
@@ -27,6 +30,9 @@
 #ifdef CHECKER
 #import illum::pathtrace::surfaces::checker_albedo
 #endif
+
+// Adaptive sampling's blocks: 8 x 8 pixels, the workgroup (allocation.rs, BLOCK).
+const ADAPTIVE_BLOCK: u32 = 8u;
 
 // Shadow rays end this fraction of their length short of the light (on top of the light's own
 // error band, see direct_light). It covers rounding only: the computed length of the segment and
@@ -277,9 +283,16 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.x >= params.width || gid.y >= params.rows || first >= params.sample_count) {
         return;
     }
-    let count = min(params.chunk_samples, params.sample_count - first);
+    var count = min(params.chunk_samples, params.sample_count - first);
     let x = gid.x;
     let y = gid.y + params.row_offset;
+#ifdef ADAPTIVE
+    // The pixel's block ends at sample index `limit`: this chunk takes the part of its samples
+    // below it (none once the block is done; the slot then holds zeros, as the fold expects).
+    let limit = block_samples[(y / ADAPTIVE_BLOCK) * ((params.width + ADAPTIVE_BLOCK - 1u) / ADAPTIVE_BLOCK) + x / ADAPTIVE_BLOCK];
+    let start = params.sample_base + first;
+    count = select(0u, min(count, limit - start), limit > start);
+#endif
     let pixel = y * params.width + x;
     var sum = vec3<f32>(0.0);
     var sum_sq = vec3<f32>(0.0);

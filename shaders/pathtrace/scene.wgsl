@@ -64,3 +64,8 @@ struct Light {
 // number of finite samples) and (sum of squares, number of dropped samples).
 @group(0) @binding(4) var<storage, read_write> batch_sum: array<vec4<f32>>;
 @group(0) @binding(5) var<storage, read_write> batch_sum_sq: array<vec4<f32>>;
+#ifdef ADAPTIVE
+// Adaptive sampling (allocation.rs): samples per pixel of each block of ADAPTIVE_BLOCK x
+// ADAPTIVE_BLOCK pixels, row-major over blocks; a pixel takes sample indices [0, n) of its block.
+@group(0) @binding(6) var<storage, read> block_samples: array<u32>;
+#endif

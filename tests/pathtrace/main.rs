@@ -2,6 +2,7 @@
 //! lavapipe. (One binary, not one per file: each test binary links wgpu, and a dozen of them
 //! filled the CI machine's disk.)
 //!
+//! - `adaptive`: adaptive sampling gives each pixel its block's samples and stays unbiased;
 //! - `caustic`: the caustic's light tracer against the oracle, a closed form (an index-1 ball
 //!   vanishes), the error estimate with two estimators, extremes and its fixed point;
 //! - `closed_form`: direct light at floor points against Lambert's polygon formula;
@@ -25,6 +26,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod adaptive;
 mod caustic;
 mod closed_form;
 mod display_sum;

@@ -51,8 +51,13 @@ pub(crate) fn compare_scene(label: &str, scene: &illum::scene::Scene) {
 
 /// As [`compare_scene`], the oracle taking `oracle_spp` samples (the GPU: the scene's spp).
 pub(crate) fn compare_scene_with(label: &str, scene: &illum::scene::Scene, oracle_spp: u32) {
-    let scene = scene.clone();
-    let gpu = common::render(&scene);
+    compare_render(label, &common::render(scene), oracle_spp);
+}
+
+/// The image `gpu` has rendered (SIZE x SIZE, of its scene) against the oracle's at
+/// `oracle_spp`: the per-pixel Z-test and the whole-image means, each with its power check.
+pub(crate) fn compare_render(label: &str, gpu: &illum::pathtrace::PathTracer, oracle_spp: u32) {
+    let scene = gpu.scene().clone();
     let oracle = illum_oracle::render(&scene, oracle_spp, 99).expect("the oracle renders this scene");
     assert_eq!(oracle.dropped, 0);
     let (mean, variance) = (gpu.accumulator().mean_image(), gpu.accumulator().variance_image());

@@ -33,20 +33,17 @@ pub(crate) struct BatchBuffers {
 }
 
 impl BatchBuffers {
-    /// Allocates buffers of `slots` slots each and binds them, after the scene's buffers
-    /// (`scene_buffers`: params, objects, materials, lights), to `layout`. The lights are bound
-    /// only with `bind_lights` (a pipeline without area lights does not declare them), the
-    /// objects and materials only with `bind_scene_data` (a specialised pipeline holds them as
-    /// literals). `mapped_readback`: `Some(timestamp bytes)` when the CPU maps the sums where the
-    /// shader wrote them (a device with `MAPPABLE_PRIMARY_BUFFERS`); that many bytes of mappable
-    /// buffer then take the band's timestamps.
+    /// Allocates the two batch buffers of `slots` slots each (bindings 4 and 5) and binds them,
+    /// with the `inputs` the pipeline reads (binding, buffer: the scene's params, objects,
+    /// materials and lights, and adaptive sampling's block counts, as far as the pipeline
+    /// declares them), to `layout`. `mapped_readback`: `Some(timestamp bytes)` when the CPU maps
+    /// the sums where the shader wrote them (a device with `MAPPABLE_PRIMARY_BUFFERS`); that many
+    /// bytes of mappable buffer then take the band's timestamps.
     pub(crate) fn new(
         gpu: &GpuContext,
         slots: u64,
         layout: &wgpu::BindGroupLayout,
-        scene_buffers: [&wgpu::Buffer; 4],
-        bind_lights: bool,
-        bind_scene_data: bool,
+        inputs: &[(u32, &wgpu::Buffer)],
         mapped_readback: Option<u64>,
     ) -> Result<Self, GpuError> {
         let device = &gpu.device;
@@ -74,14 +71,8 @@ impl BatchBuffers {
                     mapped_at_creation: false,
                 })
             });
-            let [params, objects, materials, lights] = scene_buffers;
-            let bound: Vec<(u32, &wgpu::Buffer)> =
-                [(0, params), (1, objects), (2, materials), (3, lights), (4, &sum), (5, &sum_sq)]
-                    .into_iter()
-                    .filter(|&(binding, _)| {
-                        (bind_lights || binding != 3) && (bind_scene_data || !(1..=2).contains(&binding))
-                    })
-                    .collect();
+            let mut bound: Vec<(u32, &wgpu::Buffer)> = inputs.to_vec();
+            bound.extend([(4, &sum), (5, &sum_sq)]);
             let bind_group = buffer_bind_group(device, "pathtrace", layout, &bound);
             BatchBuffers { slots, sum, sum_sq, timestamps, bind_group }
         })
@@ -131,27 +122,35 @@ pub(crate) fn decode_slots(bytes: &[u8]) -> Vec<[f32; 4]> {
         .collect()
 }
 
-/// Checks that every slot accounts for all of its chunk's samples (finite + dropped): `spp`
-/// samples in chunks of `chunk`, `band_pixels` slots per chunk. A shortfall means the driver
-/// ended an invocation early, and the band's statistics would silently be short.
+/// Checks that every slot accounts for all of its chunk's samples (finite + dropped): `chunks`
+/// chunks of `band_pixels` slots each, slot i of chunk k expecting `expected(k, i)` samples.
+/// A shortfall means the driver ended an invocation early, and the band's statistics would
+/// silently be short. Returns the samples of the band.
 pub(crate) fn check_complete(
     sums: &[[f32; 4]],
     sums_sq: &[[f32; 4]],
-    spp: u32,
-    chunk: u32,
+    chunks: u32,
     band_pixels: usize,
-) -> Result<(), PathTraceError> {
-    for k in 0..spp.div_ceil(chunk) {
-        let expected = chunk.min(spp - k * chunk);
+    expected: impl Fn(u32, usize) -> u32,
+) -> Result<u64, PathTraceError> {
+    let mut total = 0;
+    for k in 0..chunks {
         let range = k as usize * band_pixels..(k as usize + 1) * band_pixels;
-        for (s, q) in sums[range.clone()].iter().zip(&sums_sq[range]) {
+        for (i, (s, q)) in sums[range.clone()].iter().zip(&sums_sq[range]).enumerate() {
             let found = s[3] as u64 + q[3] as u64;
+            let expected = expected(k, i);
             if found != u64::from(expected) {
                 return Err(PathTraceError::IncompleteBatch { expected, found });
             }
+            total += found;
         }
     }
-    Ok(())
+    Ok(total)
+}
+
+/// The samples slot i of chunk k holds in a pass of `spp` samples in chunks of `chunk`.
+pub(crate) fn uniform_chunk(spp: u32, chunk: u32) -> impl Fn(u32, usize) -> u32 {
+    move |k, _| chunk.min(spp - k * chunk)
 }
 
 #[cfg(test)]
@@ -163,10 +162,12 @@ mod tests {
         // 2 pixels, 20 spp in chunks of 16: chunk 0 holds 16 samples, chunk 1 holds 4.
         let sums = [[0.0, 0.0, 0.0, 16.0], [0.0, 0.0, 0.0, 15.0], [0.0, 0.0, 0.0, 4.0], [0.0, 0.0, 0.0, 3.0]];
         let sums_sq = [[0.0; 4], [0.0, 0.0, 0.0, 1.0], [0.0; 4], [0.0, 0.0, 0.0, 1.0]];
-        check_complete(&sums, &sums_sq, 20, 16, 2).expect("dropped samples count");
+        let total =
+            check_complete(&sums, &sums_sq, 2, 2, uniform_chunk(20, 16)).expect("dropped samples count");
+        assert_eq!(total, 40);
         let mut short = sums_sq;
         short[3][3] = 0.0;
-        let error = check_complete(&sums, &short, 20, 16, 2).expect_err("a lost sample");
+        let error = check_complete(&sums, &short, 2, 2, uniform_chunk(20, 16)).expect_err("a lost sample");
         assert!(matches!(error, PathTraceError::IncompleteBatch { expected: 4, found: 3 }), "{error}");
     }
 

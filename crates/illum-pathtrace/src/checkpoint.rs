@@ -192,6 +192,12 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint, String> {
         let text = metadata.get(key).ok_or_else(|| at(format!("illum.{key} is missing")))?;
         text.parse().map_err(|_| at(format!("illum.{key} = {text:?} is not a whole number")))
     };
+    if let Some(adaptive) = metadata.get("adaptive").filter(|a| *a != "off") {
+        return Err(at(format!(
+            "illum.adaptive = {adaptive:?}: an adaptive render's pixels hold different numbers of samples, \
+             chosen for its budget, so it cannot be continued or merged (render it again with a larger --spp)"
+        )));
+    }
     let spp_done = number("spp")?;
     let sample_start = number("sample_start")?;
     let partial = (number("partial_pass_spp")?, number("partial_pass_rows")?);

@@ -12,6 +12,7 @@
 //! through the CPU.
 
 pub mod accumulator;
+pub mod allocation;
 mod batch;
 pub mod checkpoint;
 pub mod display_sum;
@@ -28,6 +29,7 @@ pub mod specialise;
 mod tracer;
 
 pub use accumulator::Accumulator;
+pub use allocation::SampleAllocation;
 pub use batch::{CHUNK_SAMPLES, SLOT_BYTES};
 pub use display_sum::{DISPLAY_PIXEL_BYTES, DISPLAY_SUM_SHADER};
 pub use error::PathTraceError;

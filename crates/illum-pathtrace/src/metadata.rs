@@ -21,6 +21,9 @@ pub const RENDERER: &str = "pathtrace";
 ///   2 spp); `dropped_samples`: NaN/Inf samples left out;
 /// - `stopped_by`: the stop rule that ended the render (`spp`, `target_error`, `time_budget`,
 ///   `cancelled`), or `none` for an image saved while rendering (the viewer);
+/// - `adaptive`: `off`, or with adaptive sampling (`allocation.rs`) its blocks' samples per
+///   pixel, e.g. `8x8 blocks, 16 to 4096 spp, mean 1023.5, pilot 16 spp`; `spp` then counts the
+///   sample indices reached, which each block has taken up to its own count;
 /// - `adapter`: the GPU adapter's name; `source`: the program that wrote the file;
 /// - `scene_hash`: [`crate::checkpoint::scene_content_hash`]; `sample_start`: the first sample
 ///   index (see [`PathTracer::set_sample_offset`]); `partial_pass_spp` and `partial_pass_rows`:
@@ -44,6 +47,12 @@ pub fn exr_metadata(
         ("estimated_relative_error", accumulator.estimated_relative_error().to_string()),
         ("dropped_samples", accumulator.dropped_samples().to_string()),
         ("stopped_by", stopped_by.map_or("none", StopReason::name).to_owned()),
+        (
+            "adaptive",
+            tracer
+                .sample_allocation()
+                .map_or("off".to_owned(), crate::allocation::SampleAllocation::describe),
+        ),
         ("adapter", tracer.adapter_name().to_owned()),
         ("source", source.to_owned()),
         ("scene_hash", crate::checkpoint::scene_content_hash(scene)),

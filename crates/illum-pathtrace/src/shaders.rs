@@ -62,17 +62,22 @@ pub fn shader_modules(scene: &Scene, gpu_scene: &GpuScene, traversal: Traversal)
 
 /// The path-tracing pipeline for `scene` with `options`, and the traversal source it was built
 /// with. The context caches pipelines by their source: two scenes with the same specialisation
-/// share one, so switching back to a scene does not recompile.
+/// share one, so switching back to a scene does not recompile. `adaptive`: with shader def
+/// ADAPTIVE, each block of pixels takes its own number of samples (allocation.rs).
 pub(crate) fn pathtrace_pipeline(
     gpu: &GpuContext,
     scene: &Scene,
     gpu_scene: &GpuScene,
     options: TracerOptions,
+    adaptive: bool,
 ) -> Result<(wgpu::ComputePipeline, String), PathTraceError> {
     let modules = shader_modules(scene, gpu_scene, options.traversal);
     let traversal_source = modules[modules.len() - 2].source.to_string();
     let mut defs = options.shader_defs();
     defs.extend(gpu_scene.shader_defs());
+    if adaptive {
+        defs.push(("ADAPTIVE", shader::Def::Bool(true)));
+    }
     let pipeline = shader::compute_pipeline(gpu, &modules, &PATHTRACE_SHADER, &defs, "path-tracing")?;
     Ok((pipeline, traversal_source))
 }
@@ -160,6 +165,13 @@ mod tests {
                         &shader_modules(&scene, &gpu_scene, traversal),
                         &PATHTRACE_SHADER,
                         &defs,
+                    );
+                    let mut adaptive = defs.clone();
+                    adaptive.push(("ADAPTIVE", shader::Def::Bool(true)));
+                    compose_and_validate(
+                        &shader_modules(&scene, &gpu_scene, traversal),
+                        &PATHTRACE_SHADER,
+                        &adaptive,
                     );
                     if gpu_scene.defs.contains(&"CAUSTIC") {
                         let mut all = defs.clone();

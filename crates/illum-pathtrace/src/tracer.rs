@@ -19,7 +19,7 @@ use crate::display_sum::DisplaySum;
 use crate::gpu_scene::{self, GpuParams, GpuScene};
 use crate::options::{TracerOptions, Traversal};
 use crate::planner::{BatchPlanner, DEFAULT_TARGET_SECONDS, PassPlan};
-use crate::{Accumulator, PathTraceError, limits, shaders, specialise};
+use crate::{Accumulator, PathTraceError, SampleAllocation, limits, shaders, specialise};
 
 mod caustic;
 mod passes;
@@ -32,7 +32,8 @@ const TIMED_PASS: &str = "pathtrace";
 /// What one submission did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct StepReport {
-    /// Paths traced (pixels in the band x spp of the pass).
+    /// Paths traced: the band's pixels x the pass's spp, or with adaptive sampling the samples
+    /// its blocks took.
     pub samples: u64,
     /// Wall time of the submission, including readback and the f64 fold.
     pub wall_seconds: f64,
@@ -121,6 +122,9 @@ pub struct PathTracer {
     /// [`Self::set_polled_readback`]), and the band it is waiting for.
     polled_readback: bool,
     in_flight: Option<submit::InFlightBand>,
+    /// Adaptive sampling: the samples of each block of pixels, and the buffer the shader reads
+    /// them from (see [`Self::set_sample_allocation`]).
+    allocation: Option<(SampleAllocation, wgpu::Buffer)>,
 }
 
 /// The placeholder record bound when a scene has no area light.
@@ -174,7 +178,8 @@ impl PathTracer {
         let gpu_scene = GpuScene::new(scene)?;
         let base_params = gpu_scene::params(scene, &gpu_scene);
         accumulator.set_radiance_exponent(gpu_scene.radiance_exponent);
-        let (pipeline, traversal_source) = shaders::pathtrace_pipeline(gpu, scene, &gpu_scene, options)?;
+        let (pipeline, traversal_source) =
+            shaders::pathtrace_pipeline(gpu, scene, &gpu_scene, options, false)?;
 
         let device = &gpu.device;
         let storage =
@@ -245,6 +250,7 @@ impl PathTracer {
             gpu_seconds: 0.0,
             polled_readback: false,
             in_flight: None,
+            allocation: None,
         })
     }
 
@@ -386,6 +392,12 @@ impl PathTracer {
             if self.display_sum.is_some() {
                 resized.enable_display_sum()?;
             }
+            // An allocation belongs to its resolution; with the same one it carries over.
+            if let Some((allocation, _)) = self.allocation.take()
+                && (allocation.width, allocation.height) == (scene.camera.width, scene.camera.height)
+            {
+                resized.set_sample_allocation(Some(allocation))?;
+            }
             *self = resized;
             return Ok(());
         }
@@ -401,6 +413,79 @@ impl PathTracer {
         self.scene = scene.clone();
         self.reset();
         Ok(())
+    }
+
+    /// Adaptive sampling (`allocation.rs`): from now on each block of 8 x 8 pixels takes the
+    /// samples `allocation` gives it, sample indices `0..n` of each of its pixels, and a render
+    /// to [`SampleAllocation::max`] spp is complete ([`Self::spp_done`] then counts sample
+    /// indices reached, which every block below it has taken in full). `None`: every pixel takes
+    /// every sample again. Restarts the accumulation, and switches the pipeline (shader def
+    /// ADAPTIVE) when adaptivity is turned on or off. Refused for an allocation of another
+    /// resolution and with the caustic's light tracer (whose passes cover the whole image at
+    /// one spp). [`Self::update_scene`] keeps it while the resolution stays.
+    pub fn set_sample_allocation(
+        &mut self,
+        allocation: Option<SampleAllocation>,
+    ) -> Result<(), PathTraceError> {
+        let camera = self.scene.camera;
+        if let Some(a) = &allocation {
+            let refuse =
+                |message: String| PathTraceError::Unsupported { scene: self.scene.name.clone(), message };
+            let (bx, by) = SampleAllocation::blocks(camera.width, camera.height);
+            if (a.width, a.height) != (camera.width, camera.height) || a.samples.len() != (bx * by) as usize {
+                return Err(refuse(format!(
+                    "a sample allocation for {} x {} pixels ({} blocks) cannot drive a {} x {} render ({} blocks)",
+                    a.width,
+                    a.height,
+                    a.samples.len(),
+                    camera.width,
+                    camera.height,
+                    bx * by
+                )));
+            }
+            if let Some(block) = a.samples.iter().position(|&n| n == 0) {
+                return Err(refuse(format!(
+                    "a sample allocation gives block {block} no samples: every pixel needs at least one"
+                )));
+            }
+            if self.caustic.is_some() {
+                return Err(refuse(
+                    "adaptive sampling is not available with the caustic's light tracer (its passes cover the \
+                     whole image at one spp); render with caustics off or without adaptive sampling"
+                        .to_owned(),
+                ));
+            }
+        }
+        self.reset();
+        if allocation.is_some() != self.allocation.is_some() {
+            let gpu_scene = GpuScene::new(&self.scene)?;
+            let adaptive = allocation.is_some();
+            self.pipeline =
+                shaders::pathtrace_pipeline(&self.gpu, &self.scene, &gpu_scene, self.options, adaptive)?.0;
+        }
+        let device = &self.gpu.device;
+        self.allocation = match allocation {
+            Some(a) => {
+                let buffer = self.gpu.scoped("allocating the adaptive sample counts", || {
+                    illum_gpu::buffers::storage_buffer(
+                        device,
+                        "pathtrace block samples",
+                        bytemuck::cast_slice(&a.samples),
+                    )
+                })?;
+                Some((a, buffer))
+            }
+            None => None,
+        };
+        // The batch buffers' bind groups name the old pipeline's bindings: made anew.
+        self.batch = None;
+        self.spare_batch = None;
+        Ok(())
+    }
+
+    /// The adaptive sample allocation, when one is set.
+    pub fn sample_allocation(&self) -> Option<&SampleAllocation> {
+        self.allocation.as_ref().map(|(a, _)| a)
     }
 
     /// Sets the samples per invocation (default [`CHUNK_SAMPLES`]; values below 1 count as 1),

@@ -4,8 +4,9 @@
 //! (`restore`, `aligned_prefix`).
 
 use super::{ActivePass, PathTracer, StepReport};
+use crate::allocation::BLOCK;
 use crate::planner::PassPlan;
-use crate::{Accumulator, PathTraceError};
+use crate::{Accumulator, PathTraceError, SampleAllocation};
 
 impl PathTracer {
     /// With `true`, every pass [`Self::render_step`] plans ends on a multiple of the chunk size in
@@ -109,7 +110,8 @@ impl PathTracer {
                 Some(t) => t - self.spp_done,
                 None => u32::MAX - self.spp_done,
             };
-            let mut plan = self.fit(self.planner.plan(camera.width, camera.height, remaining));
+            let planned = self.planner.plan(camera.width, self.active_height(), remaining);
+            let mut plan = self.fit(PassPlan { rows: self.spread_rows(planned.rows), ..planned });
             if self.chunk_aligned {
                 let start = self.sample_offset + self.spp_done;
                 plan = align_pass(plan, start, remaining, self.chunk_samples);
@@ -154,7 +156,7 @@ impl PathTracer {
         // would otherwise be a thousand tiny submissions, each paying the driver's fixed cost.
         // Bands are rows, so their size never changes which samples a pixel's chunks hold.
         if let Some(spp) = self.pass.as_ref().map(|p| p.plan.spp) {
-            let rows = self.planner.rows_for(camera.width, camera.height, spp);
+            let rows = self.spread_rows(self.planner.rows_for(camera.width, self.active_height(), spp));
             let fitted = self.fit(PassPlan { spp, rows });
             if let Some(pass) = self.pass.as_mut().filter(|_| fitted.spp == spp) {
                 pass.plan.rows = fitted.rows;
@@ -196,6 +198,51 @@ impl PathTracer {
         Ok(())
     }
 }
+impl PathTracer {
+    /// The height of an image with as many pixels as the next pass traces, for the planner,
+    /// which sizes passes by pixels: the image's, or with adaptive sampling the rows' worth of
+    /// pixels whose blocks are not done yet.
+    fn active_height(&self) -> u32 {
+        let camera = self.scene.camera;
+        match &self.allocation {
+            None => camera.height,
+            Some((allocation, _)) => {
+                let active = allocation.pixels_beyond(self.sample_offset + self.spp_done);
+                (active.div_ceil(u64::from(camera.width)) as u32).clamp(1, camera.height)
+            }
+        }
+    }
+
+    /// The rows from row `from` on that a pass starting at absolute sample index `start` traces:
+    /// (first, end), all rows to the image's end, or with adaptive sampling from the first to
+    /// the last block row with a block not done yet; `None` when no such row is left (a band
+    /// there would trace nothing, and its workgroups would still cost their dispatch).
+    pub(super) fn active_rows(&self, from: u32, start: u32) -> Option<(u32, u32)> {
+        let height = self.scene.camera.height;
+        if from >= height {
+            return None;
+        }
+        let Some((allocation, _)) = &self.allocation else {
+            return Some((from, height));
+        };
+        let (bx, by) = SampleAllocation::blocks(allocation.width, allocation.height);
+        let busy = |j: u32| {
+            allocation.samples[(j * bx) as usize..((j + 1) * bx) as usize].iter().any(|&n| n > start)
+        };
+        let first = (from / BLOCK..by).find(|&j| busy(j))?;
+        let last = (first..by).rev().find(|&j| busy(j)).expect("first is busy");
+        Some(((first * BLOCK).max(from), ((last + 1) * BLOCK).min(height)))
+    }
+
+    /// Rows of the image holding `rows` rows' worth of traced pixels: with adaptive sampling the
+    /// pixels still traced are spread over the whole image.
+    fn spread_rows(&self, rows: u32) -> u32 {
+        let height = self.scene.camera.height;
+        let active = self.active_height();
+        (u64::from(rows) * u64::from(height) / u64::from(active)).clamp(1, u64::from(height)) as u32
+    }
+}
+
 /// A pass plan changed so that the pass ends on a multiple of `chunk` in absolute sample indices
 /// (`start` is the pass's first index), or at the end of the render (`remaining` samples): one
 /// chunk more when the plan would end inside the first chunk, fewer when it ends past a chunk

@@ -62,21 +62,21 @@ impl PathTracer {
         let doubled = self.batch.as_ref().map_or(0, |b| 2 * b.slots).min(self.max_slots);
         let slots = slots.max(doubled);
         let layout = self.pipeline.get_bind_group_layout(0);
-        let scene_buffers =
-            [&self.params_buffer, &self.objects_buffer, &self.materials_buffer, &self.lights_buffer];
-        let bind_lights = self.base_params.num_lights > 0;
+        let mut inputs = vec![(0, &self.params_buffer)];
         // A specialised pipeline has its objects and materials as literals (specialise.rs).
-        let bind_scene_data = self.options.traversal == Traversal::Generic;
+        if self.options.traversal == Traversal::Generic {
+            inputs.extend([(1, &self.objects_buffer), (2, &self.materials_buffer)]);
+        }
+        // A pipeline without area lights does not declare them.
+        if self.base_params.num_lights > 0 {
+            inputs.push((3, &self.lights_buffer));
+        }
+        // Adaptive sampling's block counts (shader def ADAPTIVE).
+        if let Some((_, block_samples)) = &self.allocation {
+            inputs.push((6, block_samples));
+        }
         let mapped_readback = self.mapped_readback.then(|| self.timer.result_size());
-        self.batch = Some(BatchBuffers::new(
-            &self.gpu,
-            slots,
-            &layout,
-            scene_buffers,
-            bind_lights,
-            bind_scene_data,
-            mapped_readback,
-        )?);
+        self.batch = Some(BatchBuffers::new(&self.gpu, slots, &layout, &inputs, mapped_readback)?);
         Ok(())
     }
 
@@ -145,8 +145,9 @@ impl PathTracer {
     /// with mapped readback, the other set of batch buffers (the caustic's passes fold frames
     /// traced per pass and are left serial).
     fn launch_ahead(&mut self, band: &Band) -> Result<(), PathTraceError> {
-        let height = self.scene.camera.height;
-        if self.caustic.is_some() || band.row_offset + band.rows >= height {
+        if self.caustic.is_some()
+            || self.active_rows(band.row_offset + band.rows, band.sample_start).is_none()
+        {
             return Ok(());
         }
         self.ahead = Some(AheadBand { band: self.begin_band(self.mapped_readback)? });
@@ -195,10 +196,13 @@ impl PathTracer {
         let width = self.scene.camera.width;
         let height = self.scene.camera.height;
         let pass = self.pass.as_ref().expect("submit_band needs an active pass");
-        let row_offset = pass.launched_row;
-        let rows = pass.plan.rows.min(height - row_offset);
         let spp = pass.plan.spp;
         let sample_base = pass.sample_base;
+        // Rows with nothing to trace (adaptive sampling's finished blocks) are skipped.
+        let (row_offset, end) = self
+            .active_rows(pass.launched_row, self.sample_offset + sample_base)
+            .unwrap_or((pass.launched_row.min(height - 1), height));
+        let rows = pass.plan.rows.min(end - row_offset);
         let chunk = self.chunk_samples;
         let chunks = spp.div_ceil(chunk);
         let band_pixels = rows as usize * width as usize;
@@ -273,25 +277,51 @@ impl PathTracer {
         if let Some(pass) = self.pass.as_mut() {
             pass.launched_row = row_offset + rows;
         }
-        Ok(Band { started, row_offset, rows, spp, chunk, chunks, band_pixels, bytes, staging_size, readback })
+        let sample_start = params.sample_base;
+        Ok(Band {
+            started,
+            row_offset,
+            rows,
+            spp,
+            sample_start,
+            chunk,
+            chunks,
+            band_pixels,
+            bytes,
+            staging_size,
+            readback,
+        })
     }
 
     /// Checks and folds a band's read-back bytes (its sums, sums of squares and timestamps), and
     /// moves the pass on.
     fn finish_band(&mut self, band: &Band, bytes: BandBytes) -> Result<StepReport, PathTraceError> {
-        let Band { started, row_offset, rows, spp, chunk, chunks, band_pixels, .. } = *band;
+        let Band { started, row_offset, rows, spp, sample_start, chunk, chunks, band_pixels, .. } = *band;
         let width = self.scene.camera.width;
         let height = self.scene.camera.height;
         let (sums, sums_sq) = (batch::slots(bytes.sums), batch::slots(bytes.sums_sq));
         let (sums, sums_sq) = (&sums[..], &sums_sq[..]);
-        if let Err(error) = batch::check_complete(sums, sums_sq, spp, chunk, band_pixels) {
-            // The accumulator drops this band, but the display pass already added it: set the
-            // display sum back to the accumulator's samples.
-            if let Some(display) = &self.display_sum {
-                display.seed(&self.gpu, &self.accumulator, self.radiance_exponent);
+        let uniform = batch::uniform_chunk(spp, chunk);
+        let checked = match &self.allocation {
+            None => batch::check_complete(sums, sums_sq, chunks, band_pixels, uniform),
+            // A block takes the part of each chunk below its count (the shader's ADAPTIVE code).
+            Some((allocation, _)) => batch::check_complete(sums, sums_sq, chunks, band_pixels, |k, i| {
+                let (x, y) = (i as u32 % width, row_offset + i as u32 / width);
+                let start = sample_start + k * chunk;
+                allocation.at(x, y).saturating_sub(start).min(uniform(k, i))
+            }),
+        };
+        let samples = match checked {
+            Ok(samples) => samples,
+            Err(error) => {
+                // The accumulator drops this band, but the display pass already added it: set
+                // the display sum back to the accumulator's samples.
+                if let Some(display) = &self.display_sum {
+                    display.seed(&self.gpu, &self.accumulator, self.radiance_exponent);
+                }
+                return Err(error);
             }
-            return Err(error);
-        }
+        };
         for k in 0..chunks as usize {
             let range = k * band_pixels..(k + 1) * band_pixels;
             self.accumulator.fold(
@@ -310,7 +340,13 @@ impl PathTracer {
         let gpu_seconds = self.timer.decode(bytes.timestamps).map(|timings| timings[0].1 * 1e-3);
 
         let pass = self.pass.as_mut().expect("still active");
-        pass.next_row += rows;
+        pass.next_row = row_offset + rows;
+        let start = self.sample_offset + pass.sample_base;
+        if self.active_rows(row_offset + rows, start).is_none() {
+            // Nothing left to trace below: the pass is complete.
+            self.pass.as_mut().expect("still active").next_row = height;
+        }
+        let pass = self.pass.as_mut().expect("still active");
         let pass_completed = pass.next_row >= height;
         if pass_completed {
             self.spp_done += spp;
@@ -327,12 +363,7 @@ impl PathTracer {
         self.last_fold = Some(now);
         self.wall_seconds += wall_seconds;
         self.gpu_seconds += gpu_seconds.unwrap_or(0.0);
-        Ok(StepReport {
-            samples: rows as u64 * width as u64 * spp as u64,
-            wall_seconds,
-            gpu_seconds,
-            pass_completed,
-        })
+        Ok(StepReport { samples, wall_seconds, gpu_seconds, pass_completed })
     }
 }
 
@@ -342,6 +373,8 @@ pub(super) struct Band {
     row_offset: u32,
     rows: u32,
     spp: u32,
+    /// The pass's first sample index (absolute: the sample offset included).
+    sample_start: u32,
     /// Samples per chunk when it was recorded (a later `set_chunk_samples` must not change it).
     chunk: u32,
     chunks: u32,
