@@ -15,6 +15,9 @@ the throughput, the relMSE against a converged reference and the efficiency
     venv/bin/python bench/vs_mitsuba.py [--size 256] [--spp 1024] [--bounces 2]
         [--samplers independent,multijitter,orthogonal,ldsampler] [--reference-spp 16384]
 
+illum renders with independent numbers, the low-discrepancy sequence, and that sequence with
+adaptive sampling (`--adaptive`, the same mean spp).
+
 Run it on an idle machine: a parallel build doubles every time. The reference is an illum render
 with --sequence low-discrepancy at --reference-spp and its own seed, cached in out/vs-mitsuba/; its own relMSE
 adds about spp / reference-spp to every figure.
@@ -164,11 +167,11 @@ def mitsuba_child(args):
     mi.util.write_bitmap(path, image)
 
 
-def run_illum(args, path, spp, sequence, seed=0):
+def run_illum(args, path, spp, sequence, seed=0, extra=()):
     started = time.perf_counter()
     subprocess.run(
         [RENDER, args.scene, "--width", str(args.size), "--height", str(args.size), "--spp", str(spp),
-         "--bounces", str(args.bounces), "--sequence", sequence, "--seed", str(seed), "-o", path],
+         "--bounces", str(args.bounces), "--sequence", sequence, "--seed", str(seed), "-o", path, *extra],
         check=True, stdout=subprocess.DEVNULL,
     )
     return time.perf_counter() - started
@@ -200,11 +203,13 @@ def main():
     reference = load_exr(reference_path)
 
     rows = []
-    for sequence in ["independent", "low-discrepancy"]:
-        path = os.path.join(OUT, f"illum-{sequence}-{tag}.exr")
-        seconds = run_illum(args, path, args.spp, sequence)
+    # Adaptive sampling (render --adaptive): the same mean spp, spread over the image by a pilot.
+    for sequence, extra in [("independent", ()), ("low-discrepancy", ()), ("low-discrepancy", ("--adaptive",))]:
+        label = sequence + "".join(", " + e.lstrip("-") for e in extra)
+        path = os.path.join(OUT, f"illum-{label.replace(', ', '-')}-{tag}.exr")
+        seconds = run_illum(args, path, args.spp, sequence, extra=extra)
         image = load_exr(path)
-        rows.append((f"illum ({sequence})", seconds, rel_mse(image, reference), image.mean() / reference.mean()))
+        rows.append((f"illum ({label})", seconds, rel_mse(image, reference), image.mean() / reference.mean()))
     for sampler in args.samplers.split(","):
         path = os.path.join(OUT, f"mitsuba-{sampler}-{tag}.exr")
         seconds = run_mitsuba(args, sampler, path)

@@ -42,7 +42,16 @@ impl RenderProgress {
 /// One line: "37 spp  4.21 Msamples/s  error 2.31% (target 1%)  to time budget: 41%, 3 s left".
 pub fn describe(progressive: &Progressive, tracer: &PathTracer) -> String {
     let status = progressive.status(tracer);
-    let mut text = format!("{} spp  {:.2} Msamples/s", status.spp_done, status.samples_per_second() * 1e-6);
+    let spp = match status.planned_samples {
+        // Adaptive sampling: blocks take different counts; show the mean so far.
+        Some(_) => {
+            let camera = tracer.scene().camera;
+            let pixels = (f64::from(camera.width) * f64::from(camera.height)).max(1.0);
+            format!("{:.0} spp on average", status.samples as f64 / pixels)
+        }
+        None => format!("{} spp", status.spp_done),
+    };
+    let mut text = format!("{spp}  {:.2} Msamples/s", status.samples_per_second() * 1e-6);
     match (status.relative_error, progressive.rules.target_error) {
         (Some(e), Some(t)) => text += &format!("  error {:.2}% (target {}%)", e * 100.0, t * 100.0),
         (Some(e), None) => text += &format!("  error {:.2}%", e * 100.0),

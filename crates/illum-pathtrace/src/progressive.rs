@@ -85,7 +85,8 @@ impl StopRules {
         };
         if let Some(spp) = self.spp {
             // Samples, not complete passes, so the bar moves within a long pass.
-            consider(Rule::Spp, status.samples as f64 / (pixels.max(1) as f64 * f64::from(spp.max(1))));
+            let planned = status.planned_samples.unwrap_or(pixels.max(1) * u64::from(spp.max(1)));
+            consider(Rule::Spp, status.samples as f64 / planned.max(1) as f64);
         }
         if let Some(target) = self.target_error {
             let fraction =
@@ -204,6 +205,9 @@ pub struct Status {
     pub elapsed: Duration,
     /// The estimated relative error after the last completed pass, once it has 2 spp.
     pub relative_error: Option<f64>,
+    /// With adaptive sampling, the samples of the whole render (its allocation's total), which
+    /// the spp rule's progress is measured against: the pixels do not all take `spp`.
+    pub planned_samples: Option<u64>,
 }
 
 impl Status {
@@ -314,6 +318,7 @@ impl Progressive {
             run_samples: tracer.accumulator().total_samples().saturating_sub(self.start_samples.unwrap_or(0)),
             elapsed: self.clock.elapsed(),
             relative_error: self.relative_error,
+            planned_samples: tracer.sample_allocation().map(crate::SampleAllocation::total),
         }
     }
 
@@ -389,6 +394,7 @@ mod tests {
             run_samples: 0,
             elapsed: Duration::from_secs_f64(seconds),
             relative_error: error,
+            planned_samples: None,
         }
     }
 
@@ -436,6 +442,11 @@ mod tests {
         assert_eq!(p.rule, Rule::Error);
         assert!((p.fraction - (0.01f64 / 0.011).powi(2)).abs() < 1e-12);
         assert_eq!(StopRules::default().progress(&s, 100), None);
+        // Adaptive sampling: the spp rule's target is the blocks' largest count, and its
+        // progress the share of the allocation's samples taken.
+        let rules = StopRules { spp: Some(4000), ..Default::default() };
+        let s = Status { samples: 50_000, planned_samples: Some(100_000), ..status(900, 1.0, None) };
+        assert!((rules.progress(&s, 100).unwrap().fraction - 0.5).abs() < 1e-12);
     }
 
     #[test]
