@@ -3,15 +3,17 @@
 //
 // Estimator (docs/theory.md): at every diffuse hit x the direct light is estimated by next-event
 // estimation on the rectangular lights,
-//     L_direct(x) = (albedo / pi) * Le * cos(theta_x) cos(theta_y) / |x - y|^2 * A_total * V(x, y),
-// with y uniform on the union of the lights (pdf 1 / A_total over area). Bounce directions are
+//     L_direct(x) = (albedo / pi) * Le * cos(theta_x) cos(theta_y) / |x - y|^2 * A_total / p(s, t) * V(x, y),
+// with a light chosen in proportion to its area and y = corner + s u + t v on it, (s, t) drawn
+// with the density p of the bilinear fit to the geometric term (sampling.wgsl,
+// sample_light_bilinear; p = 1 is uniform over area, pdf 1 / A_total). Bounce directions are
 // drawn from the cosine or the uniform hemisphere pdf; a bounce ray that reaches a light adds
 // nothing, because that light was already counted by next-event estimation at the previous hit.
 // A camera ray that hits a light sees its emitted radiance.
 
 #import illum::constants::{PI, TWO_PI, INV_PI}
 #import illum::sampler::{Sampler, sampler_new, sample_1d, sample_2d}
-#import illum::sampling::{sample_cosine_hemisphere, sample_uniform_hemisphere, to_world, sample_parallelogram}
+#import illum::sampling::{sample_cosine_hemisphere, sample_uniform_hemisphere, to_world, sample_parallelogram, sample_light_bilinear}
 #import illum::spawn::{spawn_point, spawn_error, max_abs}
 #import illum::rtcore::geometry::{NO_HIT, FAR, Surface}
 #import illum::pathtrace::scene::{Material, params, lights, batch_sum, batch_sum_sq}
@@ -43,8 +45,8 @@ const ADAPTIVE_BLOCK: u32 = 8u;
 const SHADOW_SHORTEN: f32 = 9.5367431640625e-7;
 
 // Next-event estimation at the surface point s (normal s.n facing the incoming ray): radiance
-// arriving from one point sampled uniformly on the lights, already divided by its pdf
-// (1 / A_total) and multiplied by cos(theta_x); the caller multiplies by albedo / pi. The
+// arriving from one point sampled on the lights, already divided by its pdf
+// (p(s, t) / A_total) and multiplied by cos(theta_x); the caller multiplies by albedo / pi. The
 // geometry uses the surface point itself; only visibility is tested from the spawned origin.
 fn direct_light(s: Surface, origin: vec3<f32>, sampler: ptr<function, Sampler>) -> vec3<f32> {
 #ifdef LIGHT_CHOICE
@@ -54,7 +56,9 @@ fn direct_light(s: Surface, origin: vec3<f32>, sampler: ptr<function, Sampler>) 
     let light = lights[0];
 #endif
     let u = sample_2d(sampler);
-    let y = sample_parallelogram(light.corner.xyz, light.edge_u.xyz, light.edge_v.xyz, u.x, u.y);
+    // (s, t) on the light and 1 / pdf(s, t), the density following the geometric term.
+    let st = sample_light_bilinear(s.p, s.n, light.corner.xyz, light.edge_u.xyz, light.edge_v.xyz, light.normal.xyz, u.x, u.y);
+    let y = sample_parallelogram(light.corner.xyz, light.edge_u.xyz, light.edge_v.xyz, st.x, st.y);
     let to_light = y - s.p;
     let dist2 = dot(to_light, to_light);
     let wi = to_light / sqrt(dist2);
@@ -73,7 +77,7 @@ fn direct_light(s: Surface, origin: vec3<f32>, sampler: ptr<function, Sampler>) 
         let length_to_light = length(segment);
         let t_max = length_to_light * (1.0 - SHADOW_SHORTEN) - err_l / cos_y;
         if (!occluded(origin, segment / length_to_light, t_max)) {
-            return light.emission.xyz * (cos_x * cos_y / dist2 * params.light_area);
+            return light.emission.xyz * (cos_x * cos_y / dist2 * params.light_area * st.z);
         }
     }
     return vec3<f32>(0.0);

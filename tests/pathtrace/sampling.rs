@@ -26,7 +26,7 @@ fn run_on_gpu(expression: &str, seed: u32) -> Vec<DVec3> {
     let gpu = common::gpu();
     let source = format!(
         "#import illum::rng::{{rng_seed, rng_f32}}
-#import illum::sampling::{{sample_cosine_hemisphere, sample_uniform_hemisphere, sample_uniform_cone, to_world, sample_parallelogram, sample_disc}}
+#import illum::sampling::{{sample_cosine_hemisphere, sample_uniform_hemisphere, sample_uniform_cone, to_world, sample_parallelogram, sample_disc, sample_light_bilinear}}
 @group(0) @binding(0) var<storage, read_write> samples: array<vec4<f32>>;
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {{
@@ -230,6 +230,134 @@ fn rectangular_light_sampling_is_uniform_over_area() {
     }
     // pdf = 1/A over area: every cell of the (s, t) grid has the same area, so p = 1/256.
     chi_square_test("rectangle", &counts, &vec![1.0 / (BINS * BINS) as f64; BINS * BINS]);
+}
+
+/// The Cornell box's light: corner, edges, and the unit normal of its emitting side.
+const LIGHT: [DVec3; 4] =
+    [DVec3::new(213.0, 555.0, 225.5), DVec3::new(130.0, 0.0, 0.0), DVec3::new(0.0, 0.0, 105.0), DVec3::NEG_Y];
+
+fn wgsl_vec(v: DVec3) -> String {
+    format!("vec3<f32>({:?}, {:?}, {:?})", v.x as f32, v.y as f32, v.z as f32)
+}
+
+/// The density next-event estimation draws light points (s, t) with at shading point p (unit
+/// normal n), from its definition in shaders/common/sampling.wgsl, in f64: the bilinear
+/// interpolation of cos(theta_x) cos(theta_y) / r^2 at the four corners, each plus a sixteenth
+/// of their mean, divided by its mean over the square. `None` where the shader falls back to
+/// uniform sampling.
+fn bilinear_light_pdf(p: DVec3, n: DVec3) -> Option<impl Fn(f64, f64) -> f64> {
+    let [corner, u, v, normal] = LIGHT;
+    let g = |q: DVec3| {
+        let w = q - p;
+        let d2 = w.length_squared();
+        (n.dot(w) / d2).max(0.0) * (-normal.dot(w) / d2).max(0.0)
+    };
+    let mut w = [g(corner), g(corner + u), g(corner + v), g(corner + u + v)];
+    let mean = w.iter().sum::<f64>() / 4.0;
+    if !(mean > 0.0 && mean < 3.0e38) {
+        return None;
+    }
+    for x in &mut w {
+        *x += mean / 16.0;
+    }
+    let total = mean * 17.0 / 16.0;
+    Some(move |s: f64, t: f64| {
+        ((1.0 - s) * (1.0 - t) * w[0] + s * (1.0 - t) * w[1] + (1.0 - s) * t * w[2] + s * t * w[3]) / total
+    })
+}
+
+/// Next-event estimation's light points follow the bilinear density of the geometric term: a
+/// chi-square test over a 16 x 16 grid of (s, t) at shading points near and far, facing the
+/// light and tilted so that some corners lie behind them; the returned 1 / pdf matches the
+/// density; and the test rejects uniform samples where the density is far from uniform.
+#[test]
+fn light_points_follow_the_bilinear_geometric_term() {
+    const BINS: usize = 16;
+    let cases = [
+        ("floor centre", DVec3::new(278.0, 0.0, 278.0), DVec3::Y),
+        ("back wall, 30 below the ceiling", DVec3::new(278.0, 525.0, 555.0), DVec3::NEG_Z),
+        ("left wall beside the light", DVec3::new(200.0, 540.0, 278.0), DVec3::new(1.0, 0.0, 0.0)),
+        ("tilted, two corners behind", DVec3::new(278.0, 500.0, 278.0), DVec3::new(0.8, 0.6, 0.0)),
+        ("1e-3 under the light's centre", DVec3::new(278.0, 554.999, 278.0), DVec3::Y),
+        ("1e4 away", DVec3::new(278.0, -9445.0, 278.0), DVec3::Y),
+    ];
+    for (seed, (name, p, n)) in cases.into_iter().enumerate() {
+        let [corner, u, v, normal] = LIGHT;
+        let expression = format!(
+            "sample_light_bilinear({}, {}, {}, {}, {}, {}, u1, u2)",
+            wgsl_vec(p),
+            wgsl_vec(n),
+            wgsl_vec(corner),
+            wgsl_vec(u),
+            wgsl_vec(v),
+            wgsl_vec(normal)
+        );
+        let samples = run_on_gpu(&expression, 40 + seed as u32);
+        let pdf = bilinear_light_pdf(p, n).unwrap_or_else(|| panic!("{name}: the light is lit from here"));
+        let mut counts = vec![0u64; BINS * BINS];
+        for (k, q) in samples.iter().enumerate() {
+            let (s, t, inverse) = (q.x, q.y, q.z);
+            assert!((0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&t), "{name}: ({s}, {t}) outside");
+            assert!(
+                inverse.is_finite() && inverse > 0.0 && inverse <= 17.0 + 1e-4,
+                "{name}: 1/pdf = {inverse}"
+            );
+            if k % 1024 == 0 {
+                let expected = 1.0 / pdf(s, t);
+                assert!(
+                    (inverse - expected).abs() <= 1e-4 * expected,
+                    "{name}: 1/pdf {inverse} against {expected}"
+                );
+            }
+            counts[((s * BINS as f64) as usize).min(BINS - 1) * BINS
+                + ((t * BINS as f64) as usize).min(BINS - 1)] += 1;
+        }
+        // A bilinear density's mean over a cell is its value at the cell's centre.
+        let cell = |i: usize, j: usize| pdf((i as f64 + 0.5) / BINS as f64, (j as f64 + 0.5) / BINS as f64);
+        let probability: Vec<f64> =
+            (0..BINS * BINS).map(|k| cell(k / BINS, k % BINS) / (BINS * BINS) as f64).collect();
+        chi_square_test(name, &counts, &probability);
+        if name.starts_with("left wall") {
+            // Power: here the density is far from uniform, and uniform cells must fail.
+            let uniform = vec![1.0 / (BINS * BINS) as f64; BINS * BINS];
+            let result =
+                std::panic::catch_unwind(|| chi_square_test("bilinear as uniform", &counts, &uniform));
+            assert!(result.is_err(), "the chi-square test accepted uniform cells for a bilinear density");
+        }
+    }
+}
+
+/// Where no corner weight is usable (the point on a corner, in the light's plane, behind the
+/// light, or so far that the weights underflow), sampling falls back to uniform, pdf 1: finite
+/// and unbiased.
+#[test]
+fn light_sampling_falls_back_to_uniform_at_the_extremes() {
+    let [corner, u, v, normal] = LIGHT;
+    for (name, p, n) in [
+        ("on a corner", corner, DVec3::Y),
+        ("in the light's plane", DVec3::new(100.0, 555.0, 278.0), DVec3::NEG_Y),
+        ("behind the light", DVec3::new(278.0, 600.0, 278.0), DVec3::NEG_Y),
+        ("1e30 away", DVec3::new(278.0, -1e30, 278.0), DVec3::Y),
+    ] {
+        let expression = format!(
+            "sample_light_bilinear({}, {}, {}, {}, {}, {}, u1, u2)",
+            wgsl_vec(p),
+            wgsl_vec(n),
+            wgsl_vec(corner),
+            wgsl_vec(u),
+            wgsl_vec(v),
+            wgsl_vec(normal)
+        );
+        let samples = run_on_gpu(&expression, 7);
+        for q in samples.iter().step_by(997) {
+            assert!(q.x.is_finite() && q.y.is_finite(), "{name}: {q}");
+            assert_eq!(q.z, 1.0, "{name}: 1/pdf of the uniform fallback");
+        }
+        // In f64 the weights 1e30 away do not underflow: only f32's fallback is checked there.
+        if p.y > -1e29 {
+            assert!(bilinear_light_pdf(p, n).is_none(), "{name}: the f64 density should fall back too");
+        }
+    }
 }
 
 #[test]
