@@ -4,9 +4,10 @@
 // Estimator (docs/theory.md): at every diffuse hit x the direct light is estimated by next-event
 // estimation on the rectangular lights,
 //     L_direct(x) = (albedo / pi) * Le * cos(theta_x) cos(theta_y) / |x - y|^2 * A_total / p(s, t) * V(x, y),
-// with a light chosen in proportion to its area and y = corner + s u + t v on it, (s, t) drawn
-// with the density p of the bilinear fit to the geometric term (sampling.wgsl,
-// sample_light_bilinear; p = 1 is uniform over area, pdf 1 / A_total). Bounce directions are
+// with a light chosen in proportion to its area and y = corner + s u + t v on it, (s, t) uniform
+// (p = 1: pdf 1 / A_total over area) or, with shader def BILINEAR_LIGHT (the low-discrepancy
+// sequence, options.rs), drawn with the density p of the bilinear fit to the geometric term
+// (sampling.wgsl, sample_light_bilinear). Bounce directions are
 // drawn from the cosine or the uniform hemisphere pdf; a bounce ray that reaches a light adds
 // nothing, because that light was already counted by next-event estimation at the previous hit.
 // A camera ray that hits a light sees its emitted radiance.
@@ -56,8 +57,13 @@ fn direct_light(s: Surface, origin: vec3<f32>, sampler: ptr<function, Sampler>) 
     let light = lights[0];
 #endif
     let u = sample_2d(sampler);
+#ifdef BILINEAR_LIGHT
     // (s, t) on the light and 1 / pdf(s, t), the density following the geometric term.
     let st = sample_light_bilinear(s.p, s.n, light.corner.xyz, light.edge_u.xyz, light.edge_v.xyz, light.normal.xyz, u.x, u.y);
+#else
+    // Uniform over the light's area.
+    let st = vec3<f32>(u, 1.0);
+#endif
     let y = sample_parallelogram(light.corner.xyz, light.edge_u.xyz, light.edge_v.xyz, st.x, st.y);
     let to_light = y - s.p;
     let dist2 = dot(to_light, to_light);
