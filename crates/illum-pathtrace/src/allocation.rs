@@ -146,7 +146,9 @@ impl SampleAllocation {
         let total_pixels: u64 = pixels.iter().sum();
         let budget = total_pixels * u64::from(mean_spp);
         let floor = chunk;
-        let cap = (u64::from(mean_spp) * u64::from(MAX_FACTOR)).max(floor);
+        // Counts are u32 sample indices: the cap is also the largest whole chunk a u32 holds.
+        let cap =
+            (u64::from(mean_spp) * u64::from(MAX_FACTOR)).max(floor).min(u64::from(u32::MAX) / chunk * chunk);
         let counts = |scale: f64| -> Vec<u64> {
             weights
                 .iter()
@@ -293,6 +295,10 @@ mod tests {
         assert!(dark.total() <= 2 * 64 * 256);
         let inf = allocate(&[f64::INFINITY, 1.0], 256);
         assert!(inf.total() <= 2 * 64 * 256 && inf.samples[1] >= CHUNK_SAMPLES, "{inf:?}");
+        // The largest budget: no count wraps past u32 (16 x the mean would).
+        let huge = allocate(&[1.0, 9.0], u32::MAX);
+        assert!(huge.samples.iter().all(|&n| n >= u32::MAX - 2 * CHUNK_SAMPLES), "{huge:?}");
+        assert!(huge.total() <= 2 * 64 * u64::from(u32::MAX), "{huge:?}");
         let nan = allocate(&[f64::NAN, 1.0], 256);
         assert!(nan.total() <= 2 * 64 * 256 && nan.samples.iter().all(|&n| n >= CHUNK_SAMPLES), "{nan:?}");
     }
