@@ -42,7 +42,7 @@ impl RenderProgress {
 /// One line: "37 spp  4.21 Msamples/s  error 2.31% (target 1%)  to time budget: 41%, 3 s left".
 pub fn describe(progressive: &Progressive, tracer: &PathTracer) -> String {
     let status = progressive.status(tracer);
-    let spp = match status.planned_samples {
+    let spp = match tracer.sample_allocation() {
         // Adaptive sampling: blocks take different counts; show the mean so far.
         Some(_) => {
             let camera = tracer.scene().camera;

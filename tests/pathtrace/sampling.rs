@@ -240,6 +240,13 @@ fn wgsl_vec(v: DVec3) -> String {
     format!("vec3<f32>({:?}, {:?}, {:?})", v.x as f32, v.y as f32, v.z as f32)
 }
 
+/// The WGSL call drawing a point on [`LIGHT`] for the shading point p with normal n.
+fn bilinear_expression(p: DVec3, n: DVec3) -> String {
+    let [corner, u, v, normal] = LIGHT;
+    let args = [p, n, corner, u, v, normal].map(wgsl_vec).join(", ");
+    format!("sample_light_bilinear({args}, u1, u2)")
+}
+
 /// The density next-event estimation draws light points (s, t) with at shading point p (unit
 /// normal n), from its definition in shaders/common/sampling.wgsl, in f64: the bilinear
 /// interpolation of cos(theta_x) cos(theta_y) / r^2 at the four corners, each plus a sixteenth
@@ -282,17 +289,7 @@ fn light_points_follow_the_bilinear_geometric_term() {
         ("1e4 away", DVec3::new(278.0, -9445.0, 278.0), DVec3::Y),
     ];
     for (seed, (name, p, n)) in cases.into_iter().enumerate() {
-        let [corner, u, v, normal] = LIGHT;
-        let expression = format!(
-            "sample_light_bilinear({}, {}, {}, {}, {}, {}, u1, u2)",
-            wgsl_vec(p),
-            wgsl_vec(n),
-            wgsl_vec(corner),
-            wgsl_vec(u),
-            wgsl_vec(v),
-            wgsl_vec(normal)
-        );
-        let samples = run_on_gpu(&expression, 40 + seed as u32);
+        let samples = run_on_gpu(&bilinear_expression(p, n), 40 + seed as u32);
         let pdf = bilinear_light_pdf(p, n).unwrap_or_else(|| panic!("{name}: the light is lit from here"));
         let mut counts = vec![0u64; BINS * BINS];
         for (k, q) in samples.iter().enumerate() {
@@ -332,23 +329,14 @@ fn light_points_follow_the_bilinear_geometric_term() {
 /// and unbiased.
 #[test]
 fn light_sampling_falls_back_to_uniform_at_the_extremes() {
-    let [corner, u, v, normal] = LIGHT;
+    let corner = LIGHT[0];
     for (name, p, n) in [
         ("on a corner", corner, DVec3::Y),
         ("in the light's plane", DVec3::new(100.0, 555.0, 278.0), DVec3::NEG_Y),
         ("behind the light", DVec3::new(278.0, 600.0, 278.0), DVec3::NEG_Y),
         ("1e30 away", DVec3::new(278.0, -1e30, 278.0), DVec3::Y),
     ] {
-        let expression = format!(
-            "sample_light_bilinear({}, {}, {}, {}, {}, {}, u1, u2)",
-            wgsl_vec(p),
-            wgsl_vec(n),
-            wgsl_vec(corner),
-            wgsl_vec(u),
-            wgsl_vec(v),
-            wgsl_vec(normal)
-        );
-        let samples = run_on_gpu(&expression, 7);
+        let samples = run_on_gpu(&bilinear_expression(p, n), 7);
         for q in samples.iter().step_by(997) {
             assert!(q.x.is_finite() && q.y.is_finite(), "{name}: {q}");
             assert_eq!(q.z, 1.0, "{name}: 1/pdf of the uniform fallback");

@@ -74,8 +74,10 @@ impl StopRules {
     /// How far the render is toward the rule that will stop it first: the largest fraction
     /// among the rules given (`None` when no rule is given). For the error rule the fraction is
     /// (target / error)^2, the share of the samples needed that are done, since the error falls
-    /// as 1 / sqrt(samples).
-    pub fn progress(&self, status: &Status, pixels: u64) -> Option<Progress> {
+    /// as 1 / sqrt(samples). The spp rule's fraction is of `pixels` x spp samples, or with
+    /// adaptive sampling of `adaptive_samples`, its allocation's total (the pixels do not all
+    /// take `spp`, which is then the largest block count).
+    pub fn progress(&self, status: &Status, pixels: u64, adaptive_samples: Option<u64>) -> Option<Progress> {
         let mut best: Option<Progress> = None;
         let mut consider = |rule: Rule, fraction: f64| {
             let fraction = if fraction.is_finite() { fraction.clamp(0.0, 1.0) } else { 0.0 };
@@ -85,7 +87,7 @@ impl StopRules {
         };
         if let Some(spp) = self.spp {
             // Samples, not complete passes, so the bar moves within a long pass.
-            let planned = status.planned_samples.unwrap_or(pixels.max(1) * u64::from(spp.max(1)));
+            let planned = adaptive_samples.unwrap_or(pixels.max(1) * u64::from(spp.max(1)));
             consider(Rule::Spp, status.samples as f64 / planned.max(1) as f64);
         }
         if let Some(target) = self.target_error {
@@ -205,9 +207,6 @@ pub struct Status {
     pub elapsed: Duration,
     /// The estimated relative error after the last completed pass, once it has 2 spp.
     pub relative_error: Option<f64>,
-    /// With adaptive sampling, the samples of the whole render (its allocation's total), which
-    /// the spp rule's progress is measured against: the pixels do not all take `spp`.
-    pub planned_samples: Option<u64>,
 }
 
 impl Status {
@@ -318,14 +317,18 @@ impl Progressive {
             run_samples: tracer.accumulator().total_samples().saturating_sub(self.start_samples.unwrap_or(0)),
             elapsed: self.clock.elapsed(),
             relative_error: self.relative_error,
-            planned_samples: tracer.sample_allocation().map(crate::SampleAllocation::total),
         }
     }
 
     /// Progress toward the nearest rule.
     pub fn progress(&self, tracer: &PathTracer) -> Option<Progress> {
         let camera = tracer.scene().camera;
-        self.rules.progress(&self.status(tracer), u64::from(camera.width) * u64::from(camera.height))
+        let adaptive_samples = tracer.sample_allocation().map(crate::SampleAllocation::total);
+        self.rules.progress(
+            &self.status(tracer),
+            u64::from(camera.width) * u64::from(camera.height),
+            adaptive_samples,
+        )
     }
 
     /// Checks the rules, and when none holds runs one submission. Returns why the render
@@ -394,7 +397,6 @@ mod tests {
             run_samples: 0,
             elapsed: Duration::from_secs_f64(seconds),
             relative_error: error,
-            planned_samples: None,
         }
     }
 
@@ -433,20 +435,20 @@ mod tests {
             time_budget: Some(Duration::from_secs(4)),
         };
         let s = Status { samples: 10 * 100, ..status(10, 1.0, Some(0.04)) };
-        let p = rules.progress(&s, 100).unwrap();
+        let p = rules.progress(&s, 100, None).unwrap();
         assert_eq!(p.rule, Rule::Time);
         assert!((p.fraction - 0.25).abs() < 1e-12);
         assert!((p.eta(s.elapsed).unwrap().as_secs_f64() - 3.0).abs() < 1e-9);
         let s = status(10, 1.0, Some(0.011));
-        let p = rules.progress(&s, 100).unwrap();
+        let p = rules.progress(&s, 100, None).unwrap();
         assert_eq!(p.rule, Rule::Error);
         assert!((p.fraction - (0.01f64 / 0.011).powi(2)).abs() < 1e-12);
-        assert_eq!(StopRules::default().progress(&s, 100), None);
+        assert_eq!(StopRules::default().progress(&s, 100, None), None);
         // Adaptive sampling: the spp rule's target is the blocks' largest count, and its
         // progress the share of the allocation's samples taken.
         let rules = StopRules { spp: Some(4000), ..Default::default() };
-        let s = Status { samples: 50_000, planned_samples: Some(100_000), ..status(900, 1.0, None) };
-        assert!((rules.progress(&s, 100).unwrap().fraction - 0.5).abs() < 1e-12);
+        let s = Status { samples: 50_000, ..status(900, 1.0, None) };
+        assert!((rules.progress(&s, 100, Some(100_000)).unwrap().fraction - 0.5).abs() < 1e-12);
     }
 
     #[test]
