@@ -99,6 +99,14 @@ impl SampleAllocation {
         (width.div_ceil(BLOCK), height.div_ceil(BLOCK))
     }
 
+    /// The pixels of each block of an image of `width x height`, row-major over blocks (the last
+    /// row and column of blocks are cut by the image's edge).
+    pub fn block_pixels(width: u32, height: u32) -> Vec<u64> {
+        let (bx, by) = Self::blocks(width, height);
+        let side = |i: u32, size: u32| u64::from(BLOCK.min(size - i * BLOCK));
+        (0..by).flat_map(|j| (0..bx).map(move |i| side(i, width) * side(j, height))).collect()
+    }
+
     /// Every block `spp` samples per pixel.
     pub fn uniform(width: u32, height: u32, spp: u32) -> Self {
         let (bx, by) = Self::blocks(width, height);
@@ -114,13 +122,12 @@ impl SampleAllocation {
         let (width, height) = (pilot.width, pilot.height);
         let (bx, by) = Self::blocks(width, height);
         let mut noise = vec![0.0f64; bx as usize * by as usize];
-        let mut pixels = vec![0u64; noise.len()];
+        let pixels = Self::block_pixels(width, height);
         for y in 0..height {
             for x in 0..width {
                 let b = (y / BLOCK * bx + x / BLOCK) as usize;
                 let p = (y * width + x) as usize;
                 let n = pilot.pixel_count(p) as f64;
-                pixels[b] += 1;
                 if n < 2.0 {
                     continue;
                 }
@@ -215,16 +222,8 @@ impl SampleAllocation {
 
     /// Samples over the whole image.
     pub fn total(&self) -> u64 {
-        let (bx, by) = Self::blocks(self.width, self.height);
-        let mut total = 0;
-        for j in 0..by {
-            for i in 0..bx {
-                let w = u64::from(BLOCK.min(self.width - i * BLOCK));
-                let h = u64::from(BLOCK.min(self.height - j * BLOCK));
-                total += w * h * u64::from(self.samples[(j * bx + i) as usize]);
-            }
-        }
-        total
+        let pixels = Self::block_pixels(self.width, self.height);
+        pixels.iter().zip(&self.samples).map(|(&p, &n)| p * u64::from(n)).sum()
     }
 
     /// Mean samples per pixel.
@@ -235,18 +234,8 @@ impl SampleAllocation {
     /// Pixels of the image whose blocks take more than `index` samples: the pixels a pass
     /// starting at sample index `index` still traces.
     pub fn pixels_beyond(&self, index: u32) -> u64 {
-        let (bx, by) = Self::blocks(self.width, self.height);
-        let mut pixels = 0;
-        for j in 0..by {
-            for i in 0..bx {
-                if self.samples[(j * bx + i) as usize] > index {
-                    let w = u64::from(BLOCK.min(self.width - i * BLOCK));
-                    let h = u64::from(BLOCK.min(self.height - j * BLOCK));
-                    pixels += w * h;
-                }
-            }
-        }
-        pixels
+        let pixels = Self::block_pixels(self.width, self.height);
+        pixels.iter().zip(&self.samples).filter(|&(_, &n)| n > index).map(|(&p, _)| p).sum()
     }
 }
 
@@ -255,7 +244,7 @@ mod tests {
     use super::*;
 
     fn allocate(weights: &[f64], mean_spp: u32) -> SampleAllocation {
-        // 16 x 8 pixels: two blocks per row of blocks, one row... generalised by the weights.
+        // One row of whole blocks, one per weight.
         let width = BLOCK * weights.len() as u32;
         let pixels = vec![u64::from(BLOCK * BLOCK); weights.len()];
         SampleAllocation::from_weights(width, BLOCK, weights, &pixels, mean_spp)
@@ -312,5 +301,6 @@ mod tests {
         assert_eq!(a.pixels_beyond(31), 90);
         assert_eq!(a.pixels_beyond(32), 0);
         assert_eq!(a.at(9, 8), 32);
+        assert_eq!(SampleAllocation::block_pixels(10, 9), [64, 16, 8, 2]);
     }
 }
