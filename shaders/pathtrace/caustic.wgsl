@@ -36,7 +36,7 @@
 #import illum::spawn::spawn_point
 #import illum::rtcore::geometry::{NO_HIT, Surface}
 #import illum::pathtrace::scene::{params, objects, materials}
-#import illum::rtcore::traversal::{closest_hit, surface_at}
+#import illum::rtcore::traversal::{closest_hit, scattering_surface_at}
 #import illum::pathtrace::surfaces::{MATERIAL_CHECKER, MATERIAL_DIELECTRIC, MATERIAL_MIRROR, UNBOUNDED, RR_START, RR_MAX_SURVIVAL, UNBOUNDED_DEPTH_CAP, max3, scatter_dielectric, sample_sun}
 #ifdef CHECKER
 #import illum::pathtrace::surfaces::checker_albedo
@@ -218,7 +218,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         if (obj.emitter != 0u) {
             return;
         }
-        var s = surface_at(obj, o + hit.t * d);
+        var s = scattering_surface_at(obj, o + hit.t * d);
         let front = dot(s.n, d) < 0.0;
         if (!front) {
             s.n = -s.n;

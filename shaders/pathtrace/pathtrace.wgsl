@@ -22,7 +22,7 @@
 #import illum::pathtrace::scene::block_samples
 #endif
 #import illum::pathtrace::materials::material_at
-#import illum::rtcore::traversal::{closest_hit, occluded, surface_at, choose_light, object_at}
+#import illum::rtcore::traversal::{closest_hit, occluded, scattering_surface_at, choose_light, object_at}
 #import illum::pathtrace::surfaces::{MATERIAL_CHECKER, MATERIAL_DIELECTRIC, MATERIAL_MIRROR, UNBOUNDED, RR_START, RR_MAX_SURVIVAL, UNBOUNDED_DEPTH_CAP, max3}
 #ifdef SUN
 #import illum::pathtrace::surfaces::sample_sun
@@ -164,18 +164,19 @@ fn radiance(origin: vec3<f32>, direction: vec3<f32>, sampler: ptr<function, Samp
         }
         // object_at and material_at: literals in a specialised pipeline (see specialise.rs).
         let obj = object_at(hit.index);
-        // One reconstruction for both uses below: lavapipe (Mesa 22) runs the body of every
-        // `if` for all lanes under a mask, so a second one inside the emitter's branch would be
-        // paid on every hit.
-        var s = surface_at(obj, o + hit.t * d);
-        let front = dot(s.n, d) < 0.0;
         if (obj.emitter != 0u) {
             if (direct_counts) {
-                // One-sided emitter: visible only from its front.
+                // One-sided emitter: visible only from its front, the side its normal
+                // edge_u x edge_v (obj.d; emitters are quads) points to. No surface is rebuilt
+                // for it: lavapipe (Mesa 22) runs the body of every `if` for all lanes under a
+                // mask, so the quad's reconstruction would be paid on every hit.
+                let front = dot(obj.d.xyz, d) < 0.0;
                 radiance += select(vec3<f32>(0.0), throughput * material_at(obj.material).emission.xyz, front);
             }
             break;
         }
+        var s = scattering_surface_at(obj, o + hit.t * d);
+        let front = dot(s.n, d) < 0.0;
         if (!front) {
             s.n = -s.n;
         }

@@ -66,6 +66,11 @@ fn surface_at(obj: Object, p: vec3<f32>) -> Surface {
     }
 }
 
+// The surface of a non-emitter; the generic pipeline reconstructs every kind.
+fn scattering_surface_at(obj: Object, p: vec3<f32>) -> Surface {
+    return surface_at(obj, p);
+}
+
 // The light whose share of the total light area contains `pick` (in [0, total area)): lights
 // are chosen with probability proportional to their area.
 fn choose_light(pick: f32) -> u32 {

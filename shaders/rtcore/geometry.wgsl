@@ -24,8 +24,10 @@ const FAR: f32 = 3.0e38;
 // that the image could resolve.
 const EMITTER_TIE: f32 = 1.0e-5;
 
-// Box: a = (local min, cos), b = (local max, sin), c = (offset, 0): world = R_y local + offset.
-// Axis-aligned box (a box without rotation): a = world min, b = world max.
+// Box: a = (local min, cos), b = (local max, sin), c = (offset, err): world = R_y local + offset,
+// err the error bound of its rebuilt surface points (see surface_box).
+// Axis-aligned box: a = (world min, 1), b = (world max, 0), c = 0: also valid as a box rotated by
+// zero whose rebuilt points are exact (err 0), so surface_box can serve both kinds.
 // Quad: a = corner, b = edge_u, c = edge_v, d = (edge_u x edge_v, 0).
 // Sphere: a = (centre, radius).
 struct Object {
@@ -180,6 +182,9 @@ fn surface_aabb(obj: Object, p: vec3<f32>) -> Surface {
     return Surface(snap_to_face(p, n, lo, hi), n, 0.0);
 }
 
+// Also an axis-aligned box's record (cos 1, sin 0, offset 0, err 0): the rotations by zero and
+// the added zero offset are exact in floats (x * 1 = x, x * 0 + y = y), so the point, normal and
+// bound are surface_aabb's.
 fn surface_box(obj: Object, p: vec3<f32>) -> Surface {
     // Local frame: the face is the axis on which p sits farthest out, relative to the
     // half-extent.
@@ -190,8 +195,8 @@ fn surface_box(obj: Object, p: vec3<f32>) -> Surface {
     let pl = rotate_y_inverse(p - obj.c.xyz, c, s);
     let nl = box_face_normal((pl - 0.5 * (lo + hi)) / (0.5 * (hi - lo)));
     let q = rotate_y(snap_to_face(pl, nl, lo, hi), c, s) + obj.c.xyz;
-    let magnitude = max_abs(obj.c.xyz) + 2.0 * max(max_abs(lo), max_abs(hi));
-    return Surface(q, rotate_y(nl, c, s), spawn_error(magnitude));
+    // err = spawn_error(|offset| + 2 max(|lo|, |hi|)), stored in the record (gpu_scene.rs).
+    return Surface(q, rotate_y(nl, c, s), obj.c.w);
 }
 
 fn surface_quad(obj: Object, p: vec3<f32>) -> Surface {

@@ -42,6 +42,14 @@ fn each_scene_file_picks_the_specialisation_it_should() {
         assert_eq!(occluders, expected_occluders, "{file}");
         assert!(!key.source.contains("hit_sphere("), "{file}: a scene without spheres has sphere code");
         assert!(!key.source.contains("surface_sphere("), "{file}: a scene without spheres has sphere code");
+        // The path tracer rebuilds surfaces of non-emitters only, and both kinds of box with one
+        // function: one reconstruction per hit instead of three.
+        let scattering = &key.source[key.source.find("fn scattering_surface_at").expect("generated")..];
+        let scattering = &scattering[..scattering.find("\n}\n").expect("ends")];
+        assert!(
+            scattering.contains("default: { return surface_box(obj, p); }") && !scattering.contains("case "),
+            "{file}: {scattering}"
+        );
         assert!(
             key.source.contains("return 0u;") && !key.source.contains("pick <"),
             "{file}: one light needs no selection"
@@ -177,4 +185,140 @@ fn settings_that_choose_code_rebuild_the_pipeline_on_update() {
     let (a, b) = (updated.accumulator().mean_image(), fresh.accumulator().mean_image());
     assert!(a.pixels == b.pixels, "the updated tracer does not render the new settings' image");
     assert!(before.pixels != a.pixels, "the two settings rendered the same image: the test proves nothing");
+}
+
+/// A specialised pipeline reconstructs axis-aligned and rotated boxes with one function,
+/// `surface_box` (lavapipe runs every case of a switch for every lane): an axis-aligned box is
+/// uploaded as a box rotated by zero with an error bound of zero. That must change nothing: on
+/// the GPU, `surface_box` and `surface_aabb` give bit for bit the same point, normal and bound at
+/// points on every face, edge and corner of boxes from 1e-3 to 1e5 units across, near the origin
+/// and 1e5 units from it, with each point a few floats off its face as a hit point is.
+#[test]
+fn a_box_rotated_by_zero_rebuilds_exactly_the_axis_aligned_surface() {
+    use glam::Vec3;
+    use illum::gpu::readback::read_buffer;
+    use illum::gpu::shader::{self, ShaderFile};
+    use illum::gpu::wgpu;
+    use illum::pathtrace::gpu_scene::{GpuObject, GpuShape, ObjectRecord, ShapeKind};
+    use illum::pathtrace::shaders::{GEOMETRY_MODULE, SPAWN_MODULE};
+
+    let boxes = [
+        (Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 2.0, 3.0)),
+        (Vec3::new(-1.0, 555.0, 0.0), Vec3::new(557.0, 557.0, 556.0)),
+        (Vec3::new(1e5, -1e5, 1e5), Vec3::new(1e5 + 1e-3, -1e5 + 7.0, 1e5 + 0.5)),
+        (Vec3::new(-3e-3, -1e-3, 2e-3), Vec3::new(-2e-3, 1e-3, 3e-3)),
+        (Vec3::new(-1e5, -1e5, -1e5), Vec3::new(1e5, 1e5, 1e5)),
+    ];
+    let records: Vec<ObjectRecord> = boxes
+        .iter()
+        .map(|&(min, max)| {
+            GpuObject { shape: GpuShape::Aabb { min, max }, material: 0, emitter: false }.record()
+        })
+        .collect();
+    assert!(records.iter().all(|r| r.kind == ShapeKind::Aabb.code() && r.a[3] == 1.0 && r.b[3] == 0.0));
+    // Points on the faces: the face's coordinate moved by -2..2 floats, the others at the
+    // face's edges, corners or inside (a fixed LCG, so failures repeat).
+    let mut state = 0x2545f491u32;
+    let mut next = move || {
+        state = state.wrapping_mul(1664525).wrapping_add(1013904223);
+        (state >> 8) as f32 / (1u32 << 24) as f32
+    };
+    let mut points: Vec<[f32; 4]> = Vec::new();
+    for (index, &(min, max)) in boxes.iter().enumerate() {
+        for axis in 0..3 {
+            for on_max in [false, true] {
+                for k in 0..200 {
+                    let mut p = [0.0f32; 3];
+                    for a in 0..3 {
+                        // Corners and edges first, then the inside of the face.
+                        let u = match k {
+                            0..=3 => ((k >> (a % 2)) & 1) as f32,
+                            _ => next(),
+                        };
+                        p[a] = min[a] + u * (max[a] - min[a]);
+                    }
+                    let face = if on_max { max[axis] } else { min[axis] };
+                    let bits = face.to_bits() as i64 + (k as i64 % 5) - 2;
+                    p[axis] = if face == 0.0 { 0.0 } else { f32::from_bits(bits as u32) };
+                    points.push([p[0], p[1], p[2], f32::from_bits(index as u32)]);
+                }
+            }
+        }
+    }
+    let source = "#import illum::rtcore::geometry::{Object, surface_aabb, surface_box}
+@group(0) @binding(0) var<storage, read> objects: array<Object>;
+@group(0) @binding(1) var<storage, read> points: array<vec4<f32>>;
+@group(0) @binding(2) var<storage, read_write> out: array<vec4<u32>>;
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= arrayLength(&points)) { return; }
+    let obj = objects[bitcast<u32>(points[i].w)];
+    let a = surface_aabb(obj, points[i].xyz);
+    let b = surface_box(obj, points[i].xyz);
+    out[4u * i] = bitcast<vec4<u32>>(vec4<f32>(a.p, a.err));
+    out[4u * i + 1u] = bitcast<vec4<u32>>(vec4<f32>(a.n, 0.0));
+    out[4u * i + 2u] = bitcast<vec4<u32>>(vec4<f32>(b.p, b.err));
+    out[4u * i + 3u] = bitcast<vec4<u32>>(vec4<f32>(b.n, 0.0));
+}
+";
+    let gpu = common::gpu();
+    let entry = ShaderFile::generated("surface harness".into(), source.into());
+    let pipeline =
+        shader::compute_pipeline(gpu, &[SPAWN_MODULE, GEOMETRY_MODULE], &entry, &[], "surface harness")
+            .unwrap_or_else(|e| panic!("the harness compiles: {e}"));
+    let storage = |label: &str, bytes: &[u8]| {
+        use wgpu::util::DeviceExt;
+        gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: bytes,
+            usage: wgpu::BufferUsages::STORAGE,
+        })
+    };
+    let objects = storage("objects", bytemuck::cast_slice(&records));
+    let point_buffer = storage("points", bytemuck::cast_slice(&points));
+    let size = points.len() as u64 * 64;
+    let out = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("surfaces"),
+        size,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[
+            wgpu::BindGroupEntry { binding: 0, resource: objects.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 1, resource: point_buffer.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 2, resource: out.as_entire_binding() },
+        ],
+    });
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    {
+        let mut pass = encoder.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        pass.dispatch_workgroups((points.len() as u32).div_ceil(64), 1, 1);
+    }
+    gpu.queue.submit([encoder.finish()]);
+    let bytes = read_buffer(gpu, &out, 0, size, "surface harness").expect("readback");
+    let words: &[u32] = bytemuck::cast_slice(&bytes);
+    let mut compared = 0;
+    for (i, point) in points.iter().enumerate() {
+        let w = &words[16 * i..16 * i + 16];
+        let (aabb, rotated) = (&w[0..8], &w[8..16]);
+        assert_eq!(
+            aabb,
+            rotated,
+            "point {:?} on box {}: surface_aabb gives p, err, n = {:?}, surface_box {:?}",
+            &point[..3],
+            point[3].to_bits(),
+            aabb.iter().map(|b| f32::from_bits(*b)).collect::<Vec<_>>(),
+            rotated.iter().map(|b| f32::from_bits(*b)).collect::<Vec<_>>()
+        );
+        // The bound is zero: the point lies on the face's plane exactly.
+        assert_eq!(f32::from_bits(aabb[3]), 0.0);
+        compared += 1;
+    }
+    assert_eq!(compared, boxes.len() * 6 * 200);
 }

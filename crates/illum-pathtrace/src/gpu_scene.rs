@@ -8,6 +8,7 @@ use glam::Vec3;
 use illum_scene::{Bounces, Feature, MaterialKind, RendererKind, Sampling, Scene, Shape};
 
 use crate::PathTraceError;
+use crate::spawn::spawn_error;
 
 /// What the path tracer implements: every feature of the scene model. Each is compiled into a
 /// scene's pipeline only when the scene uses it (see [`GpuScene::shader_defs`]).
@@ -129,9 +130,15 @@ impl GpuObject {
     /// The record the shader reads (see [`ObjectRecord`]).
     pub fn record(&self) -> ObjectRecord {
         let (a, b, c, d) = match self.shape {
-            GpuShape::Aabb { min, max } => (v4(min, 0.0), v4(max, 0.0), [0.0; 4], [0.0; 4]),
+            // Also a box rotated by zero (cos 1, sin 0, no offset) whose rebuilt points are exact
+            // (error bound 0), so that surface_box can serve both kinds (specialise.rs).
+            GpuShape::Aabb { min, max } => (v4(min, 1.0), v4(max, 0.0), [0.0; 4], [0.0; 4]),
             GpuShape::Box { local_min, local_max, cos, sin, offset } => {
-                (v4(local_min, cos), v4(local_max, sin), v4(offset, 0.0), [0.0; 4])
+                // The error bound of its rebuilt points (geometry.wgsl, surface_box), computed
+                // here once instead of at every hit; the same f32 operations as the shader's.
+                let magnitude = offset.abs().max_element()
+                    + 2.0 * local_min.abs().max_element().max(local_max.abs().max_element());
+                (v4(local_min, cos), v4(local_max, sin), v4(offset, spawn_error(magnitude)), [0.0; 4])
             }
             GpuShape::Quad { corner, edge_u, edge_v } => {
                 (v4(corner, 0.0), v4(edge_u, 0.0), v4(edge_v, 0.0), v4(edge_u.cross(edge_v), 0.0))

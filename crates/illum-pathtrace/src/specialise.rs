@@ -6,7 +6,8 @@
 //! emit one straight-line test per object with its numbers as literals: the compiler then folds
 //! the constants (an axis-aligned box needs no frame change) and no object data is read while
 //! tracing. The generated module also contains only what the scene uses:
-//! - surface reconstruction only for the kinds of shape present;
+//! - surface reconstruction only for the kinds of shape present (for the path tracer, only
+//!   those of non-emitters), one function for axis-aligned and rotated boxes;
 //! - no light-selection code when there is one light;
 //! - shadow rays test only the objects that can block a light (see [`can_block_light`]);
 //! - the object and material at a hit come from literals (`object_at`, and `material_at` in
@@ -15,7 +16,8 @@
 //!   per lane and component, which made the Cornell box 29% slower at 2 bounces.
 //!
 //! The module (`illum::rtcore::traversal`) is shared: the Whitted ray tracer imports the same
-//! `closest_hit`, `occluded` and `surface_at` (`choose_light` is the path tracer's alone).
+//! `closest_hit`, `occluded` and `surface_at` (`choose_light` and `scattering_surface_at` are the
+//! path tracer's alone).
 //!
 //! About 400 lines, one concept: the generator of one WGSL module, each function writing one of
 //! its functions.
@@ -270,6 +272,37 @@ pub fn can_block_light(scene: &GpuScene, index: usize) -> bool {
     true
 }
 
+/// The cases of a `switch obj.kind` that reconstructs the surface of each kind in `kinds`; the
+/// last one is the default (WGSL requires one). lavapipe runs every case of a switch for every
+/// lane, so kinds share a case where one function serves them: an axis-aligned box is stored as
+/// a box rotated by zero with an error bound of zero ([`GpuObject::record`]), which
+/// `surface_box` reconstructs exactly as `surface_aabb` does (same point, normal and bound), so
+/// where both kinds occur `surface_box` serves both.
+fn surface_cases(kinds: &BTreeSet<ShapeKind>) -> String {
+    let mut groups: Vec<(Vec<ShapeKind>, &str)> = Vec::new();
+    for &kind in kinds {
+        if kind == ShapeKind::Aabb && kinds.contains(&ShapeKind::Box) {
+            continue;
+        }
+        let mut members = vec![kind];
+        if kind == ShapeKind::Box && kinds.contains(&ShapeKind::Aabb) {
+            members.insert(0, ShapeKind::Aabb);
+        }
+        groups.push((members, kind.surface_function()));
+    }
+    let mut cases = String::new();
+    for (i, (members, function)) in groups.iter().enumerate() {
+        let call = format!("{function}(obj, p)");
+        if i + 1 == groups.len() {
+            cases.push_str(&format!("        default: {{ return {call}; }}\n"));
+        } else {
+            let selectors = members.iter().map(|k| k.wgsl_constant()).collect::<Vec<_>>().join(", ");
+            cases.push_str(&format!("        case {selectors}: {{ return {call}; }}\n"));
+        }
+    }
+    cases
+}
+
 /// Builds the `illum::rtcore::traversal` module for `scene`: `closest_hit`, `occluded`,
 /// `surface_at` and `choose_light`.
 pub fn specialise(scene: &Scene, gpu_scene: &GpuScene) -> Specialisation {
@@ -310,17 +343,12 @@ pub fn specialise(scene: &Scene, gpu_scene: &GpuScene) -> Specialisation {
             }
         }
     }
-    // Every kind but the last gets a case; the last is the default (WGSL requires one).
-    let mut normal_cases = String::new();
-    let last_kind = kinds.iter().next_back().copied();
-    for kind in &kinds {
-        let call = format!("{}(obj, p)", kind.surface_function());
-        if Some(*kind) == last_kind {
-            normal_cases.push_str(&format!("        default: {{ return {call}; }}\n"));
-        } else {
-            normal_cases.push_str(&format!("        case {}: {{ return {call}; }}\n", kind.wgsl_constant()));
-        }
-    }
+    let normal_cases = surface_cases(&kinds);
+    // The path tracer never asks for an emitter's surface (a hit on a light only needs the side,
+    // from the light's normal), so its reconstruction covers the non-emitters' kinds alone.
+    let scattering: BTreeSet<ShapeKind> =
+        gpu_scene.objects.iter().filter(|o| !o.emitter).map(|o| o.shape.kind()).collect();
+    let scattering_cases = surface_cases(if scattering.is_empty() { &kinds } else { &scattering });
     let object_cases = switch_cases(gpu_scene.object_records().iter().map(object_literal));
     let choose_light = if gpu_scene.lights.len() <= 1 {
         "    // One light (or none: then nothing calls this): nothing to choose.\n    return 0u;\n".to_owned()
@@ -367,6 +395,13 @@ fn object_at(index: u32) -> Object {{
 fn surface_at(obj: Object, p: vec3<f32>) -> Surface {{
     switch obj.kind {{
 {normal_cases}    }}
+}}
+
+// The surface of a non-emitter (`obj.emitter == 0`), for the path tracer: only the kinds that
+// scatter light in this scene.
+fn scattering_surface_at(obj: Object, p: vec3<f32>) -> Surface {{
+    switch obj.kind {{
+{scattering_cases}    }}
 }}
 
 fn choose_light(pick: f32) -> u32 {{
