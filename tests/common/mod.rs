@@ -11,6 +11,7 @@ use illum::pathtrace::PathTracer;
 use illum::scene::{Bounces, Overrides, Sampling, Scene};
 
 pub mod edit;
+pub mod harness;
 
 /// The device every test in this binary shares. Without a Vulkan adapter this panics with the
 /// error, which names the fix (`apt-get install mesa-vulkan-drivers`): a missing driver fails

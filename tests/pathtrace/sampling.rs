@@ -10,9 +10,6 @@
 use std::f64::consts::PI;
 
 use glam::DVec3;
-use illum::gpu::readback::read_buffer;
-use illum::gpu::shader::{self, ShaderFile};
-use illum::gpu::wgpu;
 use illum::pathtrace::SAMPLING_MODULES;
 use illum_oracle::chi_square;
 
@@ -23,7 +20,6 @@ const ALPHA: f64 = 0.01;
 
 /// Runs `expression` (WGSL, may use u1, u2 in [0, 1) and must give a vec3<f32>) for N samples.
 fn run_on_gpu(expression: &str, seed: u32) -> Vec<DVec3> {
-    let gpu = common::gpu();
     let source = format!(
         "#import illum::rng::{{rng_seed, rng_f32}}
 #import illum::sampling::{{sample_cosine_hemisphere, sample_uniform_hemisphere, sample_uniform_cone, to_world, sample_parallelogram, sample_disc, sample_light_bilinear}}
@@ -39,31 +35,15 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {{
 }}
 "
     );
-    let entry = ShaderFile::generated("sampling harness".into(), source);
-    let pipeline = shader::compute_pipeline(gpu, SAMPLING_MODULES, &entry, &[], "sampling harness")
-        .unwrap_or_else(|e| panic!("the harness compiles: {e}"));
-    let size = N as u64 * 16;
-    let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("samples"),
-        size,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: None,
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }],
-    });
-    let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    {
-        let mut pass = encoder.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &bind_group, &[]);
-        let groups = N / 64;
-        pass.dispatch_workgroups(groups.min(1024), groups.div_ceil(1024), 1);
-    }
-    gpu.queue.submit([encoder.finish()]);
-    let bytes = read_buffer(gpu, &buffer, 0, size, "sampling harness").expect("readback");
+    let groups = N / 64;
+    let bytes = common::harness::run_compute(
+        "sampling harness",
+        SAMPLING_MODULES,
+        source,
+        &[],
+        N as u64 * 16,
+        (groups.min(1024), groups.div_ceil(1024), 1),
+    );
     bytes
         .chunks_exact(16)
         .map(|c| {

@@ -196,9 +196,6 @@ fn settings_that_choose_code_rebuild_the_pipeline_on_update() {
 #[test]
 fn a_box_rotated_by_zero_rebuilds_exactly_the_axis_aligned_surface() {
     use glam::Vec3;
-    use illum::gpu::readback::read_buffer;
-    use illum::gpu::shader::{self, ShaderFile};
-    use illum::gpu::wgpu;
     use illum::pathtrace::gpu_scene::{GpuObject, GpuShape, ObjectRecord, ShapeKind};
     use illum::pathtrace::shaders::{GEOMETRY_MODULE, SPAWN_MODULE};
 
@@ -262,46 +259,14 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     out[4u * i + 3u] = bitcast<vec4<u32>>(vec4<f32>(b.n, 0.0));
 }
 ";
-    let gpu = common::gpu();
-    let entry = ShaderFile::generated("surface harness".into(), source.into());
-    let pipeline =
-        shader::compute_pipeline(gpu, &[SPAWN_MODULE, GEOMETRY_MODULE], &entry, &[], "surface harness")
-            .unwrap_or_else(|e| panic!("the harness compiles: {e}"));
-    let storage = |label: &str, bytes: &[u8]| {
-        use wgpu::util::DeviceExt;
-        gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(label),
-            contents: bytes,
-            usage: wgpu::BufferUsages::STORAGE,
-        })
-    };
-    let objects = storage("objects", bytemuck::cast_slice(&records));
-    let point_buffer = storage("points", bytemuck::cast_slice(&points));
-    let size = points.len() as u64 * 64;
-    let out = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("surfaces"),
-        size,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: None,
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[
-            wgpu::BindGroupEntry { binding: 0, resource: objects.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 1, resource: point_buffer.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 2, resource: out.as_entire_binding() },
-        ],
-    });
-    let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    {
-        let mut pass = encoder.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &bind_group, &[]);
-        pass.dispatch_workgroups((points.len() as u32).div_ceil(64), 1, 1);
-    }
-    gpu.queue.submit([encoder.finish()]);
-    let bytes = read_buffer(gpu, &out, 0, size, "surface harness").expect("readback");
+    let bytes = common::harness::run_compute(
+        "surface harness",
+        &[SPAWN_MODULE, GEOMETRY_MODULE],
+        source.into(),
+        &[bytemuck::cast_slice(&records), bytemuck::cast_slice(&points)],
+        points.len() as u64 * 64,
+        ((points.len() as u32).div_ceil(64), 1, 1),
+    );
     let words: &[u32] = bytemuck::cast_slice(&bytes);
     let mut compared = 0;
     for (i, point) in points.iter().enumerate() {
