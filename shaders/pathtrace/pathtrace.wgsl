@@ -260,7 +260,8 @@ fn diffuse_vertex(material: u32, index: u32, s: Surface, depth: u32, last: bool,
     let u = sample_2d(sampler);
     // Lambertian f = albedo / pi. Cosine pdf cos/pi: f cos / pdf = albedo.
     // Uniform pdf 1/(2 pi): f cos / pdf = 2 albedo cos. A shader def, not a branch on
-    // params: lavapipe would run both samplers (and their sin and cos) for every lane.
+    // params: on lavapipe code costs time by being in the shader, even where no lane runs it
+    // (docs/performance.md, "What lavapipe does with a branch").
 #ifdef UNIFORM_SAMPLING
     let local = sample_uniform_hemisphere(u.x, u.y);
     (*next).d = to_world(s.n, local);
@@ -291,8 +292,8 @@ fn direct(s: Surface, origin: vec3<f32>, sampler: ptr<function, Sampler>) -> vec
     return l;
 }
 
-// Russian roulette in unbounded mode (shader def UNBOUNDED_BOUNCES; compiled out otherwise, as
-// lavapipe would run its body for every lane) from bounce RR_START on: survive with probability
+// Russian roulette in unbounded mode (shader def UNBOUNDED_BOUNCES; compiled out otherwise: on
+// lavapipe code present costs time even where no lane runs it) from bounce RR_START on: survive with probability
 // q = min(max channel, 0.95) and divide by q, so E[throughput] is unchanged. False: the path
 // ends (also when nothing more can be added).
 fn roulette(depth: u32, throughput: ptr<function, vec3<f32>>, sampler: ptr<function, Sampler>) -> bool {
