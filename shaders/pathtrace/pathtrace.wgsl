@@ -376,9 +376,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         var second_sampler = sampler_new(params.seed, pixel, params.sample_base + first + i + 1u);
         var a = camera_path(camera_ray(x, y, inv_width, inv_height, &first_sampler));
         var b = camera_path(camera_ray(x, y, inv_width, inv_height, &second_sampler));
-        // An odd count: the last pair has no second sample. Its path is traced all the same and
-        // discarded (behind a branch lavapipe did not skip it; a separate loop for the odd
-        // sample cost 4% everywhere else), so the planner gives passes an even spp where it can.
+        // An odd count: the last pair has no second sample.
         let second = i + 1u < count;
         b.alive = second;
         loop {

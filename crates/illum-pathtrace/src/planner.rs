@@ -40,10 +40,6 @@ impl BatchPlanner {
         };
         if pixels <= budget {
             let spp = (budget / pixels).clamp(1, max_spp as u64) as u32;
-            // The path tracer traces a pixel's samples two at a time (pathtrace.wgsl, main), so
-            // a pass of odd spp wastes the second half of its last pair: a pass the budget
-            // limits gets an even spp. One that reaches `max_spp` keeps it, not to add a pass.
-            let spp = if spp > 1 && spp < max_spp { spp & !1 } else { spp };
             PassPlan { spp, rows: height }
         } else {
             let rows = (budget / width as u64).clamp(1, height as u64) as u32;
@@ -94,9 +90,6 @@ mod tests {
         let p = planner.plan(100, 100, 1000);
         assert_eq!(p, PassPlan { spp: 100, rows: 100 });
         assert_eq!(planner.plan(100, 100, 7).spp, 7);
-        // A budget of 1e6 samples over 300 x 300 pixels allows 11 spp: 10, an even number.
-        assert_eq!(planner.plan(300, 300, 1000).spp, 10);
-        assert_eq!(planner.plan(300, 300, 11).spp, 11, "the cap is reached in one pass");
     }
 
     #[test]
