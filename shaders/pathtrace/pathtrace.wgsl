@@ -73,18 +73,20 @@ fn direct_light(s: Surface, origin: vec3<f32>, sampler: ptr<function, Sampler>) 
     // Only a point in front of the light, facing it, receives light. Written as a positive test
     // so that a NaN cosine (a point on the light itself: dist2 = 0) fails it as well, whatever a
     // compiler does with negated comparisons.
-    let lit = cos_x > 0.0 && cos_y > 0.0;
-    // The light's plane, and any surface lying in it such as the ceiling around the light, is
-    // known only to within the light's error bound err_l; along a ray arriving at angle theta_y
-    // that band is err_l / cos(theta_y) long, so the shadow ray stops that much short of y, and
-    // SHADOW_SHORTEN more for rounding. Computed whether or not the point is lit (straight code,
-    // see path_step): an unlit point's t_max may be meaningless, and `lit` discards it.
-    let err_l = spawn_error(max_abs(light.corner.xyz) + max_abs(light.edge_u.xyz) + max_abs(light.edge_v.xyz));
-    let segment = y - origin;
-    let length_to_light = length(segment);
-    let t_max = length_to_light * (1.0 - SHADOW_SHORTEN) - err_l / cos_y;
-    let visible = lit && !occluded(origin, segment / length_to_light, t_max);
-    return select(vec3<f32>(0.0), light.emission.xyz * (cos_x * cos_y / dist2 * params.light_area * st.z), visible);
+    if (cos_x > 0.0 && cos_y > 0.0) {
+        // The light's plane, and any surface lying in it such as the ceiling around the light,
+        // is known only to within the light's error bound err_l; along a ray arriving at angle
+        // theta_y that band is err_l / cos(theta_y) long, so the shadow ray stops that much short
+        // of y, and SHADOW_SHORTEN more for rounding.
+        let err_l = spawn_error(max_abs(light.corner.xyz) + max_abs(light.edge_u.xyz) + max_abs(light.edge_v.xyz));
+        let segment = y - origin;
+        let length_to_light = length(segment);
+        let t_max = length_to_light * (1.0 - SHADOW_SHORTEN) - err_l / cos_y;
+        if (!occluded(origin, segment / length_to_light, t_max)) {
+            return light.emission.xyz * (cos_x * cos_y / dist2 * params.light_area * st.z);
+        }
+    }
+    return vec3<f32>(0.0);
 }
 
 #ifdef SUN
