@@ -168,8 +168,8 @@ fn radiance(origin: vec3<f32>, direction: vec3<f32>, sampler: ptr<function, Samp
             if (direct_counts) {
                 // One-sided emitter: visible only from its front, the side its normal
                 // edge_u x edge_v (obj.d; emitters are quads) points to. No surface is rebuilt
-                // for it: lavapipe (Mesa 22) runs the body of every `if` for all lanes under a
-                // mask, so the quad's reconstruction would be paid on every hit.
+                // for it, so the reconstruction below covers the non-emitters' kinds only: on
+                // lavapipe every kind's code in it costs time on every hit.
                 let front = dot(obj.d.xyz, d) < 0.0;
                 radiance += select(vec3<f32>(0.0), throughput * material_at(obj.material).emission.xyz, front);
             }
