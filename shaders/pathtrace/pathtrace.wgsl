@@ -260,9 +260,9 @@ fn direct(s: Surface, origin: vec3<f32>, sampler: ptr<function, Sampler>) -> vec
 }
 
 // Russian roulette in unbounded mode (shader def UNBOUNDED_BOUNCES; compiled out otherwise: on
-// lavapipe code present costs time even where no lane runs it) from bounce RR_START on: survive with probability
-// q = min(max channel, 0.95) and divide by q, so E[throughput] is unchanged. False: the path
-// ends (also when nothing more can be added).
+// lavapipe code present costs time even where no lane runs it) from bounce RR_START on: survive
+// with probability q = min(max channel, 0.95) and divide by q, so E[throughput] is unchanged.
+// False: the path ends (also when nothing more can be added).
 fn roulette(depth: u32, throughput: ptr<function, vec3<f32>>, sampler: ptr<function, Sampler>) -> bool {
 #ifdef UNBOUNDED_BOUNCES
     if (depth >= RR_START) {

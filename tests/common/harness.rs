@@ -1,6 +1,7 @@
 //! A compute shader run once on the test device, for tests of single WGSL routines: the entry
 //! point reads storage buffers at bindings 0..k-1 and writes the last one, which comes back.
 
+use illum::gpu::buffers::{buffer_bind_group, dispatch};
 use illum::gpu::readback::read_buffer;
 use illum::gpu::shader::{self, ShaderFile};
 use illum::gpu::wgpu;
@@ -39,23 +40,11 @@ pub fn run_compute(
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
         mapped_at_creation: false,
     }));
-    let entries: Vec<wgpu::BindGroupEntry> = buffers
-        .iter()
-        .enumerate()
-        .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
-        .collect();
-    let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: None,
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &entries,
-    });
+    let bindings: Vec<(u32, &wgpu::Buffer)> =
+        buffers.iter().enumerate().map(|(i, b)| (i as u32, b)).collect();
+    let bind_group = buffer_bind_group(&gpu.device, label, &pipeline.get_bind_group_layout(0), &bindings);
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    {
-        let mut pass = encoder.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &bind_group, &[]);
-        pass.dispatch_workgroups(workgroups.0, workgroups.1, workgroups.2);
-    }
+    dispatch(&mut encoder, label, &pipeline, &bind_group, [workgroups.0, workgroups.1, workgroups.2]);
     gpu.queue.submit([encoder.finish()]);
     let output = buffers.last().expect("the output buffer");
     read_buffer(gpu, output, 0, output_bytes, label).expect("readback")

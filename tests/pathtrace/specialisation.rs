@@ -188,7 +188,7 @@ fn settings_that_choose_code_rebuild_the_pipeline_on_update() {
 }
 
 /// A specialised pipeline reconstructs axis-aligned and rotated boxes with one function,
-/// `surface_box` (lavapipe runs every case of a switch for every lane): an axis-aligned box is
+/// `surface_box` (on lavapipe every case of a switch costs time): an axis-aligned box is
 /// uploaded as a box rotated by zero with an error bound of zero. That must change nothing: on
 /// the GPU, `surface_box` and `surface_aabb` give bit for bit the same point, normal and bound at
 /// points on every face, edge and corner of boxes from 1e-3 to 1e5 units across, near the origin

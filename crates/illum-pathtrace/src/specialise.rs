@@ -273,8 +273,9 @@ pub fn can_block_light(scene: &GpuScene, index: usize) -> bool {
 }
 
 /// The cases of a `switch obj.kind` that reconstructs the surface of each kind in `kinds`; the
-/// last one is the default (WGSL requires one). lavapipe runs every case of a switch for every
-/// lane, so kinds share a case where one function serves them: an axis-aligned box is stored as
+/// last one is the default (WGSL requires one). On lavapipe each case costs time by being in
+/// the shader, and at a bounce the 8 lanes of a group hit different kinds, so kinds share a case
+/// where one function serves them: an axis-aligned box is stored as
 /// a box rotated by zero with an error bound of zero ([`GpuObject::record`]), which
 /// `surface_box` reconstructs exactly as `surface_aabb` does (same point, normal and bound), so
 /// where both kinds occur `surface_box` serves both.
