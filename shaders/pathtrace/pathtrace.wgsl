@@ -73,20 +73,18 @@ fn direct_light(s: Surface, origin: vec3<f32>, sampler: ptr<function, Sampler>) 
     // Only a point in front of the light, facing it, receives light. Written as a positive test
     // so that a NaN cosine (a point on the light itself: dist2 = 0) fails it as well, whatever a
     // compiler does with negated comparisons.
-    if (cos_x > 0.0 && cos_y > 0.0) {
-        // The light's plane, and any surface lying in it such as the ceiling around the light,
-        // is known only to within the light's error bound err_l; along a ray arriving at angle
-        // theta_y that band is err_l / cos(theta_y) long, so the shadow ray stops that much short
-        // of y, and SHADOW_SHORTEN more for rounding.
-        let err_l = spawn_error(max_abs(light.corner.xyz) + max_abs(light.edge_u.xyz) + max_abs(light.edge_v.xyz));
-        let segment = y - origin;
-        let length_to_light = length(segment);
-        let t_max = length_to_light * (1.0 - SHADOW_SHORTEN) - err_l / cos_y;
-        if (!occluded(origin, segment / length_to_light, t_max)) {
-            return light.emission.xyz * (cos_x * cos_y / dist2 * params.light_area * st.z);
-        }
-    }
-    return vec3<f32>(0.0);
+    let lit = cos_x > 0.0 && cos_y > 0.0;
+    // The light's plane, and any surface lying in it such as the ceiling around the light, is
+    // known only to within the light's error bound err_l; along a ray arriving at angle theta_y
+    // that band is err_l / cos(theta_y) long, so the shadow ray stops that much short of y, and
+    // SHADOW_SHORTEN more for rounding. Computed whether or not the point is lit (straight code,
+    // see path_step): an unlit point's t_max may be meaningless, and `lit` discards it.
+    let err_l = spawn_error(max_abs(light.corner.xyz) + max_abs(light.edge_u.xyz) + max_abs(light.edge_v.xyz));
+    let segment = y - origin;
+    let length_to_light = length(segment);
+    let t_max = length_to_light * (1.0 - SHADOW_SHORTEN) - err_l / cos_y;
+    let visible = lit && !occluded(origin, segment / length_to_light, t_max);
+    return select(vec3<f32>(0.0), light.emission.xyz * (cos_x * cos_y / dist2 * params.light_area * st.z), visible);
 }
 
 #ifdef SUN
@@ -138,113 +136,148 @@ fn escaped(d: vec3<f32>, direct_counts: bool, caustic_owned: bool) -> vec3<f32> 
 
 
 
-// One path's radiance estimate along the camera ray (o, d).
-//
-// Light that reaches a ray straight from an emitter or a sun disc counts for the camera ray and
-// after specular scattering (`direct_counts`), not after a diffuse bounce, whose point already
-// sampled the lights. Specular scattering (shader def SPECULAR): a mirror reflects with weight
-// its reflectance; a dielectric reflects with probability F (exact Fresnel) and else refracts,
-// weight 1 either way, with no eta^2 scaling (every light and diffuse surface is outside, so
-// the factors of entering and leaving cancel). Each scattering counts as a bounce.
-fn radiance(origin: vec3<f32>, direction: vec3<f32>, sampler: ptr<function, Sampler>) -> vec3<f32> {
-    var o = origin;
-    var d = direction;
-    var radiance = vec3<f32>(0.0);
-    var throughput = vec3<f32>(1.0);
-    var depth = 0u;
-    var direct_counts = true;
+// One path: its state between two vertices.
+struct Path {
+    o: vec3<f32>,
+    d: vec3<f32>,
+    throughput: vec3<f32>,
+    radiance: vec3<f32>,
+    // Bounces taken so far (each diffuse or specular scattering counts as one).
+    depth: u32,
+    // False once the path has ended: it left the scene, reached a light, took its last bounce
+    // or lost the roulette.
+    alive: bool,
+    // Light that reaches a ray straight from an emitter or a sun disc counts for the camera ray
+    // and after specular scattering, not after a diffuse bounce, whose point already sampled the
+    // lights.
+    direct_counts: bool,
     // Set at the camera ray's own diffuse hit when the caustic estimator is on, kept through
     // specular scattering: the path E D S+ L it would complete belongs to the light tracer.
-    var caustic_owned = false;
-    loop {
-        let hit = closest_hit(o, d);
-        if (hit.index == NO_HIT) {
-            radiance += throughput * escaped(d, direct_counts, caustic_owned);
-            break;
-        }
-        // object_at and material_at: literals in a specialised pipeline (see specialise.rs).
-        let obj = object_at(hit.index);
-        if (obj.emitter != 0u) {
-            if (direct_counts) {
-                // One-sided emitter: visible only from its front, the side its normal
-                // edge_u x edge_v (obj.d; emitters are quads) points to. No surface is rebuilt
-                // for it, so the reconstruction below covers the non-emitters' kinds only: on
-                // lavapipe every kind's code in it costs time on every hit.
-                let front = dot(obj.d.xyz, d) < 0.0;
-                radiance += select(vec3<f32>(0.0), throughput * material_at(obj.material).emission.xyz, front);
-            }
-            break;
-        }
-        var s = scattering_surface_at(obj, o + hit.t * d);
-        let front = dot(s.n, d) < 0.0;
-        if (!front) {
-            s.n = -s.n;
-        }
-        let last = (params.bounces != UNBOUNDED && depth >= params.bounces) || depth >= UNBOUNDED_DEPTH_CAP;
+    caustic_owned: bool,
+}
+
+// A path starting with the camera ray from the eye along d.
+fn camera_path(d: vec3<f32>) -> Path {
+    return Path(params.eye, d, vec3<f32>(1.0), vec3<f32>(0.0), 0u, true, true, false);
+}
+
+// Traces one vertex of the path: its radiance estimate gains what this vertex adds, and the
+// path moves on to its next ray or ends (alive = false).
+//
+// Estimator: at a diffuse vertex, next-event estimation (direct) and a bounce drawn from the
+// cosine or the uniform pdf; a bounce ray that reaches a light adds nothing, because that light
+// was already counted by next-event estimation at the previous vertex. Specular scattering
+// (shader def SPECULAR): a mirror reflects with weight its reflectance; a dielectric reflects
+// with probability F (exact Fresnel) and else refracts, weight 1 either way, with no eta^2
+// scaling (every light and diffuse surface is outside, so the factors of entering and leaving
+// cancel). Each scattering counts as a bounce.
+//
+// Written with few branches: the vertex is computed for every path, ended or not, and `select`
+// keeps what a path may not add. lavapipe runs a branch's body, under a lane mask, whenever one
+// of the 8 lanes of a group takes it, so branches save little here; straight code is what let
+// the CPU overlap the two paths of a pair (see main: the same pair written with a branch per
+// `break` of the old loop ran slower than one path at a time). An ended path (its ray missed,
+// or it reached a light) computes a meaningless vertex, perhaps with infinities or NaN, that no
+// select lets through. A live path draws the same numbers in the same order as it would alone:
+// the ones drawn after its end are never used.
+fn path_step(path: ptr<function, Path>, sampler: ptr<function, Sampler>) {
+    let o = (*path).o;
+    let d = (*path).d;
+    let depth = (*path).depth;
+    let direct_counts = (*path).direct_counts;
+    let throughput = (*path).throughput;
+    let caustic_owned = (*path).caustic_owned;
+    let was_alive = (*path).alive;
+    var radiance = (*path).radiance;
+
+    let hit = closest_hit(o, d);
+    let missed = hit.index == NO_HIT;
+    // object_at and material_at: literals in a specialised pipeline (see specialise.rs). A missed
+    // ray looks at object 0, whose vertex is never used.
+    let obj = object_at(select(hit.index, 0u, missed));
+    let emitter = !missed && obj.emitter != 0u;
+    radiance += select(vec3<f32>(0.0), throughput * escaped(d, direct_counts, caustic_owned), was_alive && missed);
+    // One-sided emitter: visible only from its front, the side its normal edge_u x edge_v (obj.d;
+    // emitters are quads) points to. No surface is rebuilt for it.
+    let sees_emitter = was_alive && emitter && direct_counts && dot(obj.d.xyz, d) < 0.0;
+    radiance += select(vec3<f32>(0.0), throughput * material_at(obj.material).emission.xyz, sees_emitter);
+
+    var s = scattering_surface_at(obj, o + hit.t * d);
+    let front = dot(s.n, d) < 0.0;
+    s.n = select(-s.n, s.n, front);
+    let last = (params.bounces != UNBOUNDED && depth >= params.bounces) || depth >= UNBOUNDED_DEPTH_CAP;
+    let at_surface = was_alive && !missed && !emitter;
+    var next = Path(o, d, throughput, radiance, depth + 1u, false, false, caustic_owned);
 #ifdef SPECULAR
-        let m = material_at(obj.material);
-        let kind = u32(m.albedo.w);
-        if (kind == MATERIAL_MIRROR || kind == MATERIAL_DIELECTRIC) {
-            // Its only continuation is the bounce it may not take.
-            if (last) {
-                break;
-            }
-            if (kind == MATERIAL_MIRROR) {
-                throughput *= m.albedo.xyz;
-                d = reflect(d, s.n);
-                o = spawn_point(s.p, s.n, s.err);
-            } else {
-                let next = scatter_dielectric(s, d, m.emission.w, front, sampler);
-                o = next.o;
-                d = next.d;
-            }
-            direct_counts = true;
-            if (!roulette(depth, &throughput, sampler)) {
-                break;
-            }
-            depth += 1u;
-            continue;
+    let m = material_at(obj.material);
+    let kind = u32(m.albedo.w);
+    let specular = kind == MATERIAL_MIRROR || kind == MATERIAL_DIELECTRIC;
+    // Its only continuation is the bounce it may not take.
+    if (at_surface && specular && !last) {
+        if (kind == MATERIAL_MIRROR) {
+            next.throughput *= m.albedo.xyz;
+            next.d = reflect(d, s.n);
+            next.o = spawn_point(s.p, s.n, s.err);
+        } else {
+            let scattered = scatter_dielectric(s, d, m.emission.w, front, sampler);
+            next.o = scattered.o;
+            next.d = scattered.d;
         }
-#endif
-#ifdef CHECKER
-        let checker = material_at(obj.material);
-        var albedo = checker.albedo.xyz;
-        if (u32(checker.albedo.w) == MATERIAL_CHECKER) {
-            albedo = checker_albedo(hit.index, checker, s.p);
-        }
-#else
-        let albedo = material_at(obj.material).albedo.xyz;
-#endif
-        // Every ray leaving this point (shadow and bounce) starts here, off the surface.
-        let spawned = spawn_point(s.p, s.n, s.err);
-        radiance += throughput * albedo * INV_PI * direct(s, spawned, sampler);
-        if (last) {
-            break;
-        }
-        let u = sample_2d(sampler);
-        // Lambertian f = albedo / pi. Cosine pdf cos/pi: f cos / pdf = albedo.
-        // Uniform pdf 1/(2 pi): f cos / pdf = 2 albedo cos. A shader def, not a branch on
-        // params: on lavapipe code costs time by being in the shader, even where no lane runs it
-        // (docs/performance.md, "What lavapipe does with a branch").
-#ifdef UNIFORM_SAMPLING
-        let local = sample_uniform_hemisphere(u.x, u.y);
-        d = to_world(s.n, local);
-        throughput *= albedo * (2.0 * local.z);
-#else
-        d = to_world(s.n, sample_cosine_hemisphere(u.x, u.y));
-        throughput *= albedo;
-#endif
-        if (!roulette(depth, &throughput, sampler)) {
-            break;
-        }
-        o = spawned;
-        direct_counts = false;
-#ifdef CAUSTIC
-        caustic_owned = depth == 0u;
-#endif
-        depth += 1u;
+        next.direct_counts = true;
+        var scattered_throughput = next.throughput;
+        next.alive = roulette(depth, &scattered_throughput, sampler);
+        next.throughput = scattered_throughput;
     }
-    return radiance;
+    if (at_surface && !specular) {
+        diffuse_vertex(obj.material, hit.index, s, depth, last, true, &next, sampler);
+    }
+#else
+    diffuse_vertex(obj.material, hit.index, s, depth, last, at_surface, &next, sampler);
+#endif
+    *path = next;
+}
+
+// The diffuse part of path_step at surface s of object `index` (its material `material`), the
+// path's vertex number
+// `depth`: next-event estimation, then, unless this is the last vertex, the bounce. `next` holds
+// the path as it arrived, with its depth already increased; this adds the vertex's light (if
+// `live`: without SPECULAR it is called for ended paths too) and sets the next ray and `alive`.
+fn diffuse_vertex(material: u32, index: u32, s: Surface, depth: u32, last: bool, live: bool, next: ptr<function, Path>, sampler: ptr<function, Sampler>) {
+#ifdef CHECKER
+    let checker = material_at(material);
+    var albedo = checker.albedo.xyz;
+    if (u32(checker.albedo.w) == MATERIAL_CHECKER) {
+        albedo = checker_albedo(index, checker, s.p);
+    }
+#else
+    let albedo = material_at(material).albedo.xyz;
+#endif
+    // Every ray leaving this point (shadow and bounce) starts here, off the surface.
+    let spawned = spawn_point(s.p, s.n, s.err);
+    var throughput = (*next).throughput;
+    let light = throughput * albedo * INV_PI * direct(s, spawned, sampler);
+    (*next).radiance += select(vec3<f32>(0.0), light, live);
+    let u = sample_2d(sampler);
+    // Lambertian f = albedo / pi. Cosine pdf cos/pi: f cos / pdf = albedo.
+    // Uniform pdf 1/(2 pi): f cos / pdf = 2 albedo cos. A shader def, not a branch on
+    // params: on lavapipe code costs time by being in the shader, even where no lane runs it
+    // (docs/performance.md, "What lavapipe does with a branch").
+#ifdef UNIFORM_SAMPLING
+    let local = sample_uniform_hemisphere(u.x, u.y);
+    (*next).d = to_world(s.n, local);
+    throughput *= albedo * (2.0 * local.z);
+#else
+    (*next).d = to_world(s.n, sample_cosine_hemisphere(u.x, u.y));
+    throughput *= albedo;
+#endif
+    let survives = roulette(depth, &throughput, sampler);
+    (*next).throughput = throughput;
+    (*next).o = spawned;
+    (*next).direct_counts = false;
+#ifdef CAUSTIC
+    (*next).caustic_owned = depth == 0u;
+#endif
+    (*next).alive = live && !last && survives;
 }
 
 // Next-event estimation at a diffuse point: the area lights and the directional light.
@@ -274,6 +307,26 @@ fn roulette(depth: u32, throughput: ptr<function, vec3<f32>>, sampler: ptr<funct
     }
 #endif
     return max3(*throughput) > 0.0;
+}
+
+// The camera ray through a point of pixel (x, y) jittered uniformly inside it (row 0 is the top
+// of the image): its direction from the eye.
+fn camera_ray(x: u32, y: u32, inv_width: f32, inv_height: f32, sampler: ptr<function, Sampler>) -> vec3<f32> {
+    let jitter = sample_2d(sampler);
+    let sx = (2.0 * (f32(x) + jitter.x) * inv_width - 1.0) * params.aspect * params.tan_half_fov;
+    let sy = (1.0 - 2.0 * (f32(y) + jitter.y) * inv_height) * params.tan_half_fov;
+    return normalize(params.forward + sx * params.right + sy * params.up);
+}
+
+// Adds a sample's radiance l to the sums when it is finite; counts it as dropped otherwise.
+fn accumulate(l: vec3<f32>, sum: ptr<function, vec3<f32>>, sum_sq: ptr<function, vec3<f32>>, finite: ptr<function, u32>, dropped: ptr<function, u32>) {
+    if (is_finite3(l)) {
+        *sum += l;
+        *sum_sq += l * l;
+        *finite += 1u;
+    } else {
+        *dropped += 1u;
+    }
 }
 
 // True when no component is Inf or NaN (exponent bits all ones), tested on the bits so no
@@ -312,20 +365,34 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var dropped = 0u;
     let inv_width = 1.0 / f32(params.width);
     let inv_height = 1.0 / f32(params.height);
-    for (var i = 0u; i < count; i++) {
-        var sampler = sampler_new(params.seed, pixel, params.sample_base + first + i);
-        // Jitter uniformly inside the pixel; row 0 is the top of the image.
-        let jitter = sample_2d(&sampler);
-        let sx = (2.0 * (f32(x) + jitter.x) * inv_width - 1.0) * params.aspect * params.tan_half_fov;
-        let sy = (1.0 - 2.0 * (f32(y) + jitter.y) * inv_height) * params.tan_half_fov;
-        let d = normalize(params.forward + sx * params.right + sy * params.up);
-        let l = radiance(params.eye, d, &sampler);
-        if (is_finite3(l)) {
-            sum += l;
-            sum_sq += l * l;
-            finite += 1u;
-        } else {
-            dropped += 1u;
+    // Two samples at a time, traced in lockstep, vertex by vertex: lavapipe runs each 8-lane
+    // group's instructions as one stream on one core, and a second independent path in that
+    // stream gives the CPU work to overlap with the first one's chains of dependent operations
+    // (square roots, divisions). 12 to 16% faster at 2 bounces, 8% at 8; four paths were slower
+    // than two (docs/performance.md). Each path keeps its own sampler, so every sample is what it
+    // would be traced alone, and the sums take them in order: the image is bit for bit the same.
+    for (var i = 0u; i < count; i += 2u) {
+        var first_sampler = sampler_new(params.seed, pixel, params.sample_base + first + i);
+        var second_sampler = sampler_new(params.seed, pixel, params.sample_base + first + i + 1u);
+        var a = camera_path(camera_ray(x, y, inv_width, inv_height, &first_sampler));
+        var b = camera_path(camera_ray(x, y, inv_width, inv_height, &second_sampler));
+        // An odd count: the last pair has no second sample. Its path is traced all the same and
+        // discarded, so the planner gives passes an even spp where it can. A separate one-path
+        // loop for the odd sample cost by being in the shader: 4% at 16 spp per invocation, and
+        // passes of 1 and 2 spp at 1024 x 1024 ran 16 to 22% slower than with no pairs at all
+        // (docs/performance.md, "Paired paths, merged").
+        let second = i + 1u < count;
+        b.alive = second;
+        loop {
+            path_step(&a, &first_sampler);
+            path_step(&b, &second_sampler);
+            if (!(a.alive || b.alive)) {
+                break;
+            }
+        }
+        accumulate(a.radiance, &sum, &sum_sq, &finite, &dropped);
+        if (second) {
+            accumulate(b.radiance, &sum, &sum_sq, &finite, &dropped);
         }
     }
     let slot = (gid.z * params.rows + gid.y) * params.width + x;

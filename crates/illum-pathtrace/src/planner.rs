@@ -8,8 +8,8 @@
 /// Default wall time aimed at per submission.
 pub const DEFAULT_TARGET_SECONDS: f64 = 0.15;
 
-/// Pixels in the first, measuring submission (before any cost is known).
-const PROBE_PIXELS: u64 = 16 * 1024;
+/// Samples in the first, measuring submission (before any cost is known).
+const PROBE_SAMPLES: u64 = 16 * 1024;
 
 #[derive(Clone, Debug)]
 pub struct BatchPlanner {
@@ -35,15 +35,22 @@ impl BatchPlanner {
         let max_spp = max_spp.max(1);
         let pixels = width as u64 * height as u64;
         let budget = match self.seconds_per_sample {
-            None => PROBE_PIXELS,
+            None => PROBE_SAMPLES,
             Some(cost) => (self.target_seconds / cost).max(1.0) as u64,
         };
-        if pixels <= budget {
+        // The path tracer traces a pixel's samples two at a time (pathtrace.wgsl, main), so a
+        // pass of odd spp wastes the second half of its last pair, and a pass of 1 spp costs
+        // what 2 do. Where the budget allows, passes get an even spp; where the image does not
+        // fit in one submission, a pass of 2 spp in bands rather than 1 (unless `max_spp` is 1).
+        // One that reaches `max_spp` keeps it, not to add a pass.
+        let pass_spp = if max_spp >= 2 { 2 } else { 1 };
+        if pixels * u64::from(pass_spp) <= budget {
             let spp = (budget / pixels).clamp(1, max_spp as u64) as u32;
+            let spp = if spp > 1 && spp < max_spp { spp & !1 } else { spp };
             PassPlan { spp, rows: height }
         } else {
-            let rows = (budget / width as u64).clamp(1, height as u64) as u32;
-            PassPlan { spp: 1, rows }
+            let rows = (budget / (width as u64 * u64::from(pass_spp))).clamp(1, height as u64) as u32;
+            PassPlan { spp: pass_spp, rows }
         }
     }
 
@@ -52,7 +59,7 @@ impl BatchPlanner {
     /// the image). Before any measurement: the probe's size.
     pub fn rows_for(&self, width: u32, height: u32, spp: u32) -> u32 {
         let budget = match self.seconds_per_sample {
-            None => PROBE_PIXELS,
+            None => PROBE_SAMPLES,
             Some(cost) => (self.target_seconds / cost).max(1.0) as u64,
         };
         (budget / (u64::from(width) * u64::from(spp.max(1)))).clamp(1, u64::from(height)) as u32
@@ -79,8 +86,10 @@ mod tests {
     #[test]
     fn first_pass_is_a_small_probe() {
         let p = BatchPlanner::new(0.15).plan(1024, 1024, 64);
-        assert_eq!(p.spp, 1);
-        assert_eq!(p.rows as u64 * 1024, PROBE_PIXELS);
+        assert_eq!(p.spp, 2, "samples are traced in pairs");
+        assert_eq!(p.rows as u64 * 1024 * 2, PROBE_SAMPLES);
+        let single = BatchPlanner::new(0.15).plan(1024, 1024, 1);
+        assert_eq!((single.spp, single.rows as u64 * 1024), (1, PROBE_SAMPLES), "a 1-spp render");
     }
 
     #[test]
@@ -90,6 +99,9 @@ mod tests {
         let p = planner.plan(100, 100, 1000);
         assert_eq!(p, PassPlan { spp: 100, rows: 100 });
         assert_eq!(planner.plan(100, 100, 7).spp, 7);
+        // A budget of 1e6 samples over 300 x 300 pixels allows 11 spp: 10, an even number.
+        assert_eq!(planner.plan(300, 300, 1000).spp, 10);
+        assert_eq!(planner.plan(300, 300, 11).spp, 11, "the cap is reached in one pass");
     }
 
     #[test]
@@ -97,7 +109,9 @@ mod tests {
         let mut planner = BatchPlanner::new(0.1);
         planner.record(1000, 1.0); // 1 ms per sample: 100 samples per submission
         let p = planner.plan(50, 40, 16);
-        assert_eq!(p, PassPlan { spp: 1, rows: 2 });
+        assert_eq!(p, PassPlan { spp: 2, rows: 1 });
+        assert_eq!(planner.plan(25, 40, 16), PassPlan { spp: 2, rows: 2 });
+        assert_eq!(planner.plan(50, 40, 1), PassPlan { spp: 1, rows: 2 });
         planner.record(1, 10.0);
         assert_eq!(planner.plan(50, 40, 16).rows, 1);
     }
