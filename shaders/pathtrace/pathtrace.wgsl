@@ -365,6 +365,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var dropped = 0u;
     let inv_width = 1.0 / f32(params.width);
     let inv_height = 1.0 / f32(params.height);
+#ifdef PAIRED_PATHS
     // Two samples at a time, traced in lockstep, vertex by vertex: lavapipe runs each 8-lane
     // group's instructions as one stream on one core, and a second independent path in that
     // stream gives the CPU work to overlap with the first one's chains of dependent operations
@@ -395,6 +396,20 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             accumulate(b.radiance, &sum, &sum_sq, &finite, &dropped);
         }
     }
+#else
+    // One sample at a time (TracerOptions::paired_paths off: the browser).
+    for (var i = 0u; i < count; i++) {
+        var sampler = sampler_new(params.seed, pixel, params.sample_base + first + i);
+        var a = camera_path(camera_ray(x, y, inv_width, inv_height, &sampler));
+        loop {
+            path_step(&a, &sampler);
+            if (!a.alive) {
+                break;
+            }
+        }
+        accumulate(a.radiance, &sum, &sum_sq, &finite, &dropped);
+    }
+#endif
     let slot = (gid.z * params.rows + gid.y) * params.width + x;
     batch_sum[slot] = vec4<f32>(sum, f32(finite));
     batch_sum_sq[slot] = vec4<f32>(sum_sq, f32(dropped));

@@ -149,19 +149,20 @@ fn a_scene_the_pipeline_was_not_built_for_is_refused() {
 fn a_resize_keeps_the_submission_size_the_caller_chose() {
     // A viewer asks for short submissions; resizing its window rebuilds the buffers but must not
     // bring back the default 0.15 s ones. With a target far below one sample's cost, every
-    // submission is the smallest band: one row at 1 spp. (A fresh planner's first submission
-    // would take 16384 samples.)
+    // submission is the smallest band: one row at 2 spp (samples are traced in pairs, so a pass
+    // in bands takes 2 spp, planner.rs). (A fresh planner's first submission would take 16384
+    // samples.)
     let scene = common::scene("cornell", common::small(40, 30, 4));
     let mut tracer = PathTracer::new(common::gpu(), &scene).expect("builds");
     tracer.set_target_seconds(1e-9);
     tracer.render_step(None).expect("renders"); // the probe, which measures a sample's cost
-    assert_eq!(tracer.render_step(None).expect("renders").samples, 40, "one row per submission");
+    assert_eq!(tracer.render_step(None).expect("renders").samples, 2 * 40, "one row per submission");
     let mut larger = scene.clone();
     larger.camera.width = 52;
     larger.camera.height = 36;
     tracer.update_scene(&larger).expect("same geometry, new size");
     let report = tracer.render_step(None).expect("renders");
-    assert_eq!(report.samples, 52, "after the resize: {} samples in one submission", report.samples);
+    assert_eq!(report.samples, 2 * 52, "after the resize: {} samples in one submission", report.samples);
 }
 
 #[test]

@@ -169,6 +169,37 @@ fn generic_and_specialised_traversal_give_the_same_image() {
     assert!(differing <= generic.pixels.len() / 200, "{differing} pixels differ between traversals");
 }
 
+/// Samples traced two at a time in lockstep (the native default) and one at a time (the
+/// browser's shader) are the same samples summed in the same order: the images agree bit for
+/// bit, with both sequences, on the Cornell box and on the Whitted scene (mirror, glass,
+/// checkerboard, sun and the caustic's light tracer), with an odd spp so that an invocation's
+/// last pair has no second sample.
+#[test]
+fn paired_and_single_paths_give_the_same_image() {
+    let whitted = common::scene("whitted", common::small(20, 16, 8));
+    for scene in [cornell(20, 16, 3, Sampling::Cosine, 5), whitted] {
+        for sequence in [Sequence::Independent, Sequence::LowDiscrepancy] {
+            let render = |paired_paths| {
+                let options = TracerOptions { sequence, paired_paths, ..Default::default() };
+                let mut tracer = PathTracer::with_options(common::gpu(), &scene, options).expect("builds");
+                tracer.add_samples_in_one_pass(21).expect("renders");
+                tracer.accumulator().mean_image()
+            };
+            let (paired, single) = (render(true), render(false));
+            assert!(
+                paired.pixels.iter().zip(&single.pixels).all(|(p, s)| p == s),
+                "{} with {sequence:?}: the paired and one-path shaders differ",
+                scene.name
+            );
+            assert!(
+                paired.pixels.iter().any(|p| p.iter().any(|&c| c > 0.0)),
+                "{}: a black image",
+                scene.name
+            );
+        }
+    }
+}
+
 #[test]
 fn the_background_outside_the_box_is_black_and_the_light_is_its_radiance() {
     // At 45 degrees from z = -724.26 the image spans x, y in [-22, 578] at the box's open front,

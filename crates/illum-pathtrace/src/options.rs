@@ -15,10 +15,27 @@ pub enum Traversal {
 }
 
 /// Pipeline choices that do not change the expected image, only speed or noise.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct TracerOptions {
     pub traversal: Traversal,
     pub sequence: Sequence,
+    /// Trace a pixel's samples two at a time, in lockstep (shader def PAIRED_PATHS,
+    /// pathtrace.wgsl's `main`): the same image bit for bit; on lavapipe 13 to 20% faster with
+    /// 16 samples per invocation (docs/performance.md, "Paired paths, merged"). The default
+    /// natively; off in the browser, where Chrome's SwiftShader lost the device on the paired
+    /// shader (a blank page and failed readbacks in the web test, 2026-12-02) and runs the
+    /// one-path loop.
+    pub paired_paths: bool,
+}
+
+impl Default for TracerOptions {
+    fn default() -> Self {
+        TracerOptions {
+            traversal: Traversal::default(),
+            sequence: Sequence::default(),
+            paired_paths: !cfg!(target_arch = "wasm32"),
+        }
+    }
 }
 
 impl TracerOptions {
@@ -31,11 +48,15 @@ impl TracerOptions {
     /// bounce directions, 11% less error for 15 to 20% more time, a loss, so they keep uniform
     /// points.
     pub fn shader_defs(&self) -> Vec<(&'static str, Def)> {
-        match self.sequence {
+        let mut defs = match self.sequence {
             Sequence::Independent => Vec::new(),
             Sequence::LowDiscrepancy => {
                 vec![("LOW_DISCREPANCY", Def::Bool(true)), ("BILINEAR_LIGHT", Def::Bool(true))]
             }
+        };
+        if self.paired_paths {
+            defs.push(("PAIRED_PATHS", Def::Bool(true)));
         }
+        defs
     }
 }

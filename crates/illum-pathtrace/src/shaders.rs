@@ -160,7 +160,7 @@ mod tests {
             let gpu_scene = GpuScene::new(&scene).unwrap_or_else(|e| panic!("{e}"));
             for traversal in [Traversal::Generic, Traversal::Specialised] {
                 for sequence in [Sequence::Independent, Sequence::LowDiscrepancy] {
-                    let defs = TracerOptions { traversal, sequence }.shader_defs();
+                    let defs = TracerOptions { traversal, sequence, paired_paths: false }.shader_defs();
                     compose_and_validate(
                         &shader_modules(&scene, &gpu_scene, traversal),
                         &PATHTRACE_SHADER,
@@ -172,6 +172,14 @@ mod tests {
                         &shader_modules(&scene, &gpu_scene, traversal),
                         &PATHTRACE_SHADER,
                         &adaptive,
+                    );
+                    // Samples in pairs (native) and one at a time (the browser).
+                    let mut paired = adaptive.clone();
+                    paired.push(("PAIRED_PATHS", shader::Def::Bool(true)));
+                    compose_and_validate(
+                        &shader_modules(&scene, &gpu_scene, traversal),
+                        &PATHTRACE_SHADER,
+                        &paired,
                     );
                     if gpu_scene.defs.contains(&"CAUSTIC") {
                         let mut all = defs.clone();
