@@ -20,8 +20,9 @@ pub struct TracerOptions {
     pub traversal: Traversal,
     pub sequence: Sequence,
     /// Trace a pixel's samples two at a time, in lockstep (shader def PAIRED_PATHS,
-    /// pathtrace.wgsl's `main`): the same image bit for bit; on lavapipe 13 to 20% faster with
-    /// 16 samples per invocation (docs/performance.md, "Paired paths, merged"). The default
+    /// pathtrace.wgsl's `main`), with the specialised traversal (the generic one always traces
+    /// one path at a time, see `shader_defs`): the same image bit for bit; on lavapipe 13 to 20%
+    /// faster with 16 samples per invocation (docs/performance.md, "Paired paths, merged"). The default
     /// natively; off in the browser, where Chrome's SwiftShader lost the device on the paired
     /// shader (a blank page and failed readbacks in the web test, 2026-12-02) and runs the
     /// one-path loop.
@@ -54,7 +55,10 @@ impl TracerOptions {
                 vec![("LOW_DISCREPANCY", Def::Bool(true)), ("BILINEAR_LIGHT", Def::Bool(true))]
             }
         };
-        if self.paired_paths {
+        // Pairs pay with the specialised traversal only: with the generic one's loop over the
+        // object buffer they were slower (bench, 256 x 256, bounces 2: 2.45 / 2.48 against
+        // 2.83 / 2.62 Msamples/s one path at a time; bounces 8: 0.73 / 0.82 against 0.95 / 1.03).
+        if self.paired_paths && self.traversal == Traversal::Specialised {
             defs.push(("PAIRED_PATHS", Def::Bool(true)));
         }
         defs
