@@ -381,7 +381,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         // discarded, so the planner gives passes an even spp where it can. A separate one-path
         // loop for the odd sample cost by being in the shader: 4% at 16 spp per invocation, and
         // passes of 1 and 2 spp at 1024 x 1024 ran 16 to 22% slower than with no pairs at all
-        // (docs/performance.md, "Paired paths, merged").
+        // (docs/performance.md, "Levers of 2026-12-02, midday").
         let second = i + 1u < count;
         b.alive = second;
         loop {

@@ -21,11 +21,11 @@ pub struct TracerOptions {
     pub sequence: Sequence,
     /// Trace a pixel's samples two at a time, in lockstep (shader def PAIRED_PATHS,
     /// pathtrace.wgsl's `main`), with the specialised traversal (the generic one always traces
-    /// one path at a time, see `shader_defs`): the same image bit for bit; on lavapipe 13 to 20%
-    /// faster with 16 samples per invocation (docs/performance.md, "Paired paths, merged"). The default
-    /// natively; off in the browser, where Chrome's SwiftShader lost the device on the paired
-    /// shader (a blank page and failed readbacks in the web test, 2026-12-02) and runs the
-    /// one-path loop.
+    /// one path at a time, see `shader_defs`): the same image bit for bit; on lavapipe 14%
+    /// faster at bounces 2 with 16 samples per invocation (docs/performance.md, "Levers of
+    /// 2026-12-02, midday"). The default natively; off in the browser, where Chrome's
+    /// SwiftShader lost the device on the paired shader (a blank page and failed readbacks in
+    /// the web test, 2026-12-02) and runs the one-path loop.
     pub paired_paths: bool,
 }
 
