@@ -161,26 +161,19 @@ mod tests {
             for traversal in [Traversal::Generic, Traversal::Specialised] {
                 for sequence in [Sequence::Independent, Sequence::LowDiscrepancy] {
                     let defs = TracerOptions { traversal, sequence, paired_paths: false }.shader_defs();
-                    compose_and_validate(
-                        &shader_modules(&scene, &gpu_scene, traversal),
-                        &PATHTRACE_SHADER,
-                        &defs,
-                    );
-                    let mut adaptive = defs.clone();
-                    adaptive.push(("ADAPTIVE", shader::Def::Bool(true)));
-                    compose_and_validate(
-                        &shader_modules(&scene, &gpu_scene, traversal),
-                        &PATHTRACE_SHADER,
-                        &adaptive,
-                    );
-                    // Samples in pairs (native) and one at a time (the browser).
-                    let mut paired = adaptive.clone();
-                    paired.push(("PAIRED_PATHS", shader::Def::Bool(true)));
-                    compose_and_validate(
-                        &shader_modules(&scene, &gpu_scene, traversal),
-                        &PATHTRACE_SHADER,
-                        &paired,
-                    );
+                    // Alone, with adaptive sampling, and with adaptive sampling and samples in
+                    // pairs (native; the browser traces them one at a time).
+                    let adaptive = ("ADAPTIVE", shader::Def::Bool(true));
+                    let paired = ("PAIRED_PATHS", shader::Def::Bool(true));
+                    for extra in [vec![], vec![adaptive], vec![adaptive, paired]] {
+                        let mut all = defs.clone();
+                        all.extend(extra);
+                        compose_and_validate(
+                            &shader_modules(&scene, &gpu_scene, traversal),
+                            &PATHTRACE_SHADER,
+                            &all,
+                        );
+                    }
                     if gpu_scene.defs.contains(&"CAUSTIC") {
                         let mut all = defs.clone();
                         all.extend(gpu_scene.shader_defs());
