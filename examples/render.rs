@@ -44,7 +44,9 @@ use illum::cli::{self, DEFAULT_SCENE, OutputFormat, SceneArgs, output_format};
 use illum::image::{Encoding, save_png};
 use illum::interrupt::Interrupt;
 use illum::pathtrace::checkpoint::{Checkpoint, load_checkpoint, save_checkpoint};
-use illum::pathtrace::{PathTracer, Sequence, StopReason, StopRules, TracerOptions, render_progressive};
+use illum::pathtrace::{
+    PathTracer, SampleAllocation, Sequence, StopReason, StopRules, TracerOptions, render_progressive,
+};
 use illum::progress::RenderProgress;
 use illum::raster_cli::{RasterArgs, RasterRequest, render_raster};
 use illum::scene::{RendererKind, Scene};
@@ -326,8 +328,16 @@ fn run(args: Args) -> anyhow::Result<()> {
     // compilation is handled like one during the render: a message and status 130.
     let interrupt = Interrupt::install()?;
     let gpu = cli::gpu()?;
-    let mut tracer =
-        PathTracer::with_options(&gpu, &scene, TracerOptions { sequence, ..Default::default() })?;
+    let options = TracerOptions { sequence, ..Default::default() };
+    let mut tracer = if args.adaptive {
+        // Built with the adaptive pipeline, which plan_adaptive's pilot runs (every block
+        // unlimited until it sets the allocation): one compilation instead of two.
+        let camera = scene.camera;
+        let unlimited = SampleAllocation::uniform(camera.width, camera.height, u32::MAX);
+        PathTracer::with_sample_allocation(&gpu, &scene, options, unlimited)?
+    } else {
+        PathTracer::with_options(&gpu, &scene, options)?
+    };
     // Passes end on chunk boundaries, so that this render, a resumed one and a straight one
     // fold the very same f32 chunk sums: see illum_pathtrace::checkpoint.
     tracer.set_chunk_aligned_passes(true);

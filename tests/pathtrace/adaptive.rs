@@ -57,6 +57,38 @@ fn every_pixel_takes_its_blocks_samples() {
     }
 }
 
+/// A tracer built with its allocation (`PathTracer::with_sample_allocation`, one compilation)
+/// is the tracer switched to it after construction: the same pipeline, the same image bit for
+/// bit; and it refuses an allocation of another size as `set_sample_allocation` does.
+#[test]
+fn a_tracer_built_adaptive_is_one_switched_to_adaptive() {
+    let (width, height) = (2 * BLOCK, 2 * BLOCK);
+    let scene = common::scene("cornell", Overrides { seed: Some(9), ..common::small(width, height, 1) });
+    let allocation = SampleAllocation { width, height, samples: vec![16, 48, 32, 7] };
+    let options = TracerOptions { sequence: Sequence::LowDiscrepancy, ..Default::default() };
+    let mut switched = PathTracer::with_options(common::gpu(), &scene, options).expect("tracer");
+    switched.set_sample_allocation(Some(allocation.clone())).expect("allocation fits");
+    let mut built = PathTracer::with_sample_allocation(common::gpu(), &scene, options, allocation.clone())
+        .expect("tracer");
+    assert!(built.shares_pipeline_with(&switched), "one adaptive pipeline, from the context's cache");
+    assert_eq!(built.sample_allocation(), Some(&allocation));
+    for tracer in [&mut switched, &mut built] {
+        tracer.render_to_spp(allocation.max()).expect("render");
+    }
+    let (a, b) = (switched.accumulator(), built.accumulator());
+    assert_eq!(a.total_samples(), allocation.total());
+    for p in 0..(width * height) as usize {
+        assert_eq!(a.pixel_count(p), b.pixel_count(p), "pixel {p}");
+        assert_eq!(a.pixel_mean(p), b.pixel_mean(p), "pixel {p}");
+    }
+    let wrong = SampleAllocation::uniform(width + 1, height, 16);
+    let refused = PathTracer::with_sample_allocation(common::gpu(), &scene, options, wrong)
+        .err()
+        .expect("another size is refused")
+        .to_string();
+    assert!(refused.contains("17 x 16"), "{refused}");
+}
+
 /// The pilot's allocation on the Cornell box: within the budget, every block at least one chunk,
 /// the noisy ceiling (top rows, lit only by interreflection) given more samples than the
 /// directly lit floor and walls below.
