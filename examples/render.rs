@@ -113,7 +113,7 @@ struct Args {
     sample_range: Option<std::ops::Range<u32>>,
     /// Path-tracer scenes: adaptive sampling. A pilot of 16 spp (another seed, then discarded)
     /// measures the noise of every 8 x 8 block of pixels, and the --spp budget is spread over
-    /// the blocks in proportion to it: the spp is then the mean over the image (docs/adaptive.md).
+    /// the blocks in proportion to it: the spp is then the mean over the image (docs/accuracy.md, "Adaptive sampling").
     /// Needs --spp; not with --resume, --sample-range or the caustic's light tracer.
     #[arg(long)]
     adaptive: bool,
