@@ -6,7 +6,12 @@
 // outside the floor's rectangle discarded. Then the whole rectangle without any lookup, in a
 // pipeline with a small depth bias, so that it fails the depth test wherever the receiver
 // already drew and fills in only the rest. A CPU rasterizer pays for a shader's every texture
-// tap on every pixel it shades, so the taps are spent only where a shadow can be.
+// tap on every pixel it shades, so the taps are spent only where a shadow can be. In the main
+// pass, when the light comes from above and the spheres stand above the floor, the receiver is
+// narrowed further to each shadow's penumbra ring (PART 1), the only place where the lookup can
+// return anything but 0 or 1; the umbra inside a ring (PART 2) is drawn dark without a lookup,
+// with a bias between the ring's and the rest's, and the rest as above. The floor's taps cost
+// 3 to 6 ms of a 15 to 20 ms main pass on lavapipe, in proportion to the floor that runs them.
 //
 // In the main view with anti-aliasing on (EDGE_AA), the rectangle's outline is anti-aliased like
 // the spheres' silhouettes: the rectangle reaches past it by EDGE_REACH_PIXELS, and each pixel is
@@ -16,25 +21,81 @@
 // the other then fails the depth test there, as everywhere.)
 
 #import illum::raster::scene::{scene, view, quad_corner, Switches, WorldVertex, world_vertex, edge_coverage, EDGE_REACH_PIXELS}
-#import illum::raster::lighting::shade_floor
+#import illum::raster::lighting::{shade_floor, floor_albedo}
 
 // Set per pipeline (see Switches in scene.wgsl). RECEIVER: draw the receiver parallelogram with
 // shadows; otherwise the whole floor without.
 override RECEIVER: bool = true;
 override PCF: bool = true;
 override EDGE_AA: bool = false;
+// Which part of the floor (variants.rs, Surface): 0 the receiver parallelogram (RECEIVER) or
+// the whole floor; 1 each sphere's penumbra ring, with the shadow lookup (RECEIVER); 2 each
+// sphere's umbra disc inside its ring, dark, without the lookup. Rings and discs are drawn
+// instead of the receiver in the main pass when the light comes from above and the spheres
+// stand above the floor (shadow_fit.rs, rings); instance 0 is the glass's, 1 the metal's.
+override PART: u32 = 0u;
+
+// Sides of the polygons that stand for the circles of a ring: the outer one circumscribes the
+// outer circle, the inner one is inscribed in the inner circle, so the ring holds every point
+// within the reach of the outline and the disc only points farther inside.
+const RING_SIDES: u32 = 32u;
+// How far from a sphere's outline in the shadow map a lookup can still see it, in texels: the
+// four bilinear taps at +-1/2 texel read texels whose centres lie within 1.5 texels along each
+// axis, 1.5 sqrt(2) = 2.12 at the corners; 2.5 leaves room for rounding. Inside the outline by
+// more than this every texel read holds the sphere (the lookup returns exactly 0); outside by
+// more, none does (exactly 1).
+const RING_REACH_TEXELS: f32 = 2.5;
+
+// Vertex `vertex` of sphere `instance`'s ring (PART 1: RING_SIDES quads, 6 vertices each) or
+// disc (PART 2: RING_SIDES triangles around the centre), on the floor. Built in the shadow map's
+// coordinates, where the sphere is a circle about its centre's image, and taken to the floor
+// through the map's footprint there (scene.receiver: the map's corner (-1, -1) and its two
+// edges' images, an affine map).
+fn ring_vertex(vertex: u32, instance: u32) -> vec2<f32> {
+    let sphere = select(scene.metal_sphere, scene.glass_sphere, instance == 0u);
+    let m = scene.shadow_view_proj;
+    let centre = (m * vec4<f32>(sphere.xyz, 1.0)).xy;
+    // Map units per scene unit across the light (the projection is orthographic and square).
+    let scale = length(vec3<f32>(m[0].x, m[1].x, m[2].x));
+    let reach = RING_REACH_TEXELS * scene.shadow_params.z * scale;
+    let radius = sphere.w * scale;
+    let inner = max(radius - reach, 0.0);
+    let outer = (radius + reach) / cos(3.14159265 / f32(RING_SIDES));
+    var side: u32;
+    var r: f32;
+    if PART == 1u {
+        // Quad `side`: inner and outer corners at angles side and side + 1.
+        side = vertex / 6u;
+        let corner = vertex % 6u;
+        let next = corner == 2u || corner == 4u || corner == 5u;
+        side += select(0u, 1u, next);
+        // The ring's inner edge a little inside the disc's (which is at `inner`), so that the
+        // two overlap rather than leave a crack through rounding; in the overlap the ring is
+        // drawn and its lookup returns the umbra's 0.
+        r = select(0.999 * inner, outer, corner == 1u || corner == 2u || corner == 4u);
+    } else {
+        side = vertex / 3u + select(0u, 1u, vertex % 3u == 2u);
+        r = select(inner, 0.0, vertex % 3u == 0u);
+    }
+    let angle = 6.2831853 * f32(side % RING_SIDES) / f32(RING_SIDES);
+    let map = centre + r * vec2<f32>(cos(angle), sin(angle));
+    let to_unit = 0.5 * (map + vec2<f32>(1.0));
+    return scene.receiver.xy + to_unit.x * scene.receiver.zw + to_unit.y * scene.receiver_v.xy;
+}
 
 @vertex
-fn vs_main(@builtin(vertex_index) vertex: u32) -> WorldVertex {
+fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> WorldVertex {
     let corner = 0.5 * quad_corner(vertex) + vec2<f32>(0.5);
     var xz: vec2<f32>;
-    if RECEIVER {
+    if PART != 0u {
+        xz = ring_vertex(vertex, instance);
+    } else if RECEIVER {
         xz = scene.receiver.xy + corner.x * scene.receiver.zw + corner.y * scene.receiver_v.xy;
     } else {
         xz = mix(scene.floor_rect.xy, scene.floor_rect.zw, corner);
     }
     var world = vec3<f32>(xz.x, scene.floor_params.x, xz.y);
-    if EDGE_AA && !RECEIVER {
+    if EDGE_AA && !RECEIVER && PART == 0u {
         // Grow the rectangle at this corner by EDGE_REACH_PIXELS of the corner's own pixel
         // footprint along the floor: a pixel at distance D spans about D x view.eye.w across the
         // view, stretched by 1 / sin(elevation) along a floor seen at a grazing angle (capped
@@ -78,12 +139,18 @@ fn fs_main(in: WorldVertex) -> @location(0) vec4<f32> {
         if coverage <= 0.0 {
             discard;
         }
-    } else if RECEIVER && (any(in.world.xz < scene.floor_rect.xy) || any(in.world.xz > scene.floor_rect.zw)) {
+    } else if (RECEIVER || PART != 0u) && (any(in.world.xz < scene.floor_rect.xy) || any(in.world.xz > scene.floor_rect.zw)) {
         discard;
     }
     let sw = Switches(false, RECEIVER, PCF, false, false, false, false);
     // The side of the floor the view sees: its top from above, its underside from below.
     let n = vec3<f32>(0.0, select(-1.0, 1.0, view.eye.y >= scene.floor_params.x), 0.0);
-    let colour = shade_floor(sw, in.world, n, tile_coord, footprint);
+    var colour: vec3<f32>;
+    if PART == 2u {
+        // The umbra: what shade_floor gives where the lookup returns 0, the ambient term alone.
+        colour = floor_albedo(tile_coord, footprint) * (scene.ambient.rgb + scene.light_radiance.rgb * 0.0);
+    } else {
+        colour = shade_floor(sw, in.world, n, tile_coord, footprint);
+    }
     return vec4<f32>(mix(scene.background.rgb, colour, coverage), 1.0);
 }

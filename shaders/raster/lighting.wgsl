@@ -102,14 +102,19 @@ fn filtered_checker(t: vec2<f32>, width: vec2<f32>) -> f32 {
 // `tile_coord` is p's position in tiles from the floor's minimum corner and `footprint` the
 // pixel's extent in the same units (from screen-space derivatives, taken by the caller).
 fn shade_floor(sw: Switches, p: vec3<f32>, n: vec3<f32>, tile_coord: vec2<f32>, footprint: vec2<f32>) -> vec3<f32> {
-    let odd = filtered_checker(tile_coord, footprint);
-    let albedo = mix(scene.floor_color_a.rgb, scene.floor_color_b.rgb, odd);
+    let albedo = floor_albedo(tile_coord, footprint);
     let n_dot_l = max(dot(n, scene.to_light.xyz), 0.0);
     var direct = 0.0;
     if n_dot_l > 0.0 {
         direct = n_dot_l * shadow_visibility(sw, p, n, 0.0);
     }
     return albedo * (scene.ambient.rgb + scene.light_radiance.rgb * direct);
+}
+
+// The checkerboard's colour at `tile_coord`, box-filtered over the pixel's `footprint`.
+fn floor_albedo(tile_coord: vec2<f32>, footprint: vec2<f32>) -> vec3<f32> {
+    let odd = filtered_checker(tile_coord, footprint);
+    return mix(scene.floor_color_a.rgb, scene.floor_color_b.rgb, odd);
 }
 
 // Radiance arriving along `dirs[0]` at the glass sphere's centre, and, below, at the metal

@@ -61,7 +61,8 @@ struct Scene {
     // and receivers' depth range).
     shadow_view_proj: mat4x4<f32>,
     // x: distance a sphere's lookup point moves along its normal (the normal-offset bias),
-    // y: depth bias in shadow-map depth units.
+    // y: depth bias in shadow-map depth units, z: the side of one shadow-map texel in scene
+    // units.
     shadow_params: vec4<f32>,
     // x: the angle (radians) one texel of the glass's cube map spans at a face's centre,
     // y: log2 of the side ratio between that cube map and its coarse copy.

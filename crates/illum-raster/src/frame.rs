@@ -31,6 +31,9 @@ pub const VIEW_COUNT: usize = 14;
 
 /// Six vertices: the two triangles of a quad.
 const QUAD: std::ops::Range<u32> = 0..6;
+/// A penumbra ring and an umbra disc: RING_SIDES (floor.wgsl) quads and triangles.
+const RING_VERTICES: std::ops::Range<u32> = 0..6 * 32;
+const DISC_VERTICES: std::ops::Range<u32> = 0..3 * 32;
 
 /// Everything a frame's passes bind or render into.
 pub struct FrameResources<'a> {
@@ -45,6 +48,11 @@ pub struct FrameResources<'a> {
     /// The floor's shadow receiver (`None`: shadows off), for the cube faces and the main view.
     pub cube_floor_receiver: Option<&'a wgpu::RenderPipeline>,
     pub main_floor_receiver: Option<&'a wgpu::RenderPipeline>,
+    /// The floor's shadows as each sphere's penumbra ring and umbra disc, instead of the
+    /// receiver (floor.wgsl, PART 1 and 2), and the spheres present (instance 0 the glass, 1 the
+    /// metal).
+    pub main_floor_rings: Option<(&'a wgpu::RenderPipeline, &'a wgpu::RenderPipeline)>,
+    pub ring_spheres: std::ops::Range<u32>,
     /// The metal sphere as the glass capture draws it (`None`: no metal sphere).
     pub cube_metal: Option<&'a wgpu::RenderPipeline>,
     /// The glass sphere as the metal capture draws it (`None`: no glass sphere, or no metal cube).
@@ -231,8 +239,19 @@ impl FrameResources<'_> {
         // (The floor fragments under the spheres are now shaded too; measured in
         // docs/performance-raster.md, far less than the 4x MSAA this replaces.)
         let [back, front] = self.main_spheres;
-        let pipelines = [self.main_floor_receiver, Some(self.main_floor), back, front];
-        for pipeline in pipelines.into_iter().flatten() {
+        if let Some(receiver) = self.main_floor_receiver {
+            pass.set_pipeline(receiver);
+            pass.draw(QUAD, 0..1);
+        }
+        // Or the rings (the lookups), then the discs inside them (biased: they fail where a
+        // ring drew), then the rest of the floor (biased more).
+        if let Some((penumbra, umbra)) = self.main_floor_rings {
+            pass.set_pipeline(penumbra);
+            pass.draw(RING_VERTICES, self.ring_spheres.clone());
+            pass.set_pipeline(umbra);
+            pass.draw(DISC_VERTICES, self.ring_spheres.clone());
+        }
+        for pipeline in [Some(self.main_floor), back, front].into_iter().flatten() {
             pass.set_pipeline(pipeline);
             pass.draw(QUAD, 0..1);
         }

@@ -54,6 +54,7 @@ mod tests {
             glass_shadowed: false,
             metal_shadowed: true,
             metal_cube: true,
+            shadow_rings: true,
             reuse_views: false,
         };
         let named: Vec<(String, f64)> = plan.pass_names().into_iter().map(|n| (n, 0.5)).collect();

@@ -66,6 +66,11 @@ fn depth_state(compare: wgpu::CompareFunction) -> wgpu::DepthStencilState {
 const FLOOR_AFTER_RECEIVER_BIAS: wgpu::DepthBiasState =
     wgpu::DepthBiasState { constant: 16, slope_scale: 1.0, clamp: 0.0 };
 
+/// The bias of the umbra discs drawn after the penumbra rings: half the floor's (see
+/// FLOOR_AFTER_RECEIVER_BIAS), so that ring < umbra < rest of the floor in depth.
+const UMBRA_AFTER_RING_BIAS: wgpu::DepthBiasState =
+    wgpu::DepthBiasState { constant: 8, slope_scale: 0.5, clamp: 0.0 };
+
 /// Anti-aliased edges: a sphere fragment's alpha is the fraction of its pixel that the sphere
 /// covers, and the sphere goes over what is already there (the floor and the background, and the
 /// sphere behind it), `colour x alpha + behind x (1 - alpha)`. The alpha channel composes the
@@ -120,7 +125,14 @@ fn surface_pipeline(
                 buffers: &[],
             },
             primitive: primitive(),
-            depth_stencil: Some(if key.surface == Surface::Floor {
+            depth_stencil: Some(if key.surface == Surface::FloorUmbra {
+                // Between the rings (no bias) and the rest of the floor (FLOOR_AFTER_RECEIVER_BIAS):
+                // it fails where a ring drew, and the rest fails where it drew.
+                wgpu::DepthStencilState {
+                    bias: UMBRA_AFTER_RING_BIAS,
+                    ..depth_state(wgpu::CompareFunction::Less)
+                }
+            } else if key.surface == Surface::Floor {
                 // The biased floor compares LessEqual: near the far plane its bias pushes the
                 // depth past 1, where it is clamped to 1, the cleared value; with Less the floor's
                 // far end then vanished (a band of background before the far plane, found by
@@ -237,7 +249,9 @@ impl Pipelines {
     pub fn ensure(&mut self, gpu: &GpuContext, key: PipelineKey) -> Result<(), GpuError> {
         if !self.surfaces.contains_key(&key) {
             let module = match key.surface {
-                Surface::Floor | Surface::FloorReceiver => &self.floor_module,
+                Surface::Floor | Surface::FloorReceiver | Surface::FloorPenumbra | Surface::FloorUmbra => {
+                    &self.floor_module
+                }
                 Surface::Glass | Surface::Metal => &self.spheres_module,
             };
             let pipeline = surface_pipeline(gpu, &self.surface_layout, module, &key)?;

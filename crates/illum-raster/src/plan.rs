@@ -77,6 +77,10 @@ pub struct FramePlan {
     pub metal_shadowed: bool,
     /// The metal sphere's cube map is captured and mirrored.
     pub metal_cube: bool,
+    /// The main pass draws the floor's shadows as each sphere's penumbra ring (with the shadow
+    /// lookups) and umbra disc (dark, without them) instead of the receiver parallelogram
+    /// (`ShadowFit::rings`, floor.wgsl).
+    pub shadow_rings: bool,
     /// The shadow map and cube maps of the previous frame are this frame's (same scene but for
     /// the camera, same options): their passes are not recorded.
     pub reuse_views: bool,
@@ -96,6 +100,7 @@ impl FramePlan {
             glass_shadowed: shadow_pass && fit.glass_shadowed,
             metal_shadowed: shadow_pass && fit.metal_shadowed,
             metal_cube,
+            shadow_rings: shadow_pass && fit.rings,
             reuse_views: false,
         }
     }

@@ -27,6 +27,9 @@ struct Keys {
     cube_glass: PipelineKey,
     main_floor: PipelineKey,
     main_receiver: PipelineKey,
+    /// The floor's shadows as rings and discs (`FramePlan::shadow_rings`), in the main pass.
+    main_penumbra: PipelineKey,
+    main_umbra: PipelineKey,
     main_glass: PipelineKey,
     main_metal: PipelineKey,
 }
@@ -291,6 +294,8 @@ impl RasterRenderer {
             cube_glass: key(Surface::Glass, Target::Cube),
             main_floor: key(Surface::Floor, main),
             main_receiver: key(Surface::FloorReceiver, main),
+            main_penumbra: key(Surface::FloorPenumbra, main),
+            main_umbra: key(Surface::FloorUmbra, main),
             main_glass: key(Surface::Glass, main),
             main_metal: key(Surface::Metal, main),
         };
@@ -298,13 +303,17 @@ impl RasterRenderer {
         let mut needed = std::collections::HashSet::new();
         for pass in plan.passes() {
             let draws = plan.draws(pass);
+            // The main pass draws the floor's shadows as rings and discs when the plan allows.
+            let rings = pass == Pass::Main && plan.shadow_rings;
+            let (penumbra, umbra) = (keys.main_penumbra, keys.main_umbra);
             let keys = match pass {
                 Pass::Shadow => continue,
                 Pass::Capture(_) => [keys.cube_floor, keys.cube_receiver, keys.cube_glass, keys.cube_metal],
                 Pass::Main => [keys.main_floor, keys.main_receiver, keys.main_glass, keys.main_metal],
             };
-            for (key, drawn) in keys.into_iter().zip([draws.floor, draws.receiver, draws.glass, draws.metal])
-            {
+            let drawn = [draws.floor, draws.receiver && !rings, draws.glass, draws.metal];
+            let ring_keys = [(penumbra, draws.receiver && rings), (umbra, draws.receiver && rings)];
+            for (key, drawn) in keys.into_iter().zip(drawn).chain(ring_keys) {
                 if drawn {
                     self.pipelines.ensure(&self.gpu, key)?;
                     needed.insert(key);
@@ -329,6 +338,8 @@ impl RasterRenderer {
             cube_floor: get(keys.cube_floor),
             cube_floor_receiver: get(keys.cube_receiver),
             main_floor_receiver: get(keys.main_receiver),
+            main_floor_rings: get(keys.main_penumbra).zip(get(keys.main_umbra)),
+            ring_spheres: u32::from(!plan.glass)..1 + u32::from(plan.metal),
             cube_metal: get(keys.cube_metal),
             cube_glass: get(keys.cube_glass),
             cube_depth: &self.cubes.depth,

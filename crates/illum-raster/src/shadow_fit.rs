@@ -44,6 +44,11 @@ pub struct ShadowFit {
     /// with one sphere has neither.
     pub glass_shadowed: bool,
     pub metal_shadowed: bool,
+    /// Whether the floor's shadows may be drawn as rings and discs (floor.wgsl, PART 1 and 2):
+    /// the light comes from above, every sphere lies wholly above the floor (so it is in front
+    /// of every floor point it covers in the map) and `receiver` is the map's own footprint (the
+    /// rings are placed through it).
+    pub rings: bool,
 }
 
 /// Whether sphere `receiver` (centre, radius) can lie in the shadow of sphere `caster` under
@@ -139,6 +144,13 @@ pub fn fit_shadow(scene: &RasterScene, max_size: u32) -> ShadowFit {
         Vec4::W,
     );
     let receiver = receiver_on_floor(&view_proj, floor);
+    let rings = receiver.is_some()
+        && direction.y < 0.0
+        && scene.spheres().iter().all(|&(c, r)| c.y - r > floor.height());
+    let receiver = receiver.unwrap_or_else(|| {
+        let (lo, hi) = (floor.min_corner(), floor.max_corner());
+        [lo, Vec2::new(hi.x - lo.x, 0.0), Vec2::new(0.0, hi.y - lo.y)]
+    });
     // The soft edge reaches pcf_radius beyond the sharp one, and a sphere's lookup point moves a
     // kernel and a texel along its normal: twice the kernel plus two texels covers both.
     let margin = 2.0 * (PCF_REACH_TEXELS + 1.0) * texel;
@@ -152,34 +164,33 @@ pub fn fit_shadow(scene: &RasterScene, max_size: u32) -> ShadowFit {
         receiver,
         glass_shadowed: pair.is_some_and(|(glass, metal)| can_shadow(metal, glass, direction, margin)),
         metal_shadowed: pair.is_some_and(|(glass, metal)| can_shadow(glass, metal, direction, margin)),
+        rings,
     }
 }
 
 /// The floor points whose shadow-map coordinates lie in [-1, 1]^2. On the plane y = h the map's
 /// (X, Y) are affine in (x, z): (X, Y) = A (x, z) + b, with A and b read off the matrix. The
 /// map's corners (-1, -1), (1, -1), (-1, 1) map back through A^-1 to the parallelogram's corner
-/// and the ends of its two edges. A nearly singular A (light grazing the floor) falls back to
-/// the floor rectangle.
-fn receiver_on_floor(view_proj: &Mat4, floor: &crate::scene::CheckerFloor) -> [Vec2; 3] {
+/// and the ends of its two edges. `None` for a nearly singular A (light grazing the floor),
+/// whose parallelogram would be unbounded: the caller takes the whole floor rectangle.
+fn receiver_on_floor(view_proj: &Mat4, floor: &crate::scene::CheckerFloor) -> Option<[Vec2; 3]> {
     let rows = [view_proj.row(0), view_proj.row(1)];
     let a = Mat2::from_cols(Vec2::new(rows[0].x, rows[1].x), Vec2::new(rows[0].z, rows[1].z));
     let h = floor.height();
     let b = Vec2::new(rows[0].y * h + rows[0].w, rows[1].y * h + rows[1].w);
-    let (lo, hi) = (floor.min_corner(), floor.max_corner());
-    let whole = [lo, Vec2::new(hi.x - lo.x, 0.0), Vec2::new(0.0, hi.y - lo.y)];
     // |det A| relates map area to floor area: a map a million times smaller than its floor
     // footprint means light nearly parallel to the floor.
     if a.determinant().abs() < 1e-6 * a.abs().to_cols_array().iter().fold(0.0f32, |m, v| m.max(*v)).powi(2) {
-        return whole;
+        return None;
     }
     let inverse = a.inverse();
     let corner = inverse * (Vec2::splat(-1.0) - b);
     let u = inverse * Vec2::new(2.0, 0.0);
     let v = inverse * Vec2::new(0.0, 2.0);
     if !(corner.is_finite() && u.is_finite() && v.is_finite()) {
-        return whole;
+        return None;
     }
-    [corner, u, v]
+    Some([corner, u, v])
 }
 
 #[cfg(test)]
@@ -263,6 +274,24 @@ mod tests {
         grazing.light.direction = Vec3::NEG_X;
         let whole = fit_shadow(&grazing, 8192).receiver;
         assert_eq!(whole[0], s.floor.min_corner());
+    }
+
+    /// Rings and discs (floor.wgsl) only where a disc is sure to be shadow: a light from above,
+    /// spheres wholly above the floor, and a map whose footprint on the floor is bounded.
+    #[test]
+    fn shadows_are_drawn_as_rings_only_where_the_discs_are_sure() {
+        let s = scene();
+        assert!(fit_shadow(&s, 8192).rings, "the shipped scene");
+        let mut grazing = s.clone();
+        grazing.light.direction = Vec3::NEG_X;
+        assert!(!fit_shadow(&grazing, 8192).rings, "a light level with the floor");
+        let mut below = s.clone();
+        below.light.direction = Vec3::new(-10.0, 13.0, 2.0).normalize();
+        assert!(!fit_shadow(&below, 8192).rings, "a light from below the floor");
+        let mut dipping = s.clone();
+        let h = s.floor.height();
+        dipping.metal.as_mut().unwrap().center.y = h + 0.5 * dipping.metal.unwrap().radius;
+        assert!(!fit_shadow(&dipping, 8192).rings, "a sphere through the floor");
     }
 
     #[test]

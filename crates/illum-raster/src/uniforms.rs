@@ -114,7 +114,7 @@ pub fn scene_uniform(scene: &RasterScene, shadow: &ShadowFit) -> SceneUniform {
         metal_color,
         metal_specular,
         shadow_view_proj: shadow.view_proj.to_cols_array_2d(),
-        shadow_params: [normal_offset, SHADOW_DEPTH_BIAS, 0.0, 0.0],
+        shadow_params: [normal_offset, SHADOW_DEPTH_BIAS, shadow.texel, 0.0],
         env_params: env_params(scene.quality.cube_size),
         floor_edges: floor_edges(scene),
     }

@@ -19,6 +19,11 @@ pub enum Surface {
     Floor,
     /// The floor under the shadow map, with shadow lookups (only drawn with shadows on).
     FloorReceiver,
+    /// Each sphere's penumbra ring on the floor, with shadow lookups: in the main pass instead of
+    /// the receiver when the frame allows it (`FramePlan::shadow_rings`).
+    FloorPenumbra,
+    /// Each sphere's umbra on the floor inside its ring: shaded dark, no lookups.
+    FloorUmbra,
     Glass,
     Metal,
 }
@@ -74,7 +79,10 @@ impl PipelineKey {
         let enhanced = options.look == Look::Enhanced;
         let switches = match surface {
             Surface::Floor => Switches::default(),
-            Surface::FloorReceiver => Switches { shadows: true, pcf: e.pcf, ..Default::default() },
+            Surface::FloorReceiver | Surface::FloorPenumbra => {
+                Switches { shadows: true, pcf: e.pcf, ..Default::default() }
+            }
+            Surface::FloorUmbra => Switches::default(),
             // The figure's glass is unlit: only refraction matters.
             Surface::Glass if !enhanced => Switches { refraction: e.refraction, ..Default::default() },
             Surface::Glass => Switches {
@@ -107,8 +115,19 @@ impl PipelineKey {
         let s = &self.switches;
         let flag = |b: bool| if b { 1.0 } else { 0.0 };
         let edge_aa = flag(self.target.antialiased());
-        if matches!(self.surface, Surface::Floor | Surface::FloorReceiver) {
-            return vec![("RECEIVER", flag(s.shadows)), ("PCF", flag(s.pcf)), ("EDGE_AA", edge_aa)];
+        let floor_part = match self.surface {
+            Surface::Floor | Surface::FloorReceiver => Some(0.0),
+            Surface::FloorPenumbra => Some(1.0),
+            Surface::FloorUmbra => Some(2.0),
+            Surface::Glass | Surface::Metal => None,
+        };
+        if let Some(part) = floor_part {
+            return vec![
+                ("RECEIVER", flag(s.shadows)),
+                ("PCF", flag(s.pcf)),
+                ("EDGE_AA", edge_aa),
+                ("PART", part),
+            ];
         }
         let mut constants = vec![("SHADOWS", flag(s.shadows)), ("PCF", flag(s.pcf))];
         {
@@ -143,6 +162,7 @@ mod tests {
             glass_shadowed: shadow_pass && shadowed,
             metal_shadowed: shadow_pass && shadowed,
             metal_cube: options.look == Look::Enhanced && options.effects.reflection,
+            shadow_rings: shadow_pass,
             reuse_views: false,
         }
     }
@@ -214,12 +234,15 @@ mod tests {
         let receiver =
             PipelineKey::new(Surface::FloorReceiver, Target::Cube, &enhanced, &plan(&enhanced, true))
                 .constants();
-        assert_eq!(receiver, vec![("RECEIVER", 1.0), ("PCF", 1.0), ("EDGE_AA", 0.0)]);
+        assert_eq!(receiver, vec![("RECEIVER", 1.0), ("PCF", 1.0), ("EDGE_AA", 0.0), ("PART", 0.0)]);
         let floor =
             PipelineKey::new(Surface::Floor, Target::Cube, &enhanced, &plan(&enhanced, true)).constants();
-        assert_eq!(floor, vec![("RECEIVER", 0.0), ("PCF", 0.0), ("EDGE_AA", 0.0)]);
+        assert_eq!(floor, vec![("RECEIVER", 0.0), ("PCF", 0.0), ("EDGE_AA", 0.0), ("PART", 0.0)]);
         let main_floor =
             PipelineKey::new(Surface::Floor, Target::main(&enhanced), &enhanced, &plan(&enhanced, true));
-        assert_eq!(main_floor.constants(), vec![("RECEIVER", 0.0), ("PCF", 0.0), ("EDGE_AA", 1.0)]);
+        assert_eq!(
+            main_floor.constants(),
+            vec![("RECEIVER", 0.0), ("PCF", 0.0), ("EDGE_AA", 1.0), ("PART", 0.0)]
+        );
     }
 }
