@@ -37,7 +37,8 @@ override PART: u32 = 0u;
 
 // Sides of the polygons that stand for the circles of a ring: the outer one circumscribes the
 // outer circle, the inner one is inscribed in the inner circle, so the ring holds every point
-// within the reach of the outline and the disc only points farther inside.
+// within the reach of the outline and the disc only points farther inside. frame.rs draws
+// RING_SIDES of its own, which a test keeps equal to this.
 const RING_SIDES: u32 = 32u;
 // How far from a sphere's outline in the shadow map a lookup can still see it, in texels: the
 // four bilinear taps at +-1/2 texel read texels whose centres lie within 1.5 texels along each
@@ -148,7 +149,7 @@ fn fs_main(in: WorldVertex) -> @location(0) vec4<f32> {
     var colour: vec3<f32>;
     if PART == 2u {
         // The umbra: what shade_floor gives where the lookup returns 0, the ambient term alone.
-        colour = floor_albedo(tile_coord, footprint) * (scene.ambient.rgb + scene.light_radiance.rgb * 0.0);
+        colour = floor_albedo(tile_coord, footprint) * scene.ambient.rgb;
     } else {
         colour = shade_floor(sw, in.world, n, tile_coord, footprint);
     }

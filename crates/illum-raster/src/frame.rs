@@ -31,9 +31,11 @@ pub const VIEW_COUNT: usize = 14;
 
 /// Six vertices: the two triangles of a quad.
 const QUAD: std::ops::Range<u32> = 0..6;
-/// A penumbra ring and an umbra disc: RING_SIDES (floor.wgsl) quads and triangles.
-const RING_VERTICES: std::ops::Range<u32> = 0..6 * 32;
-const DISC_VERTICES: std::ops::Range<u32> = 0..3 * 32;
+/// Sides of a penumbra ring and an umbra disc (`RING_SIDES` in floor.wgsl, which builds them).
+const RING_SIDES: u32 = 32;
+/// A penumbra ring and an umbra disc: RING_SIDES quads and triangles.
+const RING_VERTICES: std::ops::Range<u32> = 0..6 * RING_SIDES;
+const DISC_VERTICES: std::ops::Range<u32> = 0..3 * RING_SIDES;
 
 /// Everything a frame's passes bind or render into.
 pub struct FrameResources<'a> {
@@ -273,6 +275,15 @@ pub fn metal_behind_glass(eye: glam::Vec3, glass: (glam::Vec3, f32), metal: (gla
 mod tests {
     use super::*;
     use glam::Vec3;
+
+    #[test]
+    fn the_rings_drawn_have_the_sides_the_shader_builds() {
+        let declaration = format!("const RING_SIDES: u32 = {RING_SIDES}u;");
+        assert!(
+            crate::shaders::FLOOR_SHADER.source.contains(&declaration),
+            "floor.wgsl must declare `{declaration}`"
+        );
+    }
 
     #[test]
     fn spheres_are_ordered_by_power_not_by_centre_distance() {
