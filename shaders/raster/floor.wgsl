@@ -18,7 +18,13 @@
 // the floor's colour mixed with the background by the fraction of the pixel inside the rectangle.
 // The renderer draws the floor first, over nothing but the background, so the shader mixes with
 // the background colour itself and needs no blending. (Either part may draw an outline pixel;
-// the other then fails the depth test there, as everywhere.)
+// the other then fails the depth test there, as everywhere.) Only a band along the outline can be
+// partly covered, so the rest of the floor is drawn in two pieces: its interior (PART 3, the
+// rectangle shrunk by EDGE_REACH_PIXELS) without the coverage, and the band between the shrunk
+// and the grown outline with it, which took 2 to 8 ms (about a quarter) off lavapipe's main
+// pass (docs/performance-raster.md): besides the coverage of four edges on every floor pixel,
+// the coverage's `discard` made the depth test wait for the shading, so the floor was shaded
+// even where the shadows' rings and discs had already drawn.
 
 #import illum::raster::scene::{scene, view, quad_corner, Switches, WorldVertex, world_vertex, edge_coverage, EDGE_REACH_PIXELS}
 #import illum::raster::lighting::{shade_floor, floor_albedo}
@@ -33,6 +39,8 @@ override EDGE_AA: bool = false;
 // sphere's umbra disc inside its ring, dark, without the lookup. Rings and discs are drawn
 // instead of the receiver in the main pass when the light comes from above and the spheres
 // stand above the floor (shadow_fit.rs, rings); instance 0 is the glass's, 1 the metal's.
+// 3: the interior of the floor, inside the band that EDGE_AA draws along the outline (drawn
+// with EDGE_AA off). With EDGE_AA on, PART 0 without RECEIVER draws that band alone.
 override PART: u32 = 0u;
 
 // Sides of the polygons that stand for the circles of a ring: the outer one circumscribes the
@@ -84,9 +92,49 @@ fn ring_vertex(vertex: u32, instance: u32) -> vec2<f32> {
     return scene.receiver.xy + to_unit.x * scene.receiver.zw + to_unit.y * scene.receiver_v.xy;
 }
 
+// Corner `corner` ((0 or 1, 0 or 1): min or max along x and z) of the floor rectangle, moved
+// diagonally outward (`outward` true) or inward by EDGE_REACH_PIXELS of the corner's own pixel
+// footprint along the floor: a pixel at distance D spans about D x view.eye.w across the view,
+// stretched by 1 / sin(elevation) along a floor seen at a grazing angle (capped near the
+// horizon). The footprint grows faster than linearly with distance, so the straight line between
+// two moved corners is at least as far from the outline as needed between them, outward and
+// inward. Inward, a corner stops at the rectangle's centre lines, so the interior never turns
+// inside out (a floor seen edge-on is then all band).
+fn floor_corner(corner: vec2<f32>, outward: bool) -> vec3<f32> {
+    let xz = mix(scene.floor_rect.xy, scene.floor_rect.zw, corner);
+    let world = vec3<f32>(xz.x, scene.floor_params.x, xz.y);
+    let to_eye = view.eye.xyz - world;
+    let distance = length(to_eye);
+    let sin_elevation = max(abs(to_eye.y) / max(distance, 1e-30), 0.02);
+    let reach = EDGE_REACH_PIXELS * distance * view.eye.w / sin_elevation;
+    let half_side = 0.5 * (scene.floor_rect.zw - scene.floor_rect.xy);
+    let move_by = select(-min(reach, min(half_side.x, half_side.y)), reach, outward);
+    let away = select(vec2<f32>(-1.0), vec2<f32>(1.0), corner > vec2<f32>(0.5));
+    return world + move_by * vec3<f32>(away.x, 0.0, away.y);
+}
+
+// Vertex `vertex` (0..24) of the band along the floor's outline: for each side of the rectangle,
+// the quad between that side's grown and shrunk copies. The sides share their moved corners with
+// each other and with the interior (PART 3), so together they tile the grown rectangle.
+fn outline_vertex(vertex: u32) -> vec3<f32> {
+    let side = vertex / 6u;
+    let q = quad_corner(vertex % 6u);
+    let corners = array<vec2<f32>, 4>(
+        vec2<f32>(0.0, 0.0), vec2<f32>(1.0, 0.0), vec2<f32>(1.0, 1.0), vec2<f32>(0.0, 1.0),
+    );
+    let index = (side + select(0u, 1u, q.x > 0.0)) % 4u;
+    return floor_corner(corners[index], q.y < 0.0);
+}
+
 @vertex
 fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> WorldVertex {
     let corner = 0.5 * quad_corner(vertex) + vec2<f32>(0.5);
+    if PART == 3u {
+        return world_vertex(floor_corner(corner, false));
+    }
+    if EDGE_AA && !RECEIVER && PART == 0u {
+        return world_vertex(outline_vertex(vertex));
+    }
     var xz: vec2<f32>;
     if PART != 0u {
         xz = ring_vertex(vertex, instance);
@@ -95,21 +143,7 @@ fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance
     } else {
         xz = mix(scene.floor_rect.xy, scene.floor_rect.zw, corner);
     }
-    var world = vec3<f32>(xz.x, scene.floor_params.x, xz.y);
-    if EDGE_AA && !RECEIVER && PART == 0u {
-        // Grow the rectangle at this corner by EDGE_REACH_PIXELS of the corner's own pixel
-        // footprint along the floor: a pixel at distance D spans about D x view.eye.w across the
-        // view, stretched by 1 / sin(elevation) along a floor seen at a grazing angle (capped
-        // near the horizon). The footprint grows faster than linearly with distance, so the
-        // straight line between two grown corners reaches at least as far as needed between them.
-        let to_eye = view.eye.xyz - world;
-        let distance = length(to_eye);
-        let sin_elevation = max(abs(to_eye.y) / max(distance, 1e-30), 0.02);
-        let grow = EDGE_REACH_PIXELS * distance * view.eye.w / sin_elevation;
-        let outward = vec2<f32>(select(-1.0, 1.0, corner.x > 0.5), select(-1.0, 1.0, corner.y > 0.5));
-        world += grow * vec3<f32>(outward.x, 0.0, outward.y);
-    }
-    return world_vertex(world);
+    return world_vertex(vec3<f32>(xz.x, scene.floor_params.x, xz.y));
 }
 
 @fragment
@@ -140,7 +174,9 @@ fn fs_main(in: WorldVertex) -> @location(0) vec4<f32> {
         if coverage <= 0.0 {
             discard;
         }
-    } else if (RECEIVER || PART != 0u) && (any(in.world.xz < scene.floor_rect.xy) || any(in.world.xz > scene.floor_rect.zw)) {
+    } else if (RECEIVER || PART == 1u || PART == 2u) && (any(in.world.xz < scene.floor_rect.xy) || any(in.world.xz > scene.floor_rect.zw)) {
+        // The shadows' shapes may reach past the floor. (The interior, PART 3, cannot, and
+        // without a discard its depth test comes before its shading.)
         discard;
     }
     let sw = Switches(false, RECEIVER, PCF, false, false, false, false);

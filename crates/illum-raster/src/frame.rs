@@ -36,6 +36,8 @@ const RING_SIDES: u32 = 32;
 /// A penumbra ring and an umbra disc: RING_SIDES quads and triangles.
 const RING_VERTICES: std::ops::Range<u32> = 0..6 * RING_SIDES;
 const DISC_VERTICES: std::ops::Range<u32> = 0..3 * RING_SIDES;
+/// The band along the floor's outline: a quad for each of its four sides (floor.wgsl).
+const OUTLINE_VERTICES: std::ops::Range<u32> = 0..24;
 
 /// Everything a frame's passes bind or render into.
 pub struct FrameResources<'a> {
@@ -69,7 +71,10 @@ pub struct FrameResources<'a> {
     pub glass_capture_textures: &'a wgpu::BindGroup,
     pub metal_capture_textures: &'a wgpu::BindGroup,
     pub main_textures: &'a wgpu::BindGroup,
+    /// The floor without the shadow lookups: the whole floor, or, with `main_floor_interior`
+    /// (an anti-aliased view), only the band along its outline.
     pub main_floor: &'a wgpu::RenderPipeline,
+    pub main_floor_interior: Option<&'a wgpu::RenderPipeline>,
     /// The spheres in the main view, the farther first (`None`: the scene lacks that sphere);
     /// see [`metal_behind_glass`].
     pub main_spheres: [Option<&'a wgpu::RenderPipeline>; 2],
@@ -253,7 +258,14 @@ impl FrameResources<'_> {
             pass.set_pipeline(umbra);
             pass.draw(DISC_VERTICES, self.ring_spheres.clone());
         }
-        for pipeline in [Some(self.main_floor), back, front].into_iter().flatten() {
+        // The interior and the outline's band share their edges and never overlap.
+        if let Some(interior) = self.main_floor_interior {
+            pass.set_pipeline(interior);
+            pass.draw(QUAD, 0..1);
+        }
+        pass.set_pipeline(self.main_floor);
+        pass.draw(if self.main_floor_interior.is_some() { OUTLINE_VERTICES } else { QUAD }, 0..1);
+        for pipeline in [back, front].into_iter().flatten() {
             pass.set_pipeline(pipeline);
             pass.draw(QUAD, 0..1);
         }

@@ -132,7 +132,7 @@ fn surface_pipeline(
                     bias: UMBRA_AFTER_RING_BIAS,
                     ..depth_state(wgpu::CompareFunction::Less)
                 }
-            } else if key.surface == Surface::Floor {
+            } else if matches!(key.surface, Surface::Floor | Surface::FloorInterior) {
                 // The biased floor compares LessEqual: near the far plane its bias pushes the
                 // depth past 1, where it is clamped to 1, the cleared value; with Less the floor's
                 // far end then vanished (a band of background before the far plane, found by
@@ -249,9 +249,11 @@ impl Pipelines {
     pub fn ensure(&mut self, gpu: &GpuContext, key: PipelineKey) -> Result<(), GpuError> {
         if !self.surfaces.contains_key(&key) {
             let module = match key.surface {
-                Surface::Floor | Surface::FloorReceiver | Surface::FloorPenumbra | Surface::FloorUmbra => {
-                    &self.floor_module
-                }
+                Surface::Floor
+                | Surface::FloorReceiver
+                | Surface::FloorPenumbra
+                | Surface::FloorUmbra
+                | Surface::FloorInterior => &self.floor_module,
                 Surface::Glass | Surface::Metal => &self.spheres_module,
             };
             let pipeline = surface_pipeline(gpu, &self.surface_layout, module, &key)?;

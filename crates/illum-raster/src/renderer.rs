@@ -26,6 +26,8 @@ struct Keys {
     cube_metal: PipelineKey,
     cube_glass: PipelineKey,
     main_floor: PipelineKey,
+    /// The floor's interior, when `main_floor` draws only the band along its outline.
+    main_floor_interior: PipelineKey,
     main_receiver: PipelineKey,
     /// The floor's shadows as rings and discs (`FramePlan::shadow_rings`), in the main pass.
     main_penumbra: PipelineKey,
@@ -293,6 +295,7 @@ impl RasterRenderer {
             cube_metal: key(Surface::Metal, Target::Cube),
             cube_glass: key(Surface::Glass, Target::Cube),
             main_floor: key(Surface::Floor, main),
+            main_floor_interior: key(Surface::FloorInterior, main),
             main_receiver: key(Surface::FloorReceiver, main),
             main_penumbra: key(Surface::FloorPenumbra, main),
             main_umbra: key(Surface::FloorUmbra, main),
@@ -306,6 +309,7 @@ impl RasterRenderer {
             // The main pass draws the floor's shadows as rings and discs when the plan allows.
             let rings = pass == Pass::Main && plan.shadow_rings;
             let (penumbra, umbra) = (keys.main_penumbra, keys.main_umbra);
+            let keys_all = &keys;
             let keys = match pass {
                 Pass::Shadow => continue,
                 Pass::Capture(_) => [keys.cube_floor, keys.cube_receiver, keys.cube_glass, keys.cube_metal],
@@ -313,7 +317,10 @@ impl RasterRenderer {
             };
             let drawn = [draws.floor, draws.receiver && !rings, draws.glass, draws.metal];
             let ring_keys = [(penumbra, draws.receiver && rings), (umbra, draws.receiver && rings)];
-            for (key, drawn) in keys.into_iter().zip(drawn).chain(ring_keys) {
+            // With anti-aliasing the main floor is its outline's band and the interior.
+            let interior = pass == Pass::Main && draws.floor && main.antialiased();
+            let more_keys = ring_keys.into_iter().chain([(keys_all.main_floor_interior, interior)]);
+            for (key, drawn) in keys.into_iter().zip(drawn).chain(more_keys) {
                 if drawn {
                     self.pipelines.ensure(&self.gpu, key)?;
                     needed.insert(key);
@@ -351,6 +358,7 @@ impl RasterRenderer {
             metal_capture_textures: &self.texture_groups.metal_capture,
             main_textures: &self.texture_groups.main,
             main_floor: get(keys.main_floor).expect("the main pass draws the floor"),
+            main_floor_interior: get(keys.main_floor_interior),
             main_spheres: if self.metal_behind_glass() {
                 [get(keys.main_metal), get(keys.main_glass)]
             } else {

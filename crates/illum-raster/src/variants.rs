@@ -24,6 +24,9 @@ pub enum Surface {
     FloorPenumbra,
     /// Each sphere's umbra on the floor inside its ring: shaded dark, no lookups.
     FloorUmbra,
+    /// The floor inside the band along its outline, without the outline's coverage: in an
+    /// anti-aliased main view, where `Floor` draws only that band (floor.wgsl, PART 3).
+    FloorInterior,
     Glass,
     Metal,
 }
@@ -82,7 +85,7 @@ impl PipelineKey {
             Surface::FloorReceiver | Surface::FloorPenumbra => {
                 Switches { shadows: true, pcf: e.pcf, ..Default::default() }
             }
-            Surface::FloorUmbra => Switches::default(),
+            Surface::FloorUmbra | Surface::FloorInterior => Switches::default(),
             // The figure's glass is unlit: only refraction matters.
             Surface::Glass if !enhanced => Switches { refraction: e.refraction, ..Default::default() },
             Surface::Glass => Switches {
@@ -114,11 +117,13 @@ impl PipelineKey {
     pub fn constants(&self) -> Vec<(&'static str, f64)> {
         let s = &self.switches;
         let flag = |b: bool| if b { 1.0 } else { 0.0 };
-        let edge_aa = flag(self.target.antialiased());
+        // The floor's interior is wholly inside the outline: nothing there to anti-alias.
+        let edge_aa = flag(self.target.antialiased() && self.surface != Surface::FloorInterior);
         let floor_part = match self.surface {
             Surface::Floor | Surface::FloorReceiver => Some(0.0),
             Surface::FloorPenumbra => Some(1.0),
             Surface::FloorUmbra => Some(2.0),
+            Surface::FloorInterior => Some(3.0),
             Surface::Glass | Surface::Metal => None,
         };
         if let Some(part) = floor_part {
