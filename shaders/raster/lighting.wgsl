@@ -118,22 +118,22 @@ fn floor_albedo(tile_coord: vec2<f32>, footprint: vec2<f32>) -> vec3<f32> {
     return mix(scene.floor_color_a.rgb, scene.floor_color_b.rgb, odd);
 }
 
-// Radiance arriving along `dirs[0]` at the glass sphere's centre, and, below, at the metal
-// sphere's. Looking up from the centre rather than from the surface point is the cube-map
-// approximation: exact for a distant environment, slightly off for the nearby floor.
+// Radiance arriving along `dir` at the glass sphere's centre, and, below, at the metal sphere's.
+// Looking up from the centre rather than from the surface point is the cube-map approximation:
+// exact for a distant environment, slightly off for the nearby floor.
 //
-// `dirs[1]` and `dirs[2]` are the lookup directions of the pixel's right and lower neighbours:
-// their spread is the pixel's footprint in the environment. Near the glass's rim refraction
-// sweeps many texels across one pixel, and a single bilinear lookup would alias into moire;
-// there the lookup blends toward the coarse copy, by the log2 of the footprint in fine texels
-// (a two-level mip chain whose coarse level is rendered, not downsampled: the floor's own box
-// filter prefilters it).
-fn glass_environment(dirs: array<vec3<f32>, 3>) -> vec3<f32> {
-    let spread = max(length(dirs[1] - dirs[0]), length(dirs[2] - dirs[0]));
+// `dir_dx` and `dir_dy` are the direction's screen derivatives, its change to the next pixel
+// across and down: their length is the pixel's footprint in the environment. Near the glass's rim
+// refraction sweeps many texels across one pixel, and a single bilinear lookup would alias into
+// moire; there the lookup blends toward the coarse copy, by the log2 of the footprint in fine
+// texels (a two-level mip chain whose coarse level is rendered, not downsampled: the floor's own
+// box filter prefilters it).
+fn glass_environment(dir: vec3<f32>, dir_dx: vec3<f32>, dir_dy: vec3<f32>) -> vec3<f32> {
+    let spread = max(length(dir_dx), length(dir_dy));
     let level = log2(max(spread / scene.env_params.x, 1.0));
     let coarse_weight = clamp(level / scene.env_params.y, 0.0, 1.0);
-    let fine = textureSampleLevel(glass_env, env_sampler, dirs[0], 0.0).rgb;
-    let coarse = textureSampleLevel(glass_env_coarse, env_sampler, dirs[0], 0.0).rgb;
+    let fine = textureSampleLevel(glass_env, env_sampler, dir, 0.0).rgb;
+    let coarse = textureSampleLevel(glass_env_coarse, env_sampler, dir, 0.0).rgb;
     return mix(fine, coarse, coarse_weight);
 }
 
@@ -219,8 +219,7 @@ fn refract_through_sphere(p1: vec3<f32>, n1: vec3<f32>, incident: vec3<f32>, eta
     return out;
 }
 
-// The glass sphere seen from `eye` at points p[i] with unit normals n[i]: the pixel's own (0)
-// and its right and lower neighbours' (1, 2), for the footprint of the environment lookups.
+// The glass sphere seen from `eye` at point p with unit normal n.
 //
 // Figure look (the assignment's figure 1): unlit; (1 - reflectivity) x colour + reflectivity x
 // the environment along the view ray refracted once at the front face (refraction off: along
@@ -229,48 +228,48 @@ fn refract_through_sphere(p1: vec3<f32>, n1: vec3<f32>, incident: vec3<f32>, eta
 // Enhanced look: Schlick's Fresnel weight F = F0 + (1 - F0)(1 - cos)^5 between the mirror
 // reflection and the refraction through both faces of the sphere, plus a white highlight.
 // Without Fresnel F is F0 (normal incidence) everywhere; without reflection F is 0.
-fn shade_glass(sw: Switches, p: array<vec3<f32>, 3>, n: array<vec3<f32>, 3>, eye: vec3<f32>) -> vec3<f32> {
+//
+// The environment lookups take their footprint from the screen derivatives of their directions
+// (within each 2 x 2 block of pixels), which the caller keeps in uniform control flow. (Until
+// 2026-12-02 the refraction was traced a second and third time for the right and lower
+// neighbours' points instead; docs/performance-raster.md.)
+fn shade_glass(sw: Switches, p: vec3<f32>, n: vec3<f32>, eye: vec3<f32>) -> vec3<f32> {
     let eta = scene.glass_params.x;
-    var through: array<vec3<f32>, 3>;
-    var mirrored: array<vec3<f32>, 3>;
-    for (var i = 0; i < 3; i++) {
-        let incident = normalize(p[i] - eye);
-        through[i] = incident;
-        if sw.refraction {
-            if sw.enhanced {
-                through[i] = refract_through_sphere(p[i], n[i], incident, eta);
-            } else {
-                through[i] = refract_or_reflect(incident, n[i], eta);
-            }
+    let incident = normalize(p - eye);
+    var through = incident;
+    if sw.refraction {
+        if sw.enhanced {
+            through = refract_through_sphere(p, n, incident, eta);
+        } else {
+            through = refract_or_reflect(incident, n, eta);
         }
-        mirrored[i] = reflect(incident, n[i]);
     }
+    let transmitted = glass_environment(through, dpdx(through), dpdy(through));
     if !sw.enhanced {
         let r = scene.glass_color.w;
-        return (1.0 - r) * scene.glass_color.rgb + r * glass_environment(through);
+        return (1.0 - r) * scene.glass_color.rgb + r * transmitted;
     }
-    let v = normalize(eye - p[0]);
+    let v = -incident;
     var fresnel = 0.0;
     var reflected = vec3<f32>(0.0);
     if sw.reflection {
-        reflected = glass_environment(mirrored);
+        let mirrored = reflect(incident, n);
+        reflected = glass_environment(mirrored, dpdx(mirrored), dpdy(mirrored));
         let f0 = scene.glass_params.z;
         fresnel = f0;
         if sw.fresnel {
             // Schlick's approximation takes the cosine on the less dense side: for eta > 1 the
             // refracted angle's, and under total internal reflection everything is reflected.
-            var c = clamp(dot(n[0], v), 0.0, 1.0);
-            if eta > 1.0 {
-                let k = 1.0 - eta * eta * (1.0 - c * c);
-                c = sqrt(max(k, 0.0));
-            }
+            // (A select, not an `if`: see shade_floor on branches on uniforms alone.)
+            let c_outside = clamp(dot(n, v), 0.0, 1.0);
+            let k = 1.0 - eta * eta * (1.0 - c_outside * c_outside);
+            let c = select(c_outside, sqrt(max(k, 0.0)), eta > 1.0);
             fresnel = f0 + (1.0 - f0) * pow(1.0 - c, 5.0);
         }
     }
-    let transmitted = scene.glass_color.rgb * glass_environment(through);
-    var spark = highlight(n[0], v, scene.glass_params.y);
+    var spark = highlight(n, v, scene.glass_params.y);
     if spark > 0.0 {
-        spark *= shadow_visibility(sw, p[0], n[0], scene.shadow_params.x);
+        spark *= shadow_visibility(sw, p, n, scene.shadow_params.x);
     }
-    return fresnel * reflected + (1.0 - fresnel) * transmitted + scene.light_radiance.rgb * spark;
+    return fresnel * reflected + (1.0 - fresnel) * scene.glass_color.rgb * transmitted + scene.light_radiance.rgb * spark;
 }

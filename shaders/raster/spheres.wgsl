@@ -52,28 +52,17 @@ fn fs_main(in: WorldVertex) -> FragmentOut {
     } else if !ray_meets_sphere(eye, normalize(in.world - eye), sphere) {
         discard;
     }
-    // The visible point of this pixel and of its right and lower neighbours (the impostor is a
-    // plane, so a neighbour's point on it is one derivative away): the glass's environment
-    // lookups measure their footprint between them.
-    let p = array<vec3<f32>, 3>(
-        visible_point(eye, normalize(in.world - eye), sphere),
-        visible_point(eye, normalize(in.world + dx - eye), sphere),
-        visible_point(eye, normalize(in.world + dy - eye), sphere),
-    );
-    let n = array<vec3<f32>, 3>(
-        normalize(p[0] - sphere.xyz),
-        normalize(p[1] - sphere.xyz),
-        normalize(p[2] - sphere.xyz),
-    );
+    let p = visible_point(eye, normalize(in.world - eye), sphere);
+    let n = normalize(p - sphere.xyz);
     let sw = Switches(ENHANCED, SHADOWS, PCF, REFRACTION, REFLECTION, FRESNEL, METAL_ENV);
     var color: vec3<f32>;
     if SPHERE == SPHERE_GLASS {
         color = shade_glass(sw, p, n, eye);
     } else {
-        color = shade_metal(sw, p[0], n[0], eye);
+        color = shade_metal(sw, p, n, eye);
     }
     var out: FragmentOut;
     out.color = vec4<f32>(color, coverage);
-    out.depth = view_depth(p[0]);
+    out.depth = view_depth(p);
     return out;
 }
