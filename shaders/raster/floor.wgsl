@@ -21,10 +21,10 @@
 // the other then fails the depth test there, as everywhere.) Only a band along the outline can be
 // partly covered, so the rest of the floor is drawn in two pieces: its interior (PART 3, the
 // rectangle shrunk by EDGE_REACH_PIXELS) without the coverage, and the band between the shrunk
-// and the grown outline with it, which took 2 to 8 ms (about a quarter) off lavapipe's main
-// pass (docs/performance-raster.md): besides the coverage of four edges on every floor pixel,
-// the coverage's `discard` made the depth test wait for the shading, so the floor was shaded
-// even where the shadows' rings and discs had already drawn.
+// and the grown outline with it (docs/performance-raster.md: the coverage of four edges on every
+// floor pixel cost about 2.4 ms of lavapipe's main pass). Without the coverage's `discard` the
+// interior's depth test may also run before its shading, which then skips the floor where the
+// shadows' rings and discs have drawn.
 
 #import illum::raster::scene::{scene, view, quad_corner, Switches, WorldVertex, world_vertex, edge_coverage, EDGE_REACH_PIXELS}
 #import illum::raster::lighting::{shade_floor, floor_albedo}
