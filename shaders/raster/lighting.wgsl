@@ -104,9 +104,9 @@ fn filtered_checker(t: vec2<f32>, width: vec2<f32>) -> f32 {
 fn shade_floor(sw: Switches, p: vec3<f32>, n: vec3<f32>, tile_coord: vec2<f32>, footprint: vec2<f32>) -> vec3<f32> {
     let albedo = floor_albedo(tile_coord, footprint);
     // No `if n_dot_l > 0.0` around the lookup: a branch on uniforms alone makes lavapipe (Mesa
-    // 22.3) specialise the shader on the uniforms' values at every draw (its uniform inlining),
-    // about 2 ms a frame for a penumbra pass drawn alone; a fragment shader runs both sides of a
-    // branch anyway. Where n_dot_l is 0 the product is 0.
+    // 22.3) specialise the shader on the uniforms' values at every draw (its uniform inlining;
+    // 2 ms for a penumbra pass drawn alone, docs/performance-raster.md), and a fragment shader
+    // runs both sides of a branch anyway. Where n_dot_l is 0 the product is 0.
     let n_dot_l = max(dot(n, scene.to_light.xyz), 0.0);
     let direct = n_dot_l * shadow_visibility(sw, p, n, 0.0);
     return albedo * (scene.ambient.rgb + scene.light_radiance.rgb * direct);
