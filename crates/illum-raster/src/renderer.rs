@@ -306,21 +306,22 @@ impl RasterRenderer {
         let mut needed = std::collections::HashSet::new();
         for pass in plan.passes() {
             let draws = plan.draws(pass);
-            // The main pass draws the floor's shadows as rings and discs when the plan allows.
+            // The main pass draws the floor's shadows as rings and discs when the plan allows,
+            // and, anti-aliased, the floor as its interior and the band along its outline.
             let rings = pass == Pass::Main && plan.shadow_rings;
-            let (penumbra, umbra) = (keys.main_penumbra, keys.main_umbra);
-            let keys_all = &keys;
-            let keys = match pass {
+            let interior = pass == Pass::Main && draws.floor && main.antialiased();
+            let pass_keys = match pass {
                 Pass::Shadow => continue,
                 Pass::Capture(_) => [keys.cube_floor, keys.cube_receiver, keys.cube_glass, keys.cube_metal],
                 Pass::Main => [keys.main_floor, keys.main_receiver, keys.main_glass, keys.main_metal],
             };
             let drawn = [draws.floor, draws.receiver && !rings, draws.glass, draws.metal];
-            let ring_keys = [(penumbra, draws.receiver && rings), (umbra, draws.receiver && rings)];
-            // With anti-aliasing the main floor is its outline's band and the interior.
-            let interior = pass == Pass::Main && draws.floor && main.antialiased();
-            let more_keys = ring_keys.into_iter().chain([(keys_all.main_floor_interior, interior)]);
-            for (key, drawn) in keys.into_iter().zip(drawn).chain(more_keys) {
+            let main_only = [
+                (keys.main_penumbra, draws.receiver && rings),
+                (keys.main_umbra, draws.receiver && rings),
+                (keys.main_floor_interior, interior),
+            ];
+            for (key, drawn) in pass_keys.into_iter().zip(drawn).chain(main_only) {
                 if drawn {
                     self.pipelines.ensure(&self.gpu, key)?;
                     needed.insert(key);
