@@ -16,6 +16,9 @@ pub struct BatchPlanner {
     target_seconds: f64,
     /// Smoothed wall seconds per sample (one path), once measured.
     seconds_per_sample: Option<f64>,
+    /// When set, a pass over the whole image is not split into bands as long as one pass of the
+    /// smallest spp traces at most this many paths (see [`Self::set_whole_passes_up_to`]).
+    whole_passes_up_to: Option<u64>,
 }
 
 /// What the next pass does: `spp` samples for every pixel, in bands of `rows` rows.
@@ -27,23 +30,49 @@ pub struct PassPlan {
 
 impl BatchPlanner {
     pub fn new(target_seconds: f64) -> Self {
-        Self { target_seconds, seconds_per_sample: None }
+        Self { target_seconds, seconds_per_sample: None, whole_passes_up_to: None }
+    }
+
+    /// Changes the wall time aimed at per submission, keeping the learnt cost of a sample (a
+    /// viewer gives its path tracer more or less of each frame as the frame's other work
+    /// changes).
+    pub fn set_target_seconds(&mut self, seconds: f64) {
+        self.target_seconds = seconds;
+    }
+
+    /// With `Some(cap)`, a pass of the smallest spp is one submission over the whole image
+    /// whenever it traces at most `cap` paths, even when that takes longer than the target: an
+    /// interactive viewer then shows a complete image after every submission, instead of bands
+    /// of a pass spread over several frames. A count, not a time: which submissions are whole
+    /// passes does not depend on how busy the machine is.
+    pub fn set_whole_passes_up_to(&mut self, cap: Option<u64>) {
+        self.whole_passes_up_to = cap;
+    }
+
+    /// Samples one submission may carry over an image of `pixels` pixels whose passes take at
+    /// least `pass_spp` spp: the target's worth at the learnt cost (the probe's size before
+    /// any measurement), raised to a whole pass where [`Self::set_whole_passes_up_to`] allows.
+    fn budget(&self, pixels: u64, pass_spp: u32) -> u64 {
+        let Some(cost) = self.seconds_per_sample else { return PROBE_SAMPLES };
+        let budget = (self.target_seconds / cost).max(1.0) as u64;
+        let pass = pixels * u64::from(pass_spp);
+        match self.whole_passes_up_to {
+            Some(cap) if pass <= cap => budget.max(pass),
+            _ => budget,
+        }
     }
 
     /// Plans a pass over a `width` x `height` image with at most `max_spp` samples per pixel.
     pub fn plan(&self, width: u32, height: u32, max_spp: u32) -> PassPlan {
         let max_spp = max_spp.max(1);
         let pixels = width as u64 * height as u64;
-        let budget = match self.seconds_per_sample {
-            None => PROBE_SAMPLES,
-            Some(cost) => (self.target_seconds / cost).max(1.0) as u64,
-        };
         // The path tracer traces a pixel's samples two at a time (pathtrace.wgsl, main), so a
         // pass of odd spp wastes the second half of its last pair, and a pass of 1 spp costs
         // what 2 do. Where the budget allows, passes get an even spp; where the image does not
         // fit in one submission, a pass of 2 spp in bands rather than 1 (unless `max_spp` is 1).
         // One that reaches `max_spp` keeps it, not to add a pass.
         let pass_spp = if max_spp >= 2 { 2 } else { 1 };
+        let budget = self.budget(pixels, pass_spp);
         if pixels * u64::from(pass_spp) <= budget {
             let spp = (budget / pixels).clamp(1, max_spp as u64) as u32;
             let spp = if spp > 1 && spp < max_spp { spp & !1 } else { spp };
@@ -58,10 +87,7 @@ impl BatchPlanner {
     /// what the learnt cost of a sample allows in one submission (at least one row, at most
     /// the image). Before any measurement: the probe's size.
     pub fn rows_for(&self, width: u32, height: u32, spp: u32) -> u32 {
-        let budget = match self.seconds_per_sample {
-            None => PROBE_SAMPLES,
-            Some(cost) => (self.target_seconds / cost).max(1.0) as u64,
-        };
+        let budget = self.budget(u64::from(width) * u64::from(height), spp.max(1));
         (budget / (u64::from(width) * u64::from(spp.max(1)))).clamp(1, u64::from(height)) as u32
     }
 
@@ -114,6 +140,27 @@ mod tests {
         assert_eq!(planner.plan(50, 40, 1), PassPlan { spp: 1, rows: 2 });
         planner.record(1, 10.0);
         assert_eq!(planner.plan(50, 40, 16).rows, 1);
+    }
+
+    /// A viewer's planner keeps whole passes in one submission up to its cap, and splits them
+    /// beyond it; the target alone still sizes the spp of a pass it can cover several times.
+    #[test]
+    fn whole_passes_stay_whole_up_to_the_cap() {
+        // Powers of two, so that the budgets are exact: 2^-23 s per sample, 2^-6 s per
+        // submission, 2^17 = 131,072 samples.
+        let mut planner = BatchPlanner::new(2f64.powi(-6));
+        planner.record(1 << 20, 0.125);
+        // 300 x 300 at 2 spp is 180,000 samples, 21 ms: above the target.
+        assert_eq!(planner.plan(300, 300, 1000).rows, 131_072 / 600, "split without a cap");
+        planner.set_whole_passes_up_to(Some(1 << 20));
+        assert_eq!(planner.plan(300, 300, 1000), PassPlan { spp: 2, rows: 300 });
+        assert_eq!(planner.rows_for(300, 300, 2), 300);
+        // 2000 x 2000 at 2 spp is 8,000,000 paths: beyond the cap, in bands of the target's size.
+        assert_eq!(planner.plan(2000, 2000, 1000), PassPlan { spp: 2, rows: 131_072 / 4000 });
+        // A longer target (2^20 samples) packs more spp into the one pass, and keeps the learnt
+        // cost: 11 spp, 10 (an even number).
+        planner.set_target_seconds(0.125);
+        assert_eq!(planner.plan(300, 300, 1000), PassPlan { spp: 10, rows: 300 });
     }
 
     /// The rows of a band follow the learnt cost: a pass planned before the first measurement

@@ -41,6 +41,10 @@ pub struct StepReport {
     pub gpu_seconds: Option<f64>,
     /// True when this submission finished a pass over the whole image.
     pub pass_completed: bool,
+    /// Paths the band was planned to trace (its pixels x the pass's spp, or with adaptive
+    /// sampling what its blocks' counts allow): `samples` falls short of it only by samples
+    /// dropped as NaN or Inf.
+    pub scheduled_samples: u64,
 }
 
 struct ActivePass {
@@ -85,6 +89,13 @@ pub struct PathTracer {
     ahead: Option<submit::AheadBand>,
     /// When the last band was folded: a band launched ahead counts its wall time from there.
     last_fold: Option<web_time::Instant>,
+    /// When [`Self::render_step`] last returned, and how long its caller then took to call it
+    /// again: a band is launched ahead only for a caller that comes straight back (see
+    /// `submit.rs`, `launch_ahead`).
+    returned_at: Option<web_time::Instant>,
+    caller_absence: std::time::Duration,
+    /// What the last submission did (see [`Self::last_step`]).
+    last_step: StepReport,
     /// Samples per invocation.
     chunk_samples: u32,
     /// Most slots one batch buffer may hold: the device's storage binding limit (or a lower cap
@@ -259,6 +270,9 @@ impl PathTracer {
             staging: None,
             ahead: None,
             last_fold: None,
+            returned_at: None,
+            caller_absence: std::time::Duration::ZERO,
+            last_step: StepReport::default(),
             chunk_samples: CHUNK_SAMPLES,
             max_slots,
             max_chunks: limits.max_compute_workgroups_per_dimension,
@@ -368,9 +382,23 @@ impl PathTracer {
         self.gpu_seconds
     }
 
-    /// Sets the wall time aimed at per submission (default 0.15 s).
+    /// Sets the wall time aimed at per submission (default 0.15 s). The cost of a sample learnt
+    /// so far is kept, so a viewer may change it every frame.
     pub fn set_target_seconds(&mut self, seconds: f64) {
-        self.planner = BatchPlanner::new(seconds);
+        self.planner.set_target_seconds(seconds);
+    }
+
+    /// With `Some(cap)`, a pass over the whole image is one submission whenever it traces at
+    /// most `cap` paths (see `BatchPlanner::set_whole_passes_up_to`): what an interactive viewer
+    /// wants, a complete image after every frame.
+    pub fn set_whole_passes_up_to(&mut self, cap: Option<u64>) {
+        self.planner.set_whole_passes_up_to(cap);
+    }
+
+    /// What the last call of [`Self::render_step`] did (a default report before any, or when
+    /// it had nothing to do or was still waiting for a polled readback).
+    pub fn last_step(&self) -> StepReport {
+        self.last_step
     }
 
     /// Takes a new camera and render settings (spp, bounces, seed, sampling) without rebuilding

@@ -344,6 +344,26 @@ impl ViewerApp {
         ]
     }
 
+    /// One line of the shown mode's statistics and the window's frame rate, as a
+    /// `--screenshot` run prints them on exit (the smoke test and `bench --viewer` read it).
+    pub fn summary(&self) -> String {
+        let mode = match self.mode {
+            Mode::PathTrace => self.pathtrace().map(PathTraceMode::summary),
+            Mode::Raster => self.raster().map(|r| {
+                let gpu = r
+                    .pass_times()
+                    .map_or("n/a".to_owned(), |t| format!("{:.2} ms", t.shadow_ms + t.cube_ms + t.main_ms));
+                format!("raster: GPU time per frame {gpu}")
+            }),
+            Mode::Whitted => self.whitted().map(|w| {
+                let ms = w.frame_ms.map_or("n/a".to_owned(), |ms| format!("{ms:.1} ms"));
+                format!("whitted: {} frames rendered, last frame {ms}", w.frames)
+            }),
+        };
+        let fps = self.frame_rate.fps().map_or("n/a".to_owned(), |f| format!("{f:.1} fps"));
+        format!("{}, window {fps}", mode.unwrap_or_else(|| format!("{}: no scene", self.mode)))
+    }
+
     fn top_bar(&mut self, ui: &mut egui::Ui) {
         // A narrow window gets a compact bar (the modes in a drop-down, no status text), so
         // that the bar stays about two lines high and the image keeps most of the window.
@@ -539,8 +559,9 @@ impl eframe::App for ViewerApp {
                 .show(ui, |ui| self.side_panel(ui));
         }
         egui::CentralPanel::default().show(ui, |ui| self.view(ui));
-        if let Some(job) = &mut self.screenshot {
-            job.tick(ui.ctx(), self.frame_rate.fps());
+        if let Some(mut job) = self.screenshot.take() {
+            job.tick(ui.ctx(), || self.summary());
+            self.screenshot = Some(job);
         }
         #[cfg(target_arch = "wasm32")]
         {

@@ -8,6 +8,7 @@
 //!   into the texture egui shows;
 //! - [`gpu_setup`]: how eframe creates the device the renderers share;
 //! - [`frame_rate`]: frames per second over recent frames;
+//! - [`pacer`]: how much of each frame the path tracer gets;
 //! - [`scene_file`]: opening scene files of either kind, with errors as text;
 //! - [`cli`] and [`screenshot`]: the command line, and `--screenshot FILE --frames N`;
 //! - [`platform`]: what differs between the desktop and the browser (readback, scene files,
@@ -19,6 +20,7 @@ pub mod cli;
 pub mod display;
 pub mod frame_rate;
 pub mod gpu_setup;
+pub mod pacer;
 pub mod pathtrace_panel;
 pub mod platform;
 pub mod raster_panel;

@@ -1,10 +1,11 @@
 //! The path-tracer mode: its settings, its `PathTracer` on the shared device, the per-frame
 //! slice of rendering work, live statistics, stop rules and saving.
 //!
-//! Responsiveness: each frame runs one short submission (`set_target_seconds(FRAME_BUDGET)`),
-//! so the window keeps repainting while samples accumulate. A change of camera, window size or
-//! setting goes through `PathTracer::update_scene`, which restarts the accumulation without
-//! recompiling the pipeline.
+//! Responsiveness: each frame runs one submission, sized by the [`FramePacer`] to what the rest
+//! of the frame leaves of a 12 fps frame (short while the view changes), and covering the whole
+//! image whenever one pass is at most [`WHOLE_PASS_SAMPLES`] paths, so that every frame shows a
+//! complete image. A change of camera, window size or setting goes through `PathTracer::update_scene`,
+//! which restarts the accumulation without recompiling the pipeline.
 //!
 //! Stop rules and time: the panel drives an [`illum_pathtrace::Progressive`], the stop rules
 //! the `render` example uses too. Its clock is wall-clock time while this mode renders (not
@@ -15,7 +16,7 @@
 //! arrived or the exposure changed; the f64 statistics are only read for the panel's numbers and
 //! for saving.
 //!
-//! Over 400 lines, one concept: the path tracer's mode of the viewer (its settings, its panel,
+//! Over 450 lines, one concept: the path tracer's mode of the viewer (its settings, its panel,
 //! its stepping and saving), which reads better whole than split between widgets and state.
 
 use std::path::{Path, PathBuf};
@@ -28,10 +29,14 @@ use illum_scene::{Bounces, Sampling, Scene};
 
 use crate::camera::OrbitCamera;
 use crate::display::Display;
+use crate::pacer::FramePacer;
 
-/// Wall time aimed at per submission: short enough that a frame (submission, readback and f64
-/// fold, display pass, egui) stays well under the 50 ms of 20 fps on lavapipe.
-pub const FRAME_BUDGET: f64 = 0.015;
+/// Most paths a pass at the smallest spp may trace and still be one submission, a whole image
+/// per frame, when it takes longer than the pacer's share: about 0.1 s at lavapipe's 10 million
+/// samples per second on 2 cores, the default window's image 6 times over. A larger image (a
+/// large window at full resolution) is split into bands over several frames, so that the
+/// window keeps repainting.
+pub const WHOLE_PASS_SAMPLES: u64 = 1 << 20;
 /// Highest fixed bounce count offered by the slider (the scene format allows more).
 pub const MAX_UI_BOUNCES: u32 = 64;
 /// Default resolution scale: half the view's pixels in each direction keeps lavapipe
@@ -86,6 +91,20 @@ pub struct Stats {
     pub height: u32,
 }
 
+/// The submissions since the accumulation last restarted: what the planner scheduled and what
+/// the frames carried (a check that every frame's share of samples arrives).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct WorkLog {
+    /// Submissions folded.
+    pub submissions: u64,
+    /// Paths they were planned to trace.
+    pub scheduled_samples: u64,
+    /// The smallest submission's planned paths (`u64::MAX` before the first).
+    pub smallest_submission: u64,
+    /// Submissions that completed a pass over the whole image.
+    pub passes: u64,
+}
+
 /// The path-tracer mode.
 pub struct PathTraceMode {
     scene_path: PathBuf,
@@ -101,6 +120,9 @@ pub struct PathTraceMode {
     active: bool,
     /// Stop rules, wall clock and why the render stopped.
     progressive: Progressive,
+    /// Each frame's share of wall time for the path tracer.
+    pacer: FramePacer,
+    work: WorkLog,
     stats: Stats,
     /// Total samples at the last statistics update, to tell when new samples arrived.
     shown_samples: u64,
@@ -125,6 +147,8 @@ impl PathTraceMode {
             display: None,
             paused: false,
             active: true,
+            pacer: FramePacer::default(),
+            work: WorkLog { smallest_submission: u64::MAX, ..WorkLog::default() },
             stats: Stats::default(),
             shown_samples: 0,
             shown_exposure: 0.0,
@@ -147,6 +171,31 @@ impl PathTraceMode {
 
     pub fn stats(&self) -> Stats {
         self.stats
+    }
+
+    /// The submissions since the accumulation last restarted.
+    pub fn work(&self) -> WorkLog {
+        self.work
+    }
+
+    /// Total samples folded into the current accumulation.
+    pub fn total_samples(&self) -> u64 {
+        self.tracer.as_ref().map_or(0, |t| t.accumulator().total_samples())
+    }
+
+    /// One line of the mode's statistics, as a `--screenshot` run prints them on exit.
+    pub fn summary(&self) -> String {
+        let st = &self.stats;
+        let error =
+            st.relative_error.map_or("n/a (needs 2 spp)".to_owned(), |e| format!("{:.2}%", e * 100.0));
+        format!(
+            "pathtrace: {} x {}, spp done {}, samples/s (wall) {:.3} M, elapsed {:.2} s, estimated error {error}",
+            st.width,
+            st.height,
+            st.spp,
+            st.samples_per_second / 1e6,
+            st.elapsed_seconds
+        )
     }
 
     /// Wall-clock and GPU seconds of the tracer's submissions since the last reset (the GPU's
@@ -216,6 +265,7 @@ impl PathTraceMode {
         self.sync_clock();
         self.stats = Stats { width: self.stats.width, height: self.stats.height, ..Stats::default() };
         self.shown_samples = u64::MAX;
+        self.work = WorkLog { smallest_submission: u64::MAX, ..WorkLog::default() };
     }
 
     /// The scene to render at `width` x `height`: the file's geometry with the panel's settings
@@ -242,23 +292,42 @@ impl PathTraceMode {
         if self.failed.as_ref() == Some(&wanted) {
             return;
         }
-        if let Err(message) = self.sync_tracer(gpu, &wanted) {
-            self.message = Some(format!("path tracer: {message}"));
-            self.tracer = None;
-            self.failed = Some(wanted);
-            return;
-        }
+        let restarted = match self.sync_tracer(gpu, &wanted) {
+            Ok(restarted) => restarted,
+            Err(message) => {
+                self.message = Some(format!("path tracer: {message}"));
+                self.tracer = None;
+                self.failed = Some(wanted);
+                return;
+            }
+        };
         self.failed = None;
         let Some(tracer) = self.tracer.as_mut() else { return };
         // The rules follow the panel (a changed spp target restarts the accumulation through
         // the scene; a changed error target or budget applies from now on).
         self.progressive.rules = self.settings.stop;
-        if !self.paused
-            && let Err(e) = self.progressive.step(tracer)
-        {
-            self.message = Some(format!("path tracer: {e}"));
-            self.set_paused(true);
-            return;
+        if !self.paused {
+            // The web page never waits for a band (each comes back a frame or more later), so
+            // there the submission keeps its fixed size; natively the frame waits for it.
+            if !crate::platform::POLLED_READBACK {
+                tracer.set_target_seconds(self.pacer.submission_seconds(restarted));
+            }
+            let started = web_time::Instant::now();
+            let stepped = self.progressive.step(tracer);
+            self.pacer.stepped(started, started.elapsed().as_secs_f64());
+            if let Err(e) = stepped {
+                self.message = Some(format!("path tracer: {e}"));
+                self.set_paused(true);
+                return;
+            }
+            let report = tracer.last_step();
+            if report.scheduled_samples > 0 {
+                let work = &mut self.work;
+                work.submissions += 1;
+                work.scheduled_samples += report.scheduled_samples;
+                work.smallest_submission = work.smallest_submission.min(report.scheduled_samples);
+                work.passes += u64::from(report.pass_completed);
+            }
         }
         let total = tracer.accumulator().total_samples();
         let display = self.display.get_or_insert_with(|| Display::new(gpu));
@@ -291,14 +360,15 @@ impl PathTraceMode {
     }
 
     /// Creates the tracer, or hands it the new scene when anything changed (which restarts the
-    /// accumulation). Errors are the renderer's messages.
-    fn sync_tracer(&mut self, gpu: &GpuContext, wanted: &Scene) -> Result<(), String> {
+    /// accumulation). Returns whether it restarted. Errors are the renderer's messages.
+    fn sync_tracer(&mut self, gpu: &GpuContext, wanted: &Scene) -> Result<bool, String> {
         match &mut self.tracer {
-            Some(tracer) if tracer.scene() == wanted => return Ok(()),
+            Some(tracer) if tracer.scene() == wanted => return Ok(false),
             Some(tracer) => tracer.update_scene(wanted).map_err(|e| e.to_string())?,
             None => {
                 let mut tracer = PathTracer::new(gpu, wanted).map_err(|e| e.to_string())?;
-                tracer.set_target_seconds(crate::platform::submission_seconds(FRAME_BUDGET));
+                tracer.set_target_seconds(crate::platform::submission_seconds(crate::pacer::MOVING_SECONDS));
+                tracer.set_whole_passes_up_to(Some(WHOLE_PASS_SAMPLES));
                 tracer.set_polled_readback(crate::platform::POLLED_READBACK);
                 // The window shows the GPU-resident sum; it follows resets and resizes itself.
                 tracer.enable_display_sum().map_err(|e| e.to_string())?;
@@ -309,7 +379,8 @@ impl PathTraceMode {
         self.progressive.restart();
         self.sync_clock();
         self.shown_samples = u64::MAX;
-        Ok(())
+        self.work = WorkLog { smallest_submission: u64::MAX, ..WorkLog::default() };
+        Ok(true)
     }
 
     fn measure(tracer: &PathTracer, progressive: &Progressive) -> Stats {

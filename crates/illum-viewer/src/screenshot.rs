@@ -25,9 +25,9 @@ impl ScreenshotJob {
     }
 
     /// Called once per frame. Counts frames, then asks for the capture, then saves it and closes
-    /// the window. Keeps the window repainting until done.
-    /// `fps` is the window's frame rate, printed with the result.
-    pub fn tick(&mut self, ctx: &egui::Context, fps: Option<f64>) {
+    /// the window. Keeps the window repainting until done. `summary` gives the shown mode's
+    /// statistics and the frame rate, printed with the result.
+    pub fn tick(&mut self, ctx: &egui::Context, summary: impl FnOnce() -> String) {
         ctx.request_repaint();
         if self.frames_left > 0 {
             self.frames_left -= 1;
@@ -45,9 +45,7 @@ impl ScreenshotJob {
         }
         let Some(image) = self.captured.lock().unwrap_or_else(|p| p.into_inner()).take() else { return };
         let result = save(&self.path, &image).map(|()| self.path.clone());
-        if let Some(fps) = fps {
-            println!("window frame rate over the last frames: {fps:.1} fps");
-        }
+        println!("statistics: {}", summary());
         if let Err(e) = &result {
             log::error!("{e}");
         }

@@ -1,6 +1,7 @@
 //! Starts the real viewer binary under Xvfb in each mode with `--screenshot FILE --frames N`,
-//! and checks that each screenshot shows a picture (not one flat colour) and that the two modes
-//! draw different pictures.
+//! and checks that each screenshot shows a picture (not one flat colour), that the modes draw
+//! different pictures, and that each run printed its mode's statistics (the path tracer's spp,
+//! sample rate, elapsed time, error estimate, and the window's frame rate).
 
 use std::path::Path;
 use std::process::{Command, Stdio};
@@ -24,7 +25,8 @@ fn xvfb_run() -> &'static str {
 /// Longest a screenshot run may take before it counts as hung (it takes seconds on lavapipe).
 const RUN_TIMEOUT: Duration = Duration::from_secs(180);
 
-fn screenshot(mode: &str, path: &Path) -> image::RgbaImage {
+/// The screenshot a run in `mode` saved, and the statistics line it printed.
+fn screenshot(mode: &str, path: &Path) -> (image::RgbaImage, String) {
     let (log_out, log_err) = (path.with_extension("stdout.txt"), path.with_extension("stderr.txt"));
     let mut child = Command::new(xvfb_run())
         .args(["-a", "-s", "-screen 0 1024x768x24"])
@@ -53,7 +55,23 @@ fn screenshot(mode: &str, path: &Path) -> image::RgbaImage {
         read(&log_out),
         read(&log_err)
     );
-    image::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())).to_rgba8()
+    let stdout = read(&log_out);
+    let statistics = stdout
+        .lines()
+        .find_map(|line| line.strip_prefix("statistics: "))
+        .unwrap_or_else(|| panic!("{mode}: no statistics line in the output:\n{stdout}"))
+        .to_owned();
+    println!("{mode}: {statistics}");
+    let image = image::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())).to_rgba8();
+    (image, statistics)
+}
+
+/// The number after `name ` in a statistics line ("spp done 12, ...").
+fn figure(statistics: &str, name: &str) -> f64 {
+    let rest =
+        statistics.split(&format!("{name} ")).nth(1).unwrap_or_else(|| panic!("no {name:?} in {statistics}"));
+    let number: String = rest.chars().take_while(|c| c.is_ascii_digit() || *c == '.').collect();
+    number.parse().unwrap_or_else(|_| panic!("{name:?} is not followed by a number in {statistics}"))
 }
 
 /// Standard deviation of the pixels' grey level, 0..255.
@@ -74,9 +92,17 @@ fn difference(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
 #[test]
 fn all_three_modes_draw_under_xvfb() {
     let dir = tempfile::tempdir().unwrap();
-    let raster = screenshot("raster", &dir.path().join("raster.png"));
-    let pathtrace = screenshot("pathtrace", &dir.path().join("pathtrace.png"));
-    let whitted = screenshot("whitted", &dir.path().join("whitted.png"));
+    let (raster, raster_statistics) = screenshot("raster", &dir.path().join("raster.png"));
+    let (pathtrace, statistics) = screenshot("pathtrace", &dir.path().join("pathtrace.png"));
+    let (whitted, whitted_statistics) = screenshot("whitted", &dir.path().join("whitted.png"));
+    // Each run names its mode, and the path tracer's says what it accumulated.
+    assert!(raster_statistics.starts_with("raster:"), "{raster_statistics}");
+    assert!(whitted_statistics.starts_with("whitted:") && figure(&whitted_statistics, "whitted:") >= 1.0);
+    assert!(statistics.starts_with("pathtrace:"), "{statistics}");
+    assert!(figure(&statistics, "spp done") >= 1.0, "{statistics}");
+    assert!(figure(&statistics, "samples/s (wall)") > 0.0, "{statistics}");
+    assert!(figure(&statistics, "elapsed") > 0.0, "{statistics}");
+    assert!(statistics.contains("estimated error") && statistics.contains("fps"), "{statistics}");
     let shots = [("raster", &raster), ("pathtrace", &pathtrace), ("whitted", &whitted)];
     for (name, image) in shots {
         assert!(image.width() >= 200 && image.height() >= 200, "{name}: {:?}", image.dimensions());

@@ -121,6 +121,30 @@ fn pause_and_reset() {
     assert!(harness.state().pathtrace().unwrap().stats().elapsed_seconds > 0.0);
 }
 
+/// With the view still, every frame carries its share of samples: each frame's submission is
+/// a whole pass over the image, and what the frames accumulated is exactly what the planner
+/// scheduled for them. (A planner that took the window's drawing for the cost of its samples
+/// once shrank each frame's share to a row or two of one pass.)
+#[test]
+fn every_frame_with_the_view_still_carries_a_whole_pass() {
+    let mut harness = harness(Mode::PathTrace);
+    // The first submission is the planner's probe, which measures what a sample costs.
+    harness.run_steps(3);
+    click(&mut harness, "Reset");
+    harness.run_steps(10);
+    let mode = harness.state().pathtrace().expect("path tracer loaded");
+    let (work, stats) = (mode.work(), mode.stats());
+    let pixels = u64::from(stats.width) * u64::from(stats.height);
+    println!("{work:?} over {} x {} pixels: {}", stats.width, stats.height, mode.summary());
+    assert!(work.submissions >= 10, "{work:?}: a frame without its submission");
+    assert_eq!(mode.total_samples(), work.scheduled_samples, "{work:?}: samples scheduled but not folded");
+    assert!(
+        work.smallest_submission >= pixels,
+        "{work:?}: a frame carried less than one pass over the {pixels} pixels"
+    );
+    assert_eq!(work.passes, work.submissions, "{work:?}: a submission that did not complete a pass");
+}
+
 #[test]
 fn saves_png_and_exr_into_a_directory() {
     let dir = tempfile::tempdir().unwrap();

@@ -3,6 +3,8 @@
 //! `add_samples_in_one_pass`), starting again (`reset`) and going on from a checkpoint
 //! (`restore`, `aligned_prefix`).
 
+use std::time::Duration;
+
 use super::{ActivePass, PathTracer, StepReport};
 use crate::allocation::BLOCK;
 use crate::planner::PassPlan;
@@ -81,6 +83,7 @@ impl PathTracer {
         self.in_flight = None;
         self.ahead = None;
         self.last_fold = None;
+        self.last_step = StepReport::default();
         self.accumulator.reset();
         if let Some(caustic) = &mut self.caustic {
             caustic.discard_pass();
@@ -103,6 +106,16 @@ impl PathTracer {
     /// With [`Self::set_polled_readback`] it never waits: a call submits a band, and later calls
     /// report `samples == 0` until its results are back, then fold it and report it.
     pub fn render_step(&mut self, target_spp: Option<u32>) -> Result<StepReport, PathTraceError> {
+        let entered = web_time::Instant::now();
+        self.caller_absence = self.returned_at.map_or(Duration::ZERO, |t| entered.duration_since(t));
+        let result = self.step_once(target_spp);
+        self.last_step = *result.as_ref().unwrap_or(&StepReport::default());
+        self.returned_at = Some(web_time::Instant::now());
+        result
+    }
+
+    /// [`Self::render_step`]'s work.
+    fn step_once(&mut self, target_spp: Option<u32>) -> Result<StepReport, PathTraceError> {
         let camera = self.scene.camera;
         if self.pass.is_none() {
             let remaining = match target_spp {

@@ -26,6 +26,11 @@ use crate::planner::PassPlan;
 
 const WORKGROUP: u32 = 8;
 
+/// Longest time a caller may take between two `render_step` calls and still have bands launched
+/// ahead for it (see `launch_ahead`): a render loop's progress bar takes microseconds, a
+/// viewer's frame tens of milliseconds.
+const AHEAD_MAX_ABSENCE: std::time::Duration = std::time::Duration::from_millis(1);
+
 impl PathTracer {
     /// Shrinks a pass plan to what the device can take: at most `max_chunks` chunks per dispatch
     /// (the z dimension), and a band of at most `max_slots` slots (rows x width x chunks) per
@@ -144,8 +149,15 @@ impl PathTracer {
     /// Submits the pass's next band, if `band` is not its last, into the spare staging buffer or,
     /// with mapped readback, the other set of batch buffers (the caustic's passes fold frames
     /// traced per pass and are left serial).
+    ///
+    /// Only for a caller that came straight back last time (a render loop): a band launched
+    /// ahead is timed from the last fold to its own, and a caller that goes away in between (a
+    /// viewer drawing its window) would have that time counted as the band's cost. The planner
+    /// would then shrink every later band toward one row, a feedback that once cut the viewer's
+    /// throughput to about 1/500 of `render`'s.
     fn launch_ahead(&mut self, band: &Band) -> Result<(), PathTraceError> {
         if self.caustic.is_some()
+            || self.caller_absence > AHEAD_MAX_ABSENCE
             || self.active_rows(band.row_offset + band.rows, band.sample_start).is_none()
         {
             return Ok(());
@@ -278,7 +290,15 @@ impl PathTracer {
             pass.launched_row = row_offset + rows;
         }
         let sample_start = params.sample_base;
+        let scheduled = match &self.allocation {
+            None => band_pixels as u64 * u64::from(spp),
+            Some((allocation, _)) => (row_offset..row_offset + rows)
+                .flat_map(|y| (0..width).map(move |x| (x, y)))
+                .map(|(x, y)| u64::from(allocation.at(x, y).saturating_sub(sample_start).min(spp)))
+                .sum(),
+        };
         Ok(Band {
+            scheduled,
             started,
             row_offset,
             rows,
@@ -363,7 +383,13 @@ impl PathTracer {
         self.last_fold = Some(now);
         self.wall_seconds += wall_seconds;
         self.gpu_seconds += gpu_seconds.unwrap_or(0.0);
-        Ok(StepReport { samples, wall_seconds, gpu_seconds, pass_completed })
+        Ok(StepReport {
+            samples,
+            wall_seconds,
+            gpu_seconds,
+            pass_completed,
+            scheduled_samples: band.scheduled,
+        })
     }
 }
 
@@ -381,6 +407,9 @@ pub(super) struct Band {
     band_pixels: usize,
     /// Bytes of each of the two slot arrays (sums, sums of squares).
     bytes: u64,
+    /// Paths the band traces: its pixels x spp, or with adaptive sampling what the blocks'
+    /// counts leave in its sample range.
+    scheduled: u64,
     /// Bytes of the staging copy (0 when mapped where the GPU wrote them).
     staging_size: u64,
     readback: Readback,
