@@ -169,3 +169,37 @@ fn a_camera_move_reuses_shadow_and_cube_maps_and_changes_nothing_else() {
     let figure = Options::all_on(Look::Figure);
     assert!(r.plan(&figure).pass_names().len() > 1);
 }
+
+/// With reduced cube maps while the scene changes (what the viewer turns on), the frame after a
+/// moved sphere captures them at a quarter side, and the next frame, the scene still, captures
+/// them again at full size: its picture is a fresh renderer's, bit for bit. A camera move alone
+/// is not a change of the scene.
+#[test]
+fn a_changing_scene_gets_small_cube_maps_and_a_still_one_full_ones_again() {
+    let gpu = common::gpu();
+    let options = Options::all_on(Look::Enhanced);
+    let s = scene();
+    let full = s.quality.cube_size;
+    let small = illum::raster::moving_cube_size(full);
+    assert!(small < full, "the test scene's cube maps ({full}) are too small to reduce");
+    let mut r = illum::raster::RasterRenderer::new(gpu, &s, WIDTH, HEIGHT).unwrap();
+    r.set_reduced_cubes_while_changing(true);
+    r.render(&options).unwrap();
+    let mut camera_moved = s.clone();
+    camera_moved.camera.eye += glam::Vec3::new(0.4, 0.5, -0.3);
+    r.set_scene(&camera_moved).unwrap();
+    assert_eq!(r.scene().quality.cube_size, full, "a camera move is not a change of the scene");
+
+    let mut shifted = camera_moved.clone();
+    shifted.metal.as_mut().expect("a metal sphere").center.y += 0.25;
+    r.set_scene(&shifted).unwrap();
+    assert_eq!(r.scene().quality.cube_size, small);
+    let moving = r.render(&options).unwrap();
+    let fresh =
+        illum::raster::RasterRenderer::new(gpu, &shifted, WIDTH, HEIGHT).unwrap().render(&options).unwrap();
+    assert!(differing(&moving, &fresh) > 0, "small cube maps changed nothing: no test");
+    // The scene stands still: full size again, and the exact picture.
+    let still = r.render(&options).unwrap();
+    assert_eq!(r.scene().quality.cube_size, full);
+    assert_eq!(still.pixels, fresh.pixels, "the still frame after a change is not the full-quality one");
+}

@@ -22,6 +22,9 @@ pub enum Motion {
     /// The camera orbits and the metal sphere (or else the glass one) moves up and down: the
     /// shadow map and every cube map are made again each frame.
     SceneChange,
+    /// The same, with the cube maps captured at a quarter of their side while the scene changes
+    /// (`RasterRenderer::set_reduced_cubes_while_changing`, what the viewer does).
+    SceneChangeReducedCubes,
 }
 
 impl Motion {
@@ -29,6 +32,9 @@ impl Motion {
         match self {
             Motion::CameraOrbit => "camera moving, scene unchanged",
             Motion::SceneChange => "scene changing every frame",
+            Motion::SceneChangeReducedCubes => {
+                "scene changing every frame, cube maps at 1/4 side while it changes"
+            }
         }
     }
 
@@ -38,7 +44,7 @@ impl Motion {
         let angle = (i as f32 * 0.5).to_radians();
         let offset = s.camera.eye - s.camera.target;
         s.camera.eye = s.camera.target + glam::Quat::from_rotation_y(angle) * offset;
-        if self == Motion::SceneChange {
+        if self != Motion::CameraOrbit {
             let bob = 0.05 * (i as f32 * 0.3).sin() + 0.06;
             if let Some(metal) = &mut s.metal {
                 metal.center.y += bob;
@@ -102,6 +108,7 @@ pub fn bench_frames(
     frames: u32,
 ) -> Result<BenchReport, RasterError> {
     let mut renderer = RasterRenderer::new(gpu, scene, width, height)?;
+    renderer.set_reduced_cubes_while_changing(motion == Motion::SceneChangeReducedCubes);
     // The warm-up draws every state the timed frames will (at least `warmup` frames): a moved
     // sphere can change which pipeline variants a frame needs, and their compilation must not
     // land in a timed frame.
@@ -124,4 +131,36 @@ pub fn bench_frames(
         shadow_map_size: renderer.shadow_map_resolution().0,
         cube_size: renderer.scene().quality.cube_size,
     })
+}
+
+/// What the reduced cube maps of a changing scene cost in the image: the frame after a moved
+/// sphere, drawn with cube maps at `crate::renderer::moving_cube_size` and at full size, compared
+/// in 8-bit levels of each pixel's largest channel difference: (mean over all pixels, the 99th
+/// percentile, the largest).
+pub fn reduced_cube_error(
+    gpu: &GpuContext,
+    scene: &RasterScene,
+    width: u32,
+    height: u32,
+    options: &Options,
+) -> Result<(f64, f64, f64), RasterError> {
+    let motion = Motion::SceneChangeReducedCubes;
+    let mut frames = Vec::new();
+    for reduced in [false, true] {
+        let mut renderer = RasterRenderer::new(gpu, &motion.frame(scene, 0), width, height)?;
+        renderer.set_reduced_cubes_while_changing(reduced);
+        renderer.render(options)?;
+        renderer.set_scene(&motion.frame(scene, 1))?;
+        frames.push(renderer.render(options)?);
+    }
+    let mut levels: Vec<f64> = frames[0]
+        .pixels
+        .iter()
+        .zip(&frames[1].pixels)
+        .map(|(a, b)| (0..3).map(|c| (f64::from(a[c]) - f64::from(b[c])).abs() * 255.0).fold(0.0, f64::max))
+        .collect();
+    let mean = levels.iter().sum::<f64>() / levels.len().max(1) as f64;
+    levels.sort_by(f64::total_cmp);
+    let p99 = levels.get(levels.len() * 99 / 100).copied().unwrap_or(0.0);
+    Ok((mean, p99, levels.last().copied().unwrap_or(0.0)))
 }

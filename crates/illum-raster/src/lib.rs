@@ -50,13 +50,13 @@ pub mod uniforms;
 pub mod variants;
 pub mod views;
 
-pub use bench::{BenchReport, Motion, bench_frames};
+pub use bench::{BenchReport, Motion, bench_frames, reduced_cube_error};
 pub use error::RasterError;
 pub use illum_scene::{Effects, Look};
 pub use limits::check_device_limits;
 pub use options::Options;
 pub use pass_times::{Frame, PassTimes};
 pub use plan::FramePlan;
-pub use renderer::RasterRenderer;
+pub use renderer::{MIN_MOVING_CUBE_SIZE, RasterRenderer, moving_cube_size};
 pub use scene::{CheckerFloor, GlassSphere, MetalSphere, RasterLight, RasterQuality, RasterScene};
 pub use shaders::{MODULES, SHADERS};

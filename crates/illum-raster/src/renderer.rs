@@ -61,7 +61,27 @@ pub struct RasterRenderer {
     /// What the shadow map and cube maps hold now, if a recorded frame made them (see
     /// [`ViewsKey`]).
     views: Option<ViewsKey>,
+    /// The cube-map side the scene asks for; `scene.quality.cube_size` is the side in use,
+    /// smaller while the scene changes (see [`Self::set_scene`]).
+    full_cube_size: u32,
+    /// A [`Self::set_scene`] changed what the shadow map or the cube maps show since the last
+    /// frame was recorded.
+    changed_since_frame: bool,
+    /// Whether a changing scene's cube maps are captured at [`moving_cube_size`] (see
+    /// [`Self::set_reduced_cubes_while_changing`]).
+    reduced_cubes_while_changing: bool,
 }
+
+/// Cube-map side while the scene changes from frame to frame: a quarter of the scene's side (a
+/// sixteenth of the texels to render every frame), at least [`MIN_MOVING_CUBE_SIZE`]. The first
+/// frame drawn with the scene still captures them at full size again. What it costs in the
+/// image while moving is measured in docs/performance-raster.md.
+pub fn moving_cube_size(full: u32) -> u32 {
+    (full / 4).max(MIN_MOVING_CUBE_SIZE).min(full)
+}
+
+/// Smallest side [`moving_cube_size`] chooses: the coarse level is an eighth of it, 8 texels.
+pub const MIN_MOVING_CUBE_SIZE: u32 = 64;
 
 /// Everything the shadow map and the cube maps depend on: the scene but for its camera (the
 /// captures are made from the light and the spheres' centres, with their own clip planes) and
@@ -98,6 +118,7 @@ impl RasterRenderer {
         let shadow_fit = fit_shadow(&scene, Self::max_shadow_map(gpu));
         let shadow_map = ShadowMap::new(gpu, shadow_fit.size)?;
         let cubes = CubeSet::new(gpu, scene.quality.cube_size)?;
+        let cubes_side = scene.quality.cube_size;
         let texture_groups =
             TextureGroups::new(gpu, &pipelines.textures_layout, &samplers, &shadow_map, &cubes)?;
         Ok(RasterRenderer {
@@ -117,6 +138,9 @@ impl RasterRenderer {
             timer_plan: None,
             staging: None,
             views: None,
+            full_cube_size: cubes_side,
+            changed_since_frame: false,
+            reduced_cubes_while_changing: false,
         })
     }
 
@@ -150,10 +174,35 @@ impl RasterRenderer {
         (self.shadow_fit.size, self.shadow_fit.texel)
     }
 
+    /// With `true`, a change of what the shadow map or the cube maps show (anything but the
+    /// camera) makes the next frame capture the cube maps at [`moving_cube_size`]: a scene
+    /// edited every frame (a sphere dragged in a viewer) pays a sixteenth of the capture, and
+    /// its glass and mirror show a blurrier environment while it moves. The next frame recorded
+    /// with no change in between captures them again at the scene's own size, so a still scene
+    /// always shows its full-resolution image. Off by default: every frame is then exact.
+    pub fn set_reduced_cubes_while_changing(&mut self, reduced: bool) {
+        self.reduced_cubes_while_changing = reduced;
+    }
+
     /// Replaces the scene (a moved sphere or light, other colours): refits the shadow map and,
-    /// if the cube size changed, reallocates the cube maps. The output size stays.
+    /// if the cube size changed, reallocates the cube maps. The output size stays. See
+    /// [`Self::set_reduced_cubes_while_changing`] for scenes that change every frame.
     pub fn set_scene(&mut self, scene: &RasterScene) -> Result<(), RasterError> {
-        let scene = Self::sized(&self.gpu, scene, self.width, self.height)?;
+        let mut scene = Self::sized(&self.gpu, scene, self.width, self.height)?;
+        let full = scene.quality.cube_size;
+        let mut before = self.scene.clone();
+        before.camera = scene.camera;
+        before.quality.cube_size = self.full_cube_size;
+        let changed = self.reduced_cubes_while_changing && before != scene;
+        self.changed_since_frame |= changed;
+        self.full_cube_size = full;
+        scene.quality.cube_size = if changed { moving_cube_size(full) } else { self.scene.quality.cube_size };
+        self.fit_targets(scene)
+    }
+
+    /// Takes `scene` (its cube size the one to use) and makes the shadow map and the cube maps
+    /// fit it, reallocating what changed size.
+    fn fit_targets(&mut self, scene: RasterScene) -> Result<(), RasterError> {
         let fit = fit_shadow(&scene, Self::max_shadow_map(&self.gpu));
         let cube_size = scene.quality.cube_size;
         if fit.size != self.shadow_map.size {
@@ -274,6 +323,14 @@ impl RasterRenderer {
 
     /// Writes the frame's uniforms and records its passes.
     fn record(&mut self, options: &Options) -> Result<wgpu::CommandEncoder, RasterError> {
+        // The scene stood still since the last frame: back to full-size cube maps.
+        if !std::mem::take(&mut self.changed_since_frame)
+            && self.scene.quality.cube_size != self.full_cube_size
+        {
+            let mut scene = self.scene.clone();
+            scene.quality.cube_size = self.full_cube_size;
+            self.fit_targets(scene)?;
+        }
         if self.main.is_none() {
             crate::targets::check_main_targets(&self.gpu.device.limits(), self.width, self.height)
                 .map_err(RasterError::Unsupported)?;

@@ -141,7 +141,12 @@ impl RasterMode {
             let mut gpu = gpu.clone();
             gpu.timestamps &= !crate::platform::POLLED_READBACK;
             match RasterRenderer::new(&gpu, scene, width, height) {
-                Ok(renderer) => self.renderer = Some(RasterState { renderer, texture: None }),
+                Ok(mut renderer) => {
+                    // An edited scene (a moved sphere) redraws at interactive rates; a still
+                    // one at full quality (RasterRenderer::set_reduced_cubes_while_changing).
+                    renderer.set_reduced_cubes_while_changing(true);
+                    self.renderer = Some(RasterState { renderer, texture: None })
+                }
                 Err(e) => {
                     self.failed = Some(attempt);
                     return Err(e.to_string());
