@@ -19,6 +19,10 @@ use clap::Parser;
 use illum::image::{RgbImage32, load_exr};
 
 #[derive(Parser, Debug)]
+#[command(
+    about = "Compare the anti-aliased edges of rasterizer images (EXR) pixel by pixel, with each other and with a \
+             supersampled reference: mean and largest 8-bit differences over the edge pixels"
+)]
 struct Args {
     /// The frame without anti-aliasing, at the images' size.
     #[arg(long)]

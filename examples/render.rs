@@ -96,10 +96,11 @@ struct Args {
     /// or glass object (docs/caustics.md).
     #[arg(long, value_name = "on|off", value_parser = cli::on_off_arg)]
     caustics: Option<bool>,
-    /// PNG exposure in stops, e.g. -1 or 2, at most 64 either way (EXR output is never
-    /// scaled). Default 0.
+    /// PNG exposure in stops, e.g. -1 or 2, at most 64 either way, or `auto`: the stops that
+    /// bring the median luminance to mid-grey (0.18), for scenes of any brightness. EXR output
+    /// is never scaled. Default 0.
     #[arg(long, allow_hyphen_values = true, value_parser = cli::exposure_arg)]
-    exposure: Option<f32>,
+    exposure: Option<illum::image::Exposure>,
     /// Continue the path-traced render saved in this EXR (a checkpoint) to --spp N samples per
     /// pixel (or to the end of --sample-range). Give the same scene file; the settings that
     /// change the image (size, bounces, seed, sampling, sequence, caustics) default to the
@@ -218,6 +219,30 @@ fn run(args: Args) -> anyhow::Result<()> {
     if let Some(caustics) = caustics {
         scene.pathtrace.caustics = caustics;
     }
+    if args.caustics == Some(true) && !illum::pathtrace::gpu_scene::caustics_active(&scene) {
+        anyhow::bail!(
+            "{}: --caustics on: this scene has no caustic to light-trace (the light tracer follows a \
+             directional light through mirror or glass objects, and the scene lacks one or the other)",
+            args.scene.display()
+        );
+    }
+    // Checked before the stop rules are announced: a refused render announces nothing.
+    if args.adaptive {
+        let conflicting = cli::given_flags(&[
+            (args.resume.is_some(), "--resume"),
+            (args.sample_range.is_some(), "--sample-range"),
+        ]);
+        if !conflicting.is_empty() {
+            anyhow::bail!(
+                "--adaptive spreads one render's samples unevenly over the image, so it cannot be combined with {}: \
+                 a resumed or merged render needs the same samples in every pixel",
+                conflicting.join(" or ")
+            );
+        }
+        if args.settings.spp.is_none() {
+            anyhow::bail!("--adaptive needs --spp N: the mean samples per pixel it spreads over the image");
+        }
+    }
     let no_stop_flag = args.settings.spp.is_none()
         && args.target_error.is_none()
         && args.time_budget.is_none()
@@ -291,20 +316,20 @@ fn run(args: Args) -> anyhow::Result<()> {
              --target-error and --time-budget would stop it short (a part stopped short cannot be merged)"
         );
     }
-    if args.adaptive {
-        let conflicting = cli::given_flags(&[
-            (args.resume.is_some(), "--resume"),
-            (args.sample_range.is_some(), "--sample-range"),
-        ]);
-        if !conflicting.is_empty() {
-            anyhow::bail!(
-                "--adaptive spreads one render's samples unevenly over the image, so it cannot be combined with {}: \
-                 a resumed or merged render needs the same samples in every pixel",
-                conflicting.join(" or ")
-            );
-        }
-        if args.settings.spp.is_none() {
-            anyhow::bail!("--adaptive needs --spp N: the mean samples per pixel it spreads over the image");
+    // A resume whose file already holds the spp asked for has nothing to render: the file is
+    // left as it is (rewriting it would only change its render time), and other outputs, if
+    // any, are written from its samples.
+    let nothing_to_render =
+        resumed.as_ref().is_some_and(|c| c.partial_pass.is_none() && rules.spp == Some(c.spp_done));
+    if nothing_to_render {
+        let path = args.resume.as_ref().expect("resumed");
+        println!(
+            "{} already holds the {} spp asked for: nothing to render; the file is left as it is",
+            path.display(),
+            resumed.as_ref().map_or(0, |c| c.spp_done)
+        );
+        if args.outputs.iter().all(|o| o == path) {
+            return Ok(());
         }
     }
     let outputs = if args.outputs.is_empty() {
@@ -316,6 +341,8 @@ fn run(args: Args) -> anyhow::Result<()> {
                 PathBuf::from(format!("out/{}.exr", scene.name)),
             ]
         }
+    } else if nothing_to_render {
+        args.outputs.iter().filter(|o| Some(*o) != args.resume.as_ref()).cloned().collect()
     } else {
         args.outputs.clone()
     };
@@ -405,6 +432,12 @@ fn run(args: Args) -> anyhow::Result<()> {
     if args.checkpoint_seconds.is_some() && exr_outputs.is_empty() {
         anyhow::bail!("--checkpoint-seconds writes the EXR outputs, and no -o file is a .exr");
     }
+    // A part of a split render records where its range ends, so that a part stopped early can
+    // be finished with the exact command (`merge` and the resume message name it).
+    let range_end: Option<(String, String)> = args
+        .sample_range
+        .as_ref()
+        .map(|r| (illum::pathtrace::metadata::SAMPLE_END.to_owned(), r.end.to_string()));
     let mut last_checkpoint = std::time::Instant::now();
     let mut checkpoint_error: Option<String> = None;
     let progress = RenderProgress::new();
@@ -412,8 +445,9 @@ fn run(args: Args) -> anyhow::Result<()> {
         progress.update(t, p);
         if last_checkpoint.elapsed() >= every && t.spp_done() > 0 && checkpoint_error.is_none() {
             let seconds = earlier_seconds + p.clock().elapsed().as_secs_f64();
-            let metadata =
+            let mut metadata =
                 illum::pathtrace::metadata::exr_metadata(t, seconds, None, "render example (checkpoint)");
+            metadata.fields.extend(range_end.clone());
             for output in &exr_outputs {
                 if let Err(error) = save_checkpoint(output, t, &metadata) {
                     checkpoint_error = Some(error);
@@ -442,11 +476,17 @@ fn run(args: Args) -> anyhow::Result<()> {
     }
     let accumulator = tracer.accumulator();
     let image = accumulator.mean_image();
-    let metadata = illum::pathtrace::metadata::exr_metadata(&tracer, seconds, Some(reason), "render example");
+    let mut metadata =
+        illum::pathtrace::metadata::exr_metadata(&tracer, seconds, Some(reason), "render example");
+    metadata.fields.extend(range_end);
     for output in &outputs {
         match output_format(output)? {
             OutputFormat::Png => {
-                save_png(output, &image, args.exposure.unwrap_or(0.0), args.encoding.unwrap_or_default())?
+                let stops = args.exposure.unwrap_or_default().stops_for(&image);
+                if args.exposure == Some(illum::image::Exposure::Auto) {
+                    println!("--exposure auto: {stops:.2} stops");
+                }
+                save_png(output, &image, stops, args.encoding.unwrap_or_default())?
             }
             OutputFormat::Exr => save_checkpoint(output, &tracer, &metadata).map_err(anyhow::Error::msg)?,
         }

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use clap::Args;
-use illum_image::{Encoding, ExrMetadata, RgbImage32, save_exr, save_png};
+use illum_image::{Encoding, Exposure, ExrMetadata, RgbImage32, save_exr, save_png};
 pub use illum_scene::resolve_scene_path;
 use illum_scene::{Bounces, Overrides, Sampling, Scene};
 
@@ -15,19 +15,19 @@ pub const DEFAULT_SCENE: &str = "scenes/cornell.toml";
 #[derive(Args, Clone, Debug, Default)]
 pub struct SceneArgs {
     /// Samples per pixel (>= 1).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = spp_arg)]
     pub spp: Option<u32>,
     /// Bounces of indirect light: 0 = direct only, up to 256, or `unbounded` (Russian roulette).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub bounces: Option<Bounces>,
-    /// Random seed.
-    #[arg(long)]
+    /// Random seed, 0 to 4294967295.
+    #[arg(long, allow_negative_numbers = true, value_parser = seed_arg)]
     pub seed: Option<u32>,
-    /// Image width in pixels.
-    #[arg(long)]
+    /// Image width in pixels (>= 1).
+    #[arg(long, allow_negative_numbers = true, value_parser = width_arg)]
     pub width: Option<u32>,
-    /// Image height in pixels.
-    #[arg(long)]
+    /// Image height in pixels (>= 1).
+    #[arg(long, allow_negative_numbers = true, value_parser = height_arg)]
     pub height: Option<u32>,
     /// Hemisphere sampling for bounces: `cosine` or `uniform`.
     #[arg(long)]
@@ -95,18 +95,47 @@ pub fn on_off_arg(text: &str) -> Result<bool, String> {
 /// scene model gives from black to white or back; beyond it the scale factor only overflows.
 pub const MAX_EXPOSURE_STOPS: f32 = 64.0;
 
-/// Parses a number of stops for `--exposure`: a finite number within +-[`MAX_EXPOSURE_STOPS`],
-/// negative ones as typed (`--exposure -1`; declare the flag with `allow_hyphen_values`, so that
-/// `-inf` reaches this parser too).
-pub fn exposure_arg(text: &str) -> Result<f32, String> {
+/// Parses `--exposure`: `auto` (chosen from the image, see [`Exposure::Auto`]) or a finite
+/// number of stops within +-[`MAX_EXPOSURE_STOPS`], negative ones as typed (`--exposure -1`;
+/// declare the flag with `allow_hyphen_values`, so that `-inf` reaches this parser too).
+pub fn exposure_arg(text: &str) -> Result<Exposure, String> {
+    if text.trim() == "auto" {
+        return Ok(Exposure::Auto);
+    }
     match text.trim().parse::<f32>() {
-        Ok(v) if v.is_finite() && v.abs() <= MAX_EXPOSURE_STOPS => Ok(v),
+        Ok(v) if v.is_finite() && v.abs() <= MAX_EXPOSURE_STOPS => Ok(Exposure::Stops(v)),
         Ok(v) if v.is_finite() => Err(format!(
             "{text:?}: at most {MAX_EXPOSURE_STOPS} stops either way (a factor of 2^{MAX_EXPOSURE_STOPS}); {v} \
              would turn every pixel black or white"
         )),
-        _ => Err(format!("{text:?} is not a finite number of stops (for example -1, 0 or 2.5)")),
+        _ => Err(format!("{text:?} is neither auto nor a finite number of stops (for example -1, 0 or 2.5)")),
     }
+}
+
+/// A whole number of at least `min` for `flag`, with a message that says what is allowed (a
+/// negative value reaches it as typed: the flags are declared with `allow_negative_numbers`,
+/// so that clap does not take `-1` for another flag and suggest `-- -1`).
+fn whole_number(flag: &str, text: &str, min: u32) -> Result<u32, String> {
+    match text.trim().parse::<i128>() {
+        Ok(v) if v >= i128::from(min) && v <= i128::from(u32::MAX) => Ok(v as u32),
+        _ => Err(format!("{flag} = {text}: must be a whole number from {min} to {}", u32::MAX)),
+    }
+}
+
+pub fn spp_arg(text: &str) -> Result<u32, String> {
+    whole_number("--spp", text, 1)
+}
+
+pub fn seed_arg(text: &str) -> Result<u32, String> {
+    whole_number("--seed", text, 0)
+}
+
+pub fn width_arg(text: &str) -> Result<u32, String> {
+    whole_number("--width", text, 1)
+}
+
+pub fn height_arg(text: &str) -> Result<u32, String> {
+    whole_number("--height", text, 1)
 }
 
 /// Parses `--target-error` (see [`illum_pathtrace::parse_target_error`]).
@@ -152,8 +181,8 @@ pub struct RenderRequest<'a, A> {
     pub outputs: &'a [PathBuf],
     /// PNG encoding; `None`: linear, as the assignment's figure 1 was written.
     pub encoding: Option<Encoding>,
-    /// PNG exposure in stops; `None`: 0.
-    pub exposure: Option<f32>,
+    /// PNG exposure; `None`: 0 stops.
+    pub exposure: Option<Exposure>,
     /// Flags of the other renderers that were given (e.g. "--target-error", "--look"): an error.
     pub other_flags: Vec<&'static str>,
 }
@@ -190,7 +219,8 @@ impl<A> RenderRequest<'_, A> {
         metadata: &ExrMetadata,
         summary: &str,
     ) -> anyhow::Result<()> {
-        let (exposure, encoding) = (self.exposure.unwrap_or(0.0), self.encoding.unwrap_or(Encoding::Linear));
+        let encoding = self.encoding.unwrap_or(Encoding::Linear);
+        let exposure = self.exposure.unwrap_or_default().stops_for(image);
         for output in outputs {
             match output_format(output)? {
                 OutputFormat::Png => save_png(output, image, exposure, encoding)?,

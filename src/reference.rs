@@ -20,6 +20,9 @@ pub struct Reference {
     /// The relMSE the reference estimates for itself from its per-pixel variance (NaN if the
     /// user's file does not carry it).
     pub estimated_rel_mse: f64,
+    /// Its file's metadata (renderer, scene, render time, settings), to go with any copy of it
+    /// (empty for a file that has none).
+    pub metadata: ExrMetadata,
 }
 
 /// Loads the user's reference (which must have the scene's size).
@@ -36,13 +39,38 @@ pub fn load_reference(path: &Path, scene: &Scene) -> anyhow::Result<Reference> {
         );
     }
     let metadata = ExrMetadata::from_attributes(path, &attributes)?;
+    check_same_scene(path, metadata.as_ref(), scene)?;
     let field = |name: &str| metadata.as_ref().and_then(|m| m.get(name)).and_then(|v| v.parse::<f64>().ok());
     Ok(Reference {
         image,
         path: path.to_path_buf(),
         spp: field("spp").map_or(0, |v| v as u64),
         estimated_rel_mse: field("estimated_rel_mse").unwrap_or(f64::NAN),
+        metadata: metadata.unwrap_or_default(),
     })
+}
+
+/// Refuses a reference rendered from another scene: illum's EXRs carry the scene's content hash
+/// (`illum.scene_hash`, a hash of every number that changes the image). A file without it (made
+/// by another program) is taken as it is, and said so.
+fn check_same_scene(path: &Path, metadata: Option<&ExrMetadata>, scene: &Scene) -> anyhow::Result<()> {
+    let Some(stored) = metadata.and_then(|m| m.get("scene_hash")) else {
+        println!(
+            "note: {} does not say which scene it shows (no illum.scene_hash); using it as given",
+            path.display()
+        );
+        return Ok(());
+    };
+    let expected = illum_pathtrace::checkpoint::scene_content_hash(scene);
+    if stored != expected {
+        let name = metadata.map_or("(unnamed)", |m| m.scene.as_str());
+        bail!(
+            "reference {} shows another scene: {name:?} (illum.scene_hash {stored}), but this render is of {:?}              (scene hash {expected}); give a reference rendered from the same scene file, or none to render one",
+            path.display(),
+            scene.name
+        );
+    }
+    Ok(())
 }
 
 /// The cached reference of `scene` at `spp` samples per pixel in `folder`, rendered (and
@@ -67,6 +95,7 @@ pub fn cached_reference(
                 path,
                 spp: u64::from(spp),
                 estimated_rel_mse: rel.unwrap_or(f64::NAN),
+                metadata: stored.unwrap_or_default(),
             });
         }
         println!("{} was made for other settings: rendering it again", path.display());
@@ -90,7 +119,7 @@ pub fn cached_reference(
     metadata.fields.push(("reference_key".into(), key));
     metadata.fields.push(("estimated_rel_mse".into(), format!("{estimated_rel_mse:e}")));
     save_exr(&path, &image, &metadata)?;
-    Ok(Reference { image, path, spp: u64::from(spp), estimated_rel_mse })
+    Ok(Reference { image, path, spp: u64::from(spp), estimated_rel_mse, metadata })
 }
 
 /// The scene the reference is rendered with (cosine sampling, `spp`, a seed of its own), and

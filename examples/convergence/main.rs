@@ -167,6 +167,8 @@ fn run(mut args: Args) -> anyhow::Result<()> {
         bail!("--reference-factor = 0: must be at least 1");
     }
     let scene = cli::load_scene(&args.scene, &args.settings.scene_args())?;
+    // The user's reference is checked (size, scene) before any row is rendered.
+    let given_reference = args.reference.as_ref().map(|path| load_reference(path, &scene)).transpose()?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     let gpu = cli::gpu()?;
     println!(
@@ -200,8 +202,8 @@ fn run(mut args: Args) -> anyhow::Result<()> {
     }
     // The reference must out-sample every row it judges, time-budget rows included.
     let max_spp = taken.iter().map(|t| t.spp).max().unwrap_or(1).min(u64::from(u32::MAX)) as u32;
-    let Reference { image: reference, .. } = match &args.reference {
-        Some(path) => load_reference(path, &scene)?,
+    let Reference { image: reference, .. } = match given_reference {
+        Some(reference) => reference,
         None => cached_reference(
             &gpu,
             &scene,

@@ -155,7 +155,13 @@ fn run(args: Args) -> anyhow::Result<()> {
     let gpu = cli::gpu()?;
     println!("scene {} at {w}x{h} on {}", scene.name, gpu.adapter_info.name);
 
-    let Reference { image: truth, spp: truth_spp, estimated_rel_mse: truth_error, .. } = match &args.truth {
+    let Reference {
+        image: truth,
+        spp: truth_spp,
+        estimated_rel_mse: truth_error,
+        metadata: truth_metadata,
+        ..
+    } = match &args.truth {
         Some(path) => load_reference(path, &scene)?,
         None => {
             let mut truth_scene = scene.clone();
@@ -217,8 +223,14 @@ fn run(args: Args) -> anyhow::Result<()> {
 
     let truth_bounces =
         if args.truth.is_some() { "as in the given file".to_owned() } else { args.truth_bounces.to_string() };
-    let header =
-        Header { scene: &scene, adapter: &gpu.adapter_info.name, truth_spp, truth_bounces, truth_error };
+    let header = Header {
+        scene: &scene,
+        adapter: &gpu.adapter_info.name,
+        truth_spp,
+        truth_bounces,
+        truth_error,
+        truth_metadata,
+    };
     write_outputs(&args, &header, &truth, &regions, &rows)?;
     Ok(())
 }
@@ -353,6 +365,8 @@ struct Header<'a> {
     truth_spp: u64,
     truth_bounces: String,
     truth_error: f64,
+    /// The truth's own metadata, written with its copy `truth.exr`.
+    truth_metadata: illum::image::ExrMetadata,
 }
 
 fn number(x: f64) -> String {
@@ -498,7 +512,8 @@ fn write_outputs(
     let png = |i: &RgbImage32| to_rgba8(i, 0.0, Encoding::Srgb);
     let region_map = region_colours(regions, w, h);
     save_rgba8_png(out.join("regions.png"), &region_map)?;
-    save_exr(out.join("truth.exr"), truth, &illum::image::ExrMetadata::default())?;
+    // With the metadata of the render it is (renderer, scene, time, spp, settings).
+    save_exr(out.join("truth.exr"), truth, &header.truth_metadata)?;
     let legend = regions.names.join("; ");
     let mut panels = vec![
         (format!("truth: path traced, {} spp", header.truth_spp), png(truth)),

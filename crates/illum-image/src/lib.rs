@@ -33,7 +33,7 @@ pub use metrics::{
 };
 pub use png::{png_bytes, save_png, save_rgba8_png};
 pub use rgb_image::{RgbImage32, luminance};
-pub use tonemap::{Encoding, ParseEncodingError, encode_8bit, to_rgb8, to_rgba8};
+pub use tonemap::{Encoding, Exposure, ParseEncodingError, encode_8bit, to_rgb8, to_rgba8};
 
 /// An error while writing or reading an image file. Every variant names the file it concerns.
 ///

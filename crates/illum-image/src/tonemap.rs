@@ -55,6 +55,60 @@ impl fmt::Display for Encoding {
     }
 }
 
+/// A PNG's exposure: a number of stops, or [`Exposure::Auto`], chosen from the image.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Exposure {
+    Stops(f32),
+    /// The stops that bring the median luminance of the pixels that are not black to mid-grey
+    /// (0.18): a readable PNG of any scene, however bright its lights (an emission of 1e30
+    /// needs about -100 stops).
+    Auto,
+}
+
+impl Default for Exposure {
+    fn default() -> Self {
+        Exposure::Stops(0.0)
+    }
+}
+
+/// The luminance [`Exposure::Auto`] brings the median pixel to.
+pub const MID_GREY: f64 = 0.18;
+/// Most stops [`Exposure::Auto`] chooses either way: 2^-149 is f32's smallest positive value,
+/// which still brings the brightest finite radiance (3.4e38, 2^128) below 1.
+pub const MAX_AUTO_STOPS: f64 = 149.0;
+
+impl Exposure {
+    /// The stops to apply to `image`. `Auto` over an image with no positive luminance is 0.
+    pub fn stops_for(self, image: &RgbImage32) -> f32 {
+        match self {
+            Exposure::Stops(stops) => stops,
+            Exposure::Auto => {
+                let mut lit: Vec<f64> = image
+                    .pixels
+                    .iter()
+                    .map(|&p| crate::rgb_image::luminance(p))
+                    .filter(|l| *l > 0.0 && l.is_finite())
+                    .collect();
+                if lit.is_empty() {
+                    return 0.0;
+                }
+                let mid = lit.len() / 2;
+                let median = *lit.select_nth_unstable_by(mid, f64::total_cmp).1;
+                (MID_GREY / median).log2().clamp(-MAX_AUTO_STOPS, MAX_AUTO_STOPS) as f32
+            }
+        }
+    }
+}
+
+impl fmt::Display for Exposure {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Exposure::Stops(stops) => write!(f, "{stops}"),
+            Exposure::Auto => f.write_str("auto"),
+        }
+    }
+}
+
 /// A string that names no [`Encoding`].
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error("unknown encoding '{given}': expected one of gamma2.2 (or gamma), srgb, linear")]
@@ -130,6 +184,26 @@ pub fn to_rgb8(image: &RgbImage32, exposure: f32, encoding: Encoding) -> image::
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Auto exposure brings the median pixel to mid-grey whatever the scale, up to f32's largest
+    /// values, and leaves a black image alone.
+    #[test]
+    fn auto_exposure_brings_the_median_to_mid_grey() {
+        for scale in [1e-30f32, 1.0, 1e30, 3e38] {
+            // The black pixel does not count: the median of the other four is the third, 0.5.
+            let pixels = [0.125f32, 0.25, 0.5, 0.0, 1.0].map(|v| [v * scale; 3]).to_vec();
+            let image = RgbImage32 { width: 5, height: 1, pixels };
+            let stops = Exposure::Auto.stops_for(&image);
+            let shown = 0.5 * f64::from(scale) * 2f64.powf(f64::from(stops));
+            assert!(
+                (shown / MID_GREY - 1.0).abs() < 1e-3,
+                "scale {scale}: {stops} stops show the median as {shown}"
+            );
+        }
+        let black = RgbImage32 { width: 2, height: 1, pixels: vec![[0.0; 3]; 2] };
+        assert_eq!(Exposure::Auto.stops_for(&black), 0.0);
+        assert_eq!(Exposure::Stops(-2.0).stops_for(&black), -2.0);
+    }
 
     #[test]
     fn gamma22_of_one_half() {

@@ -398,12 +398,17 @@ pub fn merge_checkpoints(inputs: Vec<(std::path::PathBuf, Checkpoint)>) -> Resul
     }
     for (path, c) in &inputs {
         let range = c.sample_range();
-        let resume = || {
-            format!(
+        let resume = || match c.metadata.get(crate::metadata::SAMPLE_END) {
+            Some(end) => format!(
+                "finish it first with `render SCENE.toml --resume {} --sample-range {}..{end}`",
+                path.display(),
+                range.start
+            ),
+            None => format!(
                 "finish it first with `render SCENE.toml --resume {} --sample-range {}..END` (END: the end of its range)",
                 path.display(),
                 range.start
-            )
+            ),
         };
         if let Some((spp, rows)) = c.partial_pass {
             return Err(format!(
@@ -509,7 +514,9 @@ pub fn merge_checkpoints(inputs: Vec<(std::path::PathBuf, Checkpoint)>) -> Resul
     merged.spp_done = spp_done;
     merged.aligned_prefix = aligned_prefix;
     let accumulator = &merged.accumulator;
+    let union_end = u64::from(merged.sample_start) + u64::from(spp_done);
     for (key, value) in [
+        (crate::metadata::SAMPLE_END, union_end.to_string()),
         ("spp", spp_done.to_string()),
         ("estimated_relative_error", accumulator.estimated_relative_error().to_string()),
         ("dropped_samples", accumulator.dropped_samples().to_string()),

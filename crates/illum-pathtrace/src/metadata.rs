@@ -9,6 +9,10 @@ use crate::{PathTracer, StopReason};
 /// The renderer name path-traced images carry (`illum.renderer`).
 pub const RENDERER: &str = "pathtrace";
 
+/// The metadata key of the end of a `--sample-range` a part was asked to render (one past its
+/// last sample index), written by the `render` example beside `sample_start`.
+pub const SAMPLE_END: &str = "sample_end";
+
 /// Metadata for the tracer's current image. Keys (each stored as `illum.<key>`):
 ///
 /// - `renderer` = `pathtrace`, `scene` = the scene's name, `render_seconds` = `render_seconds`

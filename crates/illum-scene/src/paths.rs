@@ -8,7 +8,9 @@ use std::path::{Path, PathBuf};
 /// tests.
 pub fn resolve_scene_path(path: &Path) -> PathBuf {
     if path.is_relative() && !path.exists() {
-        let from_root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join(path);
+        // crates/illum-scene -> the workspace root, without `..` in what errors then show.
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).ancestors().nth(2).unwrap_or(Path::new("."));
+        let from_root = root.join(path.strip_prefix(".").unwrap_or(path));
         if from_root.exists() {
             return from_root;
         }
@@ -24,6 +26,8 @@ mod tests {
     fn a_workspace_relative_path_is_found_from_anywhere() {
         let found = resolve_scene_path(Path::new("scenes/cornell.toml"));
         assert!(found.exists(), "{}", found.display());
+        // What an error message shows from outside the checkout: a clean path.
+        assert!(!found.components().any(|c| c == std::path::Component::ParentDir), "{}", found.display());
         let missing = Path::new("no/such/scene.toml");
         assert_eq!(resolve_scene_path(missing), missing);
     }

@@ -67,11 +67,17 @@ pub struct Quad {
 }
 
 impl Quad {
+    /// The unit normal (NaN for a degenerate quad), normalised after dividing by the largest
+    /// component, so that a quad whose area is finite in f32 has a finite normal even where the
+    /// squared length of `edge_u x edge_v` would overflow.
     pub fn normal(&self) -> Vec3 {
-        self.edge_u.cross(self.edge_v).normalize()
+        crate::camera::robust_normalize(self.edge_u.cross(self.edge_v)).unwrap_or(Vec3::NAN)
     }
+    /// `|edge_u x edge_v|`, measured the same way: finite for every quad whose area f32 holds.
     pub fn area(&self) -> f32 {
-        self.edge_u.cross(self.edge_v).length()
+        let cross = self.edge_u.cross(self.edge_v);
+        let scale = cross.abs().max_element();
+        if scale > 0.0 && scale.is_finite() { (cross / scale).length() * scale } else { cross.length() }
     }
 }
 

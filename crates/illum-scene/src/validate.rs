@@ -470,6 +470,17 @@ impl Check<'_> {
         if ok64 && ok32 {
             return Ok(());
         }
+        if ok64 {
+            return Err(self.invalid(
+                path,
+                format!("{{ edge_u = {}, edge_v = {} }}", fmt_vec(u), fmt_vec(v)),
+                format!(
+                    "the quad's area |edge_u x edge_v| = {} is beyond f32's range (at most {:e}): make it smaller",
+                    fmt_num(area64),
+                    f32::MAX
+                ),
+            ));
+        }
         Err(self.invalid(
             path,
             format!("{{ edge_u = {}, edge_v = {} }}", fmt_vec(u), fmt_vec(v)),

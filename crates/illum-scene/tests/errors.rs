@@ -155,6 +155,20 @@ fn camera_up_tilted_just_past_the_threshold_is_accepted() {
     parse(&edit("up = [0.0, 1.0, 0.0]", "up = [1e-5, 0.0, 1.0]")).unwrap();
 }
 
+/// A light 1.3e10 x 1.05e10 (the Cornell box's scaled by 1e8) has an area f32 holds, though
+/// the square of its cross product's length does not.
+#[test]
+fn a_huge_light_whose_area_f32_holds_is_accepted() {
+    let scene = parse(&edit(
+        "edge_u = [1.0, 0.0, 0.0], edge_v = [0.0, 0.0, 1.0]",
+        "edge_u = [1.3e10, 0.0, 0.0], edge_v = [0.0, 0.0, 1.05e10]",
+    ))
+    .unwrap();
+    let Shape::Quad(quad) = scene.objects[2].shape else { panic!("the lamp is a quad") };
+    assert!((quad.area() / 1.365e20 - 1.0).abs() < 1e-6, "{}", quad.area());
+    assert_eq!(quad.normal(), Vec3::new(0.0, -1.0, 0.0));
+}
+
 #[test]
 fn spp_zero_gives_the_design_documents_message() {
     let err = parse(&edit("spp = 4", "spp = 0")).unwrap_err();
