@@ -1,16 +1,20 @@
 #!/usr/bin/env bash
 # Regenerates every picture the README shows and re-measures every number it quotes, from the
-# code as it is now. One command:
+# code as it is now, and writes the numbers into the README's generated blocks (between the
+# `<!-- headline -->` and `<!-- ladder-summary -->` markers), each with the date and the CPU:
 #
-#     scripts/readme-figures.sh
+#     scripts/readme-figures.sh              pictures, the ladder, then the headline figures
+#     scripts/readme-figures.sh --headline   only the headline figures (a few minutes)
 #
-# Pictures are written over docs/images/; the numbers are printed, each under the README line it
-# backs, for the README to be updated by hand where they moved. Timings are only meaningful on an
-# idle machine (a parallel build doubles them). Needs the Vulkan driver, and xvfb-run for the
-# viewer's screenshots (sudo apt-get install mesa-vulkan-drivers xvfb xauth). About 5 minutes
+# Timings are only meaningful on an idle machine (a parallel build doubles them), and absolute
+# ones only on the host named; the headline leads with ratios measured side by side. Needs the
+# Vulkan driver, and xvfb-run for the viewer (scripts/setup.sh installs both). About 10 minutes
 # after the release build on this project's 2-core machine.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+
+headline_only=false
+[ "${1:-}" = "--headline" ] && headline_only=true
 
 cargo build --release --examples -p illum
 cargo build --release -p illum-viewer
@@ -19,6 +23,7 @@ out=out/readme-figures
 mkdir -p "$out" docs/images
 export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d)}"
 
+if ! $headline_only; then
 echo "== Pictures"
 "$bin/render" scenes/cornell.toml --spp 2048 -o docs/images/cornell.png
 "$bin/raster_figures" --out docs/images
@@ -59,18 +64,22 @@ cp "$out/ladder/contact-sheet.png" docs/images/ladder-contact-sheet.png
 cp "$out/ladder-cornell/ladder.md" docs/ladder-cornell.md
 cp "$out/ladder-cornell/contact-sheet.png" docs/images/ladder-cornell-contact-sheet.png
 
+
+# The README's ladder table: selected rows of ladder.csv.
+python3 scripts/readme-block.py ladder-summary "$out/ladder/ladder.csv"
+fi
+
 echo
-echo "== 'reaches 1% estimated relative error at about N spp' (512 x 512, the default scene)"
-"$bin/render" --target-error 0.01 -o "$out/cornell-1pct.exr"
-echo
-echo "== 'With no stop-rule flag ... (on this project's 2-core machine: N spp, X% error, in T s)'"
-"$bin/render" -o "$out/cornell-default.exr"
-echo
-echo "== 'A relMSE of 10^-2 (10% RMS error) takes about N spp'"
-"$bin/render" --target-error 0.1 -o "$out/cornell-10pct.exr"
-echo
-echo "== 'The pipeline generated for each scene is about N times faster than the generic one'"
-"$bin/bench" --quick
-echo
-echo "== 'Rasterizer, enhanced look: 1280 x 720 with every effect on, median frame about N ms' (camera moving; scene changing)"
-"$bin/raster_bench" --look enhanced
+echo "== The headline figures (README, between the headline markers)"
+"$bin/render" --target-error 0.01 -o "$out/cornell-1pct.exr" | tee "$out/render-1pct.txt"
+"$bin/render" -o "$out/cornell-default.exr" | tee "$out/render-default.txt"
+"$bin/bench" --quick --runs 3 | tee "$out/bench-quick.txt"
+"$bin/bench" --viewer --runs 3 | tee "$out/bench-viewer.txt"
+"$bin/raster_bench" --look enhanced | tee "$out/raster-bench.txt"
+if python3 -c "import mitsuba" 2> /dev/null; then
+    python3 bench/vs_mitsuba.py | tee "$out/vs-mitsuba.txt"
+else
+    echo "Mitsuba 3 is not installed here: the comparison is not re-measured (see bench/vs_mitsuba.py)" \
+        | tee "$out/vs-mitsuba.txt"
+fi
+python3 scripts/readme-block.py headline "$out"

@@ -113,9 +113,9 @@ fn bad_stop_rules_and_exposures_are_clear_errors() {
         (&["--time-budget", "0"][..], "above 0"),
         (&["--target-error", "0"][..], "above 0"),
         (&["--target-error", "-0.5"][..], "above 0"),
-        (&["--exposure", "nan"][..], "not a finite number of stops"),
-        (&["--exposure", "inf"][..], "not a finite number of stops"),
-        (&["--exposure", "-inf"][..], "not a finite number of stops"),
+        (&["--exposure", "nan"][..], "neither auto nor a finite number of stops"),
+        (&["--exposure", "inf"][..], "neither auto nor a finite number of stops"),
+        (&["--exposure", "-inf"][..], "neither auto nor a finite number of stops"),
         (&["--exposure", "1e10"][..], "at most 64 stops"),
         (&["--exposure", "-65"][..], "at most 64 stops"),
     ] {
@@ -132,6 +132,40 @@ fn a_negative_exposure_is_accepted_as_typed() {
     let out = run_to("--width 8 --height 8 --spp 1 --exposure -1", &[&png]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     assert!(png.exists());
+}
+
+/// A light of 1e30 is valid, and `--exposure auto` brings its image into view (a fixed
+/// exposure stops at 64 stops, far short of the 100 it needs).
+#[test]
+fn auto_exposure_shows_a_scene_lit_by_a_light_of_1e30() {
+    let dir = tempfile::tempdir().unwrap();
+    let cornell =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.toml")).unwrap();
+    let bright = cornell.replace("emission = [30.0, 30.0, 30.0]", "emission = [1e30, 1e30, 1e30]");
+    assert_ne!(bright, cornell, "the Cornell box's emission line moved");
+    let scene = dir.path().join("bright.toml");
+    std::fs::write(&scene, bright).unwrap();
+    let png = dir.path().join("bright.png");
+    let out = run(&[
+        scene.to_str().unwrap(),
+        "--width",
+        "24",
+        "--height",
+        "24",
+        "--spp",
+        "8",
+        "--exposure",
+        "auto",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(text(&out.stdout).contains("--exposure auto: -9"), "{}", text(&out.stdout));
+    let image = image::open(&png).unwrap().to_luma8();
+    let mut levels: Vec<u8> = image.pixels().map(|p| p[0]).collect();
+    levels.sort_unstable();
+    let median = levels[levels.len() / 2];
+    assert!((40..=220).contains(&median), "the median grey level is {median}: not brought into view");
 }
 
 #[test]
@@ -288,9 +322,29 @@ fn example_binary(name: &str) -> PathBuf {
     render_binary().with_file_name(format!("{name}{}", std::env::consts::EXE_SUFFIX))
 }
 
+/// Every example of `examples/`: a `NAME.rs` file or a `NAME/main.rs` folder.
+fn example_names() -> Vec<String> {
+    let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples");
+    let mut names: Vec<String> = std::fs::read_dir(&folder)
+        .expect("the examples folder")
+        .map(|entry| entry.expect("an entry").path())
+        .filter_map(|path| match path.extension() {
+            Some(ext) if ext == "rs" => path.file_stem().map(|s| s.to_string_lossy().into_owned()),
+            None if path.join("main.rs").exists() => {
+                path.file_name().map(|s| s.to_string_lossy().into_owned())
+            }
+            _ => None,
+        })
+        .collect();
+    names.sort();
+    names
+}
+
 #[test]
 fn every_examples_help_says_what_it_does_and_documents_each_flag() {
-    for name in ["render", "merge", "figures", "convergence", "bench", "raster_bench", "raster_figures"] {
+    let names = example_names();
+    assert!(names.len() >= 8 && names.iter().any(|n| n == "ladder"), "{names:?}");
+    for name in &names {
         let binary = example_binary(name);
         assert!(binary.exists(), "{} is missing (cargo test builds the examples)", binary.display());
         let out = Command::new(&binary).arg("--help").output().expect("runs");
@@ -349,18 +403,37 @@ fn benchmarks_refuse_absurd_repetition_counts() {
     }
 }
 
-/// Every picture the README shows exists, every `--example NAME` it names is an example, and
-/// every flag on a line that runs an example is one that example's `--help` lists. (The numbers
-/// it quotes are re-measured by `scripts/readme-figures.sh`; timings cannot be asserted.)
+/// Every picture the README and the docs show exists, every `--example NAME` they name is an
+/// example, and every flag on a line that runs an example is one that example's `--help` lists.
+/// (The numbers they quote are re-measured by `scripts/readme-figures.sh`; timings cannot be
+/// asserted.)
 #[test]
 fn the_readme_shows_only_pictures_examples_and_flags_that_exist() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let readme = std::fs::read_to_string(root.join("README.md")).expect("README.md");
-    for (i, _) in readme.match_indices("](docs/images/") {
-        let rest = &readme[i + 2..];
-        let path = &rest[..rest.find(')').expect("closing parenthesis")];
-        assert!(root.join(path).exists(), "README shows {path}, which does not exist");
+    let mut pages = vec![(root.join("README.md"), "](docs/images/", "docs/images/")];
+    for entry in std::fs::read_dir(root.join("docs")).expect("docs/") {
+        let path = entry.expect("an entry").path();
+        if path.extension().is_some_and(|e| e == "md") {
+            pages.push((path, "](images/", "docs/images/"));
+        }
     }
+    let mut text_of_all = String::new();
+    for (page, link, folder) in &pages {
+        let content = std::fs::read_to_string(page).expect("a page");
+        for (i, _) in content.match_indices(link) {
+            let rest = &content[i + link.len()..];
+            let name = &rest[..rest.find(')').expect("closing parenthesis")];
+            assert!(
+                root.join(folder).join(name).exists(),
+                "{} shows {name}, which does not exist",
+                page.display()
+            );
+        }
+        text_of_all.push_str(&content);
+        text_of_all.push('\n');
+    }
+    let readme = text_of_all;
+    let facade_examples = example_names();
     let mut checked = 0;
     for line in readme.lines() {
         let Some(at) = line.find("--example ") else { continue };
@@ -368,6 +441,14 @@ fn the_readme_shows_only_pictures_examples_and_flags_that_exist() {
             .chars()
             .take_while(|c| c.is_alphanumeric() || *c == '_')
             .collect();
+        if !facade_examples.contains(&name) {
+            // Another crate's example (`-p illum-oracle --example NAME`): it must exist.
+            let elsewhere = std::fs::read_dir(root.join("crates"))
+                .expect("crates/")
+                .any(|c| c.expect("an entry").path().join("examples").join(format!("{name}.rs")).exists());
+            assert!(elsewhere, "the docs name --example {name}, which is no example");
+            continue;
+        }
         let help = Command::new(example_binary(&name)).arg("--help").output().expect("the example starts");
         assert!(help.status.success(), "README names --example {name}, which has no working --help");
         let help = text(&help.stdout);
@@ -387,7 +468,25 @@ fn the_readme_shows_only_pictures_examples_and_flags_that_exist() {
             }
         }
     }
-    assert!(checked > 20, "only {checked} flags found in the README's example lines");
+    assert!(checked > 20, "only {checked} flags found in the example lines of the README and docs");
+}
+
+/// The README's set-up line installs exactly the packages `scripts/setup.sh` (what `.ci/run`
+/// runs) installs for the default test run, so that the two cannot drift apart.
+#[test]
+fn the_readmes_setup_line_is_the_setup_scripts_list() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let readme = std::fs::read_to_string(root.join("README.md")).expect("README.md");
+    let script = std::fs::read_to_string(root.join("scripts/setup.sh")).expect("scripts/setup.sh");
+    let base = script
+        .lines()
+        .find_map(|l| l.strip_prefix("BASE_PACKAGES=\""))
+        .and_then(|l| l.strip_suffix('"'))
+        .expect("BASE_PACKAGES in scripts/setup.sh");
+    let line = format!("sudo apt-get install -y {base}");
+    assert!(readme.contains(&format!("```sh\n{line}\n```")), "the README's set-up line is not `{line}`");
+    let ci = std::fs::read_to_string(root.join(".ci/run")).expect(".ci/run");
+    assert!(ci.contains("scripts/setup.sh"), ".ci/run does not install through scripts/setup.sh");
 }
 
 // ---- Long renders: checkpoints, resume, sample ranges and merge ----
@@ -596,6 +695,9 @@ fn checkpoints_whose_counts_do_not_add_up_and_parts_stopped_early_are_refused() 
     cancelled.metadata.fields.iter_mut().find(|(k, _)| k == "stopped_by").unwrap().1 = "cancelled".into();
     let error = merge_checkpoints(vec![(path.clone(), cancelled)]).expect_err("a cancelled part was merged");
     assert!(error.contains("stopped early") && error.contains("--resume"), "{error}");
+    // The part recorded its range, so the command to finish it is exact.
+    assert_eq!(field(&metadata(&path), "sample_end"), "32");
+    assert!(error.contains("--sample-range 0..32`") && !error.contains("END"), "{error}");
 }
 
 #[test]
@@ -704,8 +806,15 @@ fn caustics_on_off_is_recorded_and_a_checkpoint_of_the_other_setting_is_refused(
     let mut off_flags = whitted.to_vec();
     off_flags.extend(["--caustics", "off"]);
     assert_eq!(field(&render_16_exr(&off_flags), "caustics"), "off");
-    // The Cornell box has neither a sun nor glass: nothing to light-trace, even when asked.
-    assert_eq!(field(&render_16_exr(&["--spp", "16", "--caustics", "on"]), "caustics"), "off");
+    // The Cornell box has neither a sun nor glass: nothing to light-trace, so asking for it is
+    // refused like any other flag that does not apply (and `off` is what it renders anyway).
+    let out = run(&["--spp", "16", "--caustics", "on", "-o", "target/never.exr"]);
+    assert_refused(
+        &out,
+        "--caustics on on the Cornell box",
+        &["cornell.toml", "--caustics on", "no caustic"],
+    );
+    assert_eq!(field(&render_16_exr(&["--spp", "16", "--caustics", "off"]), "caustics"), "off");
 
     // A render with the caustic cannot be continued without it.
     let dir = tempfile::tempdir().unwrap();
@@ -798,4 +907,94 @@ fn adaptive_renders_record_their_allocation_and_refuse_what_cannot_combine() {
         &["adaptive sampling is not available with the caustic"],
     );
     assert_no_panic(&small(&["--adaptive", "--spp", "0"]));
+}
+
+/// Misuse found by trying the command as a new user: each gets an answer that says what is
+/// allowed, and nothing is announced, rendered or rewritten for nothing.
+#[test]
+fn negative_counts_adaptive_without_spp_and_a_resume_with_nothing_to_do_get_clear_answers() {
+    for (flag, value, expected) in [
+        ("--spp", "-1", "--spp = -1: must be a whole number from 1"),
+        ("--seed", "-1", "--seed = -1: must be a whole number from 0"),
+        ("--width", "-5", "--width = -5: must be a whole number from 1"),
+        ("--bounces", "-1", "\"-1\""),
+    ] {
+        let out = run(&[flag, value, "-o", "target/never.png"]);
+        assert_refused(&out, &format!("{flag} {value}"), &[expected]);
+        assert!(!text(&out.stderr).contains("-- -1"), "{flag} {value}: clap's tip: {}", text(&out.stderr));
+    }
+    let out = run(&["--adaptive", "--width", "8", "--height", "8", "-o", "target/never.png"]);
+    assert_refused(&out, "--adaptive without --spp", &["--adaptive needs --spp N"]);
+    assert!(!text(&out.stdout).contains("no stop rule given"), "announced: {}", text(&out.stdout));
+
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("done.exr");
+    let path = exr.to_str().unwrap();
+    render_ok(&["--spp", "16", "-o", path]);
+    let before = std::fs::read(&exr).unwrap();
+    let out = run(&["--resume", path, "--spp", "16"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(text(&out.stdout).contains("nothing to render"), "{}", text(&out.stdout));
+    assert!(!text(&out.stdout).contains("Msamples/s"), "a summary of no render: {}", text(&out.stdout));
+    assert_eq!(std::fs::read(&exr).unwrap(), before, "the finished file was rewritten");
+    // With another output, that one is written from the file's samples.
+    let png = dir.path().join("done.png");
+    let out = run(&["--resume", path, "--spp", "16", "-o", png.to_str().unwrap()]);
+    assert!(out.status.success() && png.exists(), "{}", text(&out.stderr));
+    assert_eq!(std::fs::read(&exr).unwrap(), before);
+}
+
+/// `convergence --reference` refuses an EXR of another scene, naming both, before rendering.
+#[test]
+fn a_reference_of_another_scene_is_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("whitted.exr");
+    let out = run(&[
+        "scenes/whitted.toml",
+        "--renderer",
+        "pathtrace",
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "--spp",
+        "1",
+        "-o",
+        exr.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let out = Command::new(example_binary("convergence"))
+        .args(["scenes/cornell.toml", "--width", "8", "--height", "8", "--spp-list", "1", "--reference"])
+        .arg(&exr)
+        .arg("--out")
+        .arg(dir.path().join("convergence"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("the convergence example starts");
+    assert_refused(
+        &out,
+        "a reference of the Whitted scene for the Cornell box",
+        &["\"whitted\"", "\"cornell\"", "another scene"],
+    );
+    assert!(!text(&out.stdout).contains("reference mean luminance"), "{}", text(&out.stdout));
+}
+
+/// The ladder's `truth.exr` carries the metadata of the render it is, as every EXR does.
+#[test]
+fn the_ladders_truth_exr_says_what_it_is() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = Command::new(example_binary("ladder"))
+        .args(["scenes/whitted.toml", "--width", "32", "--height", "18", "--truth-spp", "64"])
+        .args(["--spp-list", "1", "--depths", "1", "--bounce-spp", "0", "--frames", "1", "--out"])
+        .arg(dir.path())
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("the ladder example starts");
+    assert!(out.status.success(), "{}{}", text(&out.stdout), text(&out.stderr));
+    let meta = metadata(&dir.path().join("truth.exr"));
+    assert_eq!(meta.renderer, "pathtrace");
+    assert_eq!(meta.scene, "whitted");
+    assert!(meta.render_seconds > 0.0, "render_seconds = {}", meta.render_seconds);
+    assert_eq!(field(&meta, "spp"), "64");
+    assert_eq!(field(&meta, "caustics"), "on");
 }

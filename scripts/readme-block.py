@@ -1,0 +1,167 @@
+#!/usr/bin/env python3
+"""Writes one of the README's generated blocks from what scripts/readme-figures.sh measured.
+
+    readme-block.py ladder-summary LADDER.csv   selected rows of the ladder, per region
+    readme-block.py headline DIR                the headline figures, from the outputs in DIR
+
+A block sits between `<!-- NAME: ... -->` and `<!-- /NAME -->` in README.md; everything between
+the markers is replaced. Each block names the date and the CPU it was measured on, and leads
+with ratios measured side by side (absolute figures hold only for the host named).
+"""
+
+import csv
+import datetime
+import os
+import re
+import statistics
+import subprocess
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+README = os.path.join(ROOT, "README.md")
+
+
+def host():
+    """'2026-12-03, Intel(R) Xeon(R) Processor, 2 CPUs, llvmpipe': when and where."""
+    cpu = "unknown CPU"
+    try:
+        for line in subprocess.run(["lscpu"], capture_output=True, text=True, check=True).stdout.splitlines():
+            if line.startswith("Model name:"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except (OSError, subprocess.CalledProcessError):
+        pass
+    return f"{datetime.date.today().isoformat()}, {cpu}, {os.cpu_count()} CPUs"
+
+
+def replace_block(name, text):
+    readme = open(README, encoding="utf-8").read()
+    pattern = re.compile(rf"(<!-- {re.escape(name)}:[^>]*-->\n).*?(<!-- /{re.escape(name)} -->)", re.S)
+    if not pattern.search(readme):
+        sys.exit(f"README.md has no <!-- {name}: ... --> block")
+    readme = pattern.sub(lambda m: m.group(1) + text.rstrip("\n") + "\n" + m.group(2), readme)
+    tmp = README + ".tmp"
+    with open(tmp, "w", encoding="utf-8") as f:
+        f.write(readme)
+    os.replace(tmp, README)
+
+
+# The ladder's rows the README shows, and the regions beside the whole image.
+LADDER_ROWS = [
+    ("raster", "figure look"),
+    ("raster", "enhanced look"),
+    ("whitted", "depth 1, 2x2 rays per pixel"),
+    ("whitted", "depth 8, 2x2 rays per pixel"),
+    ("pathtrace", "1 spp, bounces 8"),
+    ("pathtrace", "64 spp, bounces 8"),
+    ("pathtrace", "1 spp, bounces 8, caustic estimator"),
+    ("pathtrace", "64 spp, bounces 8, caustic estimator"),
+    ("pathtrace", "1024 spp, bounces 8, caustic estimator"),
+]
+LADDER_REGIONS = [
+    ("floor, lit", "lit floor"),
+    ("floor in the glass sphere's shadow", "glass's shadow"),
+    ("glass sphere", "glass"),
+    ("metal sphere", "metal"),
+]
+
+
+def ladder_summary(path):
+    rows = {}
+    for r in csv.DictReader(open(path, encoding="utf-8")):
+        rows.setdefault((r["renderer"], r["settings"]), {})[r["region"]] = r
+    out = [
+        "| renderer | settings | wall ms | relMSE | FLIP | "
+        + " | ".join(f"luminance / truth: {short}" for _, short in LADDER_REGIONS)
+        + " |",
+        "|---" * (5 + len(LADDER_REGIONS)) + "|",
+    ]
+    for key in LADDER_ROWS:
+        regions = rows.get(key)
+        if regions is None:
+            continue
+        whole = regions["all"]
+        cells = [key[0], key[1], f"{float(whole['wall_ms']):.1f}", f"{float(whole['rel_mse']):.2e}",
+                 f"{float(whole['flip']):.3f}"]
+        cells += [f"{float(regions[name]['luminance_ratio']):.2f}" if name in regions else "n/a"
+                  for name, _ in LADDER_REGIONS]
+        out.append("| " + " | ".join(cells) + " |")
+    out.append("")
+    out.append(f"*Measured {host()} (lavapipe unless a GPU is present). wall ms: the median time per frame; "
+               "for the rasterizer a whole frame with its shadow and cube maps made again, for the path tracer "
+               "the time to render that many spp from nothing.*")
+    replace_block("ladder-summary", "\n".join(out))
+
+
+def read(directory, name):
+    path = os.path.join(directory, name)
+    return open(path, encoding="utf-8").read() if os.path.exists(path) else ""
+
+
+def number_after(text, pattern):
+    m = re.search(pattern, text)
+    return float(m.group(1)) if m else None
+
+
+def headline(directory):
+    lines = [f"Measured {host()}:", ""]
+    # Throughput of the pipeline generated per scene against the generic one (bench --quick).
+    bench = read(directory, "bench-quick.txt")
+    rates = {}
+    for row in bench.splitlines():
+        cells = [c.strip() for c in row.strip().strip("|").split("|")]
+        if len(cells) >= 6 and cells[0] == "256x256":
+            try:
+                rates[(int(cells[2]), cells[3])] = float(cells[5])
+            except ValueError:
+                pass
+    for bounces in (2, 8):
+        s, g = rates.get((bounces, "Specialised")), rates.get((bounces, "Generic"))
+        if s and g:
+            lines.append(f"- **Path tracer, pipeline generated per scene against the generic one** (`bench --quick`, "
+                         f"Cornell box 256 x 256, bounces {bounces}): **{s / g:.1f}x** the throughput "
+                         f"({s:.1f} against {g:.1f} Msamples/s on this host).")
+    # The viewer against render (bench --viewer).
+    viewer = read(directory, "bench-viewer.txt")
+    ratio = number_after(viewer, r"viewer / render, median of \d+ runs: ([0-9.]+)")
+    fps = [float(c.split("|")[4]) for c in viewer.splitlines() if re.match(r"\| \d+ \|", c)]
+    if ratio is not None:
+        lines.append(f"- **Viewer, path tracer with the view still** (`bench --viewer`, 960 x 600 window under Xvfb): "
+                     f"**{ratio:.2f}x** `render`'s throughput at the same resolution, measured side by side, "
+                     f"while the window repaints at {statistics.median(fps):.1f} fps.")
+    # Mitsuba 3 (bench/vs_mitsuba.py), when installed.
+    mitsuba = read(directory, "vs-mitsuba.txt")
+    thr = number_after(mitsuba, r"throughput illum / Mitsuba \(fastest sampler\): ([0-9.]+)x")
+    eff = number_after(mitsuba, r"efficiency illum / Mitsuba \(best of each\): ([0-9.]+)x")
+    if thr is not None and eff is not None:
+        lines.append(f"- **Against Mitsuba 3** (`bench/vs_mitsuba.py`, the same Cornell box, 256 x 256, 1024 spp, "
+                     f"whole processes): **{thr:.2f}x** its throughput and **{eff:.2f}x** its efficiency "
+                     "(1 / (relMSE x time)).")
+    else:
+        lines.append("- Against Mitsuba 3: not re-measured in this run (Mitsuba 3 not installed; "
+                     "`bench/vs_mitsuba.py` says how); earlier runs are in docs/performance.md.")
+    # The default render and the 1% target (render).
+    for name, label in (("render-default.txt", "`render` with no stop rule (Cornell box, 512 x 512)"),
+                        ("render-1pct.txt", "`render --target-error 0.01` (Cornell box, 512 x 512)")):
+        text = read(directory, name)
+        spp = number_after(text, r"512x512, (\d+) spp")
+        seconds = number_after(text, r", ([0-9.]+) s, ")
+        error = number_after(text, r"estimated relative error ([0-9.]+)")
+        if spp is not None and seconds is not None and error is not None:
+            lines.append(f"- {label}: {spp:.0f} spp, estimated relative error {100 * error:.2f}%, "
+                         f"{seconds:.1f} s on this host.")
+    # The rasterizer (raster_bench).
+    raster = read(directory, "raster-bench.txt")
+    moving = number_after(raster, r"camera moving, scene unchanged .*?median frame ([0-9.]+) ms")
+    changing = number_after(raster, r"scene changing every frame .*?median frame ([0-9.]+) ms")
+    if moving is not None and changing is not None:
+        lines.append(f"- **Rasterizer**, enhanced look, 1280 x 720, every effect on (`raster_bench`): median frame "
+                     f"{moving:.1f} ms ({1000 / moving:.0f} fps) with the camera moving, {changing:.1f} ms "
+                     f"({1000 / changing:.0f} fps) with the scene changing every frame, on this host.")
+    replace_block("headline", "\n".join(lines))
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 3 or sys.argv[1] not in ("ladder-summary", "headline"):
+        sys.exit(__doc__)
+    {"ladder-summary": ladder_summary, "headline": headline}[sys.argv[1]](sys.argv[2])
