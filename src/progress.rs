@@ -33,6 +33,9 @@ pub fn period_arg(text: &str) -> Result<Duration, String> {
         format!("allowed: a number of seconds from {MIN_PERIOD_SECONDS} to {MAX_PERIOD_SECONDS} (a day)");
     let seconds: f64 =
         text.trim().parse().map_err(|_| format!("--progress-seconds {text:?} is not a number; {allowed}"))?;
+    if seconds.is_nan() {
+        return Err(format!("--progress-seconds {text:?} is not a number; {allowed}"));
+    }
     if !(MIN_PERIOD_SECONDS..=MAX_PERIOD_SECONDS).contains(&seconds) {
         return Err(format!("--progress-seconds {text:?} is out of range; {allowed}"));
     }
