@@ -19,8 +19,16 @@
 //!
 //! Ctrl-C or SIGTERM stops the render early and still writes what has accumulated (the EXR's
 //! metadata records the spp reached and `illum.stopped_by = cancelled`), then exits with status
-//! 130 (SIGINT) or 143 (SIGTERM). Interrupted before the first complete pass, it writes nothing.
-//! A second signal ends the process at once. Every output is checked before rendering.
+//! 130 (SIGINT) or 143 (SIGTERM). Interrupted before the first complete pass, it writes nothing
+//! and says so. Copies of the signal within a second of the first (`timeout`, Slurm and
+//! systemd signal the whole process group) are the same request; a signal after that ends the
+//! process at once. The Whitted ray tracer and the rasterizer (a frame above 4 Mpixels) render in
+//! parts (bands of rows, tiles) and stop between them; their images are deterministic, so an
+//! interrupted one writes nothing and says so, and one whose image was complete writes it. Every output is checked
+//! before rendering.
+//!
+//! Progress: a bar on a terminal; when standard error is not one (a job log), a line starting
+//! with `progress: ` every `--progress-seconds` (default 10) and at every tenth of the way.
 //!
 //! With no stop-rule flag at all (`--spp`, `--target-error`, `--time-budget`, `--sample-range`)
 //! the path tracer renders until a 2% estimated error or for 5 s, whichever comes first, and
@@ -40,7 +48,7 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use clap::Parser;
-use illum::cli::{self, DEFAULT_SCENE, OutputFormat, SceneArgs, output_format};
+use illum::cli::{self, DEFAULT_SCENE, LongRender, OutputFormat, SceneArgs, output_format};
 use illum::image::{Encoding, save_png};
 use illum::interrupt::Interrupt;
 use illum::pathtrace::checkpoint::{Checkpoint, load_checkpoint, save_checkpoint};
@@ -54,7 +62,15 @@ use illum::whitted_cli::{WhittedArgs, WhittedRequest, render_whitted};
 
 #[derive(Parser, Debug)]
 #[command(
-    about = "Render a scene file to PNG and/or EXR with the path tracer, the rasterizer or the Whitted ray tracer"
+    about = "Render a scene file to PNG and/or EXR with the path tracer, the rasterizer or the Whitted ray tracer",
+    after_help = "Stopping: Ctrl-C or SIGTERM stops a render and exits with status 130 or 143. The path tracer \
+writes what has accumulated (a checkpoint that --resume continues), or, before its first complete pass, \
+nothing, and says so. The Whitted ray tracer and a raster frame above 4 Mpixels render in parts and stop \
+between them; their images are deterministic, so an interrupted one writes nothing and says so (a complete \
+one is written). Copies of the signal within a second of the first (timeout, Slurm and systemd signal the \
+whole process group) are the same request; a signal after that ends the process at once.\n\n\
+Progress: a bar on a terminal; in a job log (standard error not a terminal), lines starting with \
+\"progress: \" every --progress-seconds and at every tenth of the way."
 )]
 struct Args {
     /// Scene file (TOML).
@@ -122,6 +138,11 @@ struct Args {
     /// rendering. Default 60.
     #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = cli::checkpoint_seconds_arg)]
     checkpoint_seconds: Option<Duration>,
+    /// When standard error is not a terminal (a job log, `> log 2>&1`): print a line starting
+    /// with `progress: ` this often (0.1 to 86400 seconds; default 10), and at every tenth of the
+    /// way, with every renderer. On a terminal a progress bar shows the same.
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = illum::progress::period_arg)]
+    progress_seconds: Option<Duration>,
 }
 
 /// The default stop rules of a render given no stop-rule flag: a clean image in a few seconds
@@ -153,6 +174,13 @@ fn fill_from_checkpoint(
 }
 
 fn run(args: Args) -> anyhow::Result<()> {
+    // First, so that a stop during the (slow on lavapipe) setup is handled like one during the
+    // render: a message and the signal's status, never the default silent death.
+    let interrupt = Interrupt::install()?;
+    let long = LongRender {
+        interrupt: Some(&interrupt),
+        progress_period: args.progress_seconds.unwrap_or(illum::progress::DEFAULT_PERIOD),
+    };
     let renderer = match args.renderer {
         Some(renderer) => renderer,
         None => Scene::load(&cli::resolve_scene_path(&args.scene))?.renderer,
@@ -178,6 +206,7 @@ fn run(args: Args) -> anyhow::Result<()> {
             encoding: args.encoding,
             exposure: args.exposure,
             other_flags,
+            long,
         });
     }
     let whitted_flags = args.whitted.given();
@@ -198,6 +227,7 @@ fn run(args: Args) -> anyhow::Result<()> {
             encoding: args.encoding,
             exposure: args.exposure,
             other_flags: path_tracer_only,
+            long,
         });
     }
     args.raster.reject_for_path_tracer(&args.scene)?;
@@ -351,9 +381,7 @@ fn run(args: Args) -> anyhow::Result<()> {
     cli::check_outputs(&outputs, &png_flags)?;
     let sequence = scene.pathtrace.sequence;
 
-    // Installed before the GPU is set up, so that Ctrl-C during the (slow on lavapipe) pipeline
-    // compilation is handled like one during the render: a message and status 130.
-    let interrupt = Interrupt::install()?;
+    long.exit_if_requested("before the render started");
     let gpu = cli::gpu()?;
     let options = TracerOptions { sequence, ..Default::default() };
     let mut tracer = if args.adaptive {
@@ -440,7 +468,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         .map(|r| (illum::pathtrace::metadata::SAMPLE_END.to_owned(), r.end.to_string()));
     let mut last_checkpoint = std::time::Instant::now();
     let mut checkpoint_error: Option<String> = None;
-    let progress = RenderProgress::new();
+    let progress = RenderProgress::with_period(long.progress_period);
     let (reason, progressive) = render_progressive(&mut tracer, &rules, interrupt.flag(), |t, p| {
         progress.update(t, p);
         if last_checkpoint.elapsed() >= every && t.spp_done() > 0 && checkpoint_error.is_none() {

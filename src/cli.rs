@@ -185,6 +185,49 @@ pub struct RenderRequest<'a, A> {
     pub exposure: Option<Exposure>,
     /// Flags of the other renderers that were given (e.g. "--target-error", "--look"): an error.
     pub other_flags: Vec<&'static str>,
+    /// How the render reports progress and reacts to Ctrl-C / SIGTERM.
+    pub long: LongRender<'a>,
+}
+
+/// How a long render reports its progress and learns that it should stop.
+#[derive(Clone, Copy)]
+pub struct LongRender<'a> {
+    /// The installed SIGINT / SIGTERM handlers (`None`: nothing stops the render).
+    pub interrupt: Option<&'a crate::interrupt::Interrupt>,
+    /// Time between `progress: ` lines when standard error is not a terminal.
+    pub progress_period: std::time::Duration,
+}
+
+impl Default for LongRender<'_> {
+    fn default() -> Self {
+        LongRender { interrupt: None, progress_period: crate::progress::DEFAULT_PERIOD }
+    }
+}
+
+impl LongRender<'_> {
+    /// Whether a stop was asked for.
+    pub fn stop_requested(&self) -> bool {
+        self.interrupt.is_some_and(|i| i.requested())
+    }
+
+    /// Ends the process with the signal's status, saying that nothing was written and what was
+    /// under way, when a stop was asked for.
+    pub fn exit_if_requested(&self, what: &str) {
+        if let Some(interrupt) = self.interrupt {
+            interrupt.exit_if_requested(what);
+        }
+    }
+
+    /// After a complete image was written: when a stop was asked for meanwhile, says so and
+    /// exits with the signal's status (so that `render && next-step` stops there too).
+    pub fn exit_after_complete_image(&self) {
+        if let Some((signal, code)) = self.interrupt.and_then(|i| i.exit_status()) {
+            eprintln!(
+                "stopped by {signal} after the image was complete (it was written): exiting with status {code}"
+            );
+            std::process::exit(code);
+        }
+    }
 }
 
 impl<A> RenderRequest<'_, A> {
@@ -233,6 +276,11 @@ impl<A> RenderRequest<'_, A> {
         }
         Ok(())
     }
+}
+
+/// The outputs' paths, comma-separated (for messages).
+pub fn describe_outputs(outputs: &[PathBuf]) -> String {
+    outputs.iter().map(|o| o.display().to_string()).collect::<Vec<_>>().join(", ")
 }
 
 /// Parses `--sample-range A..B`: sample indices A to B-1, A < B.

@@ -2,6 +2,7 @@
 //! whose file says `renderer = "raster"`): its flags, and rendering to PNG / EXR with the same
 //! error quality as the path tracer's path.
 
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -10,9 +11,10 @@ use clap::Args;
 use illum_gpu::GpuContext;
 
 use illum_image::ExrMetadata;
-use illum_raster::{Look, Options, PassTimes, RasterRenderer, RasterScene};
+use illum_raster::{Frame, Look, Options, PassTimes, RasterRenderer, RasterScene};
 
 use crate::cli::{self, RenderRequest};
+use crate::progress::{Reporter, describe_parts};
 
 /// Flags that apply to rasterizer scenes only. Each effect is on unless the scene file or one of
 /// these flags turns it off.
@@ -156,6 +158,16 @@ fn antialiasing(options: &Options) -> &'static str {
     }
 }
 
+/// Pixels of the main pass per submission of a large frame: a fraction of a second on lavapipe,
+/// so that progress and Ctrl-C are seen that often. A frame of at most this many pixels (the
+/// default 1280 x 720 among them) is one submission, with its pass times.
+const PIXELS_PER_BAND: u64 = 1 << 22;
+
+/// Rows per band of a `width`-wide frame: about [`PIXELS_PER_BAND`] pixels.
+fn rows_per_band(width: u32) -> u32 {
+    (PIXELS_PER_BAND / u64::from(width.max(1))).clamp(1, u64::from(u32::MAX)) as u32
+}
+
 fn render_prepared(
     gpu: &GpuContext,
     scene: &RasterScene,
@@ -164,9 +176,41 @@ fn render_prepared(
     request: &RasterRequest,
 ) -> anyhow::Result<()> {
     let (width, height) = (scene.camera.width, scene.camera.height);
+    let long = request.long;
+    long.exit_if_requested("before the render started");
     let started = Instant::now();
     let mut renderer = RasterRenderer::new(gpu, scene, width, height)?;
-    let frame = renderer.render_timed(options)?;
+    long.exit_if_requested("while the rasterizer's pipelines were compiled");
+    let rows = rows_per_band(width);
+    let (frame, progress) = if rows >= height {
+        (renderer.render_timed(options)?, None)
+    } else {
+        // A large frame: in bands, with progress, stopping between bands.
+        let progress = Reporter::new(long.progress_period);
+        let drawing = Instant::now();
+        let mut rows_done = 0;
+        let image = renderer.render_in_bands(options, rows, |done| {
+            rows_done = done;
+            let elapsed = drawing.elapsed();
+            let rate = f64::from(done) * f64::from(width) / elapsed.as_secs_f64().max(1e-9);
+            progress.update(Some(f64::from(done) / f64::from(height)), || {
+                describe_parts(u64::from(done), u64::from(height), "rows", Some((rate, "Mpixels/s")), elapsed)
+            });
+            if done == height {
+                progress.note("reading the frame back");
+            }
+            if long.stop_requested() { ControlFlow::Break(()) } else { ControlFlow::Continue(()) }
+        })?;
+        let Some(image) = image else {
+            long.exit_if_requested(&format!(
+                "after {rows_done} of {height} rows of the raster frame ({:.1} s in; a partial frame is not an \
+                 image, and a rerun draws the same frame)",
+                started.elapsed().as_secs_f64()
+            ));
+            bail!("the raster render stopped after {rows_done} of {height} rows without a stop request");
+        };
+        (Frame { image, pass_times: None }, Some(progress))
+    };
     let seconds = started.elapsed().as_secs_f64();
     let times = frame.pass_times.map(|t: PassTimes| {
         format!(
@@ -193,5 +237,11 @@ fn render_prepared(
         seconds,
         times.map(|t| format!(", {t}")).unwrap_or_default()
     );
-    request.write(outputs, &frame.image, &metadata, &summary)
+    if let Some(progress) = progress {
+        progress.note(&format!("writing {}", cli::describe_outputs(outputs)));
+        progress.finish();
+    }
+    request.write(outputs, &frame.image, &metadata, &summary)?;
+    long.exit_after_complete_image();
+    Ok(())
 }

@@ -43,7 +43,9 @@ struct Params {
     mirror_specular: vec4<f32>,
     // x: the mirror's weight, y: the dielectric's shininess
     shading: vec4<f32>,
-    // width, height, first emitter (objects before it can cast shadows), unused
+    // width, height, first emitter (objects before it can cast shadows), row-major index of
+    // this dispatch's top-left pixel (a long render is dispatched in parts, each its own
+    // submission)
     sizes: vec4<u32>,
     // number of lights, depth, aa (n of n x n), output (0: radiance, OUTPUT_OBJECT_IDS)
     counts: vec4<u32>,
@@ -258,12 +260,14 @@ fn camera_ray(px: f32, py: f32) -> vec3<f32> {
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let width = params.sizes.x;
     let height = params.sizes.y;
-    if (id.x >= width || id.y >= height) {
+    let px = params.sizes.w % width + id.x;
+    let py = params.sizes.w / width + id.y;
+    if (px >= width || py >= height) {
         return;
     }
     if (params.counts.w == OUTPUT_OBJECT_IDS) {
-        let ids = object_ids(params.eye.xyz, camera_ray(f32(id.x) + 0.5, f32(id.y) + 0.5));
-        image[id.y * width + id.x] = vec4<f32>(bitcast<f32>(ids.x), bitcast<f32>(ids.y), 0.0, 0.0);
+        let ids = object_ids(params.eye.xyz, camera_ray(f32(px) + 0.5, f32(py) + 0.5));
+        image[py * width + px] = vec4<f32>(bitcast<f32>(ids.x), bitcast<f32>(ids.y), 0.0, 0.0);
         return;
     }
     let n = max(params.counts.z, 1u);
@@ -271,8 +275,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     for (var j = 0u; j < n; j++) {
         for (var i = 0u; i < n; i++) {
             // The cell centres of an n x n grid over the pixel.
-            sum += trace(params.eye.xyz, camera_ray(f32(id.x) + (f32(i) + 0.5) / f32(n), f32(id.y) + (f32(j) + 0.5) / f32(n)));
+            sum += trace(params.eye.xyz, camera_ray(f32(px) + (f32(i) + 0.5) / f32(n), f32(py) + (f32(j) + 0.5) / f32(n)));
         }
     }
-    image[id.y * width + id.x] = vec4<f32>(sum / f32(n * n), 1.0);
+    image[py * width + px] = vec4<f32>(sum / f32(n * n), 1.0);
 }

@@ -16,6 +16,7 @@ fn request<'a>(settings: &'a SceneArgs, raster: &'a RasterArgs, outputs: &'a [Pa
         encoding: None,
         exposure: None,
         other_flags: Vec::new(),
+        long: Default::default(),
     }
 }
 

@@ -10,6 +10,7 @@
 //!   planes, the horizon, refraction ratio 1, total internal reflection), tabulated in
 //!   docs/accuracy.md;
 //! - `passes`: a frame records only the passes its scene needs, and skipping one changes nothing;
+//! - `bands`: a large frame drawn in bands of rows is the frame drawn whole;
 //! - `cli`: the render example's raster path, its errors and its output file.
 //!
 //! The expected values are computed here from the scene file and illum-scene's camera, never
@@ -26,6 +27,7 @@ use illum::scene::Camera;
 #[path = "../common/mod.rs"]
 mod common;
 
+mod bands;
 mod cli;
 mod edges;
 mod effects;

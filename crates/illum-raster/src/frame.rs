@@ -80,7 +80,21 @@ pub struct FrameResources<'a> {
     pub main_spheres: [Option<&'a wgpu::RenderPipeline>; 2],
     pub main_output: &'a wgpu::TextureView,
     pub main_depth: &'a wgpu::TextureView,
+    /// The rows the main pass draws (`None`: all). A band after the first keeps what the
+    /// earlier bands drew (the first clears the whole output); see [`MainBand`].
+    pub main_band: Option<MainBand>,
     pub background: [f32; 3],
+}
+
+/// Rows `first_row .. first_row + rows` of a `width`-wide main view: what one submission of a
+/// long render draws ([`crate::RasterRenderer::render_in_bands`]). The scissor keeps every
+/// fragment outside the band from being written, and each band clears its own depth, so the
+/// bands together are the whole frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MainBand {
+    pub first_row: u32,
+    pub rows: u32,
+    pub width: u32,
 }
 
 /// One cube map's capture.
@@ -222,22 +236,27 @@ impl FrameResources<'_> {
     }
 
     fn main_pass(&self, encoder: &mut wgpu::CommandEncoder) {
+        // A later band draws over the output the earlier ones left.
+        let load = match self.main_band {
+            Some(band) if band.first_row > 0 => wgpu::LoadOp::Load,
+            _ => wgpu::LoadOp::Clear(self.clear_colour()),
+        };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("raster main"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
                 view: self.main_output,
                 depth_slice: None,
                 resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(self.clear_colour()),
-                    store: wgpu::StoreOp::Store,
-                },
+                ops: wgpu::Operations { load, store: wgpu::StoreOp::Store },
             })],
             depth_stencil_attachment: self.clear_depth(self.main_depth),
             timestamp_writes: self.timer.render_writes("main"),
             occlusion_query_set: None,
             multiview_mask: None,
         });
+        if let Some(band) = self.main_band {
+            pass.set_scissor_rect(0, band.first_row, band.width, band.rows);
+        }
         pass.set_bind_group(0, self.uniforms, &[self.view_offset(MAIN_VIEW)]);
         pass.set_bind_group(1, self.main_textures, &[]);
         // Unlike the cube faces, the floor comes first and the spheres after it, back to front:

@@ -1,5 +1,7 @@
 //! [`RasterRenderer`]: owns the GPU resources and turns a scene plus [`Options`] into frames.
 
+use std::ops::ControlFlow;
+
 use crate::scene::RasterScene;
 use glam::Vec3;
 use illum_gpu::timing::PassTimer;
@@ -8,7 +10,9 @@ use illum_image::RgbImage32;
 
 use crate::RasterError;
 use crate::bindings::{Samplers, TextureGroups, Uniforms};
-use crate::frame::{FrameResources, GLASS_FACE_VIEWS, MAIN_VIEW, METAL_FACE_VIEWS, SHADOW_VIEW, VIEW_COUNT};
+use crate::frame::{
+    FrameResources, GLASS_FACE_VIEWS, MAIN_VIEW, METAL_FACE_VIEWS, MainBand, SHADOW_VIEW, VIEW_COUNT,
+};
 use crate::options::Options;
 use crate::pass_times::{Frame, PassTimes};
 use crate::pipelines::Pipelines;
@@ -251,7 +255,49 @@ impl RasterRenderer {
 
     /// [`Self::render`] plus the GPU time of each pass.
     pub fn render_timed(&mut self, options: &Options) -> Result<Frame, RasterError> {
-        let mut encoder = self.record(options)?;
+        let encoder = self.record(options, None)?;
+        self.read_frame(encoder)
+    }
+
+    /// [`Self::render`] for a long render: the main pass in bands of `rows_per_band` rows
+    /// (rounded up to a multiple of 64, the tile side of Mesa's llvmpipe, so that no band edge
+    /// cuts a tile), each its own submission, waited for before the next; the shadow map and
+    /// cube maps are made with the first band. After each band `after_band`, given the rows
+    /// done, can show progress, and stop the render by returning [`ControlFlow::Break`], which
+    /// returns `Ok(None)`; after the last band (called before the readback, which takes seconds
+    /// for a frame of gigabytes) the frame is complete and is returned whatever `after_band`
+    /// says. The frame is the one
+    /// [`Self::render`] draws, pixel for pixel (`tests/raster/bands.rs`); it has no pass times
+    /// (the main pass is timed in pieces).
+    pub fn render_in_bands(
+        &mut self,
+        options: &Options,
+        rows_per_band: u32,
+        mut after_band: impl FnMut(u32) -> ControlFlow<()>,
+    ) -> Result<Option<RgbImage32>, RasterError> {
+        let band = rows_per_band.max(1).next_multiple_of(64);
+        let mut first_row = 0;
+        while first_row < self.height {
+            let rows = band.min(self.height - first_row);
+            let encoder = self.record(options, Some(MainBand { first_row, rows, width: self.width }))?;
+            self.gpu.queue.submit([encoder.finish()]);
+            self.gpu.wait_idle("drawing a band of a raster frame")?;
+            first_row += rows;
+            // After the last band the frame is complete: returned whatever `after_band` says.
+            if after_band(first_row).is_break() && first_row < self.height {
+                return Ok(None);
+            }
+        }
+        let encoder = self
+            .gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("raster readback") });
+        Ok(Some(self.read_frame(encoder)?.image))
+    }
+
+    /// Copies the output (and the pass times) into the staging buffer, submits `encoder` and
+    /// reads the frame back.
+    fn read_frame(&mut self, mut encoder: wgpu::CommandEncoder) -> Result<Frame, RasterError> {
         let row = (self.width * BYTES_PER_PIXEL).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
         let image_bytes = u64::from(row) * u64::from(self.height);
         let staging = self.staging(image_bytes + self.timer.result_size());
@@ -289,7 +335,7 @@ impl RasterRenderer {
     /// Renders one frame into [`Self::output_view`] without reading it back, waits for the GPU
     /// and returns the pass times (what a benchmark or a viewer needs).
     pub fn draw(&mut self, options: &Options) -> Result<Option<PassTimes>, RasterError> {
-        let mut encoder = self.record(options)?;
+        let mut encoder = self.record(options, None)?;
         if !self.timer.enabled() {
             self.gpu.queue.submit([encoder.finish()]);
             self.gpu.wait_idle("drawing a raster frame")?;
@@ -321,10 +367,17 @@ impl RasterRenderer {
         self.staging.clone().expect("allocated above")
     }
 
-    /// Writes the frame's uniforms and records its passes.
-    fn record(&mut self, options: &Options) -> Result<wgpu::CommandEncoder, RasterError> {
-        // The scene stood still since the last frame: back to full-size cube maps.
-        if !std::mem::take(&mut self.changed_since_frame)
+    /// Writes the frame's uniforms and records its passes, the main pass for `main_band`'s rows
+    /// only if given.
+    fn record(
+        &mut self,
+        options: &Options,
+        main_band: Option<MainBand>,
+    ) -> Result<wgpu::CommandEncoder, RasterError> {
+        // A frame's first (or only) recording: if the scene stood still since the last frame,
+        // back to full-size cube maps. Later bands of the same frame keep what the first made.
+        if main_band.is_none_or(|band| band.first_row == 0)
+            && !std::mem::take(&mut self.changed_since_frame)
             && self.scene.quality.cube_size != self.full_cube_size
         {
             let mut scene = self.scene.clone();
@@ -424,6 +477,7 @@ impl RasterRenderer {
             },
             main_output: &main.output_view,
             main_depth: &main.depth,
+            main_band,
             background: self.scene.background.to_array(),
         };
         resources.record(&mut encoder);

@@ -1,4 +1,7 @@
-//! The Whitted ray tracer's GPU side: buffers, the compute pipeline, one dispatch, readback.
+//! The Whitted ray tracer's GPU side: buffers, the compute pipeline, its dispatches (one, or
+//! parts of the image for a long render), readback.
+
+use std::ops::ControlFlow;
 
 use illum_gpu::buffers::{buffer_bind_group, dispatch};
 use illum_gpu::shader::{self, ShaderFile};
@@ -169,14 +172,59 @@ impl WhittedTracer {
 
     /// Renders the image: linear radiance per pixel, row-major from the top-left.
     pub fn render(&self) -> Result<RgbImage32, WhittedError> {
-        self.dispatch(OUTPUT_RADIANCE);
+        self.dispatch(OUTPUT_RADIANCE, 0, self.width, self.height);
         let data = self.read("reading the Whitted image")?;
         Ok(self.decode(&data))
     }
 
+    /// The image's size in pixels.
+    pub fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    /// [`Self::render`] in parts of about `pixels_per_part` pixels (at least one 8 x 8
+    /// workgroup), each its own submission, waited for before the next: a long render then
+    /// never holds the GPU for long at a time, and `after_part` (given the pixels done) can show
+    /// progress, and stop the render by returning [`ControlFlow::Break`], which returns
+    /// `Ok(None)`; after the last part the image is complete and is returned whatever
+    /// `after_part` says. The parts are bands of whole rows, a multiple of 8, when
+    /// `pixels_per_part` holds 8 rows; otherwise tiles of 8 rows and a multiple of 8 columns.
+    /// Every pixel is computed as by [`Self::render`], so the image is the same bit for bit.
+    pub fn render_in_parts(
+        &self,
+        pixels_per_part: u64,
+        mut after_part: impl FnMut(u64) -> ControlFlow<()>,
+    ) -> Result<Option<RgbImage32>, WhittedError> {
+        let (width, height) = (u64::from(self.width), u64::from(self.height));
+        let step = u64::from(WORKGROUP);
+        let per_part = pixels_per_part.max(step * step);
+        let (rows, columns) = if per_part >= width * step {
+            ((per_part / width / step * step).min(height.next_multiple_of(step)), width)
+        } else {
+            (step, per_part / step / step * step)
+        };
+        let mut done = 0;
+        for first_row in (0..height).step_by(rows as usize) {
+            let part_rows = rows.min(height - first_row);
+            for first_column in (0..width).step_by(columns as usize) {
+                let part_columns = columns.min(width - first_column);
+                let first_pixel = first_row * width + first_column;
+                self.dispatch(OUTPUT_RADIANCE, first_pixel as u32, part_columns as u32, part_rows as u32);
+                self.gpu.wait_idle("rendering a part of the Whitted image")?;
+                done += part_rows * part_columns;
+                // After the last part the image is complete: returned whatever `after_part` says.
+                if after_part(done).is_break() && done < width * height {
+                    return Ok(None);
+                }
+            }
+        }
+        let data = self.read("reading the Whitted image")?;
+        Ok(Some(self.decode(&data)))
+    }
+
     /// The object-ID image of the same camera (one ray through each pixel's centre).
     pub fn object_ids(&self) -> Result<ObjectIds, WhittedError> {
-        self.dispatch(OUTPUT_OBJECT_IDS);
+        self.dispatch(OUTPUT_OBJECT_IDS, 0, self.width, self.height);
         let data = self.read("reading the object-ID image")?;
         // Two u32 per pixel, in a vec4 of f32 bits (the copy has no alignment guarantee).
         let words: Vec<u32> =
@@ -198,7 +246,7 @@ impl WhittedTracer {
     /// [`Self::render`] without waiting (what a web page needs): submits the frame and starts
     /// its readback; [`PendingImage::poll`] on later frames returns the image.
     pub fn render_polled(&self) -> PendingImage {
-        self.dispatch(OUTPUT_RADIANCE);
+        self.dispatch(OUTPUT_RADIANCE, 0, self.width, self.height);
         let bytes = u64::from(self.width) * u64::from(self.height) * PIXEL_BYTES;
         let staging = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("whitted staging"),
@@ -231,16 +279,23 @@ impl WhittedTracer {
         Ok(data)
     }
 
-    /// Submits one dispatch writing `output` (OUTPUT_RADIANCE or OUTPUT_OBJECT_IDS).
-    fn dispatch(&self, output: u32) {
+    /// Submits one dispatch writing `output` (OUTPUT_RADIANCE or OUTPUT_OBJECT_IDS) for the
+    /// `columns` x `rows` pixels from `first_pixel` (row-major index of the top-left one). A
+    /// workgroup that reaches past them computes pixels of the next part: the same values.
+    fn dispatch(&self, output: u32, first_pixel: u32, columns: u32, rows: u32) {
         let [lights, depth, aa, _] = self.radiance_params.counts;
-        let params = WhittedParams { counts: [lights, depth, aa, output], ..self.radiance_params };
+        let [width, height, first_emitter, _] = self.radiance_params.sizes;
+        let params = WhittedParams {
+            counts: [lights, depth, aa, output],
+            sizes: [width, height, first_emitter, first_pixel],
+            ..self.radiance_params
+        };
         self.gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         let mut encoder = self
             .gpu
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("whitted") });
-        let workgroups = [self.width.div_ceil(WORKGROUP), self.height.div_ceil(WORKGROUP), 1];
+        let workgroups = [columns.div_ceil(WORKGROUP), rows.div_ceil(WORKGROUP), 1];
         dispatch(&mut encoder, "whitted", &self.pipeline, &self.bind_group, workgroups);
         self.gpu.queue.submit([encoder.finish()]);
     }
