@@ -256,6 +256,13 @@ fn two_signals_1_ms_apart_are_one_request() {
         stderr.extend(lines.map_while(Result::ok));
         let status = child.wait().expect("the render ends");
         let case = format!("{name} then SIGTERM 1 ms later, run {run}");
+        // Two different signals that are both pending when the render next runs (a loaded
+        // machine may not run it within the millisecond) are handled by two of its threads at
+        // once, in either order: either one is the request, never both.
+        let name = match (name, status.code()) {
+            ("SIGINT", Some(143)) => "SIGTERM",
+            _ => name,
+        };
         tally.add(check_stopped(&case, status, &stderr.join("\n"), &exr, name));
     }
     eprintln!("two signals 1 ms apart: {tally:?} of {RUNS} runs");
