@@ -305,13 +305,14 @@ impl Drop for Cluster {
             let pid_file = dir.path().join("run").join(format!("{daemon}.pid"));
             let Some(pid) = running_pid(&pid_file) else { continue };
             let _ = Command::new("kill").arg(pid.to_string()).status();
+            // Until the process is gone, not its pid file: a daemon removes that file before it
+            // has finished shutting down.
+            let alive = || Path::new(&format!("/proc/{pid}")).exists();
             let start = Instant::now();
-            while running_pid(&pid_file).is_some_and(|p| p == pid)
-                && start.elapsed() < Duration::from_secs(10)
-            {
+            while alive() && start.elapsed() < Duration::from_secs(10) {
                 std::thread::sleep(Duration::from_millis(100));
             }
-            if Path::new(&format!("/proc/{pid}")).exists() {
+            if alive() {
                 let _ = Command::new("kill").args(["-KILL", &pid.to_string()]).status();
             }
         }
