@@ -453,10 +453,20 @@ fn start_cluster() -> Cluster {
     cluster
 }
 
+/// The page with the recipes: README.md, or docs/long-renders.md where the README sends the
+/// long renders' details.
+fn recipes_page() -> String {
+    ["README.md", "docs/long-renders.md"]
+        .iter()
+        .filter_map(|page| std::fs::read_to_string(root().join(page)).ok())
+        .find(|text| text.contains("sbatch --parsable render.sbatch"))
+        .expect("no page (README.md, docs/long-renders.md) has the Slurm recipe")
+}
+
 /// The README's Slurm recipe: the `render.sbatch` code block (the one with `#SBATCH --array`)
 /// and the block that submits it.
 fn readme_slurm_recipe() -> (String, String) {
-    let readme = std::fs::read_to_string(root().join("README.md")).expect("README.md");
+    let readme = recipes_page();
     let blocks: Vec<&str> = readme.split("```sh\n").skip(1).filter_map(|b| b.split("\n```").next()).collect();
     let job = blocks.iter().find(|b| b.contains("#SBATCH --array")).expect("README: no render.sbatch block");
     let submit = blocks
@@ -676,7 +686,7 @@ fn gnu_parallel_recipe_merges_to_one_render() {
     }
     // The README's lines after its `cargo build`, as written; `target/release/examples/` in
     // the work folder links to the examples this test was built with.
-    let readme = std::fs::read_to_string(root().join("README.md")).expect("README.md");
+    let readme = recipes_page();
     let block = readme
         .split("```sh\n")
         .filter_map(|b| b.split("\n```").next())
