@@ -12,7 +12,10 @@
 use std::path::PathBuf;
 
 use clap::Parser;
-use illum::pathtrace::checkpoint::{load_checkpoint, merge_checkpoints, save_loaded};
+use illum::pathtrace::checkpoint::{merge_checkpoint_files, save_loaded};
+
+/// Parts listed by name in the summary; more are counted, with the first and the last named.
+const LISTED: usize = 8;
 
 #[derive(Parser, Debug)]
 #[command(about = "Merge partial path-traced renders (render --sample-range A..B) into one EXR")]
@@ -34,19 +37,22 @@ fn run(args: Args) -> anyhow::Result<()> {
         anyhow::bail!("output {}: the merge writes an EXR (.exr)", args.output.display());
     }
     illum::image::check_output(&args.output)?;
-    let mut inputs = Vec::new();
-    for path in &args.inputs {
-        inputs.push((path.clone(), load_checkpoint(path).map_err(anyhow::Error::msg)?));
-    }
-    let ranges: Vec<String> = inputs
-        .iter()
-        .map(|(p, c)| format!("{} ({}..{})", p.display(), c.sample_range().start, c.sample_range().end))
-        .collect();
-    let merged = merge_checkpoints(inputs).map_err(anyhow::Error::msg)?;
+    // The parts are read one at a time (all headers first, to refuse a bad set before any is
+    // read whole), so the merge holds one part and the running total, whatever their number.
+    let mut ranges = Vec::new();
+    let merged = merge_checkpoint_files(&args.inputs, |path, part| {
+        let range = part.sample_range();
+        ranges.push(format!("{} ({}..{})", path.display(), range.start, range.end));
+    })
+    .map_err(anyhow::Error::msg)?;
     save_loaded(&args.output, &merged).map_err(anyhow::Error::msg)?;
+    let parts = if ranges.len() <= LISTED {
+        ranges.join(", ")
+    } else {
+        format!("{} parts: {}, ..., {}", ranges.len(), ranges[0], ranges[ranges.len() - 1])
+    };
     println!(
-        "merged {}: samples {}..{} ({} spp), estimated relative error {:.4}, dropped samples {}",
-        ranges.join(", "),
+        "merged {parts}: samples {}..{} ({} spp), estimated relative error {:.4}, dropped samples {}",
         merged.sample_range().start,
         merged.sample_range().end,
         merged.spp_done,

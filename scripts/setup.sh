@@ -6,7 +6,7 @@
 #     scripts/setup.sh              the default test run: lavapipe and a virtual display
 #     scripts/setup.sh --browser    also the web viewer's browser test (chromium, node, the wasm
 #                                   target, wasm-bindgen at Cargo.lock's version, playwright-core)
-#     scripts/setup.sh --slurm      also the Slurm test (slurm-wlm, munge)
+#     scripts/setup.sh --slurm      also the farm tests (slurm-wlm, munge, GNU parallel)
 #
 # As root or with sudo. `.ci/run` runs it with both options.
 set -euo pipefail
@@ -18,7 +18,7 @@ cd "$(dirname "$0")/.."
 # brings no C++ compiler, and a clean Debian 12 with Rust has none.
 BASE_PACKAGES="mesa-vulkan-drivers libvulkan1 xvfb xauth g++"
 BROWSER_PACKAGES="chromium"
-SLURM_PACKAGES="slurm-wlm munge"
+SLURM_PACKAGES="slurm-wlm munge parallel"
 
 browser=false
 slurm=false

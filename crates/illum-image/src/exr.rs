@@ -308,6 +308,12 @@ fn encode_with_layers<W: std::io::Write + std::io::Seek>(
 /// values). `Ok(None)` when the file has no such layer; an error for an unreadable file or a
 /// channel of another sample type.
 pub fn load_u32_layer(path: impl AsRef<Path>, name: &str) -> Result<Option<U32Layer>, ImageError> {
+    Ok(load_u32_layers(path, &[name])?.pop().flatten())
+}
+
+/// [`load_u32_layer`] for several layers in one read of the file: one entry per name, in the
+/// order of `names`.
+pub fn load_u32_layers(path: impl AsRef<Path>, names: &[&str]) -> Result<Vec<Option<U32Layer>>, ImageError> {
     use exr::prelude::{FlatSamples, ReadLayers as _};
     let path = path.as_ref();
     let file = File::open(path).map_err(|e| ImageError::io(path, "opening the EXR file", e))?;
@@ -319,27 +325,90 @@ pub fn load_u32_layer(path: impl AsRef<Path>, name: &str) -> Result<Option<U32La
         .all_attributes()
         .from_buffered(BufReader::new(file))
         .map_err(|e| ImageError::Decode { path: path.to_path_buf(), format: "EXR", source: Box::new(e) })?;
-    let Some(layer) =
-        image.layer_data.iter().find(|l| l.attributes.layer_name.as_ref().is_some_and(|n| string(n) == name))
-    else {
-        return Ok(None);
-    };
-    let mut channels = Vec::new();
-    for channel in &layer.channel_data.list {
-        let channel_name = string(&channel.name);
-        match &channel.sample_data {
-            FlatSamples::U32(values) => channels.push((channel_name, values.clone())),
-            _ => {
-                return Err(ImageError::BadContent {
-                    path: path.to_path_buf(),
-                    reason: format!(
-                        "layer '{name}' channel '{channel_name}' is not 32-bit unsigned integers"
-                    ),
-                });
+    let mut found: Vec<Option<U32Layer>> = names.iter().map(|_| None).collect();
+    // Moved out, not copied: a merge holds one part's statistics at a time, and a copy would
+    // double them (56 bytes per pixel).
+    for layer in image.layer_data {
+        let layer_name = layer.attributes.layer_name.as_ref().map(string);
+        let Some(index) = names.iter().position(|n| layer_name.as_deref() == Some(*n)) else {
+            continue;
+        };
+        let mut channels = Vec::new();
+        for channel in layer.channel_data.list {
+            let channel_name = string(&channel.name);
+            match channel.sample_data {
+                FlatSamples::U32(values) => channels.push((channel_name, values)),
+                _ => {
+                    return Err(ImageError::BadContent {
+                        path: path.to_path_buf(),
+                        reason: format!(
+                            "layer '{}' channel '{channel_name}' is not 32-bit unsigned integers",
+                            names[index]
+                        ),
+                    });
+                }
             }
         }
+        found[index].get_or_insert(U32Layer { name: names[index].to_owned(), channels });
     }
-    Ok(Some(U32Layer { name: name.to_owned(), channels }))
+    Ok(found)
+}
+
+/// What an EXR file's headers say, without reading its pixels: the size and text attributes
+/// [`load_exr`] would return (the image's and its first R, G, B layer's, sorted by name) and the
+/// names of its layers. A merge of many files checks them all this way before reading any.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExrHeader {
+    pub width: u32,
+    pub height: u32,
+    pub attributes: Vec<(String, String)>,
+    /// Every layer's name (a layer without one: the empty string), in file order.
+    pub layers: Vec<String>,
+}
+
+/// Reads the headers of an EXR file (see [`ExrHeader`]). An error names the file: unreadable,
+/// not an EXR, or without a layer of R, G and B channels.
+pub fn load_exr_header(path: impl AsRef<Path>) -> Result<ExrHeader, ImageError> {
+    let path = path.as_ref();
+    let file = File::open(path).map_err(|e| ImageError::io(path, "opening the EXR file", e))?;
+    let meta = exr::meta::MetaData::read_from_buffered(BufReader::new(file), false)
+        .map_err(|e| ImageError::Decode { path: path.to_path_buf(), format: "EXR", source: Box::new(e) })?;
+    let is_rgb = |header: &&exr::meta::header::Header| {
+        ["R", "G", "B"].iter().all(|c| header.channels.list.iter().any(|ch| string(&ch.name) == *c))
+    };
+    let header = meta.headers.iter().find(is_rgb).ok_or_else(|| ImageError::BadContent {
+        path: path.to_path_buf(),
+        reason: "no layer has R, G and B channels".to_owned(),
+    })?;
+    let size = header.layer_size;
+    let (Ok(width), Ok(height)) = (u32::try_from(size.width()), u32::try_from(size.height())) else {
+        return Err(ImageError::BadContent {
+            path: path.to_path_buf(),
+            reason: format!(
+                "the image is {}x{}; illum handles at most {} pixels per side",
+                size.width(),
+                size.height(),
+                u32::MAX
+            ),
+        });
+    };
+    let mut attributes: Vec<(String, String)> = header
+        .shared_attributes
+        .other
+        .iter()
+        .chain(header.own_attributes.other.iter())
+        .filter_map(|(name, value)| match value {
+            AttributeValue::Text(t) => Some((string(name), string(t))),
+            _ => None,
+        })
+        .collect();
+    attributes.sort();
+    let layers = meta
+        .headers
+        .iter()
+        .map(|h| h.own_attributes.layer_name.as_ref().map_or_else(String::new, string))
+        .collect();
+    Ok(ExrHeader { width, height, attributes, layers })
 }
 
 /// Pixels as the reader delivers them, before the size is known to fit in `u32`.
@@ -475,8 +544,20 @@ mod tests {
             ExrMetadata::from_attributes(&path, &attrs).unwrap().unwrap().get("spp"),
             Some("1099511627776")
         );
-        assert_eq!(load_u32_layer(&path, "state").unwrap(), Some(layer));
+        assert_eq!(load_u32_layer(&path, "state").unwrap(), Some(layer.clone()));
         assert_eq!(load_u32_layer(&path, "other").unwrap(), None);
+        assert_eq!(load_u32_layers(&path, &["other", "state"]).unwrap(), [None, Some(layer)]);
+        // The headers alone: the same size and attributes as the full read, and both layers.
+        let header = load_exr_header(&path).unwrap();
+        assert_eq!((header.width, header.height), (3, 2));
+        assert_eq!(header.attributes, attrs);
+        assert_eq!(header.layers, ["rgb", "state"]);
+        let single = dir.path().join("single.exr");
+        save_exr(&single, &img, &metadata()).unwrap();
+        assert_eq!(load_exr_header(&single).unwrap().attributes, load_exr(&single).unwrap().1);
+        std::fs::write(dir.path().join("not.exr"), b"not an exr").unwrap();
+        let error = load_exr_header(dir.path().join("not.exr")).unwrap_err().to_string();
+        assert!(error.contains("not.exr"), "{error}");
     }
 
     #[test]

@@ -26,7 +26,8 @@ pub use atomic::{check_output, write_atomically};
 pub use contact_sheet::contact_sheet;
 pub use diff::{DiffImages, save_diff_images};
 pub use exr::{
-    ExrMetadata, U32Layer, exr_bytes_with_layers, load_exr, load_u32_layer, save_exr, save_exr_with_layers,
+    ExrHeader, ExrMetadata, U32Layer, exr_bytes_with_layers, load_exr, load_exr_header, load_u32_layer,
+    load_u32_layers, save_exr, save_exr_with_layers,
 };
 pub use metrics::{
     MetricsError, inverse_normal_cdf, mean_luminance_bias, median, rel_mse, rmse, z_test_pass_fraction,

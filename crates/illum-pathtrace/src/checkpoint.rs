@@ -30,7 +30,7 @@
 
 use std::path::Path;
 
-use illum_image::{ExrMetadata, U32Layer, load_exr, load_u32_layer, save_exr_with_layers};
+use illum_image::{ExrMetadata, U32Layer, load_u32_layers, save_exr_with_layers};
 use illum_scene::Scene;
 
 use crate::{Accumulator, PathTracer, TracerOptions};
@@ -166,22 +166,49 @@ pub struct Checkpoint {
     pub aligned_prefix: Option<(Accumulator, u32)>,
 }
 
-/// Reads a checkpoint. Every failure names the file and what is wrong with it: not an EXR,
-/// truncated or corrupt (with the decoder's error), not illum's, not the path tracer's, no
-/// statistics layer, a missing or unparsable key, or statistics that do not add up to the spp
-/// the metadata claims.
-pub fn load_checkpoint(path: &Path) -> Result<Checkpoint, String> {
-    let at = |reason: String| format!("{}: {reason}", path.display());
-    let unreadable = |e: &dyn std::error::Error| {
-        at(format!("cannot be read as an EXR (truncated or corrupt?): {}", with_causes(e)))
-    };
-    if !path.exists() {
-        return Err(at("no such file".into()));
+/// What a checkpoint's headers say about its samples, read without its pixels: enough to check
+/// a merge of many files before reading any of their statistics.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CheckpointHeader {
+    pub metadata: ExrMetadata,
+    pub width: u32,
+    pub height: u32,
+    /// Samples per pixel of the completed passes.
+    pub spp_done: u32,
+    /// The first sample index (0 unless rendered with `--sample-range`).
+    pub sample_start: u32,
+    /// A pass stopped inside: (its spp, rows done from row 0).
+    pub partial_pass: Option<(u32, u32)>,
+}
+
+impl CheckpointHeader {
+    /// The sample indices the file holds: `sample_start .. sample_start + spp_done`.
+    pub fn sample_range(&self) -> std::ops::Range<u64> {
+        let start = u64::from(self.sample_start);
+        start..start + u64::from(self.spp_done)
     }
-    let (image, attributes) = load_exr(path).map_err(|e| unreadable(&e))?;
-    let metadata = ExrMetadata::from_attributes(path, &attributes)
-        .map_err(|e| e.to_string())?
-        .ok_or_else(|| at("not written by illum (no illum.* metadata), so it cannot be continued".into()))?;
+
+    /// The value of a setting in the file; width and height come from the image itself.
+    fn setting(&self, key: &str) -> Option<String> {
+        match key {
+            "width" => Some(self.width.to_string()),
+            "height" => Some(self.height.to_string()),
+            "scene" => Some(self.metadata.scene.clone()),
+            // Files from before the caustic's light tracer existed rendered without it.
+            "caustics" => Some(self.metadata.get(key).unwrap_or("off").to_owned()),
+            _ => self.metadata.get(key).map(str::to_owned),
+        }
+    }
+}
+
+/// The checkpoint fields of a file's illum metadata: a path-traced, non-adaptive render with
+/// whole-number spp, start and partial pass. `at` prefixes the file's name to a reason.
+fn header_fields(
+    at: &dyn Fn(String) -> String,
+    metadata: ExrMetadata,
+    width: u32,
+    height: u32,
+) -> Result<CheckpointHeader, String> {
     if metadata.renderer != crate::metadata::RENDERER {
         return Err(at(format!(
             "illum.renderer = {}: only path-traced images can be continued",
@@ -202,28 +229,65 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint, String> {
     let sample_start = number("sample_start")?;
     let partial = (number("partial_pass_spp")?, number("partial_pass_rows")?);
     let partial_pass = (partial.0 > 0 && partial.1 > 0).then_some(partial);
+    Ok(CheckpointHeader { metadata, width, height, spp_done, sample_start, partial_pass })
+}
+
+/// Reads a checkpoint's headers only ([`CheckpointHeader`]): every failure of
+/// [`load_checkpoint`] that the headers show (not an EXR, not illum's, not the path tracer's,
+/// adaptive, a missing or unparsable key, no statistics layer), naming the file. The
+/// statistics themselves are checked when the file is read whole.
+pub fn load_checkpoint_header(path: &Path) -> Result<CheckpointHeader, String> {
+    let at = |reason: String| format!("{}: {reason}", path.display());
+    if !path.exists() {
+        return Err(at("no such file".into()));
+    }
+    let header = illum_image::load_exr_header(path)
+        .map_err(|e| at(format!("cannot be read as an EXR (truncated or corrupt?): {}", with_causes(&e))))?;
+    let metadata = ExrMetadata::from_attributes(path, &header.attributes)
+        .map_err(|e| e.to_string())?
+        .ok_or_else(|| at("not written by illum (no illum.* metadata), so it cannot be continued".into()))?;
+    let fields = header_fields(&at, metadata, header.width, header.height)?;
+    if !header.layers.iter().any(|l| l == STATISTICS_LAYER) {
+        return Err(at(format!(
+            "has no {STATISTICS_LAYER} layer (written without the statistics a render continues from)"
+        )));
+    }
+    Ok(fields)
+}
+
+/// Reads a checkpoint. Every failure names the file and what is wrong with it: not an EXR,
+/// truncated or corrupt (with the decoder's error), not illum's, not the path tracer's, no
+/// statistics layer, a missing or unparsable key, or statistics that do not add up to the spp
+/// the metadata claims.
+pub fn load_checkpoint(path: &Path) -> Result<Checkpoint, String> {
+    let at = |reason: String| format!("{}: {reason}", path.display());
+    let CheckpointHeader { metadata, width, height, spp_done, sample_start, partial_pass } =
+        load_checkpoint_header(path)?;
     let dropped = match metadata.get("dropped_samples") {
         Some(text) => {
             text.parse().map_err(|_| at(format!("illum.dropped_samples = {text:?} is not a count")))?
         }
         None => 0,
     };
-    let (width, height) = (image.width, image.height);
-    let read = |name: &str| -> Result<Option<Accumulator>, String> {
-        let Some(layer) = load_u32_layer(path, name).map_err(|e| unreadable(&e))? else {
-            return Ok(None);
-        };
-        statistics_from_layer(&layer, width, height, dropped).map(Some).map_err(at)
-    };
-    let accumulator = read(STATISTICS_LAYER)?.ok_or_else(|| {
+    // One read of the file for both layers (the mean image is recomputed from the statistics).
+    let layers = load_u32_layers(path, &[STATISTICS_LAYER, ALIGNED_LAYER])
+        .map_err(|e| at(format!("cannot be read as an EXR (truncated or corrupt?): {}", with_causes(&e))))?;
+    let mut layers = layers.into_iter().map(|layer| {
+        layer.map(|layer| statistics_from_layer(&layer, width, height, dropped).map_err(at)).transpose()
+    });
+    let accumulator = layers.next().transpose()?.flatten().ok_or_else(|| {
         at(format!(
             "has no {STATISTICS_LAYER} layer (written without the statistics a render continues from)"
         ))
     })?;
     check_counts(&accumulator, spp_done, partial_pass).map_err(at)?;
-    let aligned_prefix = match read(ALIGNED_LAYER)? {
+    let aligned_prefix = match layers.next().transpose()?.flatten() {
         Some(prefix) => {
-            let spp = number("aligned_spp")?;
+            let text =
+                metadata.get("aligned_spp").ok_or_else(|| at("illum.aligned_spp is missing".into()))?;
+            let spp: u32 = text
+                .parse()
+                .map_err(|_| at(format!("illum.aligned_spp = {text:?} is not a whole number")))?;
             if spp > spp_done || !(sample_start + spp).is_multiple_of(crate::CHUNK_SAMPLES) {
                 return Err(at(format!(
                     "illum.aligned_spp = {spp}: must be a chunk boundary (sample_start + it a multiple of {}) \
@@ -326,14 +390,15 @@ pub fn image_settings(scene: &Scene, options: TracerOptions) -> Vec<(&'static st
 }
 
 impl Checkpoint {
-    /// The value of a setting in the file; width and height come from the image itself.
-    fn setting(&self, key: &str) -> Option<String> {
-        match key {
-            "width" => Some(self.accumulator.width.to_string()),
-            "height" => Some(self.accumulator.height.to_string()),
-            // Files from before the caustic's light tracer existed rendered without it.
-            "caustics" => Some(self.metadata.get(key).unwrap_or("off").to_owned()),
-            _ => self.metadata.get(key).map(str::to_owned),
+    /// What the file's headers say about these samples (the metadata is copied).
+    pub fn header(&self) -> CheckpointHeader {
+        CheckpointHeader {
+            metadata: self.metadata.clone(),
+            width: self.accumulator.width,
+            height: self.accumulator.height,
+            spp_done: self.spp_done,
+            sample_start: self.sample_start,
+            partial_pass: self.partial_pass,
         }
     }
 
@@ -341,12 +406,13 @@ impl Checkpoint {
     /// every difference (scene name, content hash, resolution, bounces, seed, sampling,
     /// sequence, caustics), with both values.
     pub fn check_matches(&self, path: &Path, scene: &Scene, options: TracerOptions) -> Result<(), String> {
+        let header = self.header();
         let mut differences = Vec::new();
         if self.metadata.scene != scene.name {
             differences.push(format!("scene: {:?} in the file, {:?} now", self.metadata.scene, scene.name));
         }
         for (key, now) in image_settings(scene, options) {
-            let then = self.setting(key).unwrap_or_else(|| "(missing)".to_owned());
+            let then = header.setting(key).unwrap_or_else(|| "(missing)".to_owned());
             if then != now {
                 let what = if key == "scene_hash" {
                     "scene content (camera, materials, objects: the file was edited)".to_owned()
@@ -366,37 +432,29 @@ impl Checkpoint {
             ))
         }
     }
+
+    /// The sample indices this file holds: `sample_start .. sample_start + spp_done`.
+    pub fn sample_range(&self) -> std::ops::Range<u64> {
+        let start = u64::from(self.sample_start);
+        start..start + u64::from(self.spp_done)
+    }
 }
 
 /// The keys two partial renders must agree on to be merged.
 const MERGE_KEYS: [&str; 9] =
     ["scene", "scene_hash", "width", "height", "bounces", "seed", "sampling", "sequence", "caustics"];
 
-impl Checkpoint {
-    /// The sample indices this file holds: `sample_start .. sample_start + spp_done`.
-    pub fn sample_range(&self) -> std::ops::Range<u64> {
-        let start = u64::from(self.sample_start);
-        start..start + u64::from(self.spp_done)
-    }
-
-    fn merge_key(&self, key: &str) -> Option<String> {
-        if key == "scene" { Some(self.metadata.scene.clone()) } else { self.setting(key) }
-    }
-}
-
-/// Combines partial renders of the same scene and settings (files from `render --sample-range`)
-/// into one: per pixel, the f64 sums and counts added in the order of their ranges. Refused, with
-/// the files named: a file stopped inside a pass (resume it first), a setting that differs,
-/// overlapping ranges (the same samples twice would bias nothing but count double) and gaps (the
-/// result would not be one range that can be continued). The merged checkpoint's metadata is
-/// the first range's, with the union's spp, the summed times and dropped samples, and the error
-/// of the merged statistics.
-pub fn merge_checkpoints(inputs: Vec<(std::path::PathBuf, Checkpoint)>) -> Result<Checkpoint, String> {
-    let mut inputs = inputs;
-    if inputs.is_empty() {
+/// Checks that partial renders can be merged, from their headers alone, and sorts them into
+/// sample order (the order the merge adds them in). Refused, with the files named: a file
+/// stopped inside a pass or stopped early (resume it first: the message gives the command), a
+/// range not starting on a chunk, a setting that differs, overlapping ranges (the same samples
+/// twice would count double) and gaps (the result would not be one range that can be
+/// continued). Returns the merged spp.
+fn check_mergeable<T>(parts: &mut [(std::path::PathBuf, CheckpointHeader, T)]) -> Result<u32, String> {
+    if parts.is_empty() {
         return Err("nothing to merge: give at least one EXR file".to_owned());
     }
-    for (path, c) in &inputs {
+    for (path, c, _) in parts.iter() {
         let range = c.sample_range();
         let resume = || match c.metadata.get(crate::metadata::SAMPLE_END) {
             Some(end) => format!(
@@ -441,12 +499,12 @@ pub fn merge_checkpoints(inputs: Vec<(std::path::PathBuf, Checkpoint)>) -> Resul
             ));
         }
     }
-    let (first_path, first) = &inputs[0];
-    for (path, c) in &inputs[1..] {
+    let (first_path, first, _) = &parts[0];
+    for (path, c, _) in &parts[1..] {
         let differences: Vec<String> = MERGE_KEYS
             .iter()
             .filter_map(|key| {
-                let (a, b) = (first.merge_key(key), c.merge_key(key));
+                let (a, b) = (first.setting(key), c.setting(key));
                 (a != b).then(|| {
                     let show = |v: Option<String>| v.unwrap_or_else(|| "(missing)".to_owned());
                     format!(
@@ -463,9 +521,9 @@ pub fn merge_checkpoints(inputs: Vec<(std::path::PathBuf, Checkpoint)>) -> Resul
             return Err(format!("these files are renders of different images: {}", differences.join("; ")));
         }
     }
-    inputs.sort_by_key(|(_, c)| c.sample_start);
-    for pair in inputs.windows(2) {
-        let ((pa, a), (pb, b)) = (&pair[0], &pair[1]);
+    parts.sort_by_key(|(_, c, _)| c.sample_start);
+    for pair in parts.windows(2) {
+        let ((pa, a, _), (pb, b, _)) = (&pair[0], &pair[1]);
         let (ra, rb) = (a.sample_range(), b.sample_range());
         if rb.start < ra.end {
             return Err(format!(
@@ -490,27 +548,47 @@ pub fn merge_checkpoints(inputs: Vec<(std::path::PathBuf, Checkpoint)>) -> Resul
             ));
         }
     }
-    let total = inputs.iter().map(|(_, c)| u64::from(c.spp_done)).sum::<u64>();
-    let spp_done = u32::try_from(total)
-        .map_err(|_| format!("the merged render would have {total} spp, above {}", u32::MAX))?;
-    // Every range but the last ends where the next starts, on a chunk boundary; the last may
-    // end inside a chunk, and then its statistics at its last boundary, added to the others',
-    // are the merged render's (what `render --resume` goes on from).
-    let last = inputs.len() - 1;
-    let aligned_prefix = inputs[last].1.aligned_prefix.as_ref().map(|(prefix, spp)| {
-        // The same order of additions as the merge below: the ranges in sample order.
-        let mut parts = inputs[..last].iter().map(|(_, c)| &c.accumulator).chain([prefix]);
-        let mut merged = parts.next().expect("at least the prefix").clone();
-        parts.for_each(|part| merged.merge(part));
-        let earlier = inputs[..last].iter().map(|(_, c)| c.spp_done).sum::<u32>();
-        (merged, earlier + spp)
-    });
-    let mut iter = inputs.into_iter();
-    let (_, mut merged) = iter.next().expect("not empty");
-    for (_, c) in iter {
-        merged.accumulator.merge(&c.accumulator);
-        merged.metadata.render_seconds += c.metadata.render_seconds;
+    let total = parts.iter().map(|(_, c, _)| u64::from(c.spp_done)).sum::<u64>();
+    u32::try_from(total).map_err(|_| format!("the merged render would have {total} spp, above {}", u32::MAX))
+}
+
+/// Adds checked parts (in sample order) one at a time: per pixel, the f64 sums and counts in
+/// the order of their ranges, so that only the running total and the part being added are in
+/// memory. The merged metadata is the first part's, with the union's spp, the summed times and
+/// dropped samples, and the error of the merged statistics.
+fn fold_parts(
+    parts: impl ExactSizeIterator<Item = Result<Checkpoint, String>>,
+    spp_done: u32,
+) -> Result<Checkpoint, String> {
+    let last = parts.len() - 1;
+    let mut merged: Option<Checkpoint> = None;
+    let mut aligned_prefix = None;
+    for (i, part) in parts.enumerate() {
+        let part = part?;
+        if i == last {
+            // Every range but the last ends where the next starts, on a chunk boundary; the last
+            // may end inside a chunk, and then its statistics at its last boundary, added to the
+            // others' (in the same order as the merge), are the merged render's (what
+            // `render --resume` goes on from).
+            aligned_prefix = part.aligned_prefix.as_ref().map(|(prefix, spp)| match &merged {
+                Some(earlier) => {
+                    let mut sum = earlier.accumulator.clone();
+                    sum.merge(prefix);
+                    (sum, earlier.spp_done + spp)
+                }
+                None => (prefix.clone(), *spp),
+            });
+        }
+        match &mut merged {
+            None => merged = Some(part),
+            Some(merged) => {
+                merged.accumulator.merge(&part.accumulator);
+                merged.metadata.render_seconds += part.metadata.render_seconds;
+                merged.spp_done += part.spp_done;
+            }
+        }
     }
+    let mut merged = merged.expect("at least one part (checked)");
     merged.spp_done = spp_done;
     merged.aligned_prefix = aligned_prefix;
     let accumulator = &merged.accumulator;
@@ -529,6 +607,45 @@ pub fn merge_checkpoints(inputs: Vec<(std::path::PathBuf, Checkpoint)>) -> Resul
         }
     }
     Ok(merged)
+}
+
+/// Combines partial renders of the same scene and settings (files from `render --sample-range`)
+/// into one, all already in memory: see [`merge_checkpoint_files`], which reads them one at a
+/// time, for what is refused and how they are added.
+pub fn merge_checkpoints(inputs: Vec<(std::path::PathBuf, Checkpoint)>) -> Result<Checkpoint, String> {
+    let mut parts: Vec<_> = inputs.into_iter().map(|(path, c)| (path, c.header(), c)).collect();
+    let spp_done = check_mergeable(&mut parts)?;
+    fold_parts(parts.into_iter().map(|(_, _, c)| Ok(c)), spp_done)
+}
+
+/// Merges the partial renders in `paths` into one, holding one part and the running total in
+/// memory, never all parts (256 parts of a 1024 x 1024 render are 14 GB of statistics). First
+/// every file's headers are read and checked together ([`check_mergeable`]: nothing is read in
+/// full if, say, the last file is of another scene); then the files are read and added in
+/// sample order, each checked whole ([`load_checkpoint`]) and against what its header said.
+/// `on_part` is called with each file as it is added (progress for a long merge).
+pub fn merge_checkpoint_files(
+    paths: &[std::path::PathBuf],
+    mut on_part: impl FnMut(&Path, &CheckpointHeader),
+) -> Result<Checkpoint, String> {
+    let mut parts = Vec::with_capacity(paths.len());
+    for path in paths {
+        parts.push((path.clone(), load_checkpoint_header(path)?, ()));
+    }
+    let spp_done = check_mergeable(&mut parts)?;
+    let loaded = parts.into_iter().map(|(path, header, ())| {
+        let part = load_checkpoint(&path)?;
+        if part.header() != header {
+            return Err(format!(
+                "{}: changed while being merged (its samples or settings differ from when it was first read); \
+                 merge again once nothing writes to it",
+                path.display()
+            ));
+        }
+        on_part(&path, &header);
+        Ok(part)
+    });
+    fold_parts(loaded, spp_done)
 }
 
 #[cfg(test)]
