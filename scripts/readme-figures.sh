@@ -16,8 +16,7 @@ cd "$(dirname "$0")/.."
 headline_only=false
 [ "${1:-}" = "--headline" ] && headline_only=true
 
-cargo build --release --examples -p illum
-cargo build --release -p illum-viewer
+cargo build --release --workspace --examples --bins
 bin=target/release/examples
 out=out/readme-figures
 mkdir -p "$out" docs/images

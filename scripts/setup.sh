@@ -13,10 +13,12 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 # lavapipe (Mesa's software Vulkan driver) and the Vulkan loader: the GPU tests run on the CPU.
-# xvfb and xauth: a virtual display for the viewer's windowed smoke test.
+# xvfb and xauth: a virtual display for the viewer's windowed smoke test; libxcursor1, libxi6
+# and libxkbcommon-x11-0: the X11 libraries winit loads at run time (on a clean Debian 12 the
+# window failed without them: "Failed to load one of xlib's shared libraries").
 # g++: nv-flip (the FLIP image metric) builds NVIDIA's C++ reference code; rustup's toolchain
 # brings no C++ compiler, and a clean Debian 12 with Rust has none.
-BASE_PACKAGES="mesa-vulkan-drivers libvulkan1 xvfb xauth g++"
+BASE_PACKAGES="mesa-vulkan-drivers libvulkan1 xvfb xauth libxcursor1 libxi6 libxkbcommon-x11-0 g++"
 BROWSER_PACKAGES="chromium"
 SLURM_PACKAGES="slurm-wlm munge parallel"
 
