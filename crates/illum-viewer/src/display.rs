@@ -206,6 +206,8 @@ impl Display {
 
     /// The shown texture read back (RGBA, gamma-encoded, top row first), once an image has been
     /// shown; for tests, which compare it with the saved PNG. The window itself never reads it.
+    /// Waits for the GPU: native only.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn read_shown(&self, gpu: &GpuContext) -> Result<Option<image::RgbaImage>, illum_gpu::GpuError> {
         let Some(target) = &self.target else { return Ok(None) };
         let (width, height) = (target.width, target.height);

@@ -45,10 +45,14 @@ pub fn shader_modules(scene: &Scene, gpu_scene: &GpuScene) -> Vec<ShaderFile> {
 
 /// What the pipeline writes (`params.counts.w`, OUTPUT_* in the shader).
 const OUTPUT_RADIANCE: u32 = 0;
+#[cfg(not(target_arch = "wasm32"))]
 const OUTPUT_OBJECT_IDS: u32 = 1;
 /// The shader's markers in the shadow channel of the object-ID image.
+#[cfg(not(target_arch = "wasm32"))]
 const SHADOW_LIT: u32 = 0xffff_fffe;
+#[cfg(not(target_arch = "wasm32"))]
 const SHADOW_FACING_AWAY: u32 = 0xffff_fffd;
+#[cfg(not(target_arch = "wasm32"))]
 const NO_HIT: u32 = u32::MAX;
 
 /// Whitted's algorithm on one scene, at the scene's resolution, depth and anti-aliasing.
@@ -61,7 +65,9 @@ pub struct WhittedTracer {
     params: wgpu::Buffer,
     radiance_params: WhittedParams,
     image: wgpu::Buffer,
-    /// The index in `scene.objects` of each object in the GPU's order.
+    /// The index in `scene.objects` of each object in the GPU's order (for the object-ID
+    /// image, which only native tools read).
+    #[cfg(not(target_arch = "wasm32"))]
     scene_index: Vec<usize>,
 }
 
@@ -114,8 +120,11 @@ impl WhittedTracer {
         let lights = encode::lights(scene);
         let radiance_params =
             encode::params(scene, gpu_scene.first_emitter, lights.len() as u32, OUTPUT_RADIANCE);
-        let (ordered, _) = illum_pathtrace::gpu_scene::ordered_objects(scene);
-        let scene_index = ordered.iter().map(|(i, _)| *i).collect();
+        #[cfg(not(target_arch = "wasm32"))]
+        let scene_index = {
+            let (ordered, _) = illum_pathtrace::gpu_scene::ordered_objects(scene);
+            ordered.iter().map(|(i, _)| *i).collect()
+        };
 
         let device = &gpu.device;
         // Storage buffers may not be empty: a scene without lights binds one unused record.
@@ -163,36 +172,9 @@ impl WhittedTracer {
             params,
             radiance_params,
             image,
+            #[cfg(not(target_arch = "wasm32"))]
             scene_index,
         })
-    }
-
-    /// Renders the image: linear radiance per pixel, row-major from the top-left.
-    pub fn render(&self) -> Result<RgbImage32, WhittedError> {
-        self.dispatch(OUTPUT_RADIANCE);
-        let data = self.read("reading the Whitted image")?;
-        Ok(self.decode(&data))
-    }
-
-    /// The object-ID image of the same camera (one ray through each pixel's centre).
-    pub fn object_ids(&self) -> Result<ObjectIds, WhittedError> {
-        self.dispatch(OUTPUT_OBJECT_IDS);
-        let data = self.read("reading the object-ID image")?;
-        // Two u32 per pixel, in a vec4 of f32 bits (the copy has no alignment guarantee).
-        let words: Vec<u32> =
-            data.chunks_exact(4).map(|c| u32::from_le_bytes(c.try_into().expect("4 bytes"))).collect();
-        let texels: Vec<&[u32]> = words.chunks_exact(4).collect();
-        let scene_object = |gpu_index: u32| self.scene_index.get(gpu_index as usize).copied();
-        let hit = texels.iter().map(|t| scene_object(t[0])).collect();
-        let shadow = texels
-            .iter()
-            .map(|t| match t[1] {
-                SHADOW_LIT | NO_HIT => Shadow::Lit,
-                SHADOW_FACING_AWAY => Shadow::FacingAway,
-                i => scene_object(i).map_or(Shadow::Lit, Shadow::BlockedBy),
-            })
-            .collect();
-        Ok(ObjectIds { width: self.width, height: self.height, hit, shadow })
     }
 
     /// [`Self::render`] without waiting (what a web page needs): submits the frame and starts
@@ -219,18 +201,6 @@ impl WhittedTracer {
         }
     }
 
-    fn decode(&self, data: &[u8]) -> RgbImage32 {
-        decode_image(self.width, self.height, data)
-    }
-
-    /// The image buffer, read back with a wait (one vec4 per pixel).
-    fn read(&self, reading: &str) -> Result<Vec<u8>, WhittedError> {
-        let bytes = u64::from(self.width) * u64::from(self.height) * PIXEL_BYTES;
-        let data = readback::read_buffer(&self.gpu, &self.image, 0, bytes, reading)?;
-        self.gpu.check()?;
-        Ok(data)
-    }
-
     /// Submits one dispatch writing `output` (OUTPUT_RADIANCE or OUTPUT_OBJECT_IDS).
     fn dispatch(&self, output: u32) {
         let [lights, depth, aa, _] = self.radiance_params.counts;
@@ -243,6 +213,47 @@ impl WhittedTracer {
         let workgroups = [self.width.div_ceil(WORKGROUP), self.height.div_ceil(WORKGROUP), 1];
         dispatch(&mut encoder, "whitted", &self.pipeline, &self.bind_group, workgroups);
         self.gpu.queue.submit([encoder.finish()]);
+    }
+}
+
+/// The readbacks that wait for the GPU: native only (a web page cannot wait; it uses
+/// [`WhittedTracer::render_polled`]).
+#[cfg(not(target_arch = "wasm32"))]
+impl WhittedTracer {
+    /// Renders the image: linear radiance per pixel, row-major from the top-left.
+    pub fn render(&self) -> Result<RgbImage32, WhittedError> {
+        self.dispatch(OUTPUT_RADIANCE);
+        let data = self.read("reading the Whitted image")?;
+        Ok(decode_image(self.width, self.height, &data))
+    }
+
+    /// The object-ID image of the same camera (one ray through each pixel's centre).
+    pub fn object_ids(&self) -> Result<ObjectIds, WhittedError> {
+        self.dispatch(OUTPUT_OBJECT_IDS);
+        let data = self.read("reading the object-ID image")?;
+        // Two u32 per pixel, in a vec4 of f32 bits (the copy has no alignment guarantee).
+        let words: Vec<u32> =
+            data.chunks_exact(4).map(|c| u32::from_le_bytes(c.try_into().expect("4 bytes"))).collect();
+        let texels: Vec<&[u32]> = words.chunks_exact(4).collect();
+        let scene_object = |gpu_index: u32| self.scene_index.get(gpu_index as usize).copied();
+        let hit = texels.iter().map(|t| scene_object(t[0])).collect();
+        let shadow = texels
+            .iter()
+            .map(|t| match t[1] {
+                SHADOW_LIT | NO_HIT => Shadow::Lit,
+                SHADOW_FACING_AWAY => Shadow::FacingAway,
+                i => scene_object(i).map_or(Shadow::Lit, Shadow::BlockedBy),
+            })
+            .collect();
+        Ok(ObjectIds { width: self.width, height: self.height, hit, shadow })
+    }
+
+    /// The image buffer, read back with a wait (one vec4 per pixel).
+    fn read(&self, reading: &str) -> Result<Vec<u8>, WhittedError> {
+        let bytes = u64::from(self.width) * u64::from(self.height) * PIXEL_BYTES;
+        let data = readback::read_buffer(&self.gpu, &self.image, 0, bytes, reading)?;
+        self.gpu.check()?;
+        Ok(data)
     }
 }
 
