@@ -6,7 +6,7 @@
 //! them with [`PassTimer::copy_results`] and decodes the polled bytes). Without `TIMESTAMP_QUERY` the
 //! timer is inert and `read` returns `None`.
 
-use crate::{GpuContext, GpuError};
+use crate::GpuContext;
 
 pub struct PassTimer {
     queries: Option<Queries>,
@@ -125,7 +125,7 @@ impl PassTimer {
     /// Blocks until they are read back (not on `wasm32`: there copy them with
     /// [`Self::copy_results`] into a buffer read by a [`crate::readback::PendingRead`]).
     #[cfg(not(target_arch = "wasm32"))]
-    pub fn read(&self, gpu: &GpuContext) -> Result<Option<Vec<(String, f64)>>, GpuError> {
+    pub fn read(&self, gpu: &GpuContext) -> Result<Option<Vec<(String, f64)>>, crate::GpuError> {
         let Some(q) = &self.queries else { return Ok(None) };
         let bytes =
             crate::readback::read_buffer(gpu, &q.resolve, 0, q.resolve.size(), "reading GPU timestamps")?;

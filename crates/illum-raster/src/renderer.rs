@@ -41,7 +41,8 @@ struct Keys {
     main_metal: PipelineKey,
 }
 
-/// Bytes per output pixel (RGBA8) and the row alignment of texture-to-buffer copies.
+/// Bytes per output pixel (RGBA8), for the frame's readback (native only).
+#[cfg(not(target_arch = "wasm32"))]
 const BYTES_PER_PIXEL: u32 = 4;
 
 /// The rasterizer (Whitted's look, faked): a scene, a fixed output size and the GPU resources for them.

@@ -33,6 +33,8 @@ struct Params {
 struct Target {
     width: u32,
     height: u32,
+    /// Read back by `read_shown` (native tests); the window shows `view`.
+    #[cfg_attr(target_arch = "wasm32", allow(dead_code))]
     texture: wgpu::Texture,
     view: wgpu::TextureView,
 }
