@@ -17,7 +17,8 @@
 //!   and keeps the caller's submission size across a resize;
 //! - `overflow`: lights up to f32::MAX keep a finite image, error estimate and display sum;
 //! - `pacing`: a caller that goes away between steps (a viewer) is not charged for its absence;
-//! - `polled`: the web viewer's polled readback folds the same samples as the blocking one;
+//! - `polled`: the web viewer's polled readback (bands, and the caustic's frames) folds the same
+//!   samples as the blocking one;
 //! - `random_scenes`: a few hundred random valid scenes render without NaN or dropped samples;
 //! - `whitted_extremes`: the Whitted scene's sun at extreme elevations and sizes against the
 //!   floor's closed form, and albedo 1 with unbounded bounces.

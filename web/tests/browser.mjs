@@ -3,8 +3,11 @@
 //   <out>/<case>.png     a screenshot of the page's canvas
 //   <out>/<case>.status  the page's #illum-status data-* attributes, one "name=value" a line
 // Usage: node browser.mjs URL OUT_DIR
+// The matrix of scenes and modes comes from the Rust test: <out>/matrix.tsv, one cell a line,
+// "name<TAB>query<TAB>expect" with expect one of pathtrace, raster, whitted, refusal.
 // Env: CHROMIUM (default /usr/bin/chromium), WEB_TEST_TIMEOUT_S (per wait, default 300).
-// This script waits for the page's state but asserts nothing itself beyond "it got there".
+// This script waits for the page's state but asserts nothing itself beyond "it got there" (and
+// that no renderer reported an error on the way).
 import { chromium } from 'playwright-core';
 import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import { join } from 'node:path';
@@ -17,6 +20,11 @@ if (!url || !out) {
 mkdirSync(out, { recursive: true });
 const executablePath = process.env.CHROMIUM || '/usr/bin/chromium';
 const timeout = 1000 * Number(process.env.WEB_TEST_TIMEOUT_S || 300);
+const matrix = readFileSync(join(out, 'matrix.tsv'), 'utf8').split('\n').filter(Boolean)
+  .map((line) => {
+    const [name, query, expect] = line.split('\t');
+    return { name, query, expect };
+  });
 
 // Never reach out to the network, never share a profile (Playwright gives each launch a
 // fresh one).
@@ -36,7 +44,15 @@ function save(name, status) {
   console.log(`[${name}] ` + JSON.stringify(status));
 }
 
-// Waits until `predicate(status)` holds; on a timeout saves what the page had and fails.
+// A renderer's error on the page (what a user would read in its panel), if any: the wait for
+// a picture that will never come stops there, naming it.
+function rendererError(status) {
+  if ((status.pathtraceMessage || '').startsWith('path tracer:')) return status.pathtraceMessage;
+  return status.rasterMessage || status.whittedMessage || '';
+}
+
+// Waits until `predicate(status)` holds; on a timeout or a renderer's error saves what the page
+// had and fails.
 async function waitFor(page, name, what, predicate) {
   const started = Date.now();
   for (;;) {
@@ -46,6 +62,12 @@ async function waitFor(page, name, what, predicate) {
       throw new Error(`${name}: the viewer failed: ${status.failure}`);
     }
     if (predicate(status)) return status;
+    const error = rendererError(status);
+    if (error) {
+      save(name, status);
+      await page.screenshot({ path: join(out, `${name}-error.png`) });
+      throw new Error(`${name}: the page shows an error while waiting for ${what}: ${error}`);
+    }
     if (Date.now() - started > timeout) {
       save(name, status);
       await page.screenshot({ path: join(out, `${name}-timeout.png`) });
@@ -87,6 +109,40 @@ async function open(browser, query) {
   return page;
 }
 
+// What each kind of cell waits for before its screenshot.
+const done = {
+  pathtrace: ['the path tracer to reach its spp', (s) => s.pathtraceStopped === 'spp' && s.pathtraceMean],
+  raster: ['raster frames', (s) => Number(s.windowFps) > 0 && s.viewRect],
+  whitted: ['a Whitted frame', (s) => Number(s.whittedFrames) >= 1 && s.whittedMean],
+  // The mode shows why it cannot render the scene (and draws its own scene meanwhile).
+  refusal: ['the refusal and a frame', (s) => s.modeRefusal && Number(s.windowFps) > 0],
+};
+
+// The Cornell box's path-tracer page goes on with what a user does next: Save EXR, and a bad
+// scene file dropped on the window.
+async function cornellExtras(page) {
+  // Save EXR (the button's place in this 960 x 600 layout, left panel): a download.
+  const [download] = await Promise.all([
+    page.waitForEvent('download', { timeout }),
+    click(page, 118, 512),
+  ]);
+  await download.saveAs(join(out, 'download.exr'));
+  writeFileSync(join(out, 'download.name'), download.suggestedFilename());
+  console.log(`[download] ${download.suggestedFilename()}`);
+
+  // A bad scene file dropped on the window: its error shows and the Cornell box stays.
+  const transfer = await page.evaluateHandle(() => {
+    const t = new DataTransfer();
+    t.items.add(new File(['[camera]\nvfov = "wide"\n'], 'bad.toml', { type: 'text/plain' }));
+    return t;
+  });
+  for (const type of ['dragenter', 'dragover', 'drop']) {
+    await page.dispatchEvent('#illum-canvas', type, { dataTransfer: transfer });
+  }
+  const bad = await waitFor(page, 'bad-scene', 'the dropped file\'s error', (s) => s.openError);
+  await shoot(page, 'bad-scene', bad);
+}
+
 // 1. A browser without WebGPU (no --enable-unsafe-webgpu on Linux): the explanation page.
 {
   const browser = await chromium.launch({ executablePath, headless: true, args: quiet });
@@ -106,36 +162,17 @@ async function open(browser, query) {
   await browser.close();
 }
 
-// 2. With WebGPU (SwiftShader): each mode, and a bad scene file.
+// 2. With WebGPU (SwiftShader): the matrix of scenes and modes, then opening files.
 const browser = await chromium.launch({ executablePath, headless: true, args: [...quiet, ...webgpu] });
 try {
-  {
-    // The path tracer on the Cornell box, to 8 spp.
-    const page = await open(browser, '?scene=scenes/cornell.toml&mode=pathtrace&spp=8');
-    const status = await waitFor(page, 'pathtrace', 'the path tracer to reach its spp',
-      (s) => s.pathtraceStopped === 'spp' && s.pathtraceMean);
-    await shoot(page, 'pathtrace', status);
-
-    // Save EXR (the button's place in this 960 x 600 layout, left panel): a download.
-    const [download] = await Promise.all([
-      page.waitForEvent('download', { timeout }),
-      click(page, 118, 512),
-    ]);
-    await download.saveAs(join(out, 'download.exr'));
-    writeFileSync(join(out, 'download.name'), download.suggestedFilename());
-    console.log(`[download] ${download.suggestedFilename()}`);
-
-    // A bad scene file dropped on the window: its error shows and the Cornell box stays.
-    const transfer = await page.evaluateHandle(() => {
-      const t = new DataTransfer();
-      t.items.add(new File(['[camera]\nvfov = "wide"\n'], 'bad.toml', { type: 'text/plain' }));
-      return t;
-    });
-    for (const type of ['dragenter', 'dragover', 'drop']) {
-      await page.dispatchEvent('#illum-canvas', type, { dataTransfer: transfer });
-    }
-    const bad = await waitFor(page, 'bad-scene', 'the dropped file\'s error', (s) => s.openError);
-    await shoot(page, 'bad-scene', bad);
+  for (const cell of matrix) {
+    const started = Date.now();
+    const page = await open(browser, cell.query);
+    const [what, predicate] = done[cell.expect];
+    const status = await waitFor(page, cell.name, what, predicate);
+    await shoot(page, cell.name, status);
+    console.log(`[${cell.name}] ${cell.query}: ${((Date.now() - started) / 1000).toFixed(1)} s`);
+    if (cell.name === 'cornell-pathtrace') await cornellExtras(page);
     await page.close();
   }
   {
@@ -154,20 +191,6 @@ try {
     await chooser.setFiles({ name: 'picked.toml', mimeType: 'text/plain', buffer: text });
     const picked = await waitFor(page, 'picked-scene', 'the picked scene', (s) => s.scene === 'picked.toml');
     save('picked-scene', picked);
-    await page.close();
-  }
-  {
-    // The rasterizer on the Whitted scene, figure look (the file's).
-    const page = await open(browser, '?scene=scenes/whitted.toml&mode=raster');
-    const status = await waitFor(page, 'raster', 'raster frames', (s) => Number(s.windowFps) > 0);
-    await shoot(page, 'raster', status);
-    await page.close();
-  }
-  {
-    // The Whitted ray tracer on the Whitted scene.
-    const page = await open(browser, '?scene=scenes/whitted.toml&mode=whitted');
-    const status = await waitFor(page, 'whitted', 'a Whitted frame', (s) => Number(s.whittedFrames) >= 1);
-    await shoot(page, 'whitted', status);
     await page.close();
   }
 } finally {

@@ -5,6 +5,7 @@ use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use crate::error::GpuError;
+#[cfg(not(target_arch = "wasm32"))]
 use crate::policy;
 use crate::shader::ComputePipelineKey;
 
@@ -37,10 +38,15 @@ impl GpuContext {
     /// Backends, adapter, features and limits follow [`crate::policy`]: `WGPU_BACKEND` (default:
     /// Vulkan, Metal and DX12), `WGPU_ADAPTER_NAME`, a hardware adapter first except under CI
     /// (`CI` set), where lavapipe is preferred.
+    ///
+    /// Not on `wasm32`: it waits for the adapter and the device, which a web page cannot do; the
+    /// web viewer wraps the browser's device with [`GpuContext::from_device`].
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn new() -> Result<Self, GpuError> {
         pollster::block_on(Self::new_async())
     }
 
+    #[cfg(not(target_arch = "wasm32"))]
     async fn new_async() -> Result<Self, GpuError> {
         let mut instance_desc = wgpu::InstanceDescriptor::new_without_display_handle();
         instance_desc.backends = policy::backends();
@@ -95,6 +101,10 @@ impl GpuContext {
     }
 
     /// Blocks until all submitted work is done, turning a hang into [`GpuError::Timeout`].
+    ///
+    /// Not on `wasm32`: in the browser the device's poll returns at once whether or not the work
+    /// is done, so a "wait" there would silently not wait.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn wait_idle(&self, context: &str) -> Result<(), GpuError> {
         self.device
             .poll(wgpu::PollType::Wait { submission_index: None, timeout: Some(DEFAULT_GPU_TIMEOUT) })

@@ -32,11 +32,6 @@ pub enum GpuError {
     #[error("mapping a GPU buffer for readback failed in {context}: {message}")]
     Map { context: String, message: String },
 
-    #[error(
-        "{context} waits for the GPU to finish, which a web page cannot do (a programming error: use readback::PendingRead)"
-    )]
-    BlockingOnTheWeb { context: String },
-
     #[error("shader {file}: {message}")]
     Shader { file: String, message: String },
 }

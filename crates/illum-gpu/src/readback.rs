@@ -1,8 +1,12 @@
 //! Copying GPU buffers back to the CPU.
 //!
-//! Two ways: [`read_buffer`] / [`read_mapped`] block until the bytes are there (native tools and
-//! tests), and [`PendingRead`] starts the mapping and is asked again later, never waiting (the
-//! only way a web page can read the GPU: the browser maps the buffer between frames).
+//! Two ways: [`read_buffer`] / [`read_mapped`] / [`with_mapped`] block until the bytes are there
+//! (native tools and tests), and [`PendingRead`] starts the mapping and is asked again later,
+//! never waiting (the only way a web page can read the GPU: the browser maps the buffer between
+//! frames, after the page's code has returned).
+//!
+//! The blocking functions do not exist on `wasm32`: a wait there would never end, so a caller
+//! that could reach one from the web viewer is a compile error rather than a message in a panel.
 
 use std::sync::{Arc, Mutex};
 
@@ -10,6 +14,7 @@ use crate::{GpuContext, GpuError};
 
 /// Reads `size` bytes at `offset` of `source` (which needs `COPY_SRC`). Blocks until done.
 /// `offset` and `size` must be multiples of 4 (`wgpu::COPY_BUFFER_ALIGNMENT`).
+#[cfg(not(target_arch = "wasm32"))]
 pub fn read_buffer(
     gpu: &GpuContext,
     source: &wgpu::Buffer,
@@ -30,7 +35,9 @@ pub fn read_buffer(
     read_mapped(gpu, &staging, size, context)
 }
 
-/// Maps the first `size` bytes of a `MAP_READ` buffer, copies them out and unmaps it.
+/// Maps the first `size` bytes of a `MAP_READ` buffer, copies them out and unmaps it. Blocks
+/// until done.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn read_mapped(
     gpu: &GpuContext,
     buffer: &wgpu::Buffer,
@@ -41,9 +48,8 @@ pub fn read_mapped(
 }
 
 /// Maps the first `size` bytes of a `MAP_READ` buffer, gives them to `read` where they lie (no
-/// copy: a large batch is folded straight from the mapping) and unmaps it. In the browser a
-/// blocking read would never finish (the page must return to the browser for the mapping to
-/// happen), so there it is an error that names the caller; use [`PendingRead`].
+/// copy: a large batch is folded straight from the mapping) and unmaps it. Blocks until done.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn with_mapped<R>(
     gpu: &GpuContext,
     buffer: &wgpu::Buffer,
@@ -51,16 +57,8 @@ pub fn with_mapped<R>(
     context: &str,
     read: impl FnOnce(&[u8]) -> R,
 ) -> Result<R, GpuError> {
-    #[cfg(target_arch = "wasm32")]
-    {
-        let _ = (gpu, buffer, size, read);
-        Err(GpuError::BlockingOnTheWeb { context: context.to_owned() })
-    }
-    #[cfg(not(target_arch = "wasm32"))]
-    {
-        wait_for_mapping(gpu, buffer, size, context)?;
-        read_and_unmap(buffer, size, context, read)
-    }
+    wait_for_mapping(gpu, buffer, size, context)?;
+    read_and_unmap(buffer, size, context, read)
 }
 
 /// Asks for the first `size` bytes of `buffer` to be mapped and waits until they are.

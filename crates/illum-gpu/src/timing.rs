@@ -2,10 +2,11 @@
 //!
 //! A [`PassTimer`] owns a query set with two slots per named pass. Passes write their begin and
 //! end timestamps through [`PassTimer::compute_writes`] / [`PassTimer::render_writes`]; after
-//! submission [`PassTimer::read`] resolves them into milliseconds. Without `TIMESTAMP_QUERY` the
+//! submission [`PassTimer::read`] resolves them into milliseconds (natively; a web page copies
+//! them with [`PassTimer::copy_results`] and decodes the polled bytes). Without `TIMESTAMP_QUERY` the
 //! timer is inert and `read` returns `None`.
 
-use crate::{GpuContext, GpuError, readback};
+use crate::GpuContext;
 
 pub struct PassTimer {
     queries: Option<Queries>,
@@ -121,9 +122,13 @@ impl PassTimer {
     }
 
     /// Milliseconds per pass, in declaration order, after the submission that resolved them.
-    pub fn read(&self, gpu: &GpuContext) -> Result<Option<Vec<(String, f64)>>, GpuError> {
+    /// Blocks until they are read back (not on `wasm32`: there copy them with
+    /// [`Self::copy_results`] into a buffer read by a [`crate::readback::PendingRead`]).
+    #[cfg(not(target_arch = "wasm32"))]
+    pub fn read(&self, gpu: &GpuContext) -> Result<Option<Vec<(String, f64)>>, crate::GpuError> {
         let Some(q) = &self.queries else { return Ok(None) };
-        let bytes = readback::read_buffer(gpu, &q.resolve, 0, q.resolve.size(), "reading GPU timestamps")?;
+        let bytes =
+            crate::readback::read_buffer(gpu, &q.resolve, 0, q.resolve.size(), "reading GPU timestamps")?;
         Ok(self.decode(&bytes))
     }
 }

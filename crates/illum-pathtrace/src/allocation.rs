@@ -29,8 +29,10 @@
 //! [`MAX_FACTOR`] times the mean (a single wild pilot sample cannot take the budget); counts
 //! are whole chunks, and the total never exceeds the uniform render's.
 
+use crate::Accumulator;
 use crate::batch::CHUNK_SAMPLES;
-use crate::{Accumulator, PathTraceError, PathTracer, Sequence};
+#[cfg(not(target_arch = "wasm32"))]
+use crate::{PathTraceError, PathTracer, Sequence};
 use illum_image::metrics::REL_MSE_EPSILON;
 
 /// Pixels along each side of a block (the shader's workgroup; `ADAPTIVE_BLOCK` in
@@ -68,6 +70,8 @@ pub const PILOT_SEED_KEY: u32 = 0x5851_f42d;
 /// it ([`PathTracer::set_sample_allocation`]): a pilot of [`PILOT_SPP`] samples per pixel with
 /// another seed (the scene's XOR [`PILOT_SEED_KEY`]) gives each block's noise, then its samples
 /// are discarded and the tracer starts again with the scene's own seed. Returns the allocation.
+/// Waits for the pilot's readback: native only.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn plan_adaptive(tracer: &mut PathTracer, mean_spp: u32) -> Result<SampleAllocation, PathTraceError> {
     let scene = tracer.scene().clone();
     let camera = scene.camera;

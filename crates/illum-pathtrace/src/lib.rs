@@ -36,9 +36,11 @@ pub use error::PathTraceError;
 pub use gpu_scene::FEATURES;
 pub use illum_scene::Sequence;
 pub use options::{TracerOptions, Traversal};
+#[cfg(not(target_arch = "wasm32"))]
+pub use progressive::render_progressive;
 pub use progressive::{
     Progress, Progressive, RenderClock, Rule, Status, StopReason, StopRules, parse_target_error,
-    parse_time_budget, render_progressive,
+    parse_time_budget,
 };
 pub use shaders::{
     CAUSTIC_SHADER, GENERIC_MATERIALS, GENERIC_TRAVERSAL, GEOMETRY_MODULE, PATHTRACE_SHADER,

@@ -13,6 +13,7 @@
 //! Over 400 lines with its tests, and one concept: the stop rules and the loop that applies them
 //! read better whole, since each rule's meaning is defined by how the loop checks it.
 
+#[cfg(not(target_arch = "wasm32"))]
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
@@ -366,7 +367,9 @@ impl Progressive {
 }
 
 /// Renders until a rule fires or `cancel` is set. `on_step` runs after every submission (for
-/// progress bars).
+/// progress bars). A loop that never returns to its caller until the end: native only (a web
+/// page steps a [`Progressive`] once per frame instead).
+#[cfg(not(target_arch = "wasm32"))]
 pub fn render_progressive(
     tracer: &mut PathTracer,
     rules: &StopRules,

@@ -86,6 +86,7 @@ pub struct PathTracer {
     staging: Option<wgpu::Buffer>,
     /// The next band of the pass, submitted before the current one was folded (see
     /// `submit.rs`).
+    #[cfg(not(target_arch = "wasm32"))]
     ahead: Option<submit::AheadBand>,
     /// When the last band was folded: a band launched ahead counts its wall time from there.
     last_fold: Option<web_time::Instant>,
@@ -251,6 +252,7 @@ impl PathTracer {
             &gpu_scene,
             options,
             [&params_buffer, &objects_buffer, &materials_buffer],
+            base_params,
         )?;
 
         Ok(Self {
@@ -268,6 +270,7 @@ impl PathTracer {
             spare_batch: None,
             mapped_readback: gpu.device.features().contains(wgpu::Features::MAPPABLE_PRIMARY_BUFFERS),
             staging: None,
+            #[cfg(not(target_arch = "wasm32"))]
             ahead: None,
             last_fold: None,
             returned_at: None,
@@ -289,7 +292,7 @@ impl PathTracer {
             caustic,
             wall_seconds: 0.0,
             gpu_seconds: 0.0,
-            polled_readback: false,
+            polled_readback: cfg!(target_arch = "wasm32"),
             in_flight: None,
             allocation: None,
             adaptive_pipeline: adaptive,
@@ -468,6 +471,7 @@ impl PathTracer {
             &gpu_scene,
             self.options,
             [&self.params_buffer, &self.objects_buffer, &self.materials_buffer],
+            self.base_params,
         )?;
         self.scene = scene.clone();
         self.reset();
@@ -593,11 +597,12 @@ impl PathTracer {
         self.mapped_readback
     }
 
-    /// Makes [`Self::render_step`] poll for each band's results instead of waiting for them:
-    /// what a web page needs, since the browser maps buffers only between frames. The samples,
-    /// the f64 fold and the statistics are the same; only the waiting differs.
-    /// [`Self::render_to_spp`] and [`Self::add_samples_in_one_pass`] always wait.
+    /// Makes [`Self::render_step`] poll for each band's results (and the caustic's frames)
+    /// instead of waiting for them: what a web page needs, since the browser maps buffers only
+    /// between frames. The samples, the f64 fold and the statistics are the same; only the
+    /// waiting differs. [`Self::render_to_spp`] and [`Self::add_samples_in_one_pass`] always
+    /// wait. On `wasm32` readback is always polled (nothing there can wait), whatever `polled`.
     pub fn set_polled_readback(&mut self, polled: bool) {
-        self.polled_readback = polled;
+        self.polled_readback = polled || cfg!(target_arch = "wasm32");
     }
 }

@@ -32,6 +32,8 @@
 //!
 //! The WGSL lives in `shaders/raster/` ([`shaders`]).
 
+// Times frames until the GPU has finished them, which only a native program can wait for.
+#[cfg(not(target_arch = "wasm32"))]
 mod bench;
 mod bindings;
 mod error;
@@ -50,6 +52,7 @@ pub mod uniforms;
 pub mod variants;
 pub mod views;
 
+#[cfg(not(target_arch = "wasm32"))]
 pub use bench::{BenchReport, Motion, bench_frames, reduced_cube_error};
 pub use error::RasterError;
 pub use illum_scene::{Effects, Look};

@@ -15,7 +15,9 @@ pub struct PassTimes {
 }
 
 impl PassTimes {
-    /// Sums per-pass timings named as in `FramePlan::pass_names`.
+    /// Sums per-pass timings named as in `FramePlan::pass_names` (read back with a wait:
+    /// native only).
+    #[cfg(not(target_arch = "wasm32"))]
     pub(crate) fn from_named(named: &[(String, f64)]) -> Self {
         let mut t = PassTimes::default();
         for (name, ms) in named {

@@ -4,8 +4,11 @@ use std::ops::ControlFlow;
 
 use crate::scene::RasterScene;
 use glam::Vec3;
+#[cfg(not(target_arch = "wasm32"))]
+use illum_gpu::readback;
 use illum_gpu::timing::PassTimer;
-use illum_gpu::{GpuContext, readback, wgpu};
+use illum_gpu::{GpuContext, wgpu};
+#[cfg(not(target_arch = "wasm32"))]
 use illum_image::RgbImage32;
 
 use crate::RasterError;
@@ -14,7 +17,9 @@ use crate::frame::{
     FrameResources, GLASS_FACE_VIEWS, MAIN_VIEW, METAL_FACE_VIEWS, MainBand, SHADOW_VIEW, VIEW_COUNT,
 };
 use crate::options::Options;
-use crate::pass_times::{Frame, PassTimes};
+#[cfg(not(target_arch = "wasm32"))]
+use crate::pass_times::Frame;
+use crate::pass_times::PassTimes;
 use crate::pipelines::Pipelines;
 use crate::plan::{FramePlan, Pass};
 use crate::shadow_fit::{MAX_SHADOW_MAP, ShadowFit, fit_shadow};
@@ -40,7 +45,8 @@ struct Keys {
     main_metal: PipelineKey,
 }
 
-/// Bytes per output pixel (RGBA8) and the row alignment of texture-to-buffer copies.
+/// Bytes per output pixel (RGBA8), for the frame's readback (native only).
+#[cfg(not(target_arch = "wasm32"))]
 const BYTES_PER_PIXEL: u32 = 4;
 
 /// The rasterizer (Whitted's look, faked): a scene, a fixed output size and the GPU resources for them.
@@ -61,6 +67,8 @@ pub struct RasterRenderer {
     /// changes, so that every query resolved was written).
     timer: PassTimer,
     timer_plan: Option<FramePlan>,
+    /// Where frames and pass times are read back with a wait (natively only).
+    #[cfg(not(target_arch = "wasm32"))]
     staging: Option<wgpu::Buffer>,
     /// What the shadow map and cube maps hold now, if a recorded frame made them (see
     /// [`ViewsKey`]).
@@ -140,6 +148,7 @@ impl RasterRenderer {
             main: None,
             timer: PassTimer::new(gpu, &[]),
             timer_plan: None,
+            #[cfg(not(target_arch = "wasm32"))]
             staging: None,
             views: None,
             full_cube_size: cubes_side,
@@ -248,12 +257,15 @@ impl RasterRenderer {
     }
 
     /// Renders one frame and reads it back: linear RGB, row 0 at the top, each value one of the
-    /// 256 levels k / 255 of the 8-bit output.
+    /// 256 levels k / 255 of the 8-bit output. Waits for the GPU (not on `wasm32`, where a web
+    /// page shows [`Self::output_view`] instead).
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn render(&mut self, options: &Options) -> Result<RgbImage32, RasterError> {
         Ok(self.render_timed(options)?.image)
     }
 
     /// [`Self::render`] plus the GPU time of each pass.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn render_timed(&mut self, options: &Options) -> Result<Frame, RasterError> {
         let encoder = self.record(options, None)?;
         self.read_frame(encoder)
@@ -334,6 +346,7 @@ impl RasterRenderer {
 
     /// Renders one frame into [`Self::output_view`] without reading it back, waits for the GPU
     /// and returns the pass times (what a benchmark or a viewer needs).
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn draw(&mut self, options: &Options) -> Result<Option<PassTimes>, RasterError> {
         let mut encoder = self.record(options, None)?;
         if !self.timer.enabled() {
@@ -349,12 +362,24 @@ impl RasterRenderer {
         Ok(self.timer.decode(&bytes).map(|named| PassTimes::from_named(&named)))
     }
 
+    /// Renders one frame into [`Self::output_view`] and submits it, without waiting: in a web
+    /// page the browser orders the page's drawing of the output after this submission. No pass
+    /// times (reading them back would wait): always `None`.
+    #[cfg(target_arch = "wasm32")]
+    pub fn draw(&mut self, options: &Options) -> Result<Option<PassTimes>, RasterError> {
+        let encoder = self.record(options)?;
+        self.gpu.queue.submit([encoder.finish()]);
+        self.gpu.check()?;
+        Ok(None)
+    }
+
     /// The last frame (RGBA8, linear values), after [`Self::draw`] or [`Self::render`].
     pub fn output_view(&self) -> Option<&wgpu::TextureView> {
         self.main.as_ref().map(|m| &m.output_view)
     }
 
     /// A mappable staging buffer of at least `size` bytes (reused between frames).
+    #[cfg(not(target_arch = "wasm32"))]
     fn staging(&mut self, size: u64) -> wgpu::Buffer {
         if self.staging.as_ref().is_none_or(|s| s.size() != size) {
             self.staging = Some(self.gpu.device.create_buffer(&wgpu::BufferDescriptor {

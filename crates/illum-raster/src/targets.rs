@@ -153,6 +153,8 @@ fn cube_depth(gpu: &GpuContext, size: u32) -> Result<wgpu::TextureView, GpuError
 /// buffer. Edges are anti-aliased by their analytic coverage, blended into the output, so one
 /// sample per pixel suffices.
 pub struct MainTargets {
+    /// Read back by the native `RasterRenderer::render`; a web page shows `output_view`.
+    #[cfg_attr(target_arch = "wasm32", allow(dead_code))]
     pub output: wgpu::Texture,
     pub output_view: wgpu::TextureView,
     pub depth: wgpu::TextureView,

@@ -99,6 +99,9 @@ pub struct ViewerApp {
     screenshot: Option<ScreenshotJob>,
     /// How often the window repaints (shown in the top bar, printed after a screenshot run).
     frame_rate: FrameRate,
+    /// Where the image was drawn last, in physical pixels of the window: x, y, width, height
+    /// (published for scripts, which crop screenshots to it).
+    view_rect: Option<[u32; 4]>,
     /// The browser's file picker ("Open file..."), which delivers a file a few frames later.
     #[cfg(target_arch = "wasm32")]
     picker: crate::web::FilePicker,
@@ -134,6 +137,7 @@ impl ViewerApp {
             refused: None,
             screenshot: options.screenshot,
             frame_rate: FrameRate::default(),
+            view_rect: None,
             #[cfg(target_arch = "wasm32")]
             picker: crate::web::FilePicker::default(),
         };
@@ -315,6 +319,8 @@ impl ViewerApp {
         let stats = pathtrace.map(PathTraceMode::stats);
         let image = pathtrace.and_then(PathTraceMode::image_mean);
         let seconds = pathtrace.and_then(PathTraceMode::submission_seconds);
+        let whitted_image = self.whitted().and_then(|w| w.image_mean);
+        let on_off = |on: bool| if on { "on" } else { "off" };
         vec![
             ("mode", self.mode.to_string()),
             ("scene", text(self.current_scene_path())),
@@ -337,8 +343,15 @@ impl ViewerApp {
             ("pathtrace-submission-seconds", text(seconds.map(|(wall, _)| format!("{wall:.3}")))),
             ("pathtrace-gpu-seconds", text(seconds.map(|(_, gpu)| format!("{gpu:.3}")))),
             ("pathtrace-message", text(pathtrace.and_then(|p| p.message.clone()))),
+            (
+                "pathtrace-caustics",
+                text(pathtrace.and_then(PathTraceMode::caustics_running).map(|on| on_off(on).to_owned())),
+            ),
             ("raster-message", text(self.raster().and_then(|r| r.message.clone()))),
+            ("view-rect", text(self.view_rect.map(|[x, y, w, h]| format!("{x} {y} {w} {h}")))),
             ("whitted-frames", text(self.whitted().map(|w| w.frames.to_string()))),
+            ("whitted-size", text(whitted_image.map(|(_, [w, h])| format!("{w}x{h}")))),
+            ("whitted-mean", text(whitted_image.map(|(m, _)| format!("{} {} {}", m[0], m[1], m[2])))),
             ("whitted-ms", text(self.whitted().and_then(|w| w.frame_ms).map(|ms| format!("{ms:.0}")))),
             ("whitted-message", text(self.whitted().and_then(|w| w.message.clone()))),
         ]
@@ -495,6 +508,11 @@ impl ViewerApp {
             Some(id) => ui.add(egui::Image::new(egui::load::SizedTexture::new(id, size)).sense(sense)),
             None => ui.allocate_response(size, sense),
         };
+        let rect = response.rect;
+        self.view_rect = Some(
+            [rect.min.x, rect.min.y, rect.width(), rect.height()]
+                .map(|v| (v * pixels_per_point).round() as u32),
+        );
         if let Some(camera) = self.camera_of(self.mode)
             && camera.handle(ui, &response)
         {

@@ -33,6 +33,8 @@ struct Params {
 struct Target {
     width: u32,
     height: u32,
+    /// Read back by `read_shown` (native tests); the window shows `view`.
+    #[cfg_attr(target_arch = "wasm32", allow(dead_code))]
     texture: wgpu::Texture,
     view: wgpu::TextureView,
 }
@@ -206,6 +208,8 @@ impl Display {
 
     /// The shown texture read back (RGBA, gamma-encoded, top row first), once an image has been
     /// shown; for tests, which compare it with the saved PNG. The window itself never reads it.
+    /// Waits for the GPU: native only.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn read_shown(&self, gpu: &GpuContext) -> Result<Option<image::RgbaImage>, illum_gpu::GpuError> {
         let Some(target) = &self.target else { return Ok(None) };
         let (width, height) = (target.width, target.height);

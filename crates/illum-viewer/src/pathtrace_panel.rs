@@ -42,6 +42,9 @@ pub const MAX_UI_BOUNCES: u32 = 64;
 /// Default resolution scale: half the view's pixels in each direction keeps lavapipe
 /// interactive; raise it for a sharper image.
 pub const DEFAULT_SCALE: f32 = 0.5;
+/// The resolution scale's range in the panel (and in the web page's address).
+pub const MIN_SCALE: f32 = 0.1;
+pub const MAX_SCALE: f32 = 1.0;
 
 /// Everything the user sets in the path-tracer panel.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -52,6 +55,9 @@ pub struct PathTraceSettings {
     pub sampling: Sampling,
     /// Random seed.
     pub seed: u32,
+    /// The caustic's light tracer (the scene's `[pathtrace] caustics` to start with); it runs
+    /// only in a scene with a directional light and a mirror or glass object.
+    pub caustics: bool,
     /// Render resolution = view size in pixels x this.
     pub resolution_scale: f32,
     /// Display-only exposure in stops (the saved files are not scaled).
@@ -69,6 +75,7 @@ impl PathTraceSettings {
             bounces: scene.pathtrace.bounces,
             sampling: scene.pathtrace.sampling,
             seed: scene.pathtrace.seed,
+            caustics: scene.pathtrace.caustics,
             resolution_scale: DEFAULT_SCALE,
             exposure: 0.0,
             stop: StopRules::default(),
@@ -198,6 +205,20 @@ impl PathTraceMode {
         )
     }
 
+    /// Whether the caustic's light tracer runs in the current render (`None` before a tracer
+    /// was made).
+    pub fn caustics_running(&self) -> Option<bool> {
+        self.tracer.as_ref().map(PathTracer::caustics)
+    }
+
+    /// Whether the light tracer can add anything to this scene: it has a directional light
+    /// and a mirror or glass object (else the caustics setting is not offered).
+    pub fn caustics_apply(&self) -> bool {
+        let mut scene = self.scene.clone();
+        scene.pathtrace.caustics = true;
+        illum_pathtrace::gpu_scene::caustics_active(&scene)
+    }
+
     /// Wall-clock and GPU seconds of the tracer's submissions since the last reset (the GPU's
     /// where the adapter has timestamp queries, else 0).
     pub fn submission_seconds(&self) -> Option<(f64, f64)> {
@@ -276,6 +297,7 @@ impl PathTraceMode {
         scene.pathtrace.bounces = self.settings.bounces;
         scene.pathtrace.sampling = self.settings.sampling;
         scene.pathtrace.seed = self.settings.seed;
+        scene.pathtrace.caustics = self.settings.caustics;
         if let Some(spp) = self.settings.stop.spp {
             scene.pathtrace.spp = spp.max(1);
         }
@@ -448,6 +470,7 @@ impl PathTraceMode {
     /// The panel's controls.
     pub fn panel(&mut self, ui: &mut egui::Ui) {
         ui.heading("Path tracer");
+        let caustics_apply = self.caustics_apply();
         let s = &mut self.settings;
         ui.horizontal(|ui| {
             let mut unbounded = s.bounces == Bounces::Unbounded;
@@ -473,11 +496,17 @@ impl PathTraceMode {
             ui.radio_value(&mut s.sampling, Sampling::Cosine, "Cosine");
             ui.radio_value(&mut s.sampling, Sampling::Uniform, "Uniform");
         });
+        if caustics_apply {
+            ui.checkbox(&mut s.caustics, "Light tracer (caustics)").on_hover_text(
+                "Particles from the sun through the mirror and glass objects, for the caustics that \
+                 camera paths cannot find (docs/caustics.md)",
+            );
+        }
         ui.horizontal(|ui| {
             let label = ui.label("Seed");
             ui.add(egui::DragValue::new(&mut s.seed).speed(1.0)).labelled_by(label.id);
         });
-        ui.add(egui::Slider::new(&mut s.resolution_scale, 0.1..=1.0).text("Resolution scale"));
+        ui.add(egui::Slider::new(&mut s.resolution_scale, MIN_SCALE..=MAX_SCALE).text("Resolution scale"));
         ui.add(egui::Slider::new(&mut s.exposure, -8.0..=8.0).text("Exposure (display)").suffix(" stops"));
 
         ui.separator();

@@ -11,6 +11,7 @@ use wasm_bindgen::JsCast;
 use wasm_bindgen::prelude::*;
 
 use crate::app::{Mode, StartOptions, ViewerApp};
+use crate::pathtrace_panel::{MAX_SCALE, MIN_SCALE};
 use crate::scene_file::DEFAULT_PATHTRACE_SCENE;
 
 /// The canvas the page gives the viewer, and the element it reports to.
@@ -37,7 +38,7 @@ async fn run() -> Result<(), String> {
         .ok_or_else(|| format!("the page has no element #{CANVAS_ID}"))?
         .dyn_into::<web_sys::HtmlCanvasElement>()
         .map_err(|_| format!("#{CANVAS_ID} is not a canvas"))?;
-    let (options, spp, url_error) = start_options_from_url();
+    let (options, pathtrace, url_error) = start_options_from_url();
     let mut web_options = eframe::WebOptions::default();
     web_options.wgpu_options.wgpu_setup = crate::gpu_setup::wgpu_setup(false);
     eframe::WebRunner::new()
@@ -46,8 +47,11 @@ async fn run() -> Result<(), String> {
             web_options,
             Box::new(move |cc| {
                 let mut app = ViewerApp::new(cc, options);
-                if let (Some(spp), Some(pathtrace)) = (spp, app.pathtrace_mut()) {
-                    pathtrace.settings.stop.spp = Some(spp);
+                if let Some(mode) = app.pathtrace_mut() {
+                    let settings = &mut mode.settings;
+                    settings.stop.spp = pathtrace.spp.or(settings.stop.spp);
+                    settings.caustics = pathtrace.caustics.unwrap_or(settings.caustics);
+                    settings.resolution_scale = pathtrace.scale.unwrap_or(settings.resolution_scale);
                 }
                 if let Some(error) = url_error {
                     app.open_error = Some(error);
@@ -59,10 +63,22 @@ async fn run() -> Result<(), String> {
         .map_err(|e| format!("the viewer could not start: {}", js_text(&e)))
 }
 
+/// The path tracer's settings the page's address may give.
+#[derive(Default)]
+struct PathTraceQuery {
+    /// `spp=N`: the spp target.
+    spp: Option<u32>,
+    /// `caustics=on|off`: the caustic's light tracer, whatever the scene file says.
+    caustics: Option<bool>,
+    /// `scale=S`: the resolution scale (the panel's slider, 0.1 to 1).
+    scale: Option<f32>,
+}
+
 /// The page's URL query as the desktop's command line:
-/// `?scene=scenes/whitted.toml&mode=raster&spp=16` (a built-in scene, the first mode, and the
-/// path tracer's spp target). A bad value is returned as an error to show.
-fn start_options_from_url() -> (StartOptions, Option<u32>, Option<String>) {
+/// `?scene=scenes/whitted.toml&mode=pathtrace&spp=16&caustics=off&scale=0.25` (a built-in scene,
+/// the first mode, and the path tracer's spp target, light tracer and resolution scale). A bad
+/// value is returned as an error to show.
+fn start_options_from_url() -> (StartOptions, PathTraceQuery, Option<String>) {
     let search = web_sys::window().and_then(|w| w.location().search().ok()).unwrap_or_default();
     let params = web_sys::UrlSearchParams::new_with_str(&search).ok();
     let get = |key: &str| params.as_ref().and_then(|p| p.get(key)).filter(|v| !v.is_empty());
@@ -77,8 +93,24 @@ fn start_options_from_url() -> (StartOptions, Option<u32>, Option<String>) {
             None
         }
     });
+    let caustics = get("caustics").and_then(|text| match text.as_str() {
+        "on" => Some(true),
+        "off" => Some(false),
+        _ => {
+            errors.push(format!("caustics = {text:?}: must be on or off"));
+            None
+        }
+    });
+    let (min, max) = (MIN_SCALE, MAX_SCALE);
+    let scale = get("scale").and_then(|text| match text.parse::<f32>() {
+        Ok(scale) if (min..=max).contains(&scale) => Some(scale),
+        _ => {
+            errors.push(format!("scale = {text:?}: must be a number from {min} to {max}"));
+            None
+        }
+    });
     let error = (!errors.is_empty()).then(|| format!("in the page address: {}", errors.join("; ")));
-    (StartOptions { scene, mode, screenshot: None }, spp, error)
+    (StartOptions { scene, mode, screenshot: None }, PathTraceQuery { spp, caustics, scale }, error)
 }
 
 /// Publishes the viewer's status as `data-*` attributes of `#illum-status` (for scripts and

@@ -13,7 +13,6 @@ use illum_scene::{MAX_WHITTED_AA, MAX_WHITTED_DEPTH, Scene};
 use illum_whitted::{PendingImage, WhittedTracer};
 
 use crate::camera::OrbitCamera;
-use crate::platform;
 
 /// What a frame depends on: when it is unchanged, the last image stands.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -36,6 +35,9 @@ pub struct WhittedMode {
     pub frame_ms: Option<f64>,
     /// Frames rendered since the scene was opened.
     pub frames: u64,
+    /// The last frame's mean (linear RGB, before the display's clamp) and size: a summary a
+    /// check can compare with a headless render of the same scene.
+    pub image_mean: Option<([f64; 3], [u32; 2])>,
     pub message: Option<String>,
     /// A frame being read back (polled readback, in the browser): its key, start and image.
     pending: Option<(FrameKey, Instant, PendingImage)>,
@@ -53,6 +55,7 @@ impl WhittedMode {
             drawn: None,
             frame_ms: None,
             frames: 0,
+            image_mean: None,
             message: None,
             pending: None,
         }
@@ -94,17 +97,18 @@ impl WhittedMode {
             scene.whitted.aa = key.aa;
             let started = Instant::now();
             let tracer = WhittedTracer::new(gpu, &scene);
-            if platform::POLLED_READBACK {
-                match tracer {
-                    Ok(tracer) => {
-                        self.pending = Some((key, started, tracer.render_polled()));
-                        self.drawn = Some(key);
-                    }
-                    Err(e) => self.show(ctx, key, started, Err(e)),
+            // In the browser the frame is read back over the next frames (platform.rs);
+            // natively it waits.
+            #[cfg(target_arch = "wasm32")]
+            match tracer {
+                Ok(tracer) => {
+                    self.pending = Some((key, started, tracer.render_polled()));
+                    self.drawn = Some(key);
                 }
-            } else {
-                self.show(ctx, key, started, tracer.and_then(|t| t.render()));
+                Err(e) => self.show(ctx, key, started, Err(e)),
             }
+            #[cfg(not(target_arch = "wasm32"))]
+            self.show(ctx, key, started, tracer.and_then(|t| t.render()));
         }
         self.texture.as_ref().map(egui::TextureHandle::id)
     }
@@ -132,6 +136,7 @@ impl WhittedMode {
                         egui::Color32::from_rgb(r, g, b)
                     })
                     .collect();
+                self.image_mean = Some((image.mean(), [image.width, image.height]));
                 let size = [image.width as usize, image.height as usize];
                 let color = egui::ColorImage::new(size, pixels);
                 match &mut self.texture {

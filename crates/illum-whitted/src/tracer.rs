@@ -48,10 +48,14 @@ pub fn shader_modules(scene: &Scene, gpu_scene: &GpuScene) -> Vec<ShaderFile> {
 
 /// What the pipeline writes (`params.counts.w`, OUTPUT_* in the shader).
 const OUTPUT_RADIANCE: u32 = 0;
+#[cfg(not(target_arch = "wasm32"))]
 const OUTPUT_OBJECT_IDS: u32 = 1;
 /// The shader's markers in the shadow channel of the object-ID image.
+#[cfg(not(target_arch = "wasm32"))]
 const SHADOW_LIT: u32 = 0xffff_fffe;
+#[cfg(not(target_arch = "wasm32"))]
 const SHADOW_FACING_AWAY: u32 = 0xffff_fffd;
+#[cfg(not(target_arch = "wasm32"))]
 const NO_HIT: u32 = u32::MAX;
 
 /// Whitted's algorithm on one scene, at the scene's resolution, depth and anti-aliasing.
@@ -64,7 +68,9 @@ pub struct WhittedTracer {
     params: wgpu::Buffer,
     radiance_params: WhittedParams,
     image: wgpu::Buffer,
-    /// The index in `scene.objects` of each object in the GPU's order.
+    /// The index in `scene.objects` of each object in the GPU's order (for the object-ID
+    /// image, which only native tools read).
+    #[cfg(not(target_arch = "wasm32"))]
     scene_index: Vec<usize>,
 }
 
@@ -117,8 +123,11 @@ impl WhittedTracer {
         let lights = encode::lights(scene);
         let radiance_params =
             encode::params(scene, gpu_scene.first_emitter, lights.len() as u32, OUTPUT_RADIANCE);
-        let (ordered, _) = illum_pathtrace::gpu_scene::ordered_objects(scene);
-        let scene_index = ordered.iter().map(|(i, _)| *i).collect();
+        #[cfg(not(target_arch = "wasm32"))]
+        let scene_index = {
+            let (ordered, _) = illum_pathtrace::gpu_scene::ordered_objects(scene);
+            ordered.iter().map(|(i, _)| *i).collect()
+        };
 
         let device = &gpu.device;
         // Storage buffers may not be empty: a scene without lights binds one unused record.
@@ -166,20 +175,71 @@ impl WhittedTracer {
             params,
             radiance_params,
             image,
+            #[cfg(not(target_arch = "wasm32"))]
             scene_index,
         })
-    }
-
-    /// Renders the image: linear radiance per pixel, row-major from the top-left.
-    pub fn render(&self) -> Result<RgbImage32, WhittedError> {
-        self.dispatch(OUTPUT_RADIANCE, 0, self.width, self.height);
-        let data = self.read("reading the Whitted image")?;
-        Ok(self.decode(&data))
     }
 
     /// The image's size in pixels.
     pub fn size(&self) -> (u32, u32) {
         (self.width, self.height)
+    }
+
+    /// [`Self::render`] without waiting (what a web page needs): submits the frame and starts
+    /// its readback; [`PendingImage::poll`] on later frames returns the image.
+    pub fn render_polled(&self) -> PendingImage {
+        self.dispatch(OUTPUT_RADIANCE, 0, self.width, self.height);
+        let bytes = u64::from(self.width) * u64::from(self.height) * PIXEL_BYTES;
+        let staging = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("whitted staging"),
+            size: bytes,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = self
+            .gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("whitted readback") });
+        encoder.copy_buffer_to_buffer(&self.image, 0, &staging, 0, bytes);
+        self.gpu.queue.submit([encoder.finish()]);
+        PendingImage {
+            read: readback::PendingRead::start(staging, bytes, "reading the Whitted image"),
+            width: self.width,
+            height: self.height,
+        }
+    }
+
+    /// Submits one dispatch writing `output` (OUTPUT_RADIANCE or OUTPUT_OBJECT_IDS) for the
+    /// `columns` x `rows` pixels from `first_pixel` (row-major index of the top-left one). A
+    /// workgroup that reaches past them computes pixels of the next part: the same values.
+    fn dispatch(&self, output: u32, first_pixel: u32, columns: u32, rows: u32) {
+        let [lights, depth, aa, _] = self.radiance_params.counts;
+        let [width, height, first_emitter, _] = self.radiance_params.sizes;
+        let params = WhittedParams {
+            counts: [lights, depth, aa, output],
+            sizes: [width, height, first_emitter, first_pixel],
+            ..self.radiance_params
+        };
+        self.gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+        let mut encoder = self
+            .gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("whitted") });
+        let workgroups = [columns.div_ceil(WORKGROUP), rows.div_ceil(WORKGROUP), 1];
+        dispatch(&mut encoder, "whitted", &self.pipeline, &self.bind_group, workgroups);
+        self.gpu.queue.submit([encoder.finish()]);
+    }
+}
+
+/// The readbacks that wait for the GPU: native only (a web page cannot wait; it uses
+/// [`WhittedTracer::render_polled`]).
+#[cfg(not(target_arch = "wasm32"))]
+impl WhittedTracer {
+    /// Renders the image: linear radiance per pixel, row-major from the top-left.
+    pub fn render(&self) -> Result<RgbImage32, WhittedError> {
+        self.dispatch(OUTPUT_RADIANCE, 0, self.width, self.height);
+        let data = self.read("reading the Whitted image")?;
+        Ok(decode_image(self.width, self.height, &data))
     }
 
     /// [`Self::render`] in parts of about `pixels_per_part` pixels (at least one 8 x 8
@@ -219,7 +279,7 @@ impl WhittedTracer {
             }
         }
         let data = self.read("reading the Whitted image")?;
-        Ok(Some(self.decode(&data)))
+        Ok(Some(decode_image(self.width, self.height, &data)))
     }
 
     /// The object-ID image of the same camera (one ray through each pixel's centre).
@@ -243,61 +303,12 @@ impl WhittedTracer {
         Ok(ObjectIds { width: self.width, height: self.height, hit, shadow })
     }
 
-    /// [`Self::render`] without waiting (what a web page needs): submits the frame and starts
-    /// its readback; [`PendingImage::poll`] on later frames returns the image.
-    pub fn render_polled(&self) -> PendingImage {
-        self.dispatch(OUTPUT_RADIANCE, 0, self.width, self.height);
-        let bytes = u64::from(self.width) * u64::from(self.height) * PIXEL_BYTES;
-        let staging = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("whitted staging"),
-            size: bytes,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut encoder = self
-            .gpu
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("whitted readback") });
-        encoder.copy_buffer_to_buffer(&self.image, 0, &staging, 0, bytes);
-        self.gpu.queue.submit([encoder.finish()]);
-        PendingImage {
-            read: readback::PendingRead::start(staging, bytes, "reading the Whitted image"),
-            width: self.width,
-            height: self.height,
-        }
-    }
-
-    fn decode(&self, data: &[u8]) -> RgbImage32 {
-        decode_image(self.width, self.height, data)
-    }
-
     /// The image buffer, read back with a wait (one vec4 per pixel).
     fn read(&self, reading: &str) -> Result<Vec<u8>, WhittedError> {
         let bytes = u64::from(self.width) * u64::from(self.height) * PIXEL_BYTES;
         let data = readback::read_buffer(&self.gpu, &self.image, 0, bytes, reading)?;
         self.gpu.check()?;
         Ok(data)
-    }
-
-    /// Submits one dispatch writing `output` (OUTPUT_RADIANCE or OUTPUT_OBJECT_IDS) for the
-    /// `columns` x `rows` pixels from `first_pixel` (row-major index of the top-left one). A
-    /// workgroup that reaches past them computes pixels of the next part: the same values.
-    fn dispatch(&self, output: u32, first_pixel: u32, columns: u32, rows: u32) {
-        let [lights, depth, aa, _] = self.radiance_params.counts;
-        let [width, height, first_emitter, _] = self.radiance_params.sizes;
-        let params = WhittedParams {
-            counts: [lights, depth, aa, output],
-            sizes: [width, height, first_emitter, first_pixel],
-            ..self.radiance_params
-        };
-        self.gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
-        let mut encoder = self
-            .gpu
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("whitted") });
-        let workgroups = [columns.div_ceil(WORKGROUP), rows.div_ceil(WORKGROUP), 1];
-        dispatch(&mut encoder, "whitted", &self.pipeline, &self.bind_group, workgroups);
-        self.gpu.queue.submit([encoder.finish()]);
     }
 }
 

@@ -16,18 +16,26 @@
 //! unchanged. Frames depend only on (seed, particle, frame index), and integer atomics add in
 //! any order to the same result, so the image does not depend on how a render is batched.
 //!
+//! Readback: a pass's frames go to the GPU in dispatches of up to `frames_per_dispatch` frames,
+//! each read back and folded before the next is submitted. Natively the tools wait for each
+//! dispatch ([`CausticTracer::prepare_pass`]); a web page cannot wait, so there each dispatch's
+//! mapping is started and asked again on later frames ([`CausticTracer::poll_pass`]). Both
+//! submit the same dispatches and fold the same frames in the same order, so the pass's
+//! statistics are the same bit for bit.
+//!
 //! Fixed point: see [`fixed_point`].
 //!
-//! Over 400 lines with its tests (under 400 of code): one estimator, from its parameters to its
-//! fold.
+//! Over 500 lines with its tests (about 500 of code): one estimator, from its parameters to its
+//! fold, with the two ways its frames come back (waited for, or polled).
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
-use illum_gpu::{GpuContext, readback, wgpu};
+use illum_gpu::readback::PendingRead;
+use illum_gpu::{GpuContext, wgpu};
 use illum_scene::{MaterialKind, Scene};
 
 use crate::accumulator::Accumulator;
-use crate::gpu_scene::{GpuScene, GpuShape};
+use crate::gpu_scene::{GpuParams, GpuScene, GpuShape};
 use crate::options::TracerOptions;
 use crate::{PathTraceError, shaders};
 
@@ -103,21 +111,52 @@ pub fn fixed_point(particles: u64, reference: f64) -> (f32, f32) {
     (2f32.powi(exponent), cap as f32)
 }
 
-/// One pass's caustic statistics: per chunk and pixel, S1 and S2 of its frames.
+/// Which pass a caustic pass belongs to: its first absolute sample index, its spp and the
+/// samples per chunk of the camera's sums that its statistics are grouped by.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct PassKey {
+    pub first_sample: u32,
+    pub spp: u32,
+    pub chunk: u32,
+}
+
+/// One pass's caustic statistics: per chunk and pixel, S1 and S2 of its frames, complete once
+/// `frames_done` reaches the pass's spp.
 struct CausticPass {
-    first_sample: u32,
-    spp: u32,
-    chunk: u32,
+    key: PassKey,
     sum: Vec<[f64; 3]>,
     sum_sq: Vec<[f64; 3]>,
     dropped: u64,
+    /// Frames folded so far: frames `key.first_sample..key.first_sample + frames_done`.
+    frames_done: u32,
+}
+
+impl CausticPass {
+    fn complete(&self) -> bool {
+        self.frames_done >= self.key.spp
+    }
+}
+
+/// A dispatch of frames whose readback is under way (polled).
+struct InFlight {
+    read: PendingRead,
+    /// The frames it traced.
+    count: u32,
 }
 
 pub(crate) struct CausticTracer {
     pipeline: wgpu::ComputePipeline,
     params_buffer: wgpu::Buffer,
+    /// The path tracer's parameters buffer, which the shader reads the camera from, and the
+    /// scene's parameters to write there before each dispatch (a band writes its own fields
+    /// there too; the camera's are the same).
+    scene_params_buffer: wgpu::Buffer,
+    scene_params: GpuParams,
     splat: wgpu::Buffer,
-    staging: wgpu::Buffer,
+    /// The mappable copy of a dispatch's frames; taken by a polled read while it is mapped
+    /// (`None` then, or after a read was abandoned: made again when needed).
+    staging: Option<wgpu::Buffer>,
+    splat_size: u64,
     bind_group: wgpu::BindGroup,
     base: CausticParams,
     frames_per_dispatch: u32,
@@ -126,6 +165,7 @@ pub(crate) struct CausticTracer {
     /// What a fixed-point unit is worth in true radiance: 2^radiance_exponent / S.
     unit: f64,
     pass: Option<CausticPass>,
+    in_flight: Option<InFlight>,
 }
 
 impl CausticTracer {
@@ -137,6 +177,7 @@ impl CausticTracer {
         gpu_scene: &GpuScene,
         options: TracerOptions,
         scene_buffers: [&wgpu::Buffer; 3],
+        scene_params: GpuParams,
     ) -> Result<Option<Self>, PathTraceError> {
         if !gpu_scene.defs.contains(&"CAUSTIC") {
             return Ok(None);
@@ -223,32 +264,25 @@ impl CausticTracer {
         let pipeline = shaders::caustic_pipeline(gpu, scene, gpu_scene, options)?;
         let device = &gpu.device;
         let splat_size = frame_bytes * u64::from(frames_per_dispatch);
-        let (params_buffer, discs_buffer, splat, staging) =
-            gpu.scoped("allocating the caustic's buffers", || {
-                (
-                    device.create_buffer(&wgpu::BufferDescriptor {
-                        label: Some("caustic params"),
-                        size: std::mem::size_of::<CausticParams>() as u64,
-                        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                        mapped_at_creation: false,
-                    }),
-                    illum_gpu::buffers::storage_buffer(device, "caustic discs", bytemuck::cast_slice(&discs)),
-                    device.create_buffer(&wgpu::BufferDescriptor {
-                        label: Some("caustic splats"),
-                        size: splat_size,
-                        usage: wgpu::BufferUsages::STORAGE
-                            | wgpu::BufferUsages::COPY_SRC
-                            | wgpu::BufferUsages::COPY_DST,
-                        mapped_at_creation: false,
-                    }),
-                    device.create_buffer(&wgpu::BufferDescriptor {
-                        label: Some("caustic staging"),
-                        size: splat_size,
-                        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                        mapped_at_creation: false,
-                    }),
-                )
-            })?;
+        let (params_buffer, discs_buffer, splat) = gpu.scoped("allocating the caustic's buffers", || {
+            (
+                device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("caustic params"),
+                    size: std::mem::size_of::<CausticParams>() as u64,
+                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                }),
+                illum_gpu::buffers::storage_buffer(device, "caustic discs", bytemuck::cast_slice(&discs)),
+                device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("caustic splats"),
+                    size: splat_size,
+                    usage: wgpu::BufferUsages::STORAGE
+                        | wgpu::BufferUsages::COPY_SRC
+                        | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                }),
+            )
+        })?;
         let layout = pipeline.get_bind_group_layout(0);
         let [params, objects, materials] = scene_buffers;
         let bind_group = gpu.scoped("binding the caustic's buffers", || {
@@ -268,8 +302,11 @@ impl CausticTracer {
         Ok(Some(CausticTracer {
             pipeline,
             params_buffer,
+            scene_params_buffer: params.clone(),
+            scene_params,
             splat,
-            staging,
+            staging: None,
+            splat_size,
             bind_group,
             base,
             frames_per_dispatch,
@@ -277,6 +314,7 @@ impl CausticTracer {
             pixels,
             unit: 2f64.powi(gpu_scene.radiance_exponent) / f64::from(fixed_scale),
             pass: None,
+            in_flight: None,
         }))
     }
 
@@ -292,73 +330,157 @@ impl CausticTracer {
         (chunks * u64::from(chunk)).min(u64::from(u32::MAX)) as u32
     }
 
-    /// Traces the frames of the pass of `spp` samples from absolute sample index `first_sample`
-    /// (chunks of `chunk`), unless they are the ones already held.
-    pub(crate) fn prepare_pass(
-        &mut self,
-        gpu: &GpuContext,
-        first_sample: u32,
-        spp: u32,
-        chunk: u32,
-    ) -> Result<(), PathTraceError> {
-        if self.pass.as_ref().is_some_and(|p| (p.first_sample, p.spp, p.chunk) == (first_sample, spp, chunk))
-        {
-            return Ok(());
+    /// Whether the frames of pass `key` are all traced and folded.
+    pub(crate) fn holds(&self, key: PassKey) -> bool {
+        self.pass.as_ref().is_some_and(|p| p.key == key && p.complete())
+    }
+
+    /// Starts gathering pass `key` unless it is the one being gathered or held (a pass of
+    /// another key, and a dispatch in flight for it, are dropped).
+    fn begin_pass(&mut self, key: PassKey) {
+        if self.pass.as_ref().is_some_and(|p| p.key == key) {
+            return;
         }
+        self.in_flight = None;
         self.pass = None;
-        let chunks = spp.div_ceil(chunk) as usize;
-        let mut pass = CausticPass {
-            first_sample,
-            spp,
-            chunk,
+        let chunks = key.spp.div_ceil(key.chunk) as usize;
+        self.pass = Some(CausticPass {
+            key,
             sum: vec![[0.0; 3]; chunks * self.pixels],
             sum_sq: vec![[0.0; 3]; chunks * self.pixels],
             dropped: 0,
-        };
-        let words_per_frame = WORDS_PER_PIXEL as usize * self.pixels;
-        let mut done = 0u32;
-        while done < spp {
-            let count = self.frames_per_dispatch.min(spp - done);
-            let params = CausticParams { frame_base: first_sample + done, frame_count: count, ..self.base };
-            gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&params));
-            let bytes = (words_per_frame as u64 + 1) * 4 * u64::from(count);
-            let mut encoder = gpu
-                .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("caustic frames") });
-            encoder.clear_buffer(&self.splat, 0, Some(bytes));
-            {
-                let mut compute = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("caustic"),
-                    timestamp_writes: None,
-                });
-                compute.set_pipeline(&self.pipeline);
-                compute.set_bind_group(0, &self.bind_group, &[]);
-                compute.dispatch_workgroups(self.groups.0, self.groups.1, count);
+            frames_done: 0,
+        });
+    }
+
+    /// Traces the frames of pass `key` (absolute sample indices `key.first_sample..`, grouped
+    /// in chunks of `key.chunk`) and folds them, waiting for each dispatch's readback; nothing
+    /// to do when they are the ones already held.
+    #[cfg(not(target_arch = "wasm32"))]
+    pub(crate) fn prepare_pass(&mut self, gpu: &GpuContext, key: PassKey) -> Result<(), PathTraceError> {
+        self.begin_pass(key);
+        // A polled read left in flight is abandoned: its frames are traced again here.
+        self.in_flight = None;
+        while let Some((staging, bytes, count)) = self.launch_dispatch(gpu)? {
+            let folded = illum_gpu::readback::with_mapped(
+                gpu,
+                &staging,
+                bytes,
+                "reading back caustic frames",
+                |data| self.fold_frames(bytemuck::cast_slice(data), count),
+            );
+            if let Err(e) = folded {
+                self.pass = None;
+                return Err(e.into());
             }
-            encoder.copy_buffer_to_buffer(&self.splat, 0, &self.staging, 0, bytes);
-            gpu.queue.submit([encoder.finish()]);
-            let data = readback::read_mapped(gpu, &self.staging, bytes, "reading back caustic frames")?;
-            let words: &[u32] = bytemuck::cast_slice(&data);
-            for f in 0..count as usize {
-                let relative = done as usize + f;
-                let offset = (relative / chunk as usize) * self.pixels;
-                let frame = &words[f * words_per_frame..(f + 1) * words_per_frame];
-                for (p, w) in frame.chunks_exact(WORDS_PER_PIXEL as usize).enumerate() {
-                    for c in 0..3 {
-                        let q = (u64::from(w[2 * c + 1]) << 32) | u64::from(w[2 * c]);
-                        if q != 0 {
-                            let v = q as f64 * self.unit;
-                            pass.sum[offset + p][c] += v;
-                            pass.sum_sq[offset + p][c] += v * v;
-                        }
+            self.staging = Some(staging);
+        }
+        Ok(())
+    }
+
+    /// The polled form of [`Self::prepare_pass`]: true once the frames of pass `key` are all
+    /// folded. Each call folds the dispatch in flight if its mapping is done and then submits
+    /// the next one; it never waits.
+    pub(crate) fn poll_pass(&mut self, gpu: &GpuContext, key: PassKey) -> Result<bool, PathTraceError> {
+        self.begin_pass(key);
+        if let Some(flight) = &self.in_flight {
+            let Some(result) = flight.read.poll(gpu) else { return Ok(false) };
+            let flight = self.in_flight.take().expect("polled above");
+            let data = match result {
+                Ok(data) => data,
+                Err(e) => {
+                    self.pass = None;
+                    return Err(e.into());
+                }
+            };
+            self.fold_frames(bytemuck::cast_slice(&data), flight.count);
+            self.staging = Some(flight.read.into_buffer());
+        }
+        match self.launch_dispatch(gpu)? {
+            None => Ok(true),
+            Some((staging, bytes, count)) => {
+                let read = PendingRead::start(staging, bytes, "reading back caustic frames");
+                self.in_flight = Some(InFlight { read, count });
+                Ok(false)
+            }
+        }
+    }
+
+    /// Submits the next dispatch of the pass being gathered and its copy into the staging
+    /// buffer: (the staging buffer, the bytes to read, the frames traced), or `None` when the
+    /// pass is complete.
+    fn launch_dispatch(
+        &mut self,
+        gpu: &GpuContext,
+    ) -> Result<Option<(wgpu::Buffer, u64, u32)>, PathTraceError> {
+        let pass = self.pass.as_ref().expect("begin_pass before a dispatch");
+        if pass.complete() {
+            return Ok(None);
+        }
+        let count = self.frames_per_dispatch.min(pass.key.spp - pass.frames_done);
+        let params = CausticParams {
+            frame_base: pass.key.first_sample + pass.frames_done,
+            frame_count: count,
+            ..self.base
+        };
+        let words_per_frame = WORDS_PER_PIXEL * self.pixels as u64;
+        let bytes = (words_per_frame + 1) * 4 * u64::from(count);
+        let staging = match self.staging.take() {
+            Some(staging) => staging,
+            None => gpu.scoped("allocating the caustic's staging buffer", || {
+                gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("caustic staging"),
+                    size: self.splat_size,
+                    usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                })
+            })?,
+        };
+        gpu.queue.write_buffer(&self.scene_params_buffer, 0, bytemuck::bytes_of(&self.scene_params));
+        gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&params));
+        let mut encoder = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("caustic frames") });
+        encoder.clear_buffer(&self.splat, 0, Some(bytes));
+        {
+            let mut compute = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("caustic"),
+                timestamp_writes: None,
+            });
+            compute.set_pipeline(&self.pipeline);
+            compute.set_bind_group(0, &self.bind_group, &[]);
+            compute.dispatch_workgroups(self.groups.0, self.groups.1, count);
+        }
+        encoder.copy_buffer_to_buffer(&self.splat, 0, &staging, 0, bytes);
+        gpu.queue.submit([encoder.finish()]);
+        Ok(Some((staging, bytes, count)))
+    }
+
+    /// Folds `count` frames read back from a dispatch (the splat buffer's words, frames first,
+    /// then one dropped-particle counter per frame) into the pass being gathered: they are its
+    /// next frames.
+    fn fold_frames(&mut self, words: &[u32], count: u32) {
+        let pixels = self.pixels;
+        let unit = self.unit;
+        let pass = self.pass.as_mut().expect("begin_pass before a fold");
+        let words_per_frame = WORDS_PER_PIXEL as usize * pixels;
+        for f in 0..count as usize {
+            let relative = pass.frames_done as usize + f;
+            let offset = (relative / pass.key.chunk as usize) * pixels;
+            let frame = &words[f * words_per_frame..(f + 1) * words_per_frame];
+            for (p, w) in frame.chunks_exact(WORDS_PER_PIXEL as usize).enumerate() {
+                for c in 0..3 {
+                    let q = (u64::from(w[2 * c + 1]) << 32) | u64::from(w[2 * c]);
+                    if q != 0 {
+                        let v = q as f64 * unit;
+                        pass.sum[offset + p][c] += v;
+                        pass.sum_sq[offset + p][c] += v * v;
                     }
                 }
-                pass.dropped += u64::from(words[count as usize * words_per_frame + f]);
             }
-            done += count;
+            pass.dropped += u64::from(words[count as usize * words_per_frame + f]);
         }
-        self.pass = Some(pass);
-        Ok(())
+        pass.frames_done += count;
     }
 
     /// Adds the held pass's chunk `k` for the band's pixels `first_pixel..` to the accumulator,
@@ -371,8 +493,9 @@ impl CausticTracer {
         first_pixel: usize,
         camera: &[[f32; 4]],
     ) {
-        let pass = self.pass.as_ref().expect("prepare_pass before fold");
-        let frames = (pass.chunk * (k as u32 + 1)).min(pass.spp) - pass.chunk * k as u32;
+        let pass = self.pass.as_ref().filter(|p| p.complete()).expect("prepare_pass before fold");
+        let (chunk, spp) = (pass.key.chunk, pass.key.spp);
+        let frames = (chunk * (k as u32 + 1)).min(spp) - chunk * k as u32;
         let range = k * self.pixels + first_pixel..k * self.pixels + first_pixel + camera.len();
         accumulator.fold_independent(
             first_pixel,
@@ -383,8 +506,10 @@ impl CausticTracer {
         );
     }
 
-    /// Forgets the held pass (its frames belong to a render that was reset).
+    /// Forgets the held pass and abandons a dispatch in flight (their frames belong to a
+    /// render that was reset).
     pub(crate) fn discard_pass(&mut self) {
+        self.in_flight = None;
         self.pass = None;
     }
 

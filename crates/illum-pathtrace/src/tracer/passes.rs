@@ -81,7 +81,10 @@ impl PathTracer {
     /// Discards everything accumulated; the next step starts again at sample 0.
     pub fn reset(&mut self) {
         self.in_flight = None;
-        self.ahead = None;
+        #[cfg(not(target_arch = "wasm32"))]
+        {
+            self.ahead = None;
+        }
         self.last_fold = None;
         self.last_step = StepReport::default();
         self.accumulator.reset();
@@ -148,14 +151,7 @@ impl PathTracer {
             }
             self.pass = Some(ActivePass::new(plan, self.spp_done, 0));
         }
-        let report = if self.polled_readback {
-            match self.poll_band()? {
-                Some(report) => report,
-                None => return Ok(StepReport::default()),
-            }
-        } else {
-            self.submit_band()?
-        };
+        let Some(report) = self.next_band()? else { return Ok(StepReport::default()) };
         // A polled band's wall time includes the frames drawn while it was read back; its GPU
         // time (timestamp queries), where the adapter has them, is what it cost.
         let seconds = if self.polled_readback {
@@ -178,8 +174,22 @@ impl PathTracer {
         Ok(report)
     }
 
+    /// One band of the active pass: polled (`None` while its results, or the caustic's frames
+    /// before it, are not back) or waited for.
+    #[cfg(not(target_arch = "wasm32"))]
+    fn next_band(&mut self) -> Result<Option<StepReport>, PathTraceError> {
+        if self.polled_readback { self.poll_band() } else { self.submit_band().map(Some) }
+    }
+
+    /// One band of the active pass, polled: a web page cannot wait.
+    #[cfg(target_arch = "wasm32")]
+    fn next_band(&mut self) -> Result<Option<StepReport>, PathTraceError> {
+        self.poll_band()
+    }
+
     /// Renders until every pixel has `spp` samples in all (those already taken count), in
-    /// submissions sized by the measured speed.
+    /// submissions sized by the measured speed. Waits for the GPU: native only.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn render_to_spp(&mut self, spp: u32) -> Result<(), PathTraceError> {
         while self.spp_done < spp {
             self.render_step(Some(spp))?;
@@ -192,7 +202,8 @@ impl PathTracer {
     /// binding, and into several passes only if one dispatch cannot carry `spp` chunks). Unlike
     /// [`Self::render_to_spp`], the grouping of samples into f32 chunk sums then depends on the
     /// call alone, never on measured speed: tests use it to compare renders bit for bit and to
-    /// control batching.
+    /// control batching. Waits for the GPU: native only.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn add_samples_in_one_pass(&mut self, spp: u32) -> Result<(), PathTraceError> {
         assert!(self.pass.is_none(), "add_samples_in_one_pass called in the middle of a pass");
         let camera = self.scene.camera;

@@ -1,9 +1,11 @@
 //! One submission of the path tracer: a band of rows of the current pass traced on the GPU,
 //! read back, checked for lost samples and folded into the f64 accumulator.
 //!
-//! The readback is either a blocking wait ([`PathTracer::submit_band`], native tools) or polled
-//! ([`PathTracer::poll_band`], the web viewer, which cannot wait): the band is submitted and its
-//! mapping started, and later calls fold it once the browser has mapped it.
+//! The readback is either a blocking wait ([`PathTracer::submit_band`], native tools only) or
+//! polled ([`PathTracer::poll_band`], the web viewer, which cannot wait): the band is submitted
+//! and its mapping started, and later calls fold it once the browser has mapped it. With the
+//! caustic's light tracer, a pass's frames are traced and folded before its first band, the
+//! same way: waited for, or polled dispatch by dispatch (`tracer/caustic.rs`).
 //!
 //! The blocking form keeps the GPU busy while the CPU folds: once a band's results are mapped,
 //! the next band of the same pass is submitted (into a second staging buffer, or the second set
@@ -14,10 +16,13 @@
 //! Where the GPU computes in the host's memory (lavapipe, integrated GPUs) the results are not
 //! copied at all: the CPU maps the batch buffers the shader wrote ([`Readback::Mapped`]).
 
+#[cfg(not(target_arch = "wasm32"))]
+use illum_gpu::readback;
 use illum_gpu::readback::PendingRead;
-use illum_gpu::{readback, wgpu};
+use illum_gpu::wgpu;
 use web_time::Instant;
 
+use super::caustic::PassKey;
 use super::{PathTracer, StepReport, TIMED_PASS};
 use crate::PathTraceError;
 use crate::batch::{self, BatchBuffers, SLOT_BYTES};
@@ -85,12 +90,30 @@ impl PathTracer {
         Ok(())
     }
 
+    /// The caustic's pass that the active pass pairs with, when the light tracer runs.
+    fn caustic_key(&self) -> Option<PassKey> {
+        let pass = self.pass.as_ref()?;
+        self.caustic.as_ref()?;
+        Some(PassKey {
+            first_sample: self.sample_offset + pass.sample_base,
+            spp: pass.plan.spp,
+            chunk: self.chunk_samples,
+        })
+    }
+
     /// Traces one band and folds it, waiting for the readback (the band launched ahead by the
     /// previous call, if there is one), and launches the pass's next band before folding.
+    #[cfg(not(target_arch = "wasm32"))]
     pub(super) fn submit_band(&mut self) -> Result<StepReport, PathTraceError> {
         let AheadBand { band } = match self.ahead.take() {
             Some(ahead) => ahead,
-            None => AheadBand { band: self.begin_band(self.mapped_readback)? },
+            None => {
+                // The caustic's frames of this pass, traced once, before its first band.
+                if let Some(key) = self.caustic_key() {
+                    self.caustic.as_mut().expect("keyed above").prepare_pass(&self.gpu, key)?;
+                }
+                AheadBand { band: self.begin_band(self.mapped_readback)? }
+            }
         };
         // Folded straight from the mapping: at 1024 x 1024 a band is many megabytes, and
         // copying it out first (allocating and faulting in fresh pages) cost time for nothing.
@@ -135,6 +158,7 @@ impl PathTracer {
     }
 
     /// Launches the pass's next band, then folds `band` from its read-back bytes.
+    #[cfg(not(target_arch = "wasm32"))]
     fn launch_ahead_and_finish(
         &mut self,
         band: &Band,
@@ -155,6 +179,7 @@ impl PathTracer {
     /// viewer drawing its window) would have that time counted as the band's cost. The planner
     /// would then shrink every later band toward one row, a feedback that once cut the viewer's
     /// throughput to about 1/500 of `render`'s.
+    #[cfg(not(target_arch = "wasm32"))]
     fn launch_ahead(&mut self, band: &Band) -> Result<(), PathTraceError> {
         if self.caustic.is_some()
             || self.caller_absence > AHEAD_MAX_ABSENCE
@@ -170,6 +195,13 @@ impl PathTracer {
     /// folds the one in flight once its mapping is done. `None` while it is not; never waits.
     pub(super) fn poll_band(&mut self) -> Result<Option<StepReport>, PathTraceError> {
         if self.in_flight.is_none() {
+            // The caustic's frames of this pass come first, read back dispatch by dispatch over
+            // as many calls as it takes.
+            if let Some(key) = self.caustic_key()
+                && !self.caustic.as_mut().expect("keyed above").poll_pass(&self.gpu, key)?
+            {
+                return Ok(None);
+            }
             self.launch_band()?;
         }
         let Some(result) = self.in_flight.as_ref().and_then(|f| f.read.poll(&self.gpu)) else {
@@ -232,10 +264,13 @@ impl PathTracer {
         params.sample_count = spp;
         params.chunk_samples = chunk;
         self.gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&params));
-        // The caustic's frames of this pass (traced once, at its first band; after the params
-        // above, whose camera they read).
-        if let Some(caustic) = &mut self.caustic {
-            caustic.prepare_pass(&self.gpu, self.sample_offset + sample_base, spp, chunk)?;
+        // The caustic's frames of this pass were folded before its first band (the callers
+        // above): `finish_band` pairs them with the band's chunks.
+        if let Some(key) = self.caustic_key() {
+            debug_assert!(
+                self.caustic.as_ref().is_some_and(|c| c.holds(key)),
+                "caustic pass {key:?} not ready"
+            );
         }
 
         let bytes = slots * SLOT_BYTES;
@@ -438,11 +473,14 @@ pub(super) enum Readback {
     /// A staging buffer they were copied into: the sums, then the sums of squares, then the
     /// timestamps.
     Staging(wgpu::Buffer),
-    /// The batch buffers the shader wrote, and the band's timestamps (when timed).
+    /// The batch buffers the shader wrote, and the band's timestamps (when timed). Read only by
+    /// the blocking readback, which the web build has not.
+    #[cfg_attr(target_arch = "wasm32", allow(dead_code))]
     Mapped { sum: wgpu::Buffer, sum_sq: wgpu::Buffer, timestamps: Option<wgpu::Buffer> },
 }
 
-/// A band submitted while the one before it is folded.
+/// A band submitted while the one before it is folded (blocking readback: native only).
+#[cfg(not(target_arch = "wasm32"))]
 pub(super) struct AheadBand {
     band: Band,
 }
