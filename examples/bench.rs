@@ -131,10 +131,13 @@ fn run(args: Args) -> anyhow::Result<()> {
         let mut tracer = PathTracer::with_options(&gpu, &scene, options)?;
         tracer.set_mapped_readback(!config.staging_copy);
         let readback = if tracer.mapped_readback() { "mapped" } else { "staging copy" };
-        // Warm-up, one untimed run of the row: compiles the pipeline on the driver, teaches the
-        // planner the cost, and grows the batch buffers to the bands the timed runs use (a first
-        // band into freshly allocated buffers pays their page faults, 20 to 30 ms at 1024 x 1024).
-        tracer.render_to_spp(config.spp)?;
+        // Warm-up, an untimed run of the row up to 16 spp: compiles the pipeline on the driver,
+        // teaches the planner the cost, and grows the batch buffers to the bands the timed runs
+        // use (a first band into freshly allocated buffers pays their page faults). 16 spp do
+        // all three (a band's size follows the time per submission, not the spp) and keep the
+        // generic rows' warm-up short: a whole 64-spp run of the generic pipeline at 8 bounces
+        // took longer than everything else in `--quick`.
+        tracer.render_to_spp(config.spp.min(16))?;
         let (mut wall, mut gpu_rate, mut per_submission) = (Vec::new(), Vec::new(), Vec::new());
         for _ in 0..args.runs {
             tracer.reset();

@@ -1,5 +1,6 @@
 //! [`RasterRenderer`]: owns the GPU resources and turns a scene plus [`Options`] into frames.
 
+#[cfg(not(target_arch = "wasm32"))]
 use std::ops::ControlFlow;
 
 use crate::scene::RasterScene;
@@ -271,6 +272,7 @@ impl RasterRenderer {
         self.read_frame(encoder)
     }
 
+    #[cfg(not(target_arch = "wasm32"))]
     /// [`Self::render`] for a long render: the main pass in bands of `rows_per_band` rows
     /// (rounded up to a multiple of 64, the tile side of Mesa's llvmpipe, so that no band edge
     /// cuts a tile), each its own submission, waited for before the next; the shadow map and
@@ -307,6 +309,7 @@ impl RasterRenderer {
         Ok(Some(self.read_frame(encoder)?.image))
     }
 
+    #[cfg(not(target_arch = "wasm32"))]
     /// Copies the output (and the pass times) into the staging buffer, submits `encoder` and
     /// reads the frame back.
     fn read_frame(&mut self, mut encoder: wgpu::CommandEncoder) -> Result<Frame, RasterError> {
@@ -367,7 +370,7 @@ impl RasterRenderer {
     /// times (reading them back would wait): always `None`.
     #[cfg(target_arch = "wasm32")]
     pub fn draw(&mut self, options: &Options) -> Result<Option<PassTimes>, RasterError> {
-        let encoder = self.record(options)?;
+        let encoder = self.record(options, None)?;
         self.gpu.queue.submit([encoder.finish()]);
         self.gpu.check()?;
         Ok(None)

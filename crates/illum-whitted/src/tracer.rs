@@ -1,6 +1,7 @@
 //! The Whitted ray tracer's GPU side: buffers, the compute pipeline, its dispatches (one, or
 //! parts of the image for a long render), readback.
 
+#[cfg(not(target_arch = "wasm32"))]
 use std::ops::ControlFlow;
 
 use illum_gpu::buffers::{buffer_bind_group, dispatch};

@@ -34,6 +34,7 @@ const WORKGROUP: u32 = 8;
 /// Longest time a caller may take between two `render_step` calls and still have bands launched
 /// ahead for it (see `launch_ahead`): a render loop's progress bar takes microseconds, a
 /// viewer's frame tens of milliseconds.
+#[cfg(not(target_arch = "wasm32"))]
 const AHEAD_MAX_ABSENCE: std::time::Duration = std::time::Duration::from_millis(1);
 
 impl PathTracer {
