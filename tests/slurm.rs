@@ -37,9 +37,10 @@ const SIZE: u32 = 64;
 const README_SPP: u32 = 4096;
 
 /// `scripts/slurm-render.sh`'s run: not a multiple of 16, so the last range ends inside a
-/// chunk, and enough samples per task that a task is still rendering after its first
-/// checkpoint (one second in) when the test stops it.
-const SCRIPT_SPP: u32 = 12008;
+/// chunk, and enough samples per task (9002, about 3 s at lavapipe's 12 M samples/s on 2 cores)
+/// that a task is still rendering after its first checkpoint (a quarter second in) when the
+/// test stops it. With 3002 a task finished before the signal on a fast host.
+const SCRIPT_SPP: u32 = 36008;
 const SCRIPT_TASKS: u32 = 4;
 
 fn root() -> PathBuf {
@@ -528,7 +529,7 @@ fn readme_recipe_on_slurm(cluster: &Cluster) {
 /// refused, the task finished from its checkpoint with the commands the script printed.
 fn script_with_a_stopped_task(cluster: &Cluster) {
     let dir = work_dir("slurm-script");
-    let mut render_options = vec!["--checkpoint-seconds", "1"];
+    let mut render_options = vec!["--checkpoint-seconds", "0.25"];
     let progress = render_prints_progress_lines();
     if progress {
         render_options.extend(["--progress-seconds", "1"]);

@@ -150,7 +150,7 @@ mod tests {
         // submission, 2^17 = 131,072 samples.
         let mut planner = BatchPlanner::new(2f64.powi(-6));
         planner.record(1 << 20, 0.125);
-        // 300 x 300 at 2 spp is 180,000 samples, 21 ms: above the target.
+        // 300 x 300 at 2 spp is 180,000 samples: more than the target's 131,072.
         assert_eq!(planner.plan(300, 300, 1000).rows, 131_072 / 600, "split without a cap");
         planner.set_whole_passes_up_to(Some(1 << 20));
         assert_eq!(planner.plan(300, 300, 1000), PassPlan { spp: 2, rows: 300 });

@@ -5,8 +5,8 @@
 //! window's size). The pacer measures the rest of the frame and gives the path tracer what is
 //! left of [`TARGET_FRAME_SECONDS`], and at least as much as the rest takes (up to
 //! [`LONGEST_SHARE`]): with the view still, the path tracer has at least half of each frame, so
-//! that it gathers at least about half of `render`'s throughput, and where drawing the window
-//! takes under 40 ms the window stays at 12 fps. While the view changes (a camera drag, a new
+//! that it gathers about half of `render`'s throughput or more, and where drawing the window
+//! takes less than half the target frame the window keeps the target's rate. While the view changes (a camera drag, a new
 //! setting) it gets [`MOVING_SECONDS`], so that the window follows the mouse with a fresh
 //! low-spp image every frame.
 
