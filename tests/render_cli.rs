@@ -9,28 +9,13 @@
 //! shared helpers at the top.
 
 use std::io::{BufRead, BufReader};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Child, Command, Output, Stdio};
 
-/// The render example's executable.
-fn render_binary() -> PathBuf {
-    let exe = std::env::current_exe().expect("test binary path");
-    // target/<profile>/deps/render_cli-HASH -> target/<profile>/examples/render
-    let profile_dir = exe.parent().and_then(Path::parent).expect("target/<profile>");
-    let binary = profile_dir.join("examples").join(format!("render{}", std::env::consts::EXE_SUFFIX));
-    assert!(
-        binary.exists(),
-        "{} is missing: `cargo test` builds it; alone, run `cargo build --example render`",
-        binary.display()
-    );
-    binary
-}
+#[path = "common/binary.rs"]
+mod binary;
 
-fn render(args: &[&str]) -> Command {
-    let mut command = Command::new(render_binary());
-    command.args(args).current_dir(env!("CARGO_MANIFEST_DIR"));
-    command
-}
+use binary::{example_binary, field, metadata, render, statistics_bits, text};
 
 fn run(args: &[&str]) -> Output {
     render(args).output().expect("the render example starts")
@@ -45,10 +30,6 @@ fn run_to(flags: &str, outputs: &[&Path]) -> Output {
     run(&args)
 }
 
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
-
 /// Asserts that a run of `case` (what the test tried, for the failure message) failed and that
 /// its message names every one of `expected`; the message is shown when either does not hold.
 fn assert_refused(out: &Output, case: &str, expected: &[&str]) {
@@ -57,16 +38,6 @@ fn assert_refused(out: &Output, case: &str, expected: &[&str]) {
     for part in expected {
         assert!(stderr.contains(part), "{case}: the refusal lacks {part:?}: {stderr}");
     }
-}
-
-/// The `illum.*` metadata of an EXR the example wrote.
-fn metadata(path: &Path) -> illum::image::ExrMetadata {
-    let (_, attributes) = illum::image::load_exr(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    illum::image::ExrMetadata::from_attributes(path, &attributes).expect("parses").expect("illum metadata")
-}
-
-fn field(meta: &illum::image::ExrMetadata, key: &str) -> String {
-    meta.get(key).unwrap_or_else(|| panic!("no illum.{key} in {meta:?}")).to_owned()
 }
 
 fn assert_no_panic(output: &Output) {
@@ -317,11 +288,6 @@ fn a_signal_before_the_first_complete_pass_writes_nothing_and_says_so() {
     }
 }
 
-/// The examples' executables, found like [`render_binary`].
-fn example_binary(name: &str) -> PathBuf {
-    render_binary().with_file_name(format!("{name}{}", std::env::consts::EXE_SUFFIX))
-}
-
 /// Every example of `examples/`: a `NAME.rs` file or a `NAME/main.rs` folder.
 fn example_names() -> Vec<String> {
     let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples");
@@ -502,14 +468,6 @@ fn merge(args: &[&str]) -> Output {
 
 fn checkpoint(path: &Path) -> illum::pathtrace::checkpoint::Checkpoint {
     illum::pathtrace::checkpoint::load_checkpoint(path).unwrap_or_else(|e| panic!("{e}"))
-}
-
-/// Every pixel's f64 sum, sum of squares and count, as bits (for exact comparisons).
-fn statistics_bits(path: &Path) -> Vec<u64> {
-    let c = checkpoint(path);
-    let state = c.accumulator.state();
-    let floats = state.sum.iter().chain(state.sum_sq).flatten().map(|v| v.to_bits());
-    floats.chain(state.count.iter().copied()).collect()
 }
 
 /// The largest relative difference between two checkpoints' per-pixel sums and sums of squares

@@ -25,6 +25,11 @@ use std::process::{Command, Output};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
+#[path = "common/binary.rs"]
+mod binary;
+
+use binary::{example_binary, text};
+
 /// How long a job may take before the test gives up and shows the queue and the logs: a guard
 /// against a cluster that never runs the job, far above what any job here needs.
 const JOB_DEADLINE: Duration = Duration::from_secs(900);
@@ -45,23 +50,6 @@ const SCRIPT_TASKS: u32 = 4;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// An example's executable, next to the test binary: target/<profile>/examples/NAME.
-fn example_binary(name: &str) -> PathBuf {
-    let exe = std::env::current_exe().expect("test binary path");
-    let profile_dir = exe.parent().and_then(Path::parent).expect("target/<profile>");
-    let binary = profile_dir.join("examples").join(format!("{name}{}", std::env::consts::EXE_SUFFIX));
-    assert!(
-        binary.exists(),
-        "{} is missing: `cargo test` builds it; alone, run `cargo build --example render --example merge`",
-        binary.display()
-    );
-    binary
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
 }
 
 fn runs(program: &str, args: &[&str]) -> bool {
