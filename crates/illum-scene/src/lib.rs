@@ -35,6 +35,7 @@ mod camera;
 mod error;
 mod features;
 mod file;
+mod frame;
 mod lights;
 mod materials;
 mod paths;

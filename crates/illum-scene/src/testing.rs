@@ -188,3 +188,37 @@ struct Case {
     allowed: Option<String>,
     syntax: Option<String>,
 }
+
+/// Scene text with `offset` added to every position it gives: the camera's eye and target,
+/// each sphere's centre, each quad's corner, and each box's centre (a box given by min and max
+/// moves by its translation). Directions and lengths stay, so a renderer whose image does not
+/// depend on where the scene sits draws the same image. Panics on text that is not TOML.
+pub fn moved(text: &str, offset: [f64; 3]) -> String {
+    let mut table: toml::Table = text.parse().unwrap_or_else(|e| panic!("scene text is not TOML: {e}"));
+    let shift = |value: &mut toml::Value| {
+        let array = value.as_array_mut().expect("a position is an array");
+        for (x, d) in array.iter_mut().zip(offset) {
+            let v = x.as_float().or_else(|| x.as_integer().map(|i| i as f64)).expect("a number");
+            *x = toml::Value::Float(v + d);
+        }
+    };
+    let camera = table.get_mut("camera").and_then(toml::Value::as_table_mut).expect("a [camera]");
+    shift(camera.get_mut("eye").expect("camera.eye"));
+    shift(camera.get_mut("target").expect("camera.target"));
+    let objects = table.get_mut("objects").and_then(toml::Value::as_array_mut);
+    for object in objects.into_iter().flatten().filter_map(toml::Value::as_table_mut) {
+        if let Some(s) = object.get_mut("sphere").and_then(toml::Value::as_table_mut) {
+            shift(s.get_mut("center").expect("sphere.center"));
+        }
+        if let Some(q) = object.get_mut("quad").and_then(toml::Value::as_table_mut) {
+            shift(q.get_mut("corner").expect("quad.corner"));
+        }
+        if let Some(b) = object.get_mut("box").and_then(toml::Value::as_table_mut) {
+            match b.get_mut("center") {
+                Some(center) => shift(center),
+                None => shift(b.entry("translate").or_insert(toml::Value::Array(vec![0.0.into(); 3]))),
+            }
+        }
+    }
+    toml::to_string(&table).expect("a table serialises")
+}
