@@ -40,9 +40,9 @@
 //! bit the render N spp would have made straight away; `--sample-range A..B` renders sample
 //! indices A to B-1 only, for the `merge` example to combine.
 //!
-//! Over 400 lines, one concept: the command a user runs, from its flags to its written files;
-//! each renderer's flags and loops are library modules (`illum::cli`, `raster_cli`,
-//! `whitted_cli`, `illum_pathtrace::progressive`).
+//! Over 450 lines: the command a user runs, from its flags to its written files; each renderer's
+//! flags and loops are library modules (`illum::cli`, `raster_cli`, `whitted_cli`,
+//! `illum_pathtrace::progressive`).
 
 use std::path::PathBuf;
 use std::time::Duration;

@@ -18,6 +18,8 @@
 //! Prerequisites (`.ci/run` installs them): `apt-get install slurm-wlm munge parallel`, and root
 //! to start slurmd when no cluster is up. Without them each test fails under CI (`CI` set)
 //! naming the install command, and elsewhere says loudly that it did not run.
+//!
+//! Over 450 lines: the cluster this test starts is set up and torn down beside the jobs it runs.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};

@@ -34,8 +34,7 @@
 //! flip-vs-time.png (log-log, one series per renderer), contact-sheet.png (each image beside
 //! its FLIP error map, labelled), regions.png.
 //!
-//! Over 400 lines, one concept: one study from its rows to its tables (the regions, plots, the
-//! cached reference and the CSV writer are library modules the convergence study shares).
+//! Over 450 lines: one study from its rows to its tables (shared parts are library modules).
 
 use std::path::PathBuf;
 use std::time::Instant;

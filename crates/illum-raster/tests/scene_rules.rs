@@ -9,8 +9,6 @@
 //! refusals of edits of the scene are data, `cases/scene_rules.toml`, checked by one test; the
 //! tests here check what a refusal cannot say: what is accepted next to them, what the physical
 //! scene accepts and the rasterizer refuses, and edits that are not one replacement.
-//!
-//! Long (one test per rule) but one concept: every rule of the raster's view of a scene file.
 
 use glam::{Vec2, Vec3};
 use illum_gpu::wgpu;

@@ -16,8 +16,7 @@
 //! arrived or the exposure changed; the f64 statistics are only read for the panel's numbers and
 //! for saving.
 //!
-//! Over 450 lines, one concept: the path tracer's mode of the viewer (its settings, its panel,
-//! its stepping and saving), which reads better whole than split between widgets and state.
+//! Over 450 lines: the path tracer's mode (settings, panel, stepping, saving) reads best whole.
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;

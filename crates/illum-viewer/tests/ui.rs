@@ -8,8 +8,7 @@
 //! All harnesses share one device, as the real window has one (a device per harness would
 //! compile every pipeline again: the pipeline caches belong to each device's `GpuContext`).
 //!
-//! Over 400 lines, one concept: each test drives the same app through a different user action,
-//! and they share the harness setup above.
+//! Over 450 lines: each test drives the same app through one user action, on one shared harness.
 
 use std::sync::OnceLock;
 
