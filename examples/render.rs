@@ -146,7 +146,7 @@ struct Args {
 }
 
 /// The default stop rules of a render given no stop-rule flag: a clean image in a few seconds
-/// on a 2-core machine without a GPU (the Cornell box reaches about 3% in 5 s there).
+/// on a 2-core machine without a GPU (the README's headline has what it reaches there).
 const DEFAULT_TARGET_ERROR: f64 = 0.02;
 const DEFAULT_TIME_BUDGET: Duration = Duration::from_secs(5);
 const DEFAULT_CHECKPOINT: Duration = Duration::from_secs(60);

@@ -4,12 +4,11 @@
 # `<!-- headline -->` and `<!-- ladder-summary -->` markers), each with the date and the CPU:
 #
 #     scripts/readme-figures.sh              pictures, the ladder, then the headline figures
-#     scripts/readme-figures.sh --headline   only the headline figures (a few minutes)
+#     scripts/readme-figures.sh --headline   only the headline figures
 #
 # Timings are only meaningful on an idle machine (a parallel build doubles them), and absolute
 # ones only on the host named; the headline leads with ratios measured side by side. Needs the
-# Vulkan driver, and xvfb-run for the viewer (scripts/setup.sh installs both). About 10 minutes
-# after the release build on this project's 2-core machine.
+# Vulkan driver, and xvfb-run for the viewer (scripts/setup.sh installs both).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 

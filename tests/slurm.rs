@@ -44,9 +44,8 @@ const SIZE: u32 = 64;
 const README_SPP: u32 = 4096;
 
 /// `scripts/slurm-render.sh`'s run: not a multiple of 16, so the last range ends inside a
-/// chunk, and enough samples per task (9002, about 3 s at lavapipe's 12 M samples/s on 2 cores)
-/// that a task is still rendering after its first checkpoint (a quarter second in) when the
-/// test stops it. With 3002 a task finished before the signal on a fast host.
+/// chunk, and enough samples per task (9002) that a task is still rendering after its first
+/// checkpoint (a quarter second in) when the test stops it, on a fast host too.
 const SCRIPT_SPP: u32 = 36008;
 const SCRIPT_TASKS: u32 = 4;
 

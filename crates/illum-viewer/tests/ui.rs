@@ -88,7 +88,7 @@ fn switching_modes_keeps_each_modes_settings() {
 #[test]
 fn changing_bounces_restarts_the_accumulation() {
     let mut harness = harness(Mode::PathTrace);
-    // A pass may take several 15 ms slices when other tests load the machine.
+    // A pass may take several of the pacer's slices when other tests load the machine.
     for _ in 0..100 {
         harness.run_steps(1);
         if spp(&harness) > 0 {
