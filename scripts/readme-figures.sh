@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Regenerates every picture the README shows and re-measures every number it quotes, from the
-# code as it is now, and writes the numbers into the README's generated blocks (between the
-# `<!-- headline -->` and `<!-- ladder-summary -->` markers), each with the date and the CPU:
+# code as it is now, and writes the numbers into the generated blocks of the README (`headline`,
+# `ladder-summary`) and of docs/performance*.md (`bench-quick`, `viewer-bench`, `raster-bench`),
+# each with the date and the CPU:
 #
 #     scripts/readme-figures.sh              pictures, the ladder, then the headline figures
 #     scripts/readme-figures.sh --headline   only the headline figures
@@ -81,3 +82,4 @@ else
         | tee "$out/vs-mitsuba.txt"
 fi
 python3 scripts/readme-block.py headline "$out"
+python3 scripts/readme-block.py perf-tables "$out"
