@@ -32,8 +32,8 @@ pub struct Accumulator {
 ///
 /// Why: a sample is at most about the brightest emission times a geometric factor of the
 /// next-event estimator (light area / distance^2), and the GPU squares it in f32 and sums 16 such
-/// squares. Unscaled, `emission = 1e30` gave squares of 1e60, past f32's 3.4e38: an infinite
-/// variance while the image was still finite. Scaled, a sample squares in range unless that
+/// squares. Unscaled, `emission = 1e30` would give squares of 1e60, past f32's 3.4e38: an
+/// infinite variance while the image is still finite. Scaled, a sample squares in range unless that
 /// geometric factor exceeds about 1e13, so every radiance the validator accepts (up to f32::MAX)
 /// keeps a finite error estimate. Multiplying by a power of two is exact in binary floating point
 /// (short of subnormal numbers), so the scaled render is the unscaled one, bit for bit, times 2^-k;
