@@ -171,10 +171,10 @@ fn a_resize_keeps_the_submission_size_the_caller_chose() {
 
 #[test]
 fn settings_that_choose_code_rebuild_the_pipeline_on_update() {
-    // Hemisphere sampling and Russian roulette are shader defs (lavapipe would pay for the
-    // unused side of a branch on a parameter). A tracer updated to other settings must render
-    // exactly what a tracer built for them renders; with the old pipeline kept, the uniform
-    // sampler's image would be the cosine one's.
+    // Hemisphere sampling and Russian roulette are shader defs (on lavapipe code costs time by
+    // being in the shader, even where a parameter skips it). A tracer updated to other settings
+    // must render exactly what a tracer built for them renders; with the first pipeline kept,
+    // the uniform sampler's image would be the cosine one's.
     let base = Overrides { width: Some(16), height: Some(16), spp: Some(16), ..Default::default() };
     let scene = common::scene("cornell", base);
     let changed = common::scene(
