@@ -7,8 +7,8 @@
 //! from the frame's origin in f64 and rounded once (`frame.rs`); errors show them as the file
 //! gives them.
 //!
-//! Over 400 lines, one concept: the conversion of the raw file into a `Scene`, every rule in
-//! the order the file is read (the per-renderer sections are in `validate_sections.rs`).
+//! Over 450 lines: every rule of the conversion, in the order the file is read (the per-renderer
+//! sections are in `validate_sections.rs`).
 
 use std::collections::BTreeMap;
 
