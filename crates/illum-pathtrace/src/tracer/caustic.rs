@@ -1,4 +1,4 @@
-//! The caustic's light tracer on the host (shader `shaders/pathtrace/caustic.wgsl`; the
+//! The caustic's light tracer on the host (shader `crates/illum-pathtrace/shaders/caustic.wgsl`; the
 //! estimator and its path space are in docs/caustics.md).
 //!
 //! Frame k, N = width x height particles, pairs with sample index k of every pixel: pixel p's
