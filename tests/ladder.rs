@@ -11,9 +11,9 @@ use illum::gpu::GpuContext;
 use illum::image::RgbImage32;
 use illum::pathtrace::PathTracer;
 use illum::raster::{Options, RasterRenderer, RasterScene};
-use illum::regions::{Errors, Regions, compare};
 use illum::scene::{Bounces, Look, Scene};
 use illum::whitted::WhittedTracer;
+use illum_lab::regions::{Errors, Regions, compare};
 
 fn gpu() -> &'static GpuContext {
     static GPU: OnceLock<GpuContext> = OnceLock::new();

@@ -2,8 +2,8 @@
 
 use std::path::{Path, PathBuf};
 
-use illum::cli::SceneArgs;
-use illum::raster_cli::{RasterArgs, RasterRequest, render_raster_with};
+use illum_cli::SceneArgs;
+use illum_cli::raster::{RasterArgs, RasterRequest, render_raster_with};
 
 use crate::common;
 

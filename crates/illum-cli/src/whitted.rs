@@ -11,8 +11,8 @@ use illum_image::ExrMetadata;
 use illum_scene::{MAX_WHITTED_AA, MAX_WHITTED_DEPTH, Overrides, Scene};
 use illum_whitted::WhittedTracer;
 
-use crate::cli::{self, RenderRequest, given_flags};
 use crate::progress::{Reporter, describe_parts};
+use crate::{RenderRequest, given_flags};
 
 /// Flags that apply to the Whitted ray tracer only; each overrides the scene's `[whitted]`.
 #[derive(Args, Clone, Debug, Default)]
@@ -57,12 +57,12 @@ fn prepare(request: &WhittedRequest) -> anyhow::Result<(Scene, Vec<PathBuf>)> {
              --exposure, -o",
             request.scene.display(),
             flags.join(", "),
-            cli::verb(flags.len())
+            crate::verb(flags.len())
         );
     }
     let depth = in_range("--depth", request.args.depth, 0, MAX_WHITTED_DEPTH)?;
     let aa = in_range("--aa", request.args.aa, 1, MAX_WHITTED_AA)?;
-    let mut scene = Scene::load(&cli::resolve_scene_path(request.scene))?;
+    let mut scene = Scene::load(&crate::resolve_scene_path(request.scene))?;
     let sizes =
         Overrides { width: request.settings.width, height: request.settings.height, ..Default::default() };
     scene.apply_overrides(&sizes, "command line")?;
@@ -90,7 +90,7 @@ pub fn render_whitted(request: &WhittedRequest) -> anyhow::Result<()> {
     let (scene, outputs) = prepare(request)?;
     let long = request.long;
     long.exit_if_requested("before the render started");
-    let gpu = cli::gpu()?;
+    let gpu = crate::gpu()?;
     let started = Instant::now();
     let tracer = WhittedTracer::new(&gpu, &scene)?;
     long.exit_if_requested("while the Whitted ray tracer's pipeline was compiled");
@@ -134,7 +134,7 @@ pub fn render_whitted(request: &WhittedRequest) -> anyhow::Result<()> {
         "{}: {w}x{h}, Whitted ray tracer, depth {}, {} x {} rays per pixel, {seconds:.2} s including setup",
         scene.name, scene.whitted.depth, scene.whitted.aa, scene.whitted.aa
     );
-    progress.note(&format!("writing {}", cli::describe_outputs(&outputs)));
+    progress.note(&format!("writing {}", crate::describe_outputs(&outputs)));
     progress.finish();
     request.write(&outputs, &image, &metadata, &summary)?;
     long.exit_after_complete_image();

@@ -104,7 +104,7 @@ pub fn cached_reference(
     let mut tracer = PathTracer::new(gpu, &reference_scene)?;
     // A long render (minutes for the Whitted scene's caustic): a progress bar on a terminal.
     let rules = illum_pathtrace::StopRules { spp: Some(spp), target_error: None, time_budget: None };
-    let progress = crate::progress::RenderProgress::new();
+    let progress = illum_cli::progress::RenderProgress::new();
     let never = std::sync::atomic::AtomicBool::new(false);
     illum_pathtrace::render_progressive(&mut tracer, &rules, &never, |t, p| progress.update(t, p))?;
     progress.finish();
@@ -146,7 +146,7 @@ mod tests {
 
     #[test]
     fn the_reference_cache_key_changes_with_anything_that_changes_the_image() {
-        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/cornell.toml");
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/cornell.toml");
         let scene = Scene::load(Path::new(path)).unwrap();
         let (_, key) = reference_settings(&scene, 1024);
         assert_eq!(reference_settings(&scene.clone(), 1024).1, key, "the same scene, the same key");

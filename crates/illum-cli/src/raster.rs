@@ -13,7 +13,7 @@ use illum_gpu::GpuContext;
 use illum_image::ExrMetadata;
 use illum_raster::{Frame, Look, Options, PassTimes, RasterRenderer, RasterScene};
 
-use crate::cli::{self, RenderRequest};
+use crate::RenderRequest;
 use crate::progress::{Reporter, describe_parts};
 
 /// Flags that apply to rasterizer scenes only. Each effect is on unless the scene file or one of
@@ -48,7 +48,7 @@ pub struct RasterArgs {
 impl RasterArgs {
     /// The flags given, as typed.
     pub fn given(&self) -> Vec<&'static str> {
-        cli::given_flags(&[
+        crate::given_flags(&[
             (self.look.is_some(), "--look"),
             (self.no_shadows, "--no-shadows"),
             (self.no_pcf, "--no-pcf"),
@@ -84,7 +84,7 @@ impl RasterArgs {
                  scenes/whitted.toml); this render uses the path tracer",
                 scene.display(),
                 given.join(", "),
-                cli::verb(given.len())
+                crate::verb(given.len())
             );
         }
         Ok(())
@@ -97,7 +97,7 @@ pub type RasterRequest<'a> = RenderRequest<'a, RasterArgs>;
 /// Loads the scene, applies `--width` / `--height`, and checks every flag and output name,
 /// before any GPU work.
 fn prepare(request: &RasterRequest) -> anyhow::Result<(RasterScene, Options, Vec<PathBuf>)> {
-    let path = cli::resolve_scene_path(request.scene);
+    let path = crate::resolve_scene_path(request.scene);
     let flags = request.refused_flags();
     if !flags.is_empty() {
         bail!(
@@ -106,7 +106,7 @@ fn prepare(request: &RasterRequest) -> anyhow::Result<(RasterScene, Options, Vec
              --no-fresnel, --no-antialiasing, --width, --height, --encoding, --exposure, -o",
             request.scene.display(),
             flags.join(", "),
-            cli::verb(flags.len())
+            crate::verb(flags.len())
         );
     }
     let mut scene = RasterScene::load(&path)?;
@@ -119,7 +119,7 @@ fn prepare(request: &RasterRequest) -> anyhow::Result<(RasterScene, Options, Vec
 /// Renders a rasterizer scene as `request` says, creating the GPU context.
 pub fn render_raster(request: &RasterRequest) -> anyhow::Result<()> {
     let (scene, options, outputs) = prepare(request)?;
-    let gpu = cli::gpu()?;
+    let gpu = crate::gpu()?;
     render_prepared(&gpu, &scene, &options, &outputs, request)
 }
 
@@ -238,7 +238,7 @@ fn render_prepared(
         times.map(|t| format!(", {t}")).unwrap_or_default()
     );
     if let Some(progress) = progress {
-        progress.note(&format!("writing {}", cli::describe_outputs(outputs)));
+        progress.note(&format!("writing {}", crate::describe_outputs(outputs)));
         progress.finish();
     }
     request.write(outputs, &frame.image, &metadata, &summary)?;

@@ -1,4 +1,18 @@
-//! Command-line pieces shared by the examples: the scene flags and device setup.
+//! illum-cli: the command-line front end the examples share (`render`, `merge`, and the flags
+//! and device setup of every tool), kept out of the renderer crates and the `illum` facade so
+//! that a program linking a renderer does not link clap, indicatif or signal handling.
+//!
+//! - this module: the scene flags ([`SceneArgs`]), loading, device setup, output files and
+//!   [`main_with`], which runs an example's `run` and prints its error;
+//! - [`interrupt`]: Ctrl-C and SIGTERM for long renders;
+//! - [`progress`]: progress bars and log lines;
+//! - [`raster`], [`whitted`]: each renderer's path of the `render` example (the path tracer's
+//!   is in `examples/render.rs`).
+
+pub mod interrupt;
+pub mod progress;
+pub mod raster;
+pub mod whitted;
 
 use std::path::{Path, PathBuf};
 
