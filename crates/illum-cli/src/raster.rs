@@ -10,7 +10,6 @@ use anyhow::bail;
 use clap::Args;
 use illum_gpu::GpuContext;
 
-use illum_image::ExrMetadata;
 use illum_raster::{Frame, Look, Options, PassTimes, RasterRenderer, RasterScene};
 
 use crate::RenderRequest;
@@ -129,35 +128,6 @@ pub fn render_raster_with(gpu: &GpuContext, request: &RasterRequest) -> anyhow::
     render_prepared(gpu, &scene, &options, &outputs, request)
 }
 
-fn describe(options: &Options) -> String {
-    let e = &options.effects;
-    let effects: Vec<&str> = [
-        (e.shadows, "shadows"),
-        (e.pcf, "pcf"),
-        (e.refraction, "refraction"),
-        (e.reflection && options.look == Look::Enhanced, "reflection"),
-        (e.fresnel && options.look == Look::Enhanced, "fresnel"),
-        (e.antialiasing, "antialiasing"),
-    ]
-    .into_iter()
-    .filter_map(|(on, name)| on.then_some(name))
-    .collect();
-    format!(
-        "look {}, effects: {}",
-        options.look,
-        if effects.is_empty() { "none".into() } else { effects.join(" ") }
-    )
-}
-
-/// The `antialiasing` metadata field: how the frame's edges were drawn.
-fn antialiasing(options: &Options) -> &'static str {
-    if options.effects.antialiasing {
-        "analytic coverage, 1 sample per pixel"
-    } else {
-        "off, 1 sample per pixel"
-    }
-}
-
 /// Pixels of the main pass per submission of a large frame: a fraction of a second on lavapipe,
 /// so that progress and Ctrl-C are seen that often. A frame of at most this many pixels (the
 /// default 1280 x 720 among them) is one submission, with its pass times.
@@ -218,22 +188,11 @@ fn render_prepared(
             t.shadow_ms, t.cube_ms, t.main_ms
         )
     });
-    // The raster's own settings; none of the path tracer's keys (spp, bounces, seed, sampling).
-    let metadata = ExrMetadata {
-        renderer: "raster".to_owned(),
-        scene: scene.name.clone(),
-        render_seconds: seconds,
-        fields: vec![
-            ("look".into(), options.look.to_string()),
-            ("options".into(), describe(options)),
-            ("antialiasing".into(), antialiasing(options).into()),
-            ("adapter".into(), gpu.adapter_info.name.clone()),
-        ],
-    };
+    let metadata = illum_raster::metadata::exr_metadata(scene, options, &gpu.adapter_info.name, seconds);
     let summary = format!(
         "{}: {width}x{height}, {}, {:.2} s including setup{}",
         scene.name,
-        describe(options),
+        illum_raster::metadata::describe(options),
         seconds,
         times.map(|t| format!(", {t}")).unwrap_or_default()
     );

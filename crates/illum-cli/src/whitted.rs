@@ -7,7 +7,6 @@ use std::time::Instant;
 
 use anyhow::bail;
 use clap::Args;
-use illum_image::ExrMetadata;
 use illum_scene::{MAX_WHITTED_AA, MAX_WHITTED_DEPTH, Overrides, Scene};
 use illum_whitted::WhittedTracer;
 
@@ -120,16 +119,7 @@ pub fn render_whitted(request: &WhittedRequest) -> anyhow::Result<()> {
         );
     };
     let seconds = started.elapsed().as_secs_f64();
-    let metadata = ExrMetadata {
-        renderer: "whitted".to_owned(),
-        scene: scene.name.clone(),
-        render_seconds: seconds,
-        fields: vec![
-            ("depth".into(), scene.whitted.depth.to_string()),
-            ("aa".into(), scene.whitted.aa.to_string()),
-            ("adapter".into(), gpu.adapter_info.name.clone()),
-        ],
-    };
+    let metadata = illum_whitted::metadata::exr_metadata(&scene, &gpu.adapter_info.name, seconds);
     let summary = format!(
         "{}: {w}x{h}, Whitted ray tracer, depth {}, {} x {} rays per pixel, {seconds:.2} s including setup",
         scene.name, scene.whitted.depth, scene.whitted.aa, scene.whitted.aa
