@@ -61,7 +61,7 @@ fn check_same_scene(path: &Path, metadata: Option<&ExrMetadata>, scene: &Scene) 
         );
         return Ok(());
     };
-    let expected = illum_pathtrace::checkpoint::scene_content_hash(scene);
+    let expected = illum_pathtrace::metadata::scene_hash(scene);
     if stored != expected {
         let name = metadata.map_or("(unnamed)", |m| m.scene.as_str());
         bail!(
@@ -83,7 +83,8 @@ pub fn cached_reference(
     label: &str,
 ) -> anyhow::Result<Reference> {
     let (reference_scene, key) = reference_settings(scene, spp);
-    let path = folder.join(format!("reference-{}-{:016x}.exr", scene.name, fnv1a(key.as_bytes())));
+    let path =
+        folder.join(format!("reference-{}-{:016x}.exr", scene.name, illum_scene::fnv1a_64(key.as_bytes())));
     if path.exists() {
         let (image, attributes) = load_exr(&path)?;
         let stored = ExrMetadata::from_attributes(&path, &attributes)?;
@@ -123,21 +124,30 @@ pub fn cached_reference(
 }
 
 /// The scene the reference is rendered with (cosine sampling, `spp`, a seed of its own), and
-/// its cache key: everything that changes the reference image, i.e. the whole scene as loaded
-/// and overridden (geometry, materials, emission, camera, bounces, seed, spp).
+/// its cache key: everything that changes the reference image, written out explicitly: the
+/// scene's content hash ([`Scene::content_hash`], with the version of its canonical form), the
+/// resolution and every `[pathtrace]` setting.
 pub fn reference_settings(scene: &Scene, spp: u32) -> (Scene, String) {
     let mut reference_scene = scene.clone();
     reference_scene.pathtrace.sampling = Sampling::Cosine;
     reference_scene.pathtrace.spp = spp;
     // A seed the measured runs do not use, so reference and test noise are independent.
     reference_scene.pathtrace.seed = scene.pathtrace.seed.wrapping_add(0x5eed);
-    let key = format!("{reference_scene:?}");
+    let (camera, settings) = (&reference_scene.camera, &reference_scene.pathtrace);
+    let key = format!(
+        "scene {} (canonical form {}), {}x{}, spp {}, bounces {}, seed {}, sampling {}, sequence {}, caustics {}",
+        illum_pathtrace::metadata::scene_hash(&reference_scene),
+        illum_scene::CONTENT_VERSION,
+        camera.width,
+        camera.height,
+        settings.spp,
+        settings.bounces,
+        settings.seed,
+        settings.sampling,
+        settings.sequence,
+        settings.caustics
+    );
     (reference_scene, key)
-}
-
-/// 64-bit FNV-1a: a stable hash for the cache's file name (the full key is checked on reuse).
-fn fnv1a(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3))
 }
 
 #[cfg(test)]
@@ -150,8 +160,8 @@ mod tests {
         let scene = Scene::load(Path::new(path)).unwrap();
         let (_, key) = reference_settings(&scene, 1024);
         assert_eq!(reference_settings(&scene.clone(), 1024).1, key, "the same scene, the same key");
-        // A copy with the light twice as bright and the same name (the case that used to reuse
-        // the old reference), more spp, another seed, another size.
+        // A copy with the light twice as bright and the same name (only the content tells them
+        // apart), more spp, another seed, size, bounce count, sequence, or the caustic's tracer.
         let mut brighter = scene.clone();
         for m in &mut brighter.materials {
             if let illum_scene::MaterialKind::Emitter { radiance } = &mut m.kind {
@@ -162,11 +172,23 @@ mod tests {
         seeded.pathtrace.seed += 1;
         let mut wider = scene.clone();
         wider.camera.width += 1;
+        let mut taller = scene.clone();
+        taller.camera.height += 1;
+        let mut deeper = scene.clone();
+        deeper.pathtrace.bounces = illum_scene::Bounces::Unbounded;
+        let mut low_discrepancy = scene.clone();
+        low_discrepancy.pathtrace.sequence = illum_scene::Sequence::LowDiscrepancy;
+        let mut caustics = scene.clone();
+        caustics.pathtrace.caustics = true;
         for (what, other) in [
             ("emission", reference_settings(&brighter, 1024).1),
             ("spp", reference_settings(&scene, 2048).1),
             ("seed", reference_settings(&seeded, 1024).1),
             ("width", reference_settings(&wider, 1024).1),
+            ("height", reference_settings(&taller, 1024).1),
+            ("bounces", reference_settings(&deeper, 1024).1),
+            ("sequence", reference_settings(&low_discrepancy, 1024).1),
+            ("caustics", reference_settings(&caustics, 1024).1),
         ] {
             assert_ne!(other, key, "{what} changed but the key did not");
         }
@@ -174,5 +196,9 @@ mod tests {
         let mut uniform = scene.clone();
         uniform.pathtrace.sampling = Sampling::Uniform;
         assert_eq!(reference_settings(&uniform, 1024).1, key);
+        // Nor does what only another renderer reads.
+        let mut raster = scene.clone();
+        raster.raster.pcf_radius += 1.0;
+        assert_eq!(reference_settings(&raster, 1024).1, key);
     }
 }

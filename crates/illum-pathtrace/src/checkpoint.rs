@@ -7,7 +7,7 @@
 //! samples (each f64 stored as two 32-bit words, since EXR has no 64-bit samples) and the u64
 //! count (two words as well). Its metadata ([`crate::metadata::exr_metadata`]) names the scene,
 //! every setting that changes the image, a hash of the scene's content
-//! ([`scene_content_hash`]), the first sample index (`sample_start`, for `--sample-range`), the
+//! ([`crate::metadata::scene_hash`]), the first sample index (`sample_start`, for `--sample-range`), the
 //! completed spp and a pass stopped inside (`partial_pass_spp`, `partial_pass_rows`).
 //!
 //! Why a resumed render equals a straight one: a sample's random numbers depend only on (seed,
@@ -43,30 +43,6 @@ pub const STATISTICS_LAYER: &str = "illum.statistics";
 pub const ALIGNED_LAYER: &str = "illum.statistics.aligned";
 
 const CHANNELS: [&str; 3] = ["R", "G", "B"];
-
-/// 64-bit FNV-1a of the scene's physical content: the camera's placement and field of view,
-/// materials, objects and lights, as parsed (so a comment, a key's order or the `[raster]`
-/// section do not change it; every number that changes the path-traced image does). The
-/// resolution is compared on its own, like the other settings. Written as 16 hex digits in
-/// `illum.scene_hash`.
-pub fn scene_content_hash(scene: &Scene) -> String {
-    let c = &scene.camera;
-    let content = format!(
-        "{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}",
-        c.eye,
-        c.target,
-        c.up,
-        c.vfov_deg,
-        scene.materials,
-        scene.objects,
-        scene.directional_light,
-        scene.environment
-    );
-    let hash = content
-        .bytes()
-        .fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3));
-    format!("{hash:016x}")
-}
 
 /// An error and its causes on one line ("reading x.exr as EXR failed: unexpected end of file").
 fn with_causes(error: &dyn std::error::Error) -> String {
@@ -378,7 +354,7 @@ fn check_counts(accumulator: &Accumulator, spp_done: u32, partial: Option<(u32, 
 /// would store them: (key, value). Compared one by one so that a refusal names what differs.
 pub fn image_settings(scene: &Scene, options: TracerOptions) -> Vec<(&'static str, String)> {
     vec![
-        ("scene_hash", scene_content_hash(scene)),
+        ("scene_hash", crate::metadata::scene_hash(scene)),
         ("width", scene.camera.width.to_string()),
         ("height", scene.camera.height.to_string()),
         ("bounces", scene.pathtrace.bounces.to_string()),
@@ -660,17 +636,5 @@ mod tests {
         }
         let (hi, lo) = split(u64::MAX - 7);
         assert_eq!(join(hi, lo), u64::MAX - 7);
-    }
-
-    #[test]
-    fn the_hash_follows_content_not_settings() {
-        let scene = Scene::load(Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/cornell.toml")))
-            .unwrap();
-        let mut other = scene.clone();
-        other.pathtrace.spp = 4096;
-        other.raster.pcf_radius = 1.0;
-        assert_eq!(scene_content_hash(&scene), scene_content_hash(&other));
-        other.camera.vfov_deg += 1.0;
-        assert_ne!(scene_content_hash(&scene), scene_content_hash(&other));
     }
 }
