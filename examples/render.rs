@@ -469,7 +469,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         .as_ref()
         .map(|r| (illum::pathtrace::metadata::SAMPLE_END.to_owned(), r.end.to_string()));
     let mut last_checkpoint = std::time::Instant::now();
-    let mut checkpoint_error: Option<String> = None;
+    let mut checkpoint_error: Option<illum::pathtrace::checkpoint::CheckpointError> = None;
     let progress = RenderProgress::with_period(long.progress_period);
     let (reason, progressive) = render_progressive(&mut tracer, &rules, interrupt.flag(), |t, p| {
         progress.update(t, p);
