@@ -160,8 +160,9 @@ mod tests {
         let scene = Scene::load(Path::new(path)).unwrap();
         let (_, key) = reference_settings(&scene, 1024);
         assert_eq!(reference_settings(&scene.clone(), 1024).1, key, "the same scene, the same key");
-        // A copy with the light twice as bright and the same name (only the content tells them
-        // apart), more spp, another seed, size, bounce count, sequence, or the caustic's tracer.
+        // A copy with the light twice as bright and the same name (a key of the name alone
+        // would reuse the first scene's reference), more spp, another seed, size, bounce count,
+        // sequence, or the caustic's tracer.
         let mut brighter = scene.clone();
         for m in &mut brighter.materials {
             if let illum_scene::MaterialKind::Emitter { radiance } = &mut m.kind {

@@ -163,7 +163,7 @@ impl CheckpointHeader {
             "width" => Some(self.width.to_string()),
             "height" => Some(self.height.to_string()),
             "scene" => Some(self.metadata.scene.clone()),
-            // Files from before the caustic's light tracer existed rendered without it.
+            // A file without the key was rendered without the caustic's light tracer.
             "caustics" => Some(self.metadata.get(key).unwrap_or("off").to_owned()),
             _ => self.metadata.get(key).map(str::to_owned),
         }

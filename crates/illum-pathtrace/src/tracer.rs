@@ -412,14 +412,14 @@ impl PathTracer {
     pub fn update_scene(&mut self, scene: &Scene) -> Result<(), PathTraceError> {
         let gpu_scene = GpuScene::new(scene)?;
         if scene.objects != self.scene.objects || scene.materials != self.scene.materials {
-            let needed = specialise::specialise(scene, &gpu_scene);
+            let needed = specialise::traversal(&gpu_scene);
             let what = if self.options.traversal == Traversal::Specialised
                 && needed.source != self.traversal_source
             {
                 format!(
                     "its geometry needs a pipeline specialised for shapes {:?}, {} light(s) and shadow-ray occluders {:?}",
                     needed.kind_names(),
-                    needed.lights,
+                    gpu_scene.lights.len(),
                     needed.occluders
                 )
             } else {
