@@ -7,7 +7,8 @@
 //! reference's variance of the mean, on at least 97% of pixels; a correct renderer passes about
 //! 99%. Correctness itself is covered independently by the closed-form and oracle tests.
 //!
-//! Regenerate with `ILLUM_BLESS=1 cargo test --test pathtrace reference` after an intended change.
+//! Regenerate with `ILLUM_BLESS=1 cargo test --workspace --test pathtrace reference` after an
+//! intended change.
 
 use illum_image::{load_exr, save_diff_images, save_exr, z_test_pass_fraction};
 use illum_scene::{Bounces, Overrides};

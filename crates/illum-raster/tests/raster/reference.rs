@@ -8,7 +8,7 @@
 //! refraction moves thousands of pixels by tens of levels (`the_tolerance_tells_...` shows the
 //! metric catches that). The references are this renderer's output on lavapipe, checked in once
 //! the reference-free checks (`figure`, `effects`) held; regenerate them after an intended
-//! change with `ILLUM_BLESS=1 cargo test --test raster reference`.
+//! change with `ILLUM_BLESS=1 cargo test --workspace --test raster reference`.
 
 use illum_image::{Encoding, RgbImage32, save_diff_images, save_png};
 use illum_raster::{Look, Options};
