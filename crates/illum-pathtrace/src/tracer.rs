@@ -437,7 +437,7 @@ impl PathTracer {
         // caustic on or off, the hemisphere sampling, bounded or unbounded paths), build anew.
         let rebuild = (scene.camera.width, scene.camera.height)
             != (self.scene.camera.width, self.scene.camera.height)
-            || gpu_scene.defs != GpuScene::new(&self.scene)?.defs;
+            || gpu_scene.code != GpuScene::new(&self.scene)?.code;
         if rebuild {
             // An allocation belongs to its resolution; with the same one it carries over.
             let allocation = self

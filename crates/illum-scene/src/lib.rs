@@ -51,7 +51,7 @@ mod validate_sections;
 pub use camera::{Camera, CameraBasis, ClipPlanes};
 pub use content_hash::{CONTENT_TAG, CONTENT_VERSION, fnv1a_64};
 pub use error::{ParseValueError, SceneError};
-pub use features::Feature;
+pub use features::{Feature, FeatureSet};
 pub use lights::{DirectionalLight, Environment};
 pub use materials::{Checker, Material, MaterialKind};
 pub use paths::resolve_scene_path;
