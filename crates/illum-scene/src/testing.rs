@@ -275,3 +275,68 @@ pub fn scaled(text: &str, scale: f64) -> String {
     }
     toml::to_string(&table).expect("a table serialises")
 }
+
+/// Scene text with the whole scene turned by `angle_deg` about the axis `axis` through the world
+/// origin (right-handed), in f64: every position (the camera's eye and target, each sphere's
+/// centre, each quad's corner) and every direction (the camera's up, each quad's edges, the
+/// directional light's direction). Lengths, angles and radiance stay, so a renderer whose image
+/// does not depend on the scene's orientation draws the same image (the sky is uniform, so it
+/// turns with the scene). A box turns only about +Y in the file format: its turn is added to the
+/// box's `rotate_y` (a box given by centre and half-extent becomes min, max and that turn), and
+/// an axis other than +Y with a box in the scene is `Err` naming the box. Panics on text that is
+/// not TOML.
+pub fn rotated(text: &str, axis: [f64; 3], angle_deg: f64) -> Result<String, String> {
+    let mut table: toml::Table = text.parse().unwrap_or_else(|e| panic!("scene text is not TOML: {e}"));
+    let rotation = glam::DMat3::from_axis_angle(glam::DVec3::from(axis).normalize(), angle_deg.to_radians());
+    let number =
+        |x: &toml::Value| x.as_float().or_else(|| x.as_integer().map(|i| i as f64)).expect("a number");
+    let vector = |value: &toml::Value| {
+        let array = value.as_array().expect("a vector is an array");
+        glam::DVec3::new(number(&array[0]), number(&array[1]), number(&array[2]))
+    };
+    let to_value = |v: glam::DVec3| toml::Value::Array(v.to_array().map(toml::Value::Float).to_vec());
+    let turn = |value: &mut toml::Value| *value = to_value(rotation * vector(value));
+    let turn_keys = |table: &mut toml::Table, keys: &[&str]| {
+        for key in keys {
+            if let Some(value) = table.get_mut(*key) {
+                turn(value);
+            }
+        }
+    };
+    let camera = table.get_mut("camera").and_then(toml::Value::as_table_mut).expect("a [camera]");
+    camera.entry("up").or_insert(to_value(glam::DVec3::Y));
+    turn_keys(camera, &["eye", "target", "up"]);
+    if let Some(light) = table.get_mut("directional_light").and_then(toml::Value::as_table_mut) {
+        turn_keys(light, &["direction"]);
+    }
+    let about_y = glam::DVec3::from(axis).normalize().abs_diff_eq(glam::DVec3::Y, 1e-15);
+    let objects = table.get_mut("objects").and_then(toml::Value::as_array_mut);
+    for object in objects.into_iter().flatten().filter_map(toml::Value::as_table_mut) {
+        let name = object.get("name").and_then(toml::Value::as_str).unwrap_or("an object").to_owned();
+        if let Some(s) = object.get_mut("sphere").and_then(toml::Value::as_table_mut) {
+            turn_keys(s, &["center"]);
+        }
+        if let Some(q) = object.get_mut("quad").and_then(toml::Value::as_table_mut) {
+            turn_keys(q, &["corner", "edge_u", "edge_v"]);
+        }
+        if let Some(b) = object.get_mut("box").and_then(toml::Value::as_table_mut) {
+            if !about_y {
+                return Err(format!("box {name:?} turns only about +Y, not about {axis:?}"));
+            }
+            // world = R_a (R_b (local - pivot) + pivot + translate)
+            //       = R_(a+b) (local - pivot) + pivot + (R_a (pivot + translate) - pivot).
+            if let (Some(center), Some(half)) = (b.remove("center"), b.remove("half_extent")) {
+                let (center, half) = (vector(&center), vector(&half));
+                b.insert("min".into(), to_value(center - half));
+                b.insert("max".into(), to_value(center + half));
+            }
+            let pivot = b.get("pivot").map_or(glam::DVec3::ZERO, vector);
+            let translate = b.get("translate").map_or(glam::DVec3::ZERO, vector);
+            let rotate_y = b.get("rotate_y").map_or(0.0, number);
+            b.insert("pivot".into(), to_value(pivot));
+            b.insert("translate".into(), to_value(rotation * (pivot + translate) - pivot));
+            b.insert("rotate_y".into(), toml::Value::Float(rotate_y + angle_deg));
+        }
+    }
+    Ok(toml::to_string(&table).expect("a table serialises"))
+}
