@@ -15,7 +15,9 @@
 //!   two-sample |z| exceeds the two-sided level 1e-4 / 3, the cell fails when the count of failing
 //!   pixels reaches the binomial critical count at 1e-3, and each channel's whole-image mean
 //!   agrees within 4 standard errors;
-//! - the rasterizer, which has no oracle: every pixel finite;
+//! - the rasterizer, which has no oracle: every pixel finite (its sun rows' closed form, the
+//!   exact f64 shadow mask and the lit floor's colour, is checked by
+//!   `shadow_masks_with_the_light_grazing_and_overhead` in crates/illum-raster/tests/raster/extremes.rs);
 //! - or, for any renderer, a refusal whose message names the file and the field it refuses.
 //!
 //! Every figure is printed (`cargo test --workspace --test configurations -- --nocapture`).
