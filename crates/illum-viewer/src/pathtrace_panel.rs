@@ -460,7 +460,7 @@ impl PathTraceMode {
                     .map_err(|e| error_chain(&e))?;
                 (bytes, "image/png")
             };
-            crate::web::download(&name, &bytes, mime)?;
+            crate::browser::download(&name, &bytes, mime)?;
             Ok(PathBuf::from(name))
         }
         #[cfg(not(target_arch = "wasm32"))]
