@@ -46,4 +46,4 @@ pub use shaders::{
     CAUSTIC_SHADER, GENERIC_MATERIALS, GENERIC_TRAVERSAL, GEOMETRY_MODULE, PATHTRACE_SHADER,
     SAMPLING_MODULES, SCENE_MODULE, SPAWN_MODULE, SURFACES_MODULE, shader_modules,
 };
-pub use tracer::{CausticParams, PathTracer, StepReport, bounding_sphere, fixed_point};
+pub use tracer::{CausticParams, PathTracer, Readback, StepReport, bounding_sphere, fixed_point};
