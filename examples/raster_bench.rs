@@ -34,7 +34,7 @@ struct Args {
     /// Frame height in pixels.
     #[arg(long, default_value_t = 720)]
     height: u32,
-    /// Timed frames (the median is reported), 1 to 100000 (about 20 minutes at 12 ms a frame, twice).
+    /// Timed frames (the median is reported), 1 to 100000.
     #[arg(long, default_value_t = 60, value_parser = clap::value_parser!(u32).range(1..=100_000))]
     frames: u32,
     /// Untimed frames first (pipeline compilation, allocation), 0 to 10000.

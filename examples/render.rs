@@ -40,9 +40,9 @@
 //! bit the render N spp would have made straight away; `--sample-range A..B` renders sample
 //! indices A to B-1 only, for the `merge` example to combine.
 //!
-//! Over 400 lines, one concept: the command a user runs, from its flags to its written files;
-//! each renderer's flags and loops are library modules (`illum::cli`, `raster_cli`,
-//! `whitted_cli`, `illum_pathtrace::progressive`).
+//! Over 450 lines: the command a user runs, from its flags to its written files; each renderer's
+//! flags and loops are library modules (`illum::cli`, `raster_cli`, `whitted_cli`,
+//! `illum_pathtrace::progressive`).
 
 use std::path::PathBuf;
 use std::time::Duration;
@@ -146,7 +146,7 @@ struct Args {
 }
 
 /// The default stop rules of a render given no stop-rule flag: a clean image in a few seconds
-/// on a 2-core machine without a GPU (the Cornell box reaches about 3% in 5 s there).
+/// on a 2-core machine without a GPU (the README's headline has what it reaches there).
 const DEFAULT_TARGET_ERROR: f64 = 0.02;
 const DEFAULT_TIME_BUDGET: Duration = Duration::from_secs(5);
 const DEFAULT_CHECKPOINT: Duration = Duration::from_secs(60);

@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
-"""Writes one of the README's generated blocks from what scripts/readme-figures.sh measured.
+"""Writes the generated blocks of the README and the docs from what scripts/readme-figures.sh measured.
 
-    readme-block.py ladder-summary LADDER.csv   selected rows of the ladder, per region
-    readme-block.py headline DIR                the headline figures, from the outputs in DIR
+    readme-block.py ladder-summary LADDER.csv   README: selected rows of the ladder, per region
+    readme-block.py headline DIR                README: the headline figures, from the outputs in DIR
+    readme-block.py perf-tables DIR             docs/performance*.md: the bench tables, from DIR
 
-A block sits between `<!-- NAME: ... -->` and `<!-- /NAME -->` in README.md; everything between
+A block sits between `<!-- NAME: ... -->` and `<!-- /NAME -->` in its page; everything between
 the markers is replaced. Each block names the date and the CPU it was measured on, and leads
 with ratios measured side by side (absolute figures hold only for the host named).
 """
@@ -34,16 +35,16 @@ def host():
     return f"{datetime.date.today().isoformat()}, {cpu}, {os.cpu_count()} CPUs"
 
 
-def replace_block(name, text):
-    readme = open(README, encoding="utf-8").read()
+def replace_block(name, text, page=README):
+    readme = open(page, encoding="utf-8").read()
     pattern = re.compile(rf"(<!-- {re.escape(name)}:[^>]*-->\n).*?(<!-- /{re.escape(name)} -->)", re.S)
     if not pattern.search(readme):
-        sys.exit(f"README.md has no <!-- {name}: ... --> block")
+        sys.exit(f"{os.path.relpath(page, ROOT)} has no <!-- {name}: ... --> block")
     readme = pattern.sub(lambda m: m.group(1) + text.rstrip("\n") + "\n" + m.group(2), readme)
-    tmp = README + ".tmp"
+    tmp = page + ".tmp"
     with open(tmp, "w", encoding="utf-8") as f:
         f.write(readme)
-    os.replace(tmp, README)
+    os.replace(tmp, page)
 
 
 # The ladder's rows the README shows, and the regions beside the whole image.
@@ -139,7 +140,7 @@ def headline(directory):
                      "(1 / (relMSE x time)).")
     else:
         lines.append("- Against Mitsuba 3: not re-measured in this run (Mitsuba 3 not installed; "
-                     "`bench/vs_mitsuba.py` says how); earlier runs are in docs/performance.md.")
+                     "`bench/vs_mitsuba.py` says how); docs/performance.md has the last measured ratios.")
     # The default render and the 1% target (render).
     for name, label in (("render-default.txt", "`render` with no stop rule (Cornell box, 512 x 512)"),
                         ("render-1pct.txt", "`render --target-error 0.01` (Cornell box, 512 x 512)")):
@@ -168,7 +169,24 @@ def headline(directory):
     replace_block("headline", "\n".join(lines))
 
 
+def perf_tables(directory):
+    """The bench outputs as they were printed, each with the host it was measured on."""
+    measured = f"*Measured {host()}, by `scripts/readme-figures.sh`.*"
+    docs = os.path.join(ROOT, "docs")
+    bench = read(directory, "bench-quick.txt").strip()
+    if bench:
+        replace_block("bench-quick", f"{bench}\n\n{measured}", os.path.join(docs, "performance.md"))
+    viewer = read(directory, "bench-viewer.txt").strip()
+    if viewer:
+        replace_block("viewer-bench", f"{viewer}\n\n{measured}", os.path.join(docs, "performance.md"))
+    raster = read(directory, "raster-bench.txt").strip()
+    if raster:
+        replace_block("raster-bench", f"```text\n{raster}\n```\n\n{measured}",
+                      os.path.join(docs, "performance-raster.md"))
+
+
 if __name__ == "__main__":
-    if len(sys.argv) != 3 or sys.argv[1] not in ("ladder-summary", "headline"):
+    commands = {"ladder-summary": ladder_summary, "headline": headline, "perf-tables": perf_tables}
+    if len(sys.argv) != 3 or sys.argv[1] not in commands:
         sys.exit(__doc__)
-    {"ladder-summary": ladder_summary, "headline": headline}[sys.argv[1]](sys.argv[2])
+    commands[sys.argv[1]](sys.argv[2])

@@ -1,15 +1,15 @@
 #!/usr/bin/env bash
 # Regenerates every picture the README shows and re-measures every number it quotes, from the
-# code as it is now, and writes the numbers into the README's generated blocks (between the
-# `<!-- headline -->` and `<!-- ladder-summary -->` markers), each with the date and the CPU:
+# code as it is now, and writes the numbers into the generated blocks of the README (`headline`,
+# `ladder-summary`) and of docs/performance*.md (`bench-quick`, `viewer-bench`, `raster-bench`),
+# each with the date and the CPU:
 #
 #     scripts/readme-figures.sh              pictures, the ladder, then the headline figures
-#     scripts/readme-figures.sh --headline   only the headline figures (a few minutes)
+#     scripts/readme-figures.sh --headline   only the headline figures
 #
 # Timings are only meaningful on an idle machine (a parallel build doubles them), and absolute
 # ones only on the host named; the headline leads with ratios measured side by side. Needs the
-# Vulkan driver, and xvfb-run for the viewer (scripts/setup.sh installs both). About 10 minutes
-# after the release build on this project's 2-core machine.
+# Vulkan driver, and xvfb-run for the viewer (scripts/setup.sh installs both).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -82,3 +82,4 @@ else
         | tee "$out/vs-mitsuba.txt"
 fi
 python3 scripts/readme-block.py headline "$out"
+python3 scripts/readme-block.py perf-tables "$out"

@@ -6,7 +6,7 @@
 //! Why a window: GNU `timeout` signals the child and then its whole process group, Slurm and
 //! systemd signal every process of a job or unit, and a shell's Ctrl-C reaches every process
 //! of the foreground group. A render started that way receives each stop twice, microseconds
-//! apart; taken as a second request, the repeat ended the process before anything was written.
+//! apart; taken as a second request, the repeat would end the process before anything was written.
 //!
 //! After an interruption the program exits with the shell's convention, 128 + the signal's
 //! number of the first request: 130 for SIGINT, 143 for SIGTERM, so that `render && next-step`

@@ -19,5 +19,6 @@ pub use illum_gpu as gpu;
 pub use illum_image as image;
 pub use illum_pathtrace as pathtrace;
 pub use illum_raster as raster;
+pub use illum_rtcore as rtcore;
 pub use illum_scene as scene;
 pub use illum_whitted as whitted;

@@ -150,8 +150,8 @@ mod tests {
         let scene = Scene::load(Path::new(path)).unwrap();
         let (_, key) = reference_settings(&scene, 1024);
         assert_eq!(reference_settings(&scene.clone(), 1024).1, key, "the same scene, the same key");
-        // A copy with the light twice as bright and the same name (the case that used to reuse
-        // the old reference), more spp, another seed, another size.
+        // A copy with the light twice as bright and the same name (a key of the name alone
+        // would reuse the first scene's reference), more spp, another seed, another size.
         let mut brighter = scene.clone();
         for m in &mut brighter.materials {
             if let illum_scene::MaterialKind::Emitter { radiance } = &mut m.kind {

@@ -6,7 +6,7 @@
 //! `kill -TERM -- -PGID` (the group), two signals 1 ms apart, and SIGKILL after a checkpoint.
 //! Every run must leave a file that `--resume` continues to the straight render bit for bit, or,
 //! stopped before the first complete pass, say that nothing was written. The double delivery
-//! is a race (it lost the render in one run of four before the repeat window), so each case
+//! is a race (a render that takes the repeat for a second request loses its image), so each case
 //! runs [`RUNS`] times, at varying moments of the render.
 
 #![cfg(unix)]

@@ -5,8 +5,7 @@
 //! The example is built by `cargo test` (examples are built with the tests); this finds it next
 //! to the test binary, in `target/<profile>/examples/`.
 //!
-//! Over 400 lines, one concept: every test runs the same binary as a user would, through the
-//! shared helpers at the top.
+//! Over 450 lines: every test runs the binary as a user would, through the helpers at the top.
 
 use std::io::{BufRead, BufReader};
 use std::path::Path;

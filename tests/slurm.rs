@@ -18,6 +18,8 @@
 //! Prerequisites (`.ci/run` installs them): `apt-get install slurm-wlm munge parallel`, and root
 //! to start slurmd when no cluster is up. Without them each test fails under CI (`CI` set)
 //! naming the install command, and elsewhere says loudly that it did not run.
+//!
+//! Over 450 lines: the cluster this test starts is set up and torn down beside the jobs it runs.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -42,9 +44,8 @@ const SIZE: u32 = 64;
 const README_SPP: u32 = 4096;
 
 /// `scripts/slurm-render.sh`'s run: not a multiple of 16, so the last range ends inside a
-/// chunk, and enough samples per task (9002, about 3 s at lavapipe's 12 M samples/s on 2 cores)
-/// that a task is still rendering after its first checkpoint (a quarter second in) when the
-/// test stops it. With 3002 a task finished before the signal on a fast host.
+/// chunk, and enough samples per task (9002) that a task is still rendering after its first
+/// checkpoint (a quarter second in) when the test stops it, on a fast host too.
 const SCRIPT_SPP: u32 = 36008;
 const SCRIPT_TASKS: u32 = 4;
 

@@ -18,9 +18,6 @@
 //!
 //! Outputs in DIR: convergence.csv, convergence.md, bounces.csv, and the plots
 //! error-vs-time-sampling.png, error-vs-time-sequence.png, error-vs-spp.png, bounces.png.
-//!
-//! Over 400 lines, one concept: one study from its rows to its tables (plots, the cached
-//! reference and the CSV writer are library modules the ladder shares).
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};

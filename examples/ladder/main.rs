@@ -20,8 +20,8 @@
 //! a viewer pays it (no readback) and its GPU time from timestamp queries; the Whitted ray
 //! tracer's wall time per image (dispatch and readback); the path tracer's wall time to render
 //! that many samples per pixel from nothing (median of up to 3 runs).
-//! (Compute passes get no GPU time: lavapipe's timestamps around a compute dispatch read
-//! 0.06 to 0.08 ms whatever the work, 1 or 16 spp, so they do not measure it.)
+//! (Compute passes get no GPU time: on lavapipe the timestamps around a compute dispatch do not
+//! grow with its work, so they do not measure it.)
 //!
 //! The truth is a path-traced render with `--truth-spp` samples per pixel (`--truth-bounces`,
 //! by default unbounded; the caustic estimator where the scene has a caustic; cosine sampling;
@@ -34,8 +34,7 @@
 //! flip-vs-time.png (log-log, one series per renderer), contact-sheet.png (each image beside
 //! its FLIP error map, labelled), regions.png.
 //!
-//! Over 400 lines, one concept: one study from its rows to its tables (the regions, plots, the
-//! cached reference and the CSV writer are library modules the convergence study shares).
+//! Over 450 lines: one study from its rows to its tables (shared parts are library modules).
 
 use std::path::PathBuf;
 use std::time::Instant;

@@ -735,8 +735,8 @@ fn a_noisy_pixels_mean_does_not_drift_with_batching() {
     assert!(drift < 1e-6, "the mean drifted by {drift:.3e} (relative) from the f64 fold of its samples");
     // Chunks start at multiples of 16 samples either way, so the sums are the same floats.
     assert_eq!(one_pass, many_passes, "1 pass of {n} and {} passes of 16 must give identical means", n / 16);
-    // The test's power: one f32 sum over all 4096 samples of a pixel (the old one-sum-per-pass
-    // batches) is measurably off the exact fold.
+    // The test's power: one f32 sum over all 4096 samples of a pixel (a batch of a whole pass,
+    // without chunks) is measurably off the exact fold.
     let single_sum = pixel_means(&scene, n, n);
     let old = worst_relative_difference(&single_sum, &exact);
     println!("{n} spp summed in one f32 sum per pixel: worst relative difference {old:.3e}");

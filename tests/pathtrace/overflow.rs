@@ -1,6 +1,6 @@
 //! Radiance at the top of the f32 range. Validation accepts any finite emission up to f32::MAX;
-//! the GPU squares samples in f32 for the variance, so an unscaled `emission = 1e30` used to give
-//! an infinite error estimate while the image stayed finite. The tracer now uploads very bright
+//! the GPU squares samples in f32 for the variance, so an unscaled `emission = 1e30` would give
+//! an infinite error estimate while the image stayed finite. The tracer therefore uploads very bright
 //! lights scaled by a power of two 2^-k and the f64 fold scales back
 //! (`illum_pathtrace::accumulator::radiance_exponent`). These tests check the image, the error
 //! estimate, the EXR metadata and the viewer's display sum at the largest accepted value, and

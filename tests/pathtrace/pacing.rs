@@ -1,8 +1,8 @@
 //! The time a tracer counts as its bands' (what the planner learns the cost of a sample from)
 //! is the time its bands took, whoever calls `render_step`: a caller that goes away between
-//! steps (a viewer drawing its window) must not have its absence counted. When a band launched
-//! ahead was timed across the caller's absence, the planner took the window's drawing for the
-//! band's cost and shrank every later band toward one row.
+//! steps (a viewer drawing its window) must not have its absence counted. A band launched ahead
+//! and timed across the caller's absence would make the planner take the window's drawing for
+//! the band's cost and shrink every later band toward one row.
 //!
 //! Functional, not timed: the caller sleeps a known time between steps, and the time the tracer
 //! attributes to its bands must leave that out. (Comparing band sizes instead depends on the

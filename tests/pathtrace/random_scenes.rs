@@ -108,8 +108,8 @@ fn random_scene(rng: &mut Rng) -> String {
         let e = *rng.pick(&[1e-6, 1.0, 30.0, 1e6, 1e30, f32::MAX as f64]);
         text += &format!("[materials.light{l}]\nemission = [{e:e}, {:e}, 1.0]\n", e * rng.unit());
     }
-    // The caustic's light tracer compiles its pipelines for each scene (about 1.5 s on
-    // lavapipe): one scene with a sun in 16, about 10 a run.
+    // The caustic's light tracer compiles its own pipelines for each scene (slow on lavapipe):
+    // one scene with a sun in 16, about 10 a run.
     let caustics = sun && rng.next().is_multiple_of(16);
     text += &format!(
         "[pathtrace]\nbounces = {}\nseed = {}\nsampling = \"{}\"\ncaustics = {caustics}\n\n",

@@ -4,7 +4,7 @@
 
 use illum::pathtrace::PathTracer;
 use illum::pathtrace::gpu_scene::GpuScene;
-use illum::pathtrace::specialise::specialise;
+use illum::pathtrace::specialise::{light_choice_module, traversal};
 use illum::scene::{Bounces, Overrides, Sampling, Scene};
 
 use crate::common;
@@ -32,10 +32,10 @@ fn each_scene_file_picks_the_specialisation_it_should() {
     for (file, expected_occluders) in cases {
         let scene = common::scene(file, Overrides::default());
         let gpu_scene = GpuScene::new(&scene).expect("uploads");
-        let key = specialise(&scene, &gpu_scene);
+        let key = traversal(&gpu_scene);
         // Walls, floor, ceiling are axis-aligned boxes, the blocks rotated boxes, the light a quad.
         assert_eq!(key.kind_names(), ["aabb", "box", "quad"], "{file}");
-        assert_eq!(key.lights, 1, "{file}");
+        assert_eq!(gpu_scene.lights.len(), 1, "{file}");
         let mut occluders = names_of(&scene, &key.occluders);
         occluders.sort();
         // A wall cannot shadow a light inside the room; only the blocks can.
@@ -50,8 +50,9 @@ fn each_scene_file_picks_the_specialisation_it_should() {
             scattering.contains("default: { return surface_box(obj, p); }") && !scattering.contains("case "),
             "{file}: {scattering}"
         );
+        let choice = light_choice_module(&scene, &gpu_scene).source;
         assert!(
-            key.source.contains("return 0u;") && !key.source.contains("pick <"),
+            choice.contains("return 0u;") && !choice.contains("pick <"),
             "{file}: one light needs no selection"
         );
     }
@@ -77,10 +78,13 @@ fn cornell_with_sphere_and_two_lights() -> Scene {
 fn a_sphere_and_a_second_light_bring_their_code_and_nothing_else() {
     let scene = cornell_with_sphere_and_two_lights();
     let gpu_scene = GpuScene::new(&scene).expect("uploads");
-    let key = specialise(&scene, &gpu_scene);
+    let key = traversal(&gpu_scene);
     assert!(key.kind_names().contains(&"sphere"));
-    assert_eq!(key.lights, 2);
-    assert!(key.source.contains("hit_sphere(") && key.source.contains("pick <"));
+    assert_eq!(gpu_scene.lights.len(), 2);
+    assert!(
+        key.source.contains("hit_sphere(")
+            && light_choice_module(&scene, &gpu_scene).source.contains("pick <")
+    );
     let occluders = names_of(&scene, &key.occluders);
     assert!(occluders.contains(&"ball".to_owned()), "the ball can shadow the floor: {occluders:?}");
 
@@ -167,10 +171,10 @@ fn a_resize_keeps_the_submission_size_the_caller_chose() {
 
 #[test]
 fn settings_that_choose_code_rebuild_the_pipeline_on_update() {
-    // Hemisphere sampling and Russian roulette are shader defs (lavapipe would pay for the
-    // unused side of a branch on a parameter). A tracer updated to other settings must render
-    // exactly what a tracer built for them renders; with the old pipeline kept, the uniform
-    // sampler's image would be the cosine one's.
+    // Hemisphere sampling and Russian roulette are shader defs (on lavapipe code costs time by
+    // being in the shader, even where a parameter skips it). A tracer updated to other settings
+    // must render exactly what a tracer built for them renders; with the first pipeline kept,
+    // the uniform sampler's image would be the cosine one's.
     let base = Overrides { width: Some(16), height: Some(16), spp: Some(16), ..Default::default() };
     let scene = common::scene("cornell", base);
     let changed = common::scene(
@@ -197,8 +201,7 @@ fn settings_that_choose_code_rebuild_the_pipeline_on_update() {
 #[test]
 fn a_box_rotated_by_zero_rebuilds_exactly_the_axis_aligned_surface() {
     use glam::Vec3;
-    use illum::pathtrace::gpu_scene::{GpuObject, GpuShape, ObjectRecord, ShapeKind};
-    use illum::pathtrace::shaders::{GEOMETRY_MODULE, SPAWN_MODULE};
+    use illum::rtcore::{GpuObject, GpuShape, ObjectRecord, ShapeKind};
 
     let boxes = [
         (Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 2.0, 3.0)),
@@ -262,7 +265,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 ";
     let bytes = common::harness::run_compute(
         "surface harness",
-        &[SPAWN_MODULE, GEOMETRY_MODULE],
+        &illum::rtcore::shaders::core_modules(),
         source.into(),
         &[bytemuck::cast_slice(&records), bytemuck::cast_slice(&points)],
         points.len() as u64 * 64,

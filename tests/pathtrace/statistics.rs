@@ -100,9 +100,9 @@ fn the_low_discrepancy_sequence_is_unbiased_and_less_noisy() {
 #[test]
 fn the_low_discrepancy_sequence_is_less_noisy_on_the_whitted_scene_too() {
     // Sun, sky, checkerboard, mirror and glass with the caustic's light tracer, 8 bounces: many
-    // more dimensions than the Cornell box. The previous sequence (R_16, one Kronecker sequence
-    // of 16 dimensions) was worse here than independent numbers (relMSE 6.6e-4 against 4.1e-4
-    // at 160 x 90, 256 spp): this test failed with it.
+    // more dimensions than the Cornell box. One Kronecker sequence of 16 dimensions (R_16) is
+    // worse here than independent numbers and fails this test: a sequence must hold beyond the
+    // Cornell box's dimensions (docs/accuracy.md, "Independent against low-discrepancy numbers").
     let overrides = illum::scene::Overrides {
         width: Some(64),
         height: Some(36),

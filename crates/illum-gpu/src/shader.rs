@@ -1,6 +1,6 @@
 //! WGSL composition and validation.
 //!
-//! Shaders live in the workspace's `shaders/` folder and are embedded at compile time. Shared
+//! Each crate keeps its shaders in its own `shaders/` folder, embedded at compile time. Shared
 //! modules declare `#define_import_path illum::NAME` and are pulled in with `#import` by the
 //! naga_oil composer; `#ifdef` shader defs select code per pipeline. The result is a validated
 //! `naga::Module` handed to wgpu directly, so wgpu never re-parses WGSL.
@@ -14,8 +14,8 @@ use naga_oil::compose::{
 
 use crate::{GpuContext, GpuError};
 
-/// One WGSL file: its path relative to the workspace (for error messages) and its text. Files
-/// from `shaders/` are embedded (`shader_file!`); generated modules own their text.
+/// One WGSL file: its path relative to the workspace (for error messages) and its text. A
+/// crate's `shaders/` files are embedded (`shader_file!`); generated modules own their text.
 #[derive(Clone, Debug)]
 pub struct ShaderFile {
     pub path: Cow<'static, str>,
@@ -29,15 +29,16 @@ impl ShaderFile {
     }
 }
 
-/// Embeds `shaders/...` (a path relative to the workspace root) as a [`ShaderFile`].
+/// Embeds `shaders/...` of the calling crate (a path relative to its manifest) as a
+/// [`ShaderFile`] named `crates/<crate>/shaders/...`, its path in the workspace.
 #[macro_export]
 macro_rules! shader_file {
     ($path:literal) => {
         $crate::shader::ShaderFile {
-            path: ::std::borrow::Cow::Borrowed($path),
+            path: ::std::borrow::Cow::Borrowed(concat!("crates/", env!("CARGO_PKG_NAME"), "/", $path)),
             source: ::std::borrow::Cow::Borrowed(include_str!(concat!(
                 env!("CARGO_MANIFEST_DIR"),
-                "/../../",
+                "/",
                 $path
             ))),
         }

@@ -6,8 +6,7 @@
 //! image travel with it as custom text attributes named `illum.<field>`, so a reference image
 //! says how it was made.
 //!
-//! Over 400 lines with its tests (about 400 of code): writing and reading share one layout of
-//! parts, channels and attributes, which reads best side by side.
+//! Over 450 lines with its tests: writing and reading share one layout of parts and channels.
 
 use std::collections::HashMap;
 use std::fs::File;

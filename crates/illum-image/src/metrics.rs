@@ -4,9 +4,6 @@
 //! Non-finite pixel values are not filtered: they make RMSE / relMSE / bias NaN or infinite,
 //! which is the honest answer (check [`RgbImage32::has_non_finite`] first if that matters);
 //! in the Z-test a non-finite mean fails its pixel.
-//!
-//! One file for one concept, the measures of an image against a reference, kept whole (over
-//! 400 lines with their tests) so each metric's definition sits beside its checks.
 
 use crate::rgb_image::RgbImage32;
 

@@ -4,8 +4,7 @@
 //! number of finite samples, and the number of dropped (NaN/Inf) ones. Folding those batch sums in
 //! f64 keeps 10^6 spp free of drift: f32 only ever sums one short batch.
 //!
-//! Over 400 lines with its tests (about 350 of code): the statistics, their fold and what is
-//! estimated from them (mean, variance, error) are one type.
+//! Over 450 lines with its tests: the statistics, their fold and their estimates are one type.
 
 use illum_image::RgbImage32;
 // The epsilon of `illum_image::metrics::rel_mse` itself, so that the estimated and the measured
@@ -33,8 +32,8 @@ pub struct Accumulator {
 ///
 /// Why: a sample is at most about the brightest emission times a geometric factor of the
 /// next-event estimator (light area / distance^2), and the GPU squares it in f32 and sums 16 such
-/// squares. Unscaled, `emission = 1e30` gave squares of 1e60, past f32's 3.4e38: an infinite
-/// variance while the image was still finite. Scaled, a sample squares in range unless that
+/// squares. Unscaled, `emission = 1e30` would give squares of 1e60, past f32's 3.4e38: an
+/// infinite variance while the image is still finite. Scaled, a sample squares in range unless that
 /// geometric factor exceeds about 1e13, so every radiance the validator accepts (up to f32::MAX)
 /// keeps a finite error estimate. Multiplying by a power of two is exact in binary floating point
 /// (short of subnormal numbers), so the scaled render is the unscaled one, bit for bit, times 2^-k;
@@ -333,7 +332,7 @@ impl Accumulator {
 
     /// Starts over (same size and radiance scale). Zeroes the statistics in place: fresh
     /// vectors would come from the system as untouched pages, and the first fold after a reset
-    /// (a viewer's camera move) paid a page fault per 4 KiB, about 40 ms at 1024 x 1024.
+    /// (a viewer's camera move) would pay a page fault per 4 KiB of statistics.
     pub fn reset(&mut self) {
         self.sum.fill([0.0; 3]);
         self.sum_sq.fill([0.0; 3]);

@@ -51,12 +51,9 @@ pub const INDEPENDENT_EXPONENT: f64 = 0.5;
 /// integrand is smooth in each pair of dimensions (the walls' direct light) and about as 1 / n
 /// where it is not (the ceiling's interreflection). For errors v_b n_b^-beta the optimum is
 /// n_b ~ v_b^(1 / (1 + beta)); beta = 1.5, the rate of stratified sampling across edges, gives
-/// 0.4, and a faster fall a smaller exponent. Measured on the Cornell box (256 x 256, 1024 spp,
-/// bounces 2, docs/accuracy.md), relMSE for seeds 0 / 2 with the bilinear light points (uniform:
-/// 1.959 / 1.971e-5): 0.2 1.593 / 1.620, 0.25 1.570 / 1.586, 0.3 1.565 / 1.571, 0.4 1.580 /
-/// 1.600e-5; the smaller exponents also move fewer samples to the costly ceiling, so the render
-/// is 1 to 3% shorter at 0.3 than at 0.4. (With uniform light points, before: 0.35, 0.4, 0.5, 0.6
-/// and 0.7 gave 1.99, 2.00, 2.05, 2.18 and 2.37e-5, 2.57e-5 uniform.)
+/// 0.4, and a faster fall a smaller exponent. 0.3 is the exponent of lowest error measured
+/// with the bilinear light points, and it also moves fewer samples to the costly ceiling
+/// (docs/accuracy.md, "Adaptive sampling", has the relMSE of each exponent tried).
 pub const LOW_DISCREPANCY_EXPONENT: f64 = 0.3;
 
 /// No block takes more than this many times the mean spp.

@@ -18,7 +18,7 @@ pub const SLOT_BYTES: u64 = 16;
 /// (n - 1) u of the exact sum, relatively (u = 2^-24): with 16, 15 u < 1e-6, so every batch the
 /// CPU folds in f64 is within 1e-6 of the f64 fold of the very same samples. It also bounds one
 /// invocation's work: lavapipe silently ends an invocation's loops after 65535 iterations (in
-/// total), which a single invocation looping over thousands of samples used to hit, losing them.
+/// total), which a single invocation looping over thousands of samples would reach, losing them.
 pub const CHUNK_SAMPLES: u32 = 16;
 
 /// The batch buffers (sum, sum of squares) and the bind group of the pipeline that uses them.

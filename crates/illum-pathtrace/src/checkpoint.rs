@@ -27,6 +27,8 @@
 //! with the same random numbers, and the result is bit-identical to a straight render. For the
 //! same reason `--sample-range A..B` must start on a chunk boundary, so only the last of a set of
 //! ranges can end inside a chunk.
+//!
+//! Over 450 lines with its tests: writing, reading, resuming and merging share one file layout.
 
 use std::path::Path;
 
@@ -194,7 +196,7 @@ impl CheckpointHeader {
             "width" => Some(self.width.to_string()),
             "height" => Some(self.height.to_string()),
             "scene" => Some(self.metadata.scene.clone()),
-            // Files from before the caustic's light tracer existed rendered without it.
+            // A file without the key was rendered without the caustic's light tracer.
             "caustics" => Some(self.metadata.get(key).unwrap_or("off").to_owned()),
             _ => self.metadata.get(key).map(str::to_owned),
         }

@@ -22,7 +22,7 @@ use illum_gpu::{GpuContext, shader_file, wgpu};
 use crate::{Accumulator, PathTraceError};
 
 /// Adds one band's slots into the display sum (entry point `main`).
-pub const DISPLAY_SUM_SHADER: ShaderFile = shader_file!("shaders/pathtrace/display_sum.wgsl");
+pub const DISPLAY_SUM_SHADER: ShaderFile = shader_file!("shaders/display_sum.wgsl");
 /// Bytes per pixel of the display sum: one `vec4<f32>`.
 pub const DISPLAY_PIXEL_BYTES: u64 = 16;
 const WORKGROUP: u32 = 8;

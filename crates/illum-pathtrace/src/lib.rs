@@ -1,6 +1,6 @@
 //! illum-pathtrace: the Cornell box path tracer (the assignment's task 2).
 //!
-//! A WGSL compute shader (`shaders/pathtrace/pathtrace.wgsl`) traces paths over the scene's
+//! A WGSL compute shader (`shaders/pathtrace.wgsl`) traces paths over the scene's
 //! analytic boxes, quads and spheres with next-event estimation on rectangular lights and the
 //! sun; a second compute shader (`caustic.wgsl`, only with `[pathtrace] caustics = true`) traces
 //! the caustic from the sun (`tracer/caustic.rs`, docs/caustics.md). The host
@@ -24,7 +24,6 @@ mod options;
 pub mod planner;
 pub mod progressive;
 pub mod shaders;
-pub mod spawn;
 pub mod specialise;
 mod tracer;
 
@@ -43,7 +42,7 @@ pub use progressive::{
     parse_time_budget,
 };
 pub use shaders::{
-    CAUSTIC_SHADER, GENERIC_MATERIALS, GENERIC_TRAVERSAL, GEOMETRY_MODULE, PATHTRACE_SHADER,
-    SAMPLING_MODULES, SCENE_MODULE, SPAWN_MODULE, SURFACES_MODULE, shader_modules,
+    CAUSTIC_SHADER, GENERIC_LIGHT_CHOICE, GENERIC_MATERIALS, GENERIC_TRAVERSAL, PATHTRACE_SHADER,
+    SAMPLING_MODULES, SCENE_MODULE, SURFACES_MODULE, shader_modules,
 };
 pub use tracer::{CausticParams, PathTracer, Readback, StepReport, bounding_sphere, fixed_point};

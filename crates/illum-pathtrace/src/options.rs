@@ -21,11 +21,11 @@ pub struct TracerOptions {
     pub sequence: Sequence,
     /// Trace a pixel's samples two at a time, in lockstep (shader def PAIRED_PATHS,
     /// pathtrace.wgsl's `main`), with the specialised traversal (the generic one always traces
-    /// one path at a time, see `shader_defs`): the same image bit for bit; on lavapipe 14%
-    /// faster at bounces 2 with 16 samples per invocation (docs/performance.md, "Levers of
-    /// 2026-12-02, midday"). The default natively; off in the browser, where Chrome's
-    /// SwiftShader lost the device on the paired shader (a blank page and failed readbacks in
-    /// the web test, 2026-12-02) and runs the one-path loop.
+    /// one path at a time, see `shader_defs`): the same image bit for bit, and a second,
+    /// independent path gives the CPU core of a software driver work to overlap with the first
+    /// one's chains of dependent square roots and divisions (docs/performance.md, "Levers").
+    /// The default natively; off in the browser, where Chrome's SwiftShader loses the device
+    /// on the paired shader, so the page runs the one-path loop of the same shader.
     pub paired_paths: bool,
 }
 
@@ -43,11 +43,10 @@ impl TracerOptions {
     /// naga_oil shader defs for these options.
     ///
     /// The low-discrepancy sequence also draws light points from the bilinear fit of the
-    /// geometric term (`BILINEAR_LIGHT`, sampling.wgsl's `sample_light_bilinear`). Measured on
-    /// the Cornell box (256 x 256, 1024 spp, bounces 2, docs/performance.md): with it, 22% less
-    /// error for 11 to 15% more time; with independent numbers, whose error is mostly in the
-    /// bounce directions, 11% less error for 15 to 20% more time, a loss, so they keep uniform
-    /// points.
+    /// geometric term (`BILINEAR_LIGHT`, sampling.wgsl's `sample_light_bilinear`): it lowers the
+    /// error by more than it adds time there. Independent numbers keep uniform points: their
+    /// error is mostly in the bounce directions, so the better light point buys less than it
+    /// costs (docs/performance.md, "Levers").
     pub fn shader_defs(&self) -> Vec<(&'static str, Def)> {
         let mut defs = match self.sequence {
             Sequence::Independent => Vec::new(),
@@ -56,8 +55,7 @@ impl TracerOptions {
             }
         };
         // Pairs pay with the specialised traversal only: with the generic one's loop over the
-        // object buffer they were slower (bench, 256 x 256, bounces 2: 2.45 / 2.48 against
-        // 2.83 / 2.62 Msamples/s one path at a time; bounces 8: 0.73 / 0.82 against 0.95 / 1.03).
+        // object buffer they are slower than one path at a time (docs/performance.md, "Levers").
         if self.paired_paths && self.traversal == Traversal::Specialised {
             defs.push(("PAIRED_PATHS", Def::Bool(true)));
         }

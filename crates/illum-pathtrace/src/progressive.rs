@@ -10,8 +10,7 @@
 //! Every rule but cancellation waits for a **complete pass**: a pass covers the whole image, so
 //! a render that stops by spp, error or time always has at least one sample in every pixel.
 //!
-//! Over 400 lines with its tests, and one concept: the stop rules and the loop that applies them
-//! read better whole, since each rule's meaning is defined by how the loop checks it.
+//! Over 450 lines with its tests: each stop rule is defined by how the loop checks it.
 
 #[cfg(not(target_arch = "wasm32"))]
 use std::sync::atomic::{AtomicBool, Ordering};

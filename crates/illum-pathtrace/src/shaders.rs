@@ -1,10 +1,10 @@
 //! The path tracer's WGSL: the modules it composes, in import order, and its pipeline.
 //!
-//! The sampling modules (`shaders/common/`: constants, random numbers, sample sequences,
-//! hemisphere and light sampling, ray spawning) are shared ray-tracing code, registered here,
-//! by the crate that composes them; the rasterizer imports none of them and composes only its
-//! own. The scene module and the traversal (generic, or generated per scene by
-//! `specialise.rs`) follow.
+//! Its own sampling modules (constants, random numbers, sample sequences, hemisphere and light
+//! sampling) come first, then illum-rtcore's shared modules (kind codes, spawning, geometry,
+//! material record, optics, camera), then its scene module, the material lookup, the traversal
+//! and the light choice (each generic, or generated per scene: `specialise.rs`), and the
+//! surfaces module both estimators use.
 
 use illum_gpu::shader::{self, ShaderFile};
 use illum_gpu::{GpuContext, shader_file, wgpu};
@@ -15,47 +15,41 @@ use crate::options::{TracerOptions, Traversal};
 use crate::{PathTraceError, specialise};
 
 /// The integrator (entry point `main`).
-pub const PATHTRACE_SHADER: ShaderFile = shader_file!("shaders/pathtrace/pathtrace.wgsl");
-/// Scene layout, bindings and ray-shape tests.
-pub const SCENE_MODULE: ShaderFile = shader_file!("shaders/pathtrace/scene.wgsl");
-/// Material kinds and the functions both estimators use to read them.
-pub const SURFACES_MODULE: ShaderFile = shader_file!("shaders/pathtrace/surfaces.wgsl");
+pub const PATHTRACE_SHADER: ShaderFile = shader_file!("shaders/pathtrace.wgsl");
+/// Parameters, lights and bindings.
+pub const SCENE_MODULE: ShaderFile = shader_file!("shaders/scene.wgsl");
+/// What both estimators need: the sun's sampling, the path-length rule, dielectric scattering.
+pub const SURFACES_MODULE: ShaderFile = shader_file!("shaders/surfaces.wgsl");
 /// The caustic's light tracer (entry point `main`; shader def CAUSTIC).
-pub const CAUSTIC_SHADER: ShaderFile = shader_file!("shaders/pathtrace/caustic.wgsl");
+pub const CAUSTIC_SHADER: ShaderFile = shader_file!("shaders/caustic.wgsl");
 /// The generic material lookup (a read of the material buffer).
-pub const GENERIC_MATERIALS: ShaderFile = shader_file!("shaders/pathtrace/materials.wgsl");
+pub const GENERIC_MATERIALS: ShaderFile = shader_file!("shaders/materials.wgsl");
 /// The generic traversal (a loop over the object buffer).
-pub const GENERIC_TRAVERSAL: ShaderFile = shader_file!("shaders/pathtrace/traversal.wgsl");
+pub const GENERIC_TRAVERSAL: ShaderFile = shader_file!("shaders/traversal.wgsl");
+/// The generic light choice (a loop over the light buffer).
+pub const GENERIC_LIGHT_CHOICE: ShaderFile = shader_file!("shaders/light_choice.wgsl");
 
 /// The sampling modules, in dependency order (a module may import only those before it).
 pub const SAMPLING_MODULES: &[ShaderFile] = &[
-    shader_file!("shaders/common/constants.wgsl"),
-    shader_file!("shaders/common/rng.wgsl"),
-    shader_file!("shaders/common/sampling.wgsl"),
-    shader_file!("shaders/common/sampler.wgsl"),
-    SPAWN_MODULE,
+    shader_file!("shaders/constants.wgsl"),
+    shader_file!("shaders/rng.wgsl"),
+    shader_file!("shaders/sampling.wgsl"),
+    shader_file!("shaders/sampler.wgsl"),
 ];
-
-/// Ray spawning off a surface: shared by every compute ray tracer.
-pub const SPAWN_MODULE: ShaderFile = shader_file!("shaders/common/spawn.wgsl");
-
-/// Objects as the GPU stores them and the ray-shape tests: shared by every compute ray tracer
-/// (it imports the spawn module).
-pub const GEOMETRY_MODULE: ShaderFile = shader_file!("shaders/rtcore/geometry.wgsl");
 
 /// The shader modules, in import order, for `scene` with `traversal`.
 pub fn shader_modules(scene: &Scene, gpu_scene: &GpuScene, traversal: Traversal) -> Vec<ShaderFile> {
     let mut modules = SAMPLING_MODULES.to_vec();
-    modules.push(GEOMETRY_MODULE);
+    modules.extend(illum_rtcore::shaders::core_modules());
     modules.push(SCENE_MODULE);
-    modules.push(match traversal {
-        Traversal::Generic => GENERIC_MATERIALS,
-        Traversal::Specialised => specialise::materials_module(scene, gpu_scene),
-    });
-    modules.push(match traversal {
-        Traversal::Generic => GENERIC_TRAVERSAL,
-        Traversal::Specialised => specialise::traversal_module(scene, gpu_scene),
-    });
+    match traversal {
+        Traversal::Generic => modules.extend([GENERIC_MATERIALS, GENERIC_TRAVERSAL, GENERIC_LIGHT_CHOICE]),
+        Traversal::Specialised => modules.extend([
+            specialise::materials_module(scene, gpu_scene),
+            specialise::traversal_module(scene, gpu_scene),
+            specialise::light_choice_module(scene, gpu_scene),
+        ]),
+    }
     modules.push(SURFACES_MODULE);
     modules
 }
@@ -72,7 +66,7 @@ pub(crate) fn pathtrace_pipeline(
     adaptive: bool,
 ) -> Result<(wgpu::ComputePipeline, String), PathTraceError> {
     let modules = shader_modules(scene, gpu_scene, options.traversal);
-    let traversal_source = modules[modules.len() - 2].source.to_string();
+    let traversal_source = modules[modules.len() - 3].source.to_string();
     let mut defs = options.shader_defs();
     defs.extend(gpu_scene.shader_defs());
     if adaptive {
@@ -106,7 +100,7 @@ mod tests {
 
     use super::*;
     use crate::display_sum::DISPLAY_SUM_SHADER;
-    use crate::gpu_scene::{GpuLight, GpuMaterial, GpuParams, ObjectRecord};
+    use crate::gpu_scene::{GpuLight, GpuParams};
 
     /// Every scene file the path tracer can render.
     fn path_tracer_scenes() -> Vec<Scene> {
@@ -212,17 +206,10 @@ mod tests {
         };
         wgsl("Params").assert_matches(
             size_of::<GpuParams>(),
-            &members!(GpuParams: eye, tan_half_fov, right, aspect, up, light_area, forward, num_objects,
-                width, height, row_offset, rows, sample_base, sample_count, seed, bounces, padding,
-                num_lights, first_emitter, chunk_samples, sun, sun_irradiance, sky),
+            &members!(GpuParams: camera, light_area, num_objects, width, height, row_offset, rows,
+                sample_base, sample_count, seed, bounces, num_lights, first_emitter, chunk_samples, padding_a,
+                padding_b, padding_c,                 sun, sun_irradiance, sky),
         );
-        wgsl_struct(&module, "illum::rtcore::geometry", "Object")
-            .unwrap_or_else(|| panic!("no struct Object in rtcore/geometry.wgsl"))
-            .assert_matches(
-                size_of::<ObjectRecord>(),
-                &members!(ObjectRecord: kind, material, emitter, padding, a, b, c, d),
-            );
-        wgsl("Material").assert_matches(size_of::<GpuMaterial>(), &members!(GpuMaterial: albedo, emission));
         // The caustic's parameters, in a scene that has the light tracer.
         let whitted =
             path_tracer_scenes().into_iter().find(|s| s.name == "whitted").expect("scenes/whitted.toml");
@@ -252,7 +239,7 @@ mod tests {
     /// phi the plastic number (the real root of x^3 = x + 1): the R_2 sequence's steps.
     #[test]
     fn r2_steps_match_the_plastic_number() {
-        let source = include_str!("../../../shaders/common/sampler.wgsl");
+        let source = include_str!("../shaders/sampler.wgsl");
         let constant = |name: &str| -> u64 {
             source
                 .split(&format!("const {name}: u32 = "))

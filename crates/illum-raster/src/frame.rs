@@ -226,8 +226,8 @@ impl FrameResources<'_> {
         pass.set_bind_group(1, capture.textures, &[]);
         // Sphere first: it hides part of the floor, whose fragments then fail the early depth
         // test before shading (the sphere writes its depth from the fragment shader, so it gets
-        // no early test itself). On lavapipe this order also avoids a fixed cost of about a
-        // millisecond per pass that a floor-first pass pays (measured, see docs/performance-raster.md).
+        // no early test itself). On lavapipe this order also avoids a fixed cost per pass that a
+        // floor-first pass pays (docs/performance-raster.md, "Levers").
         // The floor's shadow receiver goes before the rest of the floor (floor.wgsl).
         for pipeline in [capture.sphere, self.cube_floor_receiver, self.cube_floor].into_iter().flatten() {
             pass.set_pipeline(pipeline);
@@ -262,8 +262,8 @@ impl FrameResources<'_> {
         // Unlike the cube faces, the floor comes first and the spheres after it, back to front:
         // an anti-aliased edge blends over what is already drawn behind it. So a partly covered
         // edge pixel never hides anything: all that is drawn after a sphere is the nearer sphere.
-        // (The floor fragments under the spheres are now shaded too; measured in
-        // docs/performance-raster.md, far less than the 4x MSAA this replaces.)
+        // (The floor fragments under the spheres are shaded too: docs/performance-raster.md,
+        // "Levers", has what that costs against multisampling.)
         let [back, front] = self.main_spheres;
         if let Some(receiver) = self.main_floor_receiver {
             pass.set_pipeline(receiver);

@@ -135,8 +135,8 @@ fn surface_pipeline(
             } else if matches!(key.surface, Surface::Floor | Surface::FloorInterior) {
                 // The biased floor compares LessEqual: near the far plane its bias pushes the
                 // depth past 1, where it is clamped to 1, the cleared value; with Less the floor's
-                // far end then vanished (a band of background before the far plane, found by
-                // tests/raster/extremes.rs). Where the receiver drew, the floor's biased depth is
+                // far end would vanish (a band of background before the far plane, which
+                // tests/raster/extremes.rs checks for). Where the receiver drew, the floor's biased depth is
                 // still greater and fails; only within one bias of the far plane (both clamped to
                 // 1) may it draw over the receiver, losing a shadow there.
                 wgpu::DepthStencilState {

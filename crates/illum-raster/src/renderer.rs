@@ -1,4 +1,6 @@
 //! [`RasterRenderer`]: owns the GPU resources and turns a scene plus [`Options`] into frames.
+//!
+//! Over 450 lines: the GPU resources and the frame loops that share them read best in one type.
 
 #[cfg(not(target_arch = "wasm32"))]
 use std::ops::ControlFlow;

@@ -7,11 +7,11 @@ use illum_gpu::GpuError;
 use illum_gpu::shader::{self, ShaderFile};
 
 /// Uniform layout and helpers shared by every raster pass (`illum::raster::scene`).
-pub const SCENE_MODULE: ShaderFile = illum_gpu::shader_file!("shaders/raster/scene.wgsl");
+pub const SCENE_MODULE: ShaderFile = illum_gpu::shader_file!("shaders/scene.wgsl");
 /// Sphere impostors: billboards, ray-sphere tests, silhouette coverage (`illum::raster::sphere`).
-pub const SPHERE_MODULE: ShaderFile = illum_gpu::shader_file!("shaders/raster/sphere.wgsl");
+pub const SPHERE_MODULE: ShaderFile = illum_gpu::shader_file!("shaders/sphere.wgsl");
 /// Shadows, the filtered checker, cube-map lookups and the two looks (`illum::raster::lighting`).
-pub const LIGHTING_MODULE: ShaderFile = illum_gpu::shader_file!("shaders/raster/lighting.wgsl");
+pub const LIGHTING_MODULE: ShaderFile = illum_gpu::shader_file!("shaders/lighting.wgsl");
 
 /// The raster modules, in dependency order (each imports only those before it).
 pub const MODULES: &[ShaderFile] = &[SCENE_MODULE, SPHERE_MODULE, LIGHTING_MODULE];
@@ -22,11 +22,11 @@ pub fn modules() -> Vec<ShaderFile> {
 }
 
 /// The shadow pass: sphere depth from the light (`vs_main`, `fs_main`).
-pub const SHADOW_SHADER: ShaderFile = illum_gpu::shader_file!("shaders/raster/shadow.wgsl");
+pub const SHADOW_SHADER: ShaderFile = illum_gpu::shader_file!("shaders/shadow.wgsl");
 /// The checkerboard floor (`vs_main`, `fs_main`).
-pub const FLOOR_SHADER: ShaderFile = illum_gpu::shader_file!("shaders/raster/floor.wgsl");
+pub const FLOOR_SHADER: ShaderFile = illum_gpu::shader_file!("shaders/floor.wgsl");
 /// The glass and metal spheres (`vs_main`, `fs_main`).
-pub const SPHERES_SHADER: ShaderFile = illum_gpu::shader_file!("shaders/raster/spheres.wgsl");
+pub const SPHERES_SHADER: ShaderFile = illum_gpu::shader_file!("shaders/spheres.wgsl");
 
 /// The entry files, each composed with [`MODULES`].
 pub const SHADERS: &[ShaderFile] = &[SHADOW_SHADER, FLOOR_SHADER, SPHERES_SHADER];

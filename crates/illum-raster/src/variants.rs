@@ -2,8 +2,9 @@
 //!
 //! The entry shaders declare override constants (ENHANCED, SHADOWS, ...; see `Switches` in
 //! scene.wgsl) that fix the effects when a pipeline is created, so the driver compiles out the
-//! paths not taken. On lavapipe, which runs both sides of a branch under a lane mask, this made
-//! the sphere shading several times faster than branching on uniform flags. Keys leave out the
+//! paths not taken. lavapipe's fragment shaders run both sides of a branch under a lane mask, so
+//! an effect behind a uniform flag would cost its full price when off (the measured effect is in
+//! docs/performance-raster.md, "Levers"). Keys leave out the
 //! switches a surface ignores, so toggling an effect builds only the pipelines it changes.
 
 use illum_scene::Look;

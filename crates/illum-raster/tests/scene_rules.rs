@@ -4,13 +4,9 @@
 //! the rasterizer does not implement, and `RasterScene::from_scene` refusing arrangements it
 //! cannot draw; plus resolution overrides and device limits.
 //!
-//! Ported from the rules of the old raster-only format (illum-scene's `whitted_errors.rs`): each
-//! old rule is tested at its new field path; where a rule changed, a comment says how. The
-//! refusals of edits of the scene are data, `cases/scene_rules.toml`, checked by one test; the
+//! The refusals of edits of the scene are data, `cases/scene_rules.toml`, checked by one test; the
 //! tests here check what a refusal cannot say: what is accepted next to them, what the physical
 //! scene accepts and the rasterizer refuses, and edits that are not one replacement.
-//!
-//! Long (one test per rule) but one concept: every rule of the raster's view of a scene file.
 
 use glam::{Vec2, Vec3};
 use illum_gpu::wgpu;
@@ -20,9 +16,8 @@ use illum_scene::{Feature, RendererKind, Scene, SceneError};
 
 const FILE: &str = "scenes/w.toml";
 
-/// A valid scene with every optional key written out: the old format's BASE in the physical
-/// model. The old light of intensity 1 is irradiance pi; the old `[ambient]` colour x intensity
-/// is `[shading] ambient`; the old look "whitted" is "enhanced".
+/// A valid scene with every optional key written out: the light's irradiance pi (a Lambertian
+/// floor facing it then has radiance albedo), `[shading] ambient`, the `enhanced` look.
 const BASE: &str = include_str!("scenes/w.toml");
 
 /// The glass sphere's `[[objects]]` table of BASE, whole.
@@ -168,13 +163,12 @@ fn optional_parts_take_their_defaults() {
     assert_eq!((glass.color, glass.reflectivity, glass.shininess), (Vec3::ONE, 0.9, 200.0));
     let metal = s.metal.unwrap();
     assert_eq!((metal.specular, metal.shininess, metal.mirror), (Vec3::ONE, 30.0, 0.6));
-    // The old light's `casts_shadows` is gone: shadows are the effect toggle, on by default.
+    // Shadows are an effect toggle, on by default.
     assert_eq!(s.effects, Effects::ALL_ON);
     assert_eq!((s.quality.pcf_radius, s.quality.cube_size), (0.05, 256));
 }
 
-/// The old test "the two formats refuse each other" has no subject any more: there is one
-/// format. `renderer` is now only the tools' default renderer, so the same text loads as a
+/// `renderer` is only the tools' default renderer, so the same text loads as a
 /// `Scene` and as a `RasterScene` whatever it says, and only its spelling is checked.
 #[test]
 fn the_renderer_key_is_only_a_default() {
@@ -186,14 +180,14 @@ fn the_renderer_key_is_only_a_default() {
     assert_eq!(parse(&pathtrace).unwrap(), parse(BASE).unwrap());
     let other = edit("renderer = \"raster\"", "renderer = \"vulkan\"");
     expect_invalid(&other, "renderer", "\"vulkan\"", "must be \"raster\", \"pathtrace\" or \"whitted\"");
-    // "whitted" names the Whitted ray tracer (once the raster's second look): a default renderer
+    // "whitted" names the Whitted ray tracer: a default renderer
     // like the others, which does not change what the rasterizer draws.
     let whitted = edit("renderer = \"raster\"", "renderer = \"whitted\"");
     assert_eq!(parse(&whitted).unwrap(), parse(BASE).unwrap());
 }
 
 // ---------------------------------------------------------------------------------------------
-// The refusals: the scene's own validation, at the fields the old format's rules moved to, and
+// The refusals: the scene's own validation, at the fields the rasterizer reads, and
 // the rasterizer's arrangements.
 
 #[test]
@@ -204,8 +198,7 @@ fn every_refusal_of_the_cases_file() {
 // ---------------------------------------------------------------------------------------------
 // The rasterizer's own rules: what it implements and how the scene must be arranged.
 
-/// Where the old format said "refraction_ratio in (0, 1]", the physical scene allows any
-/// ior > 0; the rasterizer refracts only into a denser medium, so it asks for ior >= 1.
+/// The physical scene allows any ior > 0; the rasterizer refracts only into a denser medium, so it asks for ior >= 1.
 #[test]
 fn the_glass_must_be_denser_than_air_for_the_rasterizer() {
     for (ior, ratio) in [("1", 1.0), ("1.0001", 1.0 / 1.0001f32), ("4", 0.25)] {
@@ -237,7 +230,7 @@ fn spheres_are_optional_and_shadows_are_an_effect() {
     let err = parse(&eye_in_metal).unwrap_err();
     check_invalid(&err, FILE, "camera.eye", "[2, 1.9, -2.4]", "outside objects[1] (\"metal sphere\")");
 
-    // The old light's `casts_shadows = false` is now `[raster.effects] shadows = false`.
+    // Shadows off: `[raster.effects] shadows = false`.
     let unshadowed = parse(&edit("shadows = true", "shadows = false")).unwrap();
     assert!(!unshadowed.effects.shadows);
     let err = parse(&edit("shadows = true", "shadows = 0")).unwrap_err();
@@ -329,8 +322,8 @@ fn clip_planes_and_a_light_are_optional_for_the_scene() {
 
 #[test]
 fn antialiasing_is_read_under_its_name_and_its_former_one() {
-    // tests/scenes/w.toml says `msaa = false`, the key's name before edges were anti-aliased
-    // analytically; old files keep loading with the same meaning (anti-aliased edges or not).
+    // tests/scenes/w.toml says `msaa = false`, the key's former name, which is still read with
+    // the same meaning (anti-aliased edges or not).
     for (key, on) in [("msaa = false", false), ("msaa = true", true), ("antialiasing = false", false)] {
         let s = parse(&edit("msaa = false", key)).unwrap_or_else(|e| panic!("{key}: {e}"));
         assert_eq!(s.effects.antialiasing, on, "{key}");

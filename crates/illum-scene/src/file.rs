@@ -5,8 +5,7 @@
 //! f64 / i64 so that range checks (`spp = 0`, `width = -1`, `vfov = 1e40`) happen in validation,
 //! where the error can name the field, rather than inside serde.
 //!
-//! Over 400 lines with its tests (about 420 of code), one concept: the file format, and the
-//! structs that mirror it beside its documentation below.
+//! Over 450 lines with its tests: the format's documentation beside the structs that mirror it.
 //!
 //! Format (lengths in scene units, angles in degrees, colours linear RGB). Every section but
 //! `[camera]` and `[[objects]]` is optional:
@@ -73,9 +72,6 @@
 //! dielectric = { shininess = 200.0 }
 //! mirror = { specular = [1.0, 1.0, 1.0], shininess = 30.0, weight = 0.6 }
 //! ```
-//!
-//! Over 400 lines, one concept: the file format's raw structs, mirroring the TOML one to one,
-//! read better together than split by section.
 
 use std::collections::BTreeMap;
 use std::fmt;

@@ -143,8 +143,8 @@ mod tests {
         for kind in RendererKind::ALL {
             assert_eq!(kind.to_string().parse::<RendererKind>(), Ok(kind));
         }
-        // The raster's second look was called "whitted" before the Whitted ray tracer existed;
-        // the name now belongs to the ray tracer only.
+        // "whitted" names the Whitted ray tracer only, never a raster look; the refusal names
+        // the look a file meant by it ("enhanced").
         let err = "whitted".parse::<Look>().unwrap_err();
         assert!(err.to_string().contains("\"enhanced\""), "{err}");
         assert!("sobol".parse::<Sequence>().unwrap_err().to_string().contains("low-discrepancy"));

@@ -5,8 +5,8 @@
 //! `nan` and `inf`, and a finite f64 such as 1e39 becomes infinite in f32 — before any check
 //! that compares it, because NaN fails every comparison silently.
 //!
-//! Over 400 lines, one concept: the conversion of the raw file into a `Scene`, every rule in
-//! the order the file is read (the per-renderer sections are in `validate_sections.rs`).
+//! Over 450 lines: every rule of the conversion, in the order the file is read (the per-renderer
+//! sections are in `validate_sections.rs`).
 
 use std::collections::BTreeMap;
 

@@ -4,8 +4,6 @@
 //! refusals of edits of the scene are data, `cases/errors.toml`, checked by one test; the tests
 //! here check what a refusal cannot say: what is accepted next to them, exact messages, syntax
 //! positions and overrides.
-//!
-//! Long (one test per rule) but one concept: every error of the file format and its overrides.
 
 use glam::Vec3;
 use illum_scene::testing::{Edits, check_invalid, edit_once as edit_text};

@@ -5,9 +5,7 @@
 //! file, field, value and what is allowed; the extremes each side of every range are tried.
 //! The refusals are data, `cases/physical_rules.toml`, checked by one test; the tests here check
 //! what a refusal cannot say: the values accepted up to the extremes, and what they load as.
-//! (`errors.rs` has the camera, shape and path-tracer rules shared with the old format.)
-//!
-//! Long (one test per rule) but one concept: every rule of the physical model.
+//! (`errors.rs` has the camera, shape and path-tracer rules.)
 
 use glam::Vec3;
 use illum_scene::testing::{Edits, edit_once as edit_text, without};

@@ -4,8 +4,7 @@
 //! between two modes that show the same scene file, so one view can be flipped between the
 //! three renderers.
 //!
-//! Over 400 lines, one concept: the mode switch, the file opening and the layout all act on the
-//! one `ViewerApp` state; each mode's own panel is its own file.
+//! Over 450 lines: the mode switch, the file opening and the layout all act on one `ViewerApp`.
 
 use std::path::{Path, PathBuf};
 

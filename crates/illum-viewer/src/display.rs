@@ -15,7 +15,7 @@ use egui_wgpu::wgpu;
 use illum_gpu::GpuContext;
 use illum_pathtrace::DISPLAY_PIXEL_BYTES;
 
-const SHADER: &str = include_str!("../../../shaders/viewer/display.wgsl");
+const SHADER: &str = include_str!("../shaders/display.wgsl");
 /// The texture egui shows: 8-bit, already gamma-encoded (egui's convention for native textures).
 const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 

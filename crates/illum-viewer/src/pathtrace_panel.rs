@@ -16,8 +16,7 @@
 //! arrived or the exposure changed; the f64 statistics are only read for the panel's numbers and
 //! for saving.
 //!
-//! Over 450 lines, one concept: the path tracer's mode of the viewer (its settings, its panel,
-//! its stepping and saving), which reads better whole than split between widgets and state.
+//! Over 450 lines: the path tracer's mode (settings, panel, stepping, saving) reads best whole.
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -32,8 +31,9 @@ use crate::display::Display;
 use crate::pacer::FramePacer;
 
 /// Most paths a pass at the smallest spp may trace and still be one submission, a whole image
-/// per frame, when it takes longer than the pacer's share: about 0.1 s at lavapipe's 10 million
-/// samples per second on 2 cores, the default window's image 6 times over. A larger image (a
+/// per frame, when it takes longer than the pacer's share: 2^20 paths, the default window's
+/// image at the default scale several times over, a fraction of a second on lavapipe
+/// (docs/performance.md has the rates). A larger image (a
 /// large window at full resolution) is split into bands over several frames, so that the
 /// window keeps repainting.
 pub const WHOLE_PASS_SAMPLES: u64 = 1 << 20;

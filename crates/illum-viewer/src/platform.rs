@@ -20,9 +20,9 @@ pub const POLLED_READBACK: bool = cfg!(target_arch = "wasm32");
 /// GPU time aimed at per path-tracing submission, given the desktop's `frame_budget`. Natively
 /// a frame waits for its submission, so it stays short. In the browser a frame never waits:
 /// the next band is already on the GPU while the page draws, and one band comes back per frame
-/// or later; so each band carries more work (measured on SwiftShader, where drawing the page
-/// takes most of the CPU: with the desktop's 15 ms the GPU was busy about 1% of the time).
-/// 50 ms keeps a hardware GPU's page responsive.
+/// or later; so each band carries more work: where drawing the page takes most of the CPU
+/// (SwiftShader), a band of the desktop's size would leave the GPU idle most of the time
+/// (docs/performance.md, "In the browser"). 50 ms keeps a hardware GPU's page responsive.
 pub fn submission_seconds(frame_budget: f64) -> f64 {
     if POLLED_READBACK { frame_budget.max(0.05) } else { frame_budget }
 }

@@ -8,8 +8,7 @@
 //! All harnesses share one device, as the real window has one (a device per harness would
 //! compile every pipeline again: the pipeline caches belong to each device's `GpuContext`).
 //!
-//! Over 400 lines, one concept: each test drives the same app through a different user action,
-//! and they share the harness setup above.
+//! Over 450 lines: each test drives the same app through one user action, on one shared harness.
 
 use std::sync::OnceLock;
 
@@ -89,7 +88,7 @@ fn switching_modes_keeps_each_modes_settings() {
 #[test]
 fn changing_bounces_restarts_the_accumulation() {
     let mut harness = harness(RendererKind::PathTrace);
-    // A pass may take several 15 ms slices when other tests load the machine.
+    // A pass may take several of the pacer's slices when other tests load the machine.
     for _ in 0..100 {
         harness.run_steps(1);
         if spp(&harness) > 0 {

@@ -1,46 +1,31 @@
-//! The scene as the Whitted shader reads it: records laid out like the WGSL structs of
-//! `shaders/whitted/whitted.wgsl` (the layout test compares them with naga's).
+//! The scene as the Whitted shader reads it: its parameters and lights, laid out like the WGSL
+//! structs of `shaders/whitted.wgsl` (the layout test compares them with naga's). The objects,
+//! materials and camera are illum-rtcore's records.
 
 use std::f32::consts::PI;
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
-use illum_scene::{Feature, MaterialKind, Scene, Shape};
+use illum_rtcore::{CameraRecord, MaterialRecord};
+use illum_scene::{Feature, Scene, Shape};
 
 /// The one feature of the scene model the Whitted ray tracer refuses: a sun of finite size
 /// (its shadow rays are hard).
 pub const FEATURES_BUT: Feature = Feature::SunDisc;
 
-pub(crate) const MAT_LAMBERTIAN: u32 = 0;
-pub(crate) const MAT_CHECKER: u32 = 1;
-pub(crate) const MAT_DIELECTRIC: u32 = 2;
-pub(crate) const MAT_MIRROR: u32 = 3;
-pub(crate) const MAT_EMITTER: u32 = 4;
 pub(crate) const LIGHT_DIRECTIONAL: u32 = 0;
 pub(crate) const LIGHT_POINT: u32 = 1;
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct WhittedParams {
-    pub eye: [f32; 4],
-    pub right: [f32; 4],
-    pub up: [f32; 4],
-    pub forward: [f32; 4],
+    pub camera: CameraRecord,
     pub background: [f32; 4],
     pub ambient: [f32; 4],
     pub mirror_specular: [f32; 4],
     pub shading: [f32; 4],
     pub sizes: [u32; 4],
     pub counts: [u32; 4],
-}
-
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
-pub struct WhittedMaterial {
-    pub kind: u32,
-    pub pad: [u32; 3],
-    pub a: [f32; 4],
-    pub b: [f32; 4],
 }
 
 #[repr(C)]
@@ -57,21 +42,9 @@ fn v4(v: Vec3, w: f32) -> [f32; 4] {
     [v.x, v.y, v.z, w]
 }
 
-pub(crate) fn materials(scene: &Scene) -> Vec<WhittedMaterial> {
-    scene
-        .materials
-        .iter()
-        .map(|m| {
-            let (kind, a, b) = match m.kind {
-                MaterialKind::Lambertian { albedo } => (MAT_LAMBERTIAN, v4(albedo, 0.0), [0.0; 4]),
-                MaterialKind::Checker(c) => (MAT_CHECKER, v4(c.even, c.tile), v4(c.odd, 0.0)),
-                MaterialKind::Dielectric { ior } => (MAT_DIELECTRIC, [0.0, 0.0, 0.0, ior], [0.0; 4]),
-                MaterialKind::Mirror { reflectance } => (MAT_MIRROR, v4(reflectance, 0.0), [0.0; 4]),
-                MaterialKind::Emitter { radiance } => (MAT_EMITTER, v4(radiance, 0.0), [0.0; 4]),
-            };
-            WhittedMaterial { kind, pad: [0; 3], a, b }
-        })
-        .collect()
+/// The scene's materials, with their radiance as it is (the Whitted tracer scales nothing).
+pub(crate) fn materials(scene: &Scene) -> Vec<MaterialRecord> {
+    scene.materials.iter().map(|m| MaterialRecord::new(&m.kind, 1.0)).collect()
 }
 
 /// The directional light, and a point light at the centre of every emitting quad.
@@ -101,13 +74,9 @@ pub(crate) fn lights(scene: &Scene) -> Vec<WhittedLight> {
 }
 
 pub(crate) fn params(scene: &Scene, first_emitter: u32, num_lights: u32, output: u32) -> WhittedParams {
-    let b = scene.camera.basis();
     let mirror = scene.shading.mirror;
     WhittedParams {
-        eye: v4(scene.camera.eye, b.tan_half_fov),
-        right: v4(b.right, b.aspect),
-        up: v4(b.up, 0.0),
-        forward: v4(b.forward, 0.0),
+        camera: CameraRecord::new(&scene.camera),
         background: v4(scene.environment.map_or(Vec3::ZERO, |e| e.radiance), 0.0),
         ambient: v4(scene.shading.ambient, 0.0),
         mirror_specular: v4(mirror.specular, mirror.shininess),

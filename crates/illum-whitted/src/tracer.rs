@@ -8,15 +8,14 @@ use illum_gpu::buffers::{buffer_bind_group, dispatch};
 use illum_gpu::shader::{self, ShaderFile};
 use illum_gpu::{GpuContext, GpuError, readback, shader_file, wgpu};
 use illum_image::RgbImage32;
-use illum_pathtrace::gpu_scene::GpuScene;
-use illum_pathtrace::{GEOMETRY_MODULE, PathTraceError, SPAWN_MODULE, specialise};
+use illum_rtcore::Geometry;
 use illum_scene::{Scene, SceneError};
 use wgpu::util::DeviceExt;
 
-use crate::encode::{self, FEATURES_BUT, WhittedLight, WhittedMaterial, WhittedParams};
+use crate::encode::{self, FEATURES_BUT, WhittedLight, WhittedParams};
 
 /// The entry shader (entry point `main`).
-pub const WHITTED_SHADER: ShaderFile = shader_file!("shaders/whitted/whitted.wgsl");
+pub const WHITTED_SHADER: ShaderFile = shader_file!("shaders/whitted.wgsl");
 
 /// Workgroup side of the entry point (8 x 8 pixels).
 const WORKGROUP: u32 = 8;
@@ -30,9 +29,6 @@ pub enum WhittedError {
     Gpu(#[from] GpuError),
     #[error(transparent)]
     Scene(#[from] SceneError),
-    /// The scene's GPU encoding (shared with the path tracer) refused it.
-    #[error(transparent)]
-    Encoding(#[from] PathTraceError),
 }
 
 /// The shader defs of the pipeline for `scene`: its ray stack's size, depth + 2 (see the
@@ -41,10 +37,14 @@ pub fn shader_defs(scene: &Scene) -> Vec<(&'static str, shader::Def)> {
     vec![("WHITTED_STACK", shader::Def::UInt(scene.whitted.depth + 2))]
 }
 
-/// The modules the entry shader imports for `scene`, in import order: ray spawning, the shared
-/// geometry, and the path tracer's traversal generated for this scene (`specialise.rs`).
-pub fn shader_modules(scene: &Scene, gpu_scene: &GpuScene) -> Vec<ShaderFile> {
-    vec![SPAWN_MODULE, GEOMETRY_MODULE, specialise::traversal_module(scene, gpu_scene)]
+/// The modules the entry shader imports for `scene`, in import order: illum-rtcore's shared
+/// modules, then its traversal and materials generated for this scene with their numbers as
+/// literals (the pipeline binds no object or material buffer).
+pub fn shader_modules(scene: &Scene, geometry: &Geometry) -> Vec<ShaderFile> {
+    let mut modules = illum_rtcore::shaders::core_modules();
+    modules.push(illum_rtcore::traversal::generate(geometry).module(&scene.name));
+    modules.push(illum_rtcore::materials_module(&scene.name, &encode::materials(scene)));
+    modules
 }
 
 /// What the pipeline writes (`params.counts.w`, OUTPUT_* in the shader).
@@ -116,17 +116,14 @@ impl WhittedTracer {
             )
             .into());
         }
-        // The path tracer's encoding: objects in its order (emitters last), as the traversal and
-        // the materials index them.
-        let gpu_scene = GpuScene::new(scene)?;
-        let records = gpu_scene.object_records();
-        let materials = encode::materials(scene);
+        // Objects in illum-rtcore's order (emitters last), as the traversal indexes them.
+        let geometry = Geometry::new(scene);
         let lights = encode::lights(scene);
         let radiance_params =
-            encode::params(scene, gpu_scene.first_emitter, lights.len() as u32, OUTPUT_RADIANCE);
+            encode::params(scene, geometry.first_emitter, lights.len() as u32, OUTPUT_RADIANCE);
         #[cfg(not(target_arch = "wasm32"))]
         let scene_index = {
-            let (ordered, _) = illum_pathtrace::gpu_scene::ordered_objects(scene);
+            let (ordered, _) = illum_rtcore::ordered_objects(scene);
             ordered.iter().map(|(i, _)| *i).collect()
         };
 
@@ -135,11 +132,9 @@ impl WhittedTracer {
         let storage =
             |label: &str, contents: &[u8]| illum_gpu::buffers::storage_buffer(device, label, contents);
         let lights_or_one = if lights.is_empty() { vec![WhittedLight::default()] } else { lights };
-        let materials_or_one =
-            if materials.is_empty() { vec![WhittedMaterial::default()] } else { materials };
         let pipeline = shader::compute_pipeline(
             gpu,
-            &shader_modules(scene, &gpu_scene),
+            &shader_modules(scene, &geometry),
             &WHITTED_SHADER,
             &shader_defs(scene),
             "whitted ray tracer",
@@ -150,8 +145,6 @@ impl WhittedTracer {
                 contents: bytemuck::bytes_of(&radiance_params),
                 usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             });
-            let objects = storage("whitted objects", bytemuck::cast_slice(&records));
-            let materials = storage("whitted materials", bytemuck::cast_slice(&materials_or_one));
             let lights = storage("whitted lights", bytemuck::cast_slice(&lights_or_one));
             let image = device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("whitted image"),
@@ -163,7 +156,7 @@ impl WhittedTracer {
                 device,
                 "whitted",
                 &pipeline.get_bind_group_layout(0),
-                &[(0, &params), (1, &objects), (2, &materials), (3, &lights), (4, &image)],
+                &[(0, &params), (1, &lights), (2, &image)],
             );
             (bind_group, image, params)
         })?;
@@ -360,9 +353,9 @@ mod tests {
         let mut module = None;
         for name in ["whitted.toml", "cornell.toml"] {
             let scene = illum_scene::testing::shipped_scene(name, 32, 32);
-            let gpu_scene = GpuScene::new(&scene).unwrap();
+            let geometry = Geometry::new(&scene);
             let composed =
-                shader::compose(&shader_modules(&scene, &gpu_scene), &WHITTED_SHADER, &shader_defs(&scene))
+                shader::compose(&shader_modules(&scene, &geometry), &WHITTED_SHADER, &shader_defs(&scene))
                     .unwrap_or_else(|e| panic!("{name}: {e}"));
             let mut validator = naga::valid::Validator::new(
                 naga::valid::ValidationFlags::all(),
@@ -377,11 +370,8 @@ mod tests {
         };
         wgsl("Params").assert_matches(
             size_of::<WhittedParams>(),
-            &members!(WhittedParams: eye, right, up, forward, background, ambient, mirror_specular, shading,
-                sizes, counts),
+            &members!(WhittedParams: camera, background, ambient, mirror_specular, shading, sizes, counts),
         );
-        wgsl("Material")
-            .assert_matches(size_of::<WhittedMaterial>(), &members!(WhittedMaterial: kind, pad, a, b));
         wgsl("Light")
             .assert_matches(size_of::<WhittedLight>(), &members!(WhittedLight: kind, pad, a, normal, power));
     }

@@ -35,7 +35,9 @@ use illum_gpu::{GpuContext, wgpu};
 use illum_scene::{MaterialKind, Scene};
 
 use crate::accumulator::Accumulator;
-use crate::gpu_scene::{GpuParams, GpuScene, GpuShape};
+use illum_rtcore::GpuShape;
+
+use crate::gpu_scene::{GpuParams, GpuScene};
 use crate::options::TracerOptions;
 use crate::{PathTraceError, shaders};
 
@@ -248,6 +250,7 @@ impl CausticTracer {
             )
         };
         let discs: Vec<[f32; 4]> = gpu_scene
+            .geometry
             .objects
             .iter()
             .filter(|o| !o.emitter && specular(o.material))
@@ -257,7 +260,8 @@ impl CausticTracer {
             })
             .collect();
         let disc_area: f32 = discs.iter().map(|d| std::f32::consts::PI * d[3] * d[3]).sum();
-        let spheres: Vec<(Vec3, f32)> = gpu_scene.objects.iter().map(|o| bounding_sphere(&o.shape)).collect();
+        let spheres: Vec<(Vec3, f32)> =
+            gpu_scene.geometry.objects.iter().map(|o| bounding_sphere(&o.shape)).collect();
         let scene_centre = spheres.iter().map(|s| s.0).sum::<Vec3>() / spheres.len() as f32;
         let scene_radius = spheres.iter().map(|(c, r)| (*c - scene_centre).length() + r).fold(0.0, f32::max);
 

@@ -191,14 +191,14 @@ impl ScenePipeline {
         if scene.objects == self.scene.objects && scene.materials == self.scene.materials {
             return Ok(());
         }
-        let needed = specialise::specialise(scene, gpu_scene);
+        let needed = specialise::traversal(gpu_scene);
         let what = if self.options.traversal == Traversal::Specialised
             && needed.source != self.traversal_source
         {
             format!(
                 "its geometry needs a pipeline specialised for shapes {:?}, {} light(s) and shadow-ray occluders {:?}",
                 needed.kind_names(),
-                needed.lights,
+                gpu_scene.lights.len(),
                 needed.occluders
             )
         } else {

@@ -1,4 +1,4 @@
-#define_import_path illum::spawn
+#define_import_path illum::rtcore::spawn
 
 // Robust ray spawning: moving a new ray's origin off the surface it leaves, by an amount derived
 // from a bound on the rounding error of the surface point (the approach of pbrt-v4's
@@ -13,15 +13,15 @@
 //   - p' is strictly on n's side of the true surface (its own surface is never hit again);
 //   - each coordinate moves at most err |n_i| plus 1.5 float steps of p'_i, so a surface further
 //     than err + 2^-22 |p| (plus a subnormal step) away along n is never skipped.
-// crates/illum-pathtrace/src/spawn.rs mirrors this function on the CPU and tests both claims.
+// crates/illum-rtcore/src/spawn.rs mirrors this function on the CPU and tests both claims.
 //
-// The error bounds themselves come from the surface routines (scene.wgsl): 0 for points snapped
+// The error bounds themselves come from the surface routines (geometry.wgsl): 0 for points snapped
 // onto an axis-aligned face, SPAWN_REL_ERROR times the magnitude of the numbers a point was
 // computed from otherwise.
 
-// Relative error bound: 32 machine epsilons (2^-18). The error analysis in scene.wgsl bounds the
-// error of a reconstructed surface point plus that of the intersection test that re-tests it at
-// about 20 epsilons of the magnitudes involved; 32 leaves a margin.
+// Relative error bound: 32 machine epsilons (2^-18). geometry.wgsl bounds the error of a
+// rebuilt surface point, and of the same shape's intersection test run again from the spawned
+// origin, by 17 u = 8.5 epsilons of the shape's magnitude for every kind; 32 leaves a margin.
 const SPAWN_REL_ERROR: f32 = 3.814697265625e-6;
 // Smallest offset used, 2^-100: keeps p + err n away from subnormals (which GPUs may flush to
 // zero) when err is 0 and p is 0. Far below any representable scene feature.

@@ -33,13 +33,15 @@
 #import illum::constants::{PI, TWO_PI, INV_PI}
 #import illum::sampler::{Sampler, sampler_new, sample_1d}
 #import illum::sampling::sample_disc
-#import illum::spawn::spawn_point
+#import illum::rtcore::spawn::spawn_point
+#import illum::rtcore::codes::{MATERIAL_CHECKER, MATERIAL_DIELECTRIC, MATERIAL_MIRROR}
 #import illum::rtcore::geometry::{NO_HIT, Surface}
+#import illum::rtcore::camera::camera_film_point
 #import illum::pathtrace::scene::{params, objects, materials}
 #import illum::rtcore::traversal::{closest_hit, scattering_surface_at}
-#import illum::pathtrace::surfaces::{MATERIAL_CHECKER, MATERIAL_DIELECTRIC, MATERIAL_MIRROR, UNBOUNDED, RR_START, RR_MAX_SURVIVAL, UNBOUNDED_DEPTH_CAP, max3, scatter_dielectric, sample_sun}
+#import illum::pathtrace::surfaces::{UNBOUNDED, RR_START, RR_MAX_SURVIVAL, UNBOUNDED_DEPTH_CAP, max3, scatter_dielectric, sample_sun}
 #ifdef CHECKER
-#import illum::pathtrace::surfaces::checker_albedo
+#import illum::rtcore::optics::checker_albedo
 #endif
 
 const TWO_POW_32: f32 = 4294967296.0;
@@ -111,19 +113,17 @@ fn drop_particle(frame: u32) {
 
 // The particle of outgoing factor `weight` (flux rho / pi) at surface s, seen from the eye.
 fn connect(frame: u32, s: Surface, weight: vec3<f32>) {
-    let to_eye = params.eye - s.p;
+    let to_eye = params.camera.eye - s.p;
     let r2 = dot(to_eye, to_eye);
     let w = to_eye / sqrt(r2);
     let cos_x = dot(s.n, w);
-    let cos_theta = -dot(w, params.forward);
+    let film = camera_film_point(params.camera, w, vec2<f32>(f32(params.width), f32(params.height)));
+    let cos_theta = film.z;
     if (!(cos_x > 0.0 && cos_theta > 0.0)) {
         return;
     }
-    // Where the eye's ray toward x crosses the image plane at distance 1, in pixels.
-    let sx = -dot(w, params.right) / cos_theta;
-    let sy = -dot(w, params.up) / cos_theta;
-    let px = (sx / (params.aspect * params.tan_half_fov) + 1.0) * 0.5 * f32(params.width);
-    let py = (1.0 - sy / params.tan_half_fov) * 0.5 * f32(params.height);
+    let px = film.x;
+    let py = film.y;
     if (!(px >= 0.0 && px < f32(params.width) && py >= 0.0 && py < f32(params.height))) {
         return;
     }
@@ -132,7 +132,7 @@ fn connect(frame: u32, s: Surface, weight: vec3<f32>) {
     // Visibility: the nearest surface (emitters included: a camera ray would see them) from x
     // toward the eye must lie beyond it.
     let origin = spawn_point(s.p, s.n, s.err);
-    let segment = params.eye - origin;
+    let segment = params.camera.eye - origin;
     let distance = length(segment);
     let hit = closest_hit(origin, segment / distance);
     if (hit.index != NO_HIT && hit.t < distance) {
@@ -224,9 +224,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             s.n = -s.n;
         }
         let m = materials[obj.material];
-        let kind = u32(m.albedo.w);
+        let kind = m.kind;
         if (kind == MATERIAL_MIRROR) {
-            if (!may_scatter(scatterings, &throughput, m.albedo.xyz, &sampler)) {
+            if (!may_scatter(scatterings, &throughput, m.a.xyz, &sampler)) {
                 return;
             }
             d = reflect(d, s.n);
@@ -236,7 +236,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 return;
             }
             // Flux crosses without an eta^2 factor (see the top of this file).
-            let next = scatter_dielectric(s, d, m.emission.w, front, &sampler);
+            let next = scatter_dielectric(s, d, m.a.w, front, &sampler);
             o = next.o;
             d = next.d;
         } else {
@@ -244,12 +244,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 return;
             }
 #ifdef CHECKER
-            var albedo = m.albedo.xyz;
+            var albedo = m.a.xyz;
             if (kind == MATERIAL_CHECKER) {
-                albedo = checker_albedo(hit.index, m, s.p);
+                albedo = checker_albedo(obj, m, s.p);
             }
 #else
-            let albedo = m.albedo.xyz;
+            let albedo = m.a.xyz;
 #endif
             connect(frame, s, throughput * albedo * INV_PI);
             return;

@@ -1,10 +1,11 @@
-#define_import_path illum::pathtrace::materials
+#define_import_path illum::rtcore::materials
 
 // Generic material lookup: reads the path tracer's material buffer, so one pipeline serves every
 // scene. (A specialised pipeline replaces this module with the scene's materials as literals:
-// specialise.rs, materials_module.)
+// illum-rtcore's material.rs, materials_module.)
 
-#import illum::pathtrace::scene::{Material, materials}
+#import illum::rtcore::material::Material
+#import illum::pathtrace::scene::materials
 
 // The material at `index`.
 fn material_at(index: u32) -> Material {

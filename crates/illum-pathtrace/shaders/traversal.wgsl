@@ -2,10 +2,12 @@
 
 // Generic traversal: loops over the path tracer's object buffer, so one pipeline serves every
 // scene. (The specialised pipelines, the path tracer's by default and the Whitted ray
-// tracer's always, replace this module with code generated from the scene: specialise.rs.)
+// tracer's always, replace this module with code generated from the scene: illum-rtcore's
+// traversal.rs.)
 
-#import illum::rtcore::geometry::{Hit, Object, FAR, NO_HIT, EMITTER_TIE, KIND_AABB, KIND_BOX, KIND_QUAD, safe_inverse, hit_slabs, hit_box, hit_quad, hit_sphere, Surface, surface_aabb, surface_box, surface_quad, surface_sphere}
-#import illum::pathtrace::scene::{params, objects, lights}
+#import illum::rtcore::codes::{KIND_AABB, KIND_BOX, KIND_QUAD}
+#import illum::rtcore::geometry::{Hit, Object, FAR, NO_HIT, EMITTER_TIE, safe_inverse, hit_slabs, hit_box, hit_quad, hit_sphere, Surface, surface_aabb, surface_box, surface_quad, surface_sphere}
+#import illum::pathtrace::scene::{params, objects}
 
 // Closest hit over all objects. `d` must be unit length. Only the fields a shape's test needs are
 // loaded: on a CPU driver each storage-buffer read is a per-lane memory access.
@@ -55,8 +57,7 @@ fn occluded(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> bool {
     return false;
 }
 
-
-// The surface at the computed hit point p on the object (see scene.wgsl's surface functions).
+// The surface at the computed hit point p on the object (see geometry.wgsl's surface functions).
 fn surface_at(obj: Object, p: vec3<f32>) -> Surface {
     switch obj.kind {
         case KIND_AABB: { return surface_aabb(obj, p); }
@@ -69,16 +70,4 @@ fn surface_at(obj: Object, p: vec3<f32>) -> Surface {
 // The surface of a non-emitter; the generic pipeline reconstructs every kind.
 fn scattering_surface_at(obj: Object, p: vec3<f32>) -> Surface {
     return surface_at(obj, p);
-}
-
-// The light whose share of the total light area contains `pick` (in [0, total area)): lights
-// are chosen with probability proportional to their area.
-fn choose_light(pick: f32) -> u32 {
-    var li = 0u;
-    for (; li + 1u < params.num_lights; li++) {
-        if (pick < lights[li].corner.w) {
-            break;
-        }
-    }
-    return li;
 }

@@ -7,36 +7,29 @@
 // stack holds at most one pending sibling per level plus the entry in hand: depth + 2 entries.
 // The pipeline is built for the scene's depth (shader def WHITTED_STACK = depth + 2, at most 66
 // for the deepest recursion the scene format accepts): WGSL zero-fills a function's arrays on
-// every call, and a stack sized for depth 64 made a depth-1 frame four times slower (160 x 90,
-// 2 x 2 rays per pixel, lavapipe: 80 against 21 ms).
+// every call, so a stack sized for the deepest recursion would cost every shallow render that
+// much more (docs/performance.md, "Levers").
 //
-// The traversal (closest_hit, occluded, surface_at) is the path tracer's, generated for the
-// scene with its numbers as constants (illum-pathtrace's specialise.rs): one copy of
-// intersection for both ray tracers. Its shadow rays test only the objects that can block a
-// light; a Whitted point light lies inside the area light it stands for, so the same
-// occluders serve.
+// The traversal (closest_hit, occluded, surface_at, object_at) and the materials (material_at)
+// are illum-rtcore's, generated for the scene with its numbers as constants, as the path
+// tracer's are: one copy of intersection, optics and camera for both ray tracers. Shadow rays
+// test only the objects that can block a light; a Whitted point light lies inside the area
+// light it stands for, so the same occluders serve.
 
-#import illum::spawn::spawn_point
-#import illum::rtcore::geometry::{Object, FAR, NO_HIT}
-#import illum::rtcore::traversal::{closest_hit, occluded, surface_at}
+#import illum::rtcore::spawn::spawn_point
+#import illum::rtcore::codes::{MATERIAL_LAMBERTIAN, MATERIAL_CHECKER, MATERIAL_MIRROR, MATERIAL_EMITTER}
+#import illum::rtcore::geometry::{FAR, NO_HIT}
+#import illum::rtcore::camera::{Camera, camera_ray}
+#import illum::rtcore::optics::{checker_albedo, transmitted_cos2, refracted, fresnel}
+#import illum::rtcore::traversal::{closest_hit, occluded, surface_at, object_at}
+#import illum::rtcore::materials::material_at
 
 const MAX_STACK: u32 = #{WHITTED_STACK}u;
-
-const MAT_LAMBERTIAN: u32 = 0u;
-const MAT_CHECKER: u32 = 1u;
-const MAT_DIELECTRIC: u32 = 2u;
-const MAT_MIRROR: u32 = 3u;
-const MAT_EMITTER: u32 = 4u;
 
 const LIGHT_DIRECTIONAL: u32 = 0u;
 
 struct Params {
-    // xyz: eye, w: tan(vfov / 2)
-    eye: vec4<f32>,
-    // xyz: right, w: aspect
-    right: vec4<f32>,
-    up: vec4<f32>,
-    forward: vec4<f32>,
+    camera: Camera,
     background: vec4<f32>,
     ambient: vec4<f32>,
     // rgb: the mirror's highlight colour, w: its shininess
@@ -51,15 +44,6 @@ struct Params {
     counts: vec4<u32>,
 }
 
-// kind MAT_*; a: albedo, checker even, mirror reflectance or emitted radiance (w: checker tile
-// or dielectric ior); b: checker odd.
-struct Material {
-    kind: u32,
-    pad: array<u32, 3>,
-    a: vec4<f32>,
-    b: vec4<f32>,
-}
-
 // A directional light: a = (unit vector toward it, 0), power = (irradiance / pi, 0). A point
 // light at an emitting quad's centre: a = (position, 1), normal = (the quad's front normal, 0),
 // power = (radiance x area, 0).
@@ -72,10 +56,8 @@ struct Light {
 }
 
 @group(0) @binding(0) var<uniform> params: Params;
-@group(0) @binding(1) var<storage, read> objects: array<Object>;
-@group(0) @binding(2) var<storage, read> materials: array<Material>;
-@group(0) @binding(3) var<storage, read> lights: array<Light>;
-@group(0) @binding(4) var<storage, read_write> image: array<vec4<f32>>;
+@group(0) @binding(1) var<storage, read> lights: array<Light>;
+@group(0) @binding(2) var<storage, read_write> image: array<vec4<f32>>;
 
 struct Ray {
     o: vec3<f32>,
@@ -122,25 +104,6 @@ fn light_at(p: vec3<f32>, n: vec3<f32>, err: f32, v: vec3<f32>, shininess: f32) 
     return lit;
 }
 
-// The checker's albedo at p on the quad obj: tile (i, j) counted from its corner along its edges.
-fn checker_albedo(obj: Object, m: Material, p: vec3<f32>) -> vec3<f32> {
-    let q = p - obj.a.xyz;
-    let lu = length(obj.b.xyz);
-    let lv = length(obj.c.xyz);
-    let i = floor(dot(q, obj.b.xyz) / lu / m.a.w);
-    let j = floor(dot(q, obj.c.xyz) / lv / m.a.w);
-    let odd = (i32(i) + i32(j)) % 2 != 0;
-    return select(m.a.rgb, m.b.rgb, odd);
-}
-
-// Exact unpolarised Fresnel reflectance for cosines of incidence and transmission and
-// eta = n_from / n_to.
-fn fresnel(cos_i: f32, cos_t: f32, eta: f32) -> f32 {
-    let rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    return 0.5 * (rs * rs + rp * rp);
-}
-
 fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
     var stack: array<Ray, MAX_STACK>;
     var top = 1u;
@@ -154,25 +117,25 @@ fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
             colour += ray.weight * params.background.rgb;
             continue;
         }
-        let obj = objects[hit.index];
-        let m = materials[obj.material];
+        let obj = object_at(hit.index);
+        let m = material_at(obj.material);
         let s = surface_at(obj, ray.o + hit.t * ray.d);
         let front = dot(s.n, ray.d) < 0.0;
         let n = select(-s.n, s.n, front);
         let v = -ray.d;
         switch m.kind {
-            case MAT_EMITTER: {
-                colour += select(vec3<f32>(0.0), ray.weight * m.a.rgb, front);
+            case MATERIAL_EMITTER: {
+                colour += select(vec3<f32>(0.0), ray.weight * m.b.rgb, front);
             }
-            case MAT_LAMBERTIAN, MAT_CHECKER: {
+            case MATERIAL_LAMBERTIAN, MATERIAL_CHECKER: {
                 var c = m.a.rgb;
-                if (m.kind == MAT_CHECKER) {
+                if (m.kind == MATERIAL_CHECKER) {
                     c = checker_albedo(obj, m, s.p);
                 }
                 let lit = light_at(s.p, n, s.err, v, 1.0);
                 colour += ray.weight * c * (params.ambient.rgb + lit.diffuse);
             }
-            case MAT_MIRROR: {
+            case MATERIAL_MIRROR: {
                 let c = m.a.rgb;
                 let w = params.shading.x;
                 let lit = light_at(s.p, n, s.err, v, params.mirror_specular.w);
@@ -191,7 +154,7 @@ fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
                 colour += ray.weight * lit.highlight;
                 if (ray.depth > 0u) {
                     let cos_i = dot(v, n);
-                    let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+                    let k = transmitted_cos2(cos_i, eta);
                     let reflected = reflect(ray.d, n);
                     if (k < 0.0) {
                         if (top < MAX_STACK) {
@@ -200,12 +163,12 @@ fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
                         }
                     } else {
                         let cos_t = sqrt(k);
-                        let refracted = normalize(eta * ray.d + (eta * cos_i - cos_t) * n);
+                        let transmitted = refracted(ray.d, n, eta, cos_i, cos_t);
                         let f = fresnel(cos_i, cos_t, eta);
                         if (top + 1u < MAX_STACK) {
                             stack[top] = Ray(spawn_point(s.p, n, s.err), reflected, ray.weight * f, ray.depth - 1u);
                             stack[top + 1u] =
-                                Ray(spawn_point(s.p, -n, s.err), refracted, ray.weight * (1.0 - f), ray.depth - 1u);
+                                Ray(spawn_point(s.p, -n, s.err), transmitted, ray.weight * (1.0 - f), ray.depth - 1u);
                             top += 2u;
                         }
                     }
@@ -230,7 +193,7 @@ fn object_ids(eye: vec3<f32>, d: vec3<f32>) -> vec2<u32> {
     if (hit.index == NO_HIT || params.counts.x == 0u) {
         return vec2<u32>(hit.index, SHADOW_LIT);
     }
-    let s = surface_at(objects[hit.index], eye + hit.t * d);
+    let s = surface_at(object_at(hit.index), eye + hit.t * d);
     let n = select(-s.n, s.n, dot(s.n, d) < 0.0);
     let light = lights[0];
     var l = light.a.xyz;
@@ -249,11 +212,9 @@ fn object_ids(eye: vec3<f32>, d: vec3<f32>) -> vec2<u32> {
 }
 
 // The unit direction through the point (px, py) of the image, in pixels from its top-left.
-fn camera_ray(px: f32, py: f32) -> vec3<f32> {
-    let x = 2.0 * px / f32(params.sizes.x) - 1.0;
-    let y = 1.0 - 2.0 * py / f32(params.sizes.y);
-    return normalize(params.forward.xyz + x * params.right.w * params.eye.w * params.right.xyz
-        + y * params.eye.w * params.up.xyz);
+fn pixel_ray(px: f32, py: f32) -> vec3<f32> {
+    let inv_size = vec2<f32>(1.0 / f32(params.sizes.x), 1.0 / f32(params.sizes.y));
+    return camera_ray(params.camera, vec2<f32>(px, py), inv_size);
 }
 
 @compute @workgroup_size(8, 8)
@@ -266,7 +227,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     if (params.counts.w == OUTPUT_OBJECT_IDS) {
-        let ids = object_ids(params.eye.xyz, camera_ray(f32(px) + 0.5, f32(py) + 0.5));
+        let ids = object_ids(params.camera.eye, pixel_ray(f32(px) + 0.5, f32(py) + 0.5));
         image[py * width + px] = vec4<f32>(bitcast<f32>(ids.x), bitcast<f32>(ids.y), 0.0, 0.0);
         return;
     }
@@ -275,7 +236,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     for (var j = 0u; j < n; j++) {
         for (var i = 0u; i < n; i++) {
             // The cell centres of an n x n grid over the pixel.
-            sum += trace(params.eye.xyz, camera_ray(f32(px) + (f32(i) + 0.5) / f32(n), f32(py) + (f32(j) + 0.5) / f32(n)));
+            sum += trace(params.camera.eye, pixel_ray(f32(px) + (f32(i) + 0.5) / f32(n), f32(py) + (f32(j) + 0.5) / f32(n)));
         }
     }
     image[py * width + px] = vec4<f32>(sum / f32(n * n), 1.0);

@@ -1,15 +1,15 @@
 #define_import_path illum::pathtrace::surfaces
 
 // What the path tracer's two estimators (pathtrace.wgsl from the camera, caustic.wgsl from the
-// sun) both need to know about surfaces and the sun: the material kinds, the functions that
-// read them, and the sun's sampled direction.
+// sun) both need: the sun's sampled direction, the paths' length rule, and the sampled choice
+// between reflection and refraction at a dielectric.
 
 #import illum::sampler::{Sampler, sample_1d}
 #import illum::sampling::{sample_uniform_cone, to_world}
-#import illum::spawn::spawn_point
+#import illum::rtcore::spawn::spawn_point
 #import illum::rtcore::geometry::Surface
-#import illum::pathtrace::scene::{Material, params}
-#import illum::rtcore::traversal::object_at
+#import illum::rtcore::optics::{transmitted_cos2, refracted, fresnel}
+#import illum::pathtrace::scene::params
 
 #ifdef SUN
 // A direction toward the directional light and its weight, radiance / pdf. A delta light: its
@@ -48,30 +48,7 @@ fn max3(v: vec3<f32>) -> f32 {
     return max(max(v.x, v.y), v.z);
 }
 
-const MATERIAL_CHECKER: u32 = 1u;
-const MATERIAL_DIELECTRIC: u32 = 2u;
-const MATERIAL_MIRROR: u32 = 3u;
-
-#ifdef CHECKER
-// The checker's albedo at p on quad obj: tile (i, j) counted from its corner along its edges.
-fn checker_albedo(obj_index: u32, m: Material, p: vec3<f32>) -> vec3<f32> {
-    let obj = object_at(obj_index);
-    let q = p - obj.a.xyz;
-    let i = floor(dot(q, obj.b.xyz) / length(obj.b.xyz) / m.emission.w);
-    let j = floor(dot(q, obj.c.xyz) / length(obj.c.xyz) / m.emission.w);
-    return select(m.albedo.rgb, m.emission.rgb, (i32(i) + i32(j)) % 2 != 0);
-}
-#endif
-
 #ifdef SPECULAR
-// Exact unpolarised Fresnel reflectance for cosines of incidence and transmission and
-// eta = n_from / n_to.
-fn fresnel(cos_i: f32, cos_t: f32, eta: f32) -> f32 {
-    let rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    return 0.5 * (rs * rs + rp * rp);
-}
-
 // A ray leaving a smooth surface: its origin and direction.
 struct Scattered {
     o: vec3<f32>,
@@ -87,11 +64,11 @@ struct Scattered {
 fn scatter_dielectric(s: Surface, d: vec3<f32>, ior: f32, front: bool, sampler: ptr<function, Sampler>) -> Scattered {
     let eta = select(ior, 1.0 / ior, front);
     let cos_i = -dot(d, s.n);
-    let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+    let k = transmitted_cos2(cos_i, eta);
     if (k >= 0.0) {
         let cos_t = sqrt(k);
         if (sample_1d(sampler) >= fresnel(cos_i, cos_t, eta)) {
-            return Scattered(spawn_point(s.p, -s.n, s.err), normalize(eta * d + (eta * cos_i - cos_t) * s.n));
+            return Scattered(spawn_point(s.p, -s.n, s.err), refracted(d, s.n, eta, cos_i, cos_t));
         }
     }
     return Scattered(spawn_point(s.p, s.n, s.err), reflect(d, s.n));

@@ -1,18 +1,15 @@
 #define_import_path illum::pathtrace::scene
 
-#import illum::rtcore::geometry::{Object}
+#import illum::rtcore::geometry::Object
+#import illum::rtcore::camera::Camera
+#import illum::rtcore::material::Material
 
-// The path tracer's scene as the GPU sees it (mirrored by gpu_scene.rs): its parameters,
-// materials, lights and bindings. Objects and ray-shape tests are in rtcore/geometry.wgsl.
+// The path tracer's scene as the GPU sees it (mirrored by gpu_scene.rs): its parameters, lights
+// and bindings. Objects, materials, the camera and the ray-shape tests are illum-rtcore's.
 
 struct Params {
-    eye: vec3<f32>,
-    tan_half_fov: f32,
-    right: vec3<f32>,
-    aspect: f32,
-    up: vec3<f32>,
+    camera: Camera,
     light_area: f32,
-    forward: vec3<f32>,
     num_objects: u32,
     width: u32,
     height: u32,
@@ -22,14 +19,15 @@ struct Params {
     sample_count: u32,
     seed: u32,
     bounces: u32,
-    // Unused: keeps the members after it at the offsets gpu_scene.rs gives them (the
-    // hemisphere sampling is the shader def UNIFORM_SAMPLING).
-    padding: u32,
     num_lights: u32,
     // Objects [first_emitter, num_objects) are the emitters.
     first_emitter: u32,
     // Samples per invocation (one chunk); the dispatch's z dimension counts chunks.
     chunk_samples: u32,
+    // Unused: the vectors after them start at a multiple of 16 bytes, as gpu_scene.rs lays them.
+    padding_a: u32,
+    padding_b: u32,
+    padding_c: u32,
     // The directional light (shader def SUN): xyz = unit vector toward it, w = 1 - cos of its
     // angular radius (0 for a delta light; see sample_uniform_cone); its irradiance on a
     // surface facing it.
@@ -37,14 +35,6 @@ struct Params {
     sun_irradiance: vec4<f32>,
     // The environment's radiance (shader def SKY).
     sky: vec4<f32>,
-}
-
-// albedo.w: the kind (MATERIAL_* in pathtrace.wgsl). Lambertian: albedo.rgb; emitter:
-// emission.rgb; checker: even albedo.rgb, odd emission.rgb, tile emission.w; mirror:
-// reflectance albedo.rgb; dielectric: ior emission.w.
-struct Material {
-    albedo: vec4<f32>,
-    emission: vec4<f32>,
 }
 
 // corner.w = running sum of light areas up to and including this light (for selection).

@@ -1,7 +1,7 @@
-//! CPU mirror of `shaders/common/spawn.wgsl`: where a ray leaving a surface starts.
+//! CPU mirror of `shaders/spawn.wgsl`: where a ray leaving a surface starts.
 //!
 //! A computed surface point `p` lies within `err` of the true surface, measured along the unit
-//! normal `n` (the surface routines in `shaders/pathtrace/scene.wgsl` supply `err`: 0 for points
+//! normal `n` (the surface routines in `shaders/geometry.wgsl` supply `err`: 0 for points
 //! snapped onto an axis-aligned face, [`SPAWN_REL_ERROR`] times the magnitude of the numbers the
 //! point was computed from otherwise). [`spawn_point`] moves `p` by `err` along `n` and then steps
 //! every coordinate that moved one more float in the same direction (pbrt-v4's OffsetRayOrigin).
@@ -21,8 +21,9 @@
 
 use glam::Vec3;
 
-/// Relative error bound of a rebuilt surface point: 32 machine epsilons (2^-18). See `surface_at`
-/// in scene.wgsl for the per-shape analysis (all under 8.5 epsilons of the shape's magnitude).
+/// Relative error bound of a rebuilt surface point: 32 machine epsilons (2^-18). See the surface
+/// functions in geometry.wgsl for the per-shape analysis (all under 8.5 epsilons of the shape's
+/// magnitude, the intersection test's own error included).
 pub const SPAWN_REL_ERROR: f32 = 1.0 / 262_144.0;
 /// Smallest offset used (2^-100), so that `p + err n` stays clear of subnormals near zero.
 pub const SPAWN_MIN_OFFSET: f32 = f32::from_bits((127 - 100) << 23);
@@ -72,7 +73,7 @@ mod tests {
 
     #[test]
     fn the_constants_are_the_shaders() {
-        let wgsl = include_str!("../../../shaders/common/spawn.wgsl");
+        let wgsl = include_str!("../shaders/spawn.wgsl");
         let constant = |name: &str| -> f32 {
             let line = wgsl
                 .lines()

@@ -1,18 +1,13 @@
 #define_import_path illum::rtcore::geometry
 
-#import illum::spawn::{spawn_error, max_abs}
+#import illum::rtcore::spawn::{spawn_error, max_abs}
 
-// What every compute ray tracer of illum shares: the objects as the GPU stores them (mirrored
-// by illum-pathtrace's gpu_scene.rs), the ray-shape tests, and the surface at a hit point made
-// precise for spawning the next ray. No bindings: each renderer binds its own object buffer.
-// The traversal over a scene's objects (closest_hit, occluded, surface_at) is the module
-// illum::rtcore::traversal, generated per scene by illum-pathtrace's specialise.rs and imported
-// by both the path tracer and the Whitted ray tracer.
+// The objects as every compute ray tracer stores them (mirrored by illum-rtcore's object.rs;
+// their KIND_* codes are generated from it into illum::rtcore::codes), the ray-shape tests, and
+// the surface at a hit point made precise for spawning the next ray. No bindings. The traversal
+// over a scene's objects (closest_hit, occluded, surface_at) is the module
+// illum::rtcore::traversal, generated per scene by illum-rtcore's traversal.rs.
 
-const KIND_BOX: u32 = 0u;
-const KIND_QUAD: u32 = 1u;
-const KIND_SPHERE: u32 = 2u;
-const KIND_AABB: u32 = 3u;
 const NO_HIT: u32 = 0xffffffffu;
 const FAR: f32 = 3.0e38;
 
@@ -195,7 +190,7 @@ fn surface_box(obj: Object, p: vec3<f32>) -> Surface {
     let pl = rotate_y_inverse(p - obj.c.xyz, c, s);
     let nl = box_face_normal((pl - 0.5 * (lo + hi)) / (0.5 * (hi - lo)));
     let q = rotate_y(snap_to_face(pl, nl, lo, hi), c, s) + obj.c.xyz;
-    // err = spawn_error(|offset| + 2 max(|lo|, |hi|)), stored in the record (gpu_scene.rs).
+    // err = spawn_error(|offset| + 2 max(|lo|, |hi|)), stored in the record (object.rs).
     return Surface(q, rotate_y(nl, c, s), obj.c.w);
 }
 

@@ -15,15 +15,18 @@
 #import illum::constants::{PI, TWO_PI, INV_PI}
 #import illum::sampler::{Sampler, sampler_new, sample_1d, sample_2d}
 #import illum::sampling::{sample_cosine_hemisphere, sample_uniform_hemisphere, to_world, sample_parallelogram, sample_light_bilinear}
-#import illum::spawn::{spawn_point, spawn_error, max_abs}
+#import illum::rtcore::spawn::{spawn_point, spawn_error, max_abs}
+#import illum::rtcore::codes::{MATERIAL_CHECKER, MATERIAL_DIELECTRIC, MATERIAL_MIRROR}
 #import illum::rtcore::geometry::{NO_HIT, FAR, Surface}
-#import illum::pathtrace::scene::{Material, params, lights, batch_sum, batch_sum_sq}
+#import illum::rtcore::camera::camera_ray
+#import illum::pathtrace::scene::{params, lights, batch_sum, batch_sum_sq}
 #ifdef ADAPTIVE
 #import illum::pathtrace::scene::block_samples
 #endif
-#import illum::pathtrace::materials::material_at
-#import illum::rtcore::traversal::{closest_hit, occluded, scattering_surface_at, choose_light, object_at}
-#import illum::pathtrace::surfaces::{MATERIAL_CHECKER, MATERIAL_DIELECTRIC, MATERIAL_MIRROR, UNBOUNDED, RR_START, RR_MAX_SURVIVAL, UNBOUNDED_DEPTH_CAP, max3}
+#import illum::rtcore::materials::material_at
+#import illum::rtcore::traversal::{closest_hit, occluded, scattering_surface_at, object_at}
+#import illum::pathtrace::light_choice::choose_light
+#import illum::pathtrace::surfaces::{UNBOUNDED, RR_START, RR_MAX_SURVIVAL, UNBOUNDED_DEPTH_CAP, max3}
 #ifdef SUN
 #import illum::pathtrace::surfaces::sample_sun
 #endif
@@ -31,7 +34,7 @@
 #import illum::pathtrace::surfaces::scatter_dielectric
 #endif
 #ifdef CHECKER
-#import illum::pathtrace::surfaces::checker_albedo
+#import illum::rtcore::optics::checker_albedo
 #endif
 
 // Adaptive sampling's blocks: 8 x 8 pixels, the workgroup (allocation.rs, BLOCK).
@@ -158,7 +161,7 @@ struct Path {
 
 // A path starting with the camera ray from the eye along d.
 fn camera_path(d: vec3<f32>) -> Path {
-    return Path(params.eye, d, vec3<f32>(1.0), vec3<f32>(0.0), 0u, true, true, false);
+    return Path(params.camera.eye, d, vec3<f32>(1.0), vec3<f32>(0.0), 0u, true, true, false);
 }
 
 // Traces one vertex of the path: its radiance estimate gains what this vertex adds, and the
@@ -192,7 +195,7 @@ fn path_step(path: ptr<function, Path>, sampler: ptr<function, Sampler>) {
 
     let hit = closest_hit(o, d);
     let missed = hit.index == NO_HIT;
-    // object_at and material_at: literals in a specialised pipeline (see specialise.rs). A missed
+    // object_at and material_at: literals in a specialised pipeline (illum-rtcore). A missed
     // ray looks at object 0, whose vertex is never used.
     let obj = object_at(select(hit.index, 0u, missed));
     let emitter = !missed && obj.emitter != 0u;
@@ -200,7 +203,7 @@ fn path_step(path: ptr<function, Path>, sampler: ptr<function, Sampler>) {
     // One-sided emitter: visible only from its front, the side its normal edge_u x edge_v (obj.d;
     // emitters are quads) points to. No surface is rebuilt for it.
     let sees_emitter = was_alive && emitter && direct_counts && dot(obj.d.xyz, d) < 0.0;
-    radiance += select(vec3<f32>(0.0), throughput * material_at(obj.material).emission.xyz, sees_emitter);
+    radiance += select(vec3<f32>(0.0), throughput * material_at(obj.material).b.xyz, sees_emitter);
 
     var s = scattering_surface_at(obj, o + hit.t * d);
     let front = dot(s.n, d) < 0.0;
@@ -210,16 +213,16 @@ fn path_step(path: ptr<function, Path>, sampler: ptr<function, Sampler>) {
     var next = Path(o, d, throughput, radiance, depth + 1u, false, false, caustic_owned);
 #ifdef SPECULAR
     let m = material_at(obj.material);
-    let kind = u32(m.albedo.w);
+    let kind = m.kind;
     let specular = kind == MATERIAL_MIRROR || kind == MATERIAL_DIELECTRIC;
     // Its only continuation is the bounce it may not take.
     if (at_surface && specular && !last) {
         if (kind == MATERIAL_MIRROR) {
-            next.throughput *= m.albedo.xyz;
+            next.throughput *= m.a.xyz;
             next.d = reflect(d, s.n);
             next.o = spawn_point(s.p, s.n, s.err);
         } else {
-            let scattered = scatter_dielectric(s, d, m.emission.w, front, sampler);
+            let scattered = scatter_dielectric(s, d, m.a.w, front, sampler);
             next.o = scattered.o;
             next.d = scattered.d;
         }
@@ -245,12 +248,12 @@ fn path_step(path: ptr<function, Path>, sampler: ptr<function, Sampler>) {
 fn diffuse_vertex(material: u32, index: u32, s: Surface, depth: u32, last: bool, live: bool, next: ptr<function, Path>, sampler: ptr<function, Sampler>) {
 #ifdef CHECKER
     let checker = material_at(material);
-    var albedo = checker.albedo.xyz;
-    if (u32(checker.albedo.w) == MATERIAL_CHECKER) {
-        albedo = checker_albedo(index, checker, s.p);
+    var albedo = checker.a.xyz;
+    if (checker.kind == MATERIAL_CHECKER) {
+        albedo = checker_albedo(object_at(index), checker, s.p);
     }
 #else
-    let albedo = material_at(material).albedo.xyz;
+    let albedo = material_at(material).a.xyz;
 #endif
     // Every ray leaving this point (shadow and bounce) starts here, off the surface.
     let spawned = spawn_point(s.p, s.n, s.err);
@@ -310,12 +313,10 @@ fn roulette(depth: u32, throughput: ptr<function, vec3<f32>>, sampler: ptr<funct
 }
 
 // The camera ray through a point of pixel (x, y) jittered uniformly inside it (row 0 is the top
-// of the image): its direction from the eye.
-fn camera_ray(x: u32, y: u32, inv_width: f32, inv_height: f32, sampler: ptr<function, Sampler>) -> vec3<f32> {
+// of the image): its direction from the eye. inv_size = 1 / the image's size in pixels.
+fn pixel_ray(x: u32, y: u32, inv_size: vec2<f32>, sampler: ptr<function, Sampler>) -> vec3<f32> {
     let jitter = sample_2d(sampler);
-    let sx = (2.0 * (f32(x) + jitter.x) * inv_width - 1.0) * params.aspect * params.tan_half_fov;
-    let sy = (1.0 - 2.0 * (f32(y) + jitter.y) * inv_height) * params.tan_half_fov;
-    return normalize(params.forward + sx * params.right + sy * params.up);
+    return camera_ray(params.camera, vec2<f32>(f32(x) + jitter.x, f32(y) + jitter.y), inv_size);
 }
 
 // Adds a sample's radiance l to the sums when it is finite; counts it as dropped otherwise.
@@ -363,8 +364,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var sum_sq = vec3<f32>(0.0);
     var finite = 0u;
     var dropped = 0u;
-    let inv_width = 1.0 / f32(params.width);
-    let inv_height = 1.0 / f32(params.height);
+    let inv_size = vec2<f32>(1.0 / f32(params.width), 1.0 / f32(params.height));
 #ifdef PAIRED_PATHS
     // Two samples at a time, traced in lockstep, vertex by vertex: lavapipe runs each 8-lane
     // group's instructions as one stream on one core, and a second independent path in that
@@ -375,8 +375,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     for (var i = 0u; i < count; i += 2u) {
         var first_sampler = sampler_new(params.seed, pixel, params.sample_base + first + i);
         var second_sampler = sampler_new(params.seed, pixel, params.sample_base + first + i + 1u);
-        var a = camera_path(camera_ray(x, y, inv_width, inv_height, &first_sampler));
-        var b = camera_path(camera_ray(x, y, inv_width, inv_height, &second_sampler));
+        var a = camera_path(pixel_ray(x, y, inv_size, &first_sampler));
+        var b = camera_path(pixel_ray(x, y, inv_size, &second_sampler));
         // An odd count: the last pair has no second sample. Its path is traced all the same and
         // discarded, so the planner gives passes an even spp where it can. A separate one-path
         // loop for the odd sample cost by being in the shader: 4% at 16 spp per invocation, and
@@ -400,7 +400,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     // One sample at a time (TracerOptions::paired_paths off: the browser).
     for (var i = 0u; i < count; i++) {
         var sampler = sampler_new(params.seed, pixel, params.sample_base + first + i);
-        var a = camera_path(camera_ray(x, y, inv_width, inv_height, &sampler));
+        var a = camera_path(pixel_ray(x, y, inv_size, &sampler));
         loop {
             path_step(&a, &sampler);
             if (!a.alive) {

@@ -1,0 +1,28 @@
+//! illum-rtcore: what illum's two compute ray tracers, the path tracer and the Whitted ray
+//! tracer, share and neither owns.
+//!
+//! - [`object`]: the objects as the shaders store them (one record layout for every kind of
+//!   shape), in the order both use (emitters last);
+//! - [`material`]: the one material record and its kind codes;
+//! - [`camera`]: the pinhole camera's record;
+//! - [`spawn`]: where a ray leaving a surface starts, with its error bound (the CPU mirror of
+//!   `shaders/spawn.wgsl`);
+//! - [`traversal`]: `closest_hit`, `occluded` and `surface_at` generated per scene, with the
+//!   scene's numbers as literals;
+//! - [`shaders`]: the WGSL modules (`shaders/`): geometry, optics (Fresnel, refraction, the
+//!   checkerboard), the camera, and the kind codes generated from the Rust enums.
+//!
+//! Each renderer keeps its own lights, parameters, errors and entry shader.
+
+pub mod camera;
+pub mod literal;
+pub mod material;
+pub mod object;
+pub mod shaders;
+pub mod spawn;
+pub mod traversal;
+
+pub use camera::CameraRecord;
+pub use material::{MaterialCode, MaterialRecord, materials_module};
+pub use object::{GpuObject, GpuShape, ObjectRecord, ShapeKind, gpu_shape, ordered_objects};
+pub use traversal::{Geometry, Traversal};

@@ -1,0 +1,389 @@
+//! The traversal generated for one scene: `illum::rtcore::traversal`, whose `closest_hit`,
+//! `occluded`, `object_at`, `surface_at` and `scattering_surface_at` both compute ray tracers
+//! import ("model only what a scene requires").
+//!
+//! A generic traversal loops over a storage buffer of objects and switches on each one's kind.
+//! On a CPU Vulkan driver such as lavapipe every one of those reads is a per-lane memory access
+//! and the loop cannot be unrolled. For a scene of a handful of analytic shapes it is cheaper to
+//! emit one straight-line test per object with its numbers as literals: the compiler then folds
+//! the constants (an axis-aligned box needs no frame change) and no object data is read while
+//! tracing. The generated module also contains only what the scene uses:
+//! - surface reconstruction only for the kinds of shape present (for `scattering_surface_at`,
+//!   only those of non-emitters), one function for axis-aligned and rotated boxes;
+//! - shadow rays test only the objects that can block a light (see [`can_block_light`]);
+//! - the object at a hit comes from literals (`object_at`), not from a storage buffer.
+//!
+//! The measured effect of each is in docs/performance.md ("Levers").
+
+use std::collections::BTreeSet;
+
+use illum_gpu::shader::ShaderFile;
+use illum_scene::{Scene, Shape};
+
+use crate::literal::{lit, switch_cases, vec3, vec4};
+use crate::object::{GpuObject, GpuShape, ObjectRecord, ShapeKind, ordered_objects};
+
+/// What a traversal is generated from: the scene's objects in the order the shaders store them,
+/// and what shadow rays can be aimed at.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Geometry {
+    /// The scene's name, for the generated module's comments.
+    pub scene: String,
+    /// Non-emitters first, then emitters ([`ordered_objects`]).
+    pub objects: Vec<GpuObject>,
+    /// Each object's name, in the same order.
+    pub names: Vec<String>,
+    /// The index of the first emitter in `objects`.
+    pub first_emitter: u32,
+    /// The corners of every emitting quad: every point a shadow ray toward an area light (or a
+    /// point light standing for one) can end at lies in their convex hulls.
+    pub light_corners: Vec<[f32; 3]>,
+    /// Whether a shadow ray can leave in any direction: a directional light, or an emitter that
+    /// is not a quad. Then every object may block a light.
+    pub unbounded_lights: bool,
+}
+
+impl Geometry {
+    pub fn new(scene: &Scene) -> Self {
+        let (ordered, first_emitter) = ordered_objects(scene);
+        let mut light_corners = Vec::new();
+        let mut unbounded_lights = scene.directional_light.is_some();
+        for (index, object) in &ordered {
+            if !object.emitter {
+                continue;
+            }
+            match scene.objects[*index].shape {
+                Shape::Quad(q) => {
+                    let (p, u, v) = (q.corner.to_array(), q.edge_u.to_array(), q.edge_v.to_array());
+                    light_corners.extend([p, add(p, u), add(p, v), add(add(p, u), v)]);
+                }
+                _ => unbounded_lights = true,
+            }
+        }
+        Self {
+            scene: scene.name.clone(),
+            names: ordered.iter().map(|(i, _)| scene.objects[*i].name.clone()).collect(),
+            objects: ordered.into_iter().map(|(_, object)| object).collect(),
+            first_emitter,
+            light_corners,
+            unbounded_lights,
+        }
+    }
+
+    /// The objects as the shaders' storage buffers hold them.
+    pub fn object_records(&self) -> Vec<ObjectRecord> {
+        self.objects.iter().map(GpuObject::record).collect()
+    }
+}
+
+/// A traversal generated for one scene. Two scenes with equal traversals share a pipeline.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct Traversal {
+    /// Kinds of shape with code in the pipeline.
+    pub kinds: BTreeSet<ShapeKind>,
+    /// Indices (into the uploaded objects) of the objects shadow rays test.
+    pub occluders: Vec<usize>,
+    /// The generated WGSL (the scene's numbers are literals in it).
+    pub source: String,
+}
+
+impl Traversal {
+    /// The names of [`Self::kinds`] ("aabb", "box", "quad", "sphere"), in order.
+    pub fn kind_names(&self) -> Vec<&'static str> {
+        self.kinds.iter().map(|k| k.name()).collect()
+    }
+
+    /// The generated module.
+    pub fn module(&self, scene: &str) -> ShaderFile {
+        ShaderFile::generated(format!("generated traversal for scene {scene:?}"), self.source.clone())
+    }
+}
+
+/// The WGSL expression for the object's hit distance along (o, d); `inv_d` = 1 / d.
+fn hit_expression(object: &GpuObject) -> String {
+    match object.shape {
+        GpuShape::Aabb { min, max } => format!("hit_slabs(o, inv_d, {}, {})", vec3(min), vec3(max)),
+        GpuShape::Box { local_min, local_max, cos, sin, offset } => format!(
+            "hit_box(o, d, {}, {}, {}, {}, {})",
+            vec3(local_min),
+            vec3(local_max),
+            lit(cos),
+            lit(sin),
+            vec3(offset)
+        ),
+        GpuShape::Quad { corner, edge_u, edge_v } => format!(
+            "hit_quad(o, d, {}, {}, {}, {})",
+            vec3(corner),
+            vec3(edge_u),
+            vec3(edge_v),
+            vec3(edge_u.cross(edge_v))
+        ),
+        GpuShape::Sphere { center, radius } => format!("hit_sphere(o, d, {}, {})", vec3(center), lit(radius)),
+    }
+}
+
+/// An object's storage record as a WGSL `Object` literal.
+fn object_literal(record: &ObjectRecord) -> String {
+    format!(
+        "Object({}u, {}u, {}u, {}u, {}, {}, {}, {})",
+        record.kind,
+        record.material,
+        record.emitter,
+        record.padding,
+        vec4(record.a),
+        vec4(record.b),
+        vec4(record.c),
+        vec4(record.d)
+    )
+}
+
+/// An axis-aligned box [lo, hi] (lo <= hi; a flat box for a quad).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Bounds {
+    lo: [f32; 3],
+    hi: [f32; 3],
+}
+
+impl Bounds {
+    fn of(object: &GpuObject) -> Self {
+        let points: Vec<[f32; 3]> = match object.shape {
+            GpuShape::Aabb { min, max } => vec![min.to_array(), max.to_array()],
+            GpuShape::Box { local_min, local_max, cos: c, sin: s, offset } => {
+                // The eight corners of the rotated box.
+                let mut corners = Vec::new();
+                for i in 0..8 {
+                    let l = [
+                        if i & 1 == 0 { local_min.x } else { local_max.x },
+                        if i & 2 == 0 { local_min.y } else { local_max.y },
+                        if i & 4 == 0 { local_min.z } else { local_max.z },
+                    ];
+                    corners.push([
+                        c * l[0] + s * l[2] + offset.x,
+                        l[1] + offset.y,
+                        -s * l[0] + c * l[2] + offset.z,
+                    ]);
+                }
+                corners
+            }
+            GpuShape::Quad { corner, edge_u, edge_v } => {
+                let (p, u, v) = (corner.to_array(), edge_u.to_array(), edge_v.to_array());
+                vec![p, add(p, u), add(p, v), add(add(p, u), v)]
+            }
+            GpuShape::Sphere { center, radius: r } => {
+                vec![[center.x - r, center.y - r, center.z - r], [center.x + r, center.y + r, center.z + r]]
+            }
+        };
+        let mut bounds = Bounds { lo: [f32::MAX; 3], hi: [f32::MIN; 3] };
+        for p in points {
+            for (a, value) in p.into_iter().enumerate() {
+                bounds.lo[a] = bounds.lo[a].min(value);
+                bounds.hi[a] = bounds.hi[a].max(value);
+            }
+        }
+        bounds
+    }
+
+    fn contains(&self, other: &Bounds) -> bool {
+        (0..3).all(|a| self.lo[a] <= other.lo[a] && other.hi[a] <= self.hi[a])
+    }
+}
+
+fn add(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+/// Whether the object at `index` can lie on a shadow ray between a lit surface point and a light.
+///
+/// Only axis-aligned boxes are ever excluded (every other shape is kept, conservatively). A box
+/// O is excluded when one of its faces lies in a plane P with:
+/// 1. every light point on the far side of P from O (or on P), and
+/// 2. every surface point that can receive light and is not inside O, also on that far side:
+///    for each other object B, the part of B beyond P is inside O, except on faces of B that
+///    face away from every light point (they never send shadow rays: cos theta <= 0).
+///
+/// Then a shadow ray runs from a point on the far side to a light point on the far side: the
+/// segment stays in that closed half-space, which meets O at most in its face on P, so O
+/// cannot block it. Points on O itself need no test either: O is convex, and next-event
+/// estimation only traces rays leaving a surface on its outer side.
+pub fn can_block_light(scene: &Geometry, index: usize) -> bool {
+    let object = &scene.objects[index];
+    // A directional light shines from everywhere on a hemisphere's worth of directions: the
+    // half-space argument below covers only lights of bounded extent.
+    if object.shape.kind() != ShapeKind::Aabb || object.emitter || scene.unbounded_lights {
+        return true;
+    }
+    let o = Bounds::of(object);
+    let lights = &scene.light_corners;
+    for axis in 0..3 {
+        // side = +1: the plane x_axis = o.hi with O below it; -1: x_axis = o.lo with O above.
+        for side in [1.0f32, -1.0] {
+            let plane = if side > 0.0 { o.hi[axis] } else { o.lo[axis] };
+            // Signed distance beyond the plane (positive on the far side from O).
+            let beyond = |value: f32| side * (value - plane);
+            if lights.iter().any(|c| beyond(c[axis]) < 0.0) {
+                continue;
+            }
+            let others_clear = scene.objects.iter().enumerate().all(|(j, b)| {
+                if j == index || b.emitter {
+                    return true; // paths end at emitters: no shading points there
+                }
+                let bounds = Bounds::of(b);
+                // The part of B on O's side of the plane (strictly): B clipped to that half-space.
+                let mut clipped = bounds;
+                if side > 0.0 {
+                    clipped.hi[axis] = clipped.hi[axis].min(plane);
+                } else {
+                    clipped.lo[axis] = clipped.lo[axis].max(plane);
+                }
+                let reaches_past = if side > 0.0 { bounds.lo[axis] < plane } else { bounds.hi[axis] > plane };
+                if !reaches_past || o.contains(&clipped) {
+                    return true;
+                }
+                if b.shape.kind() != ShapeKind::Aabb {
+                    return false;
+                }
+                // An axis-aligned B: each of its faces that some light point is in front of
+                // must, within the clipped part, lie inside O.
+                (0..3).all(|face_axis| {
+                    [1.0f32, -1.0].iter().all(|&face_side| {
+                        let face_plane =
+                            if face_side > 0.0 { bounds.hi[face_axis] } else { bounds.lo[face_axis] };
+                        let lit = lights.iter().any(|c| face_side * (c[face_axis] - face_plane) > 0.0);
+                        if !lit {
+                            return true;
+                        }
+                        let mut face = clipped;
+                        face.lo[face_axis] = face_plane;
+                        face.hi[face_axis] = face_plane;
+                        let empty = (0..3).any(|a| face.lo[a] > face.hi[a])
+                            || face_plane < clipped.lo[face_axis]
+                            || face_plane > clipped.hi[face_axis];
+                        empty || o.contains(&face)
+                    })
+                })
+            });
+            if others_clear {
+                return false;
+            }
+        }
+    }
+    true
+}
+
+/// The cases of a `switch obj.kind` that reconstructs the surface of each kind in `kinds`; the
+/// last one is the default (WGSL requires one). On lavapipe each case costs time by being in
+/// the shader, and at a bounce the 8 lanes of a group hit different kinds, so kinds share a case
+/// where one function serves them: an axis-aligned box is stored as
+/// a box rotated by zero with an error bound of zero ([`GpuObject::record`]), which
+/// `surface_box` reconstructs exactly as `surface_aabb` does (same point, normal and bound), so
+/// where both kinds occur `surface_box` serves both.
+fn surface_cases(kinds: &BTreeSet<ShapeKind>) -> String {
+    let mut groups: Vec<(Vec<ShapeKind>, &str)> = Vec::new();
+    for &kind in kinds {
+        if kind == ShapeKind::Aabb && kinds.contains(&ShapeKind::Box) {
+            continue;
+        }
+        let mut members = vec![kind];
+        if kind == ShapeKind::Box && kinds.contains(&ShapeKind::Aabb) {
+            members.insert(0, ShapeKind::Aabb);
+        }
+        groups.push((members, kind.surface_function()));
+    }
+    let mut cases = String::new();
+    for (i, (members, function)) in groups.iter().enumerate() {
+        let call = format!("{function}(obj, p)");
+        if i + 1 == groups.len() {
+            cases.push_str(&format!("        default: {{ return {call}; }}\n"));
+        } else {
+            let selectors = members.iter().map(|k| k.wgsl_constant()).collect::<Vec<_>>().join(", ");
+            cases.push_str(&format!("        case {selectors}: {{ return {call}; }}\n"));
+        }
+    }
+    cases
+}
+
+/// Generates the `illum::rtcore::traversal` module for `scene`.
+pub fn generate(scene: &Geometry) -> Traversal {
+    let kinds: BTreeSet<ShapeKind> = scene.objects.iter().map(|o| o.shape.kind()).collect();
+    let mut closest = String::new();
+    let mut occluded = String::new();
+    let mut occluders = Vec::new();
+    for (i, object) in scene.objects.iter().enumerate() {
+        let name = scene.names[i].replace(['\n', '\r'], " ");
+        let hit = hit_expression(object);
+        closest.push_str(&format!("    // {i}: {name}\n    t = {hit};\n"));
+        if object.emitter {
+            // The emitter wins a tie with the surface it is set into (EMITTER_TIE in geometry.wgsl); the cap at
+            // FAR keeps a missed emitter (which reports FAR) from counting as a hit.
+            closest.push_str(&format!(
+                "    if (t < min(best.t * (1.0 + EMITTER_TIE), FAR)) {{\n        best = Hit(t, {i}u);\n    }}\n"
+            ));
+        } else {
+            closest.push_str(&format!("    if (t < best.t) {{\n        best = Hit(t, {i}u);\n    }}\n"));
+            if can_block_light(scene, i) {
+                occluders.push(i);
+                occluded.push_str(&format!(
+                    "    // {name}\n    if ({hit} < t_max) {{\n        return true;\n    }}\n"
+                ));
+            } else {
+                occluded.push_str(&format!(
+                    "    // {name}: cannot block a light (traversal.rs, can_block_light)\n"
+                ));
+            }
+        }
+    }
+    let normal_cases = surface_cases(&kinds);
+    // Shading never needs an emitter's surface (a hit on a light only needs the side, from the
+    // light's normal), so this reconstruction covers the non-emitters' kinds alone.
+    let scattering: BTreeSet<ShapeKind> =
+        scene.objects.iter().filter(|o| !o.emitter).map(|o| o.shape.kind()).collect();
+    let scattering_cases = surface_cases(if scattering.is_empty() { &kinds } else { &scattering });
+    let object_cases = switch_cases(scene.object_records().iter().map(object_literal));
+    let source = format!(
+        "#define_import_path illum::rtcore::traversal
+
+// Generated by illum-rtcore (traversal.rs) for scene {scene_name:?}: {count} objects, each
+// test unrolled with its numbers as constants. Emitters come last.
+
+#import illum::rtcore::codes::{{KIND_AABB, KIND_BOX, KIND_QUAD, KIND_SPHERE}}
+#import illum::rtcore::geometry::{{Hit, Object, FAR, NO_HIT, EMITTER_TIE, safe_inverse, hit_slabs, hit_box, hit_quad, hit_sphere, Surface, surface_aabb, surface_box, surface_quad, surface_sphere}}
+
+fn closest_hit(o: vec3<f32>, d: vec3<f32>) -> Hit {{
+    let inv_d = safe_inverse(d);
+    var best = Hit(FAR, NO_HIT);
+    var t: f32;
+{closest}    return best;
+}}
+
+// True when an object that can block a light lies on the ray strictly between 0 and t_max.
+fn occluded(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> bool {{
+    let inv_d = safe_inverse(d);
+{occluded}    return false;
+}}
+
+// The object at `index` (< the number of objects), as the storage buffer holds it, from
+// literals (a specialised pipeline binds no object buffer).
+fn object_at(index: u32) -> Object {{
+    switch index {{
+{object_cases}    }}
+}}
+
+// Surfaces for the kinds of shape in this scene ({kind_list}).
+fn surface_at(obj: Object, p: vec3<f32>) -> Surface {{
+    switch obj.kind {{
+{normal_cases}    }}
+}}
+
+// The surface of a non-emitter (`obj.emitter == 0`): only the kinds that scatter light in this
+// scene.
+fn scattering_surface_at(obj: Object, p: vec3<f32>) -> Surface {{
+    switch obj.kind {{
+{scattering_cases}    }}
+}}
+",
+        scene_name = scene.scene,
+        count = scene.objects.len(),
+        kind_list = kinds.iter().map(|k| k.name()).collect::<Vec<_>>().join(", "),
+    );
+    Traversal { kinds, occluders, source }
+}
