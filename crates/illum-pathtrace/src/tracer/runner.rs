@@ -403,3 +403,47 @@ impl BandBuffers {
         self.staging = Some(staging);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A band launched ahead, submitted before the last fold, is timed from that fold: the
+    /// bands' times add up to the elapsed time instead of counting the overlap twice.
+    #[test]
+    fn a_band_launched_ahead_is_timed_from_the_last_fold() {
+        let mut pacing = Pacing::default();
+        let first = Instant::now();
+        let ahead = Instant::now();
+        std::thread::sleep(Duration::from_millis(2));
+        let first_seconds = pacing.band_folded(first);
+        assert!(first_seconds >= 0.002, "{first_seconds}");
+        let ahead_seconds = pacing.band_folded(ahead);
+        assert!(ahead_seconds < ahead.elapsed().as_secs_f64() - 0.001, "{ahead_seconds}");
+        // After a restart a band is timed from its own submission again.
+        pacing.restart();
+        let band = Instant::now();
+        std::thread::sleep(Duration::from_millis(1));
+        assert!(pacing.band_folded(band) >= 0.001);
+    }
+
+    /// Bands are launched ahead for a caller seen for the first time, and not for one that
+    /// stayed away longer than [`AHEAD_MAX_ABSENCE`] (a viewer drawing its window).
+    #[test]
+    fn only_a_caller_that_comes_straight_back_gets_bands_ahead() {
+        let mut pacing = Pacing::default();
+        pacing.enter();
+        assert!(pacing.may_launch_ahead(), "no absence before the first call");
+        pacing.leave();
+        std::thread::sleep(AHEAD_MAX_ABSENCE * 5);
+        pacing.enter();
+        assert!(!pacing.may_launch_ahead(), "away {:?}", pacing.caller_absence);
+    }
+
+    #[test]
+    fn a_call_that_waits_reads_a_polled_band_from_its_staging_copy() {
+        assert_eq!(Readback::Polled.waited(), Readback::Staging);
+        assert_eq!(Readback::Mapped.waited(), Readback::Mapped);
+        assert_eq!(Readback::Staging.waited(), Readback::Staging);
+    }
+}
