@@ -1,4 +1,4 @@
-//! The caustic's light tracer on the GPU (`shaders/pathtrace/caustic.wgsl`, folded by
+//! The caustic's light tracer on the GPU (`crates/illum-pathtrace/shaders/caustic.wgsl`, folded by
 //! `tracer/caustic.rs`):
 //! - a glass ball of index 1 is invisible, so with the light tracer its shadow holds exactly the
 //!   plain direct light (and the sky) of the floor: a closed form for every pixel, against

@@ -1,7 +1,7 @@
 //! Randomly generated valid scenes, rendered for a few samples: no panic, no NaN or Inf in the
 //! image, and no dropped sample. Each scene is written as a scene file and goes through the
 //! parser and validator like a user's; the generator covers every feature the path tracer
-//! renders (`illum_pathtrace::FEATURES`: boxes, rotated boxes, quads and spheres; Lambertian,
+//! renders (`illum_pathtrace::implements`: boxes, rotated boxes, quads and spheres; Lambertian,
 //! checkerboard, mirror and glass materials; quad area lights, a delta or disc sun, a constant
 //! sky; the caustic's light tracer), with the camera anywhere, objects at random sizes (1e-3 to
 //! 1e3) and places (up to 1e4 away), degenerate-but-valid ones (flat boxes, needle quads, tiny

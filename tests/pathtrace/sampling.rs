@@ -228,7 +228,7 @@ fn bilinear_expression(p: DVec3, n: DVec3) -> String {
 }
 
 /// The density next-event estimation draws light points (s, t) with at shading point p (unit
-/// normal n), from its definition in shaders/common/sampling.wgsl, in f64: the bilinear
+/// normal n), from its definition in crates/illum-pathtrace/shaders/sampling.wgsl, in f64: the bilinear
 /// interpolation of cos(theta_x) cos(theta_y) / r^2 at the four corners, each plus a sixteenth
 /// of their mean, divided by its mean over the square. `None` where the shader falls back to
 /// uniform sampling.

@@ -1,5 +1,5 @@
 //! The caustic estimator in f64: light tracing from the directional light for the paths
-//! L S+ D E, written independently of the GPU's (`shaders/pathtrace/caustic.wgsl`).
+//! L S+ D E, written independently of the GPU's (`crates/illum-pathtrace/shaders/caustic.wgsl`).
 //!
 //! Path spaces (docs/caustics.md). The camera path tracer (`integrator.rs`) finds every path
 //! whose light-side end is an area light or the sky, every path L D ... E through next-event

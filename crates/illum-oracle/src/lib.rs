@@ -1,6 +1,6 @@
 //! illum-oracle: an independent, scalar CPU reference for illum's renderers, in f64.
 //!
-//! It estimates the same per-pixel quantity as the GPU path tracer (`shaders/pathtrace/`) —
+//! It estimates the same per-pixel quantity as the GPU path tracer (`crates/illum-pathtrace/shaders/`) —
 //! equal in expectation, not sample for sample — from its own mathematics and its own random
 //! numbers, so that tests and the convergence tool can compare the two statistically. It is
 //! slow and simple on purpose: no acceleration structure, no SIMD, one ray at a time.

@@ -82,7 +82,7 @@ impl WhittedOracle {
         // Every shape and material of the scene model, a delta directional light, area lights
         // (as point lights) and a constant environment; not a sun of finite size, since
         // Whitted's shadow rays are hard.
-        scene.require_where("Whitted ray tracer", |f| f != Feature::SunDisc)?;
+        scene.require("Whitted ray tracer", |f| !matches!(f, Feature::SunDisc))?;
         let mut items = Vec::with_capacity(scene.objects.len());
         let mut lights = Vec::new();
         for object in &scene.objects {

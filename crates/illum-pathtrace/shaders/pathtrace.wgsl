@@ -178,8 +178,8 @@ fn camera_path(d: vec3<f32>) -> Path {
 // Written with few branches: the vertex is computed for every path, ended or not, and `select`
 // keeps what a path may not add. lavapipe runs a branch's body, under a lane mask, whenever one
 // of the 8 lanes of a group takes it, so branches save little here; straight code is what let
-// the CPU overlap the two paths of a pair (see main: the same pair written with a branch per
-// `break` of the old loop ran slower than one path at a time). An ended path (its ray missed,
+// the CPU overlap the two paths of a pair (see main: a pair written with a branch per `break`
+// runs slower than one path at a time, docs/performance.md, "Levers"). An ended path (its ray missed,
 // or it reached a light) computes a meaningless vertex, perhaps with infinities or NaN, that no
 // select lets through. A live path draws the same numbers in the same order as it would alone:
 // the ones drawn after its end are never used.
@@ -369,8 +369,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     // Two samples at a time, traced in lockstep, vertex by vertex: lavapipe runs each 8-lane
     // group's instructions as one stream on one core, and a second independent path in that
     // stream gives the CPU work to overlap with the first one's chains of dependent operations
-    // (square roots, divisions). 12 to 16% faster at 2 bounces, 8% at 8; four paths were slower
-    // than two (docs/performance.md). Each path keeps its own sampler, so every sample is what it
+    // (square roots, divisions); four paths gain nothing over two (docs/performance.md,
+    // "Levers"). Each path keeps its own sampler, so every sample is what it
     // would be traced alone, and the sums take them in order: the image is bit for bit the same.
     for (var i = 0u; i < count; i += 2u) {
         var first_sampler = sampler_new(params.seed, pixel, params.sample_base + first + i);
@@ -378,10 +378,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         var a = camera_path(pixel_ray(x, y, inv_size, &first_sampler));
         var b = camera_path(pixel_ray(x, y, inv_size, &second_sampler));
         // An odd count: the last pair has no second sample. Its path is traced all the same and
-        // discarded, so the planner gives passes an even spp where it can. A separate one-path
-        // loop for the odd sample cost by being in the shader: 4% at 16 spp per invocation, and
-        // passes of 1 and 2 spp at 1024 x 1024 ran 16 to 22% slower than with no pairs at all
-        // (docs/performance.md, "Levers of 2026-12-02, midday").
+        // discarded, so the planner gives passes an even spp where it can: a separate one-path
+        // loop for the odd sample would cost every invocation by being in the shader
+        // (docs/performance.md, "Levers").
         let second = i + 1u < count;
         b.alive = second;
         loop {

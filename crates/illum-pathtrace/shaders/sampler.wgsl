@@ -20,11 +20,9 @@
 // Callers draw two-dimensional integrands (pixel, light point, direction) with sample_2d, which
 // starts on an even dimension so that the two numbers are one pair.
 //
-// Why not one sequence of many dimensions (R_d, as before): its quality hangs on how the
-// dimensions' steps relate. With R_16 the Cornell box at 1024 spp had a relMSE of 2.2e-5, but
-// R_15 4.0e-5 and R_20 4.9e-4 (3 times independent numbers' 1.5e-4), and on the Whitted scene
-// R_16 itself was worse than independent numbers (6.6e-4 against 4.1e-4 at 256 spp), where
-// these pairs have 6.4e-5 (docs/performance.md). Arithmetic is in 32-bit fixed point (wrapping),
+// Why not one sequence of many dimensions (R_d): its quality hangs on how the dimensions' steps
+// relate, so some dimension counts do worse than independent numbers; pairs of R_2 do not
+// (docs/accuracy.md has the measured relMSE of both). Arithmetic is in 32-bit fixed point (wrapping),
 // exact for any sample index; any number of dimensions is as good as the first.
 
 #import illum::rng::{pcg_hash, rng_seed, rng_f32}

@@ -36,7 +36,7 @@ use crate::{PathTraceError, PathTracer, Sequence};
 use illum_image::metrics::REL_MSE_EPSILON;
 
 /// Pixels along each side of a block (the shader's workgroup; `ADAPTIVE_BLOCK` in
-/// shaders/pathtrace/pathtrace.wgsl).
+/// crates/illum-pathtrace/shaders/pathtrace.wgsl).
 pub const BLOCK: u32 = 8;
 
 /// The pilot's samples per pixel: one chunk. Per block that is 1024 samples, enough to rank

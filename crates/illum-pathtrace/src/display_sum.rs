@@ -4,7 +4,7 @@
 //! in f64 (see [`crate::accumulator`]). A viewer that showed that f64 mean would copy the whole
 //! image back to the GPU every frame. With the display sum enabled
 //! ([`crate::PathTracer::enable_display_sum`]), each band's submission also runs
-//! `shaders/pathtrace/display_sum.wgsl`, which adds the band's slots into one storage buffer of
+//! `crates/illum-pathtrace/shaders/display_sum.wgsl`, which adds the band's slots into one storage buffer of
 //! `width x height` `vec4<f32>`: rgb = running sum of finite samples, w = running count of
 //! finite samples. The viewer binds that buffer directly and divides rgb by w when it draws.
 //!

@@ -4,15 +4,30 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
-use illum_scene::{Bounces, Feature, MaterialKind, RendererKind, Sampling, Scene, Shape};
+use illum_scene::{Bounces, Feature, MaterialKind, RendererKind, Scene, Shape};
 
 use illum_rtcore::{CameraRecord, Geometry, MaterialRecord, ObjectRecord, ordered_objects};
 
 use crate::PathTraceError;
+use crate::specialise::SceneCode;
 
-/// What the path tracer implements: every feature of the scene model. Each is compiled into a
-/// scene's pipeline only when the scene uses it (see [`GpuScene::shader_defs`]).
-pub const FEATURES: &[Feature] = &Feature::ALL;
+/// What of the scene model the path tracer implements: all of it. Each feature is compiled
+/// into a scene's pipeline only when the scene uses it (see [`crate::specialise`]).
+pub fn implements(feature: Feature) -> bool {
+    match feature {
+        Feature::BoxShape
+        | Feature::QuadShape
+        | Feature::SphereShape
+        | Feature::Lambertian
+        | Feature::Checker
+        | Feature::Dielectric
+        | Feature::Mirror
+        | Feature::AreaLight
+        | Feature::DeltaDirectionalLight
+        | Feature::SunDisc
+        | Feature::Environment => true,
+    }
+}
 
 /// `Params::bounces` value meaning "unbounded, with Russian roulette".
 pub const UNBOUNDED: u32 = u32::MAX;
@@ -71,8 +86,8 @@ pub struct GpuScene {
     pub lights: Vec<GpuLight>,
     /// Sum of all light areas (the light-sampling pdf is its inverse).
     pub light_area: f32,
-    /// The shader defs of the features this scene uses (see [`GpuScene::shader_defs`]).
-    pub defs: Vec<&'static str>,
+    /// What of the scene model its pipeline contains.
+    pub code: SceneCode,
     /// Every emission above was multiplied by 2^-`radiance_exponent` (0 unless a light exceeds
     /// 2^16; see [`crate::accumulator::radiance_exponent`]), so the GPU's samples are the true
     /// ones times 2^-k, exactly.
@@ -92,7 +107,7 @@ fn v4(v: Vec3, w: f32) -> [f32; 4] {
 
 impl GpuScene {
     pub fn new(scene: &Scene) -> Result<Self, PathTraceError> {
-        scene.require(RendererKind::PathTrace, FEATURES)?;
+        scene.require(RendererKind::PathTrace.noun(), implements)?;
         let sun = scene.directional_light.map_or(0.0, |l| l.irradiance.max_element());
         let sky = scene.environment.map_or(0.0, |e| e.radiance.max_element());
         let max_emission =
@@ -138,41 +153,8 @@ impl GpuScene {
                     .to_owned(),
             });
         }
-        let mut defs = Vec::new();
-        if !lights.is_empty() {
-            defs.push("AREA_LIGHTS");
-        }
-        if lights.len() > 1 {
-            defs.push("LIGHT_CHOICE");
-        }
-        if let Some(sun) = &scene.directional_light {
-            defs.push("SUN");
-            if !sun.is_delta() {
-                defs.push("SUN_DISC");
-            }
-        }
-        if scene.environment.is_some() {
-            defs.push("SKY");
-        }
-        let kinds = || scene.objects.iter().map(|o| scene.material_of(o).kind);
-        if kinds().any(|k| matches!(k, MaterialKind::Mirror { .. } | MaterialKind::Dielectric { .. })) {
-            defs.push("SPECULAR");
-        }
-        if kinds().any(|k| matches!(k, MaterialKind::Checker(_))) {
-            defs.push("CHECKER");
-        }
-        if caustics_active(scene) {
-            defs.push("CAUSTIC");
-        }
-        // Render settings that choose code rather than numbers: lavapipe runs both sides of a
-        // branch on a uniform parameter for every lane, so the unused side costs its full price.
-        if scene.pathtrace.sampling == Sampling::Uniform {
-            defs.push("UNIFORM_SAMPLING");
-        }
-        if scene.pathtrace.bounces == Bounces::Unbounded {
-            defs.push("UNBOUNDED_BOUNCES");
-        }
-        Ok(Self { geometry: Geometry::new(scene), materials, lights, light_area, defs, radiance_exponent })
+        let code = SceneCode::new(scene, lights.len());
+        Ok(Self { geometry: Geometry::new(scene), materials, lights, light_area, code, radiance_exponent })
     }
 }
 
@@ -192,17 +174,6 @@ pub fn caustics_label(scene: &Scene) -> &'static str {
 }
 
 impl GpuScene {
-    /// naga_oil shader defs for the features the scene uses: AREA_LIGHTS (and LIGHT_CHOICE with
-    /// more than one area light), SUN, SUN_DISC, SKY,
-    /// SPECULAR (a mirror or a dielectric), CHECKER, and CAUSTIC (`caustics = true` with a
-    /// directional light and a specular object: the light tracer, see tracer/caustic.rs); and
-    /// for two render settings, UNIFORM_SAMPLING (`sampling = "uniform"`) and UNBOUNDED_BOUNCES
-    /// (Russian roulette). The Cornell box at its defaults compiles with AREA_LIGHTS alone: none
-    /// of the other features' code is in its pipeline.
-    pub fn shader_defs(&self) -> Vec<(&'static str, illum_gpu::shader::Def)> {
-        self.defs.iter().map(|&d| (d, illum_gpu::shader::Def::Bool(true))).collect()
-    }
-
     /// The objects as the shader's storage buffer holds them.
     pub fn object_records(&self) -> Vec<ObjectRecord> {
         self.geometry.object_records()

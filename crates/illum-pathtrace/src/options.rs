@@ -1,6 +1,5 @@
 //! The tracer's pipeline choices: how rays find what they hit, and which sample sequence.
 
-use illum_gpu::shader::Def;
 use illum_scene::Sequence;
 
 /// How rays find what they hit.
@@ -21,7 +20,7 @@ pub struct TracerOptions {
     pub sequence: Sequence,
     /// Trace a pixel's samples two at a time, in lockstep (shader def PAIRED_PATHS,
     /// pathtrace.wgsl's `main`), with the specialised traversal (the generic one always traces
-    /// one path at a time, see `shader_defs`): the same image bit for bit, and a second,
+    /// one path at a time, see `Specialisation::shader_defs`): the same image bit for bit, and a second,
     /// independent path gives the CPU core of a software driver work to overlap with the first
     /// one's chains of dependent square roots and divisions (docs/performance.md, "Levers").
     /// The default natively; off in the browser, where Chrome's SwiftShader loses the device
@@ -36,29 +35,5 @@ impl Default for TracerOptions {
             sequence: Sequence::default(),
             paired_paths: !cfg!(target_arch = "wasm32"),
         }
-    }
-}
-
-impl TracerOptions {
-    /// naga_oil shader defs for these options.
-    ///
-    /// The low-discrepancy sequence also draws light points from the bilinear fit of the
-    /// geometric term (`BILINEAR_LIGHT`, sampling.wgsl's `sample_light_bilinear`): it lowers the
-    /// error by more than it adds time there. Independent numbers keep uniform points: their
-    /// error is mostly in the bounce directions, so the better light point buys less than it
-    /// costs (docs/performance.md, "Levers").
-    pub fn shader_defs(&self) -> Vec<(&'static str, Def)> {
-        let mut defs = match self.sequence {
-            Sequence::Independent => Vec::new(),
-            Sequence::LowDiscrepancy => {
-                vec![("LOW_DISCREPANCY", Def::Bool(true)), ("BILINEAR_LIGHT", Def::Bool(true))]
-            }
-        };
-        // Pairs pay with the specialised traversal only: with the generic one's loop over the
-        // object buffer they are slower than one path at a time (docs/performance.md, "Levers").
-        if self.paired_paths && self.traversal == Traversal::Specialised {
-            defs.push(("PAIRED_PATHS", Def::Bool(true)));
-        }
-        defs
     }
 }

@@ -12,6 +12,7 @@ use illum_scene::Scene;
 
 use crate::gpu_scene::GpuScene;
 use crate::options::{TracerOptions, Traversal};
+use crate::specialise::Specialisation;
 use crate::{PathTraceError, specialise};
 
 /// The integrator (entry point `main`).
@@ -56,8 +57,8 @@ pub fn shader_modules(scene: &Scene, gpu_scene: &GpuScene, traversal: Traversal)
 
 /// The path-tracing pipeline for `scene` with `options`, and the traversal source it was built
 /// with. The context caches pipelines by their source: two scenes with the same specialisation
-/// share one, so switching back to a scene does not recompile. `adaptive`: with shader def
-/// ADAPTIVE, each block of pixels takes its own number of samples (allocation.rs).
+/// share one, so switching back to a scene does not recompile. `adaptive`: each block of pixels
+/// takes its own number of samples (allocation.rs).
 pub(crate) fn pathtrace_pipeline(
     gpu: &GpuContext,
     scene: &Scene,
@@ -65,28 +66,34 @@ pub(crate) fn pathtrace_pipeline(
     options: TracerOptions,
     adaptive: bool,
 ) -> Result<(wgpu::ComputePipeline, String), PathTraceError> {
+    let specialisation = Specialisation { scene: gpu_scene.code, options, adaptive };
     let modules = shader_modules(scene, gpu_scene, options.traversal);
-    let traversal_source = modules[modules.len() - 3].source.to_string();
-    let mut defs = options.shader_defs();
-    defs.extend(gpu_scene.shader_defs());
-    if adaptive {
-        defs.push(("ADAPTIVE", shader::Def::Bool(true)));
-    }
+    let traversal_source = traversal_source(&modules).to_owned();
+    let defs = specialisation.shader_defs();
     let pipeline = shader::compute_pipeline(gpu, &modules, &PATHTRACE_SHADER, &defs, "path-tracing")?;
     Ok((pipeline, traversal_source))
 }
 
-/// The caustic's light-tracing pipeline for `scene` (one with shader def CAUSTIC), built from
-/// the same modules and defs as its path-tracing pipeline.
+/// The text of the traversal module among `modules`.
+fn traversal_source(modules: &[ShaderFile]) -> &str {
+    modules
+        .iter()
+        .map(|m| m.source.as_ref())
+        .find(|s| s.starts_with("#define_import_path illum::rtcore::traversal"))
+        .expect("the modules include a traversal")
+}
+
+/// The caustic's light-tracing pipeline for `scene` (one whose scene code has the caustic),
+/// built from the same modules and defs as its path-tracing pipeline without adaptive sampling.
 pub(crate) fn caustic_pipeline(
     gpu: &GpuContext,
     scene: &Scene,
     gpu_scene: &GpuScene,
     options: TracerOptions,
 ) -> Result<wgpu::ComputePipeline, PathTraceError> {
+    let specialisation = Specialisation { scene: gpu_scene.code, options, adaptive: false };
     let modules = shader_modules(scene, gpu_scene, options.traversal);
-    let mut defs = options.shader_defs();
-    defs.extend(gpu_scene.shader_defs());
+    let defs = specialisation.shader_defs();
     Ok(shader::compute_pipeline(gpu, &modules, &CAUSTIC_SHADER, &defs, "caustic light-tracing")?)
 }
 
@@ -101,6 +108,7 @@ mod tests {
     use super::*;
     use crate::display_sum::DISPLAY_SUM_SHADER;
     use crate::gpu_scene::{GpuLight, GpuParams};
+    use crate::specialise::SceneCode;
 
     /// Every scene file the path tracer can render.
     fn path_tracer_scenes() -> Vec<Scene> {
@@ -112,7 +120,7 @@ mod tests {
             // lacks are refused by name (the raster tests check the Whitted scene's refusal).
             if path.extension().is_some_and(|e| e == "toml") {
                 let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
-                if scene.require(RendererKind::PathTrace, crate::FEATURES).is_ok() {
+                if scene.require(RendererKind::PathTrace.noun(), crate::implements).is_ok() {
                     scenes.push(scene);
                 }
             }
@@ -132,8 +140,9 @@ mod tests {
     }
 
     /// naga validates each sampling module on its own (as the import of a trivial entry point),
-    /// the path tracer generic and specialised for every scene file under both sequences, and
-    /// the display-sum pass.
+    /// the path tracer generic and specialised for every scene file under both sequences, with
+    /// and without pairs and adaptive sampling, each with its scene's code, and the display-sum
+    /// pass.
     #[test]
     fn every_pathtrace_shader_composes_and_validates() {
         for (i, module) in SAMPLING_MODULES.iter().enumerate() {
@@ -154,33 +163,78 @@ mod tests {
             let gpu_scene = GpuScene::new(&scene).unwrap_or_else(|e| panic!("{e}"));
             for traversal in [Traversal::Generic, Traversal::Specialised] {
                 for sequence in [Sequence::Independent, Sequence::LowDiscrepancy] {
-                    let defs = TracerOptions { traversal, sequence, paired_paths: false }.shader_defs();
-                    // Alone, with adaptive sampling, and with adaptive sampling and samples in
-                    // pairs (native; the browser traces them one at a time).
-                    let adaptive = ("ADAPTIVE", shader::Def::Bool(true));
-                    let paired = ("PAIRED_PATHS", shader::Def::Bool(true));
-                    for extra in [vec![], vec![adaptive], vec![adaptive, paired]] {
-                        let mut all = defs.clone();
-                        all.extend(extra);
+                    // Alone, with adaptive sampling, and with samples in pairs (native; the
+                    // browser traces them one at a time) with and without it.
+                    for (paired_paths, adaptive) in
+                        [(false, false), (false, true), (true, false), (true, true)]
+                    {
+                        let options = TracerOptions { traversal, sequence, paired_paths };
+                        let specialisation = Specialisation { scene: gpu_scene.code, options, adaptive };
                         compose_and_validate(
                             &shader_modules(&scene, &gpu_scene, traversal),
                             &PATHTRACE_SHADER,
-                            &all,
+                            &specialisation.shader_defs(),
                         );
                     }
-                    if gpu_scene.defs.contains(&"CAUSTIC") {
-                        let mut all = defs.clone();
-                        all.extend(gpu_scene.shader_defs());
+                    if gpu_scene.code.caustic {
+                        let options = TracerOptions { traversal, sequence, paired_paths: false };
+                        let specialisation =
+                            Specialisation { scene: gpu_scene.code, options, adaptive: false };
                         compose_and_validate(
                             &shader_modules(&scene, &gpu_scene, traversal),
                             &CAUSTIC_SHADER,
-                            &all,
+                            &specialisation.shader_defs(),
                         );
                     }
                 }
             }
         }
         compose_and_validate(&[], &DISPLAY_SUM_SHADER, &[]);
+    }
+
+    /// Every consistent combination of the scene code's flags composes and validates, for the
+    /// integrator and (where the caustic is on) the light tracer, without a GPU: the code behind
+    /// each `#ifdef` is checked before any scene file happens to need it. The generic modules
+    /// make the combinations independent of any one scene's geometry.
+    #[test]
+    fn every_combination_of_the_scene_code_validates() {
+        let scene = path_tracer_scenes().remove(0);
+        let gpu_scene = GpuScene::new(&scene).unwrap_or_else(|e| panic!("{e}"));
+        let modules = shader_modules(&scene, &gpu_scene, Traversal::Generic);
+        let options = TracerOptions { traversal: Traversal::Generic, ..TracerOptions::default() };
+        let mut composed = 0;
+        for bits in 0u32..1 << 10 {
+            let bit = |i: u32| bits & (1 << i) != 0;
+            let code = SceneCode {
+                area_lights: bit(0),
+                light_choice: bit(1),
+                sun: bit(2),
+                sun_disc: bit(3),
+                sky: bit(4),
+                specular: bit(5),
+                checker: bit(6),
+                caustic: bit(7),
+                uniform_sampling: bit(8),
+                unbounded_bounces: bit(9),
+            };
+            // What SceneCode::new can give: a choice among lights needs lights, a disc is a sun,
+            // the caustic needs a sun and a specular object, and something must give light.
+            let consistent = (!code.light_choice || code.area_lights)
+                && (!code.sun_disc || code.sun)
+                && (!code.caustic || (code.sun && code.specular))
+                && (code.area_lights || code.sun || code.sky);
+            if !consistent {
+                continue;
+            }
+            let defs = Specialisation { scene: code, options, adaptive: false }.shader_defs();
+            compose_and_validate(&modules, &PATHTRACE_SHADER, &defs);
+            composed += 1;
+            if code.caustic {
+                compose_and_validate(&modules, &CAUSTIC_SHADER, &defs);
+                composed += 1;
+            }
+        }
+        assert!(composed > 300, "{composed} compositions");
     }
 
     #[test]
@@ -214,15 +268,13 @@ mod tests {
         let whitted =
             path_tracer_scenes().into_iter().find(|s| s.name == "whitted").expect("scenes/whitted.toml");
         let gpu_scene = GpuScene::new(&whitted).unwrap_or_else(|e| panic!("{e}"));
-        assert!(
-            gpu_scene.defs.contains(&"CAUSTIC"),
-            "whitted.toml turns the caustic on: {:?}",
-            gpu_scene.defs
-        );
+        assert!(gpu_scene.code.caustic, "whitted.toml turns the caustic on: {:?}", gpu_scene.code);
+        let specialisation =
+            Specialisation { scene: gpu_scene.code, options: TracerOptions::default(), adaptive: false };
         let module = compose_and_validate(
             &shader_modules(&whitted, &gpu_scene, Traversal::Generic),
             &CAUSTIC_SHADER,
-            &gpu_scene.shader_defs(),
+            &specialisation.shader_defs(),
         );
         wgsl_struct(&module, "", "CausticParams").expect("struct CausticParams in caustic.wgsl").assert_matches(
             size_of::<crate::CausticParams>(),

@@ -4,15 +4,105 @@
 //! nor the material buffer; the generic modules (`shaders/traversal.wgsl`, `materials.wgsl`,
 //! `light_choice.wgsl`) read them instead.
 
-use illum_gpu::shader::ShaderFile;
-use illum_rtcore::Traversal;
+use illum_gpu::shader::{Def, ShaderFile};
 use illum_rtcore::literal::lit;
-use illum_scene::Scene;
+use illum_scene::{Bounces, Feature, Sampling, Scene, Sequence};
 
-use crate::gpu_scene::GpuScene;
+use crate::gpu_scene::{GpuScene, caustics_active};
+use crate::options::{TracerOptions, Traversal};
+
+/// What of the scene model a scene's pipeline contains, derived from [`Scene::features`], its
+/// lights and the render settings that choose code rather than numbers. Code a scene does not
+/// use is not compiled: on a CPU driver code costs time by being in the shader, even where no
+/// lane runs it (docs/performance.md, "What lavapipe does with a branch").
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct SceneCode {
+    /// Next-event estimation on rectangular lights.
+    pub area_lights: bool,
+    /// More than one area light: a light is chosen per sample.
+    pub light_choice: bool,
+    /// A directional light.
+    pub sun: bool,
+    /// ... of finite angular radius (sampled in its cone).
+    pub sun_disc: bool,
+    /// An environment light.
+    pub sky: bool,
+    /// A mirror or a dielectric.
+    pub specular: bool,
+    pub checker: bool,
+    /// The caustic's light tracer ([`caustics_active`]).
+    pub caustic: bool,
+    /// `sampling = "uniform"` hemisphere sampling instead of cosine.
+    pub uniform_sampling: bool,
+    /// `bounces = "unbounded"`: Russian roulette.
+    pub unbounded_bounces: bool,
+}
+
+impl SceneCode {
+    /// The code `scene` needs, with `area_lights` uploaded lights.
+    pub fn new(scene: &Scene, area_lights: usize) -> Self {
+        let features = scene.features();
+        SceneCode {
+            area_lights: area_lights > 0,
+            light_choice: area_lights > 1,
+            sun: features.any(&[Feature::DeltaDirectionalLight, Feature::SunDisc]),
+            sun_disc: features.contains(Feature::SunDisc),
+            sky: features.contains(Feature::Environment),
+            specular: features.any(&[Feature::Mirror, Feature::Dielectric]),
+            checker: features.contains(Feature::Checker),
+            caustic: caustics_active(scene),
+            uniform_sampling: scene.pathtrace.sampling == Sampling::Uniform,
+            unbounded_bounces: scene.pathtrace.bounces == Bounces::Unbounded,
+        }
+    }
+}
+
+/// Everything a path-tracing pipeline is specialised for: the scene's code, the tracer's
+/// options and adaptive sampling. Two pipelines with equal specialisations (and, with
+/// [`Traversal::Specialised`], equal generated modules) are the same pipeline.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Specialisation {
+    pub scene: SceneCode,
+    pub options: TracerOptions,
+    /// Each block of pixels takes its own number of samples (allocation.rs).
+    pub adaptive: bool,
+}
+
+impl Specialisation {
+    /// The naga_oil shader defs: the one place where their names are written.
+    pub fn shader_defs(&self) -> Vec<(&'static str, Def)> {
+        let code = &self.scene;
+        let options = &self.options;
+        let low_discrepancy = options.sequence == Sequence::LowDiscrepancy;
+        let flags = [
+            ("AREA_LIGHTS", code.area_lights),
+            ("LIGHT_CHOICE", code.light_choice),
+            ("SUN", code.sun),
+            ("SUN_DISC", code.sun_disc),
+            ("SKY", code.sky),
+            ("SPECULAR", code.specular),
+            ("CHECKER", code.checker),
+            ("CAUSTIC", code.caustic),
+            ("UNIFORM_SAMPLING", code.uniform_sampling),
+            ("UNBOUNDED_BOUNCES", code.unbounded_bounces),
+            ("LOW_DISCREPANCY", low_discrepancy),
+            // The low-discrepancy sequence also draws light points from the bilinear fit of the
+            // geometric term (sampling.wgsl, sample_light_bilinear): it lowers that sequence's
+            // error by more than it adds time; independent numbers' error is mostly in the
+            // bounce directions, so for them it costs more than it buys (docs/performance.md,
+            // "Levers").
+            ("BILINEAR_LIGHT", low_discrepancy),
+            // Pairs pay with the specialised traversal only: with the generic one's loop over
+            // the object buffer they are slower than one path at a time (same section).
+            ("PAIRED_PATHS", options.paired_paths && options.traversal == Traversal::Specialised),
+            ("ADAPTIVE", self.adaptive),
+        ];
+        flags.into_iter().filter(|&(_, on)| on).map(|(name, _)| (name, Def::Bool(true))).collect()
+    }
+}
 
 /// The traversal generated for `gpu_scene` (illum-rtcore's traversal.rs).
-pub fn traversal(gpu_scene: &GpuScene) -> Traversal {
+pub fn traversal(gpu_scene: &GpuScene) -> illum_rtcore::Traversal {
     illum_rtcore::traversal::generate(&gpu_scene.geometry)
 }
 

@@ -10,8 +10,8 @@
 // pass, when the light comes from above and the spheres stand above the floor, the receiver is
 // narrowed further to each shadow's penumbra ring (PART 1), the only place where the lookup can
 // return anything but 0 or 1; the umbra inside a ring (PART 2) is drawn dark without a lookup,
-// with a bias between the ring's and the rest's, and the rest as above. The floor's taps cost
-// 3 to 6 ms of a 15 to 20 ms main pass on lavapipe, in proportion to the floor that runs them.
+// with a bias between the ring's and the rest's, and the rest as above. The taps' cost is in
+// proportion to the floor that runs them (docs/performance-raster.md).
 //
 // In the main view with anti-aliasing on (EDGE_AA), the rectangle's outline is anti-aliased like
 // the spheres' silhouettes: the rectangle reaches past it by EDGE_REACH_PIXELS, and each pixel is
@@ -21,8 +21,8 @@
 // the other then fails the depth test there, as everywhere.) Only a band along the outline can be
 // partly covered, so the rest of the floor is drawn in two pieces: its interior (PART 3, the
 // rectangle shrunk by EDGE_REACH_PIXELS) without the coverage, and the band between the shrunk
-// and the grown outline with it (docs/performance-raster.md: the coverage of four edges on every
-// floor pixel cost about 2.4 ms of lavapipe's main pass). Without the coverage's `discard` the
+// and the grown outline with it: the coverage of four edges on every floor pixel would cost the
+// whole floor (docs/performance-raster.md). Without the coverage's `discard` the
 // interior's depth test may also run before its shading, which then skips the floor where the
 // shadows' rings and discs have drawn.
 

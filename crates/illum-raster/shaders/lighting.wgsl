@@ -104,8 +104,8 @@ fn filtered_checker(t: vec2<f32>, width: vec2<f32>) -> f32 {
 fn shade_floor(sw: Switches, p: vec3<f32>, n: vec3<f32>, tile_coord: vec2<f32>, footprint: vec2<f32>) -> vec3<f32> {
     let albedo = floor_albedo(tile_coord, footprint);
     // No `if n_dot_l > 0.0` around the lookup: a branch on uniforms alone makes lavapipe (Mesa
-    // 22.3) specialise the shader on the uniforms' values at every draw (its uniform inlining;
-    // 2 ms for a penumbra pass drawn alone, docs/performance-raster.md), and a fragment shader
+    // 22.3) specialise the shader on the uniforms' values at every draw (its uniform inlining,
+    // docs/performance-raster.md), and a fragment shader
     // runs both sides of a branch anyway. Where n_dot_l is 0 the product is 0.
     let n_dot_l = max(dot(n, scene.to_light.xyz), 0.0);
     let direct = n_dot_l * shadow_visibility(sw, p, n, 0.0);
@@ -230,9 +230,8 @@ fn refract_through_sphere(p1: vec3<f32>, n1: vec3<f32>, incident: vec3<f32>, eta
 // Without Fresnel F is F0 (normal incidence) everywhere; without reflection F is 0.
 //
 // The environment lookups take their footprint from the screen derivatives of their directions
-// (within each 2 x 2 block of pixels), which the caller keeps in uniform control flow. (Until
-// 2026-12-02 the refraction was traced a second and third time for the right and lower
-// neighbours' points instead; docs/performance-raster.md.)
+// (within each 2 x 2 block of pixels), which the caller keeps in uniform control flow: no second
+// and third refraction for the neighbours' points is traced (docs/performance-raster.md).
 fn shade_glass(sw: Switches, p: vec3<f32>, n: vec3<f32>, eye: vec3<f32>) -> vec3<f32> {
     let eta = scene.glass_params.x;
     let incident = normalize(p - eye);

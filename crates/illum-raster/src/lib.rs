@@ -30,7 +30,7 @@
 //! # Ok(()) }
 //! ```
 //!
-//! The WGSL lives in `shaders/raster/` ([`shaders`]).
+//! The WGSL lives in the crate's `shaders/` ([`shaders`]).
 
 // Times frames until the GPU has finished them, which only a native program can wait for.
 #[cfg(not(target_arch = "wasm32"))]

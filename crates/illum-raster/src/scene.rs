@@ -165,7 +165,7 @@ impl RasterScene {
 
     /// The rasterizer's view of `scene`, or why it cannot draw it.
     pub fn from_scene(scene: &Scene) -> Result<RasterScene, SceneError> {
-        scene.require_where(RendererKind::Raster.noun(), implements)?;
+        scene.require(RendererKind::Raster.noun(), implements)?;
         let file = scene.source.as_str();
         let needs = |field: &str, what: &str| {
             SceneError::invalid(file, field, "(missing)", format!("the rasterizer needs {what}"))

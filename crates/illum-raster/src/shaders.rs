@@ -1,4 +1,4 @@
-//! The rasterizer's WGSL: three composable modules and three entry files in `shaders/raster/`.
+//! The rasterizer's WGSL: three composable modules and three entry files in `shaders/`.
 //!
 //! Every entry file is composed with [`MODULES`] (see [`compose`]), and imports nothing else;
 //! the naga validation test below walks [`SHADERS`] the same way.

@@ -1,5 +1,5 @@
 //! The uniform blocks as the shaders see them: plain-old-data structs laid out like `Scene` and
-//! `View` in shaders/raster/scene.wgsl (every member a vec4 or mat4, so no hidden padding).
+//! `View` in crates/illum-raster/shaders/scene.wgsl (every member a vec4 or mat4, so no hidden padding).
 
 use crate::scene::RasterScene;
 use bytemuck::{Pod, Zeroable};

@@ -252,7 +252,7 @@ fn the_cornell_box_is_refused_by_the_rasterizer() {
     // (boxes) come before the light.
     assert_eq!((place.as_str(), feature.as_str()), ("objects[0] (\"left wall\")", "a box"), "{err}");
     // The area light is among what it cannot render; alone, it is what the refusal names.
-    let light = scene.features().into_iter().find(|(f, _)| *f == Feature::AreaLight).unwrap();
+    let light = scene.feature_uses().into_iter().find(|(f, _)| *f == Feature::AreaLight).unwrap();
     assert_eq!(light.1, "objects[5] (\"light\"), material \"light\"");
     assert!(!illum_raster::scene::implements(Feature::AreaLight));
     let mut lit = scene.clone();

@@ -1,13 +1,17 @@
 //! What a scene asks of a renderer, and the check that a renderer can give it.
 //!
-//! Each renderer declares the [`Feature`]s it implements; [`Scene::require`] refuses a scene
-//! that uses anything else, naming the feature, the object (or section) that uses it and the
-//! renderer. A renderer never renders a scene wrong by skipping what it does not know.
+//! [`Scene::features`] is the typed set of what a scene uses; each renderer derives its pipeline's
+//! specialisation from it. Each renderer declares what it implements with one exhaustive
+//! `match` (a `fn(Feature) -> bool`, so a new feature cannot be forgotten), and
+//! [`Scene::require`] refuses a scene that uses anything else, naming the feature, the object
+//! (or section) that uses it and the renderer. A renderer never renders a scene wrong by
+//! skipping what it does not know.
 
 use std::fmt;
 
 use crate::error::SceneError;
 use crate::materials::MaterialKind;
+#[cfg(doc)]
 use crate::renderers::RendererKind;
 use crate::scene::Scene;
 use crate::shapes::Shape;
@@ -48,6 +52,46 @@ impl Feature {
     ];
 }
 
+impl Feature {
+    fn bit(self) -> u16 {
+        1 << self as u16
+    }
+}
+
+/// A set of [`Feature`]s.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct FeatureSet(u16);
+
+impl FeatureSet {
+    pub fn contains(self, feature: Feature) -> bool {
+        self.0 & feature.bit() != 0
+    }
+
+    pub fn insert(&mut self, feature: Feature) {
+        self.0 |= feature.bit();
+    }
+
+    /// Whether any of `features` is in the set.
+    pub fn any(self, features: &[Feature]) -> bool {
+        features.iter().any(|&f| self.contains(f))
+    }
+
+    /// The features in the set, in the order of [`Feature::ALL`].
+    pub fn iter(self) -> impl Iterator<Item = Feature> {
+        Feature::ALL.into_iter().filter(move |&f| self.contains(f))
+    }
+}
+
+impl FromIterator<Feature> for FeatureSet {
+    fn from_iter<I: IntoIterator<Item = Feature>>(features: I) -> Self {
+        let mut set = FeatureSet::default();
+        for feature in features {
+            set.insert(feature);
+        }
+        set
+    }
+}
+
 impl fmt::Display for Feature {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(match self {
@@ -67,9 +111,14 @@ impl fmt::Display for Feature {
 }
 
 impl Scene {
-    /// Every feature the scene uses, each with the place that uses it (`objects[3] ("name")`,
+    /// The features the scene uses.
+    pub fn features(&self) -> FeatureSet {
+        self.feature_uses().into_iter().map(|(feature, _)| feature).collect()
+    }
+
+    /// Every use of a feature, with the place that uses it (`objects[3] ("name")`,
     /// `[directional_light]`, ...), in file order.
-    pub fn features(&self) -> Vec<(Feature, String)> {
+    pub fn feature_uses(&self) -> Vec<(Feature, String)> {
         let mut used = Vec::new();
         for (i, object) in self.objects.iter().enumerate() {
             let place = self.object_label(i);
@@ -101,26 +150,11 @@ impl Scene {
         used
     }
 
-    /// Ok if `renderer` implements every feature the scene uses; otherwise the first one it
-    /// lacks, as [`SceneError::Unsupported`].
-    pub fn require(&self, renderer: RendererKind, supported: &[Feature]) -> Result<(), SceneError> {
-        self.require_for(renderer.noun(), supported)
-    }
-
-    /// [`Scene::require`] for a renderer named in words (one that is not a [`RendererKind`]
-    /// yet, such as the oracle's copy of Whitted's algorithm).
-    pub fn require_for(&self, renderer: &str, supported: &[Feature]) -> Result<(), SceneError> {
-        self.require_where(renderer, |f| supported.contains(&f))
-    }
-
-    /// [`Scene::require_for`] with the supported features given by a predicate (for example
-    /// "everything but a sun disc").
-    pub fn require_where(
-        &self,
-        renderer: &str,
-        supported: impl Fn(Feature) -> bool,
-    ) -> Result<(), SceneError> {
-        match self.features().into_iter().find(|&(f, _)| !supported(f)) {
+    /// Ok if `renderer` (named in words, as [`RendererKind::noun`] names one) implements every
+    /// feature the scene uses, as its exhaustive `implements` says; otherwise the first use of a
+    /// feature it lacks, as [`SceneError::Unsupported`].
+    pub fn require(&self, renderer: &str, implements: impl Fn(Feature) -> bool) -> Result<(), SceneError> {
+        match self.feature_uses().into_iter().find(|&(f, _)| !implements(f)) {
             None => Ok(()),
             Some((feature, place)) => Err(SceneError::Unsupported {
                 file: self.source.clone(),

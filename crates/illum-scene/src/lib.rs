@@ -48,7 +48,7 @@ mod validate_sections;
 
 pub use camera::{Camera, CameraBasis, ClipPlanes};
 pub use error::{ParseValueError, SceneError};
-pub use features::Feature;
+pub use features::{Feature, FeatureSet};
 pub use lights::{DirectionalLight, Environment};
 pub use materials::{Checker, Material, MaterialKind};
 pub use paths::resolve_scene_path;

@@ -65,14 +65,14 @@ pub enum Sampling {
     Uniform,
 }
 
-/// Where a path's random sample values come from (see shaders/common/sampler.wgsl).
+/// Where a path's random sample values come from (see crates/illum-pathtrace/shaders/sampler.wgsl).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Sequence {
     /// Independent uniform numbers from a PCG stream per (seed, pixel, sample index).
     #[default]
     Independent,
     /// Low-discrepancy numbers: each pair of dimensions a randomly shifted R_2 sequence, visited
-    /// in its own shuffled order per pixel (see shaders/common/sampler.wgsl).
+    /// in its own shuffled order per pixel (see crates/illum-pathtrace/shaders/sampler.wgsl).
     LowDiscrepancy,
 }
 

@@ -330,7 +330,9 @@ const EVERYTHING: &[Feature] = &Feature::ALL;
 #[test]
 fn features_list_what_the_scene_uses_where_in_file_order() {
     let s = parse(BASE).unwrap();
-    let used: Vec<(Feature, String)> = s.features();
+    let used: Vec<(Feature, String)> = s.feature_uses();
+    let set = s.features();
+    assert!(Feature::ALL.iter().all(|f| set.contains(*f) == used.iter().any(|(u, _)| u == f)), "{set:?}");
     let expected = [
         (Feature::QuadShape, "objects[0] (\"floor\")"),
         (Feature::Checker, "objects[0] (\"floor\"), material \"board\""),
@@ -350,14 +352,19 @@ fn features_list_what_the_scene_uses_where_in_file_order() {
 
     // A light of angular radius 0 is the delta light; no light, no light feature.
     let delta = accepted("angular_radius = 0.25", "angular_radius = 0");
-    assert!(delta.features().contains(&(Feature::DeltaDirectionalLight, "[directional_light]".to_owned())));
-    assert!(!delta.features().iter().any(|(f, _)| *f == Feature::SunDisc));
+    assert!(
+        delta.feature_uses().contains(&(Feature::DeltaDirectionalLight, "[directional_light]".to_owned()))
+    );
+    assert!(!delta.feature_uses().iter().any(|(f, _)| *f == Feature::SunDisc));
     let dark = accepted(
         "[directional_light]\ndirection = [-1.0, -2.0, 0.5]\nirradiance = [3.0, 3.0, 3.0]\nangular_radius = 0.25\n",
         "",
     );
     assert!(
-        !dark.features().iter().any(|(f, _)| matches!(f, Feature::SunDisc | Feature::DeltaDirectionalLight))
+        !dark
+            .feature_uses()
+            .iter()
+            .any(|(f, _)| matches!(f, Feature::SunDisc | Feature::DeltaDirectionalLight))
     );
 
     // Every feature has its own description.
@@ -370,10 +377,10 @@ fn features_list_what_the_scene_uses_where_in_file_order() {
 #[test]
 fn require_refuses_the_first_feature_a_renderer_lacks() {
     let s = parse(BASE).unwrap();
-    s.require(RendererKind::PathTrace, EVERYTHING).unwrap();
-    s.require(RendererKind::Raster, EVERYTHING).unwrap();
+    s.require(RendererKind::PathTrace.noun(), |f| EVERYTHING.contains(&f)).unwrap();
+    s.require(RendererKind::Raster.noun(), |f| EVERYTHING.contains(&f)).unwrap();
 
-    let err = s.require(RendererKind::PathTrace, DIFFUSE_ONLY).unwrap_err();
+    let err = s.require(RendererKind::PathTrace.noun(), |f| DIFFUSE_ONLY.contains(&f)).unwrap_err();
     let SceneError::Unsupported { file, place, feature, renderer } = &err else { panic!("{err:?}") };
     assert_eq!(
         (file.as_str(), place.as_str(), feature.as_str(), renderer.as_str()),
@@ -396,7 +403,7 @@ fn require_refuses_the_first_feature_a_renderer_lacks() {
         (Feature::Environment, "[environment]"),
     ] {
         let supported: Vec<Feature> = EVERYTHING.iter().copied().filter(|f| *f != missing).collect();
-        let err = s.require(RendererKind::Raster, &supported).unwrap_err();
+        let err = s.require(RendererKind::Raster.noun(), |f| supported.contains(&f)).unwrap_err();
         let SceneError::Unsupported { place: p, feature, renderer, .. } = &err else { panic!("{err:?}") };
         assert_eq!(
             (p.as_str(), feature.as_str(), renderer.as_str()),
@@ -407,16 +414,16 @@ fn require_refuses_the_first_feature_a_renderer_lacks() {
     // Supporting the delta light does not cover a sun disc, nor the other way round.
     let delta_only: Vec<Feature> = EVERYTHING.iter().copied().filter(|f| *f != Feature::SunDisc).collect();
     let delta = accepted("angular_radius = 0.25", "angular_radius = 0");
-    delta.require(RendererKind::Raster, &delta_only).unwrap();
+    delta.require(RendererKind::Raster.noun(), |f| delta_only.contains(&f)).unwrap();
     let sun_only: Vec<Feature> =
         EVERYTHING.iter().copied().filter(|f| *f != Feature::DeltaDirectionalLight).collect();
-    let err = delta.require(RendererKind::Raster, &sun_only).unwrap_err();
+    let err = delta.require(RendererKind::Raster.noun(), |f| sun_only.contains(&f)).unwrap_err();
     assert!(
         err.to_string().contains("[directional_light]: the rasterizer cannot render a directional light"),
         "{err}"
     );
     // Nothing supported: the first object's shape.
-    let err = s.require(RendererKind::PathTrace, &[]).unwrap_err();
+    let err = s.require(RendererKind::PathTrace.noun(), |_| false).unwrap_err();
     assert_eq!(
         err.to_string(),
         "scenes/phys.toml: objects[0] (\"floor\"): the path tracer cannot render a quad"
@@ -440,8 +447,8 @@ fn a_cornell_style_scene_passes_a_diffuse_path_tracer() {
         text = edit_text(&text, from, to);
     }
     let s = parse(&text).unwrap();
-    s.require(RendererKind::PathTrace, DIFFUSE_ONLY).unwrap();
+    s.require(RendererKind::PathTrace.noun(), |f| DIFFUSE_ONLY.contains(&f)).unwrap();
     // Unused materials do not count: only what an object uses is a feature.
     assert!(s.materials.iter().any(|m| matches!(m.kind, MaterialKind::Dielectric { .. })));
-    assert!(!s.features().iter().any(|(f, _)| *f == Feature::Dielectric));
+    assert!(!s.feature_uses().iter().any(|(f, _)| *f == Feature::Dielectric));
 }

@@ -1,5 +1,5 @@
 // The path tracer's display: the mean of the path tracer's display sum (a GPU buffer, see
-// shaders/pathtrace/display_sum.wgsl), exposure-scaled and encoded with the PNG output's pure
+// crates/illum-pathtrace/shaders/display_sum.wgsl), exposure-scaled and encoded with the PNG output's pure
 // gamma 2.2 into an 8-bit texture that egui shows as it is (egui takes native Rgba8Unorm textures
 // as already gamma-encoded).
 

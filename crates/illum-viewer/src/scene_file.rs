@@ -54,12 +54,12 @@ pub fn load_text(label: &str, text: &str) -> Result<LoadedScene, String> {
 /// The scene as each mode sees it.
 fn split(scene: Scene) -> Result<LoadedScene, String> {
     let pathtrace = scene
-        .require(RendererKind::PathTrace, illum_pathtrace::FEATURES)
+        .require(RendererKind::PathTrace.noun(), illum_pathtrace::implements)
         .map(|()| scene.clone())
         .map_err(|e| e.to_string());
     let raster = RasterScene::from_scene(&scene).map_err(|e| e.to_string());
     let whitted = scene
-        .require_where(RendererKind::Whitted.noun(), |f| f != illum_whitted::FEATURES_BUT)
+        .require(RendererKind::Whitted.noun(), illum_whitted::implements)
         .map(|()| scene.clone())
         .map_err(|e| e.to_string());
     if let (Err(p), Err(r), Err(w)) = (&pathtrace, &raster, &whitted) {

@@ -17,7 +17,7 @@
 // light it stands for, so the same occluders serve.
 
 #import illum::rtcore::spawn::spawn_point
-#import illum::rtcore::codes::{MATERIAL_LAMBERTIAN, MATERIAL_CHECKER, MATERIAL_MIRROR, MATERIAL_EMITTER}
+#import illum::rtcore::codes::{MATERIAL_CHECKER, MATERIAL_DIELECTRIC, MATERIAL_MIRROR, MATERIAL_EMITTER}
 #import illum::rtcore::geometry::{FAR, NO_HIT}
 #import illum::rtcore::camera::{Camera, camera_ray}
 #import illum::rtcore::optics::{checker_albedo, transmitted_cos2, refracted, fresnel}
@@ -82,10 +82,16 @@ fn light_at(p: vec3<f32>, n: vec3<f32>, err: f32, v: vec3<f32>, shininess: f32) 
         var l: vec3<f32>;
         var e: vec3<f32>;
         var t_max = FAR;
-        if (light.kind == LIGHT_DIRECTIONAL) {
+#ifdef DIRECTIONAL_LIGHT
+        let directional = light.kind == LIGHT_DIRECTIONAL;
+#else
+        let directional = false;
+#endif
+        if (directional) {
             l = light.a.xyz;
             e = light.power.xyz;
         } else {
+#ifdef POINT_LIGHTS
             let to = light.a.xyz - p;
             let r2 = dot(to, to);
             let r = sqrt(r2);
@@ -93,6 +99,7 @@ fn light_at(p: vec3<f32>, n: vec3<f32>, err: f32, v: vec3<f32>, shininess: f32) 
             let cos_light = max(dot(-l, light.normal.xyz), 0.0);
             e = light.power.xyz * (cos_light / (3.14159265358979 * r2));
             t_max = r * (1.0 - 1.0e-5);
+#endif
         }
         let cos_n = dot(n, l);
         if (cos_n <= 0.0 || all(e == vec3<f32>(0.0)) || occluded(origin, l, t_max)) {
@@ -123,18 +130,15 @@ fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
         let front = dot(s.n, ray.d) < 0.0;
         let n = select(-s.n, s.n, front);
         let v = -ray.d;
+        // Only the kinds of material the scene has are compiled (shader defs EMITTERS, MIRRORS,
+        // DIELECTRICS, CHECKER): Lambertian and checker surfaces take the default case.
         switch m.kind {
+#ifdef EMITTERS
             case MATERIAL_EMITTER: {
                 colour += select(vec3<f32>(0.0), ray.weight * m.b.rgb, front);
             }
-            case MATERIAL_LAMBERTIAN, MATERIAL_CHECKER: {
-                var c = m.a.rgb;
-                if (m.kind == MATERIAL_CHECKER) {
-                    c = checker_albedo(obj, m, s.p);
-                }
-                let lit = light_at(s.p, n, s.err, v, 1.0);
-                colour += ray.weight * c * (params.ambient.rgb + lit.diffuse);
-            }
+#endif
+#ifdef MIRRORS
             case MATERIAL_MIRROR: {
                 let c = m.a.rgb;
                 let w = params.shading.x;
@@ -146,8 +150,10 @@ fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
                     top += 1u;
                 }
             }
-            default: {
-                // Dielectric: entering through the front or leaving.
+#endif
+#ifdef DIELECTRICS
+            case MATERIAL_DIELECTRIC: {
+                // Entering through the front or leaving.
                 let ior = m.a.w;
                 let eta = select(ior, 1.0 / ior, front);
                 let lit = light_at(s.p, n, s.err, v, params.shading.y);
@@ -173,6 +179,17 @@ fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
                         }
                     }
                 }
+            }
+#endif
+            default: {
+                var c = m.a.rgb;
+#ifdef CHECKER
+                if (m.kind == MATERIAL_CHECKER) {
+                    c = checker_albedo(obj, m, s.p);
+                }
+#endif
+                let lit = light_at(s.p, n, s.err, v, 1.0);
+                colour += ray.weight * c * (params.ambient.rgb + lit.diffuse);
             }
         }
     }

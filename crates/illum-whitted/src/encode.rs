@@ -6,12 +6,74 @@ use std::f32::consts::PI;
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
+use illum_gpu::shader::Def;
 use illum_rtcore::{CameraRecord, MaterialRecord};
 use illum_scene::{Feature, Scene, Shape};
 
-/// The one feature of the scene model the Whitted ray tracer refuses: a sun of finite size
-/// (its shadow rays are hard).
-pub const FEATURES_BUT: Feature = Feature::SunDisc;
+/// What of the scene model the Whitted ray tracer implements: everything but a sun of finite
+/// size (its shadow rays are hard).
+pub fn implements(feature: Feature) -> bool {
+    match feature {
+        Feature::BoxShape
+        | Feature::QuadShape
+        | Feature::SphereShape
+        | Feature::Lambertian
+        | Feature::Checker
+        | Feature::Dielectric
+        | Feature::Mirror
+        | Feature::AreaLight
+        | Feature::DeltaDirectionalLight
+        | Feature::Environment => true,
+        Feature::SunDisc => false,
+    }
+}
+
+/// What a scene's Whitted pipeline is specialised for ("model only what a scene requires"),
+/// derived from [`Scene::features`] and the scene's depth; also its pipeline's cache key
+/// together with the generated traversal and materials.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Specialisation {
+    /// Entries of the ray stack: depth + 2 (see the shader's header).
+    pub stack: u32,
+    pub checker: bool,
+    pub mirrors: bool,
+    pub dielectrics: bool,
+    /// An emitting surface a ray can see.
+    pub emitters: bool,
+    pub directional_light: bool,
+    /// A point light at the centre of an emitting quad.
+    pub point_lights: bool,
+}
+
+impl Specialisation {
+    pub fn new(scene: &Scene) -> Self {
+        let features = scene.features();
+        Specialisation {
+            stack: scene.whitted.depth + 2,
+            checker: features.contains(Feature::Checker),
+            mirrors: features.contains(Feature::Mirror),
+            dielectrics: features.contains(Feature::Dielectric),
+            emitters: features.contains(Feature::AreaLight),
+            directional_light: scene.directional_light.is_some(),
+            point_lights: lights(scene).iter().any(|l| l.kind == LIGHT_POINT),
+        }
+    }
+
+    /// The naga_oil shader defs: the one place where their names are written.
+    pub fn shader_defs(&self) -> Vec<(&'static str, Def)> {
+        let flags = [
+            ("CHECKER", self.checker),
+            ("MIRRORS", self.mirrors),
+            ("DIELECTRICS", self.dielectrics),
+            ("EMITTERS", self.emitters),
+            ("DIRECTIONAL_LIGHT", self.directional_light),
+            ("POINT_LIGHTS", self.point_lights),
+        ];
+        let mut defs = vec![("WHITTED_STACK", Def::UInt(self.stack))];
+        defs.extend(flags.into_iter().filter(|&(_, on)| on).map(|(name, _)| (name, Def::Bool(true))));
+        defs
+    }
+}
 
 pub(crate) const LIGHT_DIRECTIONAL: u32 = 0;
 pub(crate) const LIGHT_POINT: u32 = 1;

@@ -27,7 +27,7 @@
 mod encode;
 mod tracer;
 
-pub use encode::FEATURES_BUT;
+pub use encode::{Specialisation, implements};
 pub use tracer::{
     ObjectIds, PendingImage, Shadow, WHITTED_SHADER, WhittedError, WhittedTracer, shader_defs, shader_modules,
 };

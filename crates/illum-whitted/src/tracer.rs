@@ -9,10 +9,10 @@ use illum_gpu::shader::{self, ShaderFile};
 use illum_gpu::{GpuContext, GpuError, readback, shader_file, wgpu};
 use illum_image::RgbImage32;
 use illum_rtcore::Geometry;
-use illum_scene::{Scene, SceneError};
+use illum_scene::{RendererKind, Scene, SceneError};
 use wgpu::util::DeviceExt;
 
-use crate::encode::{self, FEATURES_BUT, WhittedLight, WhittedParams};
+use crate::encode::{self, WhittedLight, WhittedParams};
 
 /// The entry shader (entry point `main`).
 pub const WHITTED_SHADER: ShaderFile = shader_file!("shaders/whitted.wgsl");
@@ -31,10 +31,9 @@ pub enum WhittedError {
     Scene(#[from] SceneError),
 }
 
-/// The shader defs of the pipeline for `scene`: its ray stack's size, depth + 2 (see the
-/// shader's header).
+/// The shader defs of the pipeline for `scene` ([`encode::Specialisation`]).
 pub fn shader_defs(scene: &Scene) -> Vec<(&'static str, shader::Def)> {
-    vec![("WHITTED_STACK", shader::Def::UInt(scene.whitted.depth + 2))]
+    encode::Specialisation::new(scene).shader_defs()
 }
 
 /// The modules the entry shader imports for `scene`, in import order: illum-rtcore's shared
@@ -103,7 +102,7 @@ impl WhittedTracer {
     /// Uploads `scene`, or says which of its features Whitted's algorithm does not model or why
     /// the device cannot hold its image.
     pub fn new(gpu: &GpuContext, scene: &Scene) -> Result<Self, WhittedError> {
-        scene.require_where("Whitted ray tracer", |f| f != FEATURES_BUT)?;
+        scene.require(RendererKind::Whitted.noun(), encode::implements)?;
         let (width, height) = (scene.camera.width, scene.camera.height);
         let bytes = u64::from(width) * u64::from(height) * PIXEL_BYTES;
         let limit = gpu.device.limits().max_storage_buffer_binding_size;
@@ -345,6 +344,29 @@ mod tests {
 
     use super::*;
     use crate::encode::WhittedParams;
+
+    /// Every combination of the specialisation's flags composes and validates without a GPU, so
+    /// the code behind each `#ifdef` is checked before a scene happens to need it.
+    #[test]
+    fn every_combination_of_the_specialisation_validates() {
+        let scene = illum_scene::testing::shipped_scene("whitted.toml", 32, 32);
+        let modules = shader_modules(&scene, &Geometry::new(&scene));
+        for bits in 0u32..1 << 6 {
+            let bit = |i: u32| bits & (1 << i) != 0;
+            let specialisation = encode::Specialisation {
+                stack: 3,
+                checker: bit(0),
+                mirrors: bit(1),
+                dielectrics: bit(2),
+                emitters: bit(3),
+                directional_light: bit(4),
+                point_lights: bit(5),
+            };
+            let composed = shader::compose(&modules, &WHITTED_SHADER, &specialisation.shader_defs())
+                .unwrap_or_else(|e| panic!("{specialisation:?}: {e}"));
+            shader::validate(&composed, "whitted.wgsl").unwrap_or_else(|e| panic!("{specialisation:?}: {e}"));
+        }
+    }
 
     /// The shader composes and validates without a GPU for every shipped scene, and the Rust
     /// records have naga's layout of the WGSL structs.

@@ -1,4 +1,4 @@
-//! The caustic's light tracer on the host (shader `shaders/pathtrace/caustic.wgsl`; the
+//! The caustic's light tracer on the host (shader `crates/illum-pathtrace/shaders/caustic.wgsl`; the
 //! estimator and its path space are in docs/caustics.md).
 //!
 //! Frame k, N = width x height particles, pairs with sample index k of every pixel: pixel p's
@@ -209,7 +209,7 @@ pub(crate) struct CausticTracer {
 }
 
 impl CausticTracer {
-    /// The light tracer for `scene`, or `None` when its pipeline has no CAUSTIC def (caustics
+    /// The light tracer for `scene`, or `None` when its scene code has no caustic (caustics
     /// off, no directional light or no specular object).
     pub(crate) fn new(
         gpu: &GpuContext,
@@ -219,7 +219,7 @@ impl CausticTracer {
         scene_buffers: [&wgpu::Buffer; 3],
         scene_params: GpuParams,
     ) -> Result<Option<Self>, PathTraceError> {
-        if !gpu_scene.defs.contains(&"CAUSTIC") {
+        if !gpu_scene.code.caustic {
             return Ok(None);
         }
         let sun = scene.directional_light.expect("CAUSTIC needs a directional light");

@@ -214,11 +214,11 @@ impl ScenePipeline {
     }
 
     /// Whether `scene` (same geometry) needs another pipeline or buffers: another resolution,
-    /// or settings that choose other shader defs (the caustic on or off, the hemisphere
+    /// or settings that choose other scene code (the caustic on or off, the hemisphere
     /// sampling, bounded or unbounded paths).
     pub(super) fn needs_rebuild(&self, scene: &Scene, gpu_scene: &GpuScene) -> Result<bool, PathTraceError> {
         Ok((scene.camera.width, scene.camera.height) != (self.scene.camera.width, self.scene.camera.height)
-            || gpu_scene.defs != GpuScene::new(&self.scene)?.defs)
+            || gpu_scene.code != GpuScene::new(&self.scene)?.code)
     }
 
     /// Takes `scene`'s camera and render settings, which the pipeline and buffers serve as they
