@@ -102,6 +102,29 @@ pub fn validate(module: &naga::Module, file: &str) -> Result<naga::valid::Module
         .map_err(|e| GpuError::Shader { file: file.to_owned(), message: format!("{e:?}") })
 }
 
+/// Composes and validates each of `modules` on its own, as the import of a trivial entry point
+/// with the modules before it (a module may import only those): a module no entry point uses
+/// yet is still checked.
+pub fn validate_each_module(modules: &[ShaderFile]) -> Result<(), GpuError> {
+    for (i, module) in modules.iter().enumerate() {
+        let import_path = module
+            .source
+            .lines()
+            .find_map(|l| l.strip_prefix("#define_import_path "))
+            .ok_or_else(|| GpuError::Shader {
+                file: module.path.to_string(),
+                message: "no #define_import_path line".to_owned(),
+            })?
+            .trim();
+        let entry = ShaderFile::generated(
+            format!("entry importing {import_path}"),
+            format!("#import {import_path} as m\n@compute @workgroup_size(1)\nfn main() {{}}\n"),
+        );
+        validate(&compose(&modules[..=i], &entry, &[])?, &entry.path)?;
+    }
+    Ok(())
+}
+
 /// Creates a wgpu shader module from a composed naga module, reporting validation errors.
 pub fn create_module(
     gpu: &GpuContext,

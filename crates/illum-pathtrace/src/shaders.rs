@@ -145,20 +145,7 @@ mod tests {
     /// pass.
     #[test]
     fn every_pathtrace_shader_composes_and_validates() {
-        for (i, module) in SAMPLING_MODULES.iter().enumerate() {
-            let import_path = module
-                .source
-                .lines()
-                .find_map(|l| l.strip_prefix("#define_import_path "))
-                .unwrap_or_else(|| panic!("{} has no #define_import_path", module.path))
-                .trim()
-                .to_owned();
-            let entry = ShaderFile::generated(
-                format!("entry importing {import_path}"),
-                format!("#import {import_path} as m\n@compute @workgroup_size(1)\nfn main() {{}}\n"),
-            );
-            compose_and_validate(&SAMPLING_MODULES[..=i], &entry, &[]);
-        }
+        shader::validate_each_module(SAMPLING_MODULES).unwrap_or_else(|e| panic!("{e}"));
         for scene in path_tracer_scenes() {
             let gpu_scene = GpuScene::new(&scene).unwrap_or_else(|e| panic!("{e}"));
             for traversal in [Traversal::Generic, Traversal::Specialised] {

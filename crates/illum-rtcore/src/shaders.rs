@@ -54,22 +54,7 @@ mod tests {
     /// the modules before it.
     #[test]
     fn every_core_module_composes_and_validates() {
-        let modules = core_modules();
-        for (i, module) in modules.iter().enumerate() {
-            let import_path = module
-                .source
-                .lines()
-                .find_map(|l| l.strip_prefix("#define_import_path "))
-                .unwrap_or_else(|| panic!("{} has no #define_import_path", module.path))
-                .trim()
-                .to_owned();
-            let entry = ShaderFile::generated(
-                format!("entry importing {import_path}"),
-                format!("#import {import_path} as m\n@compute @workgroup_size(1)\nfn main() {{}}\n"),
-            );
-            let composed = shader::compose(&modules[..=i], &entry, &[]).unwrap_or_else(|e| panic!("{e}"));
-            shader::validate(&composed, &entry.path).unwrap_or_else(|e| panic!("{e}"));
-        }
+        shader::validate_each_module(&core_modules()).unwrap_or_else(|e| panic!("{e}"));
     }
 
     /// The Rust records have naga's size and member offsets of the WGSL structs they mirror.
