@@ -10,8 +10,12 @@
 //! emission, irradiance and sky radiance from 1e-6 up to f32::MAX).
 //!
 //! The generic traversal is used so that the few hundred scenes share one compiled pipeline
-//! (the specialised one is compiled per scene, which would take minutes on lavapipe); both
-//! traversals run the same intersection code (tests/pathtrace/specialisation.rs).
+//! (the specialised one is compiled per scene, which would take minutes on lavapipe). Every
+//! [`SPECIALISED_EVERY`]th scene is also rendered with the default options, the specialised
+//! traversal generated from the scene (its numbers as constants, occluders that cannot block
+//! pruned) with paired paths: the same seed traces the same paths, so each pixel must agree with
+//! the generic traversal's to f32 rounding, except where a ray grazes an edge and the two
+//! roundings send it to different sides (at most [`MAX_DISAGREEING`] of the pixels compared).
 
 use illum::pathtrace::{PathTracer, TracerOptions, Traversal};
 use illum::scene::Scene;
@@ -20,6 +24,13 @@ use crate::common::gpu;
 
 /// Scenes per run.
 const SCENES: u32 = 300;
+/// Every this many scenes, the specialised traversal too (one pipeline compiled per scene).
+const SPECIALISED_EVERY: u32 = 5;
+/// Two traversals agree on a pixel when every channel differs by at most this, relative to the
+/// larger: f32 rounding along a path of up to a few dozen operations per bounce.
+const AGREE: f64 = 1e-4;
+/// The fraction of compared pixels allowed to disagree (a grazing ray's sample on the other side).
+const MAX_DISAGREEING: f64 = 0.01;
 
 /// A small deterministic generator (SplitMix64): the same scenes every run, so a failure
 /// reproduces; the scene's text is printed when it fails.
@@ -168,6 +179,7 @@ fn random_scene(rng: &mut Rng) -> String {
 fn random_valid_scenes_render_without_nan_or_dropped_samples() {
     let mut rng = Rng(0x1111_5eed);
     let (mut rendered, mut refused, mut caustic_scenes) = (0, Vec::new(), 0);
+    let (mut specialised, mut compared, mut disagreeing, mut worst) = (0, 0usize, 0usize, 0.0f64);
     for i in 0..SCENES {
         let text = random_scene(&mut rng);
         let scene = match Scene::from_toml_str(&text, &format!("random-{i}.toml")) {
@@ -193,7 +205,40 @@ fn random_valid_scenes_render_without_nan_or_dropped_samples() {
             "scene {i}: infinite error estimate\n{text}"
         );
         rendered += 1;
+        if i % SPECIALISED_EVERY == 0 {
+            let mut tracer = PathTracer::with_options(gpu(), &scene, TracerOptions::default())
+                .unwrap_or_else(|e| panic!("scene {i}: the specialised traversal refused it: {e}\n{text}"));
+            tracer
+                .add_samples_in_one_pass(4)
+                .unwrap_or_else(|e| panic!("scene {i}, specialised: {e}\n{text}"));
+            let acc = tracer.accumulator();
+            let other = acc.mean_image();
+            assert!(!other.has_non_finite(), "scene {i}, specialised: NaN or Inf in the image\n{text}");
+            assert_eq!(acc.dropped_samples(), 0, "scene {i}, specialised: dropped samples\n{text}");
+            for (a, b) in image.pixels.iter().zip(&other.pixels) {
+                let difference = (0..3)
+                    .map(|c| {
+                        let (a, b) = (f64::from(a[c]), f64::from(b[c]));
+                        if a == b { 0.0 } else { (a - b).abs() / a.abs().max(b.abs()) }
+                    })
+                    .fold(0.0, f64::max);
+                worst = worst.max(difference);
+                disagreeing += usize::from(difference > AGREE);
+                compared += 1;
+            }
+            specialised += 1;
+        }
     }
+    let fraction = disagreeing as f64 / compared as f64;
+    println!(
+        "{specialised} scenes also with the specialised traversal: {disagreeing} of {compared} pixels differ by more \
+         than {AGREE:e} relative ({fraction:.4}); largest relative difference {worst:.2e}"
+    );
+    assert!(specialised >= SCENES / SPECIALISED_EVERY * 9 / 10, "only {specialised} scenes were specialised");
+    assert!(
+        fraction <= MAX_DISAGREEING,
+        "the specialised traversal disagrees with the generic one on {disagreeing} of {compared} pixels"
+    );
     println!(
         "{rendered} random scenes rendered ({caustic_scenes} with the caustic's light tracer), {} refused by the validator",
         refused.len()

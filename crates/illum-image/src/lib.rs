@@ -30,7 +30,8 @@ pub use exr::{
     load_u32_layers, save_exr, save_exr_with_layers,
 };
 pub use metrics::{
-    MetricsError, inverse_normal_cdf, mean_luminance_bias, median, rel_mse, rmse, z_test_pass_fraction,
+    MetricsError, binomial_critical_count, inverse_normal_cdf, mean_luminance_bias, median, rel_mse, rmse,
+    z_test_pass_fraction,
 };
 pub use png::{png_bytes, save_png, save_rgba8_png};
 pub use rgb_image::{RgbImage32, luminance};

@@ -163,6 +163,50 @@ pub fn z_test_pass_fraction(
     Ok(passed as f64 / mean_a.pixels.len() as f64)
 }
 
+/// The smallest count `k` such that a Binomial(`n`, `p`) count reaches `k` or more with
+/// probability at most `alpha`: the critical count of a one-sided binomial test at level
+/// `alpha`. A per-pixel test that fails a pixel of a correct image with probability at most `p`,
+/// on `n` independent pixels, then fails `k` or more of them with probability at most `alpha`
+/// (a count of failures at most Binomial(n, p) in distribution). Returns `n + 1` when even all
+/// `n` failing is likelier than `alpha`.
+///
+/// The tail is summed from the top, P(K >= k) = sum over j >= k of C(n, j) p^j (1 - p)^(n - j),
+/// each term from its logarithm (log-gamma), so that neither the underflow of (1 - p)^n at large
+/// `n` nor the cancellation in 1 - cdf limits it.
+pub fn binomial_critical_count(n: usize, p: f64, alpha: f64) -> usize {
+    assert!((0.0..=1.0).contains(&p) && alpha > 0.0 && alpha < 1.0, "p = {p}, alpha = {alpha}");
+    let ln_pmf = |k: usize| -> f64 {
+        let (k64, n64) = (k as f64, n as f64);
+        let ln_choose = ln_gamma(n64 + 1.0) - ln_gamma(k64 + 1.0) - ln_gamma(n64 - k64 + 1.0);
+        let with = |count: f64, q: f64| if count == 0.0 { 0.0 } else { count * q.ln() };
+        ln_choose + with(k64, p) + with(n64 - k64, 1.0 - p)
+    };
+    let mut tail = 0.0;
+    for k in (0..=n).rev() {
+        let with_k = tail + ln_pmf(k).exp();
+        if with_k > alpha {
+            return k + 1;
+        }
+        tail = with_k;
+    }
+    0
+}
+
+/// ln Γ(x) for x >= 1, by Stirling's series with the argument moved above 8 (absolute error
+/// below 1e-12 there): enough for the binomial coefficients of [`binomial_critical_count`].
+fn ln_gamma(x: f64) -> f64 {
+    let mut x = x;
+    let mut shift = 0.0;
+    while x < 8.0 {
+        shift -= x.ln();
+        x += 1.0;
+    }
+    let inv = 1.0 / x;
+    let inv2 = inv * inv;
+    let series = inv * (1.0 / 12.0 - inv2 * (1.0 / 360.0 - inv2 * (1.0 / 1260.0 - inv2 / 1680.0)));
+    shift + (x - 0.5) * x.ln() - x + 0.5 * (2.0 * std::f64::consts::PI).ln() + series
+}
+
 /// The standard normal quantile Φ⁻¹(p), by Peter J. Acklam's rational approximation
 /// ("An algorithm for computing the inverse normal cumulative distribution function",
 /// 2003): a rational function in `p - 1/2` on the central region [0.02425, 0.97575] and in
@@ -409,5 +453,29 @@ mod tests {
         assert_eq!(median(&mut [3.0, 1.0, 2.0]), 2.0);
         assert_eq!(median(&mut [4.0, 1.0, 3.0, 2.0]), 2.5);
         assert!(median(&mut []).is_nan());
+    }
+
+    #[test]
+    fn binomial_critical_counts_match_exact_tails() {
+        // Bin(100, 1/2): P(K >= 59) = 0.0443, P(K >= 58) = 0.0666 (tables).
+        assert_eq!(binomial_critical_count(100, 0.5, 0.05), 59);
+        // Bin(10, 1/2): P(K >= 10) = 1/1024 < 0.001 < P(K >= 9) = 11/1024.
+        assert_eq!(binomial_critical_count(10, 0.5, 0.001), 10);
+        assert_eq!(binomial_critical_count(10, 0.5, 0.0009), 11);
+        // p = 0: no failure is possible, so one failure is already significant.
+        assert_eq!(binomial_critical_count(576, 0.0, 0.001), 1);
+        // The oracle test's case, against a direct sum of the pmf in f64.
+        let (n, p) = (576usize, 0.01f64);
+        let k = binomial_critical_count(n, p, 1e-3);
+        let mut pmf = vec![(1.0 - p).powi(n as i32)];
+        for j in 0..n {
+            let next = pmf[j] * (n - j) as f64 / (j + 1) as f64 * p / (1.0 - p);
+            pmf.push(next);
+        }
+        let tail = |from: usize| pmf[from..].iter().sum::<f64>();
+        assert!(tail(k) <= 1e-3 && tail(k - 1) > 1e-3, "k = {k}: {} and {}", tail(k), tail(k - 1));
+        assert_eq!(k, 15);
+        // tests/pathtrace/oracle_agreement.rs: P(K >= 2) = 1.6e-3, P(K >= 3) = 3.0e-5.
+        assert_eq!(binomial_critical_count(576, 1e-4, 1e-3), 3);
     }
 }

@@ -6,6 +6,10 @@
 //! renderers consume. Every error names the file, the field, the offending value and what would
 //! have been allowed (see [`SceneError`]).
 //!
+//! Positions are read in f64 and, for a scene farther than its own size from the world origin,
+//! measured from the camera's eye before they are rounded to the f32 the renderers use
+//! ([`Scene::origin`], `frame.rs`): the image does not depend on where the scene sits.
+//!
 //! The modules follow the scene's concepts: [`Camera`] (`camera.rs`), shapes (`shapes.rs`),
 //! materials (`materials.rs`), lights (`lights.rs`; area lights are emitting quads), the
 //! per-renderer sections (`renderers.rs`), and what a renderer must implement to render a scene
@@ -35,6 +39,7 @@ mod camera;
 mod error;
 mod features;
 mod file;
+mod frame;
 mod lights;
 mod materials;
 mod paths;

@@ -3,6 +3,8 @@
 
 use std::path::Path;
 
+use glam::{DVec3, Vec3};
+
 use crate::camera::{Camera, ClipPlanes};
 use crate::error::SceneError;
 use crate::file::RawScene;
@@ -28,6 +30,14 @@ pub struct Scene {
     /// The renderer a tool uses when the user does not choose one (the file's `renderer`;
     /// default: the path tracer).
     pub renderer: RendererKind,
+    /// Where the scene's coordinates are measured from, in the file's (world) coordinates: every
+    /// position below (the camera's eye and target, each object's place) is `world - origin`,
+    /// computed in f64 and rounded to f32 once. Zero for a scene near the world origin, the eye
+    /// for one farther than its own size from it (`frame.rs`), so that the f32 numbers every
+    /// renderer computes with are no larger than the scene wherever it sits. Directions and
+    /// lengths do not depend on it. [`Scene::world_point`] gives a position back in the file's
+    /// coordinates.
+    pub origin: DVec3,
     /// Pinhole camera and output resolution.
     pub camera: Camera,
     /// The camera's clip planes (`camera.near`, `camera.far`); only a rasterizer needs them.
@@ -118,6 +128,11 @@ impl Scene {
         c.width = o.width.unwrap_or(c.width);
         c.height = o.height.unwrap_or(c.height);
         Ok(())
+    }
+
+    /// A position of this scene (measured from [`Scene::origin`]) in the file's coordinates.
+    pub fn world_point(&self, p: Vec3) -> DVec3 {
+        self.origin + p.as_dvec3()
     }
 
     /// The area lights: (object index, object, its quad) for every object whose material

@@ -188,3 +188,90 @@ struct Case {
     allowed: Option<String>,
     syntax: Option<String>,
 }
+
+/// Scene text with `offset` added to every position it gives: the camera's eye and target,
+/// each sphere's centre, each quad's corner, and each box's centre (a box given by min and max
+/// moves by its translation). Directions and lengths stay, so a renderer whose image does not
+/// depend on where the scene sits draws the same image. Panics on text that is not TOML.
+pub fn moved(text: &str, offset: [f64; 3]) -> String {
+    let mut table: toml::Table = text.parse().unwrap_or_else(|e| panic!("scene text is not TOML: {e}"));
+    let shift = |value: &mut toml::Value| {
+        let array = value.as_array_mut().expect("a position is an array");
+        for (x, d) in array.iter_mut().zip(offset) {
+            let v = x.as_float().or_else(|| x.as_integer().map(|i| i as f64)).expect("a number");
+            *x = toml::Value::Float(v + d);
+        }
+    };
+    let camera = table.get_mut("camera").and_then(toml::Value::as_table_mut).expect("a [camera]");
+    shift(camera.get_mut("eye").expect("camera.eye"));
+    shift(camera.get_mut("target").expect("camera.target"));
+    let objects = table.get_mut("objects").and_then(toml::Value::as_array_mut);
+    for object in objects.into_iter().flatten().filter_map(toml::Value::as_table_mut) {
+        if let Some(s) = object.get_mut("sphere").and_then(toml::Value::as_table_mut) {
+            shift(s.get_mut("center").expect("sphere.center"));
+        }
+        if let Some(q) = object.get_mut("quad").and_then(toml::Value::as_table_mut) {
+            shift(q.get_mut("corner").expect("quad.corner"));
+        }
+        if let Some(b) = object.get_mut("box").and_then(toml::Value::as_table_mut) {
+            match b.get_mut("center") {
+                Some(center) => shift(center),
+                None => shift(b.entry("translate").or_insert(toml::Value::Array(vec![0.0.into(); 3]))),
+            }
+        }
+    }
+    toml::to_string(&table).expect("a table serialises")
+}
+
+/// Scene text with the whole scene scaled by `scale` about the world origin: every position
+/// and every length it gives (the camera's eye, target and clip planes, each shape's place and
+/// size, a checkerboard's tile, the rasterizer's PCF radius). Angles, directions, radiance and
+/// irradiance stay, so a renderer whose image does not depend on the scene's unit draws the same
+/// image. Panics on text that is not TOML.
+pub fn scaled(text: &str, scale: f64) -> String {
+    let mut table: toml::Table = text.parse().unwrap_or_else(|e| panic!("scene text is not TOML: {e}"));
+    let times = |value: &mut toml::Value| {
+        let number = |x: &toml::Value| x.as_float().or_else(|| x.as_integer().map(|i| i as f64));
+        match value {
+            toml::Value::Array(array) => {
+                for x in array.iter_mut() {
+                    *x = toml::Value::Float(number(x).expect("a number") * scale);
+                }
+            }
+            x => *x = toml::Value::Float(number(x).expect("a number") * scale),
+        }
+    };
+    let scale_keys = |table: &mut toml::Table, keys: &[&str]| {
+        for key in keys {
+            if let Some(value) = table.get_mut(*key) {
+                times(value);
+            }
+        }
+    };
+    let camera = table.get_mut("camera").and_then(toml::Value::as_table_mut).expect("a [camera]");
+    scale_keys(camera, &["eye", "target", "near", "far"]);
+    let objects = table.get_mut("objects").and_then(toml::Value::as_array_mut);
+    for object in objects.into_iter().flatten().filter_map(toml::Value::as_table_mut) {
+        for (shape, keys) in [
+            ("sphere", &["center", "radius"][..]),
+            ("quad", &["corner", "edge_u", "edge_v"][..]),
+            ("box", &["center", "half_extent", "min", "max", "pivot", "translate"][..]),
+        ] {
+            if let Some(s) = object.get_mut(shape).and_then(toml::Value::as_table_mut) {
+                scale_keys(s, keys);
+            }
+        }
+    }
+    let materials = table.get_mut("materials").and_then(toml::Value::as_table_mut);
+    for material in
+        materials.into_iter().flat_map(|m| m.iter_mut().map(|(_, v)| v)).filter_map(toml::Value::as_table_mut)
+    {
+        if let Some(checker) = material.get_mut("checker").and_then(toml::Value::as_table_mut) {
+            scale_keys(checker, &["tile"]);
+        }
+    }
+    if let Some(raster) = table.get_mut("raster").and_then(toml::Value::as_table_mut) {
+        scale_keys(raster, &["pcf_radius"]);
+    }
+    toml::to_string(&table).expect("a table serialises")
+}

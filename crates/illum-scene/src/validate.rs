@@ -3,18 +3,21 @@
 //! Checks run in file order (camera, render, materials, objects) and stop at the first problem.
 //! Every number is checked for finiteness *after* conversion to f32 — TOML happily accepts
 //! `nan` and `inf`, and a finite f64 such as 1e39 becomes infinite in f32 — before any check
-//! that compares it, because NaN fails every comparison silently.
+//! that compares it, because NaN fails every comparison silently. Positions are then measured
+//! from the frame's origin in f64 and rounded once (`frame.rs`); errors show them as the file
+//! gives them.
 //!
 //! Over 450 lines: every rule of the conversion, in the order the file is read (the per-renderer
 //! sections are in `validate_sections.rs`).
 
 use std::collections::BTreeMap;
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 
 use crate::camera::{Camera, ClipPlanes, robust_normalize};
 use crate::error::SceneError;
 use crate::file::{Int, Num, RawBox, RawCamera, RawMaterial, RawObject, RawScene, RawVec3};
+use crate::frame::{box_local_bounds, box_local_to_world, frame_origin};
 use crate::materials::{Checker, Material, MaterialKind};
 use crate::renderers::RendererKind;
 use crate::scene::{Object, Scene};
@@ -39,7 +42,8 @@ const MAX_TILES_PER_EDGE: f64 = 100_000.0;
 
 /// Validates `raw` (read from `file`) into a scene named `raw.name` or else `default_name`.
 pub(crate) fn scene_from_raw(raw: RawScene, file: &str, default_name: &str) -> Result<Scene, SceneError> {
-    let check = Check { file };
+    let origin = frame_origin(&raw);
+    let check = Check { file, origin };
     let renderer = match &raw.renderer {
         None => RendererKind::PathTrace,
         Some(s) => s.parse().map_err(|_| check.invalid("renderer", format!("{s:?}"), RENDERER_ALLOWED))?,
@@ -66,6 +70,7 @@ pub(crate) fn scene_from_raw(raw: RawScene, file: &str, default_name: &str) -> R
         name: raw.name.unwrap_or_else(|| default_name.to_owned()),
         source: file.to_owned(),
         renderer,
+        origin,
         camera,
         clip,
         materials,
@@ -79,10 +84,11 @@ pub(crate) fn scene_from_raw(raw: RawScene, file: &str, default_name: &str) -> R
     })
 }
 
-/// Validation context: the file label every error carries. The sections' checks are in
-/// `validate_sections.rs`.
+/// Validation context: the file label every error carries, and the origin positions are
+/// measured from (`frame.rs`). The sections' checks are in `validate_sections.rs`.
 pub(crate) struct Check<'a> {
     pub(crate) file: &'a str,
+    pub(crate) origin: DVec3,
 }
 
 impl Check<'_> {
@@ -109,6 +115,37 @@ impl Check<'_> {
         }
     }
 
+    /// A position: finite in f32 as the file gives it (the rule for every number), then measured
+    /// from the frame's origin in f64 and rounded to f32 once (`frame.rs`).
+    pub(crate) fn position(&self, field: &str, v: RawVec3) -> Result<Vec3, SceneError> {
+        let world = self.vec3(field, v)?;
+        if self.origin == DVec3::ZERO {
+            return Ok(world);
+        }
+        let local = (DVec3::from_array(v.0) - self.origin).as_vec3();
+        if local.is_finite() {
+            Ok(local)
+        } else {
+            Err(self.invalid(field, fmt_vec(v.0), self.beyond_f32_from_eye()))
+        }
+    }
+
+    fn beyond_f32_from_eye(&self) -> String {
+        format!(
+            "must lie within f32 range (3.4e38) of camera.eye = {}, which positions are measured from",
+            fmt_vec(self.origin.to_array())
+        )
+    }
+
+    /// How an error shows a position converted by [`Check::position`]: as the file gives it.
+    fn shown(&self, v: Vec3) -> String {
+        if self.origin == DVec3::ZERO {
+            fmt_vec32(v)
+        } else {
+            fmt_vec((self.origin + v.as_dvec3()).to_array())
+        }
+    }
+
     /// An integer in `min..=u32::MAX`.
     pub(crate) fn u32_at_least(&self, field: &str, x: Int, min: u32) -> Result<u32, SceneError> {
         let allowed = if x.0 < i64::from(min) {
@@ -123,8 +160,8 @@ impl Check<'_> {
     }
 
     pub(crate) fn camera(&self, raw: &RawCamera) -> Result<Camera, SceneError> {
-        let eye = self.vec3("camera.eye", raw.eye)?;
-        let target = self.vec3("camera.target", raw.target)?;
+        let eye = self.position("camera.eye", raw.eye)?;
+        let target = self.position("camera.target", raw.target)?;
         let up = self.vec3("camera.up", raw.up)?;
         let vfov_deg = self.number("camera.vfov", raw.vfov)?;
         // tan(vfov / 2) must be finite and positive: 0 and 180 degrees are excluded.
@@ -147,11 +184,11 @@ impl Check<'_> {
         let Some(forward) = robust_normalize(target - eye) else {
             return Err(self.invalid(
                 "camera.target",
-                fmt_vec32(target),
+                self.shown(target),
                 format!(
                     "must differ from camera.eye = {} (the view direction target - eye must be \
                      non-zero and finite)",
-                    fmt_vec32(eye)
+                    self.shown(eye)
                 ),
             ));
         };
@@ -292,7 +329,7 @@ impl Check<'_> {
             (None, Some(q), None) => {
                 let path = format!("{label}.quad");
                 let quad = Quad {
-                    corner: self.vec3(&format!("{path}.corner"), q.corner)?,
+                    corner: self.position(&format!("{path}.corner"), q.corner)?,
                     edge_u: self.vec3(&format!("{path}.edge_u"), q.edge_u)?,
                     edge_v: self.vec3(&format!("{path}.edge_v"), q.edge_v)?,
                 };
@@ -301,7 +338,7 @@ impl Check<'_> {
             }
             (None, None, Some(s)) => {
                 let path = format!("{label}.sphere");
-                let center = self.vec3(&format!("{path}.center"), s.center)?;
+                let center = self.position(&format!("{path}.center"), s.center)?;
                 let radius_path = format!("{path}.radius");
                 let radius = self.number(&radius_path, s.radius)?;
                 if radius <= 0.0 {
@@ -448,13 +485,39 @@ impl Check<'_> {
                 ));
             }
         };
-        Ok(BoxShape {
+        let shape = BoxShape {
             min,
             max,
             rotate_y_deg: self.number(&format!("{path}.rotate_y"), raw.rotate_y)?,
             pivot: self.vec3(&format!("{path}.pivot"), raw.pivot)?,
             translate: self.vec3(&format!("{path}.translate"), raw.translate)?,
-        })
+        };
+        if self.origin == DVec3::ZERO {
+            return Ok(shape);
+        }
+        // Measured from the origin, the box is re-expressed about its own centre c, in f64:
+        // world - origin = R (local - c) + (R c + offset - origin), so the local bounds become
+        // +-half and the pivot 0, and the one large number, the box's place, is rebased before
+        // it is rounded. (The renderers' R is the f32 rotation of the same angle, applied only
+        // to +-half: its rounding moves the box by about 1e-7 of its size, as at the origin.)
+        let (lo, hi) = box_local_bounds(raw).expect("a box's bounds were checked above");
+        let (rotation, offset) = box_local_to_world(raw);
+        let (centre, half) = ((lo + hi) * 0.5, (hi - lo) * 0.5);
+        let rebased = BoxShape {
+            min: (-half).as_vec3(),
+            max: half.as_vec3(),
+            pivot: Vec3::ZERO,
+            translate: (rotation * centre + offset - self.origin).as_vec3(),
+            ..shape
+        };
+        if !(rebased.translate.is_finite() && rebased.max.cmpgt(rebased.min).all()) {
+            return Err(self.invalid(
+                path,
+                format!("{{ centre = {} }}", fmt_vec(centre.to_array())),
+                self.beyond_f32_from_eye(),
+            ));
+        }
+        Ok(rebased)
     }
 
     /// |u x v| = |u| |v| sin(angle) is the quad's area. It must be clearly non-zero relative to
