@@ -26,19 +26,19 @@
 use std::path::PathBuf;
 
 use clap::Parser;
-use illum::cli::{self, SceneArgs};
 use illum::image::median;
 use illum::pathtrace::{PathTracer, Readback, TracerOptions, Traversal};
 use illum::raster::RasterScene;
 use illum::raster::{Look, Motion, Options, bench_frames};
 use illum::scene::{Bounces, Scene};
+use illum_cli::SceneArgs;
 
 #[derive(Parser, Debug)]
 #[command(about = "Measure path-tracer throughput (samples/s, rays/s, GPU time per submission; generic \
              against specialised pipelines) and the rasterizer's frame time")]
 struct Args {
     /// Scene to benchmark.
-    #[arg(default_value = cli::DEFAULT_SCENE)]
+    #[arg(default_value = illum_cli::DEFAULT_SCENE)]
     scene: PathBuf,
     /// Repetitions per configuration (the median is reported), 1 to 1000.
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
@@ -71,7 +71,7 @@ struct Config {
 }
 
 fn main() {
-    illum::cli::main_with(run);
+    illum_cli::main_with(run);
 }
 
 /// Upper bound on rays per path for a fixed bounce count: one camera ray, then at each of the
@@ -82,7 +82,7 @@ fn rays_per_sample(bounces: u32) -> u64 {
 }
 
 fn run(args: Args) -> anyhow::Result<()> {
-    let gpu = cli::gpu()?;
+    let gpu = illum_cli::gpu()?;
     if args.viewer {
         return bench_viewer(&gpu, &args);
     }
@@ -126,7 +126,7 @@ fn run(args: Args) -> anyhow::Result<()> {
             height: Some(config.size),
             ..Default::default()
         };
-        let scene: Scene = cli::load_scene(&args.scene, &settings)?;
+        let scene: Scene = illum_cli::load_scene(&args.scene, &settings)?;
         let options = TracerOptions { traversal: config.traversal, ..Default::default() };
         let mut tracer = PathTracer::with_options(&gpu, &scene, options)?;
         tracer.set_readback(if config.staging_copy { Readback::Staging } else { Readback::Mapped });
@@ -175,7 +175,7 @@ fn run(args: Args) -> anyhow::Result<()> {
 /// The rasterizer on the Whitted scene at 1280 x 720, enhanced look, every effect on: frames per second and
 /// the GPU time of each pass (more options: `--example raster_bench`).
 fn bench_raster(gpu: &illum::gpu::GpuContext, runs: u32) -> anyhow::Result<()> {
-    let path = cli::resolve_scene_path(std::path::Path::new("scenes/whitted.toml"));
+    let path = illum_cli::resolve_scene_path(std::path::Path::new("scenes/whitted.toml"));
     let scene = RasterScene::load(&path)?;
     let options = Options::all_on(Look::Enhanced);
     println!();
@@ -282,7 +282,7 @@ fn tempfile_dir() -> anyhow::Result<PathBuf> {
 /// The viewer's path tracer against `render`'s loop at the viewer's resolution, side by side.
 fn bench_viewer(gpu: &illum::gpu::GpuContext, args: &Args) -> anyhow::Result<()> {
     use illum::pathtrace::{StopRules, render_progressive};
-    let path = cli::resolve_scene_path(&args.scene);
+    let path = illum_cli::resolve_scene_path(&args.scene);
     println!(
         "| run | resolution | viewer Msamples/s (wall) | window fps | render Msamples/s (wall), same size and time | viewer / render |"
     );
@@ -292,7 +292,7 @@ fn bench_viewer(gpu: &illum::gpu::GpuContext, args: &Args) -> anyhow::Result<()>
         let viewer = run_viewer(&path, args.frames)?;
         let settings =
             SceneArgs { width: Some(viewer.width), height: Some(viewer.height), ..Default::default() };
-        let scene: Scene = cli::load_scene(&path, &settings)?;
+        let scene: Scene = illum_cli::load_scene(&path, &settings)?;
         let mut tracer = PathTracer::new(gpu, &scene)?;
         tracer.set_chunk_aligned_passes(true);
         let rules = StopRules {

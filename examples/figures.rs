@@ -12,16 +12,16 @@
 use std::path::PathBuf;
 
 use clap::Parser;
-use illum::cli::{self, SceneArgs};
 use illum::image::{Encoding, contact_sheet, save_png, save_rgba8_png, to_rgba8};
 use illum::pathtrace::PathTracer;
 use illum::scene::{Bounces, Overrides};
+use illum_cli::SceneArgs;
 
 #[derive(Parser, Debug)]
 #[command(about = "Render the assignment's figures 2 and 3")]
 struct Args {
     /// Scene file (TOML).
-    #[arg(default_value = cli::DEFAULT_SCENE)]
+    #[arg(default_value = illum_cli::DEFAULT_SCENE)]
     scene: PathBuf,
     /// Output directory.
     #[arg(long, default_value = "out/figures")]
@@ -48,15 +48,15 @@ const PANELS: [(&str, &str, u32, u32); 6] = [
 ];
 
 fn main() {
-    illum::cli::main_with(run);
+    illum_cli::main_with(run);
 }
 
 fn run(args: Args) -> anyhow::Result<()> {
-    let gpu = cli::gpu()?;
+    let gpu = illum_cli::gpu()?;
     let base = SceneArgs { width: args.width, height: args.height, seed: args.seed, ..Default::default() };
     let mut sheet_panels = Vec::new();
     for (stem, label, bounces, spp) in PANELS {
-        let mut scene = cli::load_scene(&args.scene, &base)?;
+        let mut scene = illum_cli::load_scene(&args.scene, &base)?;
         scene.apply_overrides(
             &Overrides { bounces: Some(Bounces::Fixed(bounces)), spp: Some(spp), ..Default::default() },
             "figure settings",

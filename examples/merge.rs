@@ -29,11 +29,11 @@ struct Args {
 }
 
 fn main() {
-    illum::cli::main_with(run);
+    illum_cli::main_with(run);
 }
 
 fn run(args: Args) -> anyhow::Result<()> {
-    if illum::cli::output_format(&args.output)? != illum::cli::OutputFormat::Exr {
+    if illum_cli::output_format(&args.output)? != illum_cli::OutputFormat::Exr {
         anyhow::bail!("output {}: the merge writes an EXR (.exr)", args.output.display());
     }
     illum::image::check_output(&args.output)?;

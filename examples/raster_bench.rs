@@ -16,10 +16,10 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Parser;
-use illum::cli;
+
 use illum::raster::RasterScene;
 use illum::raster::{Look, Motion, bench_frames};
-use illum::raster_cli::RasterArgs;
+use illum_cli::raster::RasterArgs;
 
 #[derive(Parser, Debug)]
 #[command(about = "Measure the rasterizer's frame rate and the GPU time of each pass (shadow, \
@@ -48,11 +48,11 @@ struct Args {
 }
 
 fn main() {
-    illum::cli::main_with(run);
+    illum_cli::main_with(run);
 }
 
 fn run(args: Args) -> anyhow::Result<()> {
-    let path = cli::resolve_scene_path(&args.scene);
+    let path = illum_cli::resolve_scene_path(&args.scene);
     let mut scene = RasterScene::load(&path)?;
     if let Some(size) = args.cube_size {
         anyhow::ensure!(size >= 1, "--cube-size = 0: must be at least 1");
@@ -62,7 +62,7 @@ fn run(args: Args) -> anyhow::Result<()> {
     if args.raster.look.is_none() {
         options.look = Look::Enhanced;
     }
-    let gpu = cli::gpu()?;
+    let gpu = illum_cli::gpu()?;
     for motion in [Motion::CameraOrbit, Motion::SceneChange, Motion::SceneChangeReducedCubes] {
         bench_one(&gpu, &scene, &args, &options, motion)?;
     }

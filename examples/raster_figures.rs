@@ -13,7 +13,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Parser;
-use illum::cli;
+
 use illum::image::{Encoding, contact_sheet, save_png, save_rgba8_png, to_rgba8};
 use illum::raster::{Effects, Look, Options, RasterRenderer, RasterScene};
 
@@ -27,7 +27,7 @@ struct Args {
 }
 
 fn main() {
-    illum::cli::main_with(run);
+    illum_cli::main_with(run);
 }
 
 fn with(look: Look, change: impl FnOnce(&mut Effects)) -> Options {
@@ -37,8 +37,8 @@ fn with(look: Look, change: impl FnOnce(&mut Effects)) -> Options {
 }
 
 fn run(args: Args) -> anyhow::Result<()> {
-    let scene = RasterScene::load(&cli::resolve_scene_path("scenes/whitted.toml".as_ref()))?;
-    let gpu = cli::gpu()?;
+    let scene = RasterScene::load(&illum_cli::resolve_scene_path("scenes/whitted.toml".as_ref()))?;
+    let gpu = illum_cli::gpu()?;
 
     let mut large = RasterRenderer::new(&gpu, &scene, 640, 360)?;
     for look in Look::ALL {

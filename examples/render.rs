@@ -10,7 +10,7 @@
 //! `--renderer raster|pathtrace` picks the renderer; the default is the scene file's `renderer`
 //! (`scenes/whitted.toml` says `raster`). The rasterizer takes `[--look figure|enhanced]
 //! [--no-shadows] [--no-pcf] [--no-refraction] [--no-reflection] [--no-fresnel] [--no-antialiasing]`
-//! (see `illum::raster_cli`). A renderer given a scene it cannot render says what it lacks.
+//! (see `illum_cli::raster`). A renderer given a scene it cannot render says what it lacks.
 //!
 //! Stop rules: without `--target-error` or `--time-budget` the render stops at `--spp` (or the
 //! scene's spp). A target error or a time budget lifts the scene's spp: the render runs until
@@ -41,24 +41,24 @@
 //! indices A to B-1 only, for the `merge` example to combine.
 //!
 //! Over 450 lines: the command a user runs, from its flags to its written files; each renderer's
-//! flags and loops are library modules (`illum::cli`, `raster_cli`, `whitted_cli`,
+//! flags and loops are library modules (`illum_cli`, `illum_cli::raster`, `illum_cli::whitted`,
 //! `illum_pathtrace::progressive`).
 
 use std::path::PathBuf;
 use std::time::Duration;
 
 use clap::Parser;
-use illum::cli::{self, DEFAULT_SCENE, LongRender, OutputFormat, SceneArgs, output_format};
 use illum::image::{Encoding, save_png};
-use illum::interrupt::Interrupt;
 use illum::pathtrace::checkpoint::{Checkpoint, load_checkpoint, save_checkpoint};
 use illum::pathtrace::{
     PathTracer, SampleAllocation, Sequence, StopReason, StopRules, TracerOptions, render_progressive,
 };
-use illum::progress::RenderProgress;
-use illum::raster_cli::{RasterArgs, RasterRequest, render_raster};
 use illum::scene::{RendererKind, Scene};
-use illum::whitted_cli::{WhittedArgs, WhittedRequest, render_whitted};
+use illum_cli::interrupt::Interrupt;
+use illum_cli::progress::RenderProgress;
+use illum_cli::raster::{RasterArgs, RasterRequest, render_raster};
+use illum_cli::whitted::{WhittedArgs, WhittedRequest, render_whitted};
+use illum_cli::{DEFAULT_SCENE, LongRender, OutputFormat, SceneArgs, output_format};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -91,11 +91,11 @@ struct Args {
     outputs: Vec<PathBuf>,
     /// Stop once the estimated relative standard error falls to this value (e.g. 0.01). Lifts
     /// the scene's spp; with --spp too, the first rule that holds wins.
-    #[arg(long, allow_negative_numbers = true, value_parser = cli::target_error_arg)]
+    #[arg(long, allow_negative_numbers = true, value_parser = illum_cli::target_error_arg)]
     target_error: Option<f64>,
     /// Stop after this many seconds of wall-clock time (after one complete pass at least).
     /// Lifts the scene's spp; with --spp too, the first rule that holds wins.
-    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = cli::time_budget_arg)]
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = illum_cli::time_budget_arg)]
     time_budget: Option<Duration>,
     /// PNG encoding: gamma2.2, srgb or linear. Default: gamma2.2 (the assignment's) for
     /// path-traced scenes, linear for rasterizer scenes (the assignment's figure 1 is linear).
@@ -110,12 +110,12 @@ struct Args {
     /// Path-tracer scenes: the caustic's light tracer `on` or `off` (default: the file's
     /// `[pathtrace] caustics`). It runs only on a scene with a directional light and a mirror
     /// or glass object (docs/caustics.md).
-    #[arg(long, value_name = "on|off", value_parser = cli::on_off_arg)]
+    #[arg(long, value_name = "on|off", value_parser = illum_cli::on_off_arg)]
     caustics: Option<bool>,
     /// PNG exposure in stops, e.g. -1 or 2, at most 64 either way, or `auto`: the stops that
     /// bring the median luminance to mid-grey (0.18), for scenes of any brightness. EXR output
     /// is never scaled. Default 0.
-    #[arg(long, allow_hyphen_values = true, value_parser = cli::exposure_arg)]
+    #[arg(long, allow_hyphen_values = true, value_parser = illum_cli::exposure_arg)]
     exposure: Option<illum::image::Exposure>,
     /// Continue the path-traced render saved in this EXR (a checkpoint) to --spp N samples per
     /// pixel (or to the end of --sample-range). Give the same scene file; the settings that
@@ -126,7 +126,7 @@ struct Args {
     /// Render only sample indices A to B-1 of every pixel (B - A spp), for the merge example
     /// to combine with other ranges. A must be a multiple of 16 (the chunk the GPU sums in), so
     /// that merged ranges give the image of one render.
-    #[arg(long, value_name = "A..B", value_parser = cli::sample_range_arg)]
+    #[arg(long, value_name = "A..B", value_parser = illum_cli::sample_range_arg)]
     sample_range: Option<std::ops::Range<u32>>,
     /// Path-tracer scenes: adaptive sampling. A pilot of 16 spp (another seed, then discarded)
     /// measures the noise of every 8 x 8 block of pixels, and the --spp budget is spread over
@@ -136,12 +136,12 @@ struct Args {
     adaptive: bool,
     /// Write the EXR outputs (checkpoints, see --resume) every this many seconds while
     /// rendering. Default 60.
-    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = cli::checkpoint_seconds_arg)]
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = illum_cli::checkpoint_seconds_arg)]
     checkpoint_seconds: Option<Duration>,
     /// When standard error is not a terminal (a job log, `> log 2>&1`): print a line starting
     /// with `progress: ` this often (0.1 to 86400 seconds; default 10), and at every tenth of the
     /// way, with every renderer. On a terminal a progress bar shows the same.
-    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = illum::progress::period_arg)]
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = illum_cli::progress::period_arg)]
     progress_seconds: Option<Duration>,
 }
 
@@ -152,14 +152,14 @@ const DEFAULT_TIME_BUDGET: Duration = Duration::from_secs(5);
 const DEFAULT_CHECKPOINT: Duration = Duration::from_secs(60);
 
 fn main() {
-    illum::cli::main_with(run);
+    illum_cli::main_with(run);
 }
 
 /// Fills the image-changing settings not given on the command line from a checkpoint's
 /// metadata, so that `--resume FILE` needs only the scene file and the new target.
 fn fill_from_checkpoint(
     checkpoint: &Checkpoint,
-    settings: &mut cli::SceneArgs,
+    settings: &mut illum_cli::SceneArgs,
     sequence: &mut Option<Sequence>,
     caustics: &mut Option<bool>,
 ) {
@@ -170,7 +170,7 @@ fn fill_from_checkpoint(
     settings.seed = settings.seed.or_else(|| get("seed")?.parse().ok());
     settings.sampling = settings.sampling.or_else(|| get("sampling")?.parse().ok());
     *sequence = sequence.or_else(|| get("sequence")?.parse().ok());
-    *caustics = caustics.or_else(|| cli::on_off_arg(get("caustics")?).ok());
+    *caustics = caustics.or_else(|| illum_cli::on_off_arg(get("caustics")?).ok());
 }
 
 fn run(args: Args) -> anyhow::Result<()> {
@@ -179,13 +179,13 @@ fn run(args: Args) -> anyhow::Result<()> {
     let interrupt = Interrupt::install()?;
     let long = LongRender {
         interrupt: Some(&interrupt),
-        progress_period: args.progress_seconds.unwrap_or(illum::progress::DEFAULT_PERIOD),
+        progress_period: args.progress_seconds.unwrap_or(illum_cli::progress::DEFAULT_PERIOD),
     };
     let renderer = match args.renderer {
         Some(renderer) => renderer,
-        None => Scene::load(&cli::resolve_scene_path(&args.scene))?.renderer,
+        None => Scene::load(&illum_cli::resolve_scene_path(&args.scene))?.renderer,
     };
-    let path_tracer_only = cli::given_flags(&[
+    let path_tracer_only = illum_cli::given_flags(&[
         (args.target_error.is_some(), "--target-error"),
         (args.time_budget.is_some(), "--time-budget"),
         (args.sequence.is_some(), "--sequence"),
@@ -215,7 +215,7 @@ fn run(args: Args) -> anyhow::Result<()> {
             "{}: {} {} only to the Whitted ray tracer (--renderer whitted)",
             args.scene.display(),
             whitted_flags.join(", "),
-            cli::verb(whitted_flags.len())
+            illum_cli::verb(whitted_flags.len())
         );
     }
     if renderer == RendererKind::Raster {
@@ -242,7 +242,7 @@ fn run(args: Args) -> anyhow::Result<()> {
     if let Some(checkpoint) = &checkpoint {
         fill_from_checkpoint(checkpoint, &mut settings, &mut sequence, &mut caustics);
     }
-    let mut scene = cli::load_scene(&args.scene, &settings)?;
+    let mut scene = illum_cli::load_scene(&args.scene, &settings)?;
     if let Some(sequence) = sequence {
         scene.pathtrace.sequence = sequence;
     }
@@ -258,7 +258,7 @@ fn run(args: Args) -> anyhow::Result<()> {
     }
     // Checked before the stop rules are announced: a refused render announces nothing.
     if args.adaptive {
-        let conflicting = cli::given_flags(&[
+        let conflicting = illum_cli::given_flags(&[
             (args.resume.is_some(), "--resume"),
             (args.sample_range.is_some(), "--sample-range"),
         ]);
@@ -376,13 +376,15 @@ fn run(args: Args) -> anyhow::Result<()> {
     } else {
         args.outputs.clone()
     };
-    let png_flags =
-        cli::given_flags(&[(args.encoding.is_some(), "--encoding"), (args.exposure.is_some(), "--exposure")]);
-    cli::check_outputs(&outputs, &png_flags)?;
+    let png_flags = illum_cli::given_flags(&[
+        (args.encoding.is_some(), "--encoding"),
+        (args.exposure.is_some(), "--exposure"),
+    ]);
+    illum_cli::check_outputs(&outputs, &png_flags)?;
     let sequence = scene.pathtrace.sequence;
 
     long.exit_if_requested("before the render started");
-    let gpu = cli::gpu()?;
+    let gpu = illum_cli::gpu()?;
     let options = TracerOptions { sequence, ..Default::default() };
     let mut tracer = if args.adaptive {
         // Built with the adaptive pipeline, which plan_adaptive's pilot runs (every block
@@ -467,7 +469,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         .as_ref()
         .map(|r| (illum::pathtrace::metadata::SAMPLE_END.to_owned(), r.end.to_string()));
     let mut last_checkpoint = std::time::Instant::now();
-    let mut checkpoint_error: Option<String> = None;
+    let mut checkpoint_error: Option<illum::pathtrace::checkpoint::CheckpointError> = None;
     let progress = RenderProgress::with_period(long.progress_period);
     let (reason, progressive) = render_progressive(&mut tracer, &rules, interrupt.flag(), |t, p| {
         progress.update(t, p);

@@ -1,19 +1,9 @@
 //! illum: a Rust + wgpu renderer for the two scenes of an illumination assignment.
 //!
-//! This facade re-exports the workspace crates so that `examples/` and `tests/` can use one name,
-//! and holds the command-line pieces the examples share ([`cli`], [`interrupt`], [`progress`], and
-//! each renderer's path of the render example: [`raster_cli`], [`whitted_cli`]), and what the
-//! measuring tools share: the cached [`reference`](mod@reference), [`plot`]s, [`report`] tables and the
-//! ladder's [`regions`] and errors.
-pub mod cli;
-pub mod interrupt;
-pub mod plot;
-pub mod progress;
-pub mod raster_cli;
-pub mod reference;
-pub mod regions;
-pub mod report;
-pub mod whitted_cli;
+//! This facade re-exports the workspace's renderer crates under one name, for `examples/`, the
+//! cross-renderer tests in `tests/` and anyone who links illum. The command-line front end the
+//! examples share is `illum-cli`, the measuring tools' code `illum-lab`: neither is linked by
+//! this crate.
 
 pub use illum_gpu as gpu;
 pub use illum_image as image;

@@ -7,18 +7,13 @@
 
 use std::sync::OnceLock;
 
-use illum::gpu::GpuContext;
+use illum::gpu::testing::gpu;
 use illum::image::RgbImage32;
 use illum::pathtrace::PathTracer;
 use illum::raster::{Options, RasterRenderer, RasterScene};
-use illum::regions::{Errors, Regions, compare};
 use illum::scene::{Bounces, Look, Scene};
 use illum::whitted::WhittedTracer;
-
-fn gpu() -> &'static GpuContext {
-    static GPU: OnceLock<GpuContext> = OnceLock::new();
-    GPU.get_or_init(|| GpuContext::new().unwrap_or_else(|e| panic!("{e}")))
-}
+use illum_lab::regions::{Errors, Regions, compare};
 
 fn scene() -> Scene {
     illum::scene::testing::shipped_scene("whitted.toml", 80, 45)

@@ -619,7 +619,7 @@ fn a_render_ending_inside_a_chunk_resumes_and_merges_like_one_render() {
 #[test]
 fn checkpoints_whose_counts_do_not_add_up_and_parts_stopped_early_are_refused() {
     use illum::pathtrace::Accumulator;
-    use illum::pathtrace::checkpoint::{load_checkpoint, merge_checkpoints, save_loaded};
+    use illum::pathtrace::checkpoint::{CheckpointError, load_checkpoint, merge_checkpoints, save_loaded};
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("part.exr");
     render_ok(&["--sample-range", "0..32", "-o", path.to_str().unwrap()]);
@@ -636,6 +636,8 @@ fn checkpoints_whose_counts_do_not_add_up_and_parts_stopped_early_are_refused() 
         let file = dir.path().join(name);
         save_loaded(&file, c).unwrap();
         let error = load_checkpoint(&file).expect_err("an inconsistent checkpoint was accepted");
+        assert!(matches!(error, CheckpointError::Corrupt { .. }), "{error:?}");
+        let error = error.to_string();
         assert!(error.contains(name) && error.contains(expected), "{error}");
     };
     let mut more = original.clone();
@@ -651,6 +653,8 @@ fn checkpoints_whose_counts_do_not_add_up_and_parts_stopped_early_are_refused() 
     let mut cancelled = original.clone();
     cancelled.metadata.fields.iter_mut().find(|(k, _)| k == "stopped_by").unwrap().1 = "cancelled".into();
     let error = merge_checkpoints(vec![(path.clone(), cancelled)]).expect_err("a cancelled part was merged");
+    assert!(matches!(error, CheckpointError::Unfinished { .. }), "{error:?}");
+    let error = error.to_string();
     assert!(error.contains("stopped early") && error.contains("--resume"), "{error}");
     // The part recorded its range, so the command to finish it is exact.
     assert_eq!(field(&metadata(&path), "sample_end"), "32");

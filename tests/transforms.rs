@@ -28,10 +28,10 @@ use illum::gpu::GpuContext;
 use illum::image::{Encoding, RgbImage32, save_diff_images, save_png};
 use illum::pathtrace::PathTracer;
 use illum::raster::{Options, RasterRenderer, RasterScene};
-use illum::regions::{Comparison, Regions, compare};
 use illum::scene::testing::{moved, scaled};
 use illum::scene::{Scene, Shape};
 use illum::whitted::WhittedTracer;
+use illum_lab::regions::{Comparison, Regions, compare};
 
 /// relMSE (mean over pixels and channels of (a - r)^2 / (r^2 + 0.01)) that a transformed
 /// image may have against home's. The scale of f32 rounding at the Whitted scene's own size:
@@ -146,19 +146,8 @@ fn offsets() -> Vec<DVec3> {
 const SCALES: [f64; 6] = [1e-4, 1e-3, 1e-2, 1e2, 1e3, 1e4];
 
 /// Cells that fail the criterion for a known cause, expected to fail until it is fixed (the test
-/// then says so, and the cell leaves this list). The path tracer's caustic light tracer starts
-/// its particles 1 unit (an absolute length) behind the scene's bounding sphere
-/// (crates/illum-pathtrace/shaders/caustic.wgsl, `- caustic.scene_radius - 1.0`): on a scene
-/// scaled to 1e-3 that start is 60 times the scene's size away and the particles' hits lose 6
-/// bits, at 1e-4 600 times and the small glass sphere's intersections break down. Measured, same
-/// seed: image luminance 0.998799 of home's at 1e-3 (the floor in the metal sphere's shadow 2.2%
-/// off) and 1.008380 at 1e-4 (the caustic under the glass 58% off). Starting 2 scene radii back
-/// instead (a relative margin) measured 0.999987 and 0.999999, every cell within the criterion:
-/// a bias, not noise.
-const KNOWN_FAILURES: [(&str, Renderer, &str); 2] = [
-    ("whitted.toml", Renderer::PathTrace, "scaled-1e-4"),
-    ("whitted.toml", Renderer::PathTrace, "scaled-1e-3"),
-];
+/// then says so, and the cell leaves this list).
+const KNOWN_FAILURES: [(&str, Renderer, &str); 0] = [];
 
 fn check(name: &str, renderer: Renderer) {
     let home_scene = scene(name, DVec3::ZERO);

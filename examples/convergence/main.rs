@@ -25,23 +25,23 @@ use std::sync::atomic::AtomicBool;
 
 use anyhow::{Context, bail};
 use clap::Parser;
-use illum::cli::{self, SceneArgs};
 use illum::gpu::GpuContext;
 use illum::image::{RgbImage32, mean_luminance_bias, rel_mse, rmse};
 use illum::pathtrace::{
     PathTracer, Sequence, StopRules, TracerOptions, parse_time_budget, render_progressive,
 };
-use illum::plot::{self, Line, Style};
-use illum::reference::{Reference, cached_reference, load_reference};
-use illum::report::{csv_text, write_text};
 use illum::scene::{Bounces, Sampling, Scene};
+use illum_cli::SceneArgs;
+use illum_lab::plot::{self, Line, Style};
+use illum_lab::reference::{Reference, cached_reference, load_reference};
+use illum_lab::report::{csv_text, write_text};
 
 #[derive(Parser, Debug)]
 #[command(about = "Measure error against time and spp for the path tracer's options (cosine or uniform \
              sampling, independent or low-discrepancy numbers), against a reference image")]
 struct Args {
     /// Scene file (TOML).
-    #[arg(default_value = cli::DEFAULT_SCENE)]
+    #[arg(default_value = illum_cli::DEFAULT_SCENE)]
     scene: PathBuf,
     #[command(flatten)]
     settings: SceneFlags,
@@ -145,7 +145,7 @@ impl Row {
 }
 
 fn main() {
-    illum::cli::main_with(run);
+    illum_cli::main_with(run);
 }
 
 fn run(mut args: Args) -> anyhow::Result<()> {
@@ -163,11 +163,11 @@ fn run(mut args: Args) -> anyhow::Result<()> {
     if args.reference_factor < 1 {
         bail!("--reference-factor = 0: must be at least 1");
     }
-    let scene = cli::load_scene(&args.scene, &args.settings.scene_args())?;
+    let scene = illum_cli::load_scene(&args.scene, &args.settings.scene_args())?;
     // The user's reference is checked (size, scene) before any row is rendered.
     let given_reference = args.reference.as_ref().map(|path| load_reference(path, &scene)).transpose()?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
-    let gpu = cli::gpu()?;
+    let gpu = illum_cli::gpu()?;
     println!(
         "scene {} at {}x{}, bounces {}",
         scene.name, scene.camera.width, scene.camera.height, scene.pathtrace.bounces

@@ -27,7 +27,7 @@
 //! by default unbounded; the caustic estimator where the scene has a caustic; cosine sampling;
 //! its own seed), cached in DIR under a name derived from everything that
 //! changes it, or the EXR given by `--truth`. The regions come from the Whitted ray tracer's
-//! object-ID image (`illum::regions`).
+//! object-ID image (`illum_lab::regions`).
 //!
 //! Outputs in DIR: ladder.csv (one line per row and region: renderer, settings, times, pixels,
 //! relMSE, luminance ratio, FLIP), ladder.md (the tables), error-vs-time.png and
@@ -41,17 +41,17 @@ use std::time::Instant;
 
 use anyhow::{Context, bail};
 use clap::Parser;
-use illum::cli;
+
 use illum::gpu::GpuContext;
 use illum::image::{Encoding, RgbImage32, contact_sheet, median, save_exr, save_rgba8_png, to_rgba8};
 use illum::pathtrace::PathTracer;
-use illum::plot::{self, Line, Style};
 use illum::raster::{Options, RasterRenderer, RasterScene};
-use illum::reference::{Reference, cached_reference, load_reference};
-use illum::regions::{Comparison, Regions, compare, flip_heat_map};
-use illum::report::{csv_text, markdown_table, write_text};
 use illum::scene::{Bounces, Effects, Look, MAX_WHITTED_DEPTH, MaterialKind, Scene};
 use illum::whitted::WhittedTracer;
+use illum_lab::plot::{self, Line, Style};
+use illum_lab::reference::{Reference, cached_reference, load_reference};
+use illum_lab::regions::{Comparison, Regions, compare, flip_heat_map};
+use illum_lab::report::{csv_text, markdown_table, write_text};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -130,7 +130,7 @@ struct Row {
 }
 
 fn main() {
-    cli::main_with(run);
+    illum_cli::main_with(run);
 }
 
 fn run(args: Args) -> anyhow::Result<()> {
@@ -140,7 +140,7 @@ fn run(args: Args) -> anyhow::Result<()> {
     if args.truth_spp == 0 || args.spp_list.contains(&0) {
         bail!("samples per pixel must be at least 1 (--truth-spp, --spp-list)");
     }
-    let mut scene = Scene::load(&cli::resolve_scene_path(&args.scene))?;
+    let mut scene = Scene::load(&illum_cli::resolve_scene_path(&args.scene))?;
     let (w, h) = default_size(&scene, args.width, args.height);
     scene.apply_overrides(
         &illum::scene::Overrides { width: Some(w), height: Some(h), ..Default::default() },
@@ -151,7 +151,7 @@ fn run(args: Args) -> anyhow::Result<()> {
     }
     illum::image::check_output(args.out.join("ladder.csv"))?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
-    let gpu = cli::gpu()?;
+    let gpu = illum_cli::gpu()?;
     println!("scene {} at {w}x{h} on {}", scene.name, gpu.adapter_info.name);
 
     let Reference {
@@ -455,7 +455,7 @@ fn write_outputs(
         .chain(regions.names.iter().zip(&sizes).map(|(n, px)| format!("{n} ({px} px)")))
         .collect();
     let region_header: Vec<&str> = region_header.iter().map(String::as_str).collect();
-    type Metric = (&'static str, fn(&illum::regions::Errors) -> String);
+    type Metric = (&'static str, fn(&illum_lab::regions::Errors) -> String);
     let metrics: [Metric; 3] = [
         ("relMSE per region", |e| number(e.rel_mse)),
         ("Luminance ratio per region (1 = the truth's brightness)", |e| ratio(e.luminance_ratio)),

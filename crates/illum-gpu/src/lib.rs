@@ -8,6 +8,7 @@
 //! - [`readback`]: copy a GPU buffer back to the CPU.
 //! - [`timing`]: GPU pass timing with timestamp queries, where the adapter has them.
 //! - [`shader`]: WGSL composition (naga_oil) and validation.
+//! - [`testing`]: what every crate's GPU tests share (one device per test binary, paths).
 
 pub mod buffers;
 mod context;
@@ -15,6 +16,8 @@ mod error;
 pub mod policy;
 pub mod readback;
 pub mod shader;
+#[cfg(not(target_arch = "wasm32"))]
+pub mod testing;
 pub mod timing;
 
 pub use context::{DEFAULT_GPU_TIMEOUT, GpuContext};

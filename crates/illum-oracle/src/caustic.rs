@@ -278,7 +278,7 @@ impl Oracle {
 }
 
 /// The caustic's extreme cases, shared by the oracle's tests and the GPU's
-/// (`tests/pathtrace/caustic.rs`): a ball's material and the `[directional_light]` lines that
+/// (illum-pathtrace's `tests/pathtrace/caustic.rs`): a ball's material and the `[directional_light]` lines that
 /// go with it. Indices of refraction 1.0001 (grazing refraction, almost no reflection) and 4
 /// (total internal reflection chains), the sun at 0.1 and 89.9 degrees of elevation, a sun disc
 /// of 20 and of 0.01 degrees, and a perfect mirror.

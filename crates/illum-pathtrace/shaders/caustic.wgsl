@@ -206,7 +206,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         covering += select(0u, 1u, dot(across, across) <= discs[j].w * discs[j].w);
     }
     var throughput = flux_density * (caustic.area_per_particle / f32(max(covering, 1u)));
-    var o = x + d0 * (dot(caustic.scene_centre - x, d0) - caustic.scene_radius - 1.0);
+    // The particle starts one scene radius outside the bounding sphere, a margin relative to the
+    // scene's size: an absolute one would put it many scene sizes away in a scene of small units,
+    // where its hits lose precision (tests/transforms.rs scales the scene from 1e-4 to 1e4).
+    var o = x + d0 * (dot(caustic.scene_centre - x, d0) - 2.0 * caustic.scene_radius);
     var d = d0;
     var scatterings = 0u;
     loop {

@@ -3,6 +3,7 @@
 //! everywhere.
 
 use illum_image::ExrMetadata;
+use illum_scene::Scene;
 
 use crate::{PathTracer, StopReason};
 
@@ -12,6 +13,13 @@ pub const RENDERER: &str = "pathtrace";
 /// The metadata key of the end of a `--sample-range` a part was asked to render (one past its
 /// last sample index), written by the `render` example beside `sample_start`.
 pub const SAMPLE_END: &str = "sample_end";
+
+/// The scene's identity as files store it (`illum.scene_hash`): [`Scene::content_hash`] in 16
+/// hex digits. It covers the scene's physical content, not the settings (resolution, bounces,
+/// seed, ...), which files store and compare one by one.
+pub fn scene_hash(scene: &Scene) -> String {
+    format!("{:016x}", scene.content_hash())
+}
 
 /// Metadata for the tracer's current image. Keys (each stored as `illum.<key>`):
 ///
@@ -29,7 +37,7 @@ pub const SAMPLE_END: &str = "sample_end";
 ///   pixel, e.g. `8x8 blocks, 16 to 4096 spp, mean 1023.5, pilot 16 spp`; `spp` then counts the
 ///   sample indices reached, which each block has taken up to its own count;
 /// - `adapter`: the GPU adapter's name; `source`: the program that wrote the file;
-/// - `scene_hash`: [`crate::checkpoint::scene_content_hash`]; `sample_start`: the first sample
+/// - `scene_hash`: [`scene_hash`]; `sample_start`: the first sample
 ///   index (see [`PathTracer::set_sample_offset`]); `partial_pass_spp` and `partial_pass_rows`:
 ///   a pass the render stopped inside (its spp and the rows it had done; 0 and 0 for none).
 ///   With the statistics layer of [`crate::checkpoint`], these let a render be continued.
@@ -59,7 +67,7 @@ pub fn exr_metadata(
         ),
         ("adapter", tracer.adapter_name().to_owned()),
         ("source", source.to_owned()),
-        ("scene_hash", crate::checkpoint::scene_content_hash(scene)),
+        ("scene_hash", scene_hash(scene)),
         ("sample_start", tracer.sample_offset().to_string()),
         ("partial_pass_spp", tracer.partial_pass().map_or(0, |p| p.0).to_string()),
         ("partial_pass_rows", tracer.partial_pass().map_or(0, |p| p.1).to_string()),

@@ -39,6 +39,7 @@ mod bindings;
 mod error;
 pub mod frame;
 pub mod limits;
+pub mod metadata;
 mod options;
 mod pass_times;
 mod pipelines;

@@ -12,8 +12,9 @@
 //!
 //! The modules follow the scene's concepts: [`Camera`] (`camera.rs`), shapes (`shapes.rs`),
 //! materials (`materials.rs`), lights (`lights.rs`; area lights are emitting quads), the
-//! per-renderer sections (`renderers.rs`), and what a renderer must implement to render a scene
-//! (`features.rs`).
+//! per-renderer sections (`renderers.rs`), what a renderer must implement to render a scene
+//! (`features.rs`), and the scene's identity, a hash of its content over versioned canonical
+//! bytes ([`Scene::content_hash`], `content_hash.rs`).
 //!
 //! ```
 //! let text = r#"
@@ -36,6 +37,7 @@
 //! ```
 
 mod camera;
+mod content_hash;
 mod error;
 mod features;
 mod file;
@@ -52,6 +54,7 @@ mod validate;
 mod validate_sections;
 
 pub use camera::{Camera, CameraBasis, ClipPlanes};
+pub use content_hash::{CONTENT_TAG, CONTENT_VERSION, fnv1a_64};
 pub use error::{ParseValueError, SceneError};
 pub use features::{Feature, FeatureSet};
 pub use lights::{DirectionalLight, Environment};

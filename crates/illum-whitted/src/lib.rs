@@ -25,6 +25,7 @@
 //! ```
 
 mod encode;
+pub mod metadata;
 mod tracer;
 
 pub use encode::{Specialisation, implements};

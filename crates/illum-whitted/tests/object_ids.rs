@@ -5,18 +5,11 @@
 //! silhouette or a shadow edge passes within a small margin of the centre ray may fall on the
 //! other side in f32; they are skipped and counted (under 2% of the image).
 
-use std::sync::OnceLock;
-
 use glam::DVec3;
-use illum_gpu::GpuContext;
+use illum_gpu::testing::gpu;
 use illum_oracle::closed_form::pixel_ray;
 use illum_scene::{Scene, Shape};
 use illum_whitted::{Shadow, WhittedTracer};
-
-fn gpu() -> &'static GpuContext {
-    static GPU: OnceLock<GpuContext> = OnceLock::new();
-    GPU.get_or_init(|| GpuContext::new().unwrap_or_else(|e| panic!("{e}")))
-}
 
 /// How far the ray (o, d) passes from the shape's outline: from a sphere's silhouette, or from
 /// the nearest edge of a rectangle where it crosses its plane (a small margin means f32 may

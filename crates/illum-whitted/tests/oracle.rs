@@ -7,17 +7,10 @@
 //! fall on the other side in f32, which changes that ray's whole colour; such pixels are
 //! allowed, up to 1% of the image. At least 90% of the pixels must also agree within 1e-5.
 
-use std::sync::OnceLock;
-
-use illum_gpu::GpuContext;
+use illum_gpu::testing::gpu;
 use illum_oracle::WhittedOracle;
 use illum_scene::Scene;
 use illum_whitted::WhittedTracer;
-
-fn gpu() -> &'static GpuContext {
-    static GPU: OnceLock<GpuContext> = OnceLock::new();
-    GPU.get_or_init(|| GpuContext::new().unwrap_or_else(|e| panic!("{e}")))
-}
 
 /// The fraction of pixels that agree within 1e-3, the fraction within 1e-5, and the count.
 fn agreement(scene: &Scene) -> (f64, f64, usize) {

@@ -4,7 +4,6 @@
 
 use std::ops::ControlFlow;
 
-use illum_gpu::GpuContext;
 use illum_whitted::WhittedTracer;
 
 fn bits(image: &illum_image::RgbImage32) -> Vec<u32> {
@@ -13,12 +12,12 @@ fn bits(image: &illum_image::RgbImage32) -> Vec<u32> {
 
 #[test]
 fn parts_give_the_same_image_report_their_pixels_and_can_stop() {
-    let gpu = GpuContext::new().unwrap_or_else(|e| panic!("{e}"));
+    let gpu = illum_gpu::testing::gpu();
     // 40 x 45: the last band has 13 rows and a tile row 5, not multiples of the workgroup's 8;
     // 40 columns in tiles of 24 leave a last tile of 16.
     for name in ["whitted.toml", "cornell.toml"] {
         let scene = illum_scene::testing::shipped_scene(name, 40, 45);
-        let tracer = WhittedTracer::new(&gpu, &scene).unwrap();
+        let tracer = WhittedTracer::new(gpu, &scene).unwrap();
         let whole = bits(&tracer.render().unwrap());
         for (per_part, expected) in [
             // 16 rows of 40 pixels per part.
@@ -41,7 +40,7 @@ fn parts_give_the_same_image_report_their_pixels_and_can_stop() {
     }
 
     let scene = illum_scene::testing::shipped_scene("whitted.toml", 16, 64);
-    let tracer = WhittedTracer::new(&gpu, &scene).unwrap();
+    let tracer = WhittedTracer::new(gpu, &scene).unwrap();
     let mut parts = 0;
     let stopped = tracer
         .render_in_parts(16 * 8, |_| {

@@ -1,0 +1,129 @@
+//! The statistics layers of a checkpoint: per pixel the f64 sum and sum of squares of each
+//! channel and the u64 count, each 64-bit number stored as two 32-bit words (`hi`, `lo`), since
+//! EXR has no 64-bit samples; and the checks that what is read back adds up.
+
+use illum_image::U32Layer;
+
+use super::STATISTICS_LAYER;
+use crate::Accumulator;
+
+const CHANNELS: [&str; 3] = ["R", "G", "B"];
+
+fn split(bits: u64) -> (u32, u32) {
+    ((bits >> 32) as u32, bits as u32)
+}
+
+fn join(hi: u32, lo: u32) -> u64 {
+    (u64::from(hi) << 32) | u64::from(lo)
+}
+
+/// The statistics layer of `accumulator`.
+pub fn statistics_layer(accumulator: &Accumulator) -> U32Layer {
+    layer_named(STATISTICS_LAYER, accumulator)
+}
+
+pub(super) fn layer_named(name: &str, accumulator: &Accumulator) -> U32Layer {
+    let state = accumulator.state();
+    let mut channels = Vec::new();
+    for (prefix, data) in [("sum", state.sum), ("sum_sq", state.sum_sq)] {
+        for (c, name) in CHANNELS.iter().enumerate() {
+            let (hi, lo): (Vec<u32>, Vec<u32>) = data.iter().map(|v| split(v[c].to_bits())).unzip();
+            channels.push((format!("{prefix}.{name}.hi"), hi));
+            channels.push((format!("{prefix}.{name}.lo"), lo));
+        }
+    }
+    let (hi, lo): (Vec<u32>, Vec<u32>) = state.count.iter().map(|&n| split(n)).unzip();
+    channels.push(("count.hi".to_owned(), hi));
+    channels.push(("count.lo".to_owned(), lo));
+    U32Layer { name: name.to_owned(), channels }
+}
+
+/// Rebuilds an accumulator from a statistics layer of a `width x height` image.
+pub(super) fn statistics_from_layer(
+    layer: &U32Layer,
+    width: u32,
+    height: u32,
+    dropped: u64,
+) -> Result<Accumulator, String> {
+    let pixels = width as usize * height as usize;
+    let channel = |name: String| -> Result<&Vec<u32>, String> {
+        let values = layer
+            .channels
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, v)| v)
+            .ok_or_else(|| format!("layer {} has no channel {name}", layer.name))?;
+        if values.len() != pixels {
+            return Err(format!("channel {name} has {} values for {pixels} pixels", values.len()));
+        }
+        Ok(values)
+    };
+    let pair = |prefix: &str| -> Result<Vec<[f64; 3]>, String> {
+        let mut out = vec![[0.0; 3]; pixels];
+        for (c, name) in CHANNELS.iter().enumerate() {
+            let hi = channel(format!("{prefix}.{name}.hi"))?;
+            let lo = channel(format!("{prefix}.{name}.lo"))?;
+            for (p, v) in out.iter_mut().enumerate() {
+                v[c] = f64::from_bits(join(hi[p], lo[p]));
+            }
+        }
+        Ok(out)
+    };
+    let sum = pair("sum")?;
+    let sum_sq = pair("sum_sq")?;
+    let (hi, lo) = (channel("count.hi".into())?, channel("count.lo".into())?);
+    let count: Vec<u64> = hi.iter().zip(lo).map(|(&h, &l)| join(h, l)).collect();
+    if sum.iter().chain(&sum_sq).flatten().any(|v| !v.is_finite()) {
+        return Err("the statistics hold a NaN or infinite sum: the file is corrupt".into());
+    }
+    Accumulator::from_state(width, height, sum, sum_sq, count, dropped)
+}
+
+/// Checks that the per-pixel sample counts are what `spp_done` complete passes and a pass
+/// stopped inside (`partial`: its spp and the rows done from row 0) give: no pixel has more,
+/// and the samples missing in all are at most the dropped (NaN or infinite) ones.
+pub(super) fn check_counts(
+    accumulator: &Accumulator,
+    spp_done: u32,
+    partial: Option<(u32, u32)>,
+) -> Result<(), String> {
+    let width = accumulator.width as usize;
+    let mut missing = 0u64;
+    for p in 0..width * accumulator.height as usize {
+        let row = (p / width) as u32;
+        let expected = u64::from(spp_done)
+            + partial.filter(|&(_, rows)| row < rows).map_or(0, |(spp, _)| u64::from(spp));
+        let count = accumulator.pixel_count(p);
+        if count > expected {
+            return Err(format!(
+                "pixel ({}, {row}) has {count} samples, more than the {expected} the metadata's spp gives: the file is \
+                 corrupt or was edited",
+                p % width
+            ));
+        }
+        missing += expected - count;
+    }
+    if missing > accumulator.dropped_samples() {
+        return Err(format!(
+            "the statistics hold {missing} samples fewer than illum.spp = {spp_done} gives, and only {} were dropped: \
+             the file is corrupt or was edited",
+            accumulator.dropped_samples()
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn f64_and_u64_survive_the_two_word_split() {
+        for v in [0.0f64, -0.0, 1.0 / 3.0, f64::MAX, f64::MIN_POSITIVE, 5e-324] {
+            let (hi, lo) = split(v.to_bits());
+            assert_eq!(f64::from_bits(join(hi, lo)).to_bits(), v.to_bits());
+        }
+        let (hi, lo) = split(u64::MAX - 7);
+        assert_eq!(join(hi, lo), u64::MAX - 7);
+    }
+}

@@ -1,0 +1,205 @@
+//! Merging partial renders (files from `render --sample-range`) into one: what is refused, and
+//! the order the parts are added in (see the parent module for why the result equals one
+//! render up to f64 rounding).
+
+use std::path::{Path, PathBuf};
+
+use super::{Checkpoint, CheckpointError, CheckpointHeader, load_checkpoint, load_checkpoint_header};
+
+/// The keys two partial renders must agree on to be merged.
+const MERGE_KEYS: [&str; 9] =
+    ["scene", "scene_hash", "width", "height", "bounces", "seed", "sampling", "sequence", "caustics"];
+
+/// Checks that partial renders can be merged, from their headers alone, and sorts them into
+/// sample order (the order the merge adds them in). Refused, with the files named: a file
+/// stopped inside a pass or stopped early (resume it first: the message gives the command), a
+/// range not starting on a chunk, a setting that differs, overlapping ranges (the same samples
+/// twice would count double) and gaps (the result would not be one range that can be
+/// continued). Returns the merged spp.
+fn check_mergeable<T>(parts: &mut [(PathBuf, CheckpointHeader, T)]) -> Result<u32, CheckpointError> {
+    if parts.is_empty() {
+        return Err(CheckpointError::NothingToMerge);
+    }
+    for (path, c, _) in parts.iter() {
+        let range = c.sample_range();
+        let resume = || match c.metadata.get(crate::metadata::SAMPLE_END) {
+            Some(end) => format!(
+                "finish it first with `render SCENE.toml --resume {} --sample-range {}..{end}`",
+                path.display(),
+                range.start
+            ),
+            None => format!(
+                "finish it first with `render SCENE.toml --resume {} --sample-range {}..END` (END: the end of its range)",
+                path.display(),
+                range.start
+            ),
+        };
+        if let Some((spp, rows)) = c.partial_pass {
+            return Err(CheckpointError::Unfinished {
+                path: path.clone(),
+                reason: format!(
+                    "stopped inside a pass ({rows} rows of {spp} spp done after {} complete spp)",
+                    c.spp_done
+                ),
+                finish: resume(),
+            });
+        }
+        if c.spp_done == 0 {
+            return Err(CheckpointError::NoCompletePass { path: path.clone() });
+        }
+        if let Some(reason @ ("cancelled" | "time_budget")) = c.metadata.get("stopped_by") {
+            return Err(CheckpointError::Unfinished {
+                path: path.clone(),
+                reason: format!(
+                    "stopped early (illum.stopped_by = {reason}) at sample {} of its range, so it may not hold the \
+                     whole range",
+                    range.end
+                ),
+                finish: resume(),
+            });
+        }
+        if !range.start.is_multiple_of(u64::from(crate::CHUNK_SAMPLES)) {
+            return Err(CheckpointError::OffChunk {
+                path: path.clone(),
+                start: range.start,
+                chunk: crate::CHUNK_SAMPLES,
+            });
+        }
+    }
+    let (first_path, first, _) = &parts[0];
+    for (path, c, _) in &parts[1..] {
+        let differences: Vec<String> = MERGE_KEYS
+            .iter()
+            .filter_map(|key| {
+                let (a, b) = (first.setting(key), c.setting(key));
+                (a != b).then(|| {
+                    let show = |v: Option<String>| v.unwrap_or_else(|| "(missing)".to_owned());
+                    format!(
+                        "{key}: {} in {}, {} in {}",
+                        show(a),
+                        first_path.display(),
+                        show(b),
+                        path.display()
+                    )
+                })
+            })
+            .collect();
+        if !differences.is_empty() {
+            return Err(CheckpointError::DifferentImages { differences });
+        }
+    }
+    parts.sort_by_key(|(_, c, _)| c.sample_start);
+    for pair in parts.windows(2) {
+        let ((pa, a, _), (pb, b, _)) = (&pair[0], &pair[1]);
+        let (ra, rb) = (a.sample_range(), b.sample_range());
+        if rb.start < ra.end {
+            return Err(CheckpointError::Overlap {
+                first: pa.clone(),
+                first_range: ra,
+                second: pb.clone(),
+                second_range: rb,
+            });
+        }
+        if rb.start > ra.end {
+            return Err(CheckpointError::Gap {
+                before: pa.clone(),
+                after: pb.clone(),
+                missing: ra.end..rb.start,
+            });
+        }
+    }
+    let total = parts.iter().map(|(_, c, _)| u64::from(c.spp_done)).sum::<u64>();
+    u32::try_from(total).map_err(|_| CheckpointError::TooManySamples { total })
+}
+
+/// Adds checked parts (in sample order) one at a time: per pixel, the f64 sums and counts in
+/// the order of their ranges, so that only the running total and the part being added are in
+/// memory. The merged metadata is the first part's, with the union's spp, the summed times and
+/// dropped samples, and the error of the merged statistics.
+fn fold_parts(
+    parts: impl ExactSizeIterator<Item = Result<Checkpoint, CheckpointError>>,
+    spp_done: u32,
+) -> Result<Checkpoint, CheckpointError> {
+    let last = parts.len() - 1;
+    let mut merged: Option<Checkpoint> = None;
+    let mut aligned_prefix = None;
+    for (i, part) in parts.enumerate() {
+        let part = part?;
+        if i == last {
+            // Every range but the last ends where the next starts, on a chunk boundary; the last
+            // may end inside a chunk, and then its statistics at its last boundary, added to the
+            // others' (in the same order as the merge), are the merged render's (what
+            // `render --resume` goes on from).
+            aligned_prefix = part.aligned_prefix.as_ref().map(|(prefix, spp)| match &merged {
+                Some(earlier) => {
+                    let mut sum = earlier.accumulator.clone();
+                    sum.merge(prefix);
+                    (sum, earlier.spp_done + spp)
+                }
+                None => (prefix.clone(), *spp),
+            });
+        }
+        match &mut merged {
+            None => merged = Some(part),
+            Some(merged) => {
+                merged.accumulator.merge(&part.accumulator);
+                merged.metadata.render_seconds += part.metadata.render_seconds;
+                merged.spp_done += part.spp_done;
+            }
+        }
+    }
+    let mut merged = merged.expect("at least one part (checked)");
+    merged.spp_done = spp_done;
+    merged.aligned_prefix = aligned_prefix;
+    let accumulator = &merged.accumulator;
+    let union_end = u64::from(merged.sample_start) + u64::from(spp_done);
+    for (key, value) in [
+        (crate::metadata::SAMPLE_END, union_end.to_string()),
+        ("spp", spp_done.to_string()),
+        ("estimated_relative_error", accumulator.estimated_relative_error().to_string()),
+        ("dropped_samples", accumulator.dropped_samples().to_string()),
+        ("stopped_by", "spp".to_owned()),
+        ("source", "merge example".to_owned()),
+    ] {
+        match merged.metadata.fields.iter_mut().find(|(k, _)| k == key) {
+            Some(field) => field.1 = value,
+            None => merged.metadata.fields.push((key.to_owned(), value)),
+        }
+    }
+    Ok(merged)
+}
+
+/// Combines partial renders of the same scene and settings (files from `render --sample-range`)
+/// into one, all already in memory: see [`merge_checkpoint_files`], which reads them one at a
+/// time, for what is refused and how they are added.
+pub fn merge_checkpoints(inputs: Vec<(PathBuf, Checkpoint)>) -> Result<Checkpoint, CheckpointError> {
+    let mut parts: Vec<_> = inputs.into_iter().map(|(path, c)| (path, c.header(), c)).collect();
+    let spp_done = check_mergeable(&mut parts)?;
+    fold_parts(parts.into_iter().map(|(_, _, c)| Ok(c)), spp_done)
+}
+
+/// Merges the partial renders in `paths` into one, holding one part and the running total in
+/// memory, never all parts (256 parts of a 1024 x 1024 render are 14 GB of statistics). First
+/// every file's headers are read and checked together ([`check_mergeable`]: nothing is read in
+/// full if, say, the last file is of another scene); then the files are read and added in
+/// sample order, each checked whole ([`load_checkpoint`]) and against what its header said.
+/// `on_part` is called with each file as it is added (progress for a long merge).
+pub fn merge_checkpoint_files(
+    paths: &[PathBuf],
+    mut on_part: impl FnMut(&Path, &CheckpointHeader),
+) -> Result<Checkpoint, CheckpointError> {
+    let mut parts = Vec::with_capacity(paths.len());
+    for path in paths {
+        parts.push((path.clone(), load_checkpoint_header(path)?, ()));
+    }
+    let spp_done = check_mergeable(&mut parts)?;
+    let loaded = parts.into_iter().map(|(path, header, ())| {
+        let part = load_checkpoint(&path)?;
+        if part.header() != header {
+            return Err(CheckpointError::Changed { path });
+        }
+        on_part(&path, &header);
+        Ok(part)
+    });
+    fold_parts(loaded, spp_done)
+}

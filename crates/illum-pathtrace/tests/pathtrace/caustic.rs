@@ -1,0 +1,207 @@
+//! The caustic's light tracer on the GPU (`crates/illum-pathtrace/shaders/caustic.wgsl`, folded by
+//! `tracer/caustic.rs`):
+//! - a glass ball of index 1 is invisible, so with the light tracer its shadow holds exactly the
+//!   plain direct light (and the sky) of the floor: a closed form for every pixel, against
+//!   which the error estimate of the two estimators together is checked as well;
+//! - per-pixel Z-test against the f64 oracle on a view of the Whitted scene's caustic, with a
+//!   delta sun at bounces 3 and 8 and a sun disc;
+//! - batching does not change the image; extremes stay finite; a very bright sun scales.
+
+use glam::DVec3;
+use illum_image::{RgbImage32, rel_mse, z_test_pass_fraction};
+use illum_pathtrace::PathTracer;
+use illum_scene::Scene;
+
+use crate::common;
+use crate::oracle_agreement::{compare_scene, compare_scene_with, scene as shipped};
+
+const TOP_VIEW: &str = "eye = [0.0, 5.0, 0.0]\ntarget = [0.0, 0.0, 0.0]\nup = [0.0, 0.0, 1.0]\nvfov = 40.0";
+
+/// A grey floor seen from above, a ball of `material` of radius 1 at (3, 3, 0) outside the view,
+/// a sun along `sun` of irradiance `irradiance`, `extra` sections (a sky), with the caustic on.
+fn ball_scene(material: &str, sun: &str, irradiance: f32, extra: &str, bounces: &str) -> Scene {
+    let text = format!(
+        "[camera]\n{TOP_VIEW}\nwidth = 48\nheight = 32\n[pathtrace]\nbounces = {bounces}\ncaustics = true\n\
+         seed = 5\nsampling = \"uniform\"\n{extra}\n\
+         [directional_light]\n{sun}\nirradiance = [{irradiance:?}, {irradiance:?}, {irradiance:?}]\n\
+         [materials.floor]\nalbedo = [0.6, 0.6, 0.6]\n[materials.ball]\n{material}\n\
+         [[objects]]\nmaterial = \"floor\"\n\
+         quad = {{ corner = [-50.0, 0.0, -50.0], edge_u = [0.0, 0.0, 100.0], edge_v = [100.0, 0.0, 0.0] }}\n\
+         [[objects]]\nmaterial = \"ball\"\nsphere = {{ center = [3.0, 3.0, 0.0], radius = 1.0 }}\n"
+    );
+    Scene::from_toml_str(&text, "caustic.toml").unwrap_or_else(|e| panic!("{e}\n{text}"))
+}
+
+const SKY: &str = "[environment]\nradiance = [0.3, 0.5, 0.9]";
+
+#[test]
+fn an_index_1_ball_vanishes_and_the_error_estimate_of_both_estimators_is_honest() {
+    // Sun from 45 degrees: the ball's shadow is an ellipse about the origin, 22% of the view,
+    // lit only by the light tracer's particles; the sky, sampled by uniform bounces, adds
+    // noise of the camera paths everywhere. The truth is the same in every pixel:
+    // rho (E cos 45 / pi + sky).
+    let scene = ball_scene("dielectric = { ior = 1.0 }", "direction = [-1.0, -1.0, 0.0]", 3.0, SKY, "3");
+    let sky = [0.3f32, 0.5, 0.9];
+    let truth: [f64; 3] = std::array::from_fn(|c| {
+        0.6f32 as f64 * (3.0 / std::f64::consts::PI * 0.5f64.sqrt() + f64::from(sky[c]))
+    });
+    let mut reference = RgbImage32::new(48, 32);
+    for p in &mut reference.pixels {
+        *p = truth.map(|v| v as f32);
+    }
+    let mut tracer = PathTracer::new(common::gpu(), &scene).expect("builds");
+    assert!(tracer.caustics(), "the light tracer runs");
+    let mut done = 0;
+    for spp in [16, 64, 256] {
+        tracer.add_samples_in_one_pass(spp - done).expect("renders");
+        done = spp;
+        let acc = tracer.accumulator();
+        let estimated = acc.estimated_rel_mse();
+        let measured = rel_mse(&acc.mean_image(), &reference).expect("same size");
+        let ratio = estimated / measured;
+        println!("{spp} spp: estimated relMSE {estimated:.3e}, measured {measured:.3e}, ratio {ratio:.3}");
+        assert!((1.0 / 1.5..=1.5).contains(&ratio), "{spp} spp: ratio {ratio:.3} of estimated to true error");
+    }
+    let acc = tracer.accumulator();
+    assert_eq!(acc.dropped_samples(), 0);
+    // Per pixel against the closed form (Sidak over 3 N tests at alpha = 0.01; the reference
+    // has no variance).
+    let zero = RgbImage32::new(48, 32);
+    let per_test = 1.0 - (1.0 - 0.01f64).powf(1.0 / (3.0 * 48.0 * 32.0));
+    let pass =
+        z_test_pass_fraction(&acc.mean_image(), &acc.variance_image(), &reference, &zero, 3.0 * per_test)
+            .expect("same size");
+    println!("{pass:.4} of pixels agree with the closed form");
+    assert!(pass >= 0.99, "only {pass:.4} of pixels agree with rho (E cos / pi + sky)");
+    // The shadow's pixels: the ellipse (x sin 45)^2 + z^2 < 1, well inside.
+    let mut shadow = Vec::new();
+    for y in 0..32u32 {
+        for x in 0..48u32 {
+            let t = 20f64.to_radians().tan();
+            let sx = (2.0 * (f64::from(x) + 0.5) / 48.0 - 1.0) * 1.5 * t;
+            let sy = (1.0 - 2.0 * (f64::from(y) + 0.5) / 32.0) * t;
+            let p = DVec3::new(-5.0 * sx, 0.0, 5.0 * sy);
+            if (p.x * 0.5f64.sqrt()).powi(2) + p.z.powi(2) < 0.5 {
+                shadow.push((y * 48 + x) as usize);
+            }
+        }
+    }
+    let n = shadow.len() as f64;
+    let mean = shadow.iter().map(|&p| acc.pixel_mean(p)[0]).sum::<f64>() / n;
+    let sd = shadow.iter().map(|&p| acc.pixel_variance_of_mean(p)[0]).sum::<f64>().sqrt() / n;
+    println!("shadow ({n} pixels): {mean:.5} +- {sd:.5}, truth {:.5}", truth[0]);
+    assert!(
+        (mean - truth[0]).abs() < 4.0 * sd && sd < 0.005 * truth[0],
+        "shadow {mean} +- {sd} vs {}",
+        truth[0]
+    );
+
+    // Without the light tracer the shadow lacks the sun entirely.
+    let mut off = scene.clone();
+    off.pathtrace.caustics = false;
+    let mut tracer = PathTracer::new(common::gpu(), &off).expect("builds");
+    assert!(!tracer.caustics());
+    tracer.add_samples_in_one_pass(16).expect("renders");
+    let dark = shadow.iter().map(|&p| tracer.accumulator().pixel_mean(p)[0]).sum::<f64>() / n;
+    assert!(dark < 0.5 * truth[0], "without the caustic the shadow is {dark}, truth {}", truth[0]);
+}
+
+/// The Whitted scene at the oracle tests' size, with the camera on the floor under the glass
+/// ball: the caustic (about (2.2, 0, -3.8), the glass ball's shadow) and the mirror ball's.
+fn caustic_view(bounces: u32) -> Scene {
+    let mut s = shipped("whitted", bounces);
+    assert!(s.pathtrace.caustics, "scenes/whitted.toml turns the caustic on");
+    s.camera.eye = glam::Vec3::new(2.2, 6.0, -7.5);
+    s.camera.target = glam::Vec3::new(2.2, 0.0, -3.8);
+    s.camera.vfov_deg = 40.0;
+    s
+}
+
+#[test]
+fn the_caustic_agrees_with_the_oracle_at_bounces_3_and_8() {
+    for bounces in [3, 8] {
+        compare_scene(&format!("whitted caustic view, bounces {bounces}"), &caustic_view(bounces));
+    }
+}
+
+#[test]
+fn the_caustic_of_a_sun_disc_agrees_with_the_oracle() {
+    // With a sun of radius 5 degrees the camera paths E D S+ L are left to the light tracer
+    // (both renderers), and the caustic is softer. Next-event estimation toward the disc adds
+    // noise: four times the samples keep the test's power (a 2% bias fails it).
+    let mut s = caustic_view(3);
+    s.pathtrace.spp *= 4;
+    if let Some(sun) = &mut s.directional_light {
+        sun.angular_radius_deg = 5.0;
+    }
+    compare_scene_with("whitted caustic view, sun of radius 5 degrees, bounces 3", &s, 4 * 4096);
+}
+
+#[test]
+fn batching_does_not_change_the_image_bit_for_bit() {
+    let scene = caustic_view(8);
+    let mut one = PathTracer::new(common::gpu(), &scene).expect("builds");
+    one.add_samples_in_one_pass(32).expect("renders");
+    let mut two = PathTracer::new(common::gpu(), &scene).expect("builds");
+    two.add_samples_in_one_pass(16).expect("renders");
+    two.add_samples_in_one_pass(16).expect("renders");
+    let (a, b) = (one.accumulator().state(), two.accumulator().state());
+    assert!(a.sum.iter().flatten().any(|&v| v > 0.0));
+    assert_eq!(a.sum, b.sum);
+    assert_eq!(a.sum_sq, b.sum_sq);
+    assert_eq!(a.count, b.count);
+}
+
+#[test]
+fn a_very_bright_sun_scales_the_image_and_nothing_overflows() {
+    // The fixed point follows the sun: 1e30 gives the image of irradiance 3 times 1e30 / 3
+    // (no pixel's 64-bit sum overflows, no particle is dropped).
+    let dim = ball_scene("dielectric = { ior = 1.5 }", "direction = [-1.0, -1.0, 0.0]", 3.0, "", "8");
+    let bright = ball_scene("dielectric = { ior = 1.5 }", "direction = [-1.0, -1.0, 0.0]", 1e30, "", "8");
+    let a = common::render(&Scene {
+        pathtrace: illum_scene::PathTraceSettings { spp: 16, ..dim.pathtrace },
+        ..dim
+    });
+    let b = common::render(&Scene {
+        pathtrace: illum_scene::PathTraceSettings { spp: 16, ..bright.pathtrace },
+        ..bright
+    });
+    let (a, b) = (a.accumulator(), b.accumulator());
+    assert_eq!((a.dropped_samples(), b.dropped_samples()), (0, 0));
+    let ratio = 1e30f32 as f64 / 3.0;
+    let mut caustic_pixels = 0;
+    for p in 0..(48 * 32) {
+        let (x, y) = (a.pixel_mean(p)[1], b.pixel_mean(p)[1]);
+        assert!(y.is_finite() && b.pixel_variance_of_mean(p)[1].is_finite(), "pixel {p}: {y}");
+        if x > 0.0 {
+            caustic_pixels += 1;
+            assert!((y / x / ratio - 1.0).abs() < 1e-5, "pixel {p}: {y} vs {x} x {ratio}");
+        }
+    }
+    assert!(caustic_pixels > 100, "{caustic_pixels} pixels lit");
+}
+
+#[test]
+fn extremes_stay_finite_with_nothing_dropped() {
+    for (material, sun) in illum_oracle::caustic::EXTREME_CASES {
+        for bounces in ["8", "\"unbounded\""] {
+            let mut s = ball_scene(material, sun, 3.0, SKY, bounces);
+            s.pathtrace.spp = 8;
+            let tracer = common::render(&s);
+            let acc = tracer.accumulator();
+            assert_eq!(acc.dropped_samples(), 0, "{material}, {sun}, bounces {bounces}");
+            common::assert_all_finite(&acc.mean_image(), &format!("{material}, {sun}"));
+            common::assert_all_finite(&acc.variance_image(), &format!("{material}, {sun}"));
+        }
+    }
+}
+
+#[test]
+fn the_cornell_box_and_a_scene_without_the_setting_have_no_light_tracer() {
+    let mut cornell = common::scene("cornell", common::small(16, 16, 1));
+    cornell.pathtrace.caustics = true;
+    assert!(!PathTracer::new(common::gpu(), &cornell).expect("builds").caustics(), "no sun, no specular");
+    let mut whitted = shipped("whitted", 8);
+    whitted.pathtrace.caustics = false;
+    assert!(!PathTracer::new(common::gpu(), &whitted).expect("builds").caustics());
+}
