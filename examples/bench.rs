@@ -27,7 +27,7 @@ use std::path::PathBuf;
 
 use clap::Parser;
 use illum::image::median;
-use illum::pathtrace::{PathTracer, TracerOptions, Traversal};
+use illum::pathtrace::{PathTracer, Readback, TracerOptions, Traversal};
 use illum::raster::RasterScene;
 use illum::raster::{Look, Motion, Options, bench_frames};
 use illum::scene::{Bounces, Scene};
@@ -49,7 +49,7 @@ struct Args {
     /// Only the 1024 x 1024 rows (the wall-against-GPU-clock figures), without the rasterizer.
     #[arg(long)]
     large: bool,
-    /// With --large: each row also read back through a staging copy (see `PathTracer::set_mapped_readback`).
+    /// With --large: each row also read back through a staging copy (see `PathTracer::set_readback`).
     #[arg(long, requires = "large")]
     compare_readback: bool,
     /// Only the viewer's row: its path tracer's samples/s in a real window under xvfb-run,
@@ -129,8 +129,8 @@ fn run(args: Args) -> anyhow::Result<()> {
         let scene: Scene = illum_cli::load_scene(&args.scene, &settings)?;
         let options = TracerOptions { traversal: config.traversal, ..Default::default() };
         let mut tracer = PathTracer::with_options(&gpu, &scene, options)?;
-        tracer.set_mapped_readback(!config.staging_copy);
-        let readback = if tracer.mapped_readback() { "mapped" } else { "staging copy" };
+        tracer.set_readback(if config.staging_copy { Readback::Staging } else { Readback::Mapped });
+        let readback = if tracer.readback() == Readback::Mapped { "mapped" } else { "staging copy" };
         // Warm-up, an untimed run of the row up to 16 spp: compiles the pipeline on the driver,
         // teaches the planner the cost, and grows the batch buffers to the bands the timed runs
         // use (a first band into freshly allocated buffers pays their page faults). 16 spp do

@@ -1,5 +1,7 @@
 //! Renders a scene file to PNG and/or EXR.
 //!
+//! Over 450 lines: the one command a user runs, from its flags to its files, for all three renderers.
+//!
 //! ```text
 //! cargo run --release --example render -- [SCENE] [--spp N] [--bounces B|unbounded] [--seed S]
 //!     [--width W --height H] [--sampling cosine|uniform] [-o FILE.png|FILE.exr]...

@@ -8,7 +8,7 @@
 
 use glam::DVec3;
 
-use crate::scene::dvec;
+use crate::geometry::dvec;
 
 #[derive(Clone, Copy, Debug)]
 pub struct PinholeCamera {

@@ -55,10 +55,10 @@ use illum_scene::{Bounces, MaterialKind};
 
 use crate::geometry::Surface;
 use crate::integrator::{Contact, Oracle, ROULETTE_AFTER, ROULETTE_MAX_SURVIVAL};
+use crate::optics::{reflect, scatter_dielectric};
 use crate::rng::Rng;
 use crate::sampling::{local_to_world, uniform_cone};
 use crate::scene::Primitive;
-use crate::whitted::{reflect, scatter_dielectric};
 
 /// Key mixed into the particles' seed so that particle i of frame k never shares its random
 /// numbers with sample k of pixel i.

@@ -5,7 +5,12 @@
 //! front normal for parallelograms). Orientation toward the ray is the integrator's business.
 //! A ray starting inside a box or a sphere hits its inner surface on the way out.
 
-use glam::{DMat3, DVec3};
+use glam::{DMat3, DVec3, Vec3};
+
+/// A scene's f32 vector in the oracle's f64 (exact: every f32 is an f64).
+pub(crate) fn dvec(v: Vec3) -> DVec3 {
+    v.as_dvec3()
+}
 
 /// A ray-surface intersection: distance along the ray (in units of |d|) and geometric normal.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -126,9 +131,9 @@ impl Ball {
 impl OrientedBox {
     pub fn from_shape(shape: &illum_scene::BoxShape) -> OrientedBox {
         let rotation = DMat3::from_rotation_y(f64::from(shape.rotate_y_deg).to_radians());
-        let pivot = crate::scene::dvec(shape.pivot);
-        let offset = pivot + crate::scene::dvec(shape.translate) - rotation * pivot;
-        OrientedBox { lo: crate::scene::dvec(shape.min), hi: crate::scene::dvec(shape.max), rotation, offset }
+        let pivot = dvec(shape.pivot);
+        let offset = pivot + dvec(shape.translate) - rotation * pivot;
+        OrientedBox { lo: dvec(shape.min), hi: dvec(shape.max), rotation, offset }
     }
 
     /// The box is the intersection of three slabs lo_i <= x_i <= hi_i in its local frame. The
@@ -249,7 +254,7 @@ mod tests {
             b.rotation * DVec3::new(pick(0), pick(1), pick(2)) + b.offset
         });
         for (ours, theirs) in corners.iter().zip(shape.world_corners()) {
-            assert!(close(*ours, crate::scene::dvec(theirs), 1e-3), "{ours:?} vs {theirs:?}");
+            assert!(close(*ours, dvec(theirs), 1e-3), "{ours:?} vs {theirs:?}");
         }
         // docs/scenes.md: the footprint corner with local (165, 0, 0) lands at (424.4, 0, 252.3).
         assert!(close(corners[1], DVec3::new(424.4, 0.0, 252.3), 0.06), "{:?}", corners[1]);

@@ -24,10 +24,10 @@ use illum_scene::{Bounces, MaterialKind, Sampling, Scene};
 
 use crate::camera::PinholeCamera;
 use crate::geometry::Surface;
+use crate::optics::{reflect, scatter_dielectric};
 use crate::rng::Rng;
 use crate::sampling::{cosine_hemisphere, local_to_world, uniform_cone, uniform_hemisphere};
 use crate::scene::{Primitive, TraceScene};
-use crate::whitted::{reflect, scatter_dielectric};
 
 /// Relative distance by which an emitter may lie behind the nearest other surface and still
 /// be the one that is hit: lights set into a coplanar ceiling win the tie.
@@ -80,7 +80,7 @@ impl Hit<'_> {
     pub(crate) fn diffuse_albedo(&self, point: DVec3) -> DVec3 {
         match (self.primitive.material, self.primitive.surface) {
             (MaterialKind::Checker(c), Surface::Parallelogram(quad)) => {
-                crate::whitted::checker_albedo(&quad, c, point)
+                crate::optics::checker_albedo(&quad, c, point)
             }
             _ => self.primitive.albedo,
         }

@@ -48,6 +48,8 @@ pub mod chi_square;
 pub mod closed_form;
 pub mod geometry;
 mod integrator;
+pub mod optics;
+mod parallel;
 mod render;
 mod rng;
 mod sampling;

@@ -1,10 +1,10 @@
 //! The scene in the form the oracle traces: f64 shapes, each with its material, the list of
 //! emitting parallelograms for light sampling, the directional light and the sky.
 
-use glam::{DVec3, Vec3};
+use glam::DVec3;
 use illum_scene::{Feature, MaterialKind, Scene, SceneError, Shape};
 
-use crate::geometry::{Ball, OrientedBox, Parallelogram, Surface};
+use crate::geometry::{Ball, OrientedBox, Parallelogram, Surface, dvec};
 
 /// What the oracle implements: every feature of the scene model, written independently of the
 /// GPU path tracer (it shares no code with the WGSL).
@@ -22,10 +22,6 @@ pub fn implements(feature: Feature) -> bool {
         | Feature::SunDisc
         | Feature::Environment => true,
     }
-}
-
-pub(crate) fn dvec(v: Vec3) -> DVec3 {
-    v.as_dvec3()
 }
 
 /// One object: its surface and its material (`albedo` is the Lambertian albedo, zero for every

@@ -45,4 +45,4 @@ pub use shaders::{
     CAUSTIC_SHADER, GENERIC_LIGHT_CHOICE, GENERIC_MATERIALS, GENERIC_TRAVERSAL, PATHTRACE_SHADER,
     SAMPLING_MODULES, SCENE_MODULE, SURFACES_MODULE, shader_modules,
 };
-pub use tracer::{CausticParams, PathTracer, StepReport, bounding_sphere, fixed_point};
+pub use tracer::{CausticParams, PathTracer, Readback, StepReport, bounding_sphere, fixed_point};

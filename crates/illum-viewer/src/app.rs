@@ -6,9 +6,7 @@
 //!
 //! Over 450 lines: the mode switch, the file opening and the layout all act on one `ViewerApp`.
 
-use std::fmt;
 use std::path::{Path, PathBuf};
-use std::str::FromStr;
 
 use illum_gpu::GpuContext;
 use illum_scene::RendererKind;
@@ -24,61 +22,18 @@ const COMPACT_BELOW_POINTS: f32 = 520.0;
 use crate::screenshot::ScreenshotJob;
 use crate::whitted_panel::WhittedMode;
 
-/// Which renderer the window shows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Mode {
-    Raster,
-    PathTrace,
-    Whitted,
-}
-
-/// A mode is named like the renderer it shows (`--mode raster|pathtrace|whitted`).
-impl From<Mode> for RendererKind {
-    fn from(mode: Mode) -> Self {
-        match mode {
-            Mode::Raster => RendererKind::Raster,
-            Mode::PathTrace => RendererKind::PathTrace,
-            Mode::Whitted => RendererKind::Whitted,
-        }
-    }
-}
-
-impl From<RendererKind> for Mode {
-    fn from(kind: RendererKind) -> Self {
-        match kind {
-            RendererKind::Raster => Mode::Raster,
-            RendererKind::PathTrace => Mode::PathTrace,
-            RendererKind::Whitted => Mode::Whitted,
-        }
-    }
-}
-
-impl FromStr for Mode {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        s.parse::<RendererKind>().map(Mode::from).map_err(|e| format!("unknown mode {s:?}: {}", e.allowed))
-    }
-}
-
-impl fmt::Display for Mode {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(RendererKind::from(*self).as_str())
-    }
-}
-
 /// How the window starts.
 pub struct StartOptions {
     /// A scene file of either kind; it opens in its own mode.
     pub scene: PathBuf,
     /// The mode shown first (default: the scene's).
-    pub mode: Option<Mode>,
+    pub mode: Option<RendererKind>,
     pub screenshot: Option<ScreenshotJob>,
 }
 
 /// The viewer.
 pub struct ViewerApp {
-    mode: Mode,
+    mode: RendererKind,
     /// eframe's device wrapped for the renderers, or why there is none.
     gpu: Result<(GpuContext, egui_wgpu::RenderState), String>,
     /// Each mode, or why its scene could not be loaded.
@@ -94,7 +49,7 @@ pub struct ViewerApp {
     /// The last open attempt's error (the current scenes stay).
     pub open_error: Option<String>,
     /// The scene file opened last and, for each mode that cannot render it, why.
-    refused: Option<(PathBuf, Vec<(Mode, String)>)>,
+    refused: Option<(PathBuf, Vec<(RendererKind, String)>)>,
     screenshot: Option<ScreenshotJob>,
     /// How often the window repaints (shown in the top bar, printed after a screenshot run).
     frame_rate: FrameRate,
@@ -103,7 +58,7 @@ pub struct ViewerApp {
     view_rect: Option<[u32; 4]>,
     /// The browser's file picker ("Open file..."), which delivers a file a few frames later.
     #[cfg(target_arch = "wasm32")]
-    picker: crate::web::FilePicker,
+    picker: crate::browser::FilePicker,
 }
 
 impl ViewerApp {
@@ -115,7 +70,7 @@ impl ViewerApp {
                 // Browsers do not tell WebGPU's adapter name to wgpu; the page asked for it.
                 #[cfg(target_arch = "wasm32")]
                 if info.name.is_empty() {
-                    info.name = crate::web::adapter_description();
+                    info.name = crate::browser::adapter_description();
                 }
                 let gpu = GpuContext::from_device(rs.device.clone(), rs.queue.clone(), info);
                 log::info!("viewer adapter: {} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend);
@@ -124,7 +79,7 @@ impl ViewerApp {
             None => Err("eframe started without its wgpu renderer; the viewer needs wgpu".to_owned()),
         };
         let mut app = ViewerApp {
-            mode: Mode::PathTrace,
+            mode: RendererKind::PathTrace,
             gpu,
             pathtrace: Err("no path-tracer scene loaded".to_owned()),
             raster: Err("no raster scene loaded".to_owned()),
@@ -138,7 +93,7 @@ impl ViewerApp {
             frame_rate: FrameRate::default(),
             view_rect: None,
             #[cfg(target_arch = "wasm32")]
-            picker: crate::web::FilePicker::default(),
+            picker: crate::browser::FilePicker::default(),
         };
         // Each mode starts on its default scene; the given file then replaces its mode's.
         app.pathtrace = load_pathtrace(Path::new(DEFAULT_PATHTRACE_SCENE));
@@ -167,26 +122,28 @@ impl ViewerApp {
     }
 
     /// The scene file of `mode`, as it was given.
-    fn scene_path_of(&self, mode: Mode) -> Option<String> {
+    fn scene_path_of(&self, mode: RendererKind) -> Option<String> {
         match mode {
-            Mode::Raster => self.raster.as_ref().ok().map(|m| m.scene_path().display().to_string()),
-            Mode::PathTrace => self.pathtrace.as_ref().ok().map(|m| m.scene_path().display().to_string()),
-            Mode::Whitted => self.whitted.as_ref().ok().map(|m| m.scene_path().display().to_string()),
+            RendererKind::Raster => self.raster.as_ref().ok().map(|m| m.scene_path().display().to_string()),
+            RendererKind::PathTrace => {
+                self.pathtrace.as_ref().ok().map(|m| m.scene_path().display().to_string())
+            }
+            RendererKind::Whitted => self.whitted.as_ref().ok().map(|m| m.scene_path().display().to_string()),
         }
     }
 
     /// The orbit camera of `mode`, when it has a scene.
-    fn camera_of(&mut self, mode: Mode) -> Option<&mut OrbitCamera> {
+    fn camera_of(&mut self, mode: RendererKind) -> Option<&mut OrbitCamera> {
         match mode {
-            Mode::Raster => self.raster.as_mut().ok().map(|m| &mut m.camera),
-            Mode::PathTrace => self.pathtrace.as_mut().ok().map(|m| &mut m.camera),
-            Mode::Whitted => self.whitted.as_mut().ok().map(|m| &mut m.camera),
+            RendererKind::Raster => self.raster.as_mut().ok().map(|m| &mut m.camera),
+            RendererKind::PathTrace => self.pathtrace.as_mut().ok().map(|m| &mut m.camera),
+            RendererKind::Whitted => self.whitted.as_mut().ok().map(|m| &mut m.camera),
         }
     }
 
     /// Gives the mode now shown the camera of `from` if both show the same scene file (the
     /// renderer then draws the same view; each one redraws when its camera changes).
-    fn carry_camera(&mut self, from: Mode) {
+    fn carry_camera(&mut self, from: RendererKind) {
         let same_scene =
             self.scene_path_of(from).is_some() && self.scene_path_of(from) == self.current_scene_path();
         let Some(camera) = self.camera_of(from).copied() else { return };
@@ -197,7 +154,7 @@ impl ViewerApp {
 
     /// Switches to `mode` as the top bar's buttons do (the camera follows, see
     /// `carry_camera`).
-    pub fn switch_to(&mut self, mode: Mode) {
+    pub fn switch_to(&mut self, mode: RendererKind) {
         let before = std::mem::replace(&mut self.mode, mode);
         if mode != before {
             self.carry_camera(before);
@@ -217,7 +174,7 @@ impl ViewerApp {
         self.whitted.as_mut().ok()
     }
 
-    pub fn mode(&self) -> Mode {
+    pub fn mode(&self) -> RendererKind {
         self.mode
     }
 
@@ -236,7 +193,7 @@ impl ViewerApp {
     /// Opens a scene file in every mode that can render it and returns the mode to show (the
     /// file's `renderer`, when it can). A mode that cannot render it keeps its scene. On error
     /// nothing changes and the loader's message is returned.
-    pub fn open(&mut self, path: &Path) -> Result<Mode, String> {
+    pub fn open(&mut self, path: &Path) -> Result<RendererKind, String> {
         // The path as given names the scene in the UI and in saved metadata.
         let loaded = scene_file::load(path)?;
         Ok(self.install(path.to_path_buf(), loaded))
@@ -244,7 +201,7 @@ impl ViewerApp {
 
     /// As [`Self::open`], for the text of a file dropped on the window or picked in the
     /// browser; `name` (its file name) names it in errors and in the UI.
-    pub fn open_text(&mut self, name: &str, text: &str) -> Result<Mode, String> {
+    pub fn open_text(&mut self, name: &str, text: &str) -> Result<RendererKind, String> {
         let loaded = scene_file::load_text(name, text)?;
         Ok(self.install(PathBuf::from(name), loaded))
     }
@@ -263,7 +220,7 @@ impl ViewerApp {
     }
 
     /// Shows the outcome of opening a scene from the UI: its mode and name, or the error.
-    fn opened(&mut self, result: Result<Mode, String>) {
+    fn opened(&mut self, result: Result<RendererKind, String>) {
         match result {
             Ok(mode) => {
                 self.mode = mode;
@@ -279,7 +236,7 @@ impl ViewerApp {
     /// Puts a loaded scene into every mode that can render it; returns the mode to show.
     /// The modes that cannot render it keep their scene, and their reasons are kept for the
     /// top bar ([`Self::refusal_of`]).
-    fn install(&mut self, given: PathBuf, loaded: scene_file::LoadedScene) -> Mode {
+    fn install(&mut self, given: PathBuf, loaded: scene_file::LoadedScene) -> RendererKind {
         let mode = loaded.mode();
         let mut refusals = Vec::new();
         match loaded.pathtrace {
@@ -287,21 +244,21 @@ impl ViewerApp {
                 Ok(mode) => mode.set_scene(given.clone(), scene),
                 Err(_) => self.pathtrace = Ok(PathTraceMode::new(given.clone(), scene)),
             },
-            Err(reason) => refusals.push((Mode::PathTrace, reason)),
+            Err(reason) => refusals.push((RendererKind::PathTrace, reason)),
         }
         match loaded.raster {
             Ok(scene) => match &mut self.raster {
                 Ok(mode) => mode.set_scene(given.clone(), scene),
                 Err(_) => self.raster = Ok(RasterMode::new(given.clone(), scene)),
             },
-            Err(reason) => refusals.push((Mode::Raster, reason)),
+            Err(reason) => refusals.push((RendererKind::Raster, reason)),
         }
         match loaded.whitted {
             Ok(scene) => match &mut self.whitted {
                 Ok(mode) => mode.set_scene(given.clone(), scene),
                 Err(_) => self.whitted = Ok(WhittedMode::new(given.clone(), scene)),
             },
-            Err(reason) => refusals.push((Mode::Whitted, reason)),
+            Err(reason) => refusals.push((RendererKind::Whitted, reason)),
         }
         self.refused = (!refusals.is_empty()).then_some((given, refusals));
         mode
@@ -360,14 +317,14 @@ impl ViewerApp {
     /// `--screenshot` run prints them on exit (the smoke test and `bench --viewer` read it).
     pub fn summary(&self) -> String {
         let mode = match self.mode {
-            Mode::PathTrace => self.pathtrace().map(PathTraceMode::summary),
-            Mode::Raster => self.raster().map(|r| {
+            RendererKind::PathTrace => self.pathtrace().map(PathTraceMode::summary),
+            RendererKind::Raster => self.raster().map(|r| {
                 let gpu = r
                     .pass_times()
                     .map_or("n/a".to_owned(), |t| format!("{:.2} ms", t.shadow_ms + t.cube_ms + t.main_ms));
                 format!("raster: GPU time per frame {gpu}")
             }),
-            Mode::Whitted => self.whitted().map(|w| {
+            RendererKind::Whitted => self.whitted().map(|w| {
                 let ms = w.frame_ms.map_or("n/a".to_owned(), |ms| format!("{ms:.1} ms"));
                 format!("whitted: {} frames rendered, last frame {ms}", w.frames)
             }),
@@ -390,8 +347,11 @@ impl ViewerApp {
                 }
             }
             let mut chosen = self.mode;
-            let modes =
-                [(Mode::Raster, "Raster"), (Mode::PathTrace, "Path tracer"), (Mode::Whitted, "Whitted")];
+            let modes = [
+                (RendererKind::Raster, "Raster"),
+                (RendererKind::PathTrace, "Path tracer"),
+                (RendererKind::Whitted, "Whitted"),
+            ];
             if compact {
                 let shown = modes.iter().find(|(m, _)| *m == chosen).map_or("", |(_, name)| name);
                 egui::ComboBox::from_id_salt("mode").selected_text(shown).show_ui(ui, |ui| {
@@ -457,7 +417,7 @@ impl ViewerApp {
 
     /// Why the mode shown is not showing the scene file opened last (it keeps its own scene),
     /// as a sentence for the top bar.
-    pub fn refusal_of(&self, mode: Mode) -> Option<String> {
+    pub fn refusal_of(&self, mode: RendererKind) -> Option<String> {
         let (opened, refusals) = self.refused.as_ref()?;
         let (_, reason) = refusals.iter().find(|(m, _)| *m == mode)?;
         let showing = self.scene_path_of(mode).map_or(String::new(), |p| format!("; showing {p}"));
@@ -470,9 +430,9 @@ impl ViewerApp {
     fn side_panel(&mut self, ui: &mut egui::Ui) {
         egui::ScrollArea::vertical().show(ui, |ui| {
             let result = match self.mode {
-                Mode::Raster => self.raster.as_mut().map(|m| m.panel(ui)),
-                Mode::PathTrace => self.pathtrace.as_mut().map(|m| m.panel(ui)),
-                Mode::Whitted => self.whitted.as_mut().map(|m| m.panel(ui)),
+                RendererKind::Raster => self.raster.as_mut().map(|m| m.panel(ui)),
+                RendererKind::PathTrace => self.pathtrace.as_mut().map(|m| m.panel(ui)),
+                RendererKind::Whitted => self.whitted.as_mut().map(|m| m.panel(ui)),
             };
             if let Err(error) = result {
                 ui.colored_label(ui.visuals().error_fg_color, error.as_str());
@@ -495,12 +455,16 @@ impl ViewerApp {
         let view_pixels =
             [(size.x * pixels_per_point).round() as u32, (size.y * pixels_per_point).round() as u32];
         let texture = match self.mode {
-            Mode::Raster => self.raster.as_mut().ok().and_then(|m| m.frame(gpu, render_state, view_pixels)),
-            Mode::PathTrace => self.pathtrace.as_mut().ok().and_then(|m| {
+            RendererKind::Raster => {
+                self.raster.as_mut().ok().and_then(|m| m.frame(gpu, render_state, view_pixels))
+            }
+            RendererKind::PathTrace => self.pathtrace.as_mut().ok().and_then(|m| {
                 m.frame(gpu, render_state, view_pixels);
                 m.texture()
             }),
-            Mode::Whitted => self.whitted.as_mut().ok().and_then(|m| m.frame(gpu, ui.ctx(), view_pixels)),
+            RendererKind::Whitted => {
+                self.whitted.as_mut().ok().and_then(|m| m.frame(gpu, ui.ctx(), view_pixels))
+            }
         };
         let sense = egui::Sense::click_and_drag();
         let response = match texture {
@@ -520,11 +484,11 @@ impl ViewerApp {
         // The raster redraws every frame (it is a real-time renderer and its frame rate is
         // measured); the path tracer while it still has samples to take; Whitted on a change.
         let busy = match self.mode {
-            Mode::Raster => self.raster.is_ok(),
-            Mode::PathTrace => self.pathtrace.as_ref().is_ok_and(PathTraceMode::is_rendering),
+            RendererKind::Raster => self.raster.is_ok(),
+            RendererKind::PathTrace => self.pathtrace.as_ref().is_ok_and(PathTraceMode::is_rendering),
             // Whitted redraws only when the view changes (handled above), and while its
             // frame is being read back (in the browser).
-            Mode::Whitted => self.whitted.as_ref().is_ok_and(WhittedMode::is_busy),
+            RendererKind::Whitted => self.whitted.as_ref().is_ok_and(WhittedMode::is_busy),
         };
         if busy {
             ui.ctx().request_repaint();
@@ -553,7 +517,7 @@ impl eframe::App for ViewerApp {
             self.open_dropped(ui.ctx(), file);
         }
         // The path tracer's wall clock runs only while its mode is shown.
-        let showing_pathtrace = self.mode == Mode::PathTrace;
+        let showing_pathtrace = self.mode == RendererKind::PathTrace;
         if let Ok(pathtrace) = &mut self.pathtrace {
             pathtrace.set_active(showing_pathtrace);
         }
@@ -587,7 +551,7 @@ impl eframe::App for ViewerApp {
                 let result = text.and_then(|text| self.open_text(&name, &text));
                 self.opened(result);
             }
-            crate::web::publish_status(&self.status());
+            crate::browser::publish_status(&self.status());
         }
     }
 }

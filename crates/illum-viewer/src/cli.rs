@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use clap::Parser;
 
-use crate::app::Mode;
+use illum_scene::RendererKind;
 
 #[derive(Parser, Debug, Clone)]
 #[command(
@@ -18,7 +18,7 @@ pub struct Args {
     pub scene: PathBuf,
     /// The mode shown first. Default: the mode of SCENE.
     #[arg(long, value_parser = parse_mode)]
-    pub mode: Option<Mode>,
+    pub mode: Option<RendererKind>,
     /// Render `--frames` frames, save a screenshot of the window to this PNG file and exit.
     #[arg(long)]
     pub screenshot: Option<PathBuf>,
@@ -33,8 +33,10 @@ pub struct Args {
     pub height: f32,
 }
 
-fn parse_mode(text: &str) -> Result<Mode, String> {
-    text.parse()
+/// A mode is named like the renderer it shows: `raster`, `pathtrace` or `whitted` (the page's
+/// `?mode=` too).
+pub fn parse_mode(text: &str) -> Result<RendererKind, String> {
+    text.parse::<RendererKind>().map_err(|e| format!("unknown mode {text:?}: {}", e.allowed))
 }
 
 #[cfg(test)]
@@ -53,7 +55,7 @@ mod tests {
             "3",
         ])
         .unwrap();
-        assert_eq!(args.mode, Some(Mode::Raster));
+        assert_eq!(args.mode, Some(RendererKind::Raster));
         assert_eq!(args.frames, 3);
         assert_eq!(args.screenshot, Some(PathBuf::from("a.png")));
         let err = Args::try_parse_from(["illum-viewer", "--mode", "xyz"]).unwrap_err().to_string();

@@ -12,9 +12,17 @@
 //! - [`scene_file`]: opening scene files of either kind, with errors as text;
 //! - [`cli`] and [`screenshot`]: the command line, and `--screenshot FILE --frames N`;
 //! - [`platform`]: what differs between the desktop and the browser (readback, scene files,
-//!   saving), and `web` (wasm32 only): the browser's start, downloads, file picker and status.
+//!   saving); `web` (wasm32 only): the viewer's start on a page, which builds the app; and
+//!   `browser` (wasm32 only): the page's services the app uses (downloads, the file picker,
+//!   the status for scripts).
+//!
+//! The modes are the renderers, [`illum_scene::RendererKind`]. Modules depend on each other in
+//! one direction only: `web` and `cli` on `app`, `app` on the panels, `scene_file`, `platform`
+//! and `browser`, none of which depends back.
 
 pub mod app;
+#[cfg(target_arch = "wasm32")]
+pub mod browser;
 pub mod camera;
 pub mod cli;
 pub mod display;
@@ -30,4 +38,4 @@ pub mod screenshot;
 pub mod web;
 pub mod whitted_panel;
 
-pub use app::{Mode, StartOptions, ViewerApp};
+pub use app::{StartOptions, ViewerApp};

@@ -391,7 +391,10 @@ impl PathTraceMode {
                 let mut tracer = PathTracer::new(gpu, wanted).map_err(|e| e.to_string())?;
                 tracer.set_target_seconds(crate::platform::submission_seconds(crate::pacer::MOVING_SECONDS));
                 tracer.set_whole_passes_up_to(Some(WHOLE_PASS_SAMPLES));
-                tracer.set_polled_readback(crate::platform::POLLED_READBACK);
+                // Natively the device's default (mapped, or a staging copy), waited for.
+                if crate::platform::POLLED_READBACK {
+                    tracer.set_readback(illum_pathtrace::Readback::Polled);
+                }
                 // The window shows the GPU-resident sum; it follows resets and resizes itself.
                 tracer.enable_display_sum().map_err(|e| e.to_string())?;
                 self.tracer = Some(tracer);
@@ -460,7 +463,7 @@ impl PathTraceMode {
                     .map_err(|e| error_chain(&e))?;
                 (bytes, "image/png")
             };
-            crate::web::download(&name, &bytes, mime)?;
+            crate::browser::download(&name, &bytes, mime)?;
             Ok(PathBuf::from(name))
         }
         #[cfg(not(target_arch = "wasm32"))]

@@ -8,7 +8,7 @@
 //!   into the page ([`BUILT_IN_SCENES`]) and other files come from the file picker or are
 //!   dropped on the page ([`read_scene`]).
 //! - **Saving**: natively a file written atomically; in the browser a download
-//!   (`crate::web::download`).
+//!   (`crate::browser::download`).
 
 use std::path::Path;
 
@@ -47,7 +47,7 @@ pub fn built_in_scene(path: &Path) -> Option<&'static str> {
 /// Reads and validates the scene file at `path`: from disk natively.
 #[cfg(not(target_arch = "wasm32"))]
 pub fn read_scene(path: &Path) -> Result<Scene, String> {
-    crate::scene_file::read_from_disk(path)
+    Scene::load(&illum_scene::resolve_scene_path(path)).map_err(|e| e.to_string())
 }
 
 /// Reads and validates the scene file at `path`: in the browser, one of the built-in scenes.

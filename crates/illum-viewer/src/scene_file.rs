@@ -5,9 +5,7 @@
 use std::path::Path;
 
 use illum_raster::RasterScene;
-use illum_scene::{RendererKind, Scene, resolve_scene_path};
-
-use crate::app::Mode;
+use illum_scene::{RendererKind, Scene};
 
 /// The path tracer's scene when none is given: the assignment's Cornell box.
 pub const DEFAULT_PATHTRACE_SCENE: &str = "scenes/cornell.toml";
@@ -20,20 +18,20 @@ pub struct LoadedScene {
     pub pathtrace: Result<Scene, String>,
     pub raster: Result<RasterScene, String>,
     pub whitted: Result<Scene, String>,
-    /// The mode of the file's `renderer`.
-    pub preferred: Mode,
+    /// The file's `renderer`.
+    pub preferred: RendererKind,
 }
 
 impl LoadedScene {
     /// The mode to show: the file's own when it can render the scene, else the first of path
     /// tracer, raster and Whitted that can.
-    pub fn mode(&self) -> Mode {
-        let can = |mode: Mode| match mode {
-            Mode::PathTrace => self.pathtrace.is_ok(),
-            Mode::Raster => self.raster.is_ok(),
-            Mode::Whitted => self.whitted.is_ok(),
+    pub fn mode(&self) -> RendererKind {
+        let can = |mode: RendererKind| match mode {
+            RendererKind::PathTrace => self.pathtrace.is_ok(),
+            RendererKind::Raster => self.raster.is_ok(),
+            RendererKind::Whitted => self.whitted.is_ok(),
         };
-        [self.preferred, Mode::PathTrace, Mode::Raster, Mode::Whitted]
+        [self.preferred, RendererKind::PathTrace, RendererKind::Raster, RendererKind::Whitted]
             .into_iter()
             .find(|&m| can(m))
             .unwrap_or(self.preferred)
@@ -53,11 +51,6 @@ pub fn load_text(label: &str, text: &str) -> Result<LoadedScene, String> {
     split(Scene::from_toml_str(text, label).map_err(|e| e.to_string())?)
 }
 
-/// Reads a scene file from disk (native), with the loader's message on failure.
-pub fn read_from_disk(path: &Path) -> Result<Scene, String> {
-    Scene::load(&resolve_scene_path(path)).map_err(|e| e.to_string())
-}
-
 /// The scene as each mode sees it.
 fn split(scene: Scene) -> Result<LoadedScene, String> {
     let pathtrace = scene
@@ -72,7 +65,7 @@ fn split(scene: Scene) -> Result<LoadedScene, String> {
     if let (Err(p), Err(r), Err(w)) = (&pathtrace, &raster, &whitted) {
         return Err(format!("no mode can show it: {p}; {r}; {w}"));
     }
-    let preferred = Mode::from(scene.renderer);
+    let preferred = scene.renderer;
     Ok(LoadedScene { pathtrace, raster, whitted, preferred })
 }
 
@@ -83,14 +76,14 @@ mod tests {
     #[test]
     fn default_scenes_open_in_the_modes_that_can_render_them() {
         let cornell = load(Path::new(DEFAULT_PATHTRACE_SCENE)).unwrap();
-        assert_eq!(cornell.mode(), Mode::PathTrace);
+        assert_eq!(cornell.mode(), RendererKind::PathTrace);
         assert!(cornell.pathtrace.is_ok());
         let why = cornell.raster.unwrap_err();
         assert!(why.contains("rasterizer cannot render"), "{why}");
         // The Whitted scene opens in both modes (the path tracer renders its glass, mirror, sun
         // and sky), shown in its file's mode.
         let whitted = load(Path::new(DEFAULT_RASTER_SCENE)).unwrap();
-        assert_eq!(whitted.mode(), Mode::Raster);
+        assert_eq!(whitted.mode(), RendererKind::Raster);
         assert!(whitted.raster.is_ok() && whitted.pathtrace.is_ok() && whitted.whitted.is_ok());
     }
 
@@ -117,6 +110,6 @@ mod tests {
         let from_disk = load(&path).unwrap_err();
         assert_eq!(from_text, from_disk.replace(&path.display().to_string(), "dropped/bad.toml"));
         let cornell = include_str!("../../../scenes/cornell.toml");
-        assert_eq!(load_text("cornell.toml", cornell).unwrap().mode(), Mode::PathTrace);
+        assert_eq!(load_text("cornell.toml", cornell).unwrap().mode(), RendererKind::PathTrace);
     }
 }

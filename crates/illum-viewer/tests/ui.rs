@@ -14,9 +14,9 @@ use std::sync::OnceLock;
 
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
-use illum_scene::Bounces;
+use illum_scene::{Bounces, RendererKind};
 use illum_viewer::gpu_setup::wgpu_setup;
-use illum_viewer::{Mode, StartOptions, ViewerApp};
+use illum_viewer::{StartOptions, ViewerApp};
 
 /// The one device of this test process (lavapipe when present), created with the viewer's setup.
 fn shared_device() -> egui_wgpu::WgpuSetupExisting {
@@ -32,15 +32,15 @@ fn shared_device() -> egui_wgpu::WgpuSetupExisting {
     }
 }
 
-fn harness(mode: Mode) -> Harness<'static, ViewerApp> {
+fn harness(mode: RendererKind) -> Harness<'static, ViewerApp> {
     harness_with("scenes/cornell.toml", mode)
 }
 
-fn harness_with(scene: &'static str, mode: Mode) -> Harness<'static, ViewerApp> {
+fn harness_with(scene: &'static str, mode: RendererKind) -> Harness<'static, ViewerApp> {
     harness_sized(scene, mode, egui::vec2(900.0, 560.0))
 }
 
-fn harness_sized(scene: &'static str, mode: Mode, size: egui::Vec2) -> Harness<'static, ViewerApp> {
+fn harness_sized(scene: &'static str, mode: RendererKind, size: egui::Vec2) -> Harness<'static, ViewerApp> {
     Harness::builder()
         .with_size(size)
         .wgpu_setup(egui_wgpu::WgpuSetup::Existing(shared_device()))
@@ -61,20 +61,20 @@ fn spp(harness: &Harness<'_, ViewerApp>) -> u32 {
 
 #[test]
 fn switching_modes_keeps_each_modes_settings() {
-    let mut harness = harness(Mode::PathTrace);
+    let mut harness = harness(RendererKind::PathTrace);
     harness.run_steps(2);
     click(&mut harness, "Uniform");
 
     harness.get_by_label("Raster").click();
     harness.run_steps(2);
-    assert_eq!(harness.state().mode(), Mode::Raster);
+    assert_eq!(harness.state().mode(), RendererKind::Raster);
     harness.get_by_label("enhanced").click();
     harness.get_by_label("Anti-aliasing").click();
     harness.run_steps(2);
 
     harness.get_by_label("Path tracer").click();
     harness.run_steps(2);
-    assert_eq!(harness.state().mode(), Mode::PathTrace);
+    assert_eq!(harness.state().mode(), RendererKind::PathTrace);
     let settings = harness.state().pathtrace().unwrap().settings;
     assert_eq!(settings.sampling, illum_scene::Sampling::Uniform);
 
@@ -87,7 +87,7 @@ fn switching_modes_keeps_each_modes_settings() {
 
 #[test]
 fn changing_bounces_restarts_the_accumulation() {
-    let mut harness = harness(Mode::PathTrace);
+    let mut harness = harness(RendererKind::PathTrace);
     // A pass may take several of the pacer's slices when other tests load the machine.
     for _ in 0..100 {
         harness.run_steps(1);
@@ -107,7 +107,7 @@ fn changing_bounces_restarts_the_accumulation() {
 
 #[test]
 fn pause_and_reset() {
-    let mut harness = harness(Mode::PathTrace);
+    let mut harness = harness(RendererKind::PathTrace);
     harness.run_steps(6);
     click(&mut harness, "Pause");
     assert!(harness.state().pathtrace().unwrap().paused());
@@ -126,7 +126,7 @@ fn pause_and_reset() {
 /// once shrank each frame's share to a row or two of one pass.)
 #[test]
 fn every_frame_with_the_view_still_carries_a_whole_pass() {
-    let mut harness = harness(Mode::PathTrace);
+    let mut harness = harness(RendererKind::PathTrace);
     // The first submission is the planner's probe, which measures what a sample costs.
     harness.run_steps(3);
     click(&mut harness, "Reset");
@@ -148,7 +148,7 @@ fn every_frame_with_the_view_still_carries_a_whole_pass() {
 fn saves_png_and_exr_into_a_directory() {
     let dir = tempfile::tempdir().unwrap();
     let target = dir.path().join("nested").join("render.png");
-    let mut harness = harness(Mode::PathTrace);
+    let mut harness = harness(RendererKind::PathTrace);
     harness.run_steps(4);
     harness.state_mut().pathtrace_mut().unwrap().save_path = target.display().to_string();
     harness.run_steps(1);
@@ -183,7 +183,7 @@ fn a_bad_scene_file_shows_its_error_and_keeps_the_scene() {
     let dir = tempfile::tempdir().unwrap();
     let bad = dir.path().join("broken.toml");
     std::fs::write(&bad, "[camera]\nvfov = \"wide\"\n").unwrap();
-    let mut harness = harness(Mode::PathTrace);
+    let mut harness = harness(RendererKind::PathTrace);
     harness.run_steps(2);
     harness.state_mut().scene_field = bad.display().to_string();
     harness.run_steps(1);
@@ -192,20 +192,20 @@ fn a_bad_scene_file_shows_its_error_and_keeps_the_scene() {
     let error = harness.state().open_error.clone().expect("an error is shown");
     assert!(error.contains("broken.toml"), "{error}");
     harness.get_by_label_contains("Could not open the scene");
-    assert_eq!(harness.state().mode(), Mode::PathTrace);
+    assert_eq!(harness.state().mode(), RendererKind::PathTrace);
     assert!(harness.state().pathtrace().unwrap().scene_path().ends_with("scenes/cornell.toml"));
     // A good file of the other kind then opens in its own mode.
     harness.state_mut().scene_field = "scenes/whitted.toml".to_owned();
     harness.run_steps(1);
     harness.get_by_label("Open").click();
     harness.run_steps(2);
-    assert_eq!(harness.state().mode(), Mode::Raster);
+    assert_eq!(harness.state().mode(), RendererKind::Raster);
     assert!(harness.state().open_error.is_none());
 }
 
 /// The path-tracer window run until its spp target stops it (within 200 frames).
 fn stopped_at(spp_target: u32) -> Harness<'static, ViewerApp> {
-    let mut harness = harness(Mode::PathTrace);
+    let mut harness = harness(RendererKind::PathTrace);
     harness.state_mut().pathtrace_mut().unwrap().settings.stop.spp = Some(spp_target);
     for _ in 0..200 {
         harness.run_steps(1);
@@ -268,14 +268,14 @@ fn the_window_shows_what_save_png_writes() {
 
 #[test]
 fn snapshot_raster() {
-    let mut harness = harness_with("scenes/whitted.toml", Mode::Raster);
+    let mut harness = harness_with("scenes/whitted.toml", RendererKind::Raster);
     harness.run_steps(4);
     harness.snapshot("viewer_raster");
 }
 
 #[test]
 fn dragging_orbits_the_camera_and_reset_camera_restores_it() {
-    let mut harness = harness(Mode::PathTrace);
+    let mut harness = harness(RendererKind::PathTrace);
     harness.run_steps(4);
     assert!(spp(&harness) > 0);
     // Paused, so that the restart caused by the camera change stays visible as 0 spp.
@@ -293,14 +293,14 @@ fn dragging_orbits_the_camera_and_reset_camera_restores_it() {
 /// its own.
 #[test]
 fn switching_modes_keeps_the_camera_on_the_same_scene() {
-    let mut harness = harness_with("scenes/whitted.toml", Mode::Whitted);
+    let mut harness = harness_with("scenes/whitted.toml", RendererKind::Whitted);
     harness.run_steps(2);
     drag_across_the_image(&mut harness);
     let moved = harness.state().whitted().unwrap().camera;
     assert!(!moved.is_home(), "the drag did not move the camera");
     click(&mut harness, "Path tracer");
     harness.run_steps(1);
-    assert_eq!(harness.state().mode(), Mode::PathTrace);
+    assert_eq!(harness.state().mode(), RendererKind::PathTrace);
     assert_eq!(harness.state().pathtrace().unwrap().camera, moved);
     click(&mut harness, "Raster");
     harness.run_steps(1);
@@ -342,7 +342,7 @@ fn drag_across_the_image(harness: &mut Harness<'_, ViewerApp>) {
 
 #[test]
 fn the_path_tracer_follows_the_window_size() {
-    let mut harness = harness(Mode::PathTrace);
+    let mut harness = harness(RendererKind::PathTrace);
     harness.run_steps(3);
     let small = harness.state().pathtrace().unwrap().stats();
     harness.set_size(egui::vec2(1000.0, 700.0));
@@ -358,7 +358,7 @@ fn the_path_tracer_follows_the_window_size() {
 #[test]
 fn the_scene_field_follows_the_mode() {
     // Started on the Cornell box but shown in raster mode: the field names the raster's scene.
-    let mut harness = harness(Mode::Raster);
+    let mut harness = harness(RendererKind::Raster);
     harness.run_steps(1);
     assert_eq!(harness.state().scene_field, "scenes/whitted.toml");
     click(&mut harness, "Path tracer");
@@ -368,9 +368,9 @@ fn the_scene_field_follows_the_mode() {
 #[test]
 fn a_mode_that_cannot_render_the_opened_scene_says_why() {
     // The Cornell box has boxes and an area light: the rasterizer keeps its own scene and says so.
-    let mut harness = harness(Mode::Raster);
+    let mut harness = harness(RendererKind::Raster);
     harness.run_steps(1);
-    let refusal = harness.state().refusal_of(Mode::Raster).expect("a refusal for the raster");
+    let refusal = harness.state().refusal_of(RendererKind::Raster).expect("a refusal for the raster");
     assert!(
         refusal.contains("cornell.toml: objects[0]")
             && refusal.contains("cannot render")
@@ -378,17 +378,17 @@ fn a_mode_that_cannot_render_the_opened_scene_says_why() {
         "{refusal}"
     );
     harness.get_by_label_contains("cannot render");
-    assert_eq!(harness.state().refusal_of(Mode::PathTrace), None);
+    assert_eq!(harness.state().refusal_of(RendererKind::PathTrace), None);
     // A scene every mode renders clears it.
     harness.state_mut().scene_field = "scenes/whitted.toml".into();
     harness.run_steps(1);
     click(&mut harness, "Open");
-    assert_eq!(harness.state().refusal_of(Mode::Raster), None);
+    assert_eq!(harness.state().refusal_of(RendererKind::Raster), None);
 }
 
 #[test]
 fn a_small_window_still_shows_the_image_and_the_panel_hides() {
-    let mut harness = harness_sized("scenes/cornell.toml", Mode::PathTrace, egui::vec2(200.0, 150.0));
+    let mut harness = harness_sized("scenes/cornell.toml", RendererKind::PathTrace, egui::vec2(200.0, 150.0));
     harness.run_steps(3);
     // A window that starts narrow starts with the settings hidden: the image has the window
     // below a compact, two-line top bar (x 0.5 render scale).
@@ -413,7 +413,7 @@ fn a_small_window_still_shows_the_image_and_the_panel_hides() {
 
 #[test]
 fn the_path_tracers_clock_stands_still_while_the_raster_is_shown() {
-    let mut harness = harness(Mode::PathTrace);
+    let mut harness = harness(RendererKind::PathTrace);
     harness.run_steps(3);
     harness.get_by_label("Raster").click();
     harness.run_steps(2);
@@ -428,7 +428,7 @@ fn the_path_tracers_clock_stands_still_while_the_raster_is_shown() {
 
 #[test]
 fn the_whitted_mode_renders_on_change_and_keeps_its_camera() {
-    let mut harness = harness(Mode::Whitted);
+    let mut harness = harness(RendererKind::Whitted);
     harness.run_steps(3);
     // The viewer starts the Whitted mode on the Whitted scene (its default scene).
     let first = harness.state().whitted().expect("Whitted mode loaded").frames;
@@ -448,7 +448,7 @@ fn the_whitted_mode_renders_on_change_and_keeps_its_camera() {
     // The mode button shows it, and the other modes keep theirs.
     harness.get_by_label("Path tracer").click();
     harness.run_steps(2);
-    assert_eq!(harness.state().mode(), Mode::PathTrace);
+    assert_eq!(harness.state().mode(), RendererKind::PathTrace);
     harness.get_by_label("Whitted").click();
     harness.run_steps(2);
     assert_eq!(harness.state().whitted().unwrap().depth, 2);

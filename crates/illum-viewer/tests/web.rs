@@ -31,8 +31,7 @@ use std::process::Command;
 
 use illum_gpu::GpuContext;
 use illum_pathtrace::PathTracer;
-use illum_scene::Scene;
-use illum_viewer::Mode;
+use illum_scene::{RendererKind, Scene};
 use illum_viewer::platform::BUILT_IN_SCENES;
 
 /// The path tracer's samples per pixel in the browser (the page's `?spp=`).
@@ -178,7 +177,7 @@ fn distinct_colours(image: &image::RgbaImage) -> usize {
 struct Cell {
     name: String,
     scene: &'static str,
-    mode: Mode,
+    mode: RendererKind,
     /// The light tracer, for the path tracer on a scene where it can add a caustic.
     caustics: Option<bool>,
     /// Why `mode` cannot render the scene (the desktop's message), if it cannot.
@@ -189,7 +188,7 @@ impl Cell {
     /// The page's address for the cell.
     fn query(&self) -> String {
         let mut query = format!("?scene={}&mode={}", self.scene, self.mode);
-        if self.mode == Mode::PathTrace {
+        if self.mode == RendererKind::PathTrace {
             query += &format!("&spp={SPP}&scale={SCALE}");
         }
         if let Some(on) = self.caustics {
@@ -212,19 +211,22 @@ fn matrix() -> Vec<Cell> {
     for (scene, text) in BUILT_IN_SCENES {
         let loaded = illum_viewer::scene_file::load_text(scene, text).unwrap_or_else(|e| panic!("{e}"));
         let stem = scene.trim_start_matches("scenes/").trim_end_matches(".toml");
-        for mode in [Mode::PathTrace, Mode::Raster, Mode::Whitted] {
+        for mode in [RendererKind::PathTrace, RendererKind::Raster, RendererKind::Whitted] {
             let refusal = match mode {
-                Mode::PathTrace => loaded.pathtrace.as_ref().err().cloned(),
-                Mode::Raster => loaded.raster.as_ref().err().cloned(),
-                Mode::Whitted => loaded.whitted.as_ref().err().cloned(),
+                RendererKind::PathTrace => loaded.pathtrace.as_ref().err().cloned(),
+                RendererKind::Raster => loaded.raster.as_ref().err().cloned(),
+                RendererKind::Whitted => loaded.whitted.as_ref().err().cloned(),
             };
             let caustic_applies = loaded.pathtrace.as_ref().is_ok_and(|s| {
                 let mut on = s.clone();
                 on.pathtrace.caustics = true;
                 illum_pathtrace::gpu_scene::caustics_active(&on)
             });
-            let variants: &[Option<bool>] =
-                if mode == Mode::PathTrace && caustic_applies { &[Some(true), Some(false)] } else { &[None] };
+            let variants: &[Option<bool>] = if mode == RendererKind::PathTrace && caustic_applies {
+                &[Some(true), Some(false)]
+            } else {
+                &[None]
+            };
             for &caustics in variants {
                 let suffix = match caustics {
                     Some(true) => "-caustics-on",
@@ -443,9 +445,9 @@ fn the_web_viewer_works_in_headless_chromium() {
                 assert_eq!(get(&st, "modeRefusal"), "", "{name}: {st:?}");
                 assert_eq!(get(&st, "scene"), cell.scene, "{name}: {st:?}");
                 let relative = match cell.mode {
-                    Mode::PathTrace => check_pathtrace_cell(&root, &gpu, cell, &st),
-                    Mode::Whitted => check_whitted_cell(&root, &gpu, cell, &st),
-                    Mode::Raster => check_raster_cell(&root, &gpu, cell, &st, &shot),
+                    RendererKind::PathTrace => check_pathtrace_cell(&root, &gpu, cell, &st),
+                    RendererKind::Whitted => check_whitted_cell(&root, &gpu, cell, &st),
+                    RendererKind::Raster => check_raster_cell(&root, &gpu, cell, &st, &shot),
                 };
                 format!("image mean within {relative:.1e} of native")
             }

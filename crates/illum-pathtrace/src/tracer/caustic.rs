@@ -131,11 +131,49 @@ struct CausticPass {
     dropped: u64,
     /// Frames folded so far: frames `key.first_sample..key.first_sample + frames_done`.
     frames_done: u32,
+    /// The dispatch of the pass's next frames whose polled readback is under way.
+    in_flight: Option<InFlight>,
 }
 
 impl CausticPass {
+    fn new(key: PassKey, pixels: usize) -> Self {
+        let chunks = key.spp.div_ceil(key.chunk) as usize;
+        CausticPass {
+            key,
+            sum: vec![[0.0; 3]; chunks * pixels],
+            sum_sq: vec![[0.0; 3]; chunks * pixels],
+            dropped: 0,
+            frames_done: 0,
+            in_flight: None,
+        }
+    }
+
     fn complete(&self) -> bool {
         self.frames_done >= self.key.spp
+    }
+
+    /// Folds `count` frames of `pixels` pixels read back from a dispatch (the splat buffer's
+    /// words, frames first, then one dropped-particle counter per frame): they are the pass's
+    /// next frames. A fixed-point unit is worth `unit` in true radiance.
+    fn fold_frames(&mut self, words: &[u32], count: u32, pixels: usize, unit: f64) {
+        let words_per_frame = WORDS_PER_PIXEL as usize * pixels;
+        for f in 0..count as usize {
+            let relative = self.frames_done as usize + f;
+            let offset = (relative / self.key.chunk as usize) * pixels;
+            let frame = &words[f * words_per_frame..(f + 1) * words_per_frame];
+            for (p, w) in frame.chunks_exact(WORDS_PER_PIXEL as usize).enumerate() {
+                for c in 0..3 {
+                    let q = (u64::from(w[2 * c + 1]) << 32) | u64::from(w[2 * c]);
+                    if q != 0 {
+                        let v = q as f64 * unit;
+                        self.sum[offset + p][c] += v;
+                        self.sum_sq[offset + p][c] += v * v;
+                    }
+                }
+            }
+            self.dropped += u64::from(words[count as usize * words_per_frame + f]);
+        }
+        self.frames_done += count;
     }
 }
 
@@ -166,8 +204,8 @@ pub(crate) struct CausticTracer {
     pixels: usize,
     /// What a fixed-point unit is worth in true radiance: 2^radiance_exponent / S.
     unit: f64,
+    /// The pass being gathered or held, with its dispatch in flight.
     pass: Option<CausticPass>,
-    in_flight: Option<InFlight>,
 }
 
 impl CausticTracer {
@@ -318,7 +356,6 @@ impl CausticTracer {
             pixels,
             unit: 2f64.powi(gpu_scene.radiance_exponent) / f64::from(fixed_scale),
             pass: None,
-            in_flight: None,
         }))
     }
 
@@ -339,22 +376,15 @@ impl CausticTracer {
         self.pass.as_ref().is_some_and(|p| p.key == key && p.complete())
     }
 
-    /// Starts gathering pass `key` unless it is the one being gathered or held (a pass of
-    /// another key, and a dispatch in flight for it, are dropped).
-    fn begin_pass(&mut self, key: PassKey) {
-        if self.pass.as_ref().is_some_and(|p| p.key == key) {
-            return;
+    /// Takes pass `key` out of the tracer to gather its frames: the one being gathered or held,
+    /// or a new one (a pass of another key, and a dispatch in flight for it, are dropped). The
+    /// caller puts it back once its step is done; after an error it is dropped, and its frames
+    /// are traced again.
+    fn take_pass(&mut self, key: PassKey) -> CausticPass {
+        match self.pass.take() {
+            Some(pass) if pass.key == key => pass,
+            _ => CausticPass::new(key, self.pixels),
         }
-        self.in_flight = None;
-        self.pass = None;
-        let chunks = key.spp.div_ceil(key.chunk) as usize;
-        self.pass = Some(CausticPass {
-            key,
-            sum: vec![[0.0; 3]; chunks * self.pixels],
-            sum_sq: vec![[0.0; 3]; chunks * self.pixels],
-            dropped: 0,
-            frames_done: 0,
-        });
     }
 
     /// Traces the frames of pass `key` (absolute sample indices `key.first_sample..`, grouped
@@ -362,23 +392,17 @@ impl CausticTracer {
     /// to do when they are the ones already held.
     #[cfg(not(target_arch = "wasm32"))]
     pub(crate) fn prepare_pass(&mut self, gpu: &GpuContext, key: PassKey) -> Result<(), PathTraceError> {
-        self.begin_pass(key);
+        let mut pass = self.take_pass(key);
         // A polled read left in flight is abandoned: its frames are traced again here.
-        self.in_flight = None;
-        while let Some((staging, bytes, count)) = self.launch_dispatch(gpu)? {
-            let folded = illum_gpu::readback::with_mapped(
-                gpu,
-                &staging,
-                bytes,
-                "reading back caustic frames",
-                |data| self.fold_frames(bytemuck::cast_slice(data), count),
-            );
-            if let Err(e) = folded {
-                self.pass = None;
-                return Err(e.into());
-            }
+        pass.in_flight = None;
+        let (pixels, unit) = (self.pixels, self.unit);
+        while let Some((staging, bytes, count)) = self.launch_dispatch(gpu, &pass)? {
+            illum_gpu::readback::with_mapped(gpu, &staging, bytes, "reading back caustic frames", |data| {
+                pass.fold_frames(bytemuck::cast_slice(data), count, pixels, unit)
+            })?;
             self.staging = Some(staging);
         }
+        self.pass = Some(pass);
         Ok(())
     }
 
@@ -386,38 +410,33 @@ impl CausticTracer {
     /// folded. Each call folds the dispatch in flight if its mapping is done and then submits
     /// the next one; it never waits.
     pub(crate) fn poll_pass(&mut self, gpu: &GpuContext, key: PassKey) -> Result<bool, PathTraceError> {
-        self.begin_pass(key);
-        if let Some(flight) = &self.in_flight {
-            let Some(result) = flight.read.poll(gpu) else { return Ok(false) };
-            let flight = self.in_flight.take().expect("polled above");
-            let data = match result {
-                Ok(data) => data,
-                Err(e) => {
-                    self.pass = None;
-                    return Err(e.into());
-                }
+        let mut pass = self.take_pass(key);
+        if let Some(flight) = pass.in_flight.take() {
+            let Some(result) = flight.read.poll(gpu) else {
+                pass.in_flight = Some(flight);
+                self.pass = Some(pass);
+                return Ok(false);
             };
-            self.fold_frames(bytemuck::cast_slice(&data), flight.count);
+            pass.fold_frames(bytemuck::cast_slice(&result?), flight.count, self.pixels, self.unit);
             self.staging = Some(flight.read.into_buffer());
         }
-        match self.launch_dispatch(gpu)? {
-            None => Ok(true),
-            Some((staging, bytes, count)) => {
-                let read = PendingRead::start(staging, bytes, "reading back caustic frames");
-                self.in_flight = Some(InFlight { read, count });
-                Ok(false)
-            }
-        }
+        let launched = self.launch_dispatch(gpu, &pass)?;
+        let complete = launched.is_none();
+        pass.in_flight = launched.map(|(staging, bytes, count)| InFlight {
+            read: PendingRead::start(staging, bytes, "reading back caustic frames"),
+            count,
+        });
+        self.pass = Some(pass);
+        Ok(complete)
     }
 
-    /// Submits the next dispatch of the pass being gathered and its copy into the staging
-    /// buffer: (the staging buffer, the bytes to read, the frames traced), or `None` when the
-    /// pass is complete.
+    /// Submits the next dispatch of `pass` and its copy into the staging buffer: (the staging
+    /// buffer, the bytes to read, the frames traced), or `None` when the pass is complete.
     fn launch_dispatch(
         &mut self,
         gpu: &GpuContext,
+        pass: &CausticPass,
     ) -> Result<Option<(wgpu::Buffer, u64, u32)>, PathTraceError> {
-        let pass = self.pass.as_ref().expect("begin_pass before a dispatch");
         if pass.complete() {
             return Ok(None);
         }
@@ -460,33 +479,6 @@ impl CausticTracer {
         Ok(Some((staging, bytes, count)))
     }
 
-    /// Folds `count` frames read back from a dispatch (the splat buffer's words, frames first,
-    /// then one dropped-particle counter per frame) into the pass being gathered: they are its
-    /// next frames.
-    fn fold_frames(&mut self, words: &[u32], count: u32) {
-        let pixels = self.pixels;
-        let unit = self.unit;
-        let pass = self.pass.as_mut().expect("begin_pass before a fold");
-        let words_per_frame = WORDS_PER_PIXEL as usize * pixels;
-        for f in 0..count as usize {
-            let relative = pass.frames_done as usize + f;
-            let offset = (relative / pass.key.chunk as usize) * pixels;
-            let frame = &words[f * words_per_frame..(f + 1) * words_per_frame];
-            for (p, w) in frame.chunks_exact(WORDS_PER_PIXEL as usize).enumerate() {
-                for c in 0..3 {
-                    let q = (u64::from(w[2 * c + 1]) << 32) | u64::from(w[2 * c]);
-                    if q != 0 {
-                        let v = q as f64 * unit;
-                        pass.sum[offset + p][c] += v;
-                        pass.sum_sq[offset + p][c] += v * v;
-                    }
-                }
-            }
-            pass.dropped += u64::from(words[count as usize * words_per_frame + f]);
-        }
-        pass.frames_done += count;
-    }
-
     /// Adds the held pass's chunk `k` for the band's pixels `first_pixel..` to the accumulator,
     /// beside the camera's chunk sums `camera` just folded for them (see the module
     /// documentation for the cross term).
@@ -510,10 +502,9 @@ impl CausticTracer {
         );
     }
 
-    /// Forgets the held pass and abandons a dispatch in flight (their frames belong to a
+    /// Forgets the held pass and abandons its dispatch in flight (their frames belong to a
     /// render that was reset).
     pub(crate) fn discard_pass(&mut self) {
-        self.in_flight = None;
         self.pass = None;
     }
 

@@ -3,12 +3,10 @@
 //! `add_samples_in_one_pass`), starting again (`reset`) and going on from a checkpoint
 //! (`restore`, `aligned_prefix`).
 
-use std::time::Duration;
-
-use super::{ActivePass, PathTracer, StepReport};
-use crate::allocation::BLOCK;
+use super::runner::{ActivePass, Readback};
+use super::{PathTracer, StepReport};
 use crate::planner::PassPlan;
-use crate::{Accumulator, PathTraceError, SampleAllocation};
+use crate::{Accumulator, PathTraceError};
 
 impl PathTracer {
     /// With `true`, every pass [`Self::render_step`] plans ends on a multiple of the chunk size in
@@ -18,21 +16,21 @@ impl PathTracer {
     /// first pass then has a whole chunk (16 spp) rather than the planner's 1-spp probe; the
     /// bands shrink to keep each submission short. The `render` example turns it on.
     pub fn set_chunk_aligned_passes(&mut self, aligned: bool) {
-        self.chunk_aligned = aligned;
+        self.bands.chunk_aligned = aligned;
     }
 
     /// The pass in progress, if a render stopped inside one: (its spp, rows done from row 0).
     pub fn partial_pass(&self) -> Option<(u32, u32)> {
-        self.pass.as_ref().map(|p| (p.plan.spp, p.next_row))
+        self.bands.pass().map(|p| (p.plan.spp, p.next_row))
     }
 
     /// The statistics at the last chunk boundary and their spp, when the samples taken so far
     /// (or the pass in progress) end inside a chunk: what a checkpoint stores so that a resumed
     /// render can go on from that boundary (see [`Self::set_chunk_aligned_passes`]).
     pub fn aligned_prefix(&self) -> Option<(&Accumulator, u32)> {
-        let chunk = self.chunk_samples.max(1);
-        let end = self.sample_offset + self.spp_done + self.pass.as_ref().map_or(0, |p| p.plan.spp);
-        let (accumulator, spp) = self.aligned_prefix.as_ref()?;
+        let chunk = self.bands.chunk_samples.max(1);
+        let end = self.next_sample() + self.bands.pass().map_or(0, |p| p.plan.spp);
+        let (accumulator, spp) = self.accumulation.aligned_prefix.as_ref()?;
         (!end.is_multiple_of(chunk)).then_some((accumulator, *spp))
     }
 
@@ -48,57 +46,43 @@ impl PathTracer {
         partial_pass: Option<(u32, u32)>,
         aligned_prefix: Option<(Accumulator, u32)>,
     ) -> Result<(), PathTraceError> {
-        let camera = self.scene.camera;
+        let camera = self.pipeline.scene.camera;
         if (accumulator.width, accumulator.height) != (camera.width, camera.height) {
             return Err(PathTraceError::Unsupported {
-                scene: self.scene.name.clone(),
+                scene: self.pipeline.scene.name.clone(),
                 message: format!(
                     "a checkpoint of {} x {} pixels cannot continue a {} x {} render",
                     accumulator.width, accumulator.height, camera.width, camera.height
                 ),
             });
         }
-        accumulator.set_radiance_exponent(self.radiance_exponent);
+        let radiance_exponent = self.pipeline.radiance_exponent;
+        accumulator.set_radiance_exponent(radiance_exponent);
         self.reset();
-        self.accumulator = accumulator;
-        self.spp_done = spp_done;
-        self.aligned_prefix = aligned_prefix.map(|(mut prefix, spp)| {
-            prefix.set_radiance_exponent(self.radiance_exponent);
+        self.accumulation.accumulator = accumulator;
+        self.accumulation.spp_done = spp_done;
+        self.accumulation.aligned_prefix = aligned_prefix.map(|(mut prefix, spp)| {
+            prefix.set_radiance_exponent(radiance_exponent);
             (prefix, spp)
         });
-        self.pass =
-            partial_pass.filter(|&(_, rows)| rows > 0 && rows < camera.height).map(|(spp, next_row)| {
-                let planned = self.planner.plan(camera.width, camera.height, spp);
-                let rows = if planned.spp >= spp { camera.height } else { planned.rows.max(1) };
-                ActivePass::new(self.fit(PassPlan { spp, rows }), spp_done, next_row)
-            });
-        if let Some(display) = &self.display_sum {
-            display.seed(&self.gpu, &self.accumulator, self.radiance_exponent);
+        if let Some((spp, next_row)) = partial_pass.filter(|&(_, rows)| rows > 0 && rows < camera.height) {
+            let planned = self.bands.planner.plan(camera.width, camera.height, spp);
+            let rows = if planned.spp >= spp { camera.height } else { planned.rows.max(1) };
+            let plan = self.fit(PassPlan { spp, rows });
+            self.bands.start_pass(ActivePass { plan, sample_base: spp_done, next_row });
         }
+        self.accumulation.show_accumulator(&self.pipeline.gpu, radiance_exponent);
         Ok(())
     }
 
     /// Discards everything accumulated; the next step starts again at sample 0.
     pub fn reset(&mut self) {
-        self.in_flight = None;
-        #[cfg(not(target_arch = "wasm32"))]
-        {
-            self.ahead = None;
-        }
-        self.last_fold = None;
-        self.last_step = StepReport::default();
-        self.accumulator.reset();
-        if let Some(caustic) = &mut self.caustic {
+        // A band on the GPU is dropped with its pass: it is never folded.
+        self.bands.restart();
+        if let Some(caustic) = &mut self.pipeline.caustic {
             caustic.discard_pass();
         }
-        if let Some(display) = &self.display_sum {
-            display.clear(&self.gpu);
-        }
-        self.pass = None;
-        self.spp_done = 0;
-        self.aligned_prefix = None;
-        self.wall_seconds = 0.0;
-        self.gpu_seconds = 0.0;
+        self.accumulation.reset(&self.pipeline.gpu);
     }
 
     /// Runs one short submission (one band of rows of the current pass; about 0.15 s, see
@@ -106,92 +90,109 @@ impl PathTracer {
     /// Returns a report with `samples == 0` once the target is reached. Progressive renderers
     /// call it in a loop, between frames or checks of their stop rules.
     ///
-    /// With [`Self::set_polled_readback`] it never waits: a call submits a band, and later calls
+    /// With [`Readback::Polled`] it never waits: a call submits a band, and later calls
     /// report `samples == 0` until its results are back, then fold it and report it.
     pub fn render_step(&mut self, target_spp: Option<u32>) -> Result<StepReport, PathTraceError> {
-        let entered = web_time::Instant::now();
-        self.caller_absence = self.returned_at.map_or(Duration::ZERO, |t| entered.duration_since(t));
+        self.bands.pacing.enter();
         let result = self.step_once(target_spp);
-        self.last_step = *result.as_ref().unwrap_or(&StepReport::default());
-        self.returned_at = Some(web_time::Instant::now());
+        self.bands.last_step = *result.as_ref().unwrap_or(&StepReport::default());
+        self.bands.pacing.leave();
         result
     }
 
     /// [`Self::render_step`]'s work.
     fn step_once(&mut self, target_spp: Option<u32>) -> Result<StepReport, PathTraceError> {
-        let camera = self.scene.camera;
-        if self.pass.is_none() {
-            let remaining = match target_spp {
-                Some(t) if t <= self.spp_done => return Ok(StepReport::default()),
-                Some(t) => t - self.spp_done,
-                None => u32::MAX - self.spp_done,
-            };
-            let planned = self.planner.plan(camera.width, self.active_height(), remaining);
-            let mut plan = self.fit(PassPlan { rows: self.spread_rows(planned.rows), ..planned });
-            if self.chunk_aligned {
-                let start = self.sample_offset + self.spp_done;
-                plan = align_pass(plan, start, remaining, self.chunk_samples);
-                let chunk = self.chunk_samples.max(1);
-                if start.is_multiple_of(chunk) {
-                    // The last pass of a render that ends inside a chunk: keep the statistics
-                    // at this boundary (see `aligned_prefix`), if the host has the memory for
-                    // the copy with a fifth to spare (at 8192 x 8192 on 24 GB it has not: such
-                    // a render, resumed, then differs from a straight one by f32 rounding, and
-                    // the resume says so).
-                    let copy_fits = || {
-                        use crate::accumulator::{ALIGNED_COPY_BYTES_PER_PIXEL, RENDER_HOST_BYTES_PER_PIXEL};
-                        let pixels = u64::from(self.accumulator.width) * u64::from(self.accumulator.height);
-                        let peak = pixels * (RENDER_HOST_BYTES_PER_PIXEL + ALIGNED_COPY_BYTES_PER_PIXEL);
-                        crate::accumulator::available_host_memory()
-                            .is_none_or(|available| peak <= available / 5 * 4)
-                    };
-                    self.aligned_prefix = (!(start + plan.spp).is_multiple_of(chunk) && copy_fits())
-                        .then(|| (self.accumulator.clone(), self.spp_done));
+        let camera = self.pipeline.scene.camera;
+        let pass = match self.bands.pass() {
+            Some(pass) => *pass,
+            None => {
+                let spp_done = self.accumulation.spp_done;
+                let remaining = match target_spp {
+                    Some(t) if t <= spp_done => return Ok(StepReport::default()),
+                    Some(t) => t - spp_done,
+                    None => u32::MAX - spp_done,
+                };
+                let start = self.next_sample();
+                let planned =
+                    self.bands.planner.plan(camera.width, self.pipeline.active_height(start), remaining);
+                let mut plan =
+                    self.fit(PassPlan { rows: self.pipeline.spread_rows(planned.rows, start), ..planned });
+                if self.bands.chunk_aligned {
+                    let chunk = self.bands.chunk_samples;
+                    plan = align_pass(plan, start, remaining, chunk);
+                    if start.is_multiple_of(chunk.max(1)) {
+                        self.keep_aligned_prefix(start + plan.spp);
+                    }
                 }
+                let pass = ActivePass { plan, sample_base: spp_done, next_row: 0 };
+                self.bands.start_pass(pass);
+                pass
             }
-            self.pass = Some(ActivePass::new(plan, self.spp_done, 0));
-        }
-        let Some(report) = self.next_band()? else { return Ok(StepReport::default()) };
+        };
+        let Some(report) = self.next_band(pass)? else { return Ok(StepReport::default()) };
         // A polled band's wall time includes the frames drawn while it was read back; its GPU
         // time (timestamp queries), where the adapter has them, is what it cost.
-        let seconds = if self.polled_readback {
+        let seconds = if self.bands.readback() == Readback::Polled {
             report.gpu_seconds.unwrap_or(report.wall_seconds)
         } else {
             report.wall_seconds
         };
-        self.planner.record(report.samples, seconds);
+        self.bands.planner.record(report.samples, seconds);
         // Later bands of the pass follow what the planner has learnt: a pass planned before
-        // the first measurement (at 1024 x 1024 with chunk-aligned passes, bands of one row)
+        // the first measurement (a large image with chunk-aligned passes: bands of one row)
         // would otherwise be a thousand tiny submissions, each paying the driver's fixed cost.
         // Bands are rows, so their size never changes which samples a pixel's chunks hold.
-        if let Some(spp) = self.pass.as_ref().map(|p| p.plan.spp) {
-            let rows = self.spread_rows(self.planner.rows_for(camera.width, self.active_height(), spp));
-            let fitted = self.fit(PassPlan { spp, rows });
-            if let Some(pass) = self.pass.as_mut().filter(|_| fitted.spp == spp) {
+        if let Some(spp) = self.bands.pass().map(|p| p.plan.spp) {
+            let start = self.next_sample();
+            let planned = self.bands.planner.rows_for(camera.width, self.pipeline.active_height(start), spp);
+            let fitted = self.fit(PassPlan { spp, rows: self.pipeline.spread_rows(planned, start) });
+            if let Some(pass) = self.bands.pass_mut().filter(|_| fitted.spp == spp) {
                 pass.plan.rows = fitted.rows;
             }
         }
         Ok(report)
     }
 
+    /// At a chunk boundary before a pass that ends at `end` (absolute sample index): when that
+    /// is inside a chunk (the last pass of a render that ends inside one), keeps the statistics
+    /// at this boundary (see `aligned_prefix`), if the host has the memory for the copy with a
+    /// fifth to spare (a render too large for it, resumed, then differs from a straight one by
+    /// f32 rounding, and the resume says so).
+    fn keep_aligned_prefix(&mut self, end: u32) {
+        let accumulation = &mut self.accumulation;
+        let copy_fits = || {
+            use crate::accumulator::{ALIGNED_COPY_BYTES_PER_PIXEL, RENDER_HOST_BYTES_PER_PIXEL};
+            let accumulator = &accumulation.accumulator;
+            let pixels = u64::from(accumulator.width) * u64::from(accumulator.height);
+            let peak = pixels * (RENDER_HOST_BYTES_PER_PIXEL + ALIGNED_COPY_BYTES_PER_PIXEL);
+            crate::accumulator::available_host_memory().is_none_or(|available| peak <= available / 5 * 4)
+        };
+        let kept = (!end.is_multiple_of(self.bands.chunk_samples.max(1)) && copy_fits())
+            .then(|| (accumulation.accumulator.clone(), accumulation.spp_done));
+        accumulation.aligned_prefix = kept;
+    }
+
     /// One band of the active pass: polled (`None` while its results, or the caustic's frames
     /// before it, are not back) or waited for.
     #[cfg(not(target_arch = "wasm32"))]
-    fn next_band(&mut self) -> Result<Option<StepReport>, PathTraceError> {
-        if self.polled_readback { self.poll_band() } else { self.submit_band().map(Some) }
+    fn next_band(&mut self, pass: ActivePass) -> Result<Option<StepReport>, PathTraceError> {
+        match self.bands.readback() {
+            Readback::Polled => self.poll_band(pass),
+            Readback::Staging | Readback::Mapped => self.submit_band(pass).map(Some),
+        }
     }
 
     /// One band of the active pass, polled: a web page cannot wait.
     #[cfg(target_arch = "wasm32")]
-    fn next_band(&mut self) -> Result<Option<StepReport>, PathTraceError> {
-        self.poll_band()
+    fn next_band(&mut self, pass: ActivePass) -> Result<Option<StepReport>, PathTraceError> {
+        self.poll_band(pass)
     }
 
     /// Renders until every pixel has `spp` samples in all (those already taken count), in
     /// submissions sized by the measured speed. Waits for the GPU: native only.
     #[cfg(not(target_arch = "wasm32"))]
     pub fn render_to_spp(&mut self, spp: u32) -> Result<(), PathTraceError> {
-        while self.spp_done < spp {
+        while self.accumulation.spp_done < spp {
             self.render_step(Some(spp))?;
         }
         Ok(())
@@ -205,17 +206,17 @@ impl PathTracer {
     /// control batching. Waits for the GPU: native only.
     #[cfg(not(target_arch = "wasm32"))]
     pub fn add_samples_in_one_pass(&mut self, spp: u32) -> Result<(), PathTraceError> {
-        assert!(self.pass.is_none(), "add_samples_in_one_pass called in the middle of a pass");
-        let camera = self.scene.camera;
+        assert!(self.bands.pass().is_none(), "add_samples_in_one_pass called in the middle of a pass");
+        let camera = self.pipeline.scene.camera;
         let mut remaining = spp;
         while remaining > 0 {
-            let planned = self.planner.plan(camera.width, camera.height, remaining);
+            let planned = self.bands.planner.plan(camera.width, camera.height, remaining);
             let rows = if planned.spp >= remaining { camera.height } else { planned.rows.max(1) };
             let plan = self.fit(PassPlan { spp: remaining, rows });
-            self.pass = Some(ActivePass::new(plan, self.spp_done, 0));
-            while self.pass.is_some() {
-                let report = self.submit_band()?;
-                self.planner.record(report.samples, report.wall_seconds);
+            self.bands.start_pass(ActivePass { plan, sample_base: self.accumulation.spp_done, next_row: 0 });
+            while let Some(pass) = self.bands.pass().copied() {
+                let report = self.submit_band(pass)?;
+                self.bands.planner.record(report.samples, report.wall_seconds);
             }
             remaining -= plan.spp;
         }
@@ -223,47 +224,9 @@ impl PathTracer {
     }
 }
 impl PathTracer {
-    /// The height of an image with as many pixels as the next pass traces, for the planner,
-    /// which sizes passes by pixels: the image's, or with adaptive sampling the rows' worth of
-    /// pixels whose blocks are not done yet.
-    fn active_height(&self) -> u32 {
-        let camera = self.scene.camera;
-        match &self.allocation {
-            None => camera.height,
-            Some((allocation, _)) => {
-                let active = allocation.pixels_beyond(self.sample_offset + self.spp_done);
-                (active.div_ceil(u64::from(camera.width)) as u32).clamp(1, camera.height)
-            }
-        }
-    }
-
-    /// The rows from row `from` on that a pass starting at absolute sample index `start` traces:
-    /// (first, end), all rows to the image's end, or with adaptive sampling from the first to
-    /// the last block row with a block not done yet; `None` when no such row is left (a band
-    /// there would trace nothing, and its workgroups would still cost their dispatch).
-    pub(super) fn active_rows(&self, from: u32, start: u32) -> Option<(u32, u32)> {
-        let height = self.scene.camera.height;
-        if from >= height {
-            return None;
-        }
-        let Some((allocation, _)) = &self.allocation else {
-            return Some((from, height));
-        };
-        let (bx, by) = SampleAllocation::blocks(allocation.width, allocation.height);
-        let busy = |j: u32| {
-            allocation.samples[(j * bx) as usize..((j + 1) * bx) as usize].iter().any(|&n| n > start)
-        };
-        let first = (from / BLOCK..by).find(|&j| busy(j))?;
-        let last = (first..by).rev().find(|&j| busy(j)).expect("first is busy");
-        Some(((first * BLOCK).max(from), ((last + 1) * BLOCK).min(height)))
-    }
-
-    /// Rows of the image holding `rows` rows' worth of traced pixels: with adaptive sampling the
-    /// pixels still traced are spread over the whole image.
-    fn spread_rows(&self, rows: u32) -> u32 {
-        let height = self.scene.camera.height;
-        let active = self.active_height();
-        (u64::from(rows) * u64::from(height) / u64::from(active)).clamp(1, u64::from(height)) as u32
+    /// The absolute sample index the next pass starts at.
+    pub(super) fn next_sample(&self) -> u32 {
+        self.bands.sample_offset + self.accumulation.spp_done
     }
 }
 

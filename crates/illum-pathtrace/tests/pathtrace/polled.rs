@@ -1,11 +1,11 @@
 //! The ways a band comes back to the CPU fold the same samples: polled readback (what the web
-//! viewer uses, `PathTracer::set_polled_readback`) as the blocking one, and a reset while a band
+//! viewer uses, `Readback::Polled`) as the blocking one, and a reset while a band
 //! is in flight never folds that band; batch buffers mapped where the GPU wrote them (a device
 //! that shares the host's memory) as the staging copy a discrete GPU needs; and the caustic's
 //! light tracer, whose frames are polled dispatch by dispatch in the browser, gives the image of
 //! the blocking readback bit for bit.
 
-use illum_pathtrace::PathTracer;
+use illum_pathtrace::{PathTracer, Readback};
 use illum_scene::{Bounces, Sampling, Scene};
 
 use crate::common;
@@ -20,7 +20,9 @@ fn render(polled: bool, reset_after_first_step: bool) -> PathTracer {
     // One sample per chunk: each sample reaches the f64 fold as its own f32 value, so how the
     // samples were grouped into bands changes only the f64 rounding of the sums.
     tracer.set_chunk_samples(1);
-    tracer.set_polled_readback(polled);
+    if polled {
+        tracer.set_readback(Readback::Polled);
+    }
     let mut steps_without_samples = 0u64;
     if reset_after_first_step {
         tracer.render_step(Some(SPP)).expect("a step");
@@ -71,6 +73,29 @@ fn a_reset_while_a_band_is_in_flight_drops_that_band() {
     assert_same_image(&waited, &reset, "reset mid-flight against a fresh render");
 }
 
+/// A change of readback while a band is on the GPU (polled and in flight, or launched ahead of
+/// a caller that came straight back) drops that band, and its rows are traced again: the image
+/// is the one of a render read one way throughout. Passes of bands of 5 rows, so that a band
+/// is on the GPU between steps.
+#[test]
+fn a_change_of_readback_mid_pass_traces_the_dropped_band_again() {
+    let waited = render(false, false);
+    let scene = common::cornell(24, SPP, Bounces::Fixed(2), Sampling::Cosine, 5);
+    let mut tracer = PathTracer::new(common::gpu(), &scene).expect("path tracer builds");
+    tracer.set_chunk_samples(1);
+    tracer.limit_batch_bytes(5 * 24 * 16).expect("five rows of one chunk fit");
+    let mut modes =
+        [Readback::Polled, Readback::Staging, Readback::Polled, Readback::Mapped].into_iter().cycle();
+    while tracer.spp_done() < SPP {
+        tracer.set_readback(modes.next().expect("cycles"));
+        for _ in 0..3 {
+            tracer.render_step(Some(SPP)).expect("a step");
+        }
+    }
+    assert_same_image(&waited, &tracer, "readback changed mid-pass against waited");
+    assert_eq!(tracer.spp_done(), SPP);
+}
+
 /// Mapped readback, the default on lavapipe, against the staging copy, over passes split into
 /// bands of 5 rows: each band is traced while the one before it is folded, so the mapped form
 /// alternates between its two sets of batch buffers.
@@ -80,17 +105,21 @@ fn mapped_readback_folds_the_same_samples_as_the_staging_copy() {
         let scene = common::cornell(24, SPP, Bounces::Fixed(2), Sampling::Cosine, 5);
         let mut tracer = PathTracer::new(common::gpu(), &scene).expect("path tracer builds");
         tracer.set_chunk_samples(1);
-        tracer.set_mapped_readback(mapped);
+        tracer.set_readback(if mapped { Readback::Mapped } else { Readback::Staging });
         tracer.limit_batch_bytes(5 * 24 * 16).expect("five rows of one chunk fit");
         tracer.render_to_spp(SPP).expect("renders");
         tracer
     };
     let mapped = render(true);
     if common::gpu().adapter_info.device_type == illum_gpu::wgpu::DeviceType::Cpu {
-        assert!(mapped.mapped_readback(), "a software driver shares the host's memory: bands are mapped");
+        assert_eq!(
+            mapped.readback(),
+            Readback::Mapped,
+            "a software driver shares the host's memory: bands are mapped"
+        );
     }
     let copied = render(false);
-    assert!(!copied.mapped_readback());
+    assert_eq!(copied.readback(), Readback::Staging);
     assert_same_image(&mapped, &copied, "mapped against copied");
     assert_eq!(mapped.spp_done(), SPP);
 }
@@ -114,7 +143,9 @@ const CAUSTIC_SPP: u32 = 40;
 fn render_caustic(scene: &Scene, polled: bool, reset_after_first_step: bool) -> (PathTracer, u64) {
     let mut tracer = PathTracer::new(common::gpu(), scene).expect("path tracer builds");
     tracer.set_chunk_aligned_passes(true);
-    tracer.set_polled_readback(polled);
+    if polled {
+        tracer.set_readback(Readback::Polled);
+    }
     if reset_after_first_step {
         let first = tracer.render_step(Some(CAUSTIC_SPP)).expect("a step");
         assert_eq!(first.samples, 0, "a polled first step only submits the caustic's frames");
