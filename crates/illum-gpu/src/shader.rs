@@ -95,6 +95,11 @@ pub fn compose(
         .map_err(|e| GpuError::Shader { file: entry.path.to_string(), message: e.emit_to_string(&composer) })
 }
 
+/// The shader defs `#ifdef NAME` for the flags that are on, in the given order.
+pub fn flag_defs(flags: &[(&'static str, bool)]) -> Vec<(&'static str, Def)> {
+    flags.iter().filter(|&&(_, on)| on).map(|&(name, _)| (name, Def::Bool(true))).collect()
+}
+
 /// Validates a composed module with naga's validator (all capabilities wgpu's core needs).
 pub fn validate(module: &naga::Module, file: &str) -> Result<naga::valid::ModuleInfo, GpuError> {
     naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default())

@@ -97,7 +97,7 @@ impl Specialisation {
             ("PAIRED_PATHS", options.paired_paths && options.traversal == Traversal::Specialised),
             ("ADAPTIVE", self.adaptive),
         ];
-        flags.into_iter().filter(|&(_, on)| on).map(|(name, _)| (name, Def::Bool(true))).collect()
+        illum_gpu::shader::flag_defs(&flags)
     }
 }
 

@@ -70,7 +70,7 @@ impl Specialisation {
             ("POINT_LIGHTS", self.point_lights),
         ];
         let mut defs = vec![("WHITTED_STACK", Def::UInt(self.stack))];
-        defs.extend(flags.into_iter().filter(|&(_, on)| on).map(|(name, _)| (name, Def::Bool(true))));
+        defs.extend(illum_gpu::shader::flag_defs(&flags));
         defs
     }
 }
