@@ -23,6 +23,8 @@ pub const SCENE_MODULE: ShaderFile = shader_file!("shaders/scene.wgsl");
 pub const SURFACES_MODULE: ShaderFile = shader_file!("shaders/surfaces.wgsl");
 /// The caustic's light tracer (entry point `main`; shader def CAUSTIC).
 pub const CAUSTIC_SHADER: ShaderFile = shader_file!("shaders/caustic.wgsl");
+/// The denoiser's guide buffers (entry point `main`; tracer/guides.rs).
+pub const GUIDES_SHADER: ShaderFile = shader_file!("shaders/guides.wgsl");
 /// The generic material lookup (a read of the material buffer).
 pub const GENERIC_MATERIALS: ShaderFile = shader_file!("shaders/materials.wgsl");
 /// The generic traversal (a loop over the object buffer).
@@ -97,6 +99,21 @@ pub(crate) fn caustic_pipeline(
     Ok(shader::compute_pipeline(gpu, &modules, &CAUSTIC_SHADER, &defs, "caustic light-tracing")?)
 }
 
+/// The guide-buffer pipeline for `scene` (tracer/guides.rs), built from the same modules and
+/// defs as its path-tracing pipeline without adaptive sampling, so that it follows the same
+/// specular chains with the same numbers.
+pub(crate) fn guides_pipeline(
+    gpu: &GpuContext,
+    scene: &Scene,
+    gpu_scene: &GpuScene,
+    options: TracerOptions,
+) -> Result<wgpu::ComputePipeline, PathTraceError> {
+    let specialisation = Specialisation { scene: gpu_scene.code, options, adaptive: false };
+    let modules = shader_modules(scene, gpu_scene, options.traversal);
+    let defs = specialisation.shader_defs();
+    Ok(shader::compute_pipeline(gpu, &modules, &GUIDES_SHADER, &defs, "guide buffers")?)
+}
+
 #[cfg(test)]
 mod tests {
     use std::mem::size_of;
@@ -141,8 +158,8 @@ mod tests {
 
     /// naga validates each sampling module on its own (as the import of a trivial entry point),
     /// the path tracer generic and specialised for every scene file under both sequences, with
-    /// and without pairs and adaptive sampling, each with its scene's code, and the display-sum
-    /// pass.
+    /// and without pairs and adaptive sampling, each with its scene's code, its guide-buffer pass,
+    /// and the display-sum pass.
     #[test]
     fn every_pathtrace_shader_composes_and_validates() {
         shader::validate_each_module(SAMPLING_MODULES).unwrap_or_else(|e| panic!("{e}"));
@@ -163,6 +180,13 @@ mod tests {
                             &specialisation.shader_defs(),
                         );
                     }
+                    // The guide buffers (tracer/guides.rs), with the scene's code.
+                    let options = TracerOptions { traversal, sequence, paired_paths: false };
+                    compose_and_validate(
+                        &shader_modules(&scene, &gpu_scene, traversal),
+                        &GUIDES_SHADER,
+                        &Specialisation { scene: gpu_scene.code, options, adaptive: false }.shader_defs(),
+                    );
                     if gpu_scene.code.caustic {
                         let options = TracerOptions { traversal, sequence, paired_paths: false };
                         let specialisation =
@@ -180,7 +204,7 @@ mod tests {
     }
 
     /// Every consistent combination of the scene code's flags composes and validates, for the
-    /// integrator and (where the caustic is on) the light tracer, without a GPU: the code behind
+    /// integrator, the guide buffers and (where the caustic is on) the light tracer, without a GPU: the code behind
     /// each `#ifdef` is checked before any scene file happens to need it. The generic modules
     /// make the combinations independent of any one scene's geometry.
     #[test]
@@ -216,12 +240,15 @@ mod tests {
             let defs = Specialisation { scene: code, options, adaptive: false }.shader_defs();
             compose_and_validate(&modules, &PATHTRACE_SHADER, &defs);
             composed += 1;
+            // The guide buffers, composed with the same defs (tracer/guides.rs).
+            compose_and_validate(&modules, &GUIDES_SHADER, &defs);
+            composed += 1;
             if code.caustic {
                 compose_and_validate(&modules, &CAUSTIC_SHADER, &defs);
                 composed += 1;
             }
         }
-        assert!(composed > 300, "{composed} compositions");
+        assert!(composed > 600, "{composed} compositions");
     }
 
     #[test]

@@ -25,6 +25,7 @@ use crate::{Accumulator, PathTraceError, SampleAllocation, limits};
 
 mod accumulation;
 mod caustic;
+mod guides;
 mod passes;
 mod pipeline;
 mod runner;
@@ -32,6 +33,7 @@ mod submit;
 
 use accumulation::Accumulation;
 pub use caustic::{CausticParams, bounding_sphere, fixed_point};
+pub use guides::{GUIDE_SAMPLES, Guides};
 use pipeline::ScenePipeline;
 use runner::BandRunner;
 pub use runner::Readback;
