@@ -5,9 +5,11 @@
 //     w_luminance = exp(-|L_p - L_q| / (SIGMA_LUMINANCE sigma_p + TINY)),
 //     w_normal    = max(0, n_p . n_q)^NORMAL_POWER (1 where neither has a normal, 0 where one has),
 //     w_albedo    = exp(-|a_p - a_q|^2 / SIGMA_ALBEDO^2),
-// with sigma_p the standard error of p's luminance, from its variance blurred over 3 x 3 pixels
-// (a variance from few samples is itself noisy). A pixel whose standard error is 0 (converged)
-// takes nothing from a neighbour of another luminance: it is left alone. The variance is
+// with sigma_p the standard error of p's luminance: the square root of the smaller of its own
+// variance and that variance blurred over 3 x 3 pixels (a variance from few samples is itself
+// noisy, and the edge of a light, where a pixel's own variance is large, must not take in the
+// dark ceiling). A pixel whose variance is 0 (converged, or every sample the same) takes
+// nothing from a neighbour of another luminance: it is left alone. The variance is
 // carried along as that of the weighted mean of independent pixels, sum w^2 var / (sum w)^2.
 // crates/illum-denoise/src/reference.rs is the f64 CPU copy the GPU output is tested against.
 
@@ -87,7 +89,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let lp = dot(centre.xyz, LUMINANCE);
     let ap = albedo[p].xyz;
     let np = normal[p].xyz;
-    let scale = params.sigma_luminance * sqrt(blurred_variance(x, y)) + TINY;
+    let scale = params.sigma_luminance * sqrt(min(centre.w, blurred_variance(x, y))) + TINY;
     let step = i32(params.step);
     var sum = vec3<f32>(0.0);
     var weights = 0.0;

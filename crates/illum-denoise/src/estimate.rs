@@ -3,11 +3,14 @@
 //!     E (D(A) - B)^2 = E (D(A) - I)^2 + Var(B),
 //! with I the converged image, pixel by pixel: the squared difference from the other half, less
 //! that half's variance, is an unbiased estimate of D(A)'s mean squared error, bias included.
-//! Var(B) comes from B's own sample variance (`Accumulator::pixel_variance_of_mean`); a pixel
-//! with fewer than 2 samples in a half uses (A - B)^2 / 2, whose expectation is Var(B) when the
-//! halves have equal counts. Each term is divided by (den^2 + 1e-2), den the mean of D(A) and
-//! D(B), as relMSE divides by the reference's (`illum_image::metrics::rel_mse`); both halves
-//! swap roles and the two estimates are averaged.
+//! Var(B) comes from B's own sample variance (`Accumulator::pixel_variance_of_mean`), so each
+//! half needs 2 samples: below that the estimate is infinite (unknown), as the raw image's is
+//! below 2 spp. Each term is divided by (den^2 + 1e-2), den the raw mean of both
+//! halves (an unbiased estimate of the converged pixel), as relMSE divides by the reference's
+//! (`illum_image::metrics::rel_mse`); both halves swap roles and the two estimates are
+//! averaged. (Not the denoised image: where the filter darkens a pixel that truly is bright,
+//! the edge of a light, its own value in the denominator would inflate that pixel's term
+//! a hundredfold.)
 //!
 //! What it estimates is the error of a denoised half. The image a render writes is the
 //! denoised whole, from twice the samples, whose error is lower: the estimate is conservative
@@ -20,7 +23,7 @@ use illum_image::metrics::REL_MSE_EPSILON;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HalvesError {
     /// Estimated relMSE of a denoised half (mean of the two directions); may come out slightly
-    /// negative by chance when the true value is near 0.
+    /// negative by chance when the true value is near 0; infinite below 2 samples per half.
     pub rel_mse: f64,
 }
 
@@ -33,12 +36,17 @@ impl HalvesError {
         (b, var_b, db): (&RgbImage32, &RgbImage32, &RgbImage32),
     ) -> Self {
         let den = RgbImage32 {
-            width: da.width,
-            height: da.height,
-            pixels: da.pixels.iter().zip(&db.pixels).map(|(x, y)| [0, 1, 2].map(|c| 0.5 * (x[c] + y[c]))).collect(),
+            width: a.width,
+            height: a.height,
+            pixels: a
+                .pixels
+                .iter()
+                .zip(&b.pixels)
+                .map(|(x, y)| [0, 1, 2].map(|c| 0.5 * (x[c] + y[c])))
+                .collect(),
         };
-        let forward = halves_rel_mse(da, b, var_b, a, &den);
-        let backward = halves_rel_mse(db, a, var_a, b, &den);
+        let forward = halves_rel_mse(da, b, var_b, &den);
+        let backward = halves_rel_mse(db, a, var_a, &den);
         HalvesError { rel_mse: 0.5 * (forward + backward) }
     }
 
@@ -49,13 +57,13 @@ impl HalvesError {
     }
 }
 
-/// One direction: the estimated relMSE of `denoised` (made from `own`, the other half) against
-/// the half `other` with variances of the mean `other_variance`, relative to `den`.
+/// One direction: the estimated relMSE of `denoised` against the independent half `other`
+/// with variances of the mean `other_variance`, relative to `den`. Infinite where a variance
+/// is (fewer than 2 samples).
 pub fn halves_rel_mse(
     denoised: &RgbImage32,
     other: &RgbImage32,
     other_variance: &RgbImage32,
-    own: &RgbImage32,
     den: &RgbImage32,
 ) -> f64 {
     let mut total = 0.0;
@@ -64,10 +72,11 @@ pub fn halves_rel_mse(
             let d = f64::from(denoised.pixels[p][c]);
             let b = f64::from(other.pixels[p][c]);
             let v = f64::from(other_variance.pixels[p][c]);
-            let variance =
-                if v.is_finite() { v } else { 0.5 * (f64::from(own.pixels[p][c]) - b).powi(2) };
+            if !v.is_finite() {
+                return f64::INFINITY;
+            }
             let r = f64::from(den.pixels[p][c]);
-            total += ((d - b).powi(2) - variance) / (r * r + REL_MSE_EPSILON);
+            total += ((d - b).powi(2) - v) / (r * r + REL_MSE_EPSILON);
         }
     }
     total / (3 * denoised.pixels.len().max(1)) as f64

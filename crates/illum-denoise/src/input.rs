@@ -28,8 +28,9 @@ impl DenoiseInput {
             (guides.width, guides.height),
             "guides of another resolution than the image"
         );
-        let variance =
-            (0..image.pixels.len()).map(|p| luminance_variance(accumulator.pixel_variance_of_mean(p))).collect();
+        let variance = (0..image.pixels.len())
+            .map(|p| luminance_variance(accumulator.pixel_variance_of_mean(p)))
+            .collect();
         DenoiseInput { image, variance, albedo: guides.albedo.clone(), normal: guides.normal.clone() }
     }
 

@@ -37,7 +37,7 @@ pub fn denoise(input: &DenoiseInput, settings: &AtrousSettings) -> (RgbImage32, 
                         blurred += ((2 - dx.abs()) * (2 - dy.abs())) as f64 / 16.0 * current[q].1;
                     }
                 }
-                let scale = f64::from(settings.sigma_luminance) * blurred.sqrt() + TINY;
+                let scale = f64::from(settings.sigma_luminance) * current[p].1.min(blurred).sqrt() + TINY;
                 let sigma_albedo = f64::from(settings.sigma_albedo);
                 let (mut sum, mut weights, mut variance) = ([0.0; 3], 0.0, 0.0);
                 for j in -2i64..=2 {

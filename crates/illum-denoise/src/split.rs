@@ -7,13 +7,13 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use illum_gpu::GpuContext;
 use illum_image::RgbImage32;
-use illum_pathtrace::{Accumulator, Guides, PathTracer, TracerOptions};
+use illum_pathtrace::{Accumulator, GUIDE_SAMPLES, Guides, PathTracer, TracerOptions};
 use illum_scene::Scene;
 
+use crate::DenoiseError;
 use crate::atrous::{AtrousDenoiser, AtrousSettings};
 use crate::estimate::HalvesError;
 use crate::input::DenoiseInput;
-use crate::DenoiseError;
 
 /// The second half's first sample index: far beyond any render's samples of the first half.
 pub const SECOND_HALF: u32 = 1 << 31;
@@ -73,9 +73,15 @@ impl SplitRender {
     }
 
     /// Denoises both halves and the whole with the à-trous filter, and estimates the error.
-    pub fn denoise(&self, filter: &AtrousDenoiser, settings: &AtrousSettings) -> Result<Denoised, DenoiseError> {
+    pub fn denoise(
+        &self,
+        filter: &AtrousDenoiser,
+        settings: &AtrousSettings,
+    ) -> Result<Denoised, DenoiseError> {
         let clock = std::time::Instant::now();
-        let guides = self.a.guides(self.a.spp_done().max(1))?;
+        // The most samples the guides take (the first half's first GUIDE_SAMPLES sample indices,
+        // rendered or not): a guide's noise only blurs less, and the pass is cheap.
+        let guides = self.a.guides(GUIDE_SAMPLES)?;
         let guide_seconds = clock.elapsed().as_secs_f64();
         let clock = std::time::Instant::now();
         let (a, b) = (self.a.accumulator(), self.b.accumulator());

@@ -42,7 +42,9 @@ pub use progressive::{
     parse_time_budget,
 };
 pub use shaders::{
-    CAUSTIC_SHADER, GENERIC_LIGHT_CHOICE, GUIDES_SHADER, GENERIC_MATERIALS, GENERIC_TRAVERSAL, PATHTRACE_SHADER,
-    SAMPLING_MODULES, SCENE_MODULE, SURFACES_MODULE, shader_modules,
+    CAUSTIC_SHADER, GENERIC_LIGHT_CHOICE, GENERIC_MATERIALS, GENERIC_TRAVERSAL, GUIDES_SHADER,
+    PATHTRACE_SHADER, SAMPLING_MODULES, SCENE_MODULE, SURFACES_MODULE, shader_modules,
 };
-pub use tracer::{CausticParams, GUIDE_SAMPLES, Guides, PathTracer, Readback, StepReport, bounding_sphere, fixed_point};
+pub use tracer::{
+    CausticParams, GUIDE_SAMPLES, Guides, PathTracer, Readback, StepReport, bounding_sphere, fixed_point,
+};

@@ -7,9 +7,9 @@
 
 #[cfg(not(target_arch = "wasm32"))]
 use illum_gpu::buffers::{buffer_bind_group, dispatch};
-use illum_gpu::wgpu;
 #[cfg(not(target_arch = "wasm32"))]
 use illum_gpu::readback;
+use illum_gpu::wgpu;
 #[cfg(not(target_arch = "wasm32"))]
 use wgpu::util::DeviceExt;
 
@@ -96,7 +96,13 @@ impl PathTracer {
         let layout = compute.get_bind_group_layout(0);
         let bind_group = buffer_bind_group(device, "guide buffers", &layout, &bound);
         let mut encoder = device.create_command_encoder(&Default::default());
-        dispatch(&mut encoder, "guide buffers", &compute, &bind_group, [width.div_ceil(8), height.div_ceil(8), 1]);
+        dispatch(
+            &mut encoder,
+            "guide buffers",
+            &compute,
+            &bind_group,
+            [width.div_ceil(8), height.div_ceil(8), 1],
+        );
         gpu.queue.submit([encoder.finish()]);
         let read = |buffer: &wgpu::Buffer| -> Result<Vec<[f32; 3]>, PathTraceError> {
             let bytes = readback::read_buffer(gpu, buffer, 0, bytes, "reading back the guide buffers")?;
