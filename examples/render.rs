@@ -6,7 +6,7 @@
 //! cargo run --release --example render -- [SCENE] [--spp N] [--bounces B|unbounded] [--seed S]
 //!     [--width W --height H] [--sampling cosine|uniform] [-o FILE.png|FILE.exr]...
 //!     [--target-error X] [--time-budget SECONDS] [--encoding gamma2.2|srgb] [--exposure STOPS]
-//!     [--caustics on|off]
+//!     [--caustics on|off] [--denoise atrous|oidn]
 //! ```
 //! With no arguments it renders `scenes/cornell.toml` to `out/cornell.png` and `out/cornell.exr`.
 //! `--renderer raster|pathtrace` picks the renderer; the default is the scene file's `renderer`
@@ -130,6 +130,15 @@ struct Args {
     /// that merged ranges give the image of one render.
     #[arg(long, value_name = "A..B", value_parser = illum_cli::sample_range_arg)]
     sample_range: Option<std::ops::Range<u32>>,
+    /// Path-tracer scenes: denoise the image (`atrous`: the edge-avoiding à-trous filter on the
+    /// GPU; `oidn`: Intel Open Image Denoise, not in this build). The render is kept as two
+    /// independent halves, and the denoised image's error is estimated from them
+    /// (docs/denoising.md): it is the `illum.estimated_relative_error` written and the one
+    /// --target-error stops at. The EXR holds the denoised image, and layers `noisy`, `albedo`
+    /// and `normal`. --spp is rounded up to an even number. Not with --resume, --sample-range,
+    /// --adaptive or --checkpoint-seconds.
+    #[arg(long, value_name = "atrous|oidn", value_parser = denoiser_arg)]
+    denoise: Option<illum_cli::denoise::DenoiserKind>,
     /// Path-tracer scenes: adaptive sampling. A pilot of 16 spp (another seed, then discarded)
     /// measures the noise of every 8 x 8 block of pixels, and the --spp budget is spread over
     /// the blocks in proportion to it: the spp is then the mean over the image (docs/accuracy.md, "Adaptive sampling").
@@ -155,6 +164,10 @@ const DEFAULT_CHECKPOINT: Duration = Duration::from_secs(60);
 
 fn main() {
     illum_cli::main_with(run);
+}
+
+fn denoiser_arg(text: &str) -> Result<illum_cli::denoise::DenoiserKind, String> {
+    text.parse()
 }
 
 /// Fills the image-changing settings not given on the command line from a checkpoint's
@@ -196,6 +209,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         (args.sample_range.is_some(), "--sample-range"),
         (args.checkpoint_seconds.is_some(), "--checkpoint-seconds"),
         (args.adaptive, "--adaptive"),
+        (args.denoise.is_some(), "--denoise"),
     ]);
     if renderer == RendererKind::Whitted {
         let mut other_flags = path_tracer_only.clone();
@@ -259,6 +273,21 @@ fn run(args: Args) -> anyhow::Result<()> {
         );
     }
     // Checked before the stop rules are announced: a refused render announces nothing.
+    if args.denoise.is_some() {
+        let conflicting = illum_cli::given_flags(&[
+            (args.resume.is_some(), "--resume"),
+            (args.sample_range.is_some(), "--sample-range"),
+            (args.adaptive, "--adaptive"),
+            (args.checkpoint_seconds.is_some(), "--checkpoint-seconds"),
+        ]);
+        if !conflicting.is_empty() {
+            anyhow::bail!(
+                "--denoise renders two independent halves of the samples and writes a denoised image, not a \
+                 checkpoint, so it cannot be combined with {}",
+                conflicting.join(" or ")
+            );
+        }
+    }
     if args.adaptive {
         let conflicting = illum_cli::given_flags(&[
             (args.resume.is_some(), "--resume"),
@@ -388,6 +417,27 @@ fn run(args: Args) -> anyhow::Result<()> {
     long.exit_if_requested("before the render started");
     let gpu = illum_cli::gpu()?;
     let options = TracerOptions { sequence, ..Default::default() };
+    if let Some(denoiser) = args.denoise {
+        let reason = illum_cli::denoise::render_denoised(&illum_cli::denoise::DenoiseRequest {
+            gpu: &gpu,
+            scene: &scene,
+            options,
+            rules,
+            denoiser,
+            cancel: interrupt.flag(),
+            outputs: &outputs,
+            encoding: args.encoding,
+            exposure: args.exposure,
+        })?;
+        if let Some((signal, code)) = interrupt.exit_status() {
+            eprintln!("stopped by {signal}: exiting with status {code}");
+            std::process::exit(code);
+        }
+        if reason.is_none() {
+            anyhow::bail!("the denoised render stopped before its first round");
+        }
+        return Ok(());
+    }
     let mut tracer = if args.adaptive {
         // Built with the adaptive pipeline, which plan_adaptive's pilot runs (every block
         // unlimited until it sets the allocation): one compilation instead of two.

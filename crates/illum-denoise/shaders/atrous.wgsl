@@ -3,7 +3,8 @@
 // lie `step` pixels apart (1, 2, 4, ... over the iterations), each tap weighed by
 //     h(dx) h(dy) w_luminance w_normal w_albedo,
 //     w_luminance = exp(-|L_p - L_q| / (SIGMA_LUMINANCE sigma_p + TINY)),
-//     w_normal    = max(0, n_p . n_q)^NORMAL_POWER (1 where neither has a normal, 0 where one has),
+//     w_normal    = max(0, n_p . n_q)^NORMAL_POWER (1 where neither has a normal, 0 where one has;
+//                   the normals arrive as unit vectors, w = 1, or zero, w = 0: atrous.rs),
 //     w_albedo    = exp(-|a_p - a_q|^2 / SIGMA_ALBEDO^2),
 // with sigma_p the standard error of p's luminance: the square root of the smaller of its own
 // variance and that variance blurred over 3 x 3 pixels (a variance from few samples is itself
@@ -29,13 +30,12 @@ const NORMAL_SQUARINGS: u32 = 7u;
 // Keeps the luminance stop's division finite at a standard error of 0.
 const TINY: f32 = 1.0e-10;
 const LUMINANCE: vec3<f32> = vec3<f32>(0.2126, 0.7152, 0.0722);
-// Unit normals shorter than this are "no normal" (a ray that left the scene).
-const NO_NORMAL: f32 = 1.0e-3;
 
 @group(0) @binding(0) var<uniform> params: Params;
 // rgb = the image, w = the variance of its luminance.
 @group(0) @binding(1) var<storage, read> input: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read> albedo: array<vec4<f32>>;
+// xyz = the unit normal and w = 1, or 0 and 0 where there is none.
 @group(0) @binding(3) var<storage, read> normal: array<vec4<f32>>;
 @group(0) @binding(4) var<storage, read_write> output: array<vec4<f32>>;
 
@@ -49,17 +49,14 @@ fn index(x: i32, y: i32) -> u32 {
     return u32(y) * params.width + u32(x);
 }
 
-fn normal_weight(p: vec3<f32>, q: vec3<f32>) -> f32 {
-    let lp = length(p);
-    let lq = length(q);
-    if (lp < NO_NORMAL || lq < NO_NORMAL) {
-        return select(0.0, 1.0, lp < NO_NORMAL && lq < NO_NORMAL);
-    }
-    var c = max(dot(p, q) / (lp * lq), 0.0);
+// Without branches: a missing normal is the zero vector, so c = 0 where one is missing, and
+// (1 - p.w)(1 - q.w) is 1 exactly where both are.
+fn normal_weight(p: vec4<f32>, q: vec4<f32>) -> f32 {
+    var c = max(dot(p.xyz, q.xyz), 0.0);
     for (var i = 0u; i < NORMAL_SQUARINGS; i++) {
         c = c * c;
     }
-    return c;
+    return c + (1.0 - p.w) * (1.0 - q.w);
 }
 
 // The 3 x 3 binomial blur (1 2 1) x (1 2 1) / 16 of the variance around (x, y), clamped at the
@@ -88,26 +85,26 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let centre = input[p];
     let lp = dot(centre.xyz, LUMINANCE);
     let ap = albedo[p].xyz;
-    let np = normal[p].xyz;
+    let np = normal[p];
     let scale = params.sigma_luminance * sqrt(min(centre.w, blurred_variance(x, y))) + TINY;
+    let inv_sigma_albedo2 = 1.0 / (params.sigma_albedo * params.sigma_albedo);
     let step = i32(params.step);
+    let last = vec2<i32>(i32(params.width) - 1, i32(params.height) - 1);
     var sum = vec3<f32>(0.0);
     var weights = 0.0;
     var variance = 0.0;
     for (var j = -2; j <= 2; j++) {
         for (var i = -2; i <= 2; i++) {
-            let qx = x + i * step;
-            let qy = y + j * step;
-            if (qx < 0 || qy < 0 || qx >= i32(params.width) || qy >= i32(params.height)) {
-                continue;
-            }
-            let q = index(qx, qy);
+            // Straight code: a tap outside the image reads the clamped pixel and weighs 0.
+            let tap = vec2<i32>(x + i * step, y + j * step);
+            let inside = all(tap >= vec2<i32>(0)) && all(tap <= last);
+            let t = clamp(tap, vec2<i32>(0), last);
+            let q = index(t.x, t.y);
             let c = input[q];
             let da = ap - albedo[q].xyz;
-            let w = kernel(i) * kernel(j)
-                * exp(-abs(lp - dot(c.xyz, LUMINANCE)) / scale)
-                * normal_weight(np, normal[q].xyz)
-                * exp(-dot(da, da) / (params.sigma_albedo * params.sigma_albedo));
+            // The luminance and albedo stops in one exp.
+            let stops = exp(-abs(lp - dot(c.xyz, LUMINANCE)) / scale - dot(da, da) * inv_sigma_albedo2);
+            let w = select(0.0, kernel(i) * kernel(j) * stops * normal_weight(np, normal[q]), inside);
             sum += w * c.xyz;
             weights += w;
             variance += w * w * c.w;

@@ -16,10 +16,23 @@ use crate::input::DenoiseInput;
 /// One iteration of the filter (entry point `main`).
 pub const ATROUS_SHADER: ShaderFile = shader_file!("shaders/atrous.wgsl");
 
-/// The shader's constants (its `NORMAL_SQUARINGS`, `TINY`, `NO_NORMAL`; tested to agree).
+/// The shader's constants (its `NORMAL_SQUARINGS` and `TINY`; tested to agree).
 pub const NORMAL_POWER: i32 = 128;
 pub const TINY: f64 = 1.0e-10;
+/// A mean normal shorter than this is "no normal" (the pixel's rays left the scene).
 pub const NO_NORMAL: f32 = 1.0e-3;
+
+/// The normals as the filter reads them: unit vectors with w = 1, or zero with w = 0 where a
+/// pixel has none (shorter than [`NO_NORMAL`]).
+pub fn unit_normals(normals: &[[f32; 3]]) -> Vec<[f32; 4]> {
+    normals
+        .iter()
+        .map(|n| {
+            let length = n.iter().map(|v| v * v).sum::<f32>().sqrt();
+            if length < NO_NORMAL { [0.0; 4] } else { [n[0] / length, n[1] / length, n[2] / length, 1.0] }
+        })
+        .collect()
+}
 
 /// The filter's settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -94,7 +107,7 @@ impl AtrousDenoiser {
         let colour =
             vec4(&mut input.image.pixels.iter().zip(&input.variance).map(|(c, &v)| [c[0], c[1], c[2], v]));
         let albedo = vec4(&mut input.albedo.iter().map(|a| [a[0], a[1], a[2], 0.0]));
-        let normal = vec4(&mut input.normal.iter().map(|n| [n[0], n[1], n[2], 0.0]));
+        let normal = vec4(&mut unit_normals(&input.normal).into_iter());
         let iterations = settings.iterations.max(1);
         let (ping, pong, albedo, normal, params) = gpu.scoped("allocating the denoiser's buffers", || {
             let storage = |label: &str, contents: &[u8]| {
@@ -186,6 +199,5 @@ mod tests {
         };
         assert_eq!(2f64.powf(constant("NORMAL_SQUARINGS")), f64::from(NORMAL_POWER));
         assert_eq!(constant("TINY") as f32, TINY as f32);
-        assert_eq!(constant("NO_NORMAL") as f32, NO_NORMAL);
     }
 }

@@ -4,7 +4,7 @@
 use illum_image::RgbImage32;
 use illum_image::rgb_image::REC709_LUMINANCE;
 
-use crate::atrous::{AtrousSettings, NO_NORMAL, NORMAL_POWER, TINY};
+use crate::atrous::{AtrousSettings, NORMAL_POWER, TINY, unit_normals};
 use crate::input::DenoiseInput;
 
 /// One pixel of a pass: its colour and its luminance's variance.
@@ -21,7 +21,7 @@ pub fn denoise(input: &DenoiseInput, settings: &AtrousSettings) -> (RgbImage32, 
         .map(|(c, &v)| (c.map(f64::from), f64::from(v)))
         .collect();
     let albedo: Vec<[f64; 3]> = input.albedo.iter().map(|a| a.map(f64::from)).collect();
-    let normal: Vec<[f64; 3]> = input.normal.iter().map(|n| n.map(f64::from)).collect();
+    let normal: Vec<[f64; 4]> = unit_normals(&input.normal).iter().map(|n| n.map(f64::from)).collect();
     for iteration in 0..settings.iterations {
         let step = 1i64 << iteration;
         let index = |x: i64, y: i64| (y * width + x) as usize;
@@ -83,13 +83,7 @@ fn kernel(i: i64) -> f64 {
     [0.0625, 0.25, 0.375, 0.25, 0.0625][(i + 2) as usize]
 }
 
-fn normal_weight(p: [f64; 3], q: [f64; 3]) -> f64 {
-    let length = |n: [f64; 3]| n.iter().map(|v| v * v).sum::<f64>().sqrt();
-    let (lp, lq) = (length(p), length(q));
-    let none = f64::from(NO_NORMAL);
-    if lp < none || lq < none {
-        return if lp < none && lq < none { 1.0 } else { 0.0 };
-    }
-    let cos = (p[0] * q[0] + p[1] * q[1] + p[2] * q[2]) / (lp * lq);
-    cos.max(0.0).powi(NORMAL_POWER)
+fn normal_weight(p: [f64; 4], q: [f64; 4]) -> f64 {
+    let cos = p[0] * q[0] + p[1] * q[1] + p[2] * q[2];
+    cos.max(0.0).powi(NORMAL_POWER) + (1.0 - p[3]) * (1.0 - q[3])
 }

@@ -201,6 +201,58 @@ pub struct U32Layer {
     pub channels: Vec<(String, Vec<u32>)>,
 }
 
+/// An extra EXR layer of 32-bit float channels, stored after the RGB image (a multi-part file),
+/// such as a denoiser's guide buffers (`albedo`, `normal`). Other EXR readers show the RGB
+/// image and list the layer.
+#[derive(Clone, Debug, PartialEq)]
+pub struct F32Layer {
+    /// The layer's name (the part's `name` attribute).
+    pub name: String,
+    /// Channel names and their values, row-major like the image (one per pixel each).
+    pub channels: Vec<(String, Vec<f32>)>,
+}
+
+/// As [`save_exr`], plus float `layers` after the RGB image, all in one atomic write.
+pub fn save_exr_with_f32_layers(
+    path: impl AsRef<Path>,
+    image: &RgbImage32,
+    metadata: &ExrMetadata,
+    layers: Vec<F32Layer>,
+) -> Result<(), ImageError> {
+    let path = path.as_ref();
+    if layers.is_empty() {
+        return save_exr(path, image, metadata);
+    }
+    check_writable(path, image)?;
+    let layers = layers
+        .into_iter()
+        .map(|l| Part {
+            name: l.name,
+            channels: l.channels.into_iter().map(|(n, v)| (n, exr::prelude::FlatSamples::F32(v))).collect(),
+        })
+        .collect();
+    write_atomically(path, |file| encode_with_layers(path, image, metadata, layers, file))
+}
+
+/// An extra part of the file: its name and its channels.
+struct Part {
+    name: String,
+    channels: Vec<(String, exr::prelude::FlatSamples)>,
+}
+
+impl From<U32Layer> for Part {
+    fn from(layer: U32Layer) -> Self {
+        Part {
+            name: layer.name,
+            channels: layer
+                .channels
+                .into_iter()
+                .map(|(n, v)| (n, exr::prelude::FlatSamples::U32(v)))
+                .collect(),
+        }
+    }
+}
+
 /// As [`save_exr`], plus `layers` after the RGB image, all in one atomic write. The RGB layer
 /// is named `rgb` when there are extra layers (a multi-part file needs names).
 pub fn save_exr_with_layers(
@@ -214,6 +266,7 @@ pub fn save_exr_with_layers(
         return save_exr(path, image, metadata);
     }
     check_writable(path, image)?;
+    let layers = layers.into_iter().map(Part::from).collect();
     write_atomically(path, |file| encode_with_layers(path, image, metadata, layers, file))
 }
 
@@ -228,6 +281,7 @@ pub fn exr_bytes_with_layers(
     let path = Path::new(name);
     check_writable(path, image)?;
     let mut out = std::io::Cursor::new(Vec::new());
+    let layers = layers.into_iter().map(Part::from).collect();
     encode_with_layers(path, image, metadata, layers, &mut out)?;
     Ok(out.into_inner())
 }
@@ -239,7 +293,7 @@ fn encode_with_layers<W: std::io::Write + std::io::Seek>(
     path: &Path,
     image: &RgbImage32,
     metadata: &ExrMetadata,
-    layers: Vec<U32Layer>,
+    layers: Vec<Part>,
     out: W,
 ) -> Result<(), ImageError> {
     use exr::prelude::{AnyChannel, AnyChannels, FlatSamples};
@@ -280,11 +334,8 @@ fn encode_with_layers<W: std::io::Write + std::io::Seek>(
     );
     let mut all = vec![rgb];
     for layer in layers {
-        let channels = layer
-            .channels
-            .into_iter()
-            .map(|(name, values)| AnyChannel::new(name.as_str(), FlatSamples::U32(values)))
-            .collect();
+        let channels =
+            layer.channels.into_iter().map(|(name, values)| AnyChannel::new(name.as_str(), values)).collect();
         all.push(Layer::new(
             size,
             LayerAttributes::named(text(&layer.name)),

@@ -21,9 +21,10 @@ use crate::gpu_scene::GpuScene;
 use crate::{PathTraceError, shaders};
 
 /// Samples per pixel the guides average at most: albedo and normal are bounded and mostly
-/// constant over a pixel, so their mean settles long before the radiance's does; the cap keeps
-/// the pass a small fraction of a long render (docs/denoising.md).
-pub const GUIDE_SAMPLES: u32 = 64;
+/// constant over a pixel, so their mean settles long before the radiance's does. On lavapipe a
+/// guide sample costs about a fifth of a path (the camera ray and its specular chain only), so
+/// 16 of them cost about 3 spp of the path tracer (docs/denoising.md).
+pub const GUIDE_SAMPLES: u32 = 16;
 
 /// The guide buffers of an image, row-major like it.
 #[derive(Clone, Debug, PartialEq)]
