@@ -75,8 +75,8 @@ fn a_furnace_flat_region_keeps_its_mean() {
         .expect("denoises");
     let region: Vec<usize> = (0..guides.albedo.len()).filter(|&p| guides.albedo[p] == [0.5; 3]).collect();
     assert!(region.len() > 500, "the ball covers {} pixels", region.len());
-    for c in 0..3 {
-        let truth = 0.5 * sky[c];
+    for (c, sky) in sky.iter().enumerate() {
+        let truth = 0.5 * sky;
         let n = region.len() as f64;
         let raw: f64 = region.iter().map(|&p| accumulator.pixel_mean(p)[c]).sum::<f64>() / n;
         let mean: f64 = region.iter().map(|&p| f64::from(denoised.pixels[p][c])).sum::<f64>() / n;
