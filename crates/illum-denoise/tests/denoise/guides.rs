@@ -40,3 +40,35 @@ fn cornell_guides_hold_each_walls_albedo_and_normal() {
         assert!(n.iter().map(|v| v * v).sum::<f32>() <= 1.0 + 1e-5, "normal {n:?}");
     }
 }
+
+/// A ball between two walls, the camera between the ball and the near wall: the ray through
+/// the image's centre meets the ball head-on. A mirror ball (reflectance 0.5) sends it straight
+/// back to the near wall (albedo 0.8): the guide is 0.5 x 0.8 with the near wall's normal,
+/// whatever the sample. A glass ball sends it on to the far wall (albedo 0.6) or, with the
+/// Fresnel probability, back to the near wall: every sample ends on a wall, so the guide lies
+/// between 0.6 and 0.8, and a guide that stopped at the glass would not.
+#[test]
+fn guides_follow_mirrors_and_glass_to_the_next_diffuse_surface() {
+    let scene = |ball: &str| {
+        let text = format!(
+            "[camera]\neye = [0.0, 0.0, 0.0]\ntarget = [0.0, 0.0, 5.0]\nup = [0.0, 1.0, 0.0]\nvfov = 30.0\n\
+             width = 9\nheight = 9\n[environment]\nradiance = [1.0, 1.0, 1.0]\n\
+             [materials.ball]\n{ball}\n[materials.far]\nalbedo = [0.6, 0.6, 0.6]\n[materials.near]\nalbedo = [0.8, 0.8, 0.8]\n\
+             [[objects]]\nmaterial = \"ball\"\nsphere = {{ center = [0.0, 0.0, 5.0], radius = 1.0 }}\n\
+             [[objects]]\nmaterial = \"far\"\nquad = {{ corner = [-50.0, -50.0, 10.0], edge_u = [100.0, 0.0, 0.0], edge_v = [0.0, 100.0, 0.0] }}\n\
+             [[objects]]\nmaterial = \"near\"\nquad = {{ corner = [-50.0, -50.0, -3.0], edge_u = [100.0, 0.0, 0.0], edge_v = [0.0, 100.0, 0.0] }}\n\
+             [pathtrace]\nspp = 1\nbounces = 16\n"
+        );
+        illum_scene::Scene::from_toml_str(&text, "mirror-and-glass.toml").unwrap_or_else(|e| panic!("{e}"))
+    };
+    let centre = 4 * 9 + 4;
+    let mirror =
+        common::render(&scene("mirror = { reflectance = [0.5, 0.5, 0.5] }")).guides(16).expect("guides");
+    for c in 0..3 {
+        assert!((mirror.albedo[centre][c] - 0.4).abs() <= 1e-6, "mirror: albedo {:?}", mirror.albedo[centre]);
+    }
+    assert!((mirror.normal[centre][2] - 1.0).abs() <= 1e-3, "mirror: normal {:?}", mirror.normal[centre]);
+    let glass = common::render(&scene("dielectric = { ior = 1.5 }")).guides(16).expect("guides");
+    let a = glass.albedo[centre];
+    assert!(a.iter().all(|&v| (0.6 - 1e-6..=0.8 + 1e-6).contains(&v)), "glass: albedo {a:?}");
+}
