@@ -101,7 +101,8 @@ pub(crate) fn caustic_pipeline(
 
 /// The guide-buffer pipeline for `scene` (tracer/guides.rs), built from the same modules and
 /// defs as its path-tracing pipeline without adaptive sampling, so that it follows the same
-/// specular chains with the same numbers.
+/// specular chains with the same numbers. Native only, like the guide pass.
+#[cfg(not(target_arch = "wasm32"))]
 pub(crate) fn guides_pipeline(
     gpu: &GpuContext,
     scene: &Scene,

@@ -9,6 +9,7 @@
 use illum_gpu::buffers::{buffer_bind_group, dispatch};
 #[cfg(not(target_arch = "wasm32"))]
 use illum_gpu::readback;
+#[cfg(not(target_arch = "wasm32"))]
 use illum_gpu::wgpu;
 #[cfg(not(target_arch = "wasm32"))]
 use wgpu::util::DeviceExt;
