@@ -23,11 +23,13 @@ use anyhow::{Context, bail};
 use clap::Parser;
 use illum::image::{load_exr, rel_mse};
 use illum::scene::{Bounces, Overrides, Scene};
-use illum_lab::reference::cached_reference;
+use illum_lab::reference::{Reference, cached_reference, load_reference};
 use illum_lab::report::{markdown_table, write_text};
 
 #[derive(Parser, Debug)]
-#[command(about = "Checks render --renderer auto: predicted against measured error and time, per scene and target")]
+#[command(
+    about = "Checks render --renderer auto: predicted against measured error and time, per scene and target"
+)]
 struct Args {
     /// Target relative errors (comma-separated).
     #[arg(long, value_delimiter = ',', default_value = "0.3,0.1,0.03,0.01")]
@@ -35,6 +37,11 @@ struct Args {
     /// Samples per pixel of each scene's truth.
     #[arg(long, default_value_t = 8192)]
     truth_spp: u32,
+    /// A truth EXR (repeatable) to use instead of rendering one: a path-traced render of one of
+    /// the scenes at its size with bounces unbounded (and the caustic's light tracer where the
+    /// scene has one), e.g. made with `render --resume` in steps on a busy machine.
+    #[arg(long)]
+    truth: Vec<PathBuf>,
     /// Folder for the truths, the images and the table.
     #[arg(long, default_value = "out/auto-check")]
     out: PathBuf,
@@ -58,6 +65,30 @@ fn line_after<'a>(output: &'a str, prefix: &str) -> Option<&'a str> {
     output.lines().find_map(|l| l.trim_start().strip_prefix(prefix))
 }
 
+/// The truth among `files` that shows `truth_scene` (by its EXR's scene name), checked to be
+/// a converged render of it: its size and content (`load_reference`), unbounded bounces and the
+/// caustic's light tracer as the truth scene has it.
+fn given_truth(files: &[PathBuf], truth_scene: &Scene) -> anyhow::Result<Option<Reference>> {
+    for path in files {
+        let reference = load_reference(path, truth_scene)?;
+        if reference.metadata.scene != truth_scene.name {
+            continue;
+        }
+        let caustics = if truth_scene.pathtrace.caustics { "on" } else { "off" };
+        for (key, want) in [("bounces", "unbounded"), ("caustics", caustics)] {
+            if reference.metadata.get(key) != Some(want) {
+                bail!(
+                    "{}: a truth needs illum.{key} = {want}, not {:?}",
+                    path.display(),
+                    reference.metadata.get(key)
+                );
+            }
+        }
+        return Ok(Some(reference));
+    }
+    Ok(None)
+}
+
 fn run(args: Args) -> anyhow::Result<()> {
     if args.targets.iter().any(|t| !(*t > 0.0 && t.is_finite())) {
         bail!("--targets {:?}: every target must be a finite number above 0", args.targets);
@@ -79,11 +110,13 @@ fn run(args: Args) -> anyhow::Result<()> {
         let mut truth_scene = scene.clone();
         truth_scene.pathtrace.bounces = Bounces::Unbounded;
         truth_scene.pathtrace.caustics = illum_lab::auto::pilot::has_caustic(&scene);
-        let truth = {
-            let gpu = illum_cli::gpu()?;
-            adapter = gpu.adapter_info.name.clone();
-            cached_reference(&gpu, &truth_scene, args.truth_spp, &args.out, "auto check truth")?
+        let gpu = illum_cli::gpu()?;
+        adapter = gpu.adapter_info.name.clone();
+        let truth = match given_truth(&args.truth, &truth_scene)? {
+            Some(truth) => truth,
+            None => cached_reference(&gpu, &truth_scene, args.truth_spp, &args.out, "auto check truth")?,
         };
+        drop(gpu);
         let truth_noise = if truth.estimated_rel_mse.is_finite() { truth.estimated_rel_mse } else { 0.0 };
         truths.push(format!(
             "{} at {width}x{height}: {} spp, bounces unbounded, caustic light tracer {}, its own estimated relative \
@@ -109,7 +142,8 @@ fn run(args: Args) -> anyhow::Result<()> {
             let stderr = String::from_utf8_lossy(&output.stderr);
             if !output.status.success() {
                 // A refused target is a result too: its reason goes in the table.
-                let reason = stderr.lines().filter(|l| !l.starts_with("progress")).collect::<Vec<_>>().join(" ");
+                let reason =
+                    stderr.lines().filter(|l| !l.starts_with("progress")).collect::<Vec<_>>().join(" ");
                 println!("{} {target}: refused: {reason}", scene.name);
                 rows.push(vec![
                     scene.name.clone(),

@@ -58,12 +58,12 @@ use illum::pathtrace::{
 use illum::scene::{RendererKind, Scene};
 use illum_cli::auto::RendererChoice;
 use illum_cli::interrupt::Interrupt;
-use illum_lab::auto::pilot::PilotOptions;
-use illum_lab::auto::plan::{Goal, Setting};
 use illum_cli::progress::RenderProgress;
 use illum_cli::raster::{RasterArgs, RasterRequest, render_raster};
 use illum_cli::whitted::{WhittedArgs, WhittedRequest, render_whitted};
 use illum_cli::{DEFAULT_SCENE, LongRender, OutputFormat, SceneArgs, output_format};
+use illum_lab::auto::pilot::PilotOptions;
+use illum_lab::auto::plan::{Goal, Setting};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -204,7 +204,8 @@ fn run_auto(mut args: Args) -> anyhow::Result<()> {
     ]);
     chosen.extend(args.raster.given());
     chosen.extend(args.whitted.given());
-    illum_cli::auto::check_auto_flags(args.target_error, args.time_budget, &chosen).map_err(anyhow::Error::msg)?;
+    illum_cli::auto::check_auto_flags(args.target_error, args.time_budget, &chosen)
+        .map_err(anyhow::Error::msg)?;
     let goal = match (args.target_error, args.time_budget) {
         (Some(error), _) => Goal::Error(error),
         (None, budget) => Goal::Seconds(budget.expect("one goal (checked)").as_secs_f64()),
@@ -271,7 +272,9 @@ fn render(args: Args) -> anyhow::Result<Option<f64>> {
     };
     let renderer = match args.renderer {
         Some(RendererChoice::Kind(renderer)) => renderer,
-        Some(RendererChoice::Auto) | None => Scene::load(&illum_cli::resolve_scene_path(&args.scene))?.renderer,
+        Some(RendererChoice::Auto) | None => {
+            Scene::load(&illum_cli::resolve_scene_path(&args.scene))?.renderer
+        }
     };
     let path_tracer_only = illum_cli::given_flags(&[
         (args.target_error.is_some(), "--target-error"),

@@ -106,7 +106,8 @@ pub fn settings(scene: &Scene) -> Vec<Setting> {
     }
     let caustics: &[bool] = if has_caustic(scene) { &[false, true] } else { &[false] };
     for &caustics in caustics {
-        for bounces in [Bounces::Fixed(1), Bounces::Fixed(2), Bounces::Fixed(4), Bounces::Fixed(8), Bounces::Unbounded]
+        for bounces in
+            [Bounces::Fixed(1), Bounces::Fixed(2), Bounces::Fixed(4), Bounces::Fixed(8), Bounces::Unbounded]
         {
             all.push(Setting::PathTrace { bounces, caustics });
         }
@@ -162,7 +163,10 @@ pub fn pilot_size(scene: &Scene, longer_side: u32) -> (u32, u32) {
 
 fn resized(scene: &Scene, (width, height): (u32, u32)) -> anyhow::Result<Scene> {
     let mut small = scene.clone();
-    small.apply_overrides(&Overrides { width: Some(width), height: Some(height), ..Default::default() }, "auto pilot")?;
+    small.apply_overrides(
+        &Overrides { width: Some(width), height: Some(height), ..Default::default() },
+        "auto pilot",
+    )?;
     Ok(small)
 }
 
@@ -177,10 +181,16 @@ struct Measured {
 /// Measures every setting of [`settings`] for `scene` (at the size it will be rendered) on
 /// `gpu`. `overhead_seconds`, what every render pays before its renderer starts (setting up
 /// the device), is added to every candidate's fixed cost.
-pub fn measure(gpu: &GpuContext, scene: &Scene, overhead_seconds: f64, options: &PilotOptions) -> anyhow::Result<Pilot> {
+pub fn measure(
+    gpu: &GpuContext,
+    scene: &Scene,
+    overhead_seconds: f64,
+    options: &PilotOptions,
+) -> anyhow::Result<Pilot> {
     let size = pilot_size(scene, options.longer_side);
     let small = resized(scene, size)?;
-    std::fs::create_dir_all(&options.folder).with_context(|| format!("creating {}", options.folder.display()))?;
+    std::fs::create_dir_all(&options.folder)
+        .with_context(|| format!("creating {}", options.folder.display()))?;
 
     // The truth: the converged solution (unbounded bounces, the caustic's light tracer where
     // there is one), cached by content.
@@ -189,24 +199,28 @@ pub fn measure(gpu: &GpuContext, scene: &Scene, overhead_seconds: f64, options: 
     truth_scene.pathtrace.caustics = has_caustic(&small);
     let started = Instant::now();
     let truth = cached_reference(gpu, &truth_scene, options.truth_spp, &options.folder, "auto pilot truth")?;
-    let truth_seconds = if truth.metadata.get("reference_key").is_some() && started.elapsed().as_secs_f64() < 1.0 {
-        0.0
-    } else {
-        started.elapsed().as_secs_f64()
-    };
+    let truth_seconds =
+        if truth.metadata.get("reference_key").is_some() && started.elapsed().as_secs_f64() < 1.0 {
+            0.0
+        } else {
+            started.elapsed().as_secs_f64()
+        };
     let truth_rel_mse = if truth.estimated_rel_mse.is_finite() { truth.estimated_rel_mse } else { 0.0 };
 
     let all = settings(scene);
     let (_, truth_key) = reference_settings(&truth_scene, options.truth_spp);
     let key = format!(
-        "auto pilot 1; truth: {truth_key}; pilot spp {}; seed {}; sampling {}; settings: {}",
+        "auto pilot 2; truth: {truth_key}; pilot spp {}; seed {}; sampling {}; settings: {}",
         options.pilot_spp,
         small.pathtrace.seed,
         small.pathtrace.sampling,
         all.iter().map(ToString::to_string).collect::<Vec<_>>().join("; ")
     );
-    let bias_file =
-        options.folder.join(format!("auto-pilot-{}-{:016x}.csv", scene.name, illum_scene::fnv1a_64(key.as_bytes())));
+    let bias_file = options.folder.join(format!(
+        "auto-pilot-{}-{:016x}.csv",
+        scene.name,
+        illum_scene::fnv1a_64(key.as_bytes())
+    ));
     let started = Instant::now();
     let (measured, bias_seconds) = match read_cache(&bias_file, &key, all.len()) {
         Some(measured) => (measured, 0.0),
@@ -214,7 +228,15 @@ pub fn measure(gpu: &GpuContext, scene: &Scene, overhead_seconds: f64, options: 
             let regions = Regions::from_ids(&small, &WhittedTracer::new(gpu, &small)?.object_ids()?);
             let mut measured = Vec::new();
             for setting in &all {
-                measured.push(measure_bias(gpu, &small, setting, &truth.image, truth_rel_mse, &regions, options)?);
+                measured.push(measure_bias(
+                    gpu,
+                    &small,
+                    setting,
+                    &truth.image,
+                    truth_rel_mse,
+                    &regions,
+                    options,
+                )?);
             }
             write_cache(&bias_file, &key, &all, &measured)?;
             (measured, started.elapsed().as_secs_f64())
@@ -222,7 +244,8 @@ pub fn measure(gpu: &GpuContext, scene: &Scene, overhead_seconds: f64, options: 
     };
 
     let started = Instant::now();
-    let pixel_ratio = f64::from(scene.camera.width) * f64::from(scene.camera.height) / (f64::from(size.0) * f64::from(size.1));
+    let pixel_ratio = f64::from(scene.camera.width) * f64::from(scene.camera.height)
+        / (f64::from(size.0) * f64::from(size.1));
     let mut candidates = Vec::new();
     let mut raster: Option<(RasterRenderer, f64)> = None;
     for (setting, m) in all.iter().zip(measured) {
@@ -231,7 +254,8 @@ pub fn measure(gpu: &GpuContext, scene: &Scene, overhead_seconds: f64, options: 
                 if raster.is_none() {
                     let raster_scene = RasterScene::from_scene(scene)?;
                     let t = Instant::now();
-                    let renderer = RasterRenderer::new(gpu, &raster_scene, scene.camera.width, scene.camera.height)?;
+                    let renderer =
+                        RasterRenderer::new(gpu, &raster_scene, scene.camera.width, scene.camera.height)?;
                     raster = Some((renderer, t.elapsed().as_secs_f64()));
                 }
                 let (renderer, setup) = raster.as_mut().expect("made above");
@@ -292,34 +316,44 @@ fn measure_bias(
     regions: &Regions,
     options: &PilotOptions,
 ) -> anyhow::Result<Measured> {
-    let variant = apply(small, setting);
-    let (image, own_noise) = match setting {
-        Setting::Raster { look, effects } => {
-            let mut renderer =
-                RasterRenderer::new(gpu, &RasterScene::from_scene(&variant)?, small.camera.width, small.camera.height)?;
-            (renderer.render(&Options { look: *look, effects: *effects })?, None)
-        }
-        Setting::Whitted { .. } => (WhittedTracer::new(gpu, &variant)?.render()?, None),
-        Setting::PathTrace { .. } => {
-            let mut tracer = PathTracer::new(gpu, &variant)?;
-            tracer.render_to_spp(options.pilot_spp)?;
-            let accumulator = tracer.accumulator();
-            (accumulator.mean_image(), Some(accumulator.estimated_rel_mse()))
-        }
-    };
+    let (image, own_noise) = render(gpu, &apply(small, setting), setting, options.pilot_spp)?;
     let errors = compare(&image, truth, regions);
     let bias_rel_mse = (errors.overall.rel_mse - truth_rel_mse - own_noise.unwrap_or(0.0)).max(0.0);
     let worst_region = regions
         .names
         .iter()
         .zip(&errors.regions)
-        .filter(|(_, e)| e.pixels > 0 && e.rel_mse.is_finite() && e.luminance_ratio.is_finite())
-        .max_by(|a, b| a.1.rel_mse.total_cmp(&b.1.rel_mse))
+        .filter(|(_, e)| e.pixels > 0 && e.luminance_ratio.is_finite())
+        .max_by(|a, b| (a.1.luminance_ratio - 1.0).abs().total_cmp(&(b.1.luminance_ratio - 1.0).abs()))
         .map(|(name, e)| (name.clone(), e.luminance_ratio));
     Ok(Measured {
         bias_rel_mse,
         noise_per_sample: own_noise.map(|n| n * f64::from(options.pilot_spp)),
         worst_region,
+    })
+}
+
+/// Renders `scene` (with `setting` applied, see [`apply`]) by the setting's renderer, the path
+/// tracer at `spp`; returns the image and, for the path tracer, its estimated relMSE from noise.
+pub fn render(
+    gpu: &GpuContext,
+    scene: &Scene,
+    setting: &Setting,
+    spp: u32,
+) -> anyhow::Result<(RgbImage32, Option<f64>)> {
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    Ok(match setting {
+        Setting::Raster { look, effects } => {
+            let mut renderer = RasterRenderer::new(gpu, &RasterScene::from_scene(scene)?, w, h)?;
+            (renderer.render(&Options { look: *look, effects: *effects })?, None)
+        }
+        Setting::Whitted { .. } => (WhittedTracer::new(gpu, scene)?.render()?, None),
+        Setting::PathTrace { .. } => {
+            let mut tracer = PathTracer::new(gpu, scene)?;
+            tracer.render_to_spp(spp)?;
+            let accumulator = tracer.accumulator();
+            (accumulator.mean_image(), Some(accumulator.estimated_rel_mse()))
+        }
     })
 }
 
@@ -360,7 +394,8 @@ fn write_cache(path: &Path, key: &str, settings: &[Setting], measured: &[Measure
             ]
         })
         .collect();
-    let header = ["setting", "bias_rel_mse", "noise_per_sample", "worst_region", "worst_region_luminance_ratio"];
+    let header =
+        ["setting", "bias_rel_mse", "noise_per_sample", "worst_region", "worst_region_luminance_ratio"];
     write_text(path, &format!("# {key}\n{}", csv_text(&header, &rows)?))
 }
 

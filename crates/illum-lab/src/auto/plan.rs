@@ -61,7 +61,9 @@ impl fmt::Display for Setting {
                     write!(f, "rasterizer, {look} look, {} off", off.join(", "))
                 }
             }
-            Setting::Whitted { depth, aa } => write!(f, "Whitted ray tracer, depth {depth}, {aa}x{aa} rays per pixel"),
+            Setting::Whitted { depth, aa } => {
+                write!(f, "Whitted ray tracer, depth {depth}, {aa}x{aa} rays per pixel")
+            }
             Setting::PathTrace { bounces, caustics } => write!(
                 f,
                 "path tracer, bounces {bounces}, caustic light tracer {}",
@@ -85,8 +87,8 @@ pub struct Candidate {
     pub fixed_seconds: f64,
     /// The path tracer's seconds per sample per pixel over the whole image (0 otherwise).
     pub seconds_per_spp: f64,
-    /// The region it gets most wrong and that region's mean brightness relative to the truth's,
-    /// to say why a setting cannot meet a target.
+    /// The region whose mean brightness is furthest from the truth's, and that brightness
+    /// relative to the truth's, to say why a setting cannot meet a target.
     pub worst_region: Option<(String, f64)>,
 }
 
@@ -198,7 +200,8 @@ fn plan_one(candidate: &Candidate, goal: Goal) -> Result<Planned, String> {
             // The fewest samples whose noise fits in the room the bias leaves: the model's
             // inverse, ceil(per_sample / room) for 1/N, found by doubling then bisection so
             // that it holds for any decreasing noise model.
-            let meets = |n: u32| candidate.bias_rel_mse + noise_rel_mse(per_sample, f64::from(n)) <= target * target;
+            let meets =
+                |n: u32| candidate.bias_rel_mse + noise_rel_mse(per_sample, f64::from(n)) <= target * target;
             if !meets(MAX_SPP) {
                 return Err(format!("it would need more than {MAX_SPP} samples per pixel"));
             }
