@@ -70,10 +70,12 @@ fn line_after<'a>(output: &'a str, prefix: &str) -> Option<&'a str> {
 /// caustic's light tracer as the truth scene has it.
 fn given_truth(files: &[PathBuf], truth_scene: &Scene) -> anyhow::Result<Option<Reference>> {
     for path in files {
-        let reference = load_reference(path, truth_scene)?;
-        if reference.metadata.scene != truth_scene.name {
+        let (_, attributes) = load_exr(path)?;
+        let shows = illum::image::ExrMetadata::from_attributes(path, &attributes)?.map(|m| m.scene);
+        if shows.as_deref() != Some(truth_scene.name.as_str()) {
             continue;
         }
+        let reference = load_reference(path, truth_scene)?;
         let caustics = if truth_scene.pathtrace.caustics { "on" } else { "off" };
         for (key, want) in [("bounces", "unbounded"), ("caustics", caustics)] {
             if reference.metadata.get(key) != Some(want) {
@@ -117,7 +119,14 @@ fn run(args: Args) -> anyhow::Result<()> {
             None => cached_reference(&gpu, &truth_scene, args.truth_spp, &args.out, "auto check truth")?,
         };
         drop(gpu);
-        let truth_noise = if truth.estimated_rel_mse.is_finite() { truth.estimated_rel_mse } else { 0.0 };
+        // The cache's truths carry their estimated relMSE; a `render` EXR its estimated relative error.
+        let truth_noise = [
+            truth.estimated_rel_mse,
+            truth.metadata.get("estimated_relative_error").and_then(|v| v.parse::<f64>().ok()).map_or(f64::NAN, |e| e * e),
+        ]
+        .into_iter()
+        .find(|v| v.is_finite())
+        .context("the truth does not say its own error (illum.estimated_rel_mse or illum.estimated_relative_error)")?;
         truths.push(format!(
             "{} at {width}x{height}: {} spp, bounces unbounded, caustic light tracer {}, its own estimated relative \
              error {:.4}",
