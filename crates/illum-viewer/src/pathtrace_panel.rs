@@ -201,12 +201,6 @@ impl PathTraceMode {
         // leaves it (samples/s over that share is the rate while it runs).
         let stepping =
             if st.elapsed_seconds > 0.0 { self.work.step_seconds / st.elapsed_seconds } else { 0.0 };
-        if let Some((w, g)) = self.submission_seconds() {
-            eprintln!(
-                "DEBUG step {:.3} submissions wall {w:.3} gpu {g:.3} elapsed {:.3} subs {}",
-                self.work.step_seconds, st.elapsed_seconds, self.work.submissions
-            );
-        }
         format!(
             "pathtrace: {} x {}, spp done {}, samples/s (wall) {:.3} M, elapsed {:.2} s, estimated error {error}, stepping {:.0}% of the wall time",
             st.width,
