@@ -509,7 +509,7 @@ fn render(args: Args) -> anyhow::Result<Option<f64>> {
     let gpu = illum_cli::gpu()?;
     let options = TracerOptions { sequence, ..Default::default() };
     if let Some(denoiser) = args.denoise {
-        let reason = illum_cli::denoise::render_denoised(&illum_cli::denoise::DenoiseRequest {
+        let outcome = illum_cli::denoise::render_denoised(&illum_cli::denoise::DenoiseRequest {
             gpu: &gpu,
             scene: &scene,
             options,
@@ -524,10 +524,10 @@ fn render(args: Args) -> anyhow::Result<Option<f64>> {
             eprintln!("stopped by {signal}: exiting with status {code}");
             std::process::exit(code);
         }
-        if reason.is_none() {
+        let Some((_, error)) = outcome else {
             anyhow::bail!("the denoised render stopped before its first round");
-        }
-        return Ok(());
+        };
+        return Ok(Some(error));
     }
     let mut tracer = if args.adaptive {
         // Built with the adaptive pipeline, which plan_adaptive's pilot runs (every block

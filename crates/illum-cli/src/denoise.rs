@@ -35,9 +35,9 @@ pub struct DenoiseRequest<'a> {
     pub exposure: Option<Exposure>,
 }
 
-/// Renders, denoises and writes. `Ok(None)` when cancelled before the first round ended
-/// (nothing written).
-pub fn render_denoised(request: &DenoiseRequest) -> anyhow::Result<Option<StopReason>> {
+/// Renders, denoises and writes; returns why it stopped and the denoised image's estimated
+/// relative error. `Ok(None)` when cancelled before the first round ended (nothing written).
+pub fn render_denoised(request: &DenoiseRequest) -> anyhow::Result<Option<(StopReason, f64)>> {
     let DenoiseRequest { gpu, scene, options, rules, denoiser, cancel, outputs, .. } = request;
     if *denoiser == DenoiserKind::Oidn {
         anyhow::bail!(
@@ -105,7 +105,7 @@ pub fn render_denoised(request: &DenoiseRequest) -> anyhow::Result<Option<StopRe
     for output in outputs.iter() {
         println!("wrote {}", output.display());
     }
-    Ok(Some(reason))
+    Ok(Some((reason, result.estimate.relative_error())))
 }
 
 /// The PNG of the denoised image; the EXR of the denoised image with layers `noisy` (the raw
