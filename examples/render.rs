@@ -214,6 +214,8 @@ fn run_auto(mut args: Args) -> anyhow::Result<()> {
         (args.resume.is_some(), "--resume"),
         (args.sample_range.is_some(), "--sample-range"),
         (args.checkpoint_seconds.is_some(), "--checkpoint-seconds"),
+        // Its plans predict raw images' errors; a denoised one's is another (docs/denoising.md).
+        (args.denoise.is_some(), "--denoise"),
     ]);
     chosen.extend(args.raster.given());
     chosen.extend(args.whitted.given());

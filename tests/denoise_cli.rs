@@ -106,4 +106,6 @@ fn bad_denoise_flags_are_clear_errors() {
     );
     let raster = ["scenes/whitted.toml", "--renderer", "raster", "--denoise", "atrous"];
     assert_refused(&run(&raster), "--denoise with the rasterizer", &["--denoise"]);
+    let auto = ["--renderer", "auto", "--target-error", "0.1", "--denoise", "atrous"];
+    assert_refused(&run(&auto), "--denoise with --renderer auto", &["--renderer auto", "--denoise"]);
 }
