@@ -53,6 +53,7 @@ use std::f64::consts::{FRAC_1_PI, PI};
 use glam::DVec3;
 use illum_scene::{Bounces, MaterialKind};
 
+use crate::gather::Photon;
 use crate::geometry::Surface;
 use crate::integrator::{Contact, Oracle, ROULETTE_AFTER, ROULETTE_MAX_SURVIVAL};
 use crate::optics::{reflect, scatter_dielectric};
@@ -62,7 +63,7 @@ use crate::scene::Primitive;
 
 /// Key mixed into the particles' seed so that particle i of frame k never shares its random
 /// numbers with sample k of pixel i.
-const PARTICLE_SEED_KEY: u64 = 0xc0ff_ee00_ca05_71c5;
+pub(crate) const PARTICLE_SEED_KEY: u64 = 0xc0ff_ee00_ca05_71c5;
 /// A safety limit on specular scatterings for unbounded paths (survival 0.95^n beyond 3).
 const UNBOUNDED_LIMIT: u32 = 100_000;
 
@@ -90,6 +91,8 @@ pub(crate) struct Emitter {
     total_area: f64,
     scene_centre: DVec3,
     scene_radius: f64,
+    /// r_1 of the photon gather (`gather.rs`).
+    pub(crate) gather_radius: f64,
 }
 
 impl Emitter {
@@ -105,7 +108,8 @@ impl Emitter {
             oracle.scene.surfaces.iter().chain(&oracle.scene.emitters).map(bounding_sphere).collect();
         let scene_centre = spheres.iter().map(|(c, _)| *c).sum::<DVec3>() / spheres.len() as f64;
         let scene_radius = spheres.iter().map(|(c, r)| (*c - scene_centre).length() + r).fold(0.0, f64::max);
-        Some(Emitter { discs, total_area, scene_centre, scene_radius })
+        let gather_radius = crate::gather::RADIUS_FRACTION * discs.iter().map(|(_, r)| *r).fold(0.0, f64::max);
+        Some(Emitter { discs, total_area, scene_centre, scene_radius, gather_radius })
     }
 }
 
@@ -116,9 +120,9 @@ impl Oracle {
         self.caustic.is_some()
     }
 
-    /// One particle of a frame of `n` particles: its pixel index and its contribution there (the
-    /// frame's image is the sum of its particles'), or `None` when it adds nothing.
-    pub(crate) fn trace_particle(&self, n: u64, rng: &mut Rng) -> Option<(usize, DVec3)> {
+    /// One particle of a frame of `n` particles, traced to its first diffuse point after at
+    /// least one specular scattering (its photon, `gather.rs`), or `None` when it has none.
+    pub(crate) fn trace_particle(&self, n: u64, rng: &mut Rng) -> Option<Photon> {
         let emitter = self.caustic.as_ref()?;
         let sun = self.scene.sun?;
         // The direction the light travels, and the flux per unit area across the plane
@@ -186,7 +190,13 @@ impl Oracle {
                     if scatterings == 0 {
                         return None;
                     }
-                    return self.connect(p, nrm, lift, throughput * hit.diffuse_albedo(p) * FRAC_1_PI);
+                    return Some(Photon {
+                        point: p,
+                        normal: nrm,
+                        lift,
+                        weight: throughput * hit.diffuse_albedo(p) * FRAC_1_PI,
+                        scatterings,
+                    });
                 }
                 MaterialKind::Emitter { .. } => unreachable!("emitters are handled above"),
             }
@@ -260,18 +270,27 @@ impl Oracle {
     }
 
     /// The caustic image of frame `frame` (the frame that pairs with sample index `frame` of
-    /// every pixel): width x height particles, row-major pixels. All zero when caustics are off.
+    /// every pixel): width x height particles, row-major pixels, and with a delta sun the
+    /// photon gather of the caustic seen through a specular surface (`gather.rs`) from the same
+    /// particles. All zero when caustics are off.
     pub fn caustic_frame(&self, seed: u64, frame: u32) -> Vec<DVec3> {
         let n = u64::from(self.camera.width) * u64::from(self.camera.height);
         let mut image = vec![DVec3::ZERO; n as usize];
         if self.caustic.is_none() {
             return image;
         }
+        let mut photons = Vec::new();
         for particle in 0..n {
             let mut rng = Rng::for_sample(seed ^ PARTICLE_SEED_KEY, particle, u64::from(frame));
-            if let Some((pixel, value)) = self.trace_particle(n, &mut rng) {
-                image[pixel] += value;
+            if let Some(photon) = self.trace_particle(n, &mut rng) {
+                if let Some((pixel, value)) = self.connect(photon.point, photon.normal, photon.lift, photon.weight) {
+                    image[pixel] += value;
+                }
+                photons.push(photon);
             }
+        }
+        if self.gathers() {
+            self.add_gather(&mut image, photons, seed, frame);
         }
         image
     }
