@@ -6,9 +6,10 @@
 //! estimation, and, with a sun *disc*, paths E D S+ L by a bounce that happens to reach the disc.
 //! The light tracer here owns exactly the paths L S+ D E whose diffuse vertex D is the camera
 //! ray's first hit: with it on, the camera path tracer stops counting the sun disc on such
-//! paths (`caustic_owned` there), so no path is counted twice. Not covered by either, with a
-//! delta sun: the caustic seen through a specular surface (E S+ D S+ L) and light scattered
-//! from the caustic onto other diffuse surfaces (E D+ D S+ L).
+//! paths (`caustic_owned` there), so no path is counted twice. With a delta sun the caustic
+//! seen through a specular surface (E S+ D S+ L) is the photon gather's (`gather.rs`, from
+//! these particles); light scattered from the caustic onto other diffuse surfaces
+//! (E S* D S* D S+ L) is counted by no estimator (docs/caustics.md measures it).
 //!
 //! Emission. The sun's light crosses any plane perpendicular to a direction w of its disc with
 //! radiance L (a delta sun: irradiance E along one direction). Only lines that meet a specular
@@ -108,7 +109,8 @@ impl Emitter {
             oracle.scene.surfaces.iter().chain(&oracle.scene.emitters).map(bounding_sphere).collect();
         let scene_centre = spheres.iter().map(|(c, _)| *c).sum::<DVec3>() / spheres.len() as f64;
         let scene_radius = spheres.iter().map(|(c, r)| (*c - scene_centre).length() + r).fold(0.0, f64::max);
-        let gather_radius = crate::gather::RADIUS_FRACTION * discs.iter().map(|(_, r)| *r).fold(0.0, f64::max);
+        let gather_radius =
+            crate::gather::RADIUS_FRACTION * discs.iter().map(|(_, r)| *r).fold(0.0, f64::max);
         Some(Emitter { discs, total_area, scene_centre, scene_radius, gather_radius })
     }
 }
@@ -283,7 +285,9 @@ impl Oracle {
         for particle in 0..n {
             let mut rng = Rng::for_sample(seed ^ PARTICLE_SEED_KEY, particle, u64::from(frame));
             if let Some(photon) = self.trace_particle(n, &mut rng) {
-                if let Some((pixel, value)) = self.connect(photon.point, photon.normal, photon.lift, photon.weight) {
+                if let Some((pixel, value)) =
+                    self.connect(photon.point, photon.normal, photon.lift, photon.weight)
+                {
                     image[pixel] += value;
                 }
                 photons.push(photon);

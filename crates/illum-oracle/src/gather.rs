@@ -44,7 +44,7 @@ use crate::optics::{reflect, scatter_dielectric};
 use crate::rng::Rng;
 
 /// r_1 as a fraction of the largest specular object's bounding radius.
-pub const RADIUS_FRACTION: f64 = 0.05;
+pub const RADIUS_FRACTION: f64 = 0.02;
 /// Knaus and Zwicker's alpha: the kernel's area shrinks as k^(alpha - 1).
 pub const ALPHA: f64 = 2.0 / 3.0;
 /// Key mixed into the gather paths' seed, so that they share no random numbers with the camera
@@ -106,7 +106,8 @@ impl PhotonMap {
                             Bounces::Fixed(limit) => specular + p.scatterings < limit,
                             Bounces::Unbounded => true,
                         };
-                        if joins && (p.point - x).length_squared() < self.r * self.r && p.normal.dot(n) > 0.0 {
+                        if joins && (p.point - x).length_squared() < self.r * self.r && p.normal.dot(n) > 0.0
+                        {
                             sum += p.weight;
                         }
                     }
@@ -147,7 +148,8 @@ impl Oracle {
         let n = u64::from(self.camera.width) * u64::from(self.camera.height);
         let photons = (0..n)
             .filter_map(|particle| {
-                let mut rng = Rng::for_sample(seed ^ crate::caustic::PARTICLE_SEED_KEY, particle, u64::from(frame));
+                let mut rng =
+                    Rng::for_sample(seed ^ crate::caustic::PARTICLE_SEED_KEY, particle, u64::from(frame));
                 self.trace_particle(n, &mut rng)
             })
             .collect();
@@ -155,6 +157,72 @@ impl Oracle {
             Some(map) => pixels.iter().map(|&(x, y)| self.gather_pixel(&map, x, y, seed, frame)).collect(),
             None => vec![DVec3::ZERO; pixels.len()],
         }
+    }
+
+    /// A measurement of light no estimator owns (docs/caustics.md): the paths
+    /// E S* D S+ D S+ L, the caustic scattered again by a diffuse surface through a mirror or
+    /// glass, at `pixels` (x, y) for frame `frame`'s photons: one camera path per pixel through
+    /// specular scatterings to a diffuse point D1, a cosine bounce there, one or more specular
+    /// scatterings to D2, and the photon estimate at D2 (zeros when the gather is off).
+    pub fn rescattered_at(&self, seed: u64, frame: u32, pixels: &[(u32, u32)]) -> Vec<DVec3> {
+        let n = u64::from(self.camera.width) * u64::from(self.camera.height);
+        let photons = (0..n)
+            .filter_map(|particle| {
+                let mut rng =
+                    Rng::for_sample(seed ^ crate::caustic::PARTICLE_SEED_KEY, particle, u64::from(frame));
+                self.trace_particle(n, &mut rng)
+            })
+            .collect();
+        let Some(map) = self.photon_map(photons, frame) else { return vec![DVec3::ZERO; pixels.len()] };
+        pixels
+            .iter()
+            .map(|&(x, y)| {
+                let pixel = u64::from(y) * u64::from(self.camera.width) + u64::from(x);
+                let mut rng = Rng::for_sample(seed ^ GATHER_SEED_KEY ^ 1, pixel, u64::from(frame));
+                let (jx, jy) = (rng.uniform(), rng.uniform());
+                let mut d = self.camera.direction(x, y, jx, jy);
+                let mut o = self.camera.eye;
+                let mut throughput = DVec3::ONE;
+                // Continuation rays taken; specular scatterings since the diffuse bounce.
+                let (mut taken, mut specular, mut bounced) = (0u32, 0u32, false);
+                loop {
+                    let Some(hit) = self.closest_hit(o, d) else { return DVec3::ZERO };
+                    if hit.primitive.emitter || !self.may_continue(taken) {
+                        return DVec3::ZERO;
+                    }
+                    let Contact { point, front, normal, lift } = hit.contact(o, d);
+                    match hit.primitive.material {
+                        MaterialKind::Mirror { reflectance } => {
+                            throughput *= reflectance.as_dvec3();
+                            d = reflect(d, normal);
+                            o = point + normal * lift;
+                            specular += 1;
+                        }
+                        MaterialKind::Dielectric { ior } => {
+                            (o, d) = scatter_dielectric(d, normal, point, front, ior, lift, &mut rng);
+                            specular += 1;
+                        }
+                        MaterialKind::Lambertian { .. } | MaterialKind::Checker(_) => {
+                            if bounced {
+                                if specular == 0 {
+                                    return DVec3::ZERO;
+                                }
+                                // `taken` continuation rays so far; the photon's side adds s + 1.
+                                return throughput * map.radiance(point, normal, taken, self.bounces);
+                            }
+                            throughput *= hit.diffuse_albedo(point);
+                            let local = crate::sampling::cosine_hemisphere(rng.uniform(), rng.uniform());
+                            d = crate::sampling::local_to_world(normal, local).normalize();
+                            o = point + normal * lift;
+                            bounced = true;
+                            specular = 0;
+                        }
+                        MaterialKind::Emitter { .. } => unreachable!("emitters are handled above"),
+                    }
+                    taken += 1;
+                }
+            })
+            .collect()
     }
 
     fn photon_map(&self, photons: Vec<Photon>, frame: u32) -> Option<PhotonMap> {
@@ -195,7 +263,9 @@ impl Oracle {
                     o = point + normal * lift;
                 }
                 MaterialKind::Dielectric { ior } => {
-                    if !self.may_continue(specular) || !self.roulette(specular, throughput, &mut throughput, rng) {
+                    if !self.may_continue(specular)
+                        || !self.roulette(specular, throughput, &mut throughput, rng)
+                    {
                         return DVec3::ZERO;
                     }
                     (o, d) = scatter_dielectric(d, normal, point, front, ior, lift, rng);

@@ -16,7 +16,7 @@
 // vec4 (position and the next photon of its bucket's list, weight and scatterings, normal), and
 // links itself at the head of its grid bucket's list with one atomicExchange: lists built in one
 // pass, in any order, with no capacity to overflow. A bucket holds the photons of every cell that
-// hashes to it; a lookup keeps only those of the cell it asked for.
+// hashes to it; a lookup walks each bucket it needs once and keeps the photons within r.
 
 #import illum::rtcore::geometry::Surface
 #import illum::pathtrace::scene::params

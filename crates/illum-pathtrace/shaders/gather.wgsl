@@ -33,32 +33,44 @@
 const GATHER_SEED_KEY: u32 = 0x6a7e4ca5u;
 
 // The sum of the weights of frame `frame`'s photons within r of x (normal n) that a path of
-// `specular` scatterings may join.
+// `specular` scatterings may join. The disc of radius r about x meets at most two cells of side
+// 2 r per axis; each bucket they hash to is walked once (two cells may share one), and a photon
+// of any other cell in it lies farther than r or belongs to a visited cell: the distance alone
+// decides, and no photon is counted twice. Most photons walked are farther than r (the cells
+// cover 16 r^2 of a plane, the disc pi r^2): only their positions are read.
 fn photon_sum(frame: u32, x: vec3<f32>, n: vec3<f32>, r: f32, specular: u32) -> vec3<f32> {
     let side = 2.0 * r;
     let lo = photon_cell(x - vec3<f32>(r), side);
     let hi = photon_cell(x + vec3<f32>(r), side);
+    var visited = array<u32, 8>();
+    var count = 0u;
     var sum = vec3<f32>(0.0);
-    // Cells of side 2 r: at most two per axis.
     for (var cz = lo.z; cz <= hi.z; cz++) {
         for (var cy = lo.y; cy <= hi.y; cy++) {
             for (var cx = lo.x; cx <= hi.x; cx++) {
-                let cell = vec3<i32>(cx, cy, cz);
-                var next = atomicLoad(&heads[photon_bucket(frame, cell)]);
+                let bucket = photon_bucket(frame, vec3<i32>(cx, cy, cz));
+                var seen = false;
+                for (var i = 0u; i < count; i++) {
+                    seen = seen || visited[i] == bucket;
+                }
+                if (seen) {
+                    continue;
+                }
+                visited[count] = bucket;
+                count += 1u;
+                var next = atomicLoad(&heads[bucket]);
                 // A list holds each photon of its bucket once: at most N steps.
                 for (var steps = 0u; next != 0u && steps < caustic.particles; steps++) {
                     let slot = next - 1u;
                     let a = photons[3u * slot];
-                    let b = photons[3u * slot + 1u];
-                    let pn = photons[3u * slot + 2u].xyz;
                     next = bitcast<u32>(a.w);
                     let d = a.xyz - x;
-                    // Only this cell's photons: another cell of the same bucket is visited on its
-                    // own turn, or lies farther than r.
-                    let own = all(photon_cell(a.xyz, side) == cell);
-                    let joins = params.bounces == UNBOUNDED || specular + u32(b.w) + 1u <= params.bounces;
-                    if (own && joins && dot(d, d) < r * r && dot(pn, n) > 0.0) {
-                        sum += b.xyz;
+                    if (dot(d, d) < r * r) {
+                        let b = photons[3u * slot + 1u];
+                        let joins = params.bounces == UNBOUNDED || specular + u32(b.w) + 1u <= params.bounces;
+                        if (joins && dot(photons[3u * slot + 2u].xyz, n) > 0.0) {
+                            sum += b.xyz;
+                        }
                     }
                 }
             }

@@ -31,7 +31,7 @@ mod runner;
 mod submit;
 
 use accumulation::Accumulation;
-pub use caustic::{CausticParams, bounding_sphere, fixed_point};
+pub use caustic::{CausticParams, GATHER_RADIUS_FRACTION, bounding_sphere, fixed_point};
 use pipeline::ScenePipeline;
 use runner::BandRunner;
 pub use runner::Readback;

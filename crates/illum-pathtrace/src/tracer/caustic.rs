@@ -80,7 +80,7 @@ const SPLAT_BYTES: u64 = 64 << 20;
 const PHOTON_BYTES: u64 = 48;
 /// r_1 of the photon gather as a fraction of the largest specular object's bounding radius
 /// (docs/caustics.md, "The caustic seen through a specular surface").
-pub const GATHER_RADIUS_FRACTION: f32 = 0.05;
+pub const GATHER_RADIUS_FRACTION: f32 = 0.02;
 /// Host bytes per pixel and chunk of a pass: S1 and S2, three f64 each.
 pub(crate) const PASS_BYTES_PER_PIXEL_CHUNK: u64 = 48;
 /// The most host memory one pass's caustic statistics may take.
@@ -373,7 +373,10 @@ impl CausticTracer {
                         mapped_at_creation: false,
                     })
                 };
-                (storage("caustic photons", photon_frame_bytes * frames), storage("photon grid", 4 * buckets * frames))
+                (
+                    storage("caustic photons", photon_frame_bytes * frames),
+                    storage("photon grid", 4 * buckets * frames),
+                )
             })?)
         } else {
             None
