@@ -9,6 +9,7 @@
 //! - [`raster`], [`whitted`]: each renderer's path of the `render` example (the path tracer's
 //!   is in `examples/render.rs`).
 
+pub mod auto;
 pub mod interrupt;
 pub mod progress;
 pub mod raster;
