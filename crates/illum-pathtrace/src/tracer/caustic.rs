@@ -25,8 +25,12 @@
 //!
 //! Fixed point: see [`fixed_point`].
 //!
-//! Over 500 lines with its tests (about 500 of code): one estimator, from its parameters to its
-//! fold, with the two ways its frames come back (waited for, or polled).
+//! With a delta sun each dispatch also runs the photon gather (`shaders/gather.wgsl`) after the
+//! particles, into the same frames: its photon maps and grid are allocated and cleared here.
+//!
+//! Over 600 lines with its tests (about 600 of code): one estimator, from its parameters to its
+//! fold, with the two ways its frames come back (waited for, or polled), and the photon gather
+//! that shares its frames and buffers.
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
