@@ -32,7 +32,7 @@ pub use allocation::SampleAllocation;
 pub use batch::{CHUNK_SAMPLES, SLOT_BYTES};
 pub use display_sum::{DISPLAY_PIXEL_BYTES, DISPLAY_SUM_SHADER};
 pub use error::PathTraceError;
-pub use gpu_scene::implements;
+pub use gpu_scene::{caustic_estimators, implements};
 pub use illum_scene::Sequence;
 pub use options::{TracerOptions, Traversal};
 #[cfg(not(target_arch = "wasm32"))]

@@ -67,7 +67,14 @@ impl PathTracer {
         }
         let samples = samples.clamp(1, GUIDE_SAMPLES);
         let gpu_scene = GpuScene::new(scene)?;
-        let compute = shaders::guides_pipeline(gpu, scene, &gpu_scene, pipeline.options)?;
+        let compute = shaders::companion_pipeline(
+            gpu,
+            scene,
+            &gpu_scene,
+            pipeline.options,
+            &shaders::GUIDES_SHADER,
+            "guide buffers",
+        )?;
         let mut params = pipeline.base_params;
         params.row_offset = 0;
         params.rows = height;
