@@ -569,6 +569,43 @@ fn two_concurrent_processes_like_gnu_parallel_then_merge_equal_one_render() {
     assert!(difference <= 1e-12, "{difference:e}");
 }
 
+/// A low-discrepancy render keeps its replicates (crates/illum-pathtrace/src/replicates.rs), and
+/// so its error estimate, through a resume and a merge: resumed from 41 spp (inside a chunk of 2)
+/// to 96 its replicate sums are a straight render's bit for bit, and merged from the ranges 0..48
+/// and 48..96 within 1e-12.
+#[test]
+fn a_low_discrepancy_render_keeps_its_replicates_through_resume_and_merge() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).to_str().unwrap().to_owned();
+    let with = |extra: &[&str]| {
+        let mut args = vec!["--sequence", "low-discrepancy"];
+        args.extend(extra);
+        render_ok(&args)
+    };
+    with(&["--spp", "96", "-o", &p("straight.exr")]);
+    with(&["--spp", "41", "-o", &p("resumed.exr")]);
+    with(&["--resume", &p("resumed.exr"), "--spp", "96"]);
+    with(&["--sample-range", "0..48", "-o", &p("a.exr")]);
+    with(&["--sample-range", "48..96", "-o", &p("b.exr")]);
+    let out = merge(&[&p("a.exr"), &p("b.exr"), "-o", &p("merged.exr")]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let load = |name: &str| checkpoint(Path::new(&p(name))).accumulator;
+    let (straight, resumed, merged) = (load("straight.exr"), load("resumed.exr"), load("merged.exr"));
+    let replicates = |a: &illum::pathtrace::Accumulator| a.replicates().expect("replicates kept").clone();
+    assert!(replicates(&resumed) == replicates(&straight), "the resumed render's replicates differ");
+    let (m, s) = (replicates(&merged), replicates(&straight));
+    assert_eq!(m.count, s.count);
+    let worst =
+        m.sum.iter().flatten().zip(s.sum.iter().flatten()).map(|(a, b)| (a - b).abs() / a.abs().max(1e-300));
+    let worst = worst.fold(0.0, f64::max);
+    assert!(worst <= 1e-12, "merged replicate sums differ by {worst:e} relative");
+    let (e_merged, e_straight) = (merged.estimated_rel_mse(), straight.estimated_rel_mse());
+    assert!(
+        e_straight.is_finite() && (e_merged / e_straight - 1.0).abs() < 1e-9,
+        "{e_merged} vs {e_straight}"
+    );
+}
+
 /// A render whose spp is not a multiple of the chunk (16) ends inside a chunk. Resumed, it goes
 /// on from its last chunk boundary and equals a straight render bit for bit; split into ranges
 /// (each starting on a chunk), merged and resumed, it equals one render within 1e-12.

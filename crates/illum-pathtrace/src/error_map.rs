@@ -27,9 +27,10 @@ pub struct ErrorMap {
 }
 
 /// What a stop rule measures the error over.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub enum ErrorScope {
     /// The whole image: sqrt(estimated relMSE), `--target-error` alone.
+    #[default]
     Image,
     /// The pixels at or below this percentile of the per-pixel errors (0 < p <= 100):
     /// `--error-percentile P`.

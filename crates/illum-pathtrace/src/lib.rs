@@ -37,12 +37,12 @@ pub use error::PathTraceError;
 pub use gpu_scene::implements;
 pub use illum_scene::Sequence;
 pub use options::{TracerOptions, Traversal};
-#[cfg(not(target_arch = "wasm32"))]
-pub use progressive::render_progressive;
 pub use progressive::{
     Progress, Progressive, RenderClock, Rule, Status, StopReason, StopRules, parse_target_error,
     parse_time_budget,
 };
+#[cfg(not(target_arch = "wasm32"))]
+pub use progressive::{render_progressive, render_progressive_over};
 pub use shaders::{
     CAUSTIC_SHADER, GENERIC_LIGHT_CHOICE, GENERIC_MATERIALS, GENERIC_TRAVERSAL, PATHTRACE_SHADER,
     SAMPLING_MODULES, SCENE_MODULE, SURFACES_MODULE, shader_modules,
