@@ -606,6 +606,64 @@ fn a_low_discrepancy_render_keeps_its_replicates_through_resume_and_merge() {
     );
 }
 
+/// `--error-percentile` and `--region` say what `--target-error` is measured over; bad values
+/// are refused naming the flag, the value and what is allowed (for a region, the valid names).
+#[test]
+fn error_percentile_and_region_refuse_bad_values_and_stop_on_their_error() {
+    for bad in ["0", "101", "-3", "ninety"] {
+        let out = run(&["--target-error", "0.1", "--error-percentile", bad]);
+        assert_refused(&out, &format!("--error-percentile {bad}"), &["--error-percentile", bad, "100"]);
+        assert_no_panic(&out);
+    }
+    let out = run(&[
+        "scenes/whitted.toml",
+        "--renderer",
+        "pathtrace",
+        "--width",
+        "32",
+        "--height",
+        "18",
+        "--target-error",
+        "0.1",
+        "--region",
+        "teapot",
+    ]);
+    assert_refused(
+        &out,
+        "--region teapot",
+        &["--region \"teapot\"", "\"glass sphere\"", "\"metal sphere\"", "\"floor\""],
+    );
+    let out = run(&["--error-percentile", "95"]);
+    assert_refused(&out, "--error-percentile without --target-error", &["--target-error"]);
+    let out = run(&["--target-error", "0.1", "--error-percentile", "95", "--region", "floor"]);
+    assert_refused(&out, "both", &["not both"]);
+
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("glass.exr");
+    let exr_text = exr.to_str().unwrap();
+    let args = [
+        "scenes/whitted.toml",
+        "--renderer",
+        "pathtrace",
+        "--width",
+        "32",
+        "--height",
+        "18",
+        "--target-error",
+        "0.05",
+        "--region",
+        "glass sphere",
+        "-o",
+        exr_text,
+    ];
+    let out = run(&args);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert_eq!(field(&metadata(&exr), "stopped_by"), "target_error");
+    let error = illum::image::load_f32_layer(&exr, "illum.error").unwrap().expect("an illum.error layer");
+    assert_eq!(error.channels.len(), 1);
+    assert_eq!(error.channels[0].1.len(), 32 * 18);
+}
+
 /// A render whose spp is not a multiple of the chunk (16) ends inside a chunk. Resumed, it goes
 /// on from its last chunk boundary and equals a straight render bit for bit; split into ranges
 /// (each starting on a chunk), merged and resumed, it equals one render within 1e-12.

@@ -15,7 +15,7 @@
 
 use illum_image::{RgbImage32, load_exr, rel_mse};
 use illum_pathtrace::allocation::plan_adaptive;
-use illum_pathtrace::{PathTracer, Sequence, TracerOptions};
+use illum_pathtrace::{PathTracer, Sequence, StopReason, StopRules, TracerOptions, render_progressive};
 use illum_scene::{Bounces, Overrides, Sampling};
 
 use crate::common;
@@ -137,4 +137,54 @@ fn the_error_estimate_is_honest_for_every_sampler_sequence_and_adaptive_combinat
         }
     }
     assert!(failures.is_empty(), "estimated / true relMSE outside {HONEST_FACTOR} either way: {failures:#?}");
+}
+
+/// `--target-error` stops at the true error: with either sequence, the true relative error
+/// (sqrt of the measured relMSE) when the rule fires is at most the target times 1.2 (not
+/// stopped early) and at least half of it (not much later than needed: passes of about 0.02 s,
+/// so the last one overshoots little). The low-discrepancy sequence, whose estimate no longer
+/// overstates its error, stops at fewer spp.
+#[test]
+fn target_error_stops_at_the_true_error_with_either_sequence() {
+    const TARGET: f64 = 0.01;
+    let (reference, reference_noise) = reference();
+    let mut stopped_at = Vec::new();
+    for sequence in [Sequence::Independent, Sequence::LowDiscrepancy] {
+        let scene = common::scene(
+            "cornell",
+            Overrides {
+                width: Some(64),
+                height: Some(64),
+                bounces: Some(Bounces::Fixed(2)),
+                seed: Some(77),
+                ..Default::default()
+            },
+        );
+        let mut tracer =
+            PathTracer::with_options(common::gpu(), &scene, TracerOptions { sequence, ..Default::default() })
+                .expect("builds");
+        tracer.set_target_seconds(0.02);
+        let rules = StopRules { target_error: Some(TARGET), ..Default::default() };
+        let never = std::sync::atomic::AtomicBool::new(false);
+        let (reason, _) = render_progressive(&mut tracer, &rules, &never, |_, _| {}).expect("renders");
+        assert_eq!(reason, StopReason::ErrorReached);
+        let measured =
+            rel_mse(&tracer.accumulator().mean_image(), &reference).expect("same size") - reference_noise;
+        let (estimated, true_error) = (tracer.accumulator().estimated_relative_error(), measured.sqrt());
+        let spp = tracer.spp_done();
+        println!(
+            "{sequence}: stopped at {spp} spp, estimated error {estimated:.4}, true {true_error:.4} (target {TARGET})"
+        );
+        assert!(
+            (TARGET / 2.0..=TARGET * 1.2).contains(&true_error),
+            "{sequence}: stopped at {spp} spp with a true error of {true_error:.4} for a target of {TARGET}"
+        );
+        stopped_at.push(spp);
+    }
+    assert!(
+        stopped_at[1] < stopped_at[0],
+        "low-discrepancy took {} spp, independent {}",
+        stopped_at[1],
+        stopped_at[0]
+    );
 }
