@@ -108,6 +108,11 @@ struct Args {
     /// found through the Whitted tracer's object-ID image. An unknown name lists the valid ones.
     #[arg(long, value_name = "NAME")]
     region: Option<String>,
+    /// Rasterizer and Whitted ray tracer: a converged EXR of the same scene (by illum.scene_hash)
+    /// and size; the EXR outputs get the layer illum.difference, image minus reference, and the
+    /// summary its relMSE.
+    #[arg(long, value_name = "FILE.exr")]
+    reference: Option<PathBuf>,
     /// PNG encoding: gamma2.2, srgb or linear. Default: gamma2.2 (the assignment's) for
     /// path-traced scenes, linear for rasterizer scenes (the assignment's figure 1 is linear).
     #[arg(long)]
@@ -250,6 +255,7 @@ fn run(args: Args) -> anyhow::Result<()> {
             exposure: args.exposure,
             other_flags,
             long,
+            reference: args.reference.as_deref(),
         });
     }
     let whitted_flags = args.whitted.given();
@@ -271,9 +277,17 @@ fn run(args: Args) -> anyhow::Result<()> {
             exposure: args.exposure,
             other_flags: path_tracer_only,
             long,
+            reference: args.reference.as_deref(),
         });
     }
     args.raster.reject_for_path_tracer(&args.scene)?;
+    if let Some(reference) = &args.reference {
+        anyhow::bail!(
+            "--reference {}: the path tracer is the truth and writes its own error layer (illum.error); \
+             --reference applies to --renderer raster and --renderer whitted",
+            reference.display()
+        );
+    }
     // Read the checkpoint first: a bad file is refused before anything is rendered or written,
     // and the settings not given on the command line are the file's.
     let checkpoint = match &args.resume {

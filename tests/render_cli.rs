@@ -664,6 +664,76 @@ fn error_percentile_and_region_refuse_bad_values_and_stop_on_their_error() {
     assert_eq!(error.channels[0].1.len(), 32 * 18);
 }
 
+/// `--reference FILE.exr`: the rasterizer's and the Whitted tracer's EXRs get the signed
+/// difference from a path-traced truth (image minus reference, exactly), and a reference of
+/// another scene or size is refused naming both sides, before anything is rendered.
+#[test]
+fn raster_and_whitted_write_their_signed_difference_from_a_reference() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).to_str().unwrap().to_owned();
+    let size = ["--width", "32", "--height", "18"];
+    let with = |extra: &[&str]| {
+        let mut args = vec!["scenes/whitted.toml"];
+        args.extend(size);
+        args.extend(extra);
+        run(&args)
+    };
+    let out = with(&["--renderer", "pathtrace", "--spp", "64", "-o", &p("truth.exr")]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let (truth, _) = illum::image::load_exr(p("truth.exr")).unwrap();
+    for renderer in ["raster", "whitted"] {
+        let exr = p(&format!("{renderer}.exr"));
+        let out = with(&["--renderer", renderer, "--reference", &p("truth.exr"), "-o", &exr]);
+        assert!(out.status.success(), "{renderer}: {}", text(&out.stderr));
+        assert!(text(&out.stdout).contains("against the reference: relMSE"), "{}", text(&out.stdout));
+        let (image, _) = illum::image::load_exr(&exr).unwrap();
+        let layer =
+            illum::image::load_f32_layer(&exr, "illum.difference").unwrap().expect("a difference layer");
+        for (c, name) in ["R", "G", "B"].iter().enumerate() {
+            let (_, values) = layer.channels.iter().find(|(n, _)| n == name).expect("channel");
+            for (i, v) in values.iter().enumerate() {
+                assert_eq!(
+                    *v,
+                    image.pixels[i][c] - truth.pixels[i][c],
+                    "{renderer}: pixel {i} channel {name}"
+                );
+            }
+        }
+    }
+    // Another scene: the Cornell box's truth for the Whitted scene.
+    let out = run(&["--width", "32", "--height", "18", "--spp", "2", "-o", &p("cornell.exr")]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let cornell_hash = field(&metadata(Path::new(&p("cornell.exr"))), "scene_hash");
+    let whitted_hash = field(&metadata(Path::new(&p("truth.exr"))), "scene_hash");
+    let out = with(&["--renderer", "whitted", "--reference", &p("cornell.exr"), "-o", &p("x.exr")]);
+    assert_refused(
+        &out,
+        "a reference of another scene",
+        &["--reference", "\"cornell\"", &cornell_hash, "\"whitted\"", &whitted_hash],
+    );
+    // Another size.
+    let out = run(&[
+        "scenes/whitted.toml",
+        "--renderer",
+        "raster",
+        "--width",
+        "16",
+        "--height",
+        "9",
+        "--reference",
+        &p("truth.exr"),
+        "-o",
+        &p("y.exr"),
+    ]);
+    assert_refused(&out, "a reference of another size", &["32 x 18", "16 x 9"]);
+    assert!(
+        !Path::new(&p("x.exr")).exists() && !Path::new(&p("y.exr")).exists(),
+        "a refused render wrote a file"
+    );
+    let out = with(&["--renderer", "pathtrace", "--reference", &p("truth.exr")]);
+    assert_refused(&out, "--reference with the path tracer", &["--reference", "raster", "whitted"]);
+}
+
 /// A render whose spp is not a multiple of the chunk (16) ends inside a chunk. Resumed, it goes
 /// on from its last chunk boundary and equals a straight render bit for bit; split into ranges
 /// (each starting on a chunk), merged and resumed, it equals one render within 1e-12.
