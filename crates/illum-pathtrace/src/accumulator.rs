@@ -74,13 +74,21 @@ pub const RENDER_HOST_BYTES_PER_PIXEL: u64 = 2 * STATISTICS_BYTES_PER_PIXEL + 2 
 pub const ALIGNED_COPY_BYTES_PER_PIXEL: u64 = 2 * STATISTICS_BYTES_PER_PIXEL;
 
 /// Checks, before anything is allocated, that a `width x height` render fits in `available`
-/// bytes of host memory (`None`: unknown, not checked). The error says how much it would need.
-pub fn check_host_memory(width: u32, height: u32, available: Option<u64>) -> Result<(), String> {
-    let needed = u64::from(width) * u64::from(height) * RENDER_HOST_BYTES_PER_PIXEL;
+/// bytes of host memory (`None`: unknown, not checked), with `extra_per_pixel` bytes per pixel
+/// on top of [`RENDER_HOST_BYTES_PER_PIXEL`] (a low-discrepancy render's replicates and their
+/// EXR layer: 2 x `Replicates::BYTES_PER_PIXEL`). The error says how much it would need.
+pub fn check_host_memory(
+    width: u32,
+    height: u32,
+    extra_per_pixel: u64,
+    available: Option<u64>,
+) -> Result<(), String> {
+    let per_pixel = RENDER_HOST_BYTES_PER_PIXEL + extra_per_pixel;
+    let needed = u64::from(width) * u64::from(height) * per_pixel;
     match available {
         Some(available) if needed > available => Err(format!(
             "camera.width x camera.height = {width} x {height}: the render needs {:.1} GiB of host memory \
-             ({RENDER_HOST_BYTES_PER_PIXEL} bytes per pixel: the f64 statistics, the output images and their encoders' copies), \
+             ({per_pixel} bytes per pixel: the f64 statistics, the output images and their encoders' copies), \
              but only {:.1} GiB are available",
             gib(needed),
             gib(available)
@@ -473,10 +481,13 @@ mod tests {
 
     #[test]
     fn a_render_larger_than_memory_is_refused_with_what_it_needs() {
-        let err = check_host_memory(8192, 8192, Some(2 << 30)).unwrap_err();
+        let err = check_host_memory(8192, 8192, 0, Some(2 << 30)).unwrap_err();
         assert!(err.contains("8192 x 8192") && err.contains("9.9 GiB") && err.contains("2.0 GiB"), "{err}");
-        assert!(check_host_memory(16384, 16384, None).is_ok());
-        assert!(check_host_memory(512, 512, Some(1 << 30)).is_ok());
+        // With the replicates of a low-discrepancy render: 159 + 512 bytes per pixel.
+        let err = check_host_memory(8192, 8192, 512, Some(2 << 30)).unwrap_err();
+        assert!(err.contains("41.9 GiB") && err.contains("671 bytes per pixel"), "{err}");
+        assert!(check_host_memory(16384, 16384, 0, None).is_ok());
+        assert!(check_host_memory(512, 512, 0, Some(1 << 30)).is_ok());
         if cfg!(target_os = "linux") {
             assert!(available_host_memory().is_some_and(|b| b > 0));
         }

@@ -108,9 +108,16 @@ impl PathTracer {
         limits::check_texture_size(scene, &limits)?;
         let max_slots = batch::device_max_slots(&limits);
         batch::check_row_fits(scene, max_slots)?;
+        // A low-discrepancy render also keeps its replicates, and writes them into its EXR.
+        let replicate_bytes = if options.sequence == Sequence::LowDiscrepancy {
+            2 * crate::replicates::Replicates::BYTES_PER_PIXEL
+        } else {
+            0
+        };
         crate::accumulator::check_host_memory(
             scene.camera.width,
             scene.camera.height,
+            replicate_bytes,
             crate::accumulator::available_host_memory(),
         )
         .map_err(|message| PathTraceError::Unsupported { scene: scene.name.clone(), message })?;
