@@ -609,6 +609,12 @@ fn run(args: Args) -> anyhow::Result<()> {
         accumulator.estimated_relative_error(),
         accumulator.dropped_samples(),
     );
+    let scope = progressive.error_scope();
+    if *scope != illum::pathtrace::error_map::ErrorScope::Image
+        && let Some(error) = status.relative_error
+    {
+        println!("estimated relative error over {}: {error:.4}", scope.describe());
+    }
     for output in &outputs {
         println!("wrote {}", output.display());
     }

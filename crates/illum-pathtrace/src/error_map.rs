@@ -39,6 +39,19 @@ pub enum ErrorScope {
     Region { name: String, mask: Vec<bool> },
 }
 
+impl ErrorScope {
+    /// What the error is measured over, in words ("the 95th percentile of the pixels").
+    pub fn describe(&self) -> String {
+        match self {
+            ErrorScope::Image => "the image".to_owned(),
+            ErrorScope::Percentile(p) => format!("the {p}th percentile of the pixels"),
+            ErrorScope::Region { name, mask } => {
+                format!("region {name:?} ({} pixels)", mask.iter().filter(|m| **m).count())
+            }
+        }
+    }
+}
+
 impl ErrorMap {
     pub fn of(accumulator: &Accumulator) -> ErrorMap {
         let pixels = accumulator.width as usize * accumulator.height as usize;

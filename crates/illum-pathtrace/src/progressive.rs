@@ -284,6 +284,11 @@ impl Progressive {
         }
     }
 
+    /// What the error is measured over.
+    pub fn error_scope(&self) -> &ErrorScope {
+        &self.error_scope
+    }
+
     /// Measures the error (shown, and for the error rule) over `scope` instead of the image.
     pub fn with_error_scope(mut self, scope: ErrorScope) -> Self {
         self.error_scope = scope;
