@@ -118,7 +118,7 @@ struct Args {
     #[arg(long)]
     encoding: Option<Encoding>,
     /// Path-tracer scenes: `independent` (default) or `low-discrepancy` sample values (lower
-    /// error for the same spp; its error is estimated from 8 independently randomised
+    /// error for the same spp; its error is estimated from 4 independently randomised
     /// replicates: see docs/accuracy.md).
     #[arg(long)]
     sequence: Option<Sequence>,

@@ -49,7 +49,7 @@ struct Sampler {
 // identically distributed, and their spread estimates the variance of the pixel's mean
 // (src/replicates.rs); each replicate's first indices are still a prefix of its padded sequence.
 // Mirrored by src/replicates.rs (checked there by a test).
-const REPLICATES: u32 = 8u;
+const REPLICATES: u32 = 4u;
 const REPLICATE_RUN: u32 = 2u;
 
 fn sampler_new(seed: u32, pixel: u32, sample_index: u32) -> Sampler {

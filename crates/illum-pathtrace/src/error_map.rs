@@ -7,7 +7,7 @@
 //! `illum.error`, the viewer's error view) is the square root of its own. The variance is the
 //! accumulator's: from replicates for the low-discrepancy sequence, s^2 / n otherwise.
 //!
-//! A percentile of the per-pixel errors reads each pixel's own noisy estimate (7 degrees of
+//! A percentile of the per-pixel errors reads each pixel's own noisy estimate (3 degrees of
 //! freedom with replicates, n - 1 otherwise), and the noise of an estimate spreads the
 //! distribution: a high percentile of estimates lies somewhat above that of the true errors, so a
 //! percentile stop rule errs toward stopping late.

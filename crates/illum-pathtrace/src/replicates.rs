@@ -22,15 +22,18 @@
 //! stopped at an odd spp and went on) has chunks across two runs; such a chunk is counted in the
 //! replicate of its first sample, which mixes one sample into a neighbour replicate.
 
-/// Independently randomised copies of the low-discrepancy sequence per pixel. 8 gives 7 degrees
-/// of freedom per pixel (a per-pixel variance estimate within about 53% relative, one standard
-/// deviation) and costs the sequence little: the R replicates of N / R points have about
-/// R^(beta - 1) times the error of one sequence of N points, beta the measured rate of its
-/// relMSE (about 1.1 on the Cornell box: 1.25 times the relMSE at R = 8).
-pub const REPLICATES: usize = 8;
+/// Independently randomised copies of the low-discrepancy sequence per pixel. R replicates of
+/// N / R points each have more error than one sequence of N points, since the sequence's
+/// advantage grows with its length; more replicates give a steadier per-pixel estimate (R - 1
+/// degrees of freedom). Measured on the 64 x 64 Cornell box (docs/accuracy.md), relMSE over that
+/// of one sequence at 64 / 256 / 1024 / 4096 spp: R = 4: 2.0 / 1.35 / 1.22 / 0.99; R = 8: 2.1 /
+/// 2.1 / 1.56 / 1.16. 4 keeps most of the sequence's gain, with 3 degrees of freedom per pixel
+/// (a per-pixel variance within about 82% relative, one standard deviation; the image's
+/// estimate averages thousands of them).
+pub const REPLICATES: usize = 4;
 
 /// Consecutive sample indices that go to one replicate (the chunk size of a low-discrepancy
-/// render). 2: paired paths trace two samples at a time, and 16 spp already reach every replicate.
+/// render). 2: paired paths trace two samples at a time, and 8 spp already reach every replicate.
 pub const REPLICATE_RUN: u32 = 2;
 
 /// The replicate that sample index `sample` of a pixel belongs to (as the shader's sampler_new).
@@ -135,19 +138,20 @@ mod tests {
     #[test]
     fn samples_are_dealt_in_runs_over_every_replicate() {
         let dealt: Vec<usize> = (0..18).map(replicate_of).collect();
-        assert_eq!(dealt, [0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 5, 5, 6, 6, 7, 7, 0, 0]);
+        assert_eq!(dealt, [0, 0, 1, 1, 2, 2, 3, 3, 0, 0, 1, 1, 2, 2, 3, 3, 0, 0]);
     }
 
     /// Equal counts: the textbook estimate sum (m_r - m)^2 / (R (R - 1)), by hand.
     #[test]
     fn equal_counts_give_the_spread_of_the_replicate_means() {
         let mut reps = Replicates::new(1);
-        let means = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0];
+        let means = [1.0, 2.0, 3.0, 6.0];
+        assert_eq!(means.len(), REPLICATES);
         for (r, m) in means.iter().enumerate() {
             reps.add(0, r, [2.0 * m; 3], 2);
         }
-        // mean 4.5; sum of squared deviations 42; / (8 x 7) = 0.75.
-        assert!((reps.variance_of_mean(0)[0] - 0.75).abs() < 1e-12, "{:?}", reps.variance_of_mean(0));
+        // mean 3; sum of squared deviations 4 + 1 + 0 + 9 = 14; / (4 x 3) = 7 / 6.
+        assert!((reps.variance_of_mean(0)[0] - 7.0 / 6.0).abs() < 1e-12, "{:?}", reps.variance_of_mean(0));
     }
 
     #[test]

@@ -5,7 +5,7 @@
 //!
 //! Both are relMSE with the same epsilon: the estimate is mean(Var[mean] / (mean^2 + 0.01)), the
 //! truth mean((mean - ref)^2 / (ref^2 + 0.01)). Var[mean] is s^2 / n for independent numbers and
-//! the spread of the 8 randomised replicates for the low-discrepancy sequence (src/replicates.rs).
+//! the spread of the 4 randomised replicates for the low-discrepancy sequence (src/replicates.rs).
 //! The reference (tests/reference, 16384 spp, independent numbers) has its own variance, which is
 //! subtracted from the measured error.
 //!
