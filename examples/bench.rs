@@ -209,6 +209,8 @@ struct ViewerRun {
     samples_per_second: f64,
     elapsed: f64,
     fps: f64,
+    /// Share of the wall time the viewer spent in its path tracer's steps.
+    stepping: f64,
 }
 
 /// The number after `name ` in the viewer's statistics line.
@@ -269,6 +271,7 @@ fn run_viewer(scene: &std::path::Path, frames: u32) -> anyhow::Result<ViewerRun>
         samples_per_second: statistic(line, "samples/s (wall)")? * 1e6,
         elapsed: statistic(line, "elapsed")?,
         fps: statistic(line, "window")?,
+        stepping: statistic(line, "stepping")? / 100.0,
     })
 }
 
@@ -284,9 +287,9 @@ fn bench_viewer(gpu: &illum::gpu::GpuContext, args: &Args) -> anyhow::Result<()>
     use illum::pathtrace::{StopRules, render_progressive};
     let path = illum_cli::resolve_scene_path(&args.scene);
     println!(
-        "| run | resolution | viewer Msamples/s (wall) | window fps | render Msamples/s (wall), same size and time | viewer / render |"
+        "| run | resolution | viewer Msamples/s (wall) | window fps | viewer's share of wall time in the path tracer | render Msamples/s (wall), same size and time | viewer / render |"
     );
-    println!("|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|");
     let mut ratios = Vec::new();
     for run in 1..=args.runs {
         let viewer = run_viewer(&path, args.frames)?;
@@ -305,11 +308,12 @@ fn bench_viewer(gpu: &illum::gpu::GpuContext, args: &Args) -> anyhow::Result<()>
         let ratio = viewer.samples_per_second / render;
         ratios.push(ratio);
         println!(
-            "| {run} | {} x {} | {:.2} | {:.1} | {:.2} | {:.2} |",
+            "| {run} | {} x {} | {:.2} | {:.1} | {:.0}% | {:.2} | {:.2} |",
             viewer.width,
             viewer.height,
             viewer.samples_per_second * 1e-6,
             viewer.fps,
+            100.0 * viewer.stepping,
             render * 1e-6,
             ratio
         );

@@ -29,6 +29,10 @@ pub struct StartOptions {
     /// The mode shown first (default: the scene's).
     pub mode: Option<RendererKind>,
     pub screenshot: Option<ScreenshotJob>,
+    /// The window is cleared to the panels' colour before egui paints (eframe's window and
+    /// web page do that with [`eframe::App::clear_color`]; a test harness may not), so the
+    /// panels need no fill of their own.
+    pub clear_is_backdrop: bool,
 }
 
 /// The viewer.
@@ -56,6 +60,9 @@ pub struct ViewerApp {
     /// Where the image was drawn last, in physical pixels of the window: x, y, width, height
     /// (published for scripts, which crop screenshots to it).
     view_rect: Option<[u32; 4]>,
+    /// The panels' own fill for the dark and the light theme, when the window's clear paints
+    /// it instead (their fill is then transparent).
+    backdrop: Option<[egui::Color32; 2]>,
     /// The browser's file picker ("Open file..."), which delivers a file a few frames later.
     #[cfg(target_arch = "wasm32")]
     picker: crate::browser::FilePicker,
@@ -92,9 +99,17 @@ impl ViewerApp {
             screenshot: options.screenshot,
             frame_rate: FrameRate::default(),
             view_rect: None,
+            backdrop: None,
             #[cfg(target_arch = "wasm32")]
             picker: crate::browser::FilePicker::default(),
         };
+        // On a software rasterizer every pixel egui fills is shaded, and the panels' fill was
+        // a quarter of a frame's cost; a clear costs next to nothing (docs/viewer.md).
+        if options.clear_is_backdrop {
+            let fill = |theme| cc.egui_ctx.style_of(theme).visuals.panel_fill;
+            app.backdrop = Some([fill(egui::Theme::Dark), fill(egui::Theme::Light)]);
+            cc.egui_ctx.all_styles_mut(|style| style.visuals.panel_fill = egui::Color32::TRANSPARENT);
+        }
         // Each mode starts on its default scene; the given file then replaces its mode's.
         app.pathtrace = load_pathtrace(Path::new(DEFAULT_PATHTRACE_SCENE));
         app.raster = load_raster(Path::new(DEFAULT_RASTER_SCENE));
@@ -442,10 +457,12 @@ impl ViewerApp {
         });
     }
 
-    fn view(&mut self, ui: &mut egui::Ui) {
+    /// The image of the shown mode, filling `ui`; `fill` where there is none yet.
+    fn view(&mut self, ui: &mut egui::Ui, fill: egui::Color32) {
         let (gpu, render_state) = match &self.gpu {
             Ok(pair) => pair,
             Err(error) => {
+                ui.painter().rect_filled(ui.max_rect(), 0.0, fill);
                 ui.colored_label(ui.visuals().error_fg_color, error.as_str());
                 return;
             }
@@ -469,7 +486,11 @@ impl ViewerApp {
         let sense = egui::Sense::click_and_drag();
         let response = match texture {
             Some(id) => ui.add(egui::Image::new(egui::load::SizedTexture::new(id, size)).sense(sense)),
-            None => ui.allocate_response(size, sense),
+            None => {
+                let response = ui.allocate_response(size, sense);
+                ui.painter().rect_filled(response.rect, 0.0, fill);
+                response
+            }
         };
         let rect = response.rect;
         self.view_rect = Some(
@@ -496,6 +517,18 @@ impl ViewerApp {
     }
 }
 
+/// The four strips of `outer` around `inner` (top and bottom full width, left and right between
+/// them), so that a frame around an opaque image is filled without filling under it.
+fn margin_strips(outer: egui::Rect, inner: egui::Rect) -> [egui::Rect; 4] {
+    use egui::{Rect, pos2};
+    [
+        Rect::from_min_max(outer.min, pos2(outer.max.x, inner.min.y)),
+        Rect::from_min_max(pos2(outer.min.x, inner.max.y), outer.max),
+        Rect::from_min_max(pos2(outer.min.x, inner.min.y), pos2(inner.min.x, inner.max.y)),
+        Rect::from_min_max(pos2(inner.max.x, inner.min.y), pos2(outer.max.x, inner.max.y)),
+    ]
+}
+
 fn load_pathtrace(path: &Path) -> Result<PathTraceMode, String> {
     Ok(PathTraceMode::new(path.to_path_buf(), scene_file::load(path)?.pathtrace?))
 }
@@ -509,6 +542,20 @@ fn load_whitted(path: &Path) -> Result<WhittedMode, String> {
 }
 
 impl eframe::App for ViewerApp {
+    fn clear_color(&self, visuals: &egui::Visuals) -> [f32; 4] {
+        let fill = match self.backdrop {
+            Some([dark, light]) => {
+                if visuals.dark_mode {
+                    dark
+                } else {
+                    light
+                }
+            }
+            None => visuals.panel_fill,
+        };
+        fill.to_normalized_gamma_f32()
+    }
+
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         self.frame_rate.tick();
         // A scene file dropped on the window opens like one named in the Scene field.
@@ -539,7 +586,20 @@ impl eframe::App for ViewerApp {
                 .max_size(max)
                 .show(ui, |ui| self.side_panel(ui));
         }
-        egui::CentralPanel::default().show(ui, |ui| self.view(ui));
+        // The image covers the central panel but for its margin, so only the margin is filled
+        // (by the clear where that paints the panels): a fill under the image was a third of
+        // a frame's cost on a software rasterizer (docs/viewer.md).
+        let frame = egui::Frame::central_panel(ui.style());
+        let fill = frame.fill;
+        egui::CentralPanel::default().frame(frame.fill(egui::Color32::TRANSPARENT)).show(ui, |ui| {
+            let inner = ui.max_rect();
+            let outer = inner + frame.inner_margin;
+            let painter = ui.painter().with_clip_rect(outer);
+            for strip in margin_strips(outer, inner) {
+                painter.rect_filled(strip, 0.0, fill);
+            }
+            self.view(ui, fill)
+        });
         if let Some(mut job) = self.screenshot.take() {
             job.tick(ui.ctx(), || self.summary());
             self.screenshot = Some(job);

@@ -39,7 +39,8 @@ mod native {
         let outcome: Outcome = Arc::default();
         let screenshot =
             args.screenshot.clone().map(|path| ScreenshotJob::new(path, args.frames, outcome.clone()));
-        let start = StartOptions { scene: args.scene.clone(), mode: args.mode, screenshot };
+        let start =
+            StartOptions { scene: args.scene.clone(), mode: args.mode, screenshot, clear_is_backdrop: true };
 
         let mut native = eframe::NativeOptions {
             viewport: egui::ViewportBuilder::default()

@@ -104,7 +104,7 @@ pub struct Stats {
 
 /// The submissions since the accumulation last restarted: what the planner scheduled and what
 /// the frames carried (a check that every frame's share of samples arrives).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct WorkLog {
     /// Submissions folded.
     pub submissions: u64,
@@ -114,6 +114,8 @@ pub struct WorkLog {
     pub smallest_submission: u64,
     /// Submissions that completed a pass over the whole image.
     pub passes: u64,
+    /// Wall seconds the frames spent in the path tracer's steps (submitting, waiting, folding).
+    pub step_seconds: f64,
 }
 
 /// The path-tracer mode.
@@ -204,13 +206,17 @@ impl PathTraceMode {
         let st = &self.stats;
         let error =
             st.relative_error.map_or("n/a (needs 2 spp)".to_owned(), |e| format!("{:.2}%", e * 100.0));
+        // The share of the wall time in the path tracer's steps: what the window's drawing
+        // leaves it (samples/s over that share is the rate while it runs).
+        let stepping = if st.elapsed_seconds > 0.0 { self.work.step_seconds / st.elapsed_seconds } else { 0.0 };
         format!(
-            "pathtrace: {} x {}, spp done {}, samples/s (wall) {:.3} M, elapsed {:.2} s, estimated error {error}",
+            "pathtrace: {} x {}, spp done {}, samples/s (wall) {:.3} M, elapsed {:.2} s, estimated error {error}, stepping {:.0}% of the wall time",
             st.width,
             st.height,
             st.spp,
             st.samples_per_second / 1e6,
-            st.elapsed_seconds
+            st.elapsed_seconds,
+            100.0 * stepping
         )
     }
 
@@ -351,7 +357,9 @@ impl PathTraceMode {
             }
             let started = web_time::Instant::now();
             let stepped = self.progressive.step(tracer);
-            self.pacer.stepped(started, started.elapsed().as_secs_f64());
+            let step_seconds = started.elapsed().as_secs_f64();
+            self.pacer.stepped(started, step_seconds);
+            self.work.step_seconds += step_seconds;
             if let Err(e) = stepped {
                 self.message = Some(format!("path tracer: {e}"));
                 self.set_paused(true);

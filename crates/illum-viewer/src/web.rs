@@ -107,7 +107,11 @@ fn start_options_from_url() -> (StartOptions, PathTraceQuery, Option<String>) {
         }
     });
     let error = (!errors.is_empty()).then(|| format!("in the page address: {}", errors.join("; ")));
-    (StartOptions { scene, mode, screenshot: None }, PathTraceQuery { spp, caustics, scale }, error)
+    (
+        StartOptions { scene, mode, screenshot: None, clear_is_backdrop: true },
+        PathTraceQuery { spp, caustics, scale },
+        error,
+    )
 }
 
 /// Replaces the canvas with a message (the viewer could not start).

@@ -22,6 +22,9 @@ fn xvfb_run() -> &'static str {
     "xvfb-run"
 }
 
+/// egui's dark theme's panel fill, which the viewer's window clears to.
+const PANEL_GREY: u8 = 27;
+
 /// Longest a screenshot run may take before it counts as hung (it takes seconds on lavapipe).
 const RUN_TIMEOUT: Duration = Duration::from_secs(180);
 
@@ -108,6 +111,16 @@ fn all_three_modes_draw_under_xvfb() {
         assert!(image.width() >= 200 && image.height() >= 200, "{name}: {:?}", image.dimensions());
         let s = spread(image);
         assert!(s > 10.0, "{name} screenshot looks blank (grey-level spread {s:.1})");
+        // The window's clear paints the panels (they have no fill of their own): the settings
+        // panel's empty bottom corner and the image's right margin show the panel colour.
+        let (w, h) = image.dimensions();
+        for (x, y) in [(4, h - 4), (w - 3, h / 2)] {
+            let p = image.get_pixel(x, y);
+            assert!(
+                p.0[..3].iter().all(|&c| c.abs_diff(PANEL_GREY) <= 1),
+                "{name}: pixel ({x}, {y}) is {p:?}, not the panel grey {PANEL_GREY}"
+            );
+        }
     }
     // Each mode shows its own renderer's picture (the path tracer starts on the Cornell box;
     // raster and Whitted on the Whitted scene, where the ray tracer's glass and mirror differ

@@ -45,7 +45,16 @@ fn harness_sized(scene: &'static str, mode: RendererKind, size: egui::Vec2) -> H
         .with_size(size)
         .wgpu_setup(egui_wgpu::WgpuSetup::Existing(shared_device()))
         .build_eframe(move |cc| {
-            ViewerApp::new(cc, StartOptions { scene: scene.into(), mode: Some(mode), screenshot: None })
+            ViewerApp::new(
+                cc,
+                StartOptions {
+                    scene: scene.into(),
+                    mode: Some(mode),
+                    screenshot: None,
+                    // The harness clears to transparent: the panels paint their own fill.
+                    clear_is_backdrop: false,
+                },
+            )
         })
 }
 
