@@ -208,7 +208,8 @@ impl PathTraceMode {
             st.relative_error.map_or("n/a (needs 2 spp)".to_owned(), |e| format!("{:.2}%", e * 100.0));
         // The share of the wall time in the path tracer's steps: what the window's drawing
         // leaves it (samples/s over that share is the rate while it runs).
-        let stepping = if st.elapsed_seconds > 0.0 { self.work.step_seconds / st.elapsed_seconds } else { 0.0 };
+        let stepping =
+            if st.elapsed_seconds > 0.0 { self.work.step_seconds / st.elapsed_seconds } else { 0.0 };
         format!(
             "pathtrace: {} x {}, spp done {}, samples/s (wall) {:.3} M, elapsed {:.2} s, estimated error {error}, stepping {:.0}% of the wall time",
             st.width,
