@@ -570,7 +570,7 @@ fn two_concurrent_processes_like_gnu_parallel_then_merge_equal_one_render() {
 }
 
 /// A low-discrepancy render keeps its replicates (crates/illum-pathtrace/src/replicates.rs), and
-/// so its error estimate, through a resume and a merge: resumed from 41 spp (inside a chunk of 2)
+/// so its error estimate, through a resume and a merge: resumed from 41 spp (inside a chunk of 4)
 /// to 96 its replicate sums are a straight render's bit for bit, and merged from the ranges 0..48
 /// and 48..96 within 1e-12.
 #[test]

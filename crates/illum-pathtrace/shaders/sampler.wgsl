@@ -50,7 +50,7 @@ struct Sampler {
 // (src/replicates.rs); each replicate's first indices are still a prefix of its padded sequence.
 // Mirrored by src/replicates.rs (checked there by a test).
 const REPLICATES: u32 = 4u;
-const REPLICATE_RUN: u32 = 2u;
+const REPLICATE_RUN: u32 = 4u;
 
 fn sampler_new(seed: u32, pixel: u32, sample_index: u32) -> Sampler {
 #ifdef LOW_DISCREPANCY
