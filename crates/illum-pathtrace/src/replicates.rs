@@ -18,9 +18,12 @@
 //!
 //! The chunk of samples one GPU invocation sums must lie inside one run, so a low-discrepancy
 //! render uses chunks of [`REPLICATE_RUN`] samples; its folded chunk sums then add into the
-//! replicate of their first sample. A pass starting inside a run (only after a render stopped at
-//! an spp that is not a multiple of the run and went on unaligned) has chunks across two runs; such a chunk is counted in the
-//! replicate of its first sample, which mixes one sample into a neighbour replicate.
+//! replicate of their first sample. The tracer therefore ends every planned pass of such a
+//! render on a multiple of the run (`tracer/passes.rs`), as chunk-aligned passes do. A pass
+//! that starts inside a run anyway (`add_samples_in_one_pass` with an spp that is not a multiple
+//! of it, then more) has chunks across two runs, each counted in the replicate of its first
+//! sample: that mixes replicates, whose means then spread more, and the estimate errs high.
+//! Measured with unaligned passes of any spp: est./true up to 2.4 at 4096 spp.
 
 /// Independently randomised copies of the low-discrepancy sequence per pixel. R replicates of
 /// N / R points each have more error than one sequence of N points, since the sequence's
