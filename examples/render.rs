@@ -6,7 +6,7 @@
 //! cargo run --release --example render -- [SCENE] [--spp N] [--bounces B|unbounded] [--seed S]
 //!     [--width W --height H] [--sampling cosine|uniform] [-o FILE.png|FILE.exr]...
 //!     [--target-error X] [--time-budget SECONDS] [--encoding gamma2.2|srgb] [--exposure STOPS]
-//!     [--caustics on|off]
+//!     [--caustics on|off] [--denoise atrous|oidn]
 //! ```
 //! With no arguments it renders `scenes/cornell.toml` to `out/cornell.png` and `out/cornell.exr`.
 //! `--renderer raster|pathtrace` picks the renderer; the default is the scene file's `renderer`
@@ -56,11 +56,14 @@ use illum::pathtrace::{
     PathTracer, SampleAllocation, Sequence, StopReason, StopRules, TracerOptions, render_progressive_over,
 };
 use illum::scene::{RendererKind, Scene};
+use illum_cli::auto::RendererChoice;
 use illum_cli::interrupt::Interrupt;
 use illum_cli::progress::RenderProgress;
 use illum_cli::raster::{RasterArgs, RasterRequest, render_raster};
 use illum_cli::whitted::{WhittedArgs, WhittedRequest, render_whitted};
 use illum_cli::{DEFAULT_SCENE, LongRender, OutputFormat, SceneArgs, output_format};
+use illum_lab::auto::pilot::PilotOptions;
+use illum_lab::auto::plan::{Goal, Setting};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -78,9 +81,12 @@ struct Args {
     /// Scene file (TOML).
     #[arg(default_value = DEFAULT_SCENE)]
     scene: PathBuf,
-    /// Renderer: `pathtrace`, `raster` or `whitted`. Default: the scene file's `renderer`.
+    /// Renderer: `pathtrace`, `raster`, `whitted`, or `auto`: the fastest renderer and settings
+    /// predicted to reach --target-error, or the most accurate predicted to finish within
+    /// --time-budget, from a pilot of this scene on this machine (docs/auto.md). Default: the
+    /// scene file's `renderer`.
     #[arg(long)]
-    renderer: Option<RendererKind>,
+    renderer: Option<RendererChoice>,
     #[command(flatten)]
     settings: SceneArgs,
     #[command(flatten)]
@@ -143,6 +149,15 @@ struct Args {
     /// that merged ranges give the image of one render.
     #[arg(long, value_name = "A..B", value_parser = illum_cli::sample_range_arg)]
     sample_range: Option<std::ops::Range<u32>>,
+    /// Path-tracer scenes: denoise the image (`atrous`: the edge-avoiding à-trous filter on the
+    /// GPU; `oidn`: Intel Open Image Denoise, not in this build). The render is kept as two
+    /// independent halves, and the denoised image's error is estimated from them
+    /// (docs/denoising.md): it is the `illum.estimated_relative_error` written and the one
+    /// --target-error stops at. The EXR holds the denoised image, and layers `noisy`, `albedo`
+    /// and `normal`. --spp is rounded up to an even number. Not with --resume, --sample-range,
+    /// --adaptive or --checkpoint-seconds.
+    #[arg(long, value_name = "atrous|oidn", value_parser = denoiser_arg)]
+    denoise: Option<illum_cli::denoise::DenoiserKind>,
     /// Path-tracer scenes: adaptive sampling. A pilot of 16 spp (another seed, then discarded)
     /// measures the noise of every 8 x 8 block of pixels, and the --spp budget is spread over
     /// the blocks in proportion to it: the spp is then the mean over the image (docs/accuracy.md, "Adaptive sampling").
@@ -168,6 +183,10 @@ const DEFAULT_CHECKPOINT: Duration = Duration::from_secs(60);
 
 fn main() {
     illum_cli::main_with(run);
+}
+
+fn denoiser_arg(text: &str) -> Result<illum_cli::denoise::DenoiserKind, String> {
+    text.parse()
 }
 
 /// Fills the image-changing settings not given on the command line from a checkpoint's
@@ -220,6 +239,89 @@ fn error_scope(
 }
 
 fn run(args: Args) -> anyhow::Result<()> {
+    if args.renderer == Some(RendererChoice::Auto) {
+        return run_auto(args);
+    }
+    render(args).map(|_| ())
+}
+
+/// `--renderer auto`: checks the flags, runs the pilot, prints the plan, then renders it as
+/// the flags naming its renderer and settings would, and compares what it reached with what
+/// was predicted.
+fn run_auto(mut args: Args) -> anyhow::Result<()> {
+    let mut chosen = illum_cli::given_flags(&[
+        (args.settings.spp.is_some(), "--spp"),
+        (args.settings.bounces.is_some(), "--bounces"),
+        (args.sequence.is_some(), "--sequence"),
+        (args.caustics.is_some(), "--caustics"),
+        (args.adaptive, "--adaptive"),
+        (args.resume.is_some(), "--resume"),
+        (args.sample_range.is_some(), "--sample-range"),
+        (args.checkpoint_seconds.is_some(), "--checkpoint-seconds"),
+        // Its plans predict raw images' errors; a denoised one's is another (docs/denoising.md).
+        (args.denoise.is_some(), "--denoise"),
+    ]);
+    chosen.extend(args.raster.given());
+    chosen.extend(args.whitted.given());
+    illum_cli::auto::check_auto_flags(args.target_error, args.time_budget, &chosen)
+        .map_err(anyhow::Error::msg)?;
+    let goal = match (args.target_error, args.time_budget) {
+        (Some(error), _) => Goal::Error(error),
+        (None, budget) => Goal::Seconds(budget.expect("one goal (checked)").as_secs_f64()),
+    };
+    illum_lab::auto::plan::check_goal(goal).map_err(anyhow::Error::msg)?;
+    let scene = illum_cli::load_scene(&args.scene, &args.settings)?;
+    let png_flags = illum_cli::given_flags(&[
+        (args.encoding.is_some(), "--encoding"),
+        (args.exposure.is_some(), "--exposure"),
+    ]);
+    illum_cli::check_outputs(&args.outputs, &png_flags)?;
+    let started = std::time::Instant::now();
+    let gpu = illum_cli::gpu()?;
+    let device_seconds = started.elapsed().as_secs_f64();
+    let options = PilotOptions::default();
+    let pilot = illum_lab::auto::pilot::measure(&gpu, &scene, device_seconds, &options)?;
+    drop(gpu);
+    let plan = illum_lab::auto::plan::plan(&pilot.candidates, goal)
+        .map_err(|why| anyhow::anyhow!("{}: {why}", args.scene.display()))?;
+    print!("{}", illum_lab::auto::describe(&scene, &pilot, goal, &plan));
+    let choice = plan.choice;
+    args.target_error = None;
+    args.time_budget = None;
+    match &choice.candidate.setting {
+        Setting::Raster { look, effects } => {
+            args.renderer = Some(RendererChoice::Kind(RendererKind::Raster));
+            args.raster.look = Some(*look);
+            args.raster.no_shadows = !effects.shadows;
+            args.raster.no_pcf = !effects.pcf;
+            args.raster.no_refraction = !effects.refraction;
+            args.raster.no_reflection = !effects.reflection;
+            args.raster.no_fresnel = !effects.fresnel;
+            args.raster.no_antialiasing = !effects.antialiasing;
+        }
+        Setting::Whitted { depth, aa } => {
+            args.renderer = Some(RendererChoice::Kind(RendererKind::Whitted));
+            args.whitted.depth = Some(*depth);
+            args.whitted.aa = Some(*aa);
+        }
+        Setting::PathTrace { bounces, caustics } => {
+            args.renderer = Some(RendererChoice::Kind(RendererKind::PathTrace));
+            args.settings.spp = choice.spp;
+            args.settings.bounces = Some(*bounces);
+            // Named only where the scene has a caustic: elsewhere `--caustics` is refused.
+            args.caustics = illum_lab::auto::pilot::has_caustic(&scene).then_some(*caustics);
+        }
+    }
+    let started = std::time::Instant::now();
+    let noise = render(args)?;
+    let seconds = started.elapsed().as_secs_f64();
+    println!("{}", illum_lab::auto::reached(&choice, noise, seconds));
+    Ok(())
+}
+
+/// Renders with the renderer and settings the flags name; for the path tracer, returns its
+/// estimated relative error from noise.
+fn render(args: Args) -> anyhow::Result<Option<f64>> {
     // First, so that a stop during the (slow on lavapipe) setup is handled like one during the
     // render: a message and the signal's status, never the default silent death.
     let interrupt = Interrupt::install()?;
@@ -228,8 +330,10 @@ fn run(args: Args) -> anyhow::Result<()> {
         progress_period: args.progress_seconds.unwrap_or(illum_cli::progress::DEFAULT_PERIOD),
     };
     let renderer = match args.renderer {
-        Some(renderer) => renderer,
-        None => Scene::load(&illum_cli::resolve_scene_path(&args.scene))?.renderer,
+        Some(RendererChoice::Kind(renderer)) => renderer,
+        Some(RendererChoice::Auto) | None => {
+            Scene::load(&illum_cli::resolve_scene_path(&args.scene))?.renderer
+        }
     };
     let path_tracer_only = illum_cli::given_flags(&[
         (args.target_error.is_some(), "--target-error"),
@@ -242,6 +346,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         (args.sample_range.is_some(), "--sample-range"),
         (args.checkpoint_seconds.is_some(), "--checkpoint-seconds"),
         (args.adaptive, "--adaptive"),
+        (args.denoise.is_some(), "--denoise"),
     ]);
     if renderer == RendererKind::Whitted {
         let mut other_flags = path_tracer_only.clone();
@@ -256,7 +361,8 @@ fn run(args: Args) -> anyhow::Result<()> {
             other_flags,
             long,
             reference: args.reference.as_deref(),
-        });
+        })
+        .map(|()| None);
     }
     let whitted_flags = args.whitted.given();
     if !whitted_flags.is_empty() {
@@ -278,7 +384,8 @@ fn run(args: Args) -> anyhow::Result<()> {
             other_flags: path_tracer_only,
             long,
             reference: args.reference.as_deref(),
-        });
+        })
+        .map(|()| None);
     }
     args.raster.reject_for_path_tracer(&args.scene)?;
     if let Some(reference) = &args.reference {
@@ -314,6 +421,21 @@ fn run(args: Args) -> anyhow::Result<()> {
         );
     }
     // Checked before the stop rules are announced: a refused render announces nothing.
+    if args.denoise.is_some() {
+        let conflicting = illum_cli::given_flags(&[
+            (args.resume.is_some(), "--resume"),
+            (args.sample_range.is_some(), "--sample-range"),
+            (args.adaptive, "--adaptive"),
+            (args.checkpoint_seconds.is_some(), "--checkpoint-seconds"),
+        ]);
+        if !conflicting.is_empty() {
+            anyhow::bail!(
+                "--denoise renders two independent halves of the samples and writes a denoised image, not a \
+                 checkpoint, so it cannot be combined with {}",
+                conflicting.join(" or ")
+            );
+        }
+    }
     if args.adaptive {
         let conflicting = illum_cli::given_flags(&[
             (args.resume.is_some(), "--resume"),
@@ -416,7 +538,7 @@ fn run(args: Args) -> anyhow::Result<()> {
             resumed.as_ref().map_or(0, |c| c.spp_done)
         );
         if args.outputs.iter().all(|o| o == path) {
-            return Ok(());
+            return Ok(None);
         }
     }
     let outputs = if args.outputs.is_empty() {
@@ -443,6 +565,27 @@ fn run(args: Args) -> anyhow::Result<()> {
     long.exit_if_requested("before the render started");
     let gpu = illum_cli::gpu()?;
     let options = TracerOptions { sequence, ..Default::default() };
+    if let Some(denoiser) = args.denoise {
+        let outcome = illum_cli::denoise::render_denoised(&illum_cli::denoise::DenoiseRequest {
+            gpu: &gpu,
+            scene: &scene,
+            options,
+            rules,
+            denoiser,
+            cancel: interrupt.flag(),
+            outputs: &outputs,
+            encoding: args.encoding,
+            exposure: args.exposure,
+        })?;
+        if let Some((signal, code)) = interrupt.exit_status() {
+            eprintln!("stopped by {signal}: exiting with status {code}");
+            std::process::exit(code);
+        }
+        let Some((_, error)) = outcome else {
+            anyhow::bail!("the denoised render stopped before its first round");
+        };
+        return Ok(Some(error));
+    }
     let mut tracer = if args.adaptive {
         // Built with the adaptive pipeline, which plan_adaptive's pilot runs (every block
         // unlimited until it sets the allocation): one compilation instead of two.
@@ -564,6 +707,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         std::process::exit(code);
     }
     let accumulator = tracer.accumulator();
+    let estimated_error = accumulator.estimated_relative_error();
     let image = accumulator.mean_image();
     let mut metadata =
         illum::pathtrace::metadata::exr_metadata(&tracer, seconds, Some(reason), "render example");
@@ -622,5 +766,5 @@ fn run(args: Args) -> anyhow::Result<()> {
         eprintln!("stopped by {signal}: exiting with status {code}");
         std::process::exit(code);
     }
-    Ok(())
+    Ok(Some(estimated_error))
 }

@@ -62,6 +62,9 @@ cp "$out/ladder/contact-sheet.png" docs/images/ladder-contact-sheet.png
     --bounce-list 0,1,2,4,8 --bounce-spp 512 --out "$out/ladder-cornell"
 cp "$out/ladder-cornell/ladder.md" docs/ladder-cornell.md
 cp "$out/ladder-cornell/contact-sheet.png" docs/images/ladder-cornell-contact-sheet.png
+# docs/auto-check.md: render --renderer auto against the truth, predicted against measured.
+"$bin/auto_check" --out "$out/auto-check"
+cp "$out/auto-check/auto-check.md" docs/auto-check.md
 
 
 # The README's ladder table: selected rows of ladder.csv.

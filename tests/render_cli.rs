@@ -964,6 +964,31 @@ fn caustics_on_off_is_recorded_and_a_checkpoint_of_the_other_setting_is_refused(
         "32",
     ]);
     assert_refused(&out, "--caustics off on a resume", &["caustics: on in the file, off now"]);
+    // A file rendered before the photon gather (the light tracer alone, no estimators key)
+    // holds other light in the metal sphere: resuming it with the gather is refused.
+    let mut before_gather = illum::pathtrace::checkpoint::load_checkpoint(&exr).unwrap();
+    assert!(field(&metadata(&exr), "caustic_estimators").starts_with("light tracer and photon gather"));
+    before_gather.metadata.fields.retain(|(k, _)| k != "caustic_estimators");
+    let old = dir.path().join("before-gather.exr");
+    illum::pathtrace::checkpoint::save_loaded(&old, &before_gather).unwrap();
+    let out = run(&[
+        "scenes/whitted.toml",
+        "--renderer",
+        "pathtrace",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--resume",
+        old.to_str().unwrap(),
+        "--spp",
+        "32",
+    ]);
+    assert_refused(
+        &out,
+        "resuming a file from before the gather",
+        &["caustic_estimators: light tracer in the file"],
+    );
 
     // A bad value and the raster renderer are refused by name.
     let out = run(&["scenes/whitted.toml", "--renderer", "pathtrace", "--caustics", "maybe"]);

@@ -3,8 +3,9 @@
 //! - illum-rtcore (`shaders.rs`): spawning, geometry, material record, optics, camera;
 //! - illum-pathtrace (`shaders.rs`): the sampling modules, the scene module, the generic
 //!   material lookup, traversal and light choice (the specialised ones generated), the surfaces
-//!   module, the integrator, the caustic's light tracer and the display-sum pass, for every
-//!   scene file;
+//!   module, the integrator, the caustic's light tracer, the guide buffers and the display-sum
+//!   pass, for every scene file;
+//! - illum-denoise (`atrous.rs`): the à-trous filter;
 //! - illum-raster (`shaders.rs`): its modules and entry files;
 //! - illum-whitted (`tracer.rs`): its entry shader, composed with illum-rtcore's modules;
 //! - illum-viewer (`display.rs`): its display pass.
@@ -37,7 +38,9 @@ fn every_wgsl_file_is_validated_by_its_crate() {
             &PATHTRACE_SHADER,
             &SURFACES_MODULE,
             &CAUSTIC_SHADER,
+            &pathtrace::GUIDES_SHADER,
             &pathtrace::DISPLAY_SUM_SHADER,
+            &illum_denoise::ATROUS_SHADER,
         ])
         .chain(illum::raster::shaders::MODULES)
         .chain(illum::raster::shaders::SHADERS)

@@ -4,7 +4,8 @@
 //! ```text
 //! cargo run --release --example ladder -- [SCENE] [--width W --height H] [--truth-spp N]
 //!     [--truth-bounces B] [--truth FILE.exr] [--spp-list 1,4,16,64,256,1024] [--depths 1,2,8]
-//!     [--bounce-list 0,1,2,4] [--bounce-spp 1024] [--frames 5] [--out DIR]
+//!     [--bounce-list 0,1,2,4] [--bounce-spp 1024] [--denoise-spp-list 1,4,16,64,256] [--frames 5]
+//!     [--out DIR]
 //! ```
 //! Rows:
 //! - the rasterizer (if it can draw the scene): the `figure` look, the `enhanced` look, and the
@@ -14,7 +15,9 @@
 //! - the path tracer at each spp of `--spp-list` (the scene's bounces), without and (where the
 //!   scene has a caustic: a sun and a mirror or glass) with the caustic estimator, and at each
 //!   bounce count of `--bounce-list` with `--bounce-spp` samples (on the Cornell box this is
-//!   the classic "Whitted against path tracing, bounce by bounce").
+//!   the classic "Whitted against path tracing, bounce by bounce");
+//! - the path tracer at each spp of `--denoise-spp-list` followed by the à-trous denoiser
+//!   (illum-denoise; the guide pass and the filter are part of its time).
 //!
 //! Each row's time is the median of `--frames` frames: the rasterizer's wall time per frame as
 //! a viewer pays it (no readback) and its GPU time from timestamp queries; the Whitted ray
@@ -90,6 +93,9 @@ struct Args {
     /// Samples per pixel of the rows by bounce count (0 skips them).
     #[arg(long, default_value_t = 1024)]
     bounce_spp: u32,
+    /// The path tracer + à-trous rows: samples per pixel (comma-separated; empty skips them).
+    #[arg(long, value_delimiter = ',', default_value = "1,4,16,64,256")]
+    denoise_spp_list: Vec<u32>,
     /// Frames timed per row (the median is reported).
     #[arg(long, default_value_t = 5)]
     frames: u32,
@@ -110,6 +116,8 @@ enum Series {
     PathTraceCaustics,
     /// The path tracer at a fixed spp, more bounces each rung.
     PathTraceBounces,
+    /// The path tracer at the scene's bounces followed by the à-trous denoiser, more spp each rung.
+    PathTraceAtrous,
 }
 
 /// One rung: an image made by one renderer with one setting, and how long it took.
@@ -137,8 +145,8 @@ fn run(args: Args) -> anyhow::Result<()> {
     if args.frames == 0 {
         bail!("--frames 0: at least one frame must be timed");
     }
-    if args.truth_spp == 0 || args.spp_list.contains(&0) {
-        bail!("samples per pixel must be at least 1 (--truth-spp, --spp-list)");
+    if args.truth_spp == 0 || args.spp_list.contains(&0) || args.denoise_spp_list.contains(&0) {
+        bail!("samples per pixel must be at least 1 (--truth-spp, --spp-list, --denoise-spp-list)");
     }
     let mut scene = Scene::load(&illum_cli::resolve_scene_path(&args.scene))?;
     let (w, h) = default_size(&scene, args.width, args.height);
@@ -212,6 +220,13 @@ fn run(args: Args) -> anyhow::Result<()> {
         rungs.push(pathtrace_rung(&gpu, &with_caustic, setting, Series::PathTraceBounces, 1)?);
         print_rung(rungs.last().expect("pushed"));
     }
+    if !args.denoise_spp_list.is_empty() {
+        let filter = illum_denoise::AtrousDenoiser::new(&gpu)?;
+        for &spp in &args.denoise_spp_list {
+            rungs.push(atrous_rung(&gpu, &with_caustic, spp, &filter, args.frames.min(3))?);
+            print_rung(rungs.last().expect("pushed"));
+        }
+    }
     let rows: Vec<Row> = rungs
         .into_iter()
         .map(|rung| {
@@ -232,6 +247,50 @@ fn run(args: Args) -> anyhow::Result<()> {
     };
     write_outputs(&args, &header, &truth, &regions, &rows)?;
     Ok(())
+}
+
+/// The path tracer at `spp` (the scene's bounces and caustic estimator) followed by the
+/// à-trous denoiser with its default settings: the time is the render's, the guide pass's and
+/// the filter's (median of `runs`, after a warm-up that compiles the pipelines).
+fn atrous_rung(
+    gpu: &GpuContext,
+    scene: &Scene,
+    spp: u32,
+    filter: &illum_denoise::AtrousDenoiser,
+    runs: u32,
+) -> anyhow::Result<Rung> {
+    let mut scene = scene.clone();
+    scene.pathtrace.spp = spp;
+    let mut tracer = PathTracer::new(gpu, &scene)?;
+    let settings = illum_denoise::AtrousSettings::default();
+    let denoise = |tracer: &PathTracer| -> anyhow::Result<RgbImage32> {
+        let guides = tracer.guides(illum::pathtrace::GUIDE_SAMPLES)?;
+        let input = illum_denoise::DenoiseInput::from_render(tracer.accumulator(), &guides);
+        Ok(filter.denoise(&input, &settings)?.0)
+    };
+    tracer.render_to_spp(1)?; // warm-up: the pipelines and buffers
+    denoise(&tracer)?;
+    let mut ms = Vec::new();
+    let mut image = None;
+    for _ in 0..runs.max(1) {
+        tracer.reset();
+        let started = Instant::now();
+        tracer.render_to_spp(spp)?;
+        image = Some(denoise(&tracer)?);
+        ms.push(started.elapsed().as_secs_f64() * 1e3);
+    }
+    Ok(Rung {
+        renderer: "pathtrace + à-trous",
+        series: Series::PathTraceAtrous,
+        settings: format!(
+            "{spp} spp, bounces {}{}, à-trous",
+            scene.pathtrace.bounces,
+            if scene.pathtrace.caustics { ", caustic estimator" } else { "" }
+        ),
+        wall_ms: median(&mut ms),
+        gpu_ms: None,
+        image: image.expect("at least one run"),
+    })
 }
 
 /// Whether the scene has a mirror or glass.
@@ -486,6 +545,7 @@ fn write_outputs(
             ("path tracer, more spp", Series::PathTraceSpp, Style::Joined),
             ("path tracer + caustic estimator, more spp", Series::PathTraceCaustics, Style::Joined),
             ("path tracer, more bounces", Series::PathTraceBounces, Style::Joined),
+            ("path tracer + à-trous, more spp", Series::PathTraceAtrous, Style::Joined),
         ];
         let lines: Vec<Line> = series
             .iter()

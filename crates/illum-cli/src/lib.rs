@@ -9,6 +9,8 @@
 //! - [`raster`], [`whitted`]: each renderer's path of the `render` example (the path tracer's
 //!   is in `examples/render.rs`).
 
+pub mod auto;
+pub mod denoise;
 pub mod interrupt;
 pub mod progress;
 pub mod raster;

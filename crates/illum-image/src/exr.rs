@@ -201,9 +201,10 @@ pub struct U32Layer {
     pub channels: Vec<(String, Vec<u32>)>,
 }
 
-/// An extra EXR layer of 32-bit float channels, stored after the RGB image and the
-/// [`U32Layer`]s: per-pixel values meant to be looked at, such as the path tracer's estimated
-/// relative error (`illum.error`) or a signed difference from a reference.
+/// An extra EXR layer of 32-bit float channels, stored after the RGB image (a multi-part file)
+/// and any [`U32Layer`]s: per-pixel values to look at, such as a denoiser's guide buffers
+/// (`albedo`, `normal`), the path tracer's estimated relative error (`illum.error`) or a signed
+/// difference from a reference. Other EXR readers show the RGB image and list the layer.
 #[derive(Clone, Debug, PartialEq)]
 pub struct F32Layer {
     /// The layer's name (the part's `name` attribute).
@@ -212,18 +213,18 @@ pub struct F32Layer {
     pub channels: Vec<(String, Vec<f32>)>,
 }
 
-/// As [`save_exr`], plus `layers` after the RGB image, all in one atomic write. The RGB layer
-/// is named `rgb` when there are extra layers (a multi-part file needs names).
-pub fn save_exr_with_layers(
+/// As [`save_exr`], plus float `layers` after the RGB image, all in one atomic write.
+pub fn save_exr_with_f32_layers(
     path: impl AsRef<Path>,
     image: &RgbImage32,
     metadata: &ExrMetadata,
-    layers: Vec<U32Layer>,
+    layers: Vec<F32Layer>,
 ) -> Result<(), ImageError> {
-    save_exr_with_float_layers(path, image, metadata, layers, Vec::new())
+    save_exr_with_float_layers(path, image, metadata, Vec::new(), layers)
 }
 
-/// As [`save_exr_with_layers`], with f32 layers after the u32 ones.
+/// As [`save_exr`], plus the u32 `layers` and then the f32 `float_layers` after the RGB image,
+/// all in one atomic write.
 pub fn save_exr_with_float_layers(
     path: impl AsRef<Path>,
     image: &RgbImage32,
@@ -236,7 +237,51 @@ pub fn save_exr_with_float_layers(
         return save_exr(path, image, metadata);
     }
     check_writable(path, image)?;
-    write_atomically(path, |file| encode_with_layers(path, image, metadata, layers, float_layers, file))
+    let parts = layers.into_iter().map(Part::from).chain(float_layers.into_iter().map(Part::from)).collect();
+    write_atomically(path, |file| encode_with_layers(path, image, metadata, parts, file))
+}
+
+/// An extra part of the file: its name and its channels.
+struct Part {
+    name: String,
+    channels: Vec<(String, exr::prelude::FlatSamples)>,
+}
+
+impl From<U32Layer> for Part {
+    fn from(layer: U32Layer) -> Self {
+        Part {
+            name: layer.name,
+            channels: layer
+                .channels
+                .into_iter()
+                .map(|(n, v)| (n, exr::prelude::FlatSamples::U32(v)))
+                .collect(),
+        }
+    }
+}
+
+impl From<F32Layer> for Part {
+    fn from(layer: F32Layer) -> Self {
+        Part {
+            name: layer.name,
+            channels: layer
+                .channels
+                .into_iter()
+                .map(|(n, v)| (n, exr::prelude::FlatSamples::F32(v)))
+                .collect(),
+        }
+    }
+}
+
+/// As [`save_exr`], plus `layers` after the RGB image, all in one atomic write. The RGB layer
+/// is named `rgb` when there are extra layers (a multi-part file needs names).
+pub fn save_exr_with_layers(
+    path: impl AsRef<Path>,
+    image: &RgbImage32,
+    metadata: &ExrMetadata,
+    layers: Vec<U32Layer>,
+) -> Result<(), ImageError> {
+    save_exr_with_float_layers(path, image, metadata, layers, Vec::new())
 }
 
 /// [`save_exr_with_layers`] into memory: the EXR file's bytes (for a download in the browser).
@@ -251,7 +296,8 @@ pub fn exr_bytes_with_layers(
     let path = Path::new(name);
     check_writable(path, image)?;
     let mut out = std::io::Cursor::new(Vec::new());
-    encode_with_layers(path, image, metadata, layers, float_layers, &mut out)?;
+    let parts = layers.into_iter().map(Part::from).chain(float_layers.into_iter().map(Part::from)).collect();
+    encode_with_layers(path, image, metadata, parts, &mut out)?;
     Ok(out.into_inner())
 }
 
@@ -262,24 +308,23 @@ fn encode_with_layers<W: std::io::Write + std::io::Seek>(
     path: &Path,
     image: &RgbImage32,
     metadata: &ExrMetadata,
-    layers: Vec<U32Layer>,
-    float_layers: Vec<F32Layer>,
+    layers: Vec<Part>,
     out: W,
 ) -> Result<(), ImageError> {
     use exr::prelude::{AnyChannel, AnyChannels, FlatSamples};
     let attributes = metadata.to_attributes();
     check_attribute_names(path, &attributes)?;
     let pixels = image.width as usize * image.height as usize;
-    let lengths = layers
-        .iter()
-        .flat_map(|l| l.channels.iter().map(|(n, v)| (&l.name, n, v.len())))
-        .chain(float_layers.iter().flat_map(|l| l.channels.iter().map(|(n, v)| (&l.name, n, v.len()))));
-    for (layer_name, name, len) in lengths {
-        {
-            if len != pixels {
+    for layer in &layers {
+        for (name, values) in &layer.channels {
+            if values.len() != pixels {
                 return Err(ImageError::invalid(
                     path,
-                    format!("layer '{layer_name}' channel '{name}' has {len} values for {pixels} pixels"),
+                    format!(
+                        "layer '{}' channel '{name}' has {} values for {pixels} pixels",
+                        layer.name,
+                        values.len()
+                    ),
                 ));
             }
         }
@@ -304,24 +349,8 @@ fn encode_with_layers<W: std::io::Write + std::io::Seek>(
     );
     let mut all = vec![rgb];
     for layer in layers {
-        let channels = layer
-            .channels
-            .into_iter()
-            .map(|(name, values)| AnyChannel::new(name.as_str(), FlatSamples::U32(values)))
-            .collect();
-        all.push(Layer::new(
-            size,
-            LayerAttributes::named(text(&layer.name)),
-            exr::image::Encoding::SMALL_LOSSLESS,
-            AnyChannels::sort(channels),
-        ));
-    }
-    for layer in float_layers {
-        let channels = layer
-            .channels
-            .into_iter()
-            .map(|(name, values)| AnyChannel::new(name.as_str(), FlatSamples::F32(values)))
-            .collect();
+        let channels =
+            layer.channels.into_iter().map(|(name, values)| AnyChannel::new(name.as_str(), values)).collect();
         all.push(Layer::new(
             size,
             LayerAttributes::named(text(&layer.name)),

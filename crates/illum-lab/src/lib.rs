@@ -4,6 +4,7 @@
 //! renderer crates and the `illum` facade so that a renderer's users do not link plotters, csv
 //! or FLIP.
 
+pub mod auto;
 pub mod plot;
 pub mod reference;
 pub mod regions;

@@ -135,7 +135,8 @@ pub fn reference_settings(scene: &Scene, spp: u32) -> (Scene, String) {
     reference_scene.pathtrace.seed = scene.pathtrace.seed.wrapping_add(0x5eed);
     let (camera, settings) = (&reference_scene.camera, &reference_scene.pathtrace);
     let key = format!(
-        "scene {} (canonical form {}), {}x{}, spp {}, bounces {}, seed {}, sampling {}, sequence {}, caustics {}",
+        "scene {} (canonical form {}), {}x{}, spp {}, bounces {}, seed {}, sampling {}, sequence {}, caustics {}, \
+         caustic estimators {}",
         illum_pathtrace::metadata::scene_hash(&reference_scene),
         illum_scene::CONTENT_VERSION,
         camera.width,
@@ -145,7 +146,8 @@ pub fn reference_settings(scene: &Scene, spp: u32) -> (Scene, String) {
         settings.seed,
         settings.sampling,
         settings.sequence,
-        settings.caustics
+        settings.caustics,
+        illum_pathtrace::caustic_estimators(&reference_scene)
     );
     (reference_scene, key)
 }

@@ -6,9 +6,10 @@
 //! estimation, and, with a sun *disc*, paths E D S+ L by a bounce that happens to reach the disc.
 //! The light tracer here owns exactly the paths L S+ D E whose diffuse vertex D is the camera
 //! ray's first hit: with it on, the camera path tracer stops counting the sun disc on such
-//! paths (`caustic_owned` there), so no path is counted twice. Not covered by either, with a
-//! delta sun: the caustic seen through a specular surface (E S+ D S+ L) and light scattered
-//! from the caustic onto other diffuse surfaces (E D+ D S+ L).
+//! paths (`caustic_owned` there), so no path is counted twice. With a delta sun the caustic
+//! seen through a specular surface (E S+ D S+ L) is the photon gather's (`gather.rs`, from
+//! these particles); light scattered from the caustic onto other diffuse surfaces
+//! (E S* D S* D S+ L) is counted by no estimator (docs/caustics.md measures it).
 //!
 //! Emission. The sun's light crosses any plane perpendicular to a direction w of its disc with
 //! radiance L (a delta sun: irradiance E along one direction). Only lines that meet a specular
@@ -53,6 +54,7 @@ use std::f64::consts::{FRAC_1_PI, PI};
 use glam::DVec3;
 use illum_scene::{Bounces, MaterialKind};
 
+use crate::gather::Photon;
 use crate::geometry::Surface;
 use crate::integrator::{Contact, Oracle, ROULETTE_AFTER, ROULETTE_MAX_SURVIVAL};
 use crate::optics::{reflect, scatter_dielectric};
@@ -62,7 +64,7 @@ use crate::scene::Primitive;
 
 /// Key mixed into the particles' seed so that particle i of frame k never shares its random
 /// numbers with sample k of pixel i.
-const PARTICLE_SEED_KEY: u64 = 0xc0ff_ee00_ca05_71c5;
+pub(crate) const PARTICLE_SEED_KEY: u64 = 0xc0ff_ee00_ca05_71c5;
 /// A safety limit on specular scatterings for unbounded paths (survival 0.95^n beyond 3).
 const UNBOUNDED_LIMIT: u32 = 100_000;
 
@@ -90,6 +92,8 @@ pub(crate) struct Emitter {
     total_area: f64,
     scene_centre: DVec3,
     scene_radius: f64,
+    /// r_1 of the photon gather (`gather.rs`).
+    pub(crate) gather_radius: f64,
 }
 
 impl Emitter {
@@ -105,7 +109,9 @@ impl Emitter {
             oracle.scene.surfaces.iter().chain(&oracle.scene.emitters).map(bounding_sphere).collect();
         let scene_centre = spheres.iter().map(|(c, _)| *c).sum::<DVec3>() / spheres.len() as f64;
         let scene_radius = spheres.iter().map(|(c, r)| (*c - scene_centre).length() + r).fold(0.0, f64::max);
-        Some(Emitter { discs, total_area, scene_centre, scene_radius })
+        let gather_radius =
+            crate::gather::RADIUS_FRACTION * discs.iter().map(|(_, r)| *r).fold(0.0, f64::max);
+        Some(Emitter { discs, total_area, scene_centre, scene_radius, gather_radius })
     }
 }
 
@@ -116,9 +122,9 @@ impl Oracle {
         self.caustic.is_some()
     }
 
-    /// One particle of a frame of `n` particles: its pixel index and its contribution there (the
-    /// frame's image is the sum of its particles'), or `None` when it adds nothing.
-    pub(crate) fn trace_particle(&self, n: u64, rng: &mut Rng) -> Option<(usize, DVec3)> {
+    /// One particle of a frame of `n` particles, traced to its first diffuse point after at
+    /// least one specular scattering (its photon, `gather.rs`), or `None` when it has none.
+    pub(crate) fn trace_particle(&self, n: u64, rng: &mut Rng) -> Option<Photon> {
         let emitter = self.caustic.as_ref()?;
         let sun = self.scene.sun?;
         // The direction the light travels, and the flux per unit area across the plane
@@ -186,7 +192,13 @@ impl Oracle {
                     if scatterings == 0 {
                         return None;
                     }
-                    return self.connect(p, nrm, lift, throughput * hit.diffuse_albedo(p) * FRAC_1_PI);
+                    return Some(Photon {
+                        point: p,
+                        normal: nrm,
+                        lift,
+                        weight: throughput * hit.diffuse_albedo(p) * FRAC_1_PI,
+                        scatterings,
+                    });
                 }
                 MaterialKind::Emitter { .. } => unreachable!("emitters are handled above"),
             }
@@ -260,18 +272,29 @@ impl Oracle {
     }
 
     /// The caustic image of frame `frame` (the frame that pairs with sample index `frame` of
-    /// every pixel): width x height particles, row-major pixels. All zero when caustics are off.
+    /// every pixel): width x height particles, row-major pixels, and with a delta sun the
+    /// photon gather of the caustic seen through a specular surface (`gather.rs`) from the same
+    /// particles. All zero when caustics are off.
     pub fn caustic_frame(&self, seed: u64, frame: u32) -> Vec<DVec3> {
         let n = u64::from(self.camera.width) * u64::from(self.camera.height);
         let mut image = vec![DVec3::ZERO; n as usize];
         if self.caustic.is_none() {
             return image;
         }
+        let mut photons = Vec::new();
         for particle in 0..n {
             let mut rng = Rng::for_sample(seed ^ PARTICLE_SEED_KEY, particle, u64::from(frame));
-            if let Some((pixel, value)) = self.trace_particle(n, &mut rng) {
-                image[pixel] += value;
+            if let Some(photon) = self.trace_particle(n, &mut rng) {
+                if let Some((pixel, value)) =
+                    self.connect(photon.point, photon.normal, photon.lift, photon.weight)
+                {
+                    image[pixel] += value;
+                }
+                photons.push(photon);
             }
+        }
+        if self.gathers() {
+            self.add_gather(&mut image, photons, seed, frame);
         }
         image
     }

@@ -108,6 +108,8 @@ pub struct Oracle {
     pub sampling: Sampling,
     /// The light tracer of the caustic (`caustic.rs`), when on and the scene can have one.
     pub(crate) caustic: Option<crate::caustic::Emitter>,
+    /// Whether the caustic's frames add the photon gather (`gather.rs`; with a delta sun only).
+    pub(crate) gather: bool,
 }
 
 impl Oracle {
@@ -120,6 +122,7 @@ impl Oracle {
             bounces: scene.pathtrace.bounces,
             sampling: scene.pathtrace.sampling,
             caustic: None,
+            gather: true,
         };
         Ok(oracle.with_caustics(scene.pathtrace.caustics))
     }
@@ -240,7 +243,7 @@ impl Oracle {
     /// Russian roulette in unbounded mode from the fourth continuation on: survives with
     /// probability q = min(max channel of `weight`, 0.95) and then divides `throughput` by q.
     /// Returns false when the path ends.
-    fn roulette(&self, taken: u32, weight: DVec3, throughput: &mut DVec3, rng: &mut Rng) -> bool {
+    pub(crate) fn roulette(&self, taken: u32, weight: DVec3, throughput: &mut DVec3, rng: &mut Rng) -> bool {
         if self.bounces == Bounces::Unbounded && taken >= ROULETTE_AFTER {
             let q = weight.max_element().min(ROULETTE_MAX_SURVIVAL);
             if !(q > 0.0 && rng.uniform() < q) {

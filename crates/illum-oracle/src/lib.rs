@@ -46,6 +46,7 @@ mod camera;
 pub mod caustic;
 pub mod chi_square;
 pub mod closed_form;
+pub mod gather;
 pub mod geometry;
 mod integrator;
 pub mod optics;

@@ -192,3 +192,62 @@ fn extremes_stay_finite() {
         }
     }
 }
+
+/// The photon gather against a closed form: a glass ball of index 1 is invisible, so a camera
+/// looking at the floor through it along the sun's line sees the floor in the ball's shadow, lit
+/// by the sun through the ball. Next-event estimation is blocked there (the ball stops shadow
+/// rays) and the camera ray's first hit is the ball (no connection of the light tracer), so the
+/// paths E S S D S S L are the gather's alone, and must give the plain direct light. Where the
+/// ray misses the ball the floor is lit directly (next-event estimation, exactly).
+#[test]
+fn through_an_index_1_ball_the_gather_gives_the_plain_direct_light() {
+    let mut s = ball_scene("dielectric = { ior = 1.0 }", "direction = [-1.0, -1.0, 0.0]");
+    s.camera.eye = glam::Vec3::new(6.0, 6.0, 0.0);
+    s.camera.target = glam::Vec3::ZERO;
+    s.camera.up = glam::Vec3::Z;
+    s.camera.vfov_deg = 20.0;
+    s.camera.width = 48;
+    s.camera.height = 32;
+    // E S S D S S L takes 5 continuation rays.
+    let oracle =
+        Oracle::new(&s).unwrap_or_else(|e| panic!("{e}")).with_bounces(Bounces::Fixed(5)).with_caustics(true);
+    assert!(oracle.gathers());
+    let image = oracle.render(2048, 7, illum_oracle::default_threads());
+    let expected = 0.6f32 as f64 * 3.0 / PI * 0.5f64.sqrt();
+    let camera = illum_oracle::PinholeCamera::new(&s.camera);
+    let (mut through, mut z_fail, mut sum, mut var) = (0, 0, 0.0, 0.0);
+    for y in 0..32 {
+        for x in 0..48 {
+            let d = camera.direction(x, y, 0.5, 0.5);
+            // Distance from the ball's centre to the centre ray: inside 0.5 the ray passes
+            // through the ball; a margin of over a pixel (0.09 units at the ball) and the
+            // kernel's radius (0.01) is left out at the silhouette.
+            let m = DVec3::new(3.0, 3.0, 0.0) - camera.eye;
+            let miss = (m - d * m.dot(d)).length();
+            let i = image.index(x, y);
+            let (mean, v) = (image.mean[i][0], image.variance_of_mean[i][0]);
+            if miss < 0.35 {
+                through += 1;
+                sum += mean;
+                var += v;
+                if (mean - expected).abs() > 4.0 * v.sqrt() {
+                    z_fail += 1;
+                }
+            } else if miss > 0.65 {
+                assert!((mean - expected).abs() < 1e-9 * expected, "pixel ({x}, {y}) = {mean}");
+            }
+        }
+    }
+    let n = f64::from(through);
+    let (mean, sd) = (sum / n, var.sqrt() / n);
+    println!(
+        "{through} pixels through the ball: {mean:.5} +- {sd:.5}, expected {expected:.5}; {z_fail} beyond 4 sigma"
+    );
+    assert!(through >= 100, "only {through} pixels see the floor through the ball");
+    assert!(z_fail <= 1, "{z_fail} of {through} pixels beyond 4 sigma of {expected}");
+    assert!((mean - expected).abs() < 4.0 * sd, "mean {mean} +- {sd}, expected {expected}");
+    // Without the gather those pixels are black.
+    let off = oracle.with_gather(false).render(4, 7, 1);
+    let centre = off.index(24, 16);
+    assert_eq!(off.mean[centre][0], 0.0);
+}

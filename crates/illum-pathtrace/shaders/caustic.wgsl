@@ -23,7 +23,10 @@
 // (the pinhole's importance 1 / (A_p cos^4 theta) times the geometry term cos theta cos theta_x
 // / r^2) to the pixel through which the eye sees x, if nothing hides x from the eye.
 //
-// Splatting: WGSL has no float atomics, so each value is rounded to a 64-bit fixed-point
+// Photons (shader def CAUSTIC_GATHER, a delta sun): the same point and weight are also stored
+// as frame k's photon for the gather of E S+ D S+ L (gather.wgsl).
+//
+// Splatting (caustic_buffers.wgsl): WGSL has no float atomics, so each value is rounded to a 64-bit fixed-point
 // integer q = round(v S) (S = caustic.fixed_scale, a power of two) added as two u32 words with
 // an explicit carry: exact integer addition, in any order, so the image does not depend on the
 // scheduling. A particle whose q would reach caustic.fixed_cap = 2^64 / 2^ceil(log2 N) is
@@ -40,76 +43,13 @@
 #import illum::pathtrace::scene::{params, objects, materials}
 #import illum::rtcore::traversal::{closest_hit, scattering_surface_at}
 #import illum::pathtrace::surfaces::{UNBOUNDED, RR_START, RR_MAX_SURVIVAL, UNBOUNDED_DEPTH_CAP, max3, scatter_dielectric, sample_sun}
+#import illum::pathtrace::caustic_buffers::{caustic, discs, fits, splat_add, drop_particle}
+#ifdef CAUSTIC_GATHER
+#import illum::pathtrace::caustic_buffers::store_photon
+#endif
 #ifdef CHECKER
 #import illum::rtcore::optics::checker_albedo
 #endif
-
-const TWO_POW_32: f32 = 4294967296.0;
-
-// Mirrored by tracer/caustic.rs's CausticParams.
-struct CausticParams {
-    // Particles per frame (N) and the invocations per row of the dispatch.
-    particles: u32,
-    row_stride: u32,
-    // The sample index of frame 0 of this dispatch, and how many frames it traces.
-    frame_base: u32,
-    frame_count: u32,
-    num_discs: u32,
-    seed: u32,
-    // A_p: a pixel's area on the image plane at distance 1.
-    pixel_area: f32,
-    // A / N: the plane area each particle stands for (times 1 / c(x)).
-    area_per_particle: f32,
-    // The whole scene's bounding sphere: particles start outside it.
-    scene_centre: vec3<f32>,
-    scene_radius: f32,
-    fixed_scale: f32,
-    fixed_cap: f32,
-    // A: the discs' total area.
-    disc_area: f32,
-    padding: u32,
-}
-
-@group(0) @binding(6) var<uniform> caustic: CausticParams;
-// Per specular object: the centre and radius of its bounding sphere.
-@group(0) @binding(7) var<storage, read> discs: array<vec4<f32>>;
-// Frame f's pixel p, channel c: words (lo, hi) at 6 (f N_pixels + p) + 2 c; after the frames,
-// one counter of dropped particles per frame.
-@group(0) @binding(8) var<storage, read_write> splat: array<atomic<u32>>;
-
-
-// Adds value v >= 0 to pixel `pixel` of frame `frame` in fixed point; false if too large
-// (or not a number) to be added safely.
-fn fits(v: vec3<f32>) -> bool {
-    let q = floor(v * caustic.fixed_scale + 0.5);
-    return all(q < vec3<f32>(caustic.fixed_cap));
-}
-
-fn splat_add(frame: u32, pixel: u32, v: vec3<f32>) {
-    let pixels = params.width * params.height;
-    let base = 6u * (frame * pixels + pixel);
-    for (var c = 0u; c < 3u; c++) {
-        let q = floor(v[c] * caustic.fixed_scale + 0.5);
-        // q < 2^64 is an integer in f32: its high word is exact, and so is the remainder
-        // q - hi 2^32 (a multiple of q's ulp below 2^32 <= q, or q itself when q < 2^32).
-        let hi = u32(floor(q / TWO_POW_32));
-        let lo = u32(q - f32(hi) * TWO_POW_32);
-        if (lo != 0u) {
-            let old = atomicAdd(&splat[base + 2u * c], lo);
-            // old + lo wrapped past 2^32 exactly when old > 2^32 - 1 - lo: carry one.
-            let carry = select(0u, 1u, old > 0xffffffffu - lo);
-            if (hi + carry != 0u) {
-                atomicAdd(&splat[base + 2u * c + 1u], hi + carry);
-            }
-        } else if (hi != 0u) {
-            atomicAdd(&splat[base + 2u * c + 1u], hi);
-        }
-    }
-}
-
-fn drop_particle(frame: u32) {
-    atomicAdd(&splat[6u * caustic.frame_count * params.width * params.height + frame], 1u);
-}
 
 // The particle of outgoing factor `weight` (flux rho / pi) at surface s, seen from the eye.
 fn connect(frame: u32, s: Surface, weight: vec3<f32>) {
@@ -253,6 +193,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             }
 #else
             let albedo = m.a.xyz;
+#endif
+#ifdef CAUSTIC_GATHER
+            store_photon(frame, particle, s, throughput * albedo * INV_PI, scatterings);
 #endif
             connect(frame, s, throughput * albedo * INV_PI);
             return;

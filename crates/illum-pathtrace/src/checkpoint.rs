@@ -179,6 +179,15 @@ impl CheckpointHeader {
             "scene" => Some(self.metadata.scene.clone()),
             // A file without the key was rendered without the caustic's light tracer.
             "caustics" => Some(self.metadata.get(key).unwrap_or("off").to_owned()),
+            // A file without the key was rendered before the photon gather: with the light
+            // tracer alone where the caustic was on.
+            "caustic_estimators" => Some(self.metadata.get(key).map_or_else(
+                || {
+                    if self.setting("caustics").as_deref() == Some("on") { "light tracer" } else { "none" }
+                        .to_owned()
+                },
+                str::to_owned,
+            )),
             _ => self.metadata.get(key).map(str::to_owned),
         }
     }
@@ -325,6 +334,8 @@ pub fn image_settings(scene: &Scene, options: TracerOptions) -> Vec<(&'static st
         ("sampling", scene.pathtrace.sampling.to_string()),
         ("sequence", options.sequence.to_string()),
         ("caustics", crate::gpu_scene::caustics_label(scene).to_owned()),
+        // Which estimators own the caustic's paths: samples of another set hold other light.
+        ("caustic_estimators", crate::gpu_scene::caustic_estimators(scene)),
     ]
 }
 
@@ -343,7 +354,7 @@ impl Checkpoint {
 
     /// Checks that this checkpoint was rendered from `scene` with `options`: an error naming
     /// every difference (scene name, content hash, resolution, bounces, seed, sampling,
-    /// sequence, caustics), with both values.
+    /// sequence, caustics and their estimators), with both values.
     pub fn check_matches(
         &self,
         path: &Path,

@@ -34,7 +34,7 @@ pub use allocation::SampleAllocation;
 pub use batch::{CHUNK_SAMPLES, SLOT_BYTES};
 pub use display_sum::{DISPLAY_PIXEL_BYTES, DISPLAY_SUM_SHADER};
 pub use error::PathTraceError;
-pub use gpu_scene::implements;
+pub use gpu_scene::{caustic_estimators, implements};
 pub use illum_scene::Sequence;
 pub use options::{TracerOptions, Traversal};
 pub use progressive::{
@@ -44,7 +44,9 @@ pub use progressive::{
 #[cfg(not(target_arch = "wasm32"))]
 pub use progressive::{render_progressive, render_progressive_over};
 pub use shaders::{
-    CAUSTIC_SHADER, GENERIC_LIGHT_CHOICE, GENERIC_MATERIALS, GENERIC_TRAVERSAL, PATHTRACE_SHADER,
-    SAMPLING_MODULES, SCENE_MODULE, SURFACES_MODULE, shader_modules,
+    CAUSTIC_SHADER, GENERIC_LIGHT_CHOICE, GENERIC_MATERIALS, GENERIC_TRAVERSAL, GUIDES_SHADER,
+    PATHTRACE_SHADER, SAMPLING_MODULES, SCENE_MODULE, SURFACES_MODULE, shader_modules,
 };
-pub use tracer::{CausticParams, PathTracer, Readback, StepReport, bounding_sphere, fixed_point};
+pub use tracer::{
+    CausticParams, GUIDE_SAMPLES, Guides, PathTracer, Readback, StepReport, bounding_sphere, fixed_point,
+};

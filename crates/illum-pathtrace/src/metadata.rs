@@ -56,6 +56,7 @@ pub fn exr_metadata(
         ("sampling", scene.pathtrace.sampling.to_string()),
         ("sequence", tracer.options().sequence.to_string()),
         ("caustics", crate::gpu_scene::caustics_label(scene).to_owned()),
+        ("caustic_estimators", crate::gpu_scene::caustic_estimators(scene)),
         ("estimated_relative_error", accumulator.estimated_relative_error().to_string()),
         ("dropped_samples", accumulator.dropped_samples().to_string()),
         ("stopped_by", stopped_by.map_or("none", StopReason::name).to_owned()),

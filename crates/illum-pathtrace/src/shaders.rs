@@ -23,6 +23,12 @@ pub const SCENE_MODULE: ShaderFile = shader_file!("shaders/scene.wgsl");
 pub const SURFACES_MODULE: ShaderFile = shader_file!("shaders/surfaces.wgsl");
 /// The caustic's light tracer (entry point `main`; shader def CAUSTIC).
 pub const CAUSTIC_SHADER: ShaderFile = shader_file!("shaders/caustic.wgsl");
+/// The denoiser's guide buffers (entry point `main`; tracer/guides.rs).
+pub const GUIDES_SHADER: ShaderFile = shader_file!("shaders/guides.wgsl");
+/// What the light tracer and the photon gather share: parameters, splats, photon maps.
+pub const CAUSTIC_BUFFERS_MODULE: ShaderFile = shader_file!("shaders/caustic_buffers.wgsl");
+/// The photon gather of E S+ D S+ L (entry point `main`; shader def CAUSTIC_GATHER).
+pub const GATHER_SHADER: ShaderFile = shader_file!("shaders/gather.wgsl");
 /// The generic material lookup (a read of the material buffer).
 pub const GENERIC_MATERIALS: ShaderFile = shader_file!("shaders/materials.wgsl");
 /// The generic traversal (a loop over the object buffer).
@@ -52,6 +58,7 @@ pub fn shader_modules(scene: &Scene, gpu_scene: &GpuScene, traversal: Traversal)
         ]),
     }
     modules.push(SURFACES_MODULE);
+    modules.push(CAUSTIC_BUFFERS_MODULE);
     modules
 }
 
@@ -83,18 +90,23 @@ fn traversal_source(modules: &[ShaderFile]) -> &str {
         .expect("the modules include a traversal")
 }
 
-/// The caustic's light-tracing pipeline for `scene` (one whose scene code has the caustic),
-/// built from the same modules and defs as its path-tracing pipeline without adaptive sampling.
-pub(crate) fn caustic_pipeline(
+/// A pipeline that runs beside `scene`'s path-tracing pipeline: `shader` built from the same
+/// modules and defs, without adaptive sampling, so that it follows the same specular chains
+/// with the same numbers. The light tracer (`CAUSTIC_SHADER`, a scene code with the caustic),
+/// the photon gather (`GATHER_SHADER`, one with the gather) and the guide buffers
+/// (`GUIDES_SHADER`, tracer/guides.rs).
+pub(crate) fn companion_pipeline(
     gpu: &GpuContext,
     scene: &Scene,
     gpu_scene: &GpuScene,
     options: TracerOptions,
+    shader: &ShaderFile,
+    label: &str,
 ) -> Result<wgpu::ComputePipeline, PathTraceError> {
     let specialisation = Specialisation { scene: gpu_scene.code, options, adaptive: false };
     let modules = shader_modules(scene, gpu_scene, options.traversal);
     let defs = specialisation.shader_defs();
-    Ok(shader::compute_pipeline(gpu, &modules, &CAUSTIC_SHADER, &defs, "caustic light-tracing")?)
+    Ok(shader::compute_pipeline(gpu, &modules, shader, &defs, label)?)
 }
 
 #[cfg(test)]
@@ -141,8 +153,8 @@ mod tests {
 
     /// naga validates each sampling module on its own (as the import of a trivial entry point),
     /// the path tracer generic and specialised for every scene file under both sequences, with
-    /// and without pairs and adaptive sampling, each with its scene's code, and the display-sum
-    /// pass.
+    /// and without pairs and adaptive sampling, each with its scene's code, its guide-buffer pass,
+    /// and the display-sum pass.
     #[test]
     fn every_pathtrace_shader_composes_and_validates() {
         shader::validate_each_module(SAMPLING_MODULES).unwrap_or_else(|e| panic!("{e}"));
@@ -163,6 +175,13 @@ mod tests {
                             &specialisation.shader_defs(),
                         );
                     }
+                    // The guide buffers (tracer/guides.rs), with the scene's code.
+                    let options = TracerOptions { traversal, sequence, paired_paths: false };
+                    compose_and_validate(
+                        &shader_modules(&scene, &gpu_scene, traversal),
+                        &GUIDES_SHADER,
+                        &Specialisation { scene: gpu_scene.code, options, adaptive: false }.shader_defs(),
+                    );
                     if gpu_scene.code.caustic {
                         let options = TracerOptions { traversal, sequence, paired_paths: false };
                         let specialisation =
@@ -173,6 +192,16 @@ mod tests {
                             &specialisation.shader_defs(),
                         );
                     }
+                    if gpu_scene.code.caustic_gather {
+                        let options = TracerOptions { traversal, sequence, paired_paths: false };
+                        let specialisation =
+                            Specialisation { scene: gpu_scene.code, options, adaptive: false };
+                        compose_and_validate(
+                            &shader_modules(&scene, &gpu_scene, traversal),
+                            &GATHER_SHADER,
+                            &specialisation.shader_defs(),
+                        );
+                    }
                 }
             }
         }
@@ -180,7 +209,7 @@ mod tests {
     }
 
     /// Every consistent combination of the scene code's flags composes and validates, for the
-    /// integrator and (where the caustic is on) the light tracer, without a GPU: the code behind
+    /// integrator, the guide buffers and (where the caustic is on) the light tracer and the photon gather, without a GPU: the code behind
     /// each `#ifdef` is checked before any scene file happens to need it. The generic modules
     /// make the combinations independent of any one scene's geometry.
     #[test]
@@ -190,7 +219,7 @@ mod tests {
         let modules = shader_modules(&scene, &gpu_scene, Traversal::Generic);
         let options = TracerOptions { traversal: Traversal::Generic, ..TracerOptions::default() };
         let mut composed = 0;
-        for bits in 0u32..1 << 10 {
+        for bits in 0u32..1 << 11 {
             let bit = |i: u32| bits & (1 << i) != 0;
             let code = SceneCode {
                 area_lights: bit(0),
@@ -203,12 +232,14 @@ mod tests {
                 caustic: bit(7),
                 uniform_sampling: bit(8),
                 unbounded_bounces: bit(9),
+                caustic_gather: bit(10),
             };
             // What SceneCode::new can give: a choice among lights needs lights, a disc is a sun,
             // the caustic needs a sun and a specular object, and something must give light.
             let consistent = (!code.light_choice || code.area_lights)
                 && (!code.sun_disc || code.sun)
                 && (!code.caustic || (code.sun && code.specular))
+                && (!code.caustic_gather || (code.caustic && !code.sun_disc))
                 && (code.area_lights || code.sun || code.sky);
             if !consistent {
                 continue;
@@ -216,12 +247,19 @@ mod tests {
             let defs = Specialisation { scene: code, options, adaptive: false }.shader_defs();
             compose_and_validate(&modules, &PATHTRACE_SHADER, &defs);
             composed += 1;
+            // The guide buffers, composed with the same defs (tracer/guides.rs).
+            compose_and_validate(&modules, &GUIDES_SHADER, &defs);
+            composed += 1;
             if code.caustic {
                 compose_and_validate(&modules, &CAUSTIC_SHADER, &defs);
                 composed += 1;
             }
+            if code.caustic_gather {
+                compose_and_validate(&modules, &GATHER_SHADER, &defs);
+                composed += 1;
+            }
         }
-        assert!(composed > 300, "{composed} compositions");
+        assert!(composed > 600, "{composed} compositions");
     }
 
     #[test]
@@ -263,10 +301,11 @@ mod tests {
             &CAUSTIC_SHADER,
             &specialisation.shader_defs(),
         );
-        wgsl_struct(&module, "", "CausticParams").expect("struct CausticParams in caustic.wgsl").assert_matches(
+        wgsl_struct(&module, "illum::pathtrace::caustic_buffers", "CausticParams").expect("struct CausticParams in caustic.wgsl").assert_matches(
             size_of::<crate::CausticParams>(),
             &members!(crate::CausticParams: particles, row_stride, frame_base, frame_count, num_discs, seed,
-                pixel_area, area_per_particle, scene_centre, scene_radius, fixed_scale, fixed_cap, disc_area, padding),
+                pixel_area, area_per_particle, scene_centre, scene_radius, fixed_scale, fixed_cap, disc_area, gather_radius,
+                buckets, padding_a, padding_b, padding_c),
         );
         wgsl("Light").assert_matches(
             size_of::<GpuLight>(),

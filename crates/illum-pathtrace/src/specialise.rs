@@ -32,6 +32,10 @@ pub struct SceneCode {
     pub checker: bool,
     /// The caustic's light tracer ([`caustics_active`]).
     pub caustic: bool,
+    /// ... with the photon gather of the caustic seen through a specular surface (E S+ D S+ L,
+    /// `shaders/gather.wgsl`): the caustic with a delta sun and a diffuse surface to gather on.
+    /// With a sun disc the camera paths find those paths themselves.
+    pub caustic_gather: bool,
     /// `sampling = "uniform"` hemisphere sampling instead of cosine.
     pub uniform_sampling: bool,
     /// `bounces = "unbounded"`: Russian roulette.
@@ -51,6 +55,9 @@ impl SceneCode {
             specular: features.any(&[Feature::Mirror, Feature::Dielectric]),
             checker: features.contains(Feature::Checker),
             caustic: caustics_active(scene),
+            caustic_gather: caustics_active(scene)
+                && features.contains(Feature::DeltaDirectionalLight)
+                && features.any(&[Feature::Lambertian, Feature::Checker]),
             uniform_sampling: scene.pathtrace.sampling == Sampling::Uniform,
             unbounded_bounces: scene.pathtrace.bounces == Bounces::Unbounded,
         }
@@ -83,6 +90,7 @@ impl Specialisation {
             ("SPECULAR", code.specular),
             ("CHECKER", code.checker),
             ("CAUSTIC", code.caustic),
+            ("CAUSTIC_GATHER", code.caustic_gather),
             ("UNIFORM_SAMPLING", code.uniform_sampling),
             ("UNBOUNDED_BOUNCES", code.unbounded_bounces),
             ("LOW_DISCREPANCY", low_discrepancy),

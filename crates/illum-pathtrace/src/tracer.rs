@@ -26,13 +26,15 @@ use crate::{Accumulator, PathTraceError, SampleAllocation, limits};
 
 mod accumulation;
 mod caustic;
+mod guides;
 mod passes;
 mod pipeline;
 mod runner;
 mod submit;
 
 use accumulation::Accumulation;
-pub use caustic::{CausticParams, bounding_sphere, fixed_point};
+pub use caustic::{CausticParams, GATHER_RADIUS_FRACTION, bounding_sphere, fixed_point};
+pub use guides::{GUIDE_SAMPLES, Guides};
 use pipeline::ScenePipeline;
 use runner::BandRunner;
 pub use runner::Readback;

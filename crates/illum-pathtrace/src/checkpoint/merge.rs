@@ -7,8 +7,18 @@ use std::path::{Path, PathBuf};
 use super::{Checkpoint, CheckpointError, CheckpointHeader, load_checkpoint, load_checkpoint_header};
 
 /// The keys two partial renders must agree on to be merged.
-const MERGE_KEYS: [&str; 9] =
-    ["scene", "scene_hash", "width", "height", "bounces", "seed", "sampling", "sequence", "caustics"];
+const MERGE_KEYS: [&str; 10] = [
+    "scene",
+    "scene_hash",
+    "width",
+    "height",
+    "bounces",
+    "seed",
+    "sampling",
+    "sequence",
+    "caustics",
+    "caustic_estimators",
+];
 
 /// Checks that partial renders can be merged, from their headers alone, and sorts them into
 /// sample order (the order the merge adds them in). Refused, with the files named: a file

@@ -25,8 +25,12 @@
 //!
 //! Fixed point: see [`fixed_point`].
 //!
-//! Over 500 lines with its tests (about 500 of code): one estimator, from its parameters to its
-//! fold, with the two ways its frames come back (waited for, or polled).
+//! With a delta sun each dispatch also runs the photon gather (`shaders/gather.wgsl`) after the
+//! particles, into the same frames: its photon maps and grid are allocated and cleared here.
+//!
+//! Over 600 lines with its tests (about 600 of code): one estimator, from its parameters to its
+//! fold, with the two ways its frames come back (waited for, or polled), and the photon gather
+//! that shares its frames and buffers.
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
@@ -58,7 +62,13 @@ pub struct CausticParams {
     pub fixed_scale: f32,
     pub fixed_cap: f32,
     pub disc_area: f32,
-    pub padding: u32,
+    /// r_1 of the photon gather (0 without it).
+    pub gather_radius: f32,
+    /// Photon-grid buckets per frame (a power of two; 1 without the gather).
+    pub buckets: u32,
+    pub padding_a: u32,
+    pub padding_b: u32,
+    pub padding_c: u32,
 }
 
 /// Mixed into the scene's seed for the particles, so that particle i of frame k never draws
@@ -70,6 +80,11 @@ const WORDS_PER_PIXEL: u64 = 6;
 /// The most bytes one dispatch's frames take (and the most host memory one pass's chunk
 /// statistics may take, below).
 const SPLAT_BYTES: u64 = 64 << 20;
+/// Bytes per photon: three vec4 (caustic_buffers.wgsl).
+const PHOTON_BYTES: u64 = 48;
+/// r_1 of the photon gather as a fraction of the largest specular object's bounding radius
+/// (docs/caustics.md, "The caustic seen through a specular surface").
+pub const GATHER_RADIUS_FRACTION: f32 = 0.02;
 /// Host bytes per pixel and chunk of a pass: S1 and S2, three f64 each.
 pub(crate) const PASS_BYTES_PER_PIXEL_CHUNK: u64 = 48;
 /// The most host memory one pass's caustic statistics may take.
@@ -184,8 +199,19 @@ struct InFlight {
     count: u32,
 }
 
+/// The photon gather's pipeline and grid (shader def CAUSTIC_GATHER).
+struct Gather {
+    pipeline: wgpu::ComputePipeline,
+    bind_group: wgpu::BindGroup,
+    /// The grid's bucket heads, cleared before each dispatch.
+    heads: wgpu::Buffer,
+    heads_frame_bytes: u64,
+}
+
 pub(crate) struct CausticTracer {
     pipeline: wgpu::ComputePipeline,
+    /// The photon gather, with a delta sun.
+    gather: Option<Gather>,
     params_buffer: wgpu::Buffer,
     /// The path tracer's parameters buffer, which the shader reads the camera from, and the
     /// scene's parameters to write there before each dispatch (a band writes its own fields
@@ -227,21 +253,27 @@ impl CausticTracer {
         let pixels = camera.width as usize * camera.height as usize;
         let particles = pixels as u64;
         let frame_bytes = WORDS_PER_PIXEL * 4 * particles + 4;
+        let gather = gpu_scene.code.caustic_gather;
+        // The photon grid: a bucket per particle or more (a power of two), 4 bytes each.
+        let buckets = if gather { particles.next_power_of_two() } else { 1 };
+        let photon_frame_bytes = if gather { PHOTON_BYTES * particles } else { 4 };
+        let largest_frame_bytes = frame_bytes.max(photon_frame_bytes).max(4 * buckets);
         let limits = gpu.device.limits();
         let max_binding = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
-        if frame_bytes > max_binding {
+        if largest_frame_bytes > max_binding {
             return Err(PathTraceError::Unsupported {
                 scene: scene.name.clone(),
                 message: format!(
                     "pathtrace.caustics = true at camera.width x camera.height = {} x {}: one frame of the caustic \
-                     (24 bytes per pixel) needs {frame_bytes} bytes, over the device's storage binding limit of \
+                     (24 bytes per pixel, and 48 per pixel for the photons with a delta sun) needs \
+                     {largest_frame_bytes} bytes in one buffer, over the device's storage binding limit of \
                      {max_binding}; render smaller or set caustics = false",
                     camera.width, camera.height
                 ),
             });
         }
         let frames_per_dispatch =
-            (SPLAT_BYTES.min(max_binding) / frame_bytes).clamp(1, crate::CHUNK_SAMPLES as u64) as u32;
+            (SPLAT_BYTES.min(max_binding) / largest_frame_bytes).clamp(1, crate::CHUNK_SAMPLES as u64) as u32;
 
         let specular = |material: u32| {
             matches!(
@@ -282,7 +314,9 @@ impl CausticTracer {
             / particles as f64
             / std::f64::consts::PI
             / (f64::from(pixel_area) * nearest * nearest);
-        let (fixed_scale, fixed_cap) = fixed_point(particles, reference);
+        // The gather adds one value per pixel and frame beside the particles' (at most N).
+        let (fixed_scale, fixed_cap) = fixed_point(if gather { 2 * particles } else { particles }, reference);
+        let largest_radius = discs.iter().map(|d| d[3]).fold(0.0, f32::max);
 
         let groups_total = (particles as u32).div_ceil(WORKGROUP);
         let gx = groups_total.min(limits.max_compute_workgroups_per_dimension);
@@ -301,9 +335,20 @@ impl CausticTracer {
             fixed_scale,
             fixed_cap,
             disc_area,
-            padding: 0,
+            gather_radius: if gather { GATHER_RADIUS_FRACTION * largest_radius } else { 0.0 },
+            buckets: buckets as u32,
+            padding_a: 0,
+            padding_b: 0,
+            padding_c: 0,
         };
-        let pipeline = shaders::caustic_pipeline(gpu, scene, gpu_scene, options)?;
+        let pipeline = shaders::companion_pipeline(
+            gpu,
+            scene,
+            gpu_scene,
+            options,
+            &shaders::CAUSTIC_SHADER,
+            "caustic light-tracing",
+        )?;
         let device = &gpu.device;
         let splat_size = frame_bytes * u64::from(frames_per_dispatch);
         let (params_buffer, discs_buffer, splat) = gpu.scoped("allocating the caustic's buffers", || {
@@ -327,22 +372,72 @@ impl CausticTracer {
         })?;
         let layout = pipeline.get_bind_group_layout(0);
         let [params, objects, materials] = scene_buffers;
+        // The photon maps: (photons, heads), the photons not cleared (only the heads lead to them).
+        let photon_buffers = if gather {
+            let frames = u64::from(frames_per_dispatch);
+            Some(gpu.scoped("allocating the photon maps", || {
+                let storage = |label, size| {
+                    device.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some(label),
+                        size,
+                        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                        mapped_at_creation: false,
+                    })
+                };
+                (
+                    storage("caustic photons", photon_frame_bytes * frames),
+                    storage("photon grid", 4 * buckets * frames),
+                )
+            })?)
+        } else {
+            None
+        };
+        let mut entries = vec![
+            wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 1, resource: objects.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 2, resource: materials.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 6, resource: params_buffer.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 8, resource: splat.as_entire_binding() },
+        ];
+        if let Some((photons, heads)) = &photon_buffers {
+            entries.push(wgpu::BindGroupEntry { binding: 9, resource: photons.as_entire_binding() });
+            entries.push(wgpu::BindGroupEntry { binding: 10, resource: heads.as_entire_binding() });
+        }
+        // The gather reads no discs.
+        let gather_entries = entries.clone();
+        entries.push(wgpu::BindGroupEntry { binding: 7, resource: discs_buffer.as_entire_binding() });
         let bind_group = gpu.scoped("binding the caustic's buffers", || {
             device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("caustic"),
                 layout: &layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: objects.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 2, resource: materials.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 6, resource: params_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 7, resource: discs_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 8, resource: splat.as_entire_binding() },
-                ],
+                entries: &entries,
             })
         })?;
+        let gather = match &photon_buffers {
+            Some((_, heads)) => {
+                let pipeline = shaders::companion_pipeline(
+                    gpu,
+                    scene,
+                    gpu_scene,
+                    options,
+                    &shaders::GATHER_SHADER,
+                    "caustic photon gather",
+                )?;
+                let layout = pipeline.get_bind_group_layout(0);
+                let bind_group = gpu.scoped("binding the photon gather's buffers", || {
+                    device.create_bind_group(&wgpu::BindGroupDescriptor {
+                        label: Some("photon gather"),
+                        layout: &layout,
+                        entries: &gather_entries,
+                    })
+                })?;
+                Some(Gather { pipeline, bind_group, heads: heads.clone(), heads_frame_bytes: 4 * buckets })
+            }
+            None => None,
+        };
         Ok(Some(CausticTracer {
             pipeline,
+            gather,
             params_buffer,
             scene_params_buffer: params.clone(),
             scene_params,
@@ -465,6 +560,9 @@ impl CausticTracer {
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("caustic frames") });
         encoder.clear_buffer(&self.splat, 0, Some(bytes));
+        if let Some(gather) = &self.gather {
+            encoder.clear_buffer(&gather.heads, 0, Some(gather.heads_frame_bytes * u64::from(count)));
+        }
         {
             let mut compute = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("caustic"),
@@ -472,6 +570,16 @@ impl CausticTracer {
             });
             compute.set_pipeline(&self.pipeline);
             compute.set_bind_group(0, &self.bind_group, &[]);
+            compute.dispatch_workgroups(self.groups.0, self.groups.1, count);
+        }
+        // Its own pass: the gather reads what every particle of the frames stored.
+        if let Some(gather) = &self.gather {
+            let mut compute = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("photon gather"),
+                timestamp_writes: None,
+            });
+            compute.set_pipeline(&gather.pipeline);
+            compute.set_bind_group(0, &gather.bind_group, &[]);
             compute.dispatch_workgroups(self.groups.0, self.groups.1, count);
         }
         encoder.copy_buffer_to_buffer(&self.splat, 0, &staging, 0, bytes);

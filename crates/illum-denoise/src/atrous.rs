@@ -1,0 +1,203 @@
+//! The edge-avoiding à-trous wavelet filter on the GPU (`shaders/atrous.wgsl` has the
+//! formula): `iterations` dispatches of a 5 x 5 kernel whose taps spread 1, 2, 4, ... pixels,
+//! ping-ponging between two storage buffers, in one submission.
+
+use illum_gpu::buffers::{buffer_bind_group, dispatch};
+#[cfg(not(target_arch = "wasm32"))]
+use illum_gpu::readback;
+use illum_gpu::shader::{self, ShaderFile};
+use illum_gpu::{GpuContext, GpuError, shader_file, wgpu};
+use illum_image::RgbImage32;
+use wgpu::util::DeviceExt;
+
+use crate::DenoiseError;
+use crate::input::DenoiseInput;
+
+/// One iteration of the filter (entry point `main`).
+pub const ATROUS_SHADER: ShaderFile = shader_file!("shaders/atrous.wgsl");
+
+/// The shader's constants (its `NORMAL_SQUARINGS` and `TINY`; tested to agree).
+pub const NORMAL_POWER: i32 = 128;
+pub const TINY: f64 = 1.0e-10;
+/// A mean normal shorter than this is "no normal" (the pixel's rays left the scene).
+pub const NO_NORMAL: f32 = 1.0e-3;
+
+/// The normals as the filter reads them: unit vectors with w = 1, or zero with w = 0 where a
+/// pixel has none (shorter than [`NO_NORMAL`]).
+pub fn unit_normals(normals: &[[f32; 3]]) -> Vec<[f32; 4]> {
+    normals
+        .iter()
+        .map(|n| {
+            let length = n.iter().map(|v| v * v).sum::<f32>().sqrt();
+            if length < NO_NORMAL { [0.0; 4] } else { [n[0] / length, n[1] / length, n[2] / length, 1.0] }
+        })
+        .collect()
+}
+
+/// The filter's settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AtrousSettings {
+    /// Iterations: the kernel's taps reach 2 x (2^iterations - 1) pixels away.
+    pub iterations: u32,
+    /// The luminance stop's width in standard errors of the pixel's luminance (SVGF's sigma_l).
+    pub sigma_luminance: f32,
+    /// The albedo stop's width (a Gaussian in the albedo's Euclidean distance).
+    pub sigma_albedo: f32,
+}
+
+impl Default for AtrousSettings {
+    /// Four iterations (taps up to 30 pixels away), SVGF's sigma_l = 4, and an albedo
+    /// difference of 0.05 weighing e^-1: of iterations 4 and 5, sigma_l 2, 4, 8 and 16 and
+    /// sigma_a 0.05 and 0.1, the lowest relMSE on the 16-spp Cornell box (docs/denoising.md).
+    fn default() -> Self {
+        AtrousSettings { iterations: 4, sigma_luminance: 4.0, sigma_albedo: 0.05 }
+    }
+}
+
+/// Mirrors the WGSL `Params`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct GpuParams {
+    pub width: u32,
+    pub height: u32,
+    pub step: u32,
+    pub padding: u32,
+    pub sigma_luminance: f32,
+    pub sigma_albedo: f32,
+    pub padding_b: f32,
+    pub padding_c: f32,
+}
+
+/// The compiled filter.
+pub struct AtrousDenoiser {
+    gpu: GpuContext,
+    pipeline: wgpu::ComputePipeline,
+}
+
+impl AtrousDenoiser {
+    pub fn new(gpu: &GpuContext) -> Result<Self, GpuError> {
+        let pipeline = shader::compute_pipeline(gpu, &[], &ATROUS_SHADER, &[], "à-trous denoiser")?;
+        Ok(AtrousDenoiser { gpu: gpu.clone(), pipeline })
+    }
+
+    /// The filtered image, and the variance of each pixel's luminance after the filter. Blocks
+    /// until the GPU is done. Fails, naming the limit, for an image whose buffers do not fit
+    /// one storage binding of the device.
+    #[cfg(not(target_arch = "wasm32"))]
+    pub fn denoise(
+        &self,
+        input: &DenoiseInput,
+        settings: &AtrousSettings,
+    ) -> Result<(RgbImage32, Vec<f32>), DenoiseError> {
+        let (gpu, device) = (&self.gpu, &self.gpu.device);
+        let (width, height) = (input.width(), input.height());
+        let pixels = width as usize * height as usize;
+        let bytes = pixels as u64 * 16;
+        let limits = device.limits();
+        let max_binding = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+        if bytes > max_binding {
+            return Err(DenoiseError::Unsupported(format!(
+                "denoising a {width} x {height} image needs {bytes}-byte buffers (16 bytes per pixel), over the \
+                 device's storage binding limit of {max_binding}"
+            )));
+        }
+        let vec4 = |rows: &mut dyn Iterator<Item = [f32; 4]>| -> Vec<u8> {
+            rows.flat_map(|v| v.map(f32::to_le_bytes)).flatten().collect()
+        };
+        let colour =
+            vec4(&mut input.image.pixels.iter().zip(&input.variance).map(|(c, &v)| [c[0], c[1], c[2], v]));
+        let albedo = vec4(&mut input.albedo.iter().map(|a| [a[0], a[1], a[2], 0.0]));
+        let normal = vec4(&mut unit_normals(&input.normal).into_iter());
+        let iterations = settings.iterations.max(1);
+        let (ping, pong, albedo, normal, params) = gpu.scoped("allocating the denoiser's buffers", || {
+            let storage = |label: &str, contents: &[u8]| {
+                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents,
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                })
+            };
+            let params: Vec<wgpu::Buffer> = (0..iterations)
+                .map(|i| {
+                    let p = GpuParams {
+                        width,
+                        height,
+                        step: 1 << i,
+                        padding: 0,
+                        sigma_luminance: settings.sigma_luminance,
+                        sigma_albedo: settings.sigma_albedo,
+                        padding_b: 0.0,
+                        padding_c: 0.0,
+                    };
+                    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some("à-trous params"),
+                        contents: bytemuck::bytes_of(&p),
+                        usage: wgpu::BufferUsages::UNIFORM,
+                    })
+                })
+                .collect();
+            (
+                storage("à-trous ping", &colour),
+                storage("à-trous pong", &colour),
+                storage("à-trous albedo", &albedo),
+                storage("à-trous normal", &normal),
+                params,
+            )
+        })?;
+        let layout = self.pipeline.get_bind_group_layout(0);
+        let mut encoder = device.create_command_encoder(&Default::default());
+        let groups = [width.div_ceil(8), height.div_ceil(8), 1];
+        for (i, params) in params.iter().enumerate() {
+            let (from, to) = if i % 2 == 0 { (&ping, &pong) } else { (&pong, &ping) };
+            let bind_group = buffer_bind_group(
+                device,
+                "à-trous",
+                &layout,
+                &[(0, params), (1, from), (2, &albedo), (3, &normal), (4, to)],
+            );
+            dispatch(&mut encoder, "à-trous iteration", &self.pipeline, &bind_group, groups);
+        }
+        gpu.queue.submit([encoder.finish()]);
+        let result = if iterations % 2 == 1 { &pong } else { &ping };
+        let bytes = readback::read_buffer(gpu, result, 0, bytes, "reading back the denoised image")?;
+        let values: Vec<f32> =
+            bytes.chunks_exact(4).map(|b| f32::from_le_bytes(b.try_into().expect("4 bytes"))).collect();
+        let image = RgbImage32 {
+            width,
+            height,
+            pixels: values.chunks_exact(4).map(|v| [v[0], v[1], v[2]]).collect(),
+        };
+        let variance = values.chunks_exact(4).map(|v| v[3]).collect();
+        Ok((image, variance))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The shader validates without a GPU, and its `Params` has the Rust mirror's layout.
+    #[test]
+    fn the_shader_validates_and_its_params_match() {
+        let module = shader::compose(&[], &ATROUS_SHADER, &[]).unwrap_or_else(|e| panic!("{e}"));
+        shader::validate(&module, &ATROUS_SHADER.path).unwrap_or_else(|e| panic!("{e}"));
+        shader::wgsl_struct(&module, "", "Params").expect("struct Params").assert_matches(
+            size_of::<GpuParams>(),
+            &illum_gpu::members!(GpuParams: width, height, step, padding, sigma_luminance, sigma_albedo,
+                padding_b, padding_c),
+        );
+    }
+
+    /// The WGSL constants are the ones the f64 copy (reference.rs) uses.
+    #[test]
+    fn the_shader_constants_match_the_f64_copy() {
+        let source = include_str!("../shaders/atrous.wgsl");
+        let constant = |name: &str| -> f64 {
+            let rest = source.split(&format!("const {name}: ")).nth(1).unwrap_or_else(|| panic!("{name}"));
+            let value = rest.split(" = ").nth(1).and_then(|r| r.split(';').next()).expect("a value");
+            value.trim_end_matches('u').parse().unwrap_or_else(|e| panic!("{name} = {value}: {e}"))
+        };
+        assert_eq!(2f64.powf(constant("NORMAL_SQUARINGS")), f64::from(NORMAL_POWER));
+        assert_eq!(constant("TINY") as f32, TINY as f32);
+    }
+}

@@ -1,0 +1,89 @@
+//! The à-trous filter of `shaders/atrous.wgsl` in f64 on the CPU, term for term: what the GPU's
+//! output is tested against (tests/atrous.rs), and the definition in plain Rust.
+
+use illum_image::RgbImage32;
+use illum_image::rgb_image::REC709_LUMINANCE;
+
+use crate::atrous::{AtrousSettings, NORMAL_POWER, TINY, unit_normals};
+use crate::input::DenoiseInput;
+
+/// One pixel of a pass: its colour and its luminance's variance.
+type Pixel = ([f64; 3], f64);
+
+/// The filtered image and the variance of each pixel's luminance after the last iteration.
+pub fn denoise(input: &DenoiseInput, settings: &AtrousSettings) -> (RgbImage32, Vec<f64>) {
+    let (width, height) = (input.width() as i64, input.height() as i64);
+    let mut current: Vec<Pixel> = input
+        .image
+        .pixels
+        .iter()
+        .zip(&input.variance)
+        .map(|(c, &v)| (c.map(f64::from), f64::from(v)))
+        .collect();
+    let albedo: Vec<[f64; 3]> = input.albedo.iter().map(|a| a.map(f64::from)).collect();
+    let normal: Vec<[f64; 4]> = unit_normals(&input.normal).iter().map(|n| n.map(f64::from)).collect();
+    for iteration in 0..settings.iterations {
+        let step = 1i64 << iteration;
+        let index = |x: i64, y: i64| (y * width + x) as usize;
+        let mut next = Vec::with_capacity(current.len());
+        for y in 0..height {
+            for x in 0..width {
+                let p = index(x, y);
+                let lp = luminance(current[p].0);
+                let mut blurred = 0.0;
+                for dy in -1i64..=1 {
+                    for dx in -1i64..=1 {
+                        let q = index((x + dx).clamp(0, width - 1), (y + dy).clamp(0, height - 1));
+                        blurred += ((2 - dx.abs()) * (2 - dy.abs())) as f64 / 16.0 * current[q].1;
+                    }
+                }
+                let scale = f64::from(settings.sigma_luminance) * current[p].1.min(blurred).sqrt() + TINY;
+                let sigma_albedo = f64::from(settings.sigma_albedo);
+                let (mut sum, mut weights, mut variance) = ([0.0; 3], 0.0, 0.0);
+                for j in -2i64..=2 {
+                    for i in -2i64..=2 {
+                        let (qx, qy) = (x + i * step, y + j * step);
+                        if qx < 0 || qy < 0 || qx >= width || qy >= height {
+                            continue;
+                        }
+                        let q = index(qx, qy);
+                        let (c, v) = current[q];
+                        let da: f64 = (0..3).map(|k| (albedo[p][k] - albedo[q][k]).powi(2)).sum();
+                        let w = kernel(i)
+                            * kernel(j)
+                            * (-(lp - luminance(c)).abs() / scale).exp()
+                            * normal_weight(normal[p], normal[q])
+                            * (-da / (sigma_albedo * sigma_albedo)).exp();
+                        for k in 0..3 {
+                            sum[k] += w * c[k];
+                        }
+                        weights += w;
+                        variance += w * w * v;
+                    }
+                }
+                next.push((sum.map(|s| s / weights), variance / (weights * weights)));
+            }
+        }
+        current = next;
+    }
+    let image = RgbImage32 {
+        width: input.width(),
+        height: input.height(),
+        pixels: current.iter().map(|(c, _)| c.map(|v| v as f32)).collect(),
+    };
+    (image, current.iter().map(|&(_, v)| v).collect())
+}
+
+fn luminance(c: [f64; 3]) -> f64 {
+    c.iter().zip(REC709_LUMINANCE).map(|(v, w)| v * w).sum()
+}
+
+/// The B3 spline's taps at offsets -2..2.
+fn kernel(i: i64) -> f64 {
+    [0.0625, 0.25, 0.375, 0.25, 0.0625][(i + 2) as usize]
+}
+
+fn normal_weight(p: [f64; 4], q: [f64; 4]) -> f64 {
+    let cos = p[0] * q[0] + p[1] * q[1] + p[2] * q[2];
+    cos.max(0.0).powi(NORMAL_POWER) + (1.0 - p[3]) * (1.0 - q[3])
+}

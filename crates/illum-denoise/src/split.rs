@@ -1,0 +1,99 @@
+//! A path-traced render kept as two independent halves (two [`PathTracer`]s over disjoint
+//! sample indices of the same seed), so that a denoised image's error can be estimated
+//! ([`crate::estimate`]): the whole image is the halves merged, bit for bit the f64 sum of
+//! their samples.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use illum_gpu::GpuContext;
+use illum_image::RgbImage32;
+use illum_pathtrace::{Accumulator, GUIDE_SAMPLES, Guides, PathTracer, TracerOptions};
+use illum_scene::Scene;
+
+use crate::DenoiseError;
+use crate::atrous::{AtrousDenoiser, AtrousSettings};
+use crate::estimate::HalvesError;
+use crate::input::DenoiseInput;
+
+/// The second half's first sample index: far beyond any render's samples of the first half.
+pub const SECOND_HALF: u32 = 1 << 31;
+
+pub struct SplitRender {
+    pub a: PathTracer,
+    pub b: PathTracer,
+}
+
+/// A denoised render and what is known of its error.
+pub struct Denoised {
+    /// The denoised image of both halves' samples.
+    pub image: RgbImage32,
+    /// The halves' estimate (of a denoised half's error: conservative for `image`).
+    pub estimate: HalvesError,
+    /// The raw (noisy) whole: both halves merged.
+    pub raw: Accumulator,
+    pub guides: Guides,
+    /// Wall seconds the three filter runs took (both halves and the whole).
+    pub filter_seconds: f64,
+    /// Wall seconds of the guide pass.
+    pub guide_seconds: f64,
+}
+
+impl SplitRender {
+    pub fn new(gpu: &GpuContext, scene: &Scene, options: TracerOptions) -> Result<Self, DenoiseError> {
+        let a = PathTracer::with_options(gpu, scene, options)?;
+        let mut b = PathTracer::with_options(gpu, scene, options)?;
+        b.set_sample_offset(SECOND_HALF);
+        Ok(SplitRender { a, b })
+    }
+
+    /// Samples per pixel of the whole (both halves, each complete to its own spp).
+    pub fn spp_done(&self) -> u32 {
+        self.a.spp_done().min(self.b.spp_done()).saturating_mul(2)
+    }
+
+    /// Renders each half to `half_spp` samples per pixel, A then B. Returns false when `cancel`
+    /// was set (the halves may then differ in spp; [`Self::spp_done`] counts the smaller).
+    pub fn advance(&mut self, half_spp: u32, cancel: &AtomicBool) -> Result<bool, DenoiseError> {
+        for tracer in [&mut self.a, &mut self.b] {
+            while tracer.spp_done() < half_spp {
+                if cancel.load(Ordering::Relaxed) {
+                    return Ok(false);
+                }
+                tracer.render_step(Some(half_spp))?;
+            }
+        }
+        Ok(true)
+    }
+
+    /// Both halves merged: the raw image's statistics.
+    pub fn merged(&self) -> Accumulator {
+        let mut whole = self.a.accumulator().clone();
+        whole.merge(self.b.accumulator());
+        whole
+    }
+
+    /// Denoises both halves and the whole with the à-trous filter, and estimates the error.
+    pub fn denoise(
+        &self,
+        filter: &AtrousDenoiser,
+        settings: &AtrousSettings,
+    ) -> Result<Denoised, DenoiseError> {
+        let clock = std::time::Instant::now();
+        // The most samples the guides take (the first half's first GUIDE_SAMPLES sample indices,
+        // rendered or not): a guide's noise only blurs less, and the pass is cheap.
+        let guides = self.a.guides(GUIDE_SAMPLES)?;
+        let guide_seconds = clock.elapsed().as_secs_f64();
+        let clock = std::time::Instant::now();
+        let (a, b) = (self.a.accumulator(), self.b.accumulator());
+        let (da, _) = filter.denoise(&DenoiseInput::from_render(a, &guides), settings)?;
+        let (db, _) = filter.denoise(&DenoiseInput::from_render(b, &guides), settings)?;
+        let raw = self.merged();
+        let (image, _) = filter.denoise(&DenoiseInput::from_render(&raw, &guides), settings)?;
+        let filter_seconds = clock.elapsed().as_secs_f64();
+        let estimate = HalvesError::new(
+            (&a.mean_image(), &a.variance_image(), &da),
+            (&b.mean_image(), &b.variance_image(), &db),
+        );
+        Ok(Denoised { image, estimate, raw, guides, filter_seconds, guide_seconds })
+    }
+}

@@ -1,0 +1,74 @@
+//! The path tracer's guide buffers (illum-pathtrace's tracer/guides.rs) on the Cornell box.
+
+use illum_pathtrace::GUIDE_SAMPLES;
+
+use crate::common;
+
+/// Pixels that see one wall with all their samples hold its albedo and its normal facing the
+/// camera exactly (every sample's value is the same f32); every pixel's albedo lies in [0, 1]
+/// and its mean normal is at most unit length.
+#[test]
+fn cornell_guides_hold_each_walls_albedo_and_normal() {
+    let tracer = common::render(&common::cornell(4, 1));
+    let guides = tracer.guides(1000).expect("guides");
+    assert_eq!(guides.samples, GUIDE_SAMPLES, "the request is capped");
+    let size = common::SIZE as usize;
+    let at = |x: usize, y: usize| (guides.albedo[y * size + x], guides.normal[y * size + x]);
+    // The red wall (x = 555) is on the image's left, the green one on its right, the floor at
+    // the bottom, the back wall above the blocks (row 20; the ceiling meets it near row 15); the outermost 2 or 3 pixels
+    // see past the box's open front.
+    let cases = [
+        ("red wall", at(5, size / 2), [0.5608, 0.0627, 0.0627], [-1.0, 0.0, 0.0]),
+        ("green wall", at(size - 6, size / 2), [0.0588, 0.3961, 0.0863], [1.0, 0.0, 0.0]),
+        ("floor", at(size / 2, size - 6), [0.5, 0.5, 0.5], [0.0, 1.0, 0.0]),
+        ("back wall", at(size / 2, 20), [0.5, 0.5, 0.5], [0.0, 0.0, -1.0]),
+    ];
+    for (what, (albedo, normal), want_albedo, want_normal) in cases {
+        for c in 0..3 {
+            assert!(
+                (albedo[c] - want_albedo[c]).abs() <= 1e-6,
+                "{what}: albedo {albedo:?}, want {want_albedo:?}"
+            );
+            assert!(
+                (normal[c] - want_normal[c]).abs() <= 1e-6,
+                "{what}: normal {normal:?}, want {want_normal:?}"
+            );
+        }
+    }
+    for (a, n) in guides.albedo.iter().zip(&guides.normal) {
+        assert!(a.iter().all(|v| (0.0..=1.0).contains(v)), "albedo {a:?}");
+        assert!(n.iter().map(|v| v * v).sum::<f32>() <= 1.0 + 1e-5, "normal {n:?}");
+    }
+}
+
+/// A ball between two walls, the camera between the ball and the near wall: the ray through
+/// the image's centre meets the ball head-on. A mirror ball (reflectance 0.5) sends it straight
+/// back to the near wall (albedo 0.8): the guide is 0.5 x 0.8 with the near wall's normal,
+/// whatever the sample. A glass ball sends it on to the far wall (albedo 0.6) or, with the
+/// Fresnel probability, back to the near wall: every sample ends on a wall, so the guide lies
+/// between 0.6 and 0.8, and a guide that stopped at the glass would not.
+#[test]
+fn guides_follow_mirrors_and_glass_to_the_next_diffuse_surface() {
+    let scene = |ball: &str| {
+        let text = format!(
+            "[camera]\neye = [0.0, 0.0, 0.0]\ntarget = [0.0, 0.0, 5.0]\nup = [0.0, 1.0, 0.0]\nvfov = 30.0\n\
+             width = 9\nheight = 9\n[environment]\nradiance = [1.0, 1.0, 1.0]\n\
+             [materials.ball]\n{ball}\n[materials.far]\nalbedo = [0.6, 0.6, 0.6]\n[materials.near]\nalbedo = [0.8, 0.8, 0.8]\n\
+             [[objects]]\nmaterial = \"ball\"\nsphere = {{ center = [0.0, 0.0, 5.0], radius = 1.0 }}\n\
+             [[objects]]\nmaterial = \"far\"\nquad = {{ corner = [-50.0, -50.0, 10.0], edge_u = [100.0, 0.0, 0.0], edge_v = [0.0, 100.0, 0.0] }}\n\
+             [[objects]]\nmaterial = \"near\"\nquad = {{ corner = [-50.0, -50.0, -3.0], edge_u = [100.0, 0.0, 0.0], edge_v = [0.0, 100.0, 0.0] }}\n\
+             [pathtrace]\nspp = 1\nbounces = 16\n"
+        );
+        illum_scene::Scene::from_toml_str(&text, "mirror-and-glass.toml").unwrap_or_else(|e| panic!("{e}"))
+    };
+    let centre = 4 * 9 + 4;
+    let mirror =
+        common::render(&scene("mirror = { reflectance = [0.5, 0.5, 0.5] }")).guides(16).expect("guides");
+    for c in 0..3 {
+        assert!((mirror.albedo[centre][c] - 0.4).abs() <= 1e-6, "mirror: albedo {:?}", mirror.albedo[centre]);
+    }
+    assert!((mirror.normal[centre][2] - 1.0).abs() <= 1e-3, "mirror: normal {:?}", mirror.normal[centre]);
+    let glass = common::render(&scene("dielectric = { ior = 1.5 }")).guides(16).expect("guides");
+    let a = glass.albedo[centre];
+    assert!(a.iter().all(|&v| (0.6 - 1e-6..=0.8 + 1e-6).contains(&v)), "glass: albedo {a:?}");
+}

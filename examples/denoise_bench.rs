@@ -1,0 +1,85 @@
+//! What denoising costs on this machine: the à-trous filter alone and the guide pass, per
+//! megapixel, at a few image sizes (median of `--runs` after a warm-up), beside the path
+//! tracer's own time per sample per pixel at that size.
+//!
+//! ```text
+//! cargo run --release --example denoise_bench -- [SCENE] [--sizes 256,512,1024] [--runs 5]
+//! ```
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::Parser;
+use illum::image::median;
+use illum::pathtrace::{GUIDE_SAMPLES, PathTracer};
+use illum::scene::{Overrides, Scene};
+use illum_denoise::{AtrousDenoiser, AtrousSettings, DenoiseInput};
+
+#[derive(Parser, Debug)]
+#[command(about = "The à-trous denoiser's and the guide pass's cost in ms per megapixel")]
+struct Args {
+    #[arg(default_value = "scenes/cornell.toml")]
+    scene: PathBuf,
+    /// Square image sizes in pixels (comma-separated).
+    #[arg(long, value_delimiter = ',', default_value = "256,512,1024")]
+    sizes: Vec<u32>,
+    /// Timed runs per measurement (the median is reported).
+    #[arg(long, default_value_t = 5)]
+    runs: u32,
+}
+
+fn main() {
+    illum_cli::main_with(run);
+}
+
+fn run(args: Args) -> anyhow::Result<()> {
+    let gpu = illum_cli::gpu()?;
+    let filter = AtrousDenoiser::new(&gpu)?;
+    let settings = AtrousSettings::default();
+    println!("{} on {}; à-trous {settings:?}", args.scene.display(), gpu.adapter_info.name);
+    println!(
+        "| size | filter ms | filter ms/Mpixel | guides ({GUIDE_SAMPLES} spp) ms/Mpixel | path tracing ms/Mpixel per spp |"
+    );
+    println!("|---|---|---|---|---|");
+    for &size in &args.sizes {
+        let mut scene = Scene::load(&illum_cli::resolve_scene_path(&args.scene))?;
+        let overrides =
+            Overrides { width: Some(size), height: Some(size), spp: Some(4), ..Default::default() };
+        scene.apply_overrides(&overrides, "--sizes")?;
+        let mut tracer = PathTracer::new(&gpu, &scene)?;
+        tracer.render_to_spp(1)?;
+        let time = |f: &mut dyn FnMut() -> anyhow::Result<()>| -> anyhow::Result<f64> {
+            f()?; // warm-up
+            let mut ms = Vec::new();
+            for _ in 0..args.runs.max(1) {
+                let started = Instant::now();
+                f()?;
+                ms.push(started.elapsed().as_secs_f64() * 1e3);
+            }
+            Ok(median(&mut ms))
+        };
+        let trace_ms = time(&mut || {
+            tracer.reset();
+            tracer.render_to_spp(4)?;
+            Ok(())
+        })? / 4.0;
+        let guides_ms = time(&mut || {
+            tracer.guides(GUIDE_SAMPLES)?;
+            Ok(())
+        })?;
+        let guides = tracer.guides(GUIDE_SAMPLES)?;
+        let input = DenoiseInput::from_render(tracer.accumulator(), &guides);
+        let filter_ms = time(&mut || {
+            filter.denoise(&input, &settings)?;
+            Ok(())
+        })?;
+        let mp = f64::from(size) * f64::from(size) / 1e6;
+        println!(
+            "| {size} x {size} | {filter_ms:.1} | {:.0} | {:.0} | {:.0} |",
+            filter_ms / mp,
+            guides_ms / mp,
+            trace_ms / mp
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,111 @@
+//! `render --denoise` as a user runs it: the files it writes, the error it reports and stops
+//! at, and the flags it refuses.
+
+use std::process::Output;
+
+#[path = "common/binary.rs"]
+mod binary;
+
+use binary::{field, metadata, render, text};
+
+fn run(args: &[&str]) -> Output {
+    render(args).output().expect("the render example starts")
+}
+
+fn assert_refused(out: &Output, case: &str, expected: &[&str]) {
+    let stderr = text(&out.stderr);
+    assert!(!out.status.success(), "{case}: accepted, expected a refusal naming {expected:?}: {stderr}");
+    assert!(!stderr.contains("panicked"), "{case}: {stderr}");
+    for part in expected {
+        assert!(stderr.contains(part), "{case}: the refusal lacks {part:?}: {stderr}");
+    }
+}
+
+/// The EXR holds the denoised image with layers `noisy`, `albedo` and `normal`, and metadata
+/// saying which denoiser ran, the total spp (an odd target rounded up to even) and the
+/// denoised image's estimated error, below the raw image's (64 x 64: at 32 x 32 the light's
+/// edge and the box's outline are so large a share of the pixels that the filter gains
+/// nothing, and the estimate says so); the PNG is written too.
+#[test]
+fn denoise_writes_the_image_its_guide_layers_and_its_estimated_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let (exr, png) = (dir.path().join("d.exr"), dir.path().join("d.png"));
+    let out = run(&[
+        "--width",
+        "64",
+        "--height",
+        "64",
+        "--spp",
+        "15",
+        "--denoise",
+        "atrous",
+        "-o",
+        exr.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(png.exists());
+    let meta = metadata(&exr);
+    assert_eq!(field(&meta, "denoiser"), "atrous");
+    assert_eq!(field(&meta, "spp"), "16");
+    let denoised: f64 = field(&meta, "estimated_relative_error").parse().unwrap();
+    let raw: f64 = field(&meta, "raw_estimated_relative_error").parse().unwrap();
+    assert!(denoised.is_finite() && denoised < raw, "denoised {denoised}, raw {raw}");
+    let header = illum::image::load_exr_header(&exr).unwrap();
+    for layer in ["noisy", "albedo", "normal"] {
+        assert!(header.layers.iter().any(|l| l == layer), "no layer {layer}: {:?}", header.layers);
+    }
+}
+
+/// `--target-error` with `--denoise` stops at the denoised image's estimated error, which is
+/// reached with fewer samples than the raw image would need.
+#[test]
+fn the_error_target_applies_to_the_denoised_image() {
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("t.exr");
+    let out = run(&[
+        "--width",
+        "64",
+        "--height",
+        "64",
+        "--target-error",
+        "0.09",
+        "--denoise",
+        "atrous",
+        "-o",
+        exr.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let meta = metadata(&exr);
+    assert_eq!(field(&meta, "stopped_by"), "target_error");
+    let denoised: f64 = field(&meta, "estimated_relative_error").parse().unwrap();
+    let raw: f64 = field(&meta, "raw_estimated_relative_error").parse().unwrap();
+    assert!(denoised <= 0.09, "stopped at {denoised}");
+    assert!(raw > 0.09, "the raw image alone ({raw}) had reached the target: the test shows nothing");
+}
+
+#[test]
+fn bad_denoise_flags_are_clear_errors() {
+    let small = ["--width", "16", "--height", "16", "--spp", "4"];
+    let with = |extra: &[&str]| -> Vec<String> { small.iter().chain(extra).map(|s| s.to_string()).collect() };
+    let case = |extra: &[&str]| {
+        let args = with(extra);
+        run(&args.iter().map(String::as_str).collect::<Vec<_>>())
+    };
+    assert_refused(&case(&["--denoise", "blur"]), "--denoise blur", &["blur", "atrous or oidn"]);
+    assert_refused(
+        &case(&["--denoise", "atrous", "--adaptive"]),
+        "--denoise --adaptive",
+        &["--denoise", "--adaptive"],
+    );
+    assert_refused(
+        &case(&["--denoise", "oidn"]),
+        "--denoise oidn",
+        &["Open Image Denoise", "--denoise atrous"],
+    );
+    let raster = ["scenes/whitted.toml", "--renderer", "raster", "--denoise", "atrous"];
+    assert_refused(&run(&raster), "--denoise with the rasterizer", &["--denoise"]);
+    let auto = ["--renderer", "auto", "--target-error", "0.1", "--denoise", "atrous"];
+    assert_refused(&run(&auto), "--denoise with --renderer auto", &["--renderer auto", "--denoise"]);
+}
