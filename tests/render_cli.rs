@@ -569,6 +569,171 @@ fn two_concurrent_processes_like_gnu_parallel_then_merge_equal_one_render() {
     assert!(difference <= 1e-12, "{difference:e}");
 }
 
+/// A low-discrepancy render keeps its replicates (crates/illum-pathtrace/src/replicates.rs), and
+/// so its error estimate, through a resume and a merge: resumed from 41 spp (inside a chunk of 4)
+/// to 96 its replicate sums are a straight render's bit for bit, and merged from the ranges 0..48
+/// and 48..96 within 1e-12.
+#[test]
+fn a_low_discrepancy_render_keeps_its_replicates_through_resume_and_merge() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).to_str().unwrap().to_owned();
+    let with = |extra: &[&str]| {
+        let mut args = vec!["--sequence", "low-discrepancy"];
+        args.extend(extra);
+        render_ok(&args)
+    };
+    with(&["--spp", "96", "-o", &p("straight.exr")]);
+    with(&["--spp", "41", "-o", &p("resumed.exr")]);
+    with(&["--resume", &p("resumed.exr"), "--spp", "96"]);
+    with(&["--sample-range", "0..48", "-o", &p("a.exr")]);
+    with(&["--sample-range", "48..96", "-o", &p("b.exr")]);
+    let out = merge(&[&p("a.exr"), &p("b.exr"), "-o", &p("merged.exr")]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let load = |name: &str| checkpoint(Path::new(&p(name))).accumulator;
+    let (straight, resumed, merged) = (load("straight.exr"), load("resumed.exr"), load("merged.exr"));
+    let replicates = |a: &illum::pathtrace::Accumulator| a.replicates().expect("replicates kept").clone();
+    assert!(replicates(&resumed) == replicates(&straight), "the resumed render's replicates differ");
+    let (m, s) = (replicates(&merged), replicates(&straight));
+    assert_eq!(m.count, s.count);
+    let worst =
+        m.sum.iter().flatten().zip(s.sum.iter().flatten()).map(|(a, b)| (a - b).abs() / a.abs().max(1e-300));
+    let worst = worst.fold(0.0, f64::max);
+    assert!(worst <= 1e-12, "merged replicate sums differ by {worst:e} relative");
+    let (e_merged, e_straight) = (merged.estimated_rel_mse(), straight.estimated_rel_mse());
+    assert!(
+        e_straight.is_finite() && (e_merged / e_straight - 1.0).abs() < 1e-9,
+        "{e_merged} vs {e_straight}"
+    );
+}
+
+/// `--error-percentile` and `--region` say what `--target-error` is measured over; bad values
+/// are refused naming the flag, the value and what is allowed (for a region, the valid names).
+#[test]
+fn error_percentile_and_region_refuse_bad_values_and_stop_on_their_error() {
+    for bad in ["0", "101", "-3", "ninety"] {
+        let out = run(&["--target-error", "0.1", "--error-percentile", bad]);
+        assert_refused(&out, &format!("--error-percentile {bad}"), &["--error-percentile", bad, "100"]);
+        assert_no_panic(&out);
+    }
+    let out = run(&[
+        "scenes/whitted.toml",
+        "--renderer",
+        "pathtrace",
+        "--width",
+        "32",
+        "--height",
+        "18",
+        "--target-error",
+        "0.1",
+        "--region",
+        "teapot",
+    ]);
+    assert_refused(
+        &out,
+        "--region teapot",
+        &["--region \"teapot\"", "\"glass sphere\"", "\"metal sphere\"", "\"floor\""],
+    );
+    let out = run(&["--error-percentile", "95"]);
+    assert_refused(&out, "--error-percentile without --target-error", &["--target-error"]);
+    let out = run(&["--target-error", "0.1", "--error-percentile", "95", "--region", "floor"]);
+    assert_refused(&out, "both", &["not both"]);
+
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("glass.exr");
+    let exr_text = exr.to_str().unwrap();
+    let args = [
+        "scenes/whitted.toml",
+        "--renderer",
+        "pathtrace",
+        "--width",
+        "32",
+        "--height",
+        "18",
+        "--target-error",
+        "0.05",
+        "--region",
+        "glass sphere",
+        "-o",
+        exr_text,
+    ];
+    let out = run(&args);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert_eq!(field(&metadata(&exr), "stopped_by"), "target_error");
+    let error = illum::image::load_f32_layer(&exr, "illum.error").unwrap().expect("an illum.error layer");
+    assert_eq!(error.channels.len(), 1);
+    assert_eq!(error.channels[0].1.len(), 32 * 18);
+}
+
+/// `--reference FILE.exr`: the rasterizer's and the Whitted tracer's EXRs get the signed
+/// difference from a path-traced truth (image minus reference, exactly), and a reference of
+/// another scene or size is refused naming both sides, before anything is rendered.
+#[test]
+fn raster_and_whitted_write_their_signed_difference_from_a_reference() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).to_str().unwrap().to_owned();
+    let size = ["--width", "32", "--height", "18"];
+    let with = |extra: &[&str]| {
+        let mut args = vec!["scenes/whitted.toml"];
+        args.extend(size);
+        args.extend(extra);
+        run(&args)
+    };
+    let out = with(&["--renderer", "pathtrace", "--spp", "64", "-o", &p("truth.exr")]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let (truth, _) = illum::image::load_exr(p("truth.exr")).unwrap();
+    for renderer in ["raster", "whitted"] {
+        let exr = p(&format!("{renderer}.exr"));
+        let out = with(&["--renderer", renderer, "--reference", &p("truth.exr"), "-o", &exr]);
+        assert!(out.status.success(), "{renderer}: {}", text(&out.stderr));
+        assert!(text(&out.stdout).contains("against the reference: relMSE"), "{}", text(&out.stdout));
+        let (image, _) = illum::image::load_exr(&exr).unwrap();
+        let layer =
+            illum::image::load_f32_layer(&exr, "illum.difference").unwrap().expect("a difference layer");
+        for (c, name) in ["R", "G", "B"].iter().enumerate() {
+            let (_, values) = layer.channels.iter().find(|(n, _)| n == name).expect("channel");
+            for (i, v) in values.iter().enumerate() {
+                assert_eq!(
+                    *v,
+                    image.pixels[i][c] - truth.pixels[i][c],
+                    "{renderer}: pixel {i} channel {name}"
+                );
+            }
+        }
+    }
+    // Another scene: the Cornell box's truth for the Whitted scene.
+    let out = run(&["--width", "32", "--height", "18", "--spp", "2", "-o", &p("cornell.exr")]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let cornell_hash = field(&metadata(Path::new(&p("cornell.exr"))), "scene_hash");
+    let whitted_hash = field(&metadata(Path::new(&p("truth.exr"))), "scene_hash");
+    let out = with(&["--renderer", "whitted", "--reference", &p("cornell.exr"), "-o", &p("x.exr")]);
+    assert_refused(
+        &out,
+        "a reference of another scene",
+        &["--reference", "\"cornell\"", &cornell_hash, "\"whitted\"", &whitted_hash],
+    );
+    // Another size.
+    let out = run(&[
+        "scenes/whitted.toml",
+        "--renderer",
+        "raster",
+        "--width",
+        "16",
+        "--height",
+        "9",
+        "--reference",
+        &p("truth.exr"),
+        "-o",
+        &p("y.exr"),
+    ]);
+    assert_refused(&out, "a reference of another size", &["32 x 18", "16 x 9"]);
+    assert!(
+        !Path::new(&p("x.exr")).exists() && !Path::new(&p("y.exr")).exists(),
+        "a refused render wrote a file"
+    );
+    let out = with(&["--renderer", "pathtrace", "--reference", &p("truth.exr")]);
+    assert_refused(&out, "--reference with the path tracer", &["--reference", "raster", "whitted"]);
+}
+
 /// A render whose spp is not a multiple of the chunk (16) ends inside a chunk. Resumed, it goes
 /// on from its last chunk boundary and equals a straight render bit for bit; split into ranges
 /// (each starting on a chunk), merged and resumed, it equals one render within 1e-12.

@@ -14,6 +14,7 @@ pub mod denoise;
 pub mod interrupt;
 pub mod progress;
 pub mod raster;
+pub mod reference;
 pub mod whitted;
 
 use std::path::{Path, PathBuf};
@@ -203,6 +204,9 @@ pub struct RenderRequest<'a, A> {
     pub other_flags: Vec<&'static str>,
     /// How the render reports progress and reacts to Ctrl-C / SIGTERM.
     pub long: LongRender<'a>,
+    /// `--reference FILE.exr`: a truth of the same scene; the EXRs get the signed difference
+    /// from it (see [`reference`]).
+    pub reference: Option<&'a Path>,
 }
 
 /// How a long render reports its progress and learns that it should stop.
@@ -269,24 +273,47 @@ impl<A> RenderRequest<'_, A> {
         Ok(outputs)
     }
 
+    /// The `--reference` image, read and checked against the request's scene file at the
+    /// request's size (before rendering).
+    pub fn reference_image(&self) -> anyhow::Result<Option<RgbImage32>> {
+        let Some(path) = self.reference else { return Ok(None) };
+        let mut scene = Scene::load(&resolve_scene_path(self.scene))?;
+        let sizes =
+            Overrides { width: self.settings.width, height: self.settings.height, ..Default::default() };
+        scene.apply_overrides(&sizes, "command line")?;
+        reference::load_reference(path, &scene).map(Some)
+    }
+
     /// Writes `image` to every output (PNG with the request's exposure and encoding, linear by
-    /// default; EXR with `metadata`), then prints `summary` and the files written.
+    /// default; EXR with `metadata`, and with a `reference` the layer of the signed difference
+    /// from it), then prints `summary` (and the relMSE against the reference) and the files written.
     pub fn write(
         &self,
         outputs: &[PathBuf],
         image: &RgbImage32,
         metadata: &ExrMetadata,
         summary: &str,
+        reference: Option<&RgbImage32>,
     ) -> anyhow::Result<()> {
         let encoding = self.encoding.unwrap_or(Encoding::Linear);
         let exposure = self.exposure.unwrap_or_default().stops_for(image);
         for output in outputs {
-            match output_format(output)? {
-                OutputFormat::Png => save_png(output, image, exposure, encoding)?,
-                OutputFormat::Exr => save_exr(output, image, metadata)?,
+            match (output_format(output)?, reference) {
+                (OutputFormat::Png, _) => save_png(output, image, exposure, encoding)?,
+                (OutputFormat::Exr, None) => save_exr(output, image, metadata)?,
+                (OutputFormat::Exr, Some(truth)) => illum_image::save_exr_with_float_layers(
+                    output,
+                    image,
+                    metadata,
+                    Vec::new(),
+                    vec![reference::difference_layer(image, truth)],
+                )?,
             }
         }
         println!("{summary}");
+        if let Some(truth) = reference {
+            println!("against the reference: relMSE {:.4e}", illum_image::rel_mse(image, truth)?);
+        }
         for output in outputs {
             println!("wrote {}", output.display());
         }

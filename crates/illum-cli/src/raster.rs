@@ -9,6 +9,7 @@ use std::time::Instant;
 use anyhow::bail;
 use clap::Args;
 use illum_gpu::GpuContext;
+use illum_image::RgbImage32;
 
 use illum_raster::{Frame, Look, Options, PassTimes, RasterRenderer, RasterScene};
 
@@ -95,14 +96,14 @@ pub type RasterRequest<'a> = RenderRequest<'a, RasterArgs>;
 
 /// Loads the scene, applies `--width` / `--height`, and checks every flag and output name,
 /// before any GPU work.
-fn prepare(request: &RasterRequest) -> anyhow::Result<(RasterScene, Options, Vec<PathBuf>)> {
+fn prepare(request: &RasterRequest) -> anyhow::Result<Prepared> {
     let path = crate::resolve_scene_path(request.scene);
     let flags = request.refused_flags();
     if !flags.is_empty() {
         bail!(
             "{}: {} {} only to the path tracer; this render uses the rasterizer (--renderer raster), \
              whose flags are --look, --no-shadows, --no-pcf, --no-refraction, --no-reflection, \
-             --no-fresnel, --no-antialiasing, --width, --height, --encoding, --exposure, -o",
+             --no-fresnel, --no-antialiasing, --width, --height, --encoding, --exposure, --reference, -o",
             request.scene.display(),
             flags.join(", "),
             crate::verb(flags.len())
@@ -112,20 +113,29 @@ fn prepare(request: &RasterRequest) -> anyhow::Result<(RasterScene, Options, Vec
     scene.set_resolution(request.settings.width, request.settings.height, "command line")?;
     let options = request.args.options(&scene);
     let outputs = request.checked_outputs(&scene.name, options.look.as_str())?;
-    Ok((scene, options, outputs))
+    let reference = request.reference_image()?;
+    Ok(Prepared { scene, options, outputs, reference })
+}
+
+/// A rasterizer render checked and ready: its scene, options, outputs and `--reference` image.
+struct Prepared {
+    scene: RasterScene,
+    options: Options,
+    outputs: Vec<PathBuf>,
+    reference: Option<RgbImage32>,
 }
 
 /// Renders a rasterizer scene as `request` says, creating the GPU context.
 pub fn render_raster(request: &RasterRequest) -> anyhow::Result<()> {
-    let (scene, options, outputs) = prepare(request)?;
+    let prepared = prepare(request)?;
     let gpu = crate::gpu()?;
-    render_prepared(&gpu, &scene, &options, &outputs, request)
+    render_prepared(&gpu, &prepared, request)
 }
 
 /// [`render_raster`] on an existing GPU context (tests share one device).
 pub fn render_raster_with(gpu: &GpuContext, request: &RasterRequest) -> anyhow::Result<()> {
-    let (scene, options, outputs) = prepare(request)?;
-    render_prepared(gpu, &scene, &options, &outputs, request)
+    let prepared = prepare(request)?;
+    render_prepared(gpu, &prepared, request)
 }
 
 /// Pixels of the main pass per submission of a large frame: a fraction of a second on lavapipe,
@@ -138,13 +148,8 @@ fn rows_per_band(width: u32) -> u32 {
     (PIXELS_PER_BAND / u64::from(width.max(1))).clamp(1, u64::from(u32::MAX)) as u32
 }
 
-fn render_prepared(
-    gpu: &GpuContext,
-    scene: &RasterScene,
-    options: &Options,
-    outputs: &[PathBuf],
-    request: &RasterRequest,
-) -> anyhow::Result<()> {
+fn render_prepared(gpu: &GpuContext, prepared: &Prepared, request: &RasterRequest) -> anyhow::Result<()> {
+    let Prepared { scene, options, outputs, reference } = prepared;
     let (width, height) = (scene.camera.width, scene.camera.height);
     let long = request.long;
     long.exit_if_requested("before the render started");
@@ -200,7 +205,7 @@ fn render_prepared(
         progress.note(&format!("writing {}", crate::describe_outputs(outputs)));
         progress.finish();
     }
-    request.write(outputs, &frame.image, &metadata, &summary)?;
+    request.write(outputs, &frame.image, &metadata, &summary, reference.as_ref())?;
     long.exit_after_complete_image();
     Ok(())
 }

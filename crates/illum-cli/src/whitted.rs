@@ -53,7 +53,7 @@ fn prepare(request: &WhittedRequest) -> anyhow::Result<(Scene, Vec<PathBuf>)> {
         bail!(
             "{}: {} {} to the other renderers; this render uses the Whitted ray tracer \
              (--renderer whitted), whose flags are --depth, --aa, --width, --height, --encoding, \
-             --exposure, -o",
+             --exposure, --reference, -o",
             request.scene.display(),
             flags.join(", "),
             crate::verb(flags.len())
@@ -87,6 +87,7 @@ fn pixels_per_part(aa: u32) -> u64 {
 /// the start) and exits with the signal's status.
 pub fn render_whitted(request: &WhittedRequest) -> anyhow::Result<()> {
     let (scene, outputs) = prepare(request)?;
+    let reference = request.reference_image()?;
     let long = request.long;
     long.exit_if_requested("before the render started");
     let gpu = crate::gpu()?;
@@ -126,7 +127,7 @@ pub fn render_whitted(request: &WhittedRequest) -> anyhow::Result<()> {
     );
     progress.note(&format!("writing {}", crate::describe_outputs(&outputs)));
     progress.finish();
-    request.write(&outputs, &image, &metadata, &summary)?;
+    request.write(&outputs, &image, &metadata, &summary, reference.as_ref())?;
     long.exit_after_complete_image();
     Ok(())
 }

@@ -18,6 +18,7 @@ fn request<'a>(settings: &'a SceneArgs, raster: &'a RasterArgs, outputs: &'a [Pa
         exposure: None,
         other_flags: Vec::new(),
         long: Default::default(),
+        reference: None,
     }
 }
 

@@ -201,9 +201,10 @@ pub struct U32Layer {
     pub channels: Vec<(String, Vec<u32>)>,
 }
 
-/// An extra EXR layer of 32-bit float channels, stored after the RGB image (a multi-part file),
-/// such as a denoiser's guide buffers (`albedo`, `normal`). Other EXR readers show the RGB
-/// image and list the layer.
+/// An extra EXR layer of 32-bit float channels, stored after the RGB image (a multi-part file)
+/// and any [`U32Layer`]s: per-pixel values to look at, such as a denoiser's guide buffers
+/// (`albedo`, `normal`), the path tracer's estimated relative error (`illum.error`) or a signed
+/// difference from a reference. Other EXR readers show the RGB image and list the layer.
 #[derive(Clone, Debug, PartialEq)]
 pub struct F32Layer {
     /// The layer's name (the part's `name` attribute).
@@ -219,19 +220,25 @@ pub fn save_exr_with_f32_layers(
     metadata: &ExrMetadata,
     layers: Vec<F32Layer>,
 ) -> Result<(), ImageError> {
+    save_exr_with_float_layers(path, image, metadata, Vec::new(), layers)
+}
+
+/// As [`save_exr`], plus the u32 `layers` and then the f32 `float_layers` after the RGB image,
+/// all in one atomic write.
+pub fn save_exr_with_float_layers(
+    path: impl AsRef<Path>,
+    image: &RgbImage32,
+    metadata: &ExrMetadata,
+    layers: Vec<U32Layer>,
+    float_layers: Vec<F32Layer>,
+) -> Result<(), ImageError> {
     let path = path.as_ref();
-    if layers.is_empty() {
+    if layers.is_empty() && float_layers.is_empty() {
         return save_exr(path, image, metadata);
     }
     check_writable(path, image)?;
-    let layers = layers
-        .into_iter()
-        .map(|l| Part {
-            name: l.name,
-            channels: l.channels.into_iter().map(|(n, v)| (n, exr::prelude::FlatSamples::F32(v))).collect(),
-        })
-        .collect();
-    write_atomically(path, |file| encode_with_layers(path, image, metadata, layers, file))
+    let parts = layers.into_iter().map(Part::from).chain(float_layers.into_iter().map(Part::from)).collect();
+    write_atomically(path, |file| encode_with_layers(path, image, metadata, parts, file))
 }
 
 /// An extra part of the file: its name and its channels.
@@ -253,6 +260,19 @@ impl From<U32Layer> for Part {
     }
 }
 
+impl From<F32Layer> for Part {
+    fn from(layer: F32Layer) -> Self {
+        Part {
+            name: layer.name,
+            channels: layer
+                .channels
+                .into_iter()
+                .map(|(n, v)| (n, exr::prelude::FlatSamples::F32(v)))
+                .collect(),
+        }
+    }
+}
+
 /// As [`save_exr`], plus `layers` after the RGB image, all in one atomic write. The RGB layer
 /// is named `rgb` when there are extra layers (a multi-part file needs names).
 pub fn save_exr_with_layers(
@@ -261,13 +281,7 @@ pub fn save_exr_with_layers(
     metadata: &ExrMetadata,
     layers: Vec<U32Layer>,
 ) -> Result<(), ImageError> {
-    let path = path.as_ref();
-    if layers.is_empty() {
-        return save_exr(path, image, metadata);
-    }
-    check_writable(path, image)?;
-    let layers = layers.into_iter().map(Part::from).collect();
-    write_atomically(path, |file| encode_with_layers(path, image, metadata, layers, file))
+    save_exr_with_float_layers(path, image, metadata, layers, Vec::new())
 }
 
 /// [`save_exr_with_layers`] into memory: the EXR file's bytes (for a download in the browser).
@@ -277,12 +291,13 @@ pub fn exr_bytes_with_layers(
     image: &RgbImage32,
     metadata: &ExrMetadata,
     layers: Vec<U32Layer>,
+    float_layers: Vec<F32Layer>,
 ) -> Result<Vec<u8>, ImageError> {
     let path = Path::new(name);
     check_writable(path, image)?;
     let mut out = std::io::Cursor::new(Vec::new());
-    let layers = layers.into_iter().map(Part::from).collect();
-    encode_with_layers(path, image, metadata, layers, &mut out)?;
+    let parts = layers.into_iter().map(Part::from).chain(float_layers.into_iter().map(Part::from)).collect();
+    encode_with_layers(path, image, metadata, parts, &mut out)?;
     Ok(out.into_inner())
 }
 
@@ -402,6 +417,43 @@ pub fn load_u32_layers(path: impl AsRef<Path>, names: &[&str]) -> Result<Vec<Opt
         found[index].get_or_insert(U32Layer { name: names[index].to_owned(), channels });
     }
     Ok(found)
+}
+
+/// Reads the layer named `name` of an EXR file as 32-bit float channels (see [`F32Layer`]).
+/// `Ok(None)` when the file has no such layer; an error for an unreadable file or a channel of
+/// another sample type.
+pub fn load_f32_layer(path: impl AsRef<Path>, name: &str) -> Result<Option<F32Layer>, ImageError> {
+    use exr::prelude::{FlatSamples, ReadLayers as _};
+    let path = path.as_ref();
+    let file = File::open(path).map_err(|e| ImageError::io(path, "opening the EXR file", e))?;
+    let image = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .all_layers()
+        .all_attributes()
+        .from_buffered(BufReader::new(file))
+        .map_err(|e| ImageError::Decode { path: path.to_path_buf(), format: "EXR", source: Box::new(e) })?;
+    for layer in image.layer_data {
+        if layer.attributes.layer_name.as_ref().map(string).as_deref() != Some(name) {
+            continue;
+        }
+        let mut channels = Vec::new();
+        for channel in layer.channel_data.list {
+            let channel_name = string(&channel.name);
+            match channel.sample_data {
+                FlatSamples::F32(values) => channels.push((channel_name, values)),
+                _ => {
+                    return Err(ImageError::BadContent {
+                        path: path.to_path_buf(),
+                        reason: format!("layer '{name}' channel '{channel_name}' is not 32-bit floats"),
+                    });
+                }
+            }
+        }
+        return Ok(Some(F32Layer { name: name.to_owned(), channels }));
+    }
+    Ok(None)
 }
 
 /// What an EXR file's headers say, without reading its pixels: the size and text attributes
@@ -608,6 +660,23 @@ mod tests {
         std::fs::write(dir.path().join("not.exr"), b"not an exr").unwrap();
         let error = load_exr_header(dir.path().join("not.exr")).unwrap_err().to_string();
         assert!(error.contains("not.exr"), "{error}");
+    }
+
+    #[test]
+    fn f32_layers_round_trip_after_the_u32_ones() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("f.exr");
+        let mut image = RgbImage32::new(2, 1);
+        image.pixels = vec![[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]];
+        let u = U32Layer { name: "u".into(), channels: vec![("n".into(), vec![7, 8])] };
+        let f =
+            F32Layer { name: "illum.error".into(), channels: vec![("Y".into(), vec![0.25, f32::INFINITY])] };
+        save_exr_with_float_layers(&path, &image, &metadata(), vec![u.clone()], vec![f.clone()]).unwrap();
+        assert_eq!(load_f32_layer(&path, "illum.error").unwrap(), Some(f));
+        assert_eq!(load_u32_layer(&path, "u").unwrap(), Some(u));
+        assert_eq!(load_f32_layer(&path, "missing").unwrap(), None);
+        assert!(load_f32_layer(&path, "u").unwrap_err().to_string().contains("not 32-bit floats"));
+        assert_eq!(load_exr(&path).unwrap().0, image);
     }
 
     #[test]

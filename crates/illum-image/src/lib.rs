@@ -27,7 +27,8 @@ pub use contact_sheet::contact_sheet;
 pub use diff::{DiffImages, save_diff_images};
 pub use exr::{
     ExrHeader, ExrMetadata, F32Layer, U32Layer, exr_bytes_with_layers, load_exr, load_exr_header,
-    load_u32_layer, load_u32_layers, save_exr, save_exr_with_f32_layers, save_exr_with_layers,
+    load_f32_layer, load_u32_layer, load_u32_layers, save_exr, save_exr_with_f32_layers,
+    save_exr_with_float_layers, save_exr_with_layers,
 };
 pub use metrics::{
     MetricsError, binomial_critical_count, inverse_normal_cdf, mean_luminance_bias, median, rel_mse, rmse,

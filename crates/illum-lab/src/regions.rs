@@ -123,6 +123,27 @@ impl Regions {
     }
 }
 
+/// The pixels of the region called `name`: an object's name in the scene file (every pixel
+/// whose centre ray sees it) or one of [`Regions::from_ids`]'s names (e.g. "floor, lit"). An
+/// unknown name is refused with the valid ones listed.
+pub fn region_mask(scene: &Scene, ids: &ObjectIds, name: &str) -> Result<Vec<bool>, String> {
+    if let Some(object) = scene.objects.iter().position(|o| o.name == name) {
+        return Ok(ids.hit.iter().map(|&h| h == Some(object)).collect());
+    }
+    let regions = Regions::from_ids(scene, ids);
+    if let Some(index) = regions.index(name) {
+        return Ok(regions.of_pixel.iter().map(|&r| r == index).collect());
+    }
+    let mut valid: Vec<String> = scene.objects.iter().map(|o| o.name.clone()).collect();
+    valid.extend(regions.names.iter().filter(|n| !valid.contains(n)).cloned().collect::<Vec<_>>());
+    let valid: Vec<String> = valid.iter().map(|n| format!("{n:?}")).collect();
+    Err(format!(
+        "no object or region of this name in scene {:?}; valid names: {}",
+        scene.name,
+        valid.join(", ")
+    ))
+}
+
 /// The errors of an image against the reference over some pixels (NaN where undefined: a
 /// region with no pixels, a ratio to a black reference).
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -41,8 +41,27 @@ struct Sampler {
     dimension: u32,
 }
 
+// Replicates (LOW_DISCREPANCY only): the sample indices of a pixel are dealt, in runs of
+// REPLICATE_RUN consecutive indices, to REPLICATES independently randomised copies of the
+// sequence: run q = i / REPLICATE_RUN goes to replicate q mod REPLICATES, at index
+// (q / REPLICATES) REPLICATE_RUN + i mod REPLICATE_RUN of that copy. Each replicate has its own
+// shifts and shuffles (its own pixel key), so the R replicate means are independent and
+// identically distributed, and their spread estimates the variance of the pixel's mean
+// (src/replicates.rs); each replicate's first indices are still a prefix of its padded sequence.
+// Mirrored by src/replicates.rs (checked there by a test).
+const REPLICATES: u32 = 4u;
+const REPLICATE_RUN: u32 = 4u;
+
 fn sampler_new(seed: u32, pixel: u32, sample_index: u32) -> Sampler {
+#ifdef LOW_DISCREPANCY
+    let run = sample_index / REPLICATE_RUN;
+    let replicate = run % REPLICATES;
+    let index = (run / REPLICATES) * REPLICATE_RUN + sample_index % REPLICATE_RUN;
+    let key = pcg_hash(seed ^ pcg_hash(pixel) ^ pcg_hash(replicate * 0x85ebca6bu + 0x27d4eb2fu));
+    return Sampler(rng_seed(seed, pixel, sample_index), key, index, 0u);
+#else
     return Sampler(rng_seed(seed, pixel, sample_index), pcg_hash(seed ^ pcg_hash(pixel)), sample_index, 0u);
+#endif
 }
 
 // A nested random permutation of the sample index: Owen scrambling in base 2, the way Burley

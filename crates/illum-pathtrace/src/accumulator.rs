@@ -11,6 +11,8 @@ use illum_image::RgbImage32;
 // relMSE are the same quantity.
 use illum_image::metrics::REL_MSE_EPSILON;
 
+use crate::replicates::{Replicates, replicate_of};
+
 #[derive(Clone, Debug)]
 pub struct Accumulator {
     pub width: u32,
@@ -24,6 +26,9 @@ pub struct Accumulator {
     dropped: u64,
     /// 2^k: what the GPU's values are multiplied by when folded (see [`radiance_exponent`]).
     sum_scale: f64,
+    /// Per-replicate sums of a low-discrepancy render (see `replicates.rs`): when present, the
+    /// variance of each pixel's mean comes from their spread instead of s^2 / n.
+    replicates: Option<Replicates>,
 }
 
 /// Largest emitted radiance the GPU traces unscaled: 2^16. Above it the scene's emission is
@@ -69,13 +74,21 @@ pub const RENDER_HOST_BYTES_PER_PIXEL: u64 = 2 * STATISTICS_BYTES_PER_PIXEL + 2 
 pub const ALIGNED_COPY_BYTES_PER_PIXEL: u64 = 2 * STATISTICS_BYTES_PER_PIXEL;
 
 /// Checks, before anything is allocated, that a `width x height` render fits in `available`
-/// bytes of host memory (`None`: unknown, not checked). The error says how much it would need.
-pub fn check_host_memory(width: u32, height: u32, available: Option<u64>) -> Result<(), String> {
-    let needed = u64::from(width) * u64::from(height) * RENDER_HOST_BYTES_PER_PIXEL;
+/// bytes of host memory (`None`: unknown, not checked), with `extra_per_pixel` bytes per pixel
+/// on top of [`RENDER_HOST_BYTES_PER_PIXEL`] (a low-discrepancy render's replicates and their
+/// EXR layer: 2 x `Replicates::BYTES_PER_PIXEL`). The error says how much it would need.
+pub fn check_host_memory(
+    width: u32,
+    height: u32,
+    extra_per_pixel: u64,
+    available: Option<u64>,
+) -> Result<(), String> {
+    let per_pixel = RENDER_HOST_BYTES_PER_PIXEL + extra_per_pixel;
+    let needed = u64::from(width) * u64::from(height) * per_pixel;
     match available {
         Some(available) if needed > available => Err(format!(
             "camera.width x camera.height = {width} x {height}: the render needs {:.1} GiB of host memory \
-             ({RENDER_HOST_BYTES_PER_PIXEL} bytes per pixel: the f64 statistics, the output images and their encoders' copies), \
+             ({per_pixel} bytes per pixel: the f64 statistics, the output images and their encoders' copies), \
              but only {:.1} GiB are available",
             gib(needed),
             gib(available)
@@ -109,6 +122,7 @@ impl Accumulator {
             total: 0,
             dropped: 0,
             sum_scale: 1.0,
+            replicates: None,
         }
     }
 
@@ -126,7 +140,7 @@ impl Accumulator {
         sum.resize(n, [0.0; 3]);
         sum_sq.resize(n, [0.0; 3]);
         count.resize(n, 0);
-        Ok(Self { width, height, sum, sum_sq, count, total: 0, dropped: 0, sum_scale: 1.0 })
+        Ok(Self { width, height, sum, sum_sq, count, total: 0, dropped: 0, sum_scale: 1.0, replicates: None })
     }
 
     /// Folds from now on values the GPU computed with radiance scaled by 2^-`exponent` (see
@@ -161,7 +175,57 @@ impl Accumulator {
             ));
         }
         let total = count.iter().sum();
-        Ok(Self { width, height, sum, sum_sq, count, total, dropped, sum_scale: 1.0 })
+        Ok(Self { width, height, sum, sum_sq, count, total, dropped, sum_scale: 1.0, replicates: None })
+    }
+
+    /// Keeps per-replicate sums from now on (a low-discrepancy render, see `replicates.rs`); the
+    /// accumulator must be empty. Fold its chunks with [`Self::fold_chunks`].
+    pub fn enable_replicates(&mut self) {
+        debug_assert_eq!(self.total, 0, "replicates enabled on a started accumulator");
+        self.replicates = Some(Replicates::new(self.count.len()));
+    }
+
+    /// Sets the per-replicate sums (a checkpoint's); `None`: independent samples.
+    pub fn set_replicates(&mut self, replicates: Option<Replicates>) -> Result<(), String> {
+        if let Some(r) = &replicates
+            && r.pixels() != self.count.len()
+        {
+            return Err(format!(
+                "the replicate statistics have {} pixels for a {} x {} image",
+                r.pixels(),
+                self.width,
+                self.height
+            ));
+        }
+        self.replicates = replicates;
+        Ok(())
+    }
+
+    /// The per-replicate sums, when kept.
+    pub fn replicates(&self) -> Option<&Replicates> {
+        self.replicates.as_ref()
+    }
+
+    /// [`Self::fold`] for a chunk whose samples start at absolute sample index `chunk_start`:
+    /// with replicates kept, its sums also go to the replicate of that index.
+    pub fn fold_chunk(
+        &mut self,
+        first_pixel: usize,
+        chunk_start: u64,
+        sums: &[[f32; 4]],
+        sums_sq: &[[f32; 4]],
+    ) {
+        self.fold(first_pixel, sums, sums_sq);
+        let scale = self.sum_scale;
+        if let Some(replicates) = &mut self.replicates {
+            let replicate = replicate_of(chunk_start);
+            for (i, s) in sums.iter().enumerate() {
+                if s[3] > 0.0 {
+                    let sum = [s[0] as f64 * scale, s[1] as f64 * scale, s[2] as f64 * scale];
+                    replicates.add(first_pixel + i, replicate, sum, s[3] as u64);
+                }
+            }
+        }
     }
 
     /// Adds another accumulator's samples of the same image (a disjoint set of sample indices:
@@ -181,6 +245,11 @@ impl Accumulator {
         }
         self.total += other.total;
         self.dropped += other.dropped;
+        // Replicates add only when both sides kept them (a merge refuses mixed sequences first).
+        match (&mut self.replicates, &other.replicates) {
+            (Some(a), Some(b)) => a.merge(b),
+            _ => self.replicates = None,
+        }
     }
 
     /// Folds one batch for consecutive pixels starting at `first_pixel`. `sums[i]` is (sum, finite
@@ -209,10 +278,13 @@ impl Accumulator {
     /// S2 + 2 C S1 / n (C the camera sum of n samples), whose expectation is that of the paired
     /// sum of (c_k + s_k)^2 since the two are independent; so the sample variance estimates
     /// var(c) + var(s). When some camera samples of the chunk were dropped (n < frames), S1
-    /// and S2 are scaled by n / frames, the expected share of the kept samples.
+    /// and S2 are scaled by n / frames, the expected share of the kept samples. With replicates
+    /// kept, S1 joins the replicate of the chunk's first sample index `chunk_start`: frame k
+    /// pairs with sample k, and the caustic's sampler deals frames to replicates as the camera's.
     pub fn fold_independent(
         &mut self,
         first_pixel: usize,
+        chunk_start: u64,
         camera: &[[f32; 4]],
         sum: &[[f64; 3]],
         sum_sq: &[[f64; 3]],
@@ -234,6 +306,9 @@ impl Accumulator {
                 self.sum[p][c] += sum[i][c] * share;
                 self.sum_sq[p][c] +=
                     sum_sq[i][c] * share + 2.0 * f64::from(chunk[c]) * scale * sum[i][c] / frames;
+            }
+            if let Some(replicates) = &mut self.replicates {
+                replicates.add_values(p, replicate_of(chunk_start), sum[i].map(|v| v * share));
             }
         }
     }
@@ -273,8 +348,20 @@ impl Accumulator {
         self.sum[pixel].map(|s| s / n)
     }
 
-    /// Variance of the pixel's mean (sample variance / n), per channel; infinite with < 2 samples.
+    /// Variance of the pixel's mean, per channel: from the spread of the replicate means when
+    /// replicates are kept (low-discrepancy), else sample variance / n; infinite with < 2 samples
+    /// (or < 2 replicates).
     pub fn pixel_variance_of_mean(&self, pixel: usize) -> [f64; 3] {
+        match &self.replicates {
+            Some(replicates) => replicates.variance_of_mean(pixel),
+            None => self.pixel_sample_variance_over_n(pixel),
+        }
+    }
+
+    /// The sample variance over n per channel, s^2 / n, whatever the sequence (the variance of
+    /// the mean for independent samples; for the low-discrepancy sequence an overestimate, used
+    /// where the per-sample spread is wanted: adaptive sampling's pilot). Infinite with < 2 samples.
+    pub fn pixel_sample_variance_over_n(&self, pixel: usize) -> [f64; 3] {
         let n = self.count[pixel] as f64;
         if n < 2.0 {
             return [f64::INFINITY; 3];
@@ -339,6 +426,9 @@ impl Accumulator {
         self.count.fill(0);
         self.total = 0;
         self.dropped = 0;
+        if let Some(replicates) = &mut self.replicates {
+            replicates.reset();
+        }
     }
 }
 
@@ -391,10 +481,13 @@ mod tests {
 
     #[test]
     fn a_render_larger_than_memory_is_refused_with_what_it_needs() {
-        let err = check_host_memory(8192, 8192, Some(2 << 30)).unwrap_err();
+        let err = check_host_memory(8192, 8192, 0, Some(2 << 30)).unwrap_err();
         assert!(err.contains("8192 x 8192") && err.contains("9.9 GiB") && err.contains("2.0 GiB"), "{err}");
-        assert!(check_host_memory(16384, 16384, None).is_ok());
-        assert!(check_host_memory(512, 512, Some(1 << 30)).is_ok());
+        // With the replicates of a low-discrepancy render: 159 + 512 bytes per pixel.
+        let err = check_host_memory(8192, 8192, 512, Some(2 << 30)).unwrap_err();
+        assert!(err.contains("41.9 GiB") && err.contains("671 bytes per pixel"), "{err}");
+        assert!(check_host_memory(16384, 16384, 0, None).is_ok());
+        assert!(check_host_memory(512, 512, 0, Some(1 << 30)).is_ok());
         if cfg!(target_os = "linux") {
             assert!(available_host_memory().is_some_and(|b| b > 0));
         }

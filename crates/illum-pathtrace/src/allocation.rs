@@ -137,8 +137,9 @@ impl SampleAllocation {
                     continue;
                 }
                 let mean = pilot.pixel_mean(p);
-                // The per-sample variance: n times the variance of the mean.
-                let var = pilot.pixel_variance_of_mean(p);
+                // The per-sample variance: n times s^2 / n (the spread of the samples, which the
+                // exponents were fitted to, not the low-discrepancy mean's replicate variance).
+                let var = pilot.pixel_sample_variance_over_n(p);
                 noise[b] +=
                     (0..3).map(|c| n * var[c] / (mean[c] * mean[c] + REL_MSE_EPSILON)).sum::<f64>() / 3.0;
             }

@@ -38,7 +38,7 @@ mod merge;
 
 use std::path::Path;
 
-use illum_image::{ExrMetadata, U32Layer, load_u32_layers, save_exr_with_layers};
+use illum_image::{ExrMetadata, F32Layer, U32Layer, load_u32_layers, save_exr_with_float_layers};
 use illum_scene::Scene;
 
 use crate::{Accumulator, PathTracer, TracerOptions};
@@ -49,6 +49,17 @@ pub use merge::{merge_checkpoint_files, merge_checkpoints};
 
 /// Name of the EXR layer with the exact per-pixel statistics.
 pub const STATISTICS_LAYER: &str = "illum.statistics";
+
+/// Name of the f32 layer with each pixel's estimated relative standard error (channel `Y`; see
+/// [`crate::error_map`]), written into every checkpoint for people and viewers: a resume reads
+/// the statistics, never it.
+pub const ERROR_LAYER: &str = "illum.error";
+
+/// The [`ERROR_LAYER`] of `accumulator`.
+pub fn error_layer(accumulator: &Accumulator) -> F32Layer {
+    let map = crate::error_map::ErrorMap::of(accumulator);
+    F32Layer { name: ERROR_LAYER.to_owned(), channels: vec![("Y".to_owned(), map.relative_error())] }
+}
 
 /// Name of the layer with the statistics at the last chunk boundary, in files whose samples end
 /// inside a chunk (its spp: metadata `aligned_spp`).
@@ -90,7 +101,8 @@ pub fn save_checkpoint(
     metadata: &ExrMetadata,
 ) -> Result<(), CheckpointError> {
     let (metadata, layers) = checkpoint_layers(tracer.accumulator(), tracer.aligned_prefix(), metadata);
-    save_exr_with_layers(path, &tracer.accumulator().mean_image(), &metadata, layers)
+    let errors = vec![error_layer(tracer.accumulator())];
+    save_exr_with_float_layers(path, &tracer.accumulator().mean_image(), &metadata, layers, errors)
         .map_err(|e| write_error(path, &e))
 }
 
@@ -103,7 +115,8 @@ fn write_error(path: &Path, error: &illum_image::ImageError) -> CheckpointError 
 pub fn save_loaded(path: &Path, checkpoint: &Checkpoint) -> Result<(), CheckpointError> {
     let aligned = checkpoint.aligned_prefix.as_ref().map(|(a, spp)| (a, *spp));
     let (metadata, layers) = checkpoint_layers(&checkpoint.accumulator, aligned, &checkpoint.metadata);
-    save_exr_with_layers(path, &checkpoint.accumulator.mean_image(), &metadata, layers)
+    let errors = vec![error_layer(&checkpoint.accumulator)];
+    save_exr_with_float_layers(path, &checkpoint.accumulator.mean_image(), &metadata, layers, errors)
         .map_err(|e| write_error(path, &e))
 }
 
@@ -115,7 +128,8 @@ pub fn checkpoint_bytes(
     metadata: &ExrMetadata,
 ) -> Result<Vec<u8>, CheckpointError> {
     let (metadata, layers) = checkpoint_layers(tracer.accumulator(), tracer.aligned_prefix(), metadata);
-    illum_image::exr_bytes_with_layers(name, &tracer.accumulator().mean_image(), &metadata, layers)
+    let errors = vec![error_layer(tracer.accumulator())];
+    illum_image::exr_bytes_with_layers(name, &tracer.accumulator().mean_image(), &metadata, layers, errors)
         .map_err(|e| write_error(Path::new(name), &e))
 }
 
@@ -285,14 +299,18 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint, CheckpointError> {
     let aligned_prefix = match layers.next().transpose()?.flatten() {
         Some(prefix) => {
             let spp: u32 = whole_number(path, &metadata, "aligned_spp")?;
-            if spp > spp_done || !(sample_start + spp).is_multiple_of(crate::CHUNK_SAMPLES) {
+            // A low-discrepancy render's chunks are its replicates' runs (replicates.rs).
+            let chunk = match metadata.get("sequence") {
+                Some("low-discrepancy") => crate::replicates::REPLICATE_RUN,
+                _ => crate::CHUNK_SAMPLES,
+            };
+            if spp > spp_done || !(sample_start + spp).is_multiple_of(chunk) {
                 return Err(CheckpointError::InvalidField {
                     path: path.to_path_buf(),
                     field: "aligned_spp",
                     value: spp.to_string(),
                     allowed: format!(
-                        "must be a chunk boundary (sample_start + it a multiple of {}) at most illum.spp = {spp_done}",
-                        crate::CHUNK_SAMPLES
+                        "must be a chunk boundary (sample_start + it a multiple of {chunk}) at most illum.spp = {spp_done}"
                     ),
                 });
             }

@@ -17,12 +17,14 @@ mod batch;
 pub mod checkpoint;
 pub mod display_sum;
 mod error;
+pub mod error_map;
 pub mod gpu_scene;
 pub mod limits;
 pub mod metadata;
 mod options;
 pub mod planner;
 pub mod progressive;
+pub mod replicates;
 pub mod shaders;
 pub mod specialise;
 mod tracer;
@@ -35,12 +37,12 @@ pub use error::PathTraceError;
 pub use gpu_scene::{caustic_estimators, implements};
 pub use illum_scene::Sequence;
 pub use options::{TracerOptions, Traversal};
-#[cfg(not(target_arch = "wasm32"))]
-pub use progressive::render_progressive;
 pub use progressive::{
     Progress, Progressive, RenderClock, Rule, Status, StopReason, StopRules, parse_target_error,
     parse_time_budget,
 };
+#[cfg(not(target_arch = "wasm32"))]
+pub use progressive::{render_progressive, render_progressive_over};
 pub use shaders::{
     CAUSTIC_BUFFERS_MODULE, CAUSTIC_SHADER, GATHER_SHADER, GENERIC_LIGHT_CHOICE, GENERIC_MATERIALS,
     GENERIC_TRAVERSAL, GUIDES_SHADER, PATHTRACE_SHADER, SAMPLING_MODULES, SCENE_MODULE, SURFACES_MODULE,

@@ -18,6 +18,7 @@ use std::time::Duration;
 
 use web_time::Instant;
 
+use crate::error_map::ErrorScope;
 use crate::{PathTraceError, PathTracer};
 
 /// When to stop. With every field `None` the render runs until cancelled. The first rule that
@@ -264,6 +265,9 @@ pub struct Progressive {
     stopped: Option<StopReason>,
     /// The tracer's samples when this render first stepped (a resumed render starts with some).
     start_samples: Option<u64>,
+    /// What the error rule measures: the whole image (the default), a percentile of the pixels
+    /// or a region ([`ErrorScope`]).
+    error_scope: ErrorScope,
 }
 
 impl Progressive {
@@ -276,14 +280,27 @@ impl Progressive {
             error_at_spp: 0,
             stopped: None,
             start_samples: None,
+            error_scope: ErrorScope::Image,
         }
+    }
+
+    /// What the error is measured over.
+    pub fn error_scope(&self) -> &ErrorScope {
+        &self.error_scope
+    }
+
+    /// Measures the error (shown, and for the error rule) over `scope` instead of the image.
+    pub fn with_error_scope(mut self, scope: ErrorScope) -> Self {
+        self.error_scope = scope;
+        self
     }
 
     /// Starts again (after the tracer was reset): a new clock (paused if this one was), no error,
     /// not stopped.
     pub fn restart(&mut self) {
         let running = self.clock.is_running();
-        *self = Progressive::new(self.rules);
+        let scope = std::mem::take(&mut self.error_scope);
+        *self = Progressive::new(self.rules).with_error_scope(scope);
         if !running {
             self.clock.pause();
         }
@@ -360,7 +377,11 @@ impl Progressive {
         let spp = tracer.spp_done();
         if spp != self.error_at_spp || (self.relative_error.is_none() && spp >= 2) {
             self.error_at_spp = spp;
-            self.relative_error = (spp >= 2).then(|| tracer.accumulator().estimated_relative_error());
+            let accumulator = tracer.accumulator();
+            self.relative_error = (spp >= 2).then(|| match &self.error_scope {
+                ErrorScope::Image => accumulator.estimated_relative_error(),
+                scope => crate::error_map::ErrorMap::of(accumulator).error(scope),
+            });
         }
     }
 }
@@ -373,9 +394,21 @@ pub fn render_progressive(
     tracer: &mut PathTracer,
     rules: &StopRules,
     cancel: &AtomicBool,
+    on_step: impl FnMut(&PathTracer, &Progressive),
+) -> Result<(StopReason, Progressive), PathTraceError> {
+    render_progressive_over(tracer, rules, ErrorScope::Image, cancel, on_step)
+}
+
+/// [`render_progressive`] with the error measured over `scope` (`--error-percentile`, `--region`).
+#[cfg(not(target_arch = "wasm32"))]
+pub fn render_progressive_over(
+    tracer: &mut PathTracer,
+    rules: &StopRules,
+    scope: ErrorScope,
+    cancel: &AtomicBool,
     mut on_step: impl FnMut(&PathTracer, &Progressive),
 ) -> Result<(StopReason, Progressive), PathTraceError> {
-    let mut progressive = Progressive::new(*rules);
+    let mut progressive = Progressive::new(*rules).with_error_scope(scope);
     log::debug!("render started: {rules:?}");
     loop {
         if cancel.load(Ordering::Relaxed) {

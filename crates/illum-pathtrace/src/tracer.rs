@@ -15,12 +15,13 @@
 //! settings callers choose.
 
 use illum_gpu::{GpuContext, wgpu};
-use illum_scene::Scene;
+use illum_scene::{Scene, Sequence};
 
 use crate::batch::{self, SLOT_BYTES};
 use crate::display_sum::DisplaySum;
 use crate::gpu_scene::GpuScene;
 use crate::options::TracerOptions;
+use crate::replicates::REPLICATE_RUN;
 use crate::{Accumulator, PathTraceError, SampleAllocation, limits};
 
 mod accumulation;
@@ -109,9 +110,16 @@ impl PathTracer {
         limits::check_texture_size(scene, &limits)?;
         let max_slots = batch::device_max_slots(&limits);
         batch::check_row_fits(scene, max_slots)?;
+        // A low-discrepancy render also keeps its replicates, and writes them into its EXR.
+        let replicate_bytes = if options.sequence == Sequence::LowDiscrepancy {
+            2 * crate::replicates::Replicates::BYTES_PER_PIXEL
+        } else {
+            0
+        };
         crate::accumulator::check_host_memory(
             scene.camera.width,
             scene.camera.height,
+            replicate_bytes,
             crate::accumulator::available_host_memory(),
         )
         .map_err(|message| PathTraceError::Unsupported { scene: scene.name.clone(), message })?;
@@ -130,11 +138,13 @@ impl PathTracer {
         let gpu_scene = GpuScene::new(scene)?;
         accumulator.set_radiance_exponent(gpu_scene.radiance_exponent);
         let pipeline = ScenePipeline::new(gpu, scene, &gpu_scene, options, allocation)?;
-        Ok(PathTracer {
-            pipeline,
-            bands: BandRunner::new(gpu, max_slots),
-            accumulation: Accumulation::new(accumulator),
-        })
+        let mut bands = BandRunner::new(gpu, max_slots);
+        if options.sequence == Sequence::LowDiscrepancy {
+            // Its error comes from replicates, and a chunk must lie inside one replicate's run.
+            accumulator.enable_replicates();
+            bands.chunk_samples = REPLICATE_RUN;
+        }
+        Ok(PathTracer { pipeline, bands, accumulation: Accumulation::new(accumulator) })
     }
 
     pub fn scene(&self) -> &Scene {
@@ -303,9 +313,13 @@ impl PathTracer {
     /// Sets the samples per invocation (default [`crate::CHUNK_SAMPLES`]; values below 1 count as 1),
     /// from the next pass on. With 1 every sample reaches the f64 fold as its own f32 value, which
     /// makes the result the exact f64 fold of the samples (tests use it as the reference); larger
-    /// chunks round each chunk's f32 sum by up to (n - 1) x 2^-24 relative.
+    /// chunks round each chunk's f32 sum by up to (n - 1) x 2^-24 relative. With the
+    /// low-discrepancy sequence at most [`crate::replicates::REPLICATE_RUN`] (its default): a
+    /// chunk must lie inside one replicate's run of samples (see `replicates.rs`).
     pub fn set_chunk_samples(&mut self, samples: u32) {
-        self.bands.chunk_samples = samples.max(1);
+        let most =
+            if self.pipeline.options.sequence == Sequence::LowDiscrepancy { REPLICATE_RUN } else { u32::MAX };
+        self.bands.chunk_samples = samples.clamp(1, most);
     }
 
     /// Caps each batch buffer at `bytes` (at most the device's storage binding limit, which is the

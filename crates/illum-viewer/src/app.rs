@@ -476,7 +476,7 @@ impl ViewerApp {
                 self.raster.as_mut().ok().and_then(|m| m.frame(gpu, render_state, view_pixels))
             }
             RendererKind::PathTrace => self.pathtrace.as_mut().ok().and_then(|m| {
-                m.frame(gpu, render_state, view_pixels);
+                m.frame(gpu, ui.ctx(), render_state, view_pixels);
                 m.texture()
             }),
             RendererKind::Whitted => {

@@ -26,6 +26,7 @@ pub mod browser;
 pub mod camera;
 pub mod cli;
 pub mod display;
+pub mod error_view;
 pub mod frame_rate;
 pub mod gpu_setup;
 pub mod pacer;

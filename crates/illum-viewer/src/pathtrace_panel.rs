@@ -62,6 +62,9 @@ pub struct PathTraceSettings {
     pub resolution_scale: f32,
     /// Display-only exposure in stops (the saved files are not scaled).
     pub exposure: f32,
+    /// Show the heat map of each pixel's estimated relative error instead of the image
+    /// (`error_view.rs`); display only.
+    pub error_view: bool,
     /// When to stop: the `render` example's own rules, set from the panel (`spp`: the spp
     /// target, `None` to keep going). Held as the tracer's type, not a copy of its fields, so
     /// that the panel and the command line cannot drift apart.
@@ -78,6 +81,7 @@ impl PathTraceSettings {
             caustics: scene.pathtrace.caustics,
             resolution_scale: DEFAULT_SCALE,
             exposure: 0.0,
+            error_view: false,
             stop: StopRules::default(),
         }
     }
@@ -136,6 +140,9 @@ pub struct PathTraceMode {
     /// Total samples at the last statistics update, to tell when new samples arrived.
     shown_samples: u64,
     shown_exposure: f32,
+    /// The error view's texture, the heat map in it and the total samples it shows, while the
+    /// view is on.
+    error_texture: Option<(egui::TextureHandle, egui::ColorImage, u64)>,
     pub save_path: String,
     /// The last save's outcome or the renderer's last error, shown under the controls.
     pub message: Option<String>,
@@ -161,6 +168,7 @@ impl PathTraceMode {
             stats: Stats::default(),
             shown_samples: 0,
             shown_exposure: 0.0,
+            error_texture: None,
             save_path: format!("out/viewer-{stem}.png"),
             message: None,
         }
@@ -172,6 +180,7 @@ impl PathTraceMode {
         *self = PathTraceMode { display: self.display.take(), ..PathTraceMode::new(scene_path, scene) };
         self.settings.resolution_scale = keep.resolution_scale;
         self.settings.exposure = keep.exposure;
+        self.settings.error_view = keep.error_view;
     }
 
     pub fn scene_path(&self) -> &Path {
@@ -313,7 +322,13 @@ impl PathTraceMode {
 
     /// Brings the tracer in line with the settings, camera and `view_pixels` size, runs this
     /// frame's slice of work and refreshes the displayed texture.
-    pub fn frame(&mut self, gpu: &GpuContext, render_state: &egui_wgpu::RenderState, view_pixels: [u32; 2]) {
+    pub fn frame(
+        &mut self,
+        gpu: &GpuContext,
+        ctx: &egui::Context,
+        render_state: &egui_wgpu::RenderState,
+        view_pixels: [u32; 2],
+    ) {
         let scale = self.settings.resolution_scale.clamp(0.05, 2.0);
         let width = ((view_pixels[0] as f32 * scale).round() as u32).max(1);
         let height = ((view_pixels[1] as f32 * scale).round() as u32).max(1);
@@ -378,11 +393,55 @@ impl PathTraceMode {
             display.redraw(gpu, stops);
             self.shown_exposure = self.settings.exposure;
         }
+        self.refresh_error_view(ctx);
     }
 
-    /// The texture to show, once something was rendered.
+    /// Computes the error view's heat map again when it is on and new samples arrived.
+    fn refresh_error_view(&mut self, ctx: &egui::Context) {
+        let Some(tracer) = self.tracer.as_ref().filter(|_| self.settings.error_view) else {
+            self.error_texture = None;
+            return;
+        };
+        let accumulator = tracer.accumulator();
+        let total = accumulator.total_samples();
+        if self.error_texture.as_ref().is_some_and(|(_, _, shown)| *shown == total) {
+            return;
+        }
+        let errors = illum_pathtrace::error_map::ErrorMap::of(accumulator).relative_error();
+        let image = crate::error_view::heat_map(&errors, accumulator.width, accumulator.height);
+        // Nearest: each pixel's own error, not a blend of neighbours.
+        let options = egui::TextureOptions::NEAREST;
+        match &mut self.error_texture {
+            Some((handle, shown_image, shown)) => {
+                handle.set(image.clone(), options);
+                *shown_image = image;
+                *shown = total;
+            }
+            None => {
+                let handle = ctx.load_texture("path tracer error view", image.clone(), options);
+                self.error_texture = Some((handle, image, total));
+            }
+        }
+    }
+
+    /// The texture to show, once something was rendered: the image, or with the error view on,
+    /// its heat map.
     pub fn texture(&self) -> Option<egui::TextureId> {
-        self.display.as_ref().and_then(Display::texture_id)
+        match &self.error_texture {
+            Some((handle, _, _)) => Some(handle.id()),
+            None => self.display.as_ref().and_then(Display::texture_id),
+        }
+    }
+
+    /// The error view's heat map as shown and the total samples it is of, while the view is on
+    /// (tests read it).
+    pub fn error_view(&self) -> Option<(&egui::ColorImage, u64)> {
+        self.error_texture.as_ref().map(|(_, image, total)| (image, *total))
+    }
+
+    /// The tracer's statistics, once it exists.
+    pub fn accumulator(&self) -> Option<&illum_pathtrace::Accumulator> {
+        self.tracer.as_ref().map(PathTracer::accumulator)
     }
 
     /// The display pass (tests read what it shows).
@@ -520,6 +579,13 @@ impl PathTraceMode {
         });
         ui.add(egui::Slider::new(&mut s.resolution_scale, MIN_SCALE..=MAX_SCALE).text("Resolution scale"));
         ui.add(egui::Slider::new(&mut s.exposure, -8.0..=8.0).text("Exposure (display)").suffix(" stops"));
+        ui.checkbox(&mut s.error_view, "Error view").on_hover_text(
+            "A heat map of each pixel's estimated relative standard error instead of the image \
+             (the EXR layer illum.error)",
+        );
+        if s.error_view {
+            ui.small("black 0.01%, purple 0.1%, red 1%, orange 10%, yellow 100%; blue: not known yet");
+        }
 
         ui.separator();
         ui.label("Stop rules");

@@ -275,6 +275,47 @@ fn the_window_shows_what_save_png_writes() {
     }
 }
 
+/// "Error view" shows the heat map of the estimated error of every pixel, of the samples taken
+/// so far, and switching it off shows the image again. On the Cornell box the ceiling, lit only
+/// by light from the walls, is noisier than the directly lit floor: its colours are brighter.
+#[test]
+fn the_error_view_shows_where_the_error_is() {
+    let mut harness = stopped_at(16);
+    let image_texture = harness.state().pathtrace().unwrap().texture();
+    click(&mut harness, "Error view");
+    harness.run_steps(2);
+    let mode = harness.state().pathtrace().unwrap();
+    let (map, samples) = mode.error_view().expect("the error view is on");
+    let accumulator = mode.accumulator().expect("a tracer");
+    assert_eq!(samples, accumulator.total_samples());
+    assert_eq!(map.size, [accumulator.width as usize, accumulator.height as usize]);
+    assert_ne!(mode.texture(), image_texture, "the window still shows the image");
+    // Mean brightness of a band of rows, in the middle third of the columns.
+    let band = |rows: std::ops::Range<usize>| {
+        let [w, h] = map.size;
+        let (x0, x1) = (w / 3, 2 * w / 3);
+        let rows = rows.start * h / 100..rows.end * h / 100;
+        let n = (rows.len() * (x1 - x0)) as f64;
+        rows.flat_map(|y| (x0..x1).map(move |x| map.pixels[y * w + x]))
+            .map(|c| f64::from(c.r()) + f64::from(c.g()) + f64::from(c.b()))
+            .sum::<f64>()
+            / n
+    };
+    let (ceiling, floor) = (band(3..10), band(88..97));
+    println!("heat-map brightness: ceiling {ceiling:.1}, floor {floor:.1}");
+    assert!(ceiling > floor, "ceiling {ceiling:.1} not above floor {floor:.1}");
+    let path = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("error_view.png");
+    let rgba: Vec<u8> = map.pixels.iter().flat_map(|c| c.to_array()).collect();
+    image::RgbaImage::from_raw(map.size[0] as u32, map.size[1] as u32, rgba).unwrap().save(&path).unwrap();
+    println!("saved {}", path.display());
+
+    click(&mut harness, "Error view");
+    harness.run_steps(1);
+    let mode = harness.state().pathtrace().unwrap();
+    assert!(mode.error_view().is_none());
+    assert_eq!(mode.texture(), image_texture);
+}
+
 #[test]
 fn snapshot_raster() {
     let mut harness = harness_with("scenes/whitted.toml", RendererKind::Raster);

@@ -1,11 +1,15 @@
 //! The statistics layers of a checkpoint: per pixel the f64 sum and sum of squares of each
 //! channel and the u64 count, each 64-bit number stored as two 32-bit words (`hi`, `lo`), since
-//! EXR has no 64-bit samples; and the checks that what is read back adds up.
+//! EXR has no 64-bit samples; and the checks that what is read back adds up. A low-discrepancy
+//! render's layer also holds its replicates (`replicates.rs`): per replicate r the channels
+//! `replicate{r}.sum.{R,G,B}.{hi,lo}` and `replicate{r}.count.{hi,lo}`, so that a resumed or
+//! merged render keeps its honest error estimate.
 
 use illum_image::U32Layer;
 
 use super::STATISTICS_LAYER;
 use crate::Accumulator;
+use crate::replicates::{REPLICATES, Replicates};
 
 const CHANNELS: [&str; 3] = ["R", "G", "B"];
 
@@ -35,6 +39,20 @@ pub(super) fn layer_named(name: &str, accumulator: &Accumulator) -> U32Layer {
     let (hi, lo): (Vec<u32>, Vec<u32>) = state.count.iter().map(|&n| split(n)).unzip();
     channels.push(("count.hi".to_owned(), hi));
     channels.push(("count.lo".to_owned(), lo));
+    if let Some(replicates) = accumulator.replicates() {
+        for r in 0..REPLICATES {
+            let slots = || (r..replicates.count.len()).step_by(REPLICATES);
+            for (c, name) in CHANNELS.iter().enumerate() {
+                let (hi, lo): (Vec<u32>, Vec<u32>) =
+                    slots().map(|i| split(replicates.sum[i][c].to_bits())).unzip();
+                channels.push((format!("replicate{r}.sum.{name}.hi"), hi));
+                channels.push((format!("replicate{r}.sum.{name}.lo"), lo));
+            }
+            let (hi, lo): (Vec<u32>, Vec<u32>) = slots().map(|i| split(replicates.count[i])).unzip();
+            channels.push((format!("replicate{r}.count.hi"), hi));
+            channels.push((format!("replicate{r}.count.lo"), lo));
+        }
+    }
     U32Layer { name: name.to_owned(), channels }
 }
 
@@ -76,7 +94,36 @@ pub(super) fn statistics_from_layer(
     if sum.iter().chain(&sum_sq).flatten().any(|v| !v.is_finite()) {
         return Err("the statistics hold a NaN or infinite sum: the file is corrupt".into());
     }
-    Accumulator::from_state(width, height, sum, sum_sq, count, dropped)
+    let replicates = if layer.channels.iter().any(|(n, _)| n == "replicate0.count.hi") {
+        let mut replicates = Replicates::new(pixels);
+        for r in 0..REPLICATES {
+            let sums = pair(&format!("replicate{r}.sum"))?;
+            let (hi, lo) =
+                (channel(format!("replicate{r}.count.hi"))?, channel(format!("replicate{r}.count.lo"))?);
+            for p in 0..pixels {
+                replicates.sum[p * REPLICATES + r] = sums[p];
+                replicates.count[p * REPLICATES + r] = join(hi[p], lo[p]);
+            }
+        }
+        if replicates.sum.iter().flatten().any(|v| !v.is_finite()) {
+            return Err("the replicate statistics hold a NaN or infinite sum: the file is corrupt".into());
+        }
+        // Each pixel's replicates hold its samples, no more and no fewer.
+        for (p, (counts, &n)) in replicates.count.chunks_exact(REPLICATES).zip(&count).enumerate() {
+            let total: u64 = counts.iter().sum();
+            if total != n {
+                return Err(format!(
+                    "pixel {p}'s replicates hold {total} samples but its count is {n}: the file is corrupt"
+                ));
+            }
+        }
+        Some(replicates)
+    } else {
+        None
+    };
+    let mut accumulator = Accumulator::from_state(width, height, sum, sum_sq, count, dropped)?;
+    accumulator.set_replicates(replicates)?;
+    Ok(accumulator)
 }
 
 /// Checks that the per-pixel sample counts are what `spp_done` complete passes and a pass

@@ -595,6 +595,7 @@ impl CausticTracer {
         accumulator: &mut Accumulator,
         k: usize,
         first_pixel: usize,
+        chunk_start: u64,
         camera: &[[f32; 4]],
     ) {
         let pass = self.pass.as_ref().filter(|p| p.complete()).expect("prepare_pass before fold");
@@ -603,6 +604,7 @@ impl CausticTracer {
         let range = k * self.pixels + first_pixel..k * self.pixels + first_pixel + camera.len();
         accumulator.fold_independent(
             first_pixel,
+            chunk_start,
             camera,
             &pass.sum[range.clone()],
             &pass.sum_sq[range],

@@ -117,7 +117,9 @@ impl PathTracer {
                     self.bands.planner.plan(camera.width, self.pipeline.active_height(start), remaining);
                 let mut plan =
                     self.fit(PassPlan { rows: self.pipeline.spread_rows(planned.rows, start), ..planned });
-                if self.bands.chunk_aligned {
+                // Replicates (low-discrepancy) need every chunk inside one replicate's run, so
+                // their passes are always aligned (replicates.rs).
+                if self.bands.chunk_aligned || self.accumulation.accumulator.replicates().is_some() {
                     let chunk = self.bands.chunk_samples;
                     plan = align_pass(plan, start, remaining, chunk);
                     if start.is_multiple_of(chunk.max(1)) {
@@ -164,7 +166,10 @@ impl PathTracer {
             use crate::accumulator::{ALIGNED_COPY_BYTES_PER_PIXEL, RENDER_HOST_BYTES_PER_PIXEL};
             let accumulator = &accumulation.accumulator;
             let pixels = u64::from(accumulator.width) * u64::from(accumulator.height);
-            let peak = pixels * (RENDER_HOST_BYTES_PER_PIXEL + ALIGNED_COPY_BYTES_PER_PIXEL);
+            // Replicates (low-discrepancy): in the statistics and the copy, each with its EXR layer.
+            let replicates =
+                accumulator.replicates().map_or(0, |_| 4 * crate::replicates::Replicates::BYTES_PER_PIXEL);
+            let peak = pixels * (RENDER_HOST_BYTES_PER_PIXEL + ALIGNED_COPY_BYTES_PER_PIXEL + replicates);
             crate::accumulator::available_host_memory().is_none_or(|available| peak <= available / 5 * 4)
         };
         let kept = (!end.is_multiple_of(self.bands.chunk_samples.max(1)) && copy_fits())

@@ -380,9 +380,10 @@ impl PathTracer {
         for k in 0..chunks as usize {
             let range = k * band_pixels..(k + 1) * band_pixels;
             let first_pixel = row_offset as usize * width as usize;
-            accumulator.fold(first_pixel, &sums[range.clone()], &sums_sq[range.clone()]);
+            let chunk_start = u64::from(sample_start) + k as u64 * u64::from(chunk);
+            accumulator.fold_chunk(first_pixel, chunk_start, &sums[range.clone()], &sums_sq[range.clone()]);
             if let Some(caustic) = &self.pipeline.caustic {
-                caustic.fold(accumulator, k, first_pixel, &sums[range]);
+                caustic.fold(accumulator, k, first_pixel, chunk_start, &sums[range]);
             }
         }
         // The display pass added the camera's samples only: show the accumulator's image.

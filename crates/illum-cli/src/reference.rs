@@ -1,0 +1,85 @@
+//! `--reference FILE.exr` for the rasterizer and the Whitted ray tracer: where a truth is at
+//! hand (a converged path-traced EXR of the same scene), their EXRs get its signed difference,
+//! image minus reference per pixel and channel, as the f32 layer [`DIFFERENCE_LAYER`]. These
+//! renderers have no noise but a bias; the layer shows where it is.
+//!
+//! The reference must be an illum render of the same scene content (`illum.scene_hash`, which
+//! covers the camera, materials, objects and lights but no settings) and of the same size; either
+//! mismatch is refused before anything is rendered, naming both sides.
+
+use std::path::Path;
+
+use anyhow::bail;
+use illum_image::{ExrMetadata, F32Layer, RgbImage32, load_exr};
+use illum_scene::Scene;
+
+/// The EXR layer of the signed difference from the reference (channels R, G, B).
+pub const DIFFERENCE_LAYER: &str = "illum.difference";
+
+/// Reads the reference at `path` and checks that it is of `scene` (by content hash) and of the
+/// scene's camera size.
+pub fn load_reference(path: &Path, scene: &Scene) -> anyhow::Result<RgbImage32> {
+    let (image, attributes) =
+        load_exr(path).map_err(|e| anyhow::anyhow!("--reference {}: {e}", path.display()))?;
+    let metadata = ExrMetadata::from_attributes(path, &attributes)?;
+    let Some(hash) = metadata.as_ref().and_then(|m| m.get("scene_hash")) else {
+        bail!(
+            "--reference {}: the file has no illum.scene_hash, so it cannot be told to be of scene {:?}; \
+             give a path-traced EXR that `render` wrote",
+            path.display(),
+            scene.name
+        );
+    };
+    let ours = illum_pathtrace::metadata::scene_hash(scene);
+    if hash != ours {
+        let theirs = metadata.as_ref().map_or("?", |m| m.scene.as_str());
+        bail!(
+            "--reference {}: it is of scene {theirs:?} (illum.scene_hash {hash}), but this render is of scene {:?} \
+             (illum.scene_hash {ours}): a reference must show the same camera, materials, objects and lights",
+            path.display(),
+            scene.name
+        );
+    }
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    if (image.width, image.height) != (w, h) {
+        bail!(
+            "--reference {}: it is {} x {} pixels, but this render is {w} x {h}: give --width {} --height {} or a \
+             reference of this size",
+            path.display(),
+            image.width,
+            image.height,
+            image.width,
+            image.height
+        );
+    }
+    Ok(image)
+}
+
+/// The signed difference `image - reference` (same size), as the [`DIFFERENCE_LAYER`].
+pub fn difference_layer(image: &RgbImage32, reference: &RgbImage32) -> F32Layer {
+    let channel = |c: usize| -> Vec<f32> {
+        image.pixels.iter().zip(&reference.pixels).map(|(a, r)| a[c] - r[c]).collect()
+    };
+    F32Layer {
+        name: DIFFERENCE_LAYER.to_owned(),
+        channels: ["R", "G", "B"].iter().enumerate().map(|(c, n)| ((*n).to_owned(), channel(c))).collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_difference_is_image_minus_reference_per_channel() {
+        let mut a = RgbImage32::new(2, 1);
+        a.pixels = vec![[1.0, 2.0, 3.0], [0.5, 0.5, 0.5]];
+        let mut r = RgbImage32::new(2, 1);
+        r.pixels = vec![[1.5, 2.0, 1.0], [0.0, 1.0, 0.25]];
+        let layer = difference_layer(&a, &r);
+        assert_eq!(layer.name, DIFFERENCE_LAYER);
+        assert_eq!(layer.channels[0], ("R".to_owned(), vec![-0.5, 0.5]));
+        assert_eq!(layer.channels[1], ("G".to_owned(), vec![0.0, -0.5]));
+        assert_eq!(layer.channels[2], ("B".to_owned(), vec![2.0, 0.25]));
+    }
+}
