@@ -19,7 +19,8 @@ pub const OIDN_BUILT: bool = cfg!(feature = "oidn");
 
 pub enum Denoiser {
     Atrous {
-        filter: AtrousDenoiser,
+        /// Boxed: the filter's pipelines are large beside OIDN's device handle.
+        filter: Box<AtrousDenoiser>,
         settings: AtrousSettings,
     },
     #[cfg(feature = "oidn")]
@@ -31,7 +32,7 @@ impl Denoiser {
     pub fn new(gpu: &GpuContext, kind: DenoiserKind) -> Result<Self, DenoiseError> {
         match kind {
             DenoiserKind::Atrous => Ok(Denoiser::Atrous {
-                filter: AtrousDenoiser::new(gpu)?,
+                filter: Box::new(AtrousDenoiser::new(gpu)?),
                 settings: AtrousSettings::default(),
             }),
             #[cfg(feature = "oidn")]

@@ -32,7 +32,7 @@ impl OidnDenoiser {
         let flat = |pixels: &[[f32; 3]]| pixels.iter().flatten().copied().collect::<Vec<f32>>();
         let color = flat(&input.image.pixels);
         let mut output = vec![0.0f32; color.len()];
-        let mut filter = oidn::RayTracing::new(&self.device);
+        let mut filter = oidn::RayTracing::try_new(&self.device).map_err(|e| failed("no RT filter", e))?;
         filter
             .image_dimensions(input.width() as usize, input.height() as usize)
             .hdr(true)

@@ -94,7 +94,7 @@ fn a_furnace_flat_region_keeps_its_mean() {
 }
 
 /// A region of the Cornell box for the bias table: its name and its pixels.
-fn regions(albedo: &[[f32; 3]], normal: &[[f32; 3]]) -> Vec<(&'static str, Vec<usize>)> {
+pub(crate) fn regions(albedo: &[[f32; 3]], normal: &[[f32; 3]]) -> Vec<(&'static str, Vec<usize>)> {
     let size = common::SIZE as usize;
     let edge = |p: usize| {
         let (x, y) = (p % size, p / size);
