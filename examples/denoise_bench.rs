@@ -1,6 +1,7 @@
-//! What denoising costs on this machine: the à-trous filter alone and the guide pass, per
-//! megapixel, at a few image sizes (median of `--runs` after a warm-up), beside the path
-//! tracer's own time per sample per pixel at that size.
+//! What denoising costs on this machine: the à-trous filter alone, Open Image Denoise's RT
+//! filter on the CPU (in builds with `--features illum-denoise/oidn`; "-" otherwise) and the
+//! guide pass, per megapixel, at a few image sizes (median of `--runs` after a warm-up), beside
+//! the path tracer's own time per sample per pixel at that size.
 //!
 //! ```text
 //! cargo run --release --example denoise_bench -- [SCENE] [--sizes 256,512,1024] [--runs 5]
@@ -13,7 +14,7 @@ use clap::Parser;
 use illum::image::median;
 use illum::pathtrace::{GUIDE_SAMPLES, PathTracer};
 use illum::scene::{Overrides, Scene};
-use illum_denoise::{AtrousDenoiser, AtrousSettings, DenoiseInput};
+use illum_denoise::{AtrousDenoiser, AtrousSettings, DenoiseInput, Denoiser, DenoiserKind};
 
 #[derive(Parser, Debug)]
 #[command(about = "The à-trous denoiser's and the guide pass's cost in ms per megapixel")]
@@ -36,11 +37,18 @@ fn run(args: Args) -> anyhow::Result<()> {
     let gpu = illum_cli::gpu()?;
     let filter = AtrousDenoiser::new(&gpu)?;
     let settings = AtrousSettings::default();
+    let oidn = match Denoiser::new(&gpu, DenoiserKind::Oidn) {
+        Ok(oidn) => Some(oidn),
+        Err(e) => {
+            println!("no OIDN column: {e}");
+            None
+        }
+    };
     println!("{} on {}; à-trous {settings:?}", args.scene.display(), gpu.adapter_info.name);
     println!(
-        "| size | filter ms | filter ms/Mpixel | guides ({GUIDE_SAMPLES} spp) ms/Mpixel | path tracing ms/Mpixel per spp |"
+        "| size | à-trous ms | à-trous ms/Mpixel | OIDN ms/Mpixel | guides ({GUIDE_SAMPLES} spp) ms/Mpixel | path tracing ms/Mpixel per spp |"
     );
-    println!("|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|");
     for &size in &args.sizes {
         let mut scene = Scene::load(&illum_cli::resolve_scene_path(&args.scene))?;
         let overrides =
@@ -74,8 +82,18 @@ fn run(args: Args) -> anyhow::Result<()> {
             Ok(())
         })?;
         let mp = f64::from(size) * f64::from(size) / 1e6;
+        let oidn_ms = match &oidn {
+            Some(oidn) => format!(
+                "{:.0}",
+                time(&mut || {
+                    oidn.denoise(&input)?;
+                    Ok(())
+                })? / mp
+            ),
+            None => "-".to_owned(),
+        };
         println!(
-            "| {size} x {size} | {filter_ms:.1} | {:.0} | {:.0} | {:.0} |",
+            "| {size} x {size} | {filter_ms:.1} | {:.0} | {oidn_ms} | {:.0} | {:.0} |",
             filter_ms / mp,
             guides_ms / mp,
             trace_ms / mp

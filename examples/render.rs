@@ -150,7 +150,8 @@ struct Args {
     #[arg(long, value_name = "A..B", value_parser = illum_cli::sample_range_arg)]
     sample_range: Option<std::ops::Range<u32>>,
     /// Path-tracer scenes: denoise the image (`atrous`: the edge-avoiding à-trous filter on the
-    /// GPU; `oidn`: Intel Open Image Denoise, not in this build). The render is kept as two
+    /// GPU; `oidn`: Intel Open Image Denoise's RT filter on the CPU, only in builds with
+    /// `--features illum-denoise/oidn`, docs/denoising.md). The render is kept as two
     /// independent halves, and the denoised image's error is estimated from them
     /// (docs/denoising.md): it is the `illum.estimated_relative_error` written and the one
     /// --target-error stops at. The EXR holds the denoised image, and layers `noisy`, `albedo`

@@ -11,9 +11,9 @@ use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
+use illum_denoise::Denoiser;
 pub use illum_denoise::DenoiserKind;
 use illum_denoise::split::{Denoised, SplitRender};
-use illum_denoise::{AtrousDenoiser, AtrousSettings};
 use illum_gpu::GpuContext;
 use illum_image::{Encoding, Exposure, F32Layer, RgbImage32, save_exr_with_f32_layers, save_png};
 use illum_pathtrace::{Status, StopReason, StopRules, TracerOptions};
@@ -39,14 +39,8 @@ pub struct DenoiseRequest<'a> {
 /// relative error. `Ok(None)` when cancelled before the first round ended (nothing written).
 pub fn render_denoised(request: &DenoiseRequest) -> anyhow::Result<Option<(StopReason, f64)>> {
     let DenoiseRequest { gpu, scene, options, rules, denoiser, cancel, outputs, .. } = request;
-    if *denoiser == DenoiserKind::Oidn {
-        anyhow::bail!(
-            "--denoise oidn: this build has no Open Image Denoise (it is not part of illum yet); use --denoise atrous"
-        );
-    }
     let clock = Instant::now();
-    let filter = AtrousDenoiser::new(gpu)?;
-    let settings = AtrousSettings::default();
+    let filter = Denoiser::new(gpu, *denoiser).map_err(|e| anyhow::anyhow!("--denoise {denoiser}: {e}"))?;
     let mut split = SplitRender::new(gpu, scene, *options)?;
     let half_target = rules.spp.map(|spp| spp.div_ceil(2).max(1));
     // Rounds are for the error and time rules; an spp target alone is one round.
@@ -60,7 +54,7 @@ pub fn render_denoised(request: &DenoiseRequest) -> anyhow::Result<Option<(StopR
         if !split.advance(target, cancel)? {
             break StopReason::Cancelled;
         }
-        let denoised = split.denoise(&filter, &settings)?;
+        let denoised = split.denoise(&filter)?;
         let error = denoised.estimate.relative_error();
         let status = Status {
             spp_done: split.spp_done(),

@@ -6,17 +6,23 @@
 //!   `PathTracer::guides`).
 //! - [`atrous`]: the edge-avoiding à-trous wavelet filter on the GPU (`shaders/atrous.wgsl`).
 //! - [`reference`]: its f64 CPU copy, which the GPU output is tested against pixel by pixel.
+//! - `oidn` (cargo feature `oidn`): Intel Open Image Denoise's RT filter on the CPU.
+//! - [`denoiser`]: either of them behind one call ([`Denoiser`]).
 //! - [`estimate`]: the denoised image's error from two independent halves of the samples.
 //! - [`split`]: a render kept as those two halves, on two path tracers.
 
 pub mod atrous;
+pub mod denoiser;
 mod error;
 pub mod estimate;
 pub mod input;
+#[cfg(feature = "oidn")]
+pub mod oidn;
 pub mod reference;
 pub mod split;
 
 pub use atrous::{ATROUS_SHADER, AtrousDenoiser, AtrousSettings};
+pub use denoiser::{Denoiser, OIDN_BUILT};
 pub use error::DenoiseError;
 pub use estimate::{HalvesError, halves_rel_mse};
 pub use input::DenoiseInput;
@@ -27,7 +33,7 @@ pub use split::SplitRender;
 pub enum DenoiserKind {
     /// The edge-avoiding à-trous filter ([`atrous`]): runs wherever illum runs.
     Atrous,
-    /// Intel Open Image Denoise (cargo feature `oidn`).
+    /// Intel Open Image Denoise's RT filter (only in builds with the cargo feature `oidn`).
     Oidn,
 }
 

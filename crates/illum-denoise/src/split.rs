@@ -11,7 +11,7 @@ use illum_pathtrace::{Accumulator, GUIDE_SAMPLES, Guides, PathTracer, TracerOpti
 use illum_scene::Scene;
 
 use crate::DenoiseError;
-use crate::atrous::{AtrousDenoiser, AtrousSettings};
+use crate::denoiser::Denoiser;
 use crate::estimate::HalvesError;
 use crate::input::DenoiseInput;
 
@@ -72,12 +72,8 @@ impl SplitRender {
         whole
     }
 
-    /// Denoises both halves and the whole with the à-trous filter, and estimates the error.
-    pub fn denoise(
-        &self,
-        filter: &AtrousDenoiser,
-        settings: &AtrousSettings,
-    ) -> Result<Denoised, DenoiseError> {
+    /// Denoises both halves and the whole with `filter`, and estimates the error.
+    pub fn denoise(&self, filter: &Denoiser) -> Result<Denoised, DenoiseError> {
         let clock = std::time::Instant::now();
         // The most samples the guides take (the first half's first GUIDE_SAMPLES sample indices,
         // rendered or not): a guide's noise only blurs less, and the pass is cheap.
@@ -85,10 +81,10 @@ impl SplitRender {
         let guide_seconds = clock.elapsed().as_secs_f64();
         let clock = std::time::Instant::now();
         let (a, b) = (self.a.accumulator(), self.b.accumulator());
-        let (da, _) = filter.denoise(&DenoiseInput::from_render(a, &guides), settings)?;
-        let (db, _) = filter.denoise(&DenoiseInput::from_render(b, &guides), settings)?;
+        let da = filter.denoise(&DenoiseInput::from_render(a, &guides))?;
+        let db = filter.denoise(&DenoiseInput::from_render(b, &guides))?;
         let raw = self.merged();
-        let (image, _) = filter.denoise(&DenoiseInput::from_render(&raw, &guides), settings)?;
+        let image = filter.denoise(&DenoiseInput::from_render(&raw, &guides))?;
         let filter_seconds = clock.elapsed().as_secs_f64();
         let estimate = HalvesError::new(
             (&a.mean_image(), &a.variance_image(), &da),

@@ -5,7 +5,7 @@
 use std::sync::atomic::AtomicBool;
 
 use illum_denoise::input::luminance_variance;
-use illum_denoise::{AtrousDenoiser, AtrousSettings, DenoiseInput, SplitRender};
+use illum_denoise::{AtrousDenoiser, AtrousSettings, DenoiseInput, Denoiser, DenoiserKind, SplitRender};
 use illum_image::{RgbImage32, luminance};
 use illum_pathtrace::TracerOptions;
 use illum_scene::Scene;
@@ -94,7 +94,7 @@ fn a_furnace_flat_region_keeps_its_mean() {
 }
 
 /// A region of the Cornell box for the bias table: its name and its pixels.
-fn regions(albedo: &[[f32; 3]], normal: &[[f32; 3]]) -> Vec<(&'static str, Vec<usize>)> {
+pub(crate) fn regions(albedo: &[[f32; 3]], normal: &[[f32; 3]]) -> Vec<(&'static str, Vec<usize>)> {
     let size = common::SIZE as usize;
     let edge = |p: usize| {
         let (x, y) = (p % size, p / size);
@@ -173,8 +173,7 @@ fn at_16_spp_the_atrous_error_is_2_5_times_lower() {
 #[test]
 fn the_halves_estimate_tracks_the_true_error() {
     let (reference, reference_variance) = common::reference();
-    let filter = filter();
-    let settings = AtrousSettings::default();
+    let filter = Denoiser::new(common::gpu(), DenoiserKind::Atrous).expect("compiles");
     let cancel = AtomicBool::new(false);
     let mut split = SplitRender::new(common::gpu(), &common::cornell(1, 11), TracerOptions::default())
         .expect("two tracers");
@@ -182,13 +181,13 @@ fn the_halves_estimate_tracks_the_true_error() {
     println!("|---|---|---|---|---|---|");
     let mut worst: f64 = 1.0;
     assert!(split.advance(1, &cancel).expect("renders"));
-    let unknown = split.denoise(&filter, &settings).expect("denoises").estimate;
+    let unknown = split.denoise(&filter).expect("denoises").estimate;
     assert!(unknown.rel_mse.is_infinite(), "one sample per half: {unknown:?}");
     for spp in [4u32, 8, 16, 32, 64, 128, 256, 512, 1024] {
         assert!(split.advance(spp / 2, &cancel).expect("renders"));
-        let result = split.denoise(&filter, &settings).expect("denoises");
-        let (half, _) = filter
-            .denoise(&DenoiseInput::from_render(split.a.accumulator(), &result.guides), &settings)
+        let result = split.denoise(&filter).expect("denoises");
+        let half = filter
+            .denoise(&DenoiseInput::from_render(split.a.accumulator(), &result.guides))
             .expect("denoises");
         let half_true = common::true_rel_mse(&half, &reference, &reference_variance);
         let whole_true = common::true_rel_mse(&result.image, &reference, &reference_variance);
