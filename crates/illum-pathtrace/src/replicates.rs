@@ -9,7 +9,9 @@
 //! each unbiased, and the pixel's mean is their average; its variance is estimated without
 //! assuming anything about the sequence by
 //!
-//!     Var(mean) = sum_r (m_r - m)^2 / (R (R - 1)),
+//! ```text
+//! Var(mean) = sum_r (m_r - m)^2 / (R (R - 1)),
+//! ```
 //!
 //! unbiased for equal counts. With unequal counts n_r (a render whose spp is not a multiple of
 //! R x REPLICATE_RUN, or dropped NaN samples) the mean is sum_r n_r m_r / N, and the same
