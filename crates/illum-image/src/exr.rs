@@ -376,20 +376,32 @@ pub fn load_u32_layer(path: impl AsRef<Path>, name: &str) -> Result<Option<U32La
     Ok(load_u32_layers(path, &[name])?.pop().flatten())
 }
 
-/// [`load_u32_layer`] for several layers in one read of the file: one entry per name, in the
-/// order of `names`.
-pub fn load_u32_layers(path: impl AsRef<Path>, names: &[&str]) -> Result<Vec<Option<U32Layer>>, ImageError> {
-    use exr::prelude::{FlatSamples, ReadLayers as _};
-    let path = path.as_ref();
+/// Every layer of the EXR file at `path`, with all channels and attributes (the layer loaders'
+/// one read).
+fn read_all_layers(
+    path: &Path,
+) -> Result<
+    exr::prelude::Image<exr::prelude::Layers<exr::prelude::AnyChannels<exr::prelude::FlatSamples>>>,
+    ImageError,
+> {
+    use exr::prelude::ReadLayers as _;
     let file = File::open(path).map_err(|e| ImageError::io(path, "opening the EXR file", e))?;
-    let image = exr::prelude::read()
+    exr::prelude::read()
         .no_deep_data()
         .largest_resolution_level()
         .all_channels()
         .all_layers()
         .all_attributes()
         .from_buffered(BufReader::new(file))
-        .map_err(|e| ImageError::Decode { path: path.to_path_buf(), format: "EXR", source: Box::new(e) })?;
+        .map_err(|e| ImageError::Decode { path: path.to_path_buf(), format: "EXR", source: Box::new(e) })
+}
+
+/// [`load_u32_layer`] for several layers in one read of the file: one entry per name, in the
+/// order of `names`.
+pub fn load_u32_layers(path: impl AsRef<Path>, names: &[&str]) -> Result<Vec<Option<U32Layer>>, ImageError> {
+    use exr::prelude::FlatSamples;
+    let path = path.as_ref();
+    let image = read_all_layers(path)?;
     let mut found: Vec<Option<U32Layer>> = names.iter().map(|_| None).collect();
     // Moved out, not copied: a merge holds one part's statistics at a time, and a copy would
     // double them (56 bytes per pixel).
@@ -423,17 +435,9 @@ pub fn load_u32_layers(path: impl AsRef<Path>, names: &[&str]) -> Result<Vec<Opt
 /// `Ok(None)` when the file has no such layer; an error for an unreadable file or a channel of
 /// another sample type.
 pub fn load_f32_layer(path: impl AsRef<Path>, name: &str) -> Result<Option<F32Layer>, ImageError> {
-    use exr::prelude::{FlatSamples, ReadLayers as _};
+    use exr::prelude::FlatSamples;
     let path = path.as_ref();
-    let file = File::open(path).map_err(|e| ImageError::io(path, "opening the EXR file", e))?;
-    let image = exr::prelude::read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .all_layers()
-        .all_attributes()
-        .from_buffered(BufReader::new(file))
-        .map_err(|e| ImageError::Decode { path: path.to_path_buf(), format: "EXR", source: Box::new(e) })?;
+    let image = read_all_layers(path)?;
     for layer in image.layer_data {
         if layer.attributes.layer_name.as_ref().map(string).as_deref() != Some(name) {
             continue;
