@@ -22,35 +22,13 @@ pub fn load_reference(path: &Path, scene: &Scene) -> anyhow::Result<RgbImage32> 
     let (image, attributes) =
         load_exr(path).map_err(|e| anyhow::anyhow!("--reference {}: {e}", path.display()))?;
     let metadata = ExrMetadata::from_attributes(path, &attributes)?;
-    let Some(hash) = metadata.as_ref().and_then(|m| m.get("scene_hash")) else {
-        bail!(
-            "--reference {}: the file has no illum.scene_hash, so it cannot be told to be of scene {:?}; \
-             give a path-traced EXR that `render` wrote",
-            path.display(),
-            scene.name
-        );
-    };
-    let ours = illum_pathtrace::metadata::scene_hash(scene);
-    if hash != ours {
-        let theirs = metadata.as_ref().map_or("?", |m| m.scene.as_str());
-        bail!(
-            "--reference {}: it is of scene {theirs:?} (illum.scene_hash {hash}), but this render is of scene {:?} \
-             (illum.scene_hash {ours}): a reference must show the same camera, materials, objects and lights",
-            path.display(),
-            scene.name
-        );
-    }
-    let (w, h) = (scene.camera.width, scene.camera.height);
-    if (image.width, image.height) != (w, h) {
-        bail!(
-            "--reference {}: it is {} x {} pixels, but this render is {w} x {h}: give --width {} --height {} or a \
-             reference of this size",
-            path.display(),
-            image.width,
-            image.height,
-            image.width,
-            image.height
-        );
+    let advice =
+        format!("give --width {} --height {} or a reference of this size", image.width, image.height);
+    let size = [image.width, image.height];
+    if let Some(why) =
+        illum_pathtrace::metadata::reference_refusal(path, metadata.as_ref(), size, scene, &advice)
+    {
+        bail!("{why}");
     }
     Ok(image)
 }

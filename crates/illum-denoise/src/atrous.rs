@@ -1,10 +1,13 @@
 //! The edge-avoiding à-trous wavelet filter on the GPU (`shaders/atrous.wgsl` has the
 //! formula): `iterations` dispatches of a 5 x 5 kernel whose taps spread 1, 2, 4, ... pixels,
-//! ping-ponging between two storage buffers, in one submission.
+//! ping-ponging between two storage buffers, in one submission. Read back either waiting
+//! ([`AtrousDenoiser::denoise`], native) or polled over later frames
+//! ([`AtrousDenoiser::start`], the viewer, which must not wait in a web page).
 
 use illum_gpu::buffers::{buffer_bind_group, dispatch};
 #[cfg(not(target_arch = "wasm32"))]
 use illum_gpu::readback;
+use illum_gpu::readback::PendingRead;
 use illum_gpu::shader::{self, ShaderFile};
 use illum_gpu::{GpuContext, GpuError, shader_file, wgpu};
 use illum_image::RgbImage32;
@@ -89,6 +92,45 @@ impl AtrousDenoiser {
         input: &DenoiseInput,
         settings: &AtrousSettings,
     ) -> Result<(RgbImage32, Vec<f32>), DenoiseError> {
+        let (result, bytes) = self.submit(input, settings)?;
+        let bytes = readback::read_buffer(&self.gpu, &result, 0, bytes, "reading back the denoised image")?;
+        Ok(decode(input.width(), input.height(), &bytes))
+    }
+
+    /// [`Self::denoise`] without waiting: submits the filter and a copy of its result into a
+    /// mappable buffer, whose readback [`PendingDenoise::poll`] collects on later frames.
+    pub fn start(
+        &self,
+        input: &DenoiseInput,
+        settings: &AtrousSettings,
+    ) -> Result<PendingDenoise, DenoiseError> {
+        let (result, bytes) = self.submit(input, settings)?;
+        let gpu = &self.gpu;
+        let staging = gpu.scoped("allocating the denoiser's readback buffer", || {
+            gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("à-trous readback"),
+                size: bytes,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        })?;
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(&result, 0, &staging, 0, bytes);
+        gpu.queue.submit([encoder.finish()]);
+        Ok(PendingDenoise {
+            width: input.width(),
+            height: input.height(),
+            read: PendingRead::start(staging, bytes, "reading back the denoised image"),
+        })
+    }
+
+    /// Encodes and submits the filter's iterations; returns the buffer holding the result
+    /// (RGB and the luminance variance per pixel) and its size in bytes.
+    fn submit(
+        &self,
+        input: &DenoiseInput,
+        settings: &AtrousSettings,
+    ) -> Result<(wgpu::Buffer, u64), DenoiseError> {
         let (gpu, device) = (&self.gpu, &self.gpu.device);
         let (width, height) = (input.width(), input.height());
         let pixels = width as usize * height as usize;
@@ -158,18 +200,35 @@ impl AtrousDenoiser {
             dispatch(&mut encoder, "à-trous iteration", &self.pipeline, &bind_group, groups);
         }
         gpu.queue.submit([encoder.finish()]);
-        let result = if iterations % 2 == 1 { &pong } else { &ping };
-        let bytes = readback::read_buffer(gpu, result, 0, bytes, "reading back the denoised image")?;
-        let values: Vec<f32> =
-            bytes.chunks_exact(4).map(|b| f32::from_le_bytes(b.try_into().expect("4 bytes"))).collect();
-        let image = RgbImage32 {
-            width,
-            height,
-            pixels: values.chunks_exact(4).map(|v| [v[0], v[1], v[2]]).collect(),
-        };
-        let variance = values.chunks_exact(4).map(|v| v[3]).collect();
-        Ok((image, variance))
+        let result = if iterations % 2 == 1 { pong } else { ping };
+        Ok((result, bytes))
     }
+}
+
+/// A denoised image being read back without waiting ([`AtrousDenoiser::start`]).
+pub struct PendingDenoise {
+    width: u32,
+    height: u32,
+    read: PendingRead,
+}
+
+impl PendingDenoise {
+    /// `None` while the readback is under way, then the filtered image and the variance of each
+    /// pixel's luminance after the filter, or the mapping's error. Never waits.
+    pub fn poll(&self, gpu: &GpuContext) -> Option<Result<(RgbImage32, Vec<f32>), DenoiseError>> {
+        Some(self.read.poll(gpu)?.map(|bytes| decode(self.width, self.height, &bytes)).map_err(Into::into))
+    }
+}
+
+/// The filter's output buffer (RGB and luminance variance per pixel, f32) as an image and the
+/// variances.
+fn decode(width: u32, height: u32, bytes: &[u8]) -> (RgbImage32, Vec<f32>) {
+    let values: Vec<f32> =
+        bytes.chunks_exact(4).map(|b| f32::from_le_bytes(b.try_into().expect("4 bytes"))).collect();
+    let image =
+        RgbImage32 { width, height, pixels: values.chunks_exact(4).map(|v| [v[0], v[1], v[2]]).collect() };
+    let variance = values.chunks_exact(4).map(|v| v[3]).collect();
+    (image, variance)
 }
 
 #[cfg(test)]

@@ -3,9 +3,11 @@
 //! the cargo feature `oidn`; without it, asking for it is an error that says how to build it.
 
 use illum_gpu::GpuContext;
+#[cfg(not(target_arch = "wasm32"))]
 use illum_image::RgbImage32;
 
 use crate::atrous::{AtrousDenoiser, AtrousSettings};
+#[cfg(not(target_arch = "wasm32"))]
 use crate::input::DenoiseInput;
 use crate::{DenoiseError, DenoiserKind};
 
@@ -50,7 +52,8 @@ impl Denoiser {
         }
     }
 
-    /// The denoised image of `input`.
+    /// The denoised image of `input`. Waits for the GPU: native only.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn denoise(&self, input: &DenoiseInput) -> Result<RgbImage32, DenoiseError> {
         match self {
             Denoiser::Atrous { filter, settings } => Ok(filter.denoise(input, settings)?.0),

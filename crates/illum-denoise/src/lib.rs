@@ -19,13 +19,16 @@ pub mod input;
 #[cfg(feature = "oidn")]
 pub mod oidn;
 pub mod reference;
+// Waits for the GPU: native only (a web page polls instead).
+#[cfg(not(target_arch = "wasm32"))]
 pub mod split;
 
-pub use atrous::{ATROUS_SHADER, AtrousDenoiser, AtrousSettings};
+pub use atrous::{ATROUS_SHADER, AtrousDenoiser, AtrousSettings, PendingDenoise};
 pub use denoiser::{Denoiser, OIDN_BUILT};
 pub use error::DenoiseError;
 pub use estimate::{HalvesError, halves_rel_mse};
 pub use input::DenoiseInput;
+#[cfg(not(target_arch = "wasm32"))]
 pub use split::SplitRender;
 
 /// The denoisers `render --denoise` knows.

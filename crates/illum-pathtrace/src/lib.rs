@@ -49,5 +49,6 @@ pub use shaders::{
     shader_modules,
 };
 pub use tracer::{
-    CausticParams, GUIDE_SAMPLES, Guides, PathTracer, Readback, StepReport, bounding_sphere, fixed_point,
+    CausticParams, GUIDE_SAMPLES, Guides, PathTracer, PendingGuides, Readback, StepReport, bounding_sphere,
+    fixed_point,
 };

@@ -480,7 +480,8 @@ impl ViewerApp {
                 m.texture()
             }),
             RendererKind::Whitted => {
-                self.whitted.as_mut().ok().and_then(|m| m.frame(gpu, ui.ctx(), view_pixels))
+                let truth = self.pathtrace.as_ref().ok().and_then(PathTraceMode::truth);
+                self.whitted.as_mut().ok().and_then(|m| m.frame(gpu, ui.ctx(), view_pixels, truth))
             }
         };
         let sense = egui::Sense::click_and_drag();

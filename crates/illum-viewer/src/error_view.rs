@@ -6,6 +6,9 @@
 //! colour means the same error in every image and at every spp. A pixel whose error is not
 //! known yet (fewer than two samples, or replicates) shows as [`UNKNOWN`], a blue outside the ramp.
 //!
+//! [`ramp`] and [`colour_map`] are the colour-map code, shared with the difference view
+//! (`difference_view.rs`).
+//!
 //! The map reads the f64 statistics of every pixel, so it is computed on the CPU and uploaded as
 //! an egui texture, and only while the view is on (the image itself never leaves the GPU).
 
@@ -27,20 +30,37 @@ pub fn heat_colour(error: f32) -> [u8; 3] {
     }
     let t =
         ((error.max(LOWEST).log10() - LOWEST.log10()) / (HIGHEST.log10() - LOWEST.log10())).clamp(0.0, 1.0);
-    let x = t * (STOPS.len() - 1) as f32;
-    let i = (x.floor() as usize).min(STOPS.len() - 2);
+    ramp(&STOPS, t)
+}
+
+/// The colour at `t` (0 to 1, clamped) of a ramp through `stops` (at least two, evenly
+/// spaced), interpolated linearly between neighbours. The error view's and the difference
+/// view's colour maps are ramps.
+pub fn ramp(stops: &[[f32; 3]], t: f32) -> [u8; 3] {
+    let x = t.clamp(0.0, 1.0) * (stops.len() - 1) as f32;
+    let i = (x.floor() as usize).min(stops.len() - 2);
     let f = x - i as f32;
-    let (a, b) = (STOPS[i], STOPS[i + 1]);
+    let (a, b) = (stops[i], stops[i + 1]);
     [0, 1, 2].map(|c| (a[c] + (b[c] - a[c]) * f).round() as u8)
+}
+
+/// The image of per-pixel `values` (row-major, `width x height`) through `colour`.
+pub fn colour_map(
+    values: &[f32],
+    width: u32,
+    height: u32,
+    colour: impl Fn(f32) -> [u8; 3],
+) -> egui::ColorImage {
+    let pixels = values.iter().map(|&v| {
+        let [r, g, b] = colour(v);
+        egui::Color32::from_rgb(r, g, b)
+    });
+    egui::ColorImage::new([width as usize, height as usize], pixels.collect())
 }
 
 /// The heat map of per-pixel errors `errors` (row-major, `width x height`).
 pub fn heat_map(errors: &[f32], width: u32, height: u32) -> egui::ColorImage {
-    let pixels = errors.iter().map(|&e| {
-        let [r, g, b] = heat_colour(e);
-        egui::Color32::from_rgb(r, g, b)
-    });
-    egui::ColorImage::new([width as usize, height as usize], pixels.collect())
+    colour_map(errors, width, height, heat_colour)
 }
 
 #[cfg(test)]

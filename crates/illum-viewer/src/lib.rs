@@ -4,6 +4,9 @@
 //! - [`app`]: the application state, the mode switch and the scene field;
 //! - [`pathtrace_panel`] / [`raster_panel`]: each mode's settings, renderer and panel;
 //! - [`camera`]: orbit / pan / zoom with the mouse, shared by both modes;
+//! - [`denoise_view`]: the path tracer's Denoise toggle (the denoised image and its estimated
+//!   error);
+//! - [`difference_view`]: the Whitted mode's signed difference from a truth;
 //! - [`display`]: the path tracer's GPU tone-mapping pass from its display sum (a GPU buffer)
 //!   into the texture egui shows;
 //! - [`gpu_setup`]: how eframe creates the device the renderers share;
@@ -25,6 +28,8 @@ pub mod app;
 pub mod browser;
 pub mod camera;
 pub mod cli;
+pub mod denoise_view;
+pub mod difference_view;
 pub mod display;
 pub mod error_view;
 pub mod frame_rate;

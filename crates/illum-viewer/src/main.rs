@@ -57,7 +57,19 @@ mod native {
         let result = eframe::run_native(
             "illum viewer",
             native,
-            Box::new(|cc| Ok(Box::new(ViewerApp::new(cc, start)))),
+            Box::new(|cc| {
+                let mut app = ViewerApp::new(cc, start);
+                if let Some(pathtrace) = app.pathtrace_mut() {
+                    pathtrace.settings.denoise = args.denoise;
+                }
+                if let Some(whitted) = app.whitted_mut() {
+                    whitted.difference.on = args.difference || args.reference.is_some();
+                    if let Some(path) = &args.reference {
+                        whitted.difference.load_reference(path).map_err(|e| format!("error: {e}"))?;
+                    }
+                }
+                Ok(Box::new(app))
+            }),
         );
         if let Err(e) = result {
             eprintln!("error: the window could not run: {e}");

@@ -27,6 +27,7 @@ use illum_pathtrace::{PathTracer, Progressive, StopReason, StopRules};
 use illum_scene::{Bounces, Sampling, Scene};
 
 use crate::camera::OrbitCamera;
+use crate::denoise_view::DenoiseView;
 use crate::display::Display;
 use crate::pacer::FramePacer;
 
@@ -65,6 +66,8 @@ pub struct PathTraceSettings {
     /// Show the heat map of each pixel's estimated relative error instead of the image
     /// (`error_view.rs`); display only.
     pub error_view: bool,
+    /// Show the accumulation denoised, with its estimated error (`denoise_view.rs`).
+    pub denoise: bool,
     /// When to stop: the `render` example's own rules, set from the panel (`spp`: the spp
     /// target, `None` to keep going). Held as the tracer's type, not a copy of its fields, so
     /// that the panel and the command line cannot drift apart.
@@ -82,6 +85,7 @@ impl PathTraceSettings {
             resolution_scale: DEFAULT_SCALE,
             exposure: 0.0,
             error_view: false,
+            denoise: false,
             stop: StopRules::default(),
         }
     }
@@ -143,6 +147,8 @@ pub struct PathTraceMode {
     /// The error view's texture, the heat map in it and the total samples it shows, while the
     /// view is on.
     error_texture: Option<(egui::TextureHandle, egui::ColorImage, u64)>,
+    /// The Denoise toggle's images and estimates.
+    pub denoise: DenoiseView,
     pub save_path: String,
     /// The last save's outcome or the renderer's last error, shown under the controls.
     pub message: Option<String>,
@@ -169,6 +175,7 @@ impl PathTraceMode {
             shown_samples: 0,
             shown_exposure: 0.0,
             error_texture: None,
+            denoise: DenoiseView::default(),
             save_path: format!("out/viewer-{stem}.png"),
             message: None,
         }
@@ -181,6 +188,7 @@ impl PathTraceMode {
         self.settings.resolution_scale = keep.resolution_scale;
         self.settings.exposure = keep.exposure;
         self.settings.error_view = keep.error_view;
+        self.settings.denoise = keep.denoise;
     }
 
     pub fn scene_path(&self) -> &Path {
@@ -210,7 +218,7 @@ impl PathTraceMode {
         // leaves it (samples/s over that share is the rate while it runs).
         let stepping =
             if st.elapsed_seconds > 0.0 { self.work.step_seconds / st.elapsed_seconds } else { 0.0 };
-        format!(
+        let line = format!(
             "pathtrace: {} x {}, spp done {}, samples/s (wall) {:.3} M, elapsed {:.2} s, estimated error {error}, stepping {:.0}% of the wall time",
             st.width,
             st.height,
@@ -218,7 +226,8 @@ impl PathTraceMode {
             st.samples_per_second / 1e6,
             st.elapsed_seconds,
             100.0 * stepping
-        )
+        );
+        if self.settings.denoise { format!("{line}; {}", self.denoise.statistics()) } else { line }
     }
 
     /// Whether the caustic's light tracer runs in the current render (`None` before a tracer
@@ -261,7 +270,7 @@ impl PathTraceMode {
 
     /// Still has work to do this frame (so the window should keep repainting).
     pub fn is_rendering(&self) -> bool {
-        !self.paused && self.progressive.stopped().is_none()
+        (!self.paused && self.progressive.stopped().is_none()) || self.denoise.is_busy()
     }
 
     /// Wall-clock seconds spent rendering the current accumulation (the clock of the stop
@@ -394,6 +403,14 @@ impl PathTraceMode {
             self.shown_exposure = self.settings.exposure;
         }
         self.refresh_error_view(ctx);
+        if self.settings.denoise
+            && let Some(tracer) = &self.tracer
+        {
+            let stopped = self.paused || self.progressive.stopped().is_some();
+            self.denoise.frame(gpu, ctx, tracer, self.settings.exposure, stopped);
+        } else {
+            self.denoise.clear();
+        }
     }
 
     /// Computes the error view's heat map again when it is on and new samples arrived.
@@ -429,7 +446,11 @@ impl PathTraceMode {
     pub fn texture(&self) -> Option<egui::TextureId> {
         match &self.error_texture {
             Some((handle, _, _)) => Some(handle.id()),
-            None => self.display.as_ref().and_then(Display::texture_id),
+            None => self
+                .denoise
+                .texture()
+                .filter(|_| self.settings.denoise)
+                .or_else(|| self.display.as_ref().and_then(Display::texture_id)),
         }
     }
 
@@ -437,6 +458,16 @@ impl PathTraceMode {
     /// (tests read it).
     pub fn error_view(&self) -> Option<(&egui::ColorImage, u64)> {
         self.error_texture.as_ref().map(|(_, image, total)| (image, *total))
+    }
+
+    /// The accumulation as a truth for the other modes' Difference view, once it exists.
+    pub fn truth(&self) -> Option<crate::difference_view::PathTracerTruth<'_>> {
+        let tracer = self.tracer.as_ref()?;
+        Some(crate::difference_view::PathTracerTruth {
+            scene: tracer.scene(),
+            accumulator: tracer.accumulator(),
+            spp: tracer.spp_done(),
+        })
     }
 
     /// The tracer's statistics, once it exists.
@@ -501,13 +532,19 @@ impl PathTraceMode {
         if path.as_os_str().is_empty() || path.file_stem().is_none() {
             return Err(format!("{:?} is not a file name", self.save_path));
         }
+        // With Denoise on, the PNG is the denoised image shown; the EXR stays the raw samples'
+        // checkpoint (which `render --resume` continues) and records the denoised estimate.
+        let denoised = self.denoise.image().filter(|_| self.settings.denoise);
+        let denoise_fields = crate::denoise_view::exr_fields(&self.denoise).filter(|_| self.settings.denoise);
         let metadata = || {
-            illum_pathtrace::metadata::exr_metadata(
+            let mut metadata = illum_pathtrace::metadata::exr_metadata(
                 tracer,
                 self.progressive.clock().elapsed().as_secs_f64(),
                 self.progressive.stopped(),
                 "illum-viewer",
-            )
+            );
+            metadata.fields.extend(denoise_fields.clone().unwrap_or_default());
+            metadata
         };
         #[cfg(not(target_arch = "wasm32"))]
         if extension == "exr" {
@@ -515,8 +552,8 @@ impl PathTraceMode {
             // the viewer rendered).
             illum_pathtrace::checkpoint::save_checkpoint(&path, tracer, &metadata())?;
         } else {
-            // The PNG is the image as rendered: gamma 2.2, no display exposure.
-            let image: RgbImage32 = tracer.accumulator().mean_image();
+            // The PNG is the image as rendered (or denoised): gamma 2.2, no display exposure.
+            let image: RgbImage32 = denoised.cloned().unwrap_or_else(|| tracer.accumulator().mean_image());
             illum_image::save_png(&path, &image, 0.0, Encoding::Gamma22).map_err(|e| error_chain(&e))?;
         }
         // In the browser the same file, made in memory, is downloaded under the field's file name.
@@ -526,7 +563,8 @@ impl PathTraceMode {
             let (bytes, mime) = if extension == "exr" {
                 (illum_pathtrace::checkpoint::checkpoint_bytes(&name, tracer, &metadata())?, "image/x-exr")
             } else {
-                let image: RgbImage32 = tracer.accumulator().mean_image();
+                let image: RgbImage32 =
+                    denoised.cloned().unwrap_or_else(|| tracer.accumulator().mean_image());
                 let bytes = illum_image::png_bytes(&name, &image, 0.0, Encoding::Gamma22)
                     .map_err(|e| error_chain(&e))?;
                 (bytes, "image/png")
@@ -585,6 +623,14 @@ impl PathTraceMode {
         );
         if s.error_view {
             ui.small("black 0.01%, purple 0.1%, red 1%, orange 10%, yellow 100%; blue: not known yet");
+        }
+        ui.checkbox(&mut s.denoise, "Denoise").on_hover_text(
+            "Shows the accumulation through the à-trous filter, denoised again each time the spp \
+             doubles; the denoised error is estimated from two independent halves of the samples \
+             (docs/denoising.md)",
+        );
+        if s.denoise {
+            ui.small(self.denoise.summary());
         }
 
         ui.separator();

@@ -13,6 +13,7 @@ use illum_scene::{MAX_WHITTED_AA, MAX_WHITTED_DEPTH, Scene};
 use illum_whitted::{PendingImage, WhittedTracer};
 
 use crate::camera::OrbitCamera;
+use crate::difference_view::{DifferenceView, PathTracerTruth};
 
 /// What a frame depends on: when it is unchanged, the last image stands.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -41,6 +42,9 @@ pub struct WhittedMode {
     pub message: Option<String>,
     /// A frame being read back (polled readback, in the browser): its key, start and image.
     pending: Option<(FrameKey, Instant, PendingImage)>,
+    /// The last frame's image and the scene it is of (camera at its size), for the difference.
+    last: Option<(RgbImage32, Scene)>,
+    pub difference: DifferenceView,
 }
 
 impl WhittedMode {
@@ -58,19 +62,40 @@ impl WhittedMode {
             image_mean: None,
             message: None,
             pending: None,
+            last: None,
+            difference: DifferenceView::default(),
         }
     }
 
     pub fn set_scene(&mut self, scene_path: PathBuf, scene: Scene) {
-        *self = WhittedMode { texture: self.texture.take(), ..WhittedMode::new(scene_path, scene) };
+        let difference = std::mem::take(&mut self.difference);
+        *self =
+            WhittedMode { texture: self.texture.take(), difference, ..WhittedMode::new(scene_path, scene) };
     }
 
     pub fn scene_path(&self) -> &Path {
         &self.scene_path
     }
 
-    /// The image for a view of `view_pixels`, rendered again only when it changed.
+    /// The image for a view of `view_pixels`, rendered again only when it changed; with the
+    /// Difference view on, its difference from a truth (`path_tracer`: the path tracer's
+    /// accumulation, one of the truths it may use).
     pub fn frame(
+        &mut self,
+        gpu: &GpuContext,
+        ctx: &egui::Context,
+        view_pixels: [u32; 2],
+        path_tracer: Option<PathTracerTruth<'_>>,
+    ) -> Option<egui::TextureId> {
+        let image = self.render_frame(gpu, ctx, view_pixels);
+        if let Some((last, scene)) = &self.last {
+            self.difference.update(ctx, last, self.frames, scene, path_tracer);
+        }
+        self.difference.texture().or(image)
+    }
+
+    /// The image for a view of `view_pixels`, rendered again only when it changed.
+    fn render_frame(
         &mut self,
         gpu: &GpuContext,
         ctx: &egui::Context,
@@ -137,6 +162,8 @@ impl WhittedMode {
                     })
                     .collect();
                 self.image_mean = Some((image.mean(), [image.width, image.height]));
+                let mut scene = self.scene.clone();
+                scene.camera = key.camera;
                 let size = [image.width as usize, image.height as usize];
                 let color = egui::ColorImage::new(size, pixels);
                 match &mut self.texture {
@@ -147,6 +174,7 @@ impl WhittedMode {
                 }
                 self.frame_ms = Some(started.elapsed().as_secs_f64() * 1e3);
                 self.frames += 1;
+                self.last = Some((image, scene));
                 self.message = None;
             }
             Err(e) => self.message = Some(e.to_string()),
@@ -178,6 +206,7 @@ impl WhittedMode {
             ui.end_row();
         });
         ui.weak("Rendered at half the view's size each way; a frame is drawn when the view changes.");
+        self.difference.panel(ui);
         if let Some(message) = &self.message {
             ui.colored_label(ui.visuals().error_fg_color, message);
         }

@@ -3,22 +3,19 @@
 //!
 //! A pass of its own, compiled only when a caller asks for guides, from the path tracer's
 //! modules and shader defs: it follows the same camera rays and specular choices as the
-//! image's samples of the same indices, and adds no code to the integrator.
+//! image's samples of the same indices, and adds no code to the integrator. Read back either
+//! waiting ([`PathTracer::guides`], native) or polled over later frames
+//! ([`PathTracer::start_guides`], the viewer, which must not wait in a web page).
 
-#[cfg(not(target_arch = "wasm32"))]
 use illum_gpu::buffers::{buffer_bind_group, dispatch};
 #[cfg(not(target_arch = "wasm32"))]
 use illum_gpu::readback;
-#[cfg(not(target_arch = "wasm32"))]
+use illum_gpu::readback::PendingRead;
 use illum_gpu::wgpu;
-#[cfg(not(target_arch = "wasm32"))]
 use wgpu::util::DeviceExt;
 
-#[cfg(not(target_arch = "wasm32"))]
 use super::PathTracer;
-#[cfg(not(target_arch = "wasm32"))]
 use crate::gpu_scene::GpuScene;
-#[cfg(not(target_arch = "wasm32"))]
 use crate::{PathTraceError, shaders};
 
 /// Samples per pixel the guides average at most: albedo and normal are bounded and mostly
@@ -40,14 +37,90 @@ pub struct Guides {
     pub normal: Vec<[f32; 3]>,
 }
 
-// Native only: it waits for the GPU, which a web page cannot.
-#[cfg(not(target_arch = "wasm32"))]
+/// The guide pass submitted: its two output buffers, `bytes` long each.
+struct GuideOutput {
+    width: u32,
+    height: u32,
+    samples: u32,
+    bytes: u64,
+    albedo: wgpu::Buffer,
+    normal: wgpu::Buffer,
+}
+
+impl GuideOutput {
+    /// The guides from the albedo buffer's bytes followed by the normal buffer's.
+    fn decode(&self, albedo: &[u8], normal: &[u8]) -> Guides {
+        let decode = |bytes: &[u8]| -> Vec<[f32; 3]> {
+            crate::batch::decode_slots(bytes).into_iter().map(|[x, y, z, _]| [x, y, z]).collect()
+        };
+        Guides {
+            width: self.width,
+            height: self.height,
+            samples: self.samples,
+            albedo: decode(albedo),
+            normal: decode(normal),
+        }
+    }
+}
+
+/// Guide buffers being read back without waiting ([`PathTracer::start_guides`]).
+pub struct PendingGuides {
+    output: GuideOutput,
+    read: PendingRead,
+}
+
+impl PendingGuides {
+    /// `None` while the readback is under way, then the guides or the mapping's error. Never
+    /// waits.
+    pub fn poll(&self, gpu: &illum_gpu::GpuContext) -> Option<Result<Guides, PathTraceError>> {
+        let bytes = match self.read.poll(gpu)? {
+            Ok(bytes) => bytes,
+            Err(e) => return Some(Err(e.into())),
+        };
+        let half = self.output.bytes as usize;
+        Some(Ok(self.output.decode(&bytes[..half], &bytes[half..2 * half])))
+    }
+}
+
 impl PathTracer {
     /// The guide buffers over this tracer's sample indices `offset .. offset + n`, with
     /// `offset` its [`Self::sample_offset`] and `n = samples.clamp(1, GUIDE_SAMPLES)`. Blocks
-    /// until the GPU is done. Fails, naming the limit, for an image whose guides do not fit one
-    /// storage binding of the device.
+    /// until the GPU is done (native only: a web page cannot wait). Fails, naming the limit,
+    /// for an image whose guides do not fit one storage binding of the device.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn guides(&self, samples: u32) -> Result<Guides, PathTraceError> {
+        let output = self.submit_guides(samples)?;
+        let gpu = &self.pipeline.gpu;
+        let read = |buffer: &wgpu::Buffer| {
+            readback::read_buffer(gpu, buffer, 0, output.bytes, "reading back the guide buffers")
+        };
+        let (albedo, normal) = (read(&output.albedo)?, read(&output.normal)?);
+        Ok(output.decode(&albedo, &normal))
+    }
+
+    /// [`Self::guides`] without waiting: submits the pass and a copy of both buffers into one
+    /// mappable buffer, whose readback [`PendingGuides::poll`] collects on later frames.
+    pub fn start_guides(&self, samples: u32) -> Result<PendingGuides, PathTraceError> {
+        let output = self.submit_guides(samples)?;
+        let gpu = &self.pipeline.gpu;
+        let staging = gpu.scoped("allocating the guides' readback buffer", || {
+            gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("guide readback"),
+                size: 2 * output.bytes,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        })?;
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(&output.albedo, 0, &staging, 0, output.bytes);
+        encoder.copy_buffer_to_buffer(&output.normal, 0, &staging, output.bytes, output.bytes);
+        gpu.queue.submit([encoder.finish()]);
+        let read = PendingRead::start(staging, 2 * output.bytes, "reading back the guide buffers");
+        Ok(PendingGuides { output, read })
+    }
+
+    /// Encodes and submits the guide pass.
+    fn submit_guides(&self, samples: u32) -> Result<GuideOutput, PathTraceError> {
         let pipeline = &self.pipeline;
         let (gpu, scene) = (&pipeline.gpu, &pipeline.scene);
         let (width, height) = (scene.camera.width, scene.camera.height);
@@ -113,10 +186,6 @@ impl PathTracer {
             [width.div_ceil(8), height.div_ceil(8), 1],
         );
         gpu.queue.submit([encoder.finish()]);
-        let read = |buffer: &wgpu::Buffer| -> Result<Vec<[f32; 3]>, PathTraceError> {
-            let bytes = readback::read_buffer(gpu, buffer, 0, bytes, "reading back the guide buffers")?;
-            Ok(crate::batch::decode_slots(&bytes).into_iter().map(|[x, y, z, _]| [x, y, z]).collect())
-        };
-        Ok(Guides { width, height, samples, albedo: read(&albedo)?, normal: read(&normal)? })
+        Ok(GuideOutput { width, height, samples, bytes, albedo, normal })
     }
 }

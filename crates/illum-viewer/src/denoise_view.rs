@@ -1,0 +1,361 @@
+//! The path tracer's Denoise toggle: the accumulation denoised with illum-denoise's à-trous
+//! filter (WGSL, on the viewer's own device), and the halves' estimate of the denoised image's
+//! error beside the noisy image's (docs/denoising.md).
+//!
+//! The halves without a second tracer: the samples of a pixel are indices 0, 1, 2, ..., so the
+//! accumulation at an earlier spp (a snapshot, A) and what came after it (the whole less A, B)
+//! are two independent sets of samples. A refresh at spp n, with the snapshot taken at the
+//! previous refresh's spp s, denoises A (s spp), B (n - s spp) and the whole (n spp), estimates
+//! the denoised error from A and B ([`HalvesError`]), shows the denoised whole, and keeps the
+//! whole as the next snapshot.
+//!
+//! When: every refresh costs three filter runs, each on lavapipe as much as 10 to 16 spp of
+//! path tracing (docs/denoising.md, "Cost"). So the image is denoised again when the spp has
+//! doubled since the last time ([`REFRESH_FACTOR`]), which keeps the filter's share of the
+//! work bounded whatever the spp (one refresh per doubling: at most three filter runs per
+//! doubling of the work), and once more when the render stops. The first image of an
+//! accumulation (after a drag, a reset) is denoised as soon as it has [`FIRST_SPP`] samples
+//! per pixel, without an estimate (the halves need 2 samples each). The guide buffers
+//! (albedo, normal) are rendered once per accumulation, when the toggle is on.
+//!
+//! Nothing waits for the GPU: the guides and the filter's outputs are read back over later
+//! frames ([`PathTracer::start_guides`], [`AtrousDenoiser::start`]), as in a web page.
+
+use web_time::Instant;
+
+use illum_denoise::input::DenoiseInput;
+use illum_denoise::{AtrousDenoiser, AtrousSettings, HalvesError, PendingDenoise};
+use illum_gpu::GpuContext;
+use illum_image::{Encoding, RgbImage32};
+use illum_pathtrace::{Accumulator, GUIDE_SAMPLES, Guides, PathTracer, PendingGuides};
+use illum_scene::Scene;
+
+/// The image is denoised again once the spp reached this factor times the last refresh's.
+pub const REFRESH_FACTOR: u32 = 2;
+/// The spp at which an accumulation's first denoised image is made.
+pub const FIRST_SPP: u32 = 2;
+
+/// What the panel shows of the last refresh.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DenoiseEstimate {
+    /// Samples per pixel of the denoised image.
+    pub spp: u32,
+    /// The noisy image's estimated relative error at that spp (from its variance); `None`
+    /// below 2 spp.
+    pub noisy: Option<f64>,
+    /// The halves' estimate of the denoised image's relative error (of a denoised half, so
+    /// conservative for the denoised whole); `None` at the first refresh.
+    pub denoised: Option<f64>,
+    /// The halves' spp (A, B) behind `denoised`.
+    pub halves: Option<(u32, u32)>,
+    /// Wall seconds from submitting the filter runs to having their results.
+    pub seconds: f64,
+}
+
+/// Filter runs in flight: the whole, and with a snapshot the two halves.
+struct Job {
+    spp: u32,
+    whole: Accumulator,
+    /// The halves' statistics (A = the snapshot, B = the whole less A) with their spp.
+    halves: Option<[(Accumulator, u32); 2]>,
+    pending: Vec<PendingDenoise>,
+    done: Vec<RgbImage32>,
+    started: Instant,
+}
+
+/// The denoised image shown, as an egui texture.
+struct Shown {
+    image: RgbImage32,
+    exposure: f32,
+    texture: egui::TextureHandle,
+}
+
+/// The Denoise toggle's state for one accumulation.
+#[derive(Default)]
+pub struct DenoiseView {
+    filter: Option<AtrousDenoiser>,
+    /// The scene (camera, settings) the state below belongs to: another one restarts it.
+    scene: Option<Scene>,
+    guides: Option<Guides>,
+    pending_guides: Option<PendingGuides>,
+    /// The accumulation at the last refresh and its spp: the next refresh's first half.
+    snapshot: Option<(Accumulator, u32)>,
+    job: Option<Job>,
+    shown: Option<Shown>,
+    estimate: Option<DenoiseEstimate>,
+    /// Refreshes since the viewer started (tests and statistics read it).
+    pub refreshes: u64,
+    /// Wall seconds spent in this module's own work on the CPU (building the inputs, the
+    /// estimate, the texture), summed since the viewer started.
+    pub cpu_seconds: f64,
+    pub error: Option<String>,
+    /// A refresh was due at the last frame (so the window must draw another one).
+    due: bool,
+}
+
+impl DenoiseView {
+    /// Forgets everything of the current accumulation (the toggle went off, or it restarted).
+    pub fn clear(&mut self) {
+        *self = DenoiseView {
+            filter: self.filter.take(),
+            refreshes: self.refreshes,
+            cpu_seconds: self.cpu_seconds,
+            ..DenoiseView::default()
+        };
+    }
+
+    /// The last refresh's estimate for the current accumulation.
+    pub fn estimate(&self) -> Option<DenoiseEstimate> {
+        self.estimate
+    }
+
+    /// The denoised image shown (linear RGB), once there is one for the current accumulation.
+    pub fn image(&self) -> Option<&RgbImage32> {
+        self.shown.as_ref().map(|s| &s.image)
+    }
+
+    /// The guide buffers of the current accumulation, once read back.
+    pub fn guides(&self) -> Option<&Guides> {
+        self.guides.as_ref()
+    }
+
+    /// The texture to show in place of the noisy image, once there is one.
+    pub fn texture(&self) -> Option<egui::TextureId> {
+        self.shown.as_ref().map(|s| s.texture.id())
+    }
+
+    /// True while guides or filter runs are being read back (the window must keep repainting).
+    pub fn is_busy(&self) -> bool {
+        self.pending_guides.is_some() || self.job.is_some() || self.due
+    }
+
+    /// One frame of work: follows `tracer`'s accumulation, starts or collects guides and filter
+    /// runs, and shows the newest denoised image with `exposure` stops. `stopped`: the render
+    /// takes no more samples (paused or a stop rule fired), so the last samples are denoised
+    /// without waiting for the spp to double.
+    pub fn frame(
+        &mut self,
+        gpu: &GpuContext,
+        ctx: &egui::Context,
+        tracer: &PathTracer,
+        exposure: f32,
+        stopped: bool,
+    ) {
+        let accumulator = tracer.accumulator();
+        let restarted = self.scene.as_ref() != Some(tracer.scene())
+            || self.snapshot.as_ref().is_some_and(|(s, _)| s.total_samples() > accumulator.total_samples())
+            || self.job.as_ref().is_some_and(|j| j.whole.total_samples() > accumulator.total_samples());
+        if restarted {
+            self.clear();
+            self.scene = Some(tracer.scene().clone());
+        }
+        if let Err(e) = self.step(gpu, ctx, tracer, stopped) {
+            self.error = Some(e);
+            self.job = None;
+            self.pending_guides = None;
+        }
+        if let Some(shown) = &mut self.shown
+            && shown.exposure != exposure
+        {
+            shown.texture.set(colour_image(&shown.image, exposure), egui::TextureOptions::LINEAR);
+            shown.exposure = exposure;
+        }
+    }
+
+    fn step(
+        &mut self,
+        gpu: &GpuContext,
+        ctx: &egui::Context,
+        tracer: &PathTracer,
+        stopped: bool,
+    ) -> Result<(), String> {
+        if self.guides.is_none() {
+            match &self.pending_guides {
+                None => {
+                    let pending = tracer.start_guides(GUIDE_SAMPLES).map_err(|e| e.to_string())?;
+                    self.pending_guides = Some(pending);
+                    return Ok(());
+                }
+                Some(pending) => match pending.poll(gpu) {
+                    None => return Ok(()),
+                    Some(result) => {
+                        self.guides = Some(result.map_err(|e| e.to_string())?);
+                        self.pending_guides = None;
+                    }
+                },
+            }
+        }
+        if self.job.is_some() {
+            return self.collect(gpu, ctx);
+        }
+        let spp = tracer.spp_done();
+        let due = match &self.snapshot {
+            None => spp >= FIRST_SPP,
+            Some((_, last)) => spp >= last.saturating_mul(REFRESH_FACTOR) || (stopped && spp > *last),
+        };
+        self.due = due && self.error.is_none();
+        if due && accumulator_complete(tracer.accumulator(), spp) {
+            self.start(gpu, tracer.accumulator().clone(), spp)?;
+        }
+        Ok(())
+    }
+
+    /// Submits the filter runs of a refresh at `spp`.
+    fn start(&mut self, gpu: &GpuContext, whole: Accumulator, spp: u32) -> Result<(), String> {
+        let clock = Instant::now();
+        let guides = self.guides.as_ref().ok_or("no guide buffers")?;
+        if self.filter.is_none() {
+            self.filter = Some(AtrousDenoiser::new(gpu).map_err(|e| e.to_string())?);
+        }
+        let filter = self.filter.as_ref().expect("made above");
+        let settings = AtrousSettings::default();
+        let halves = match &self.snapshot {
+            Some((a, a_spp)) if *a_spp >= 2 && spp - a_spp >= 2 => {
+                Some([(a.clone(), *a_spp), (difference(&whole, a)?, spp - a_spp)])
+            }
+            _ => None,
+        };
+        let mut pending = vec![];
+        for accumulator in std::iter::once(&whole).chain(halves.iter().flat_map(|h| h.iter().map(|(a, _)| a)))
+        {
+            let input = DenoiseInput::from_render(accumulator, guides);
+            pending.push(filter.start(&input, &settings).map_err(|e| e.to_string())?);
+        }
+        self.job = Some(Job { spp, whole, halves, pending, done: vec![], started: Instant::now() });
+        self.cpu_seconds += clock.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    /// Collects the filter runs that finished; with all of them, shows the denoised whole and
+    /// estimates its error.
+    fn collect(&mut self, gpu: &GpuContext, ctx: &egui::Context) -> Result<(), String> {
+        let job = self.job.as_mut().expect("called with a job");
+        while let Some(next) = job.pending.get(job.done.len()) {
+            match next.poll(gpu) {
+                None => return Ok(()),
+                Some(result) => job.done.push(result.map_err(|e| e.to_string())?.0),
+            }
+        }
+        let clock = Instant::now();
+        let job = self.job.take().expect("present");
+        let seconds = job.started.elapsed().as_secs_f64();
+        let mut images = job.done.into_iter();
+        let image = images.next().expect("the whole is always denoised");
+        let denoised = job.halves.as_ref().map(|[(a, _), (b, _)]| {
+            let (da, db) = (images.next().expect("half A"), images.next().expect("half B"));
+            HalvesError::new(
+                (&a.mean_image(), &a.variance_image(), &da),
+                (&b.mean_image(), &b.variance_image(), &db),
+            )
+            .relative_error()
+        });
+        let noisy = job.whole.estimated_relative_error();
+        self.estimate = Some(DenoiseEstimate {
+            spp: job.spp,
+            noisy: noisy.is_finite().then_some(noisy),
+            denoised: denoised.filter(|e| e.is_finite()),
+            halves: job.halves.as_ref().map(|[(_, a), (_, b)]| (*a, *b)),
+            seconds,
+        });
+        let exposure = self.shown.as_ref().map_or(f32::NAN, |s| s.exposure);
+        let colours = colour_image(&image, if exposure.is_nan() { 0.0 } else { exposure });
+        match &mut self.shown {
+            Some(shown) => {
+                shown.texture.set(colours, egui::TextureOptions::LINEAR);
+                shown.image = image;
+            }
+            None => {
+                let texture = ctx.load_texture("path tracer denoised", colours, egui::TextureOptions::LINEAR);
+                self.shown = Some(Shown { image, exposure: 0.0, texture });
+            }
+        }
+        self.snapshot = Some((job.whole, job.spp));
+        self.refreshes += 1;
+        self.error = None;
+        self.cpu_seconds += clock.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    /// The panel's line: "estimated error: noisy X%, denoised Y%".
+    pub fn summary(&self) -> String {
+        let percent = |e: Option<f64>| e.map_or("n/a".to_owned(), |e| format!("{:.2}%", 100.0 * e));
+        match (&self.error, &self.estimate) {
+            (Some(e), _) => format!("denoiser: {e}"),
+            (None, None) => "estimated error: (denoising...)".to_owned(),
+            (None, Some(est)) => {
+                let denoised = match (est.denoised, est.halves) {
+                    (Some(e), _) => percent(Some(e)),
+                    (None, _) => format!("n/a until {} spp", (est.spp * REFRESH_FACTOR).max(4)),
+                };
+                format!(
+                    "estimated error: noisy {}, denoised {denoised} (at {} spp)",
+                    percent(est.noisy),
+                    est.spp
+                )
+            }
+        }
+    }
+}
+
+impl DenoiseView {
+    /// What a `--screenshot` run prints of the denoiser: its line in the panel, the refreshes,
+    /// the last refresh's wall time and the CPU time of this module's own work.
+    pub fn statistics(&self) -> String {
+        format!(
+            "denoise: {}, {} refreshes, last {:.0} ms from submission to result, {:.0} ms of CPU in the viewer",
+            self.summary(),
+            self.refreshes,
+            self.estimate.map_or(0.0, |e| 1e3 * e.seconds),
+            1e3 * self.cpu_seconds
+        )
+    }
+}
+
+/// The EXR metadata a save records with Denoise on (as `illum.<key>`): the denoiser, the spp
+/// of the denoised image shown, and its estimated relative error; `None` before the first
+/// denoised image.
+pub fn exr_fields(view: &DenoiseView) -> Option<Vec<(String, String)>> {
+    let estimate = view.estimate()?;
+    let mut fields = vec![
+        ("viewer_shown".to_owned(), "denoised (atrous); this file holds the raw samples".to_owned()),
+        ("denoised_spp".to_owned(), estimate.spp.to_string()),
+    ];
+    if let Some(e) = estimate.denoised {
+        fields.push(("denoised_estimated_relative_error".to_owned(), e.to_string()));
+    }
+    Some(fields)
+}
+
+/// Whether every pixel of `accumulator` has `spp` samples or more (a refresh is never made of
+/// a pass that covers only some of the image's bands).
+fn accumulator_complete(accumulator: &Accumulator, spp: u32) -> bool {
+    accumulator.total_samples() > 0 && accumulator.min_samples() >= u64::from(spp)
+}
+
+/// The samples of `whole` that are not in `earlier` (an earlier state of the same
+/// accumulation): per pixel the sums and counts less `earlier`'s, in f64.
+pub fn difference(whole: &Accumulator, earlier: &Accumulator) -> Result<Accumulator, String> {
+    let (w, e) = (whole.state(), earlier.state());
+    if (whole.width, whole.height) != (earlier.width, earlier.height) {
+        return Err("the snapshot is of another size".to_owned());
+    }
+    let sub = |a: &[[f64; 3]], b: &[[f64; 3]]| -> Vec<[f64; 3]> {
+        a.iter().zip(b).map(|(x, y)| [0, 1, 2].map(|c| x[c] - y[c])).collect()
+    };
+    let count = w.count.iter().zip(e.count).map(|(x, y)| x.saturating_sub(*y)).collect();
+    Accumulator::from_state(
+        whole.width,
+        whole.height,
+        sub(w.sum, e.sum),
+        sub(w.sum_sq, e.sum_sq),
+        count,
+        w.dropped.saturating_sub(e.dropped),
+    )
+}
+
+/// `image` as the viewer shows it: `exposure` stops, clamped, gamma 2.2 (the PNG's encoding,
+/// and the display pass's).
+pub fn colour_image(image: &RgbImage32, exposure: f32) -> egui::ColorImage {
+    let rgba = illum_image::tonemap::to_rgba8(image, exposure, Encoding::Gamma22);
+    egui::ColorImage::from_rgba_unmultiplied([image.width as usize, image.height as usize], rgba.as_raw())
+}

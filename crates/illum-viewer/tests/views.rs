@@ -1,0 +1,190 @@
+//! egui_kittest tests of the views that show an image other than the renderer's own: the path
+//! tracer's Denoise toggle (`denoise_view.rs`) and the Difference view of the rasterizer and
+//! the Whitted tracer (`difference_view.rs`), driven through the real UI on lavapipe.
+
+use std::sync::OnceLock;
+
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use illum_denoise::input::DenoiseInput;
+use illum_denoise::{AtrousSettings, reference};
+use illum_scene::RendererKind;
+use illum_viewer::gpu_setup::wgpu_setup;
+use illum_viewer::{StartOptions, ViewerApp};
+
+/// The one device of this test process, as the real window has one.
+fn shared_device() -> egui_wgpu::WgpuSetupExisting {
+    static STATE: OnceLock<egui_wgpu::RenderState> = OnceLock::new();
+    let state = STATE.get_or_init(|| {
+        egui_kittest::wgpu::create_render_state(wgpu_setup(true), egui_wgpu::RendererOptions::PREDICTABLE)
+    });
+    egui_wgpu::WgpuSetupExisting {
+        instance: state.instance.clone(),
+        adapter: state.adapter.clone(),
+        device: state.device.clone(),
+        queue: state.queue.clone(),
+    }
+}
+
+fn harness(scene: &'static str, mode: RendererKind) -> Harness<'static, ViewerApp> {
+    Harness::builder()
+        .with_size(egui::vec2(900.0, 560.0))
+        .wgpu_setup(egui_wgpu::WgpuSetup::Existing(shared_device()))
+        .build_eframe(move |cc| {
+            ViewerApp::new(
+                cc,
+                StartOptions {
+                    scene: scene.into(),
+                    mode: Some(mode),
+                    screenshot: None,
+                    clear_is_backdrop: false,
+                },
+            )
+        })
+}
+
+/// Runs frames until `done` holds (at most `frames`); returns whether it did.
+fn run_until(harness: &mut Harness<'_, ViewerApp>, frames: u32, done: impl Fn(&ViewerApp) -> bool) -> bool {
+    for _ in 0..frames {
+        if done(harness.state()) {
+            return true;
+        }
+        harness.run_steps(1);
+    }
+    done(harness.state())
+}
+
+/// Mean absolute difference between horizontal neighbours' luminance: what noise raises.
+fn roughness(image: &illum_image::RgbImage32) -> f64 {
+    let w = image.width as usize;
+    let lum = |p: [f32; 3]| 0.2126 * f64::from(p[0]) + 0.7152 * f64::from(p[1]) + 0.0722 * f64::from(p[2]);
+    let mut total = 0.0;
+    let mut n = 0usize;
+    for (i, pair) in image.pixels.windows(2).enumerate() {
+        if (i + 1) % w != 0 {
+            total += (lum(pair[0]) - lum(pair[1])).abs();
+            n += 1;
+        }
+    }
+    total / n as f64
+}
+
+/// Denoise on, to 16 spp on the Cornell box: the window shows the à-trous filter of the whole
+/// accumulation with the guides it read back (checked against the filter's f64 copy), refreshed
+/// at 2, 4, 8 and 16 spp, with the halves' estimate at 16 spp from halves of 8 and 8; the
+/// panel shows both errors; Save PNG writes the denoised image; off shows the noisy one again.
+#[test]
+fn denoise_shows_the_filtered_accumulation_and_its_estimated_error() {
+    let mut harness = harness("scenes/cornell.toml", RendererKind::PathTrace);
+    harness.state_mut().pathtrace_mut().unwrap().settings.stop.spp = Some(16);
+    harness.run_steps(1);
+    let noisy_texture = harness.state().pathtrace().unwrap().texture();
+    harness.get_by_label("Denoise").click();
+    let finished = run_until(&mut harness, 400, |app| {
+        let mode = app.pathtrace().unwrap();
+        mode.stop_reason().is_some() && mode.denoise.estimate().is_some_and(|e| e.spp == 16)
+    });
+    assert!(finished, "no denoised image at 16 spp: {}", harness.state().pathtrace().unwrap().summary());
+    harness.run_steps(2);
+    let mode = harness.state().pathtrace().unwrap();
+    let view = &mode.denoise;
+    let estimate = view.estimate().unwrap();
+    println!("{}", mode.summary());
+    assert_eq!(view.refreshes, 4, "refreshes at 2, 4, 8, 16 spp");
+    assert_eq!(estimate.halves, Some((8, 8)));
+    let (noisy, denoised) =
+        (estimate.noisy.expect("noisy estimate"), estimate.denoised.expect("denoised estimate"));
+    assert!(noisy > 0.0 && denoised > 0.0, "noisy {noisy}, denoised {denoised}");
+    assert_ne!(mode.texture(), noisy_texture, "the window still shows the noisy image");
+    assert_eq!(mode.texture(), view.texture());
+
+    // The image shown is the filter of this accumulation with these guides (f32 GPU against
+    // f64: docs/denoising.md states 1e-4 relative; the tolerance here adds 1e-6 absolute).
+    let accumulator = mode.accumulator().unwrap();
+    let input = DenoiseInput::from_render(accumulator, view.guides().expect("guides"));
+    let (expected, _) = reference::denoise(&input, &AtrousSettings::default());
+    let shown = view.image().unwrap();
+    assert_eq!((shown.width, shown.height), (accumulator.width, accumulator.height));
+    for (p, (g, c)) in shown.pixels.iter().zip(&expected.pixels).enumerate() {
+        for k in 0..3 {
+            let (g, c) = (f64::from(g[k]), f64::from(c[k]));
+            assert!(
+                (g - c).abs() <= 1e-6 + 1e-4 * c.abs(),
+                "pixel {p} channel {k}: shown {g}, f64 filter {c}"
+            );
+        }
+    }
+    let (raw, smooth) = (roughness(&accumulator.mean_image()), roughness(shown));
+    println!("neighbour luminance difference: noisy {raw:.4}, denoised {smooth:.4}");
+    assert!(smooth < 0.5 * raw, "denoised {smooth:.4} not under half the noisy {raw:.4}");
+    let panel = format!("noisy {:.2}%, denoised {:.2}%", 100.0 * noisy, 100.0 * denoised);
+    assert!(harness.query_by_label_contains(&panel).is_some(), "the panel does not show {panel:?}");
+
+    // Save PNG writes what is shown: the denoised image, gamma 2.2.
+    let dir = tempfile::tempdir().unwrap();
+    let mode = harness.state_mut().pathtrace_mut().unwrap();
+    mode.save_path = dir.path().join("denoised.png").display().to_string();
+    let saved = mode.save("png").unwrap_or_else(|e| panic!("{e}"));
+    let png = image::open(&saved).unwrap().to_rgba8();
+    let expected_png =
+        illum_image::to_rgba8(mode.denoise.image().unwrap(), 0.0, illum_image::Encoding::Gamma22);
+    assert!(png == expected_png, "the saved PNG is not the denoised image");
+    let path = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("denoised.png");
+    std::fs::copy(&saved, &path).unwrap();
+    println!("saved {}", path.display());
+
+    harness.get_by_label("Denoise").click();
+    harness.run_steps(2);
+    let mode = harness.state().pathtrace().unwrap();
+    assert_eq!(mode.texture(), noisy_texture, "Denoise off does not show the noisy image");
+    assert!(mode.denoise.estimate().is_none());
+}
+
+/// A drag restarts the accumulation: the denoised image of the old view is dropped at once and
+/// a new one, of a few spp, follows within a few frames.
+#[test]
+fn a_drag_gives_a_fresh_denoised_image_at_low_spp() {
+    let mut harness = harness("scenes/cornell.toml", RendererKind::PathTrace);
+    let mode = harness.state_mut().pathtrace_mut().unwrap();
+    mode.settings.denoise = true;
+    mode.settings.stop.spp = Some(32);
+    let denoised_at_32 = run_until(&mut harness, 400, |app| {
+        app.pathtrace().unwrap().denoise.estimate().is_some_and(|e| e.spp == 32)
+    });
+    assert!(denoised_at_32, "{}", harness.state().pathtrace().unwrap().summary());
+    let before = harness.state().pathtrace().unwrap().denoise.refreshes;
+    let start = egui::pos2(600.0, 300.0);
+    harness.event(egui::Event::PointerMoved(start));
+    harness.event(egui::Event::PointerButton {
+        pos: start,
+        button: egui::PointerButton::Primary,
+        pressed: true,
+        modifiers: egui::Modifiers::NONE,
+    });
+    harness.run_steps(1);
+    harness.event(egui::Event::PointerMoved(start + egui::vec2(40.0, 10.0)));
+    harness.run_steps(1);
+    harness.event(egui::Event::PointerButton {
+        pos: start + egui::vec2(40.0, 10.0),
+        button: egui::PointerButton::Primary,
+        pressed: false,
+        modifiers: egui::Modifiers::NONE,
+    });
+    harness.run_steps(1);
+    let mode = harness.state().pathtrace().unwrap();
+    assert!(
+        mode.denoise.estimate().is_none_or(|e| e.spp < 32),
+        "the old view's denoised image is still shown after the drag"
+    );
+    let fresh = run_until(&mut harness, 40, |app| app.pathtrace().unwrap().denoise.estimate().is_some());
+    let mode = harness.state().pathtrace().unwrap();
+    let estimate = mode.denoise.estimate();
+    println!("after the drag: {:?}, {}", estimate, mode.summary());
+    assert!(fresh, "no denoised image within 40 frames of the drag");
+    assert!(
+        estimate.unwrap().spp <= 4,
+        "the first denoised image after the drag has {} spp",
+        estimate.unwrap().spp
+    );
+    assert!(mode.denoise.refreshes > before);
+}
