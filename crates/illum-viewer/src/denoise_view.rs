@@ -48,17 +48,21 @@ pub struct DenoiseEstimate {
     pub denoised: Option<f64>,
     /// The halves' spp (A, B) behind `denoised`.
     pub halves: Option<(u32, u32)>,
-    /// Wall seconds from submitting the filter runs to having their results.
+    /// Wall seconds from the refresh's start to its estimate (its three filter runs, one per
+    /// frame, with the frames between).
     pub seconds: f64,
 }
 
-/// Filter runs in flight: the whole, and with a snapshot the two halves.
+/// A refresh under way: the filter's inputs (the whole, then with a snapshot the two halves),
+/// submitted one per frame, and their results as they come back.
 struct Job {
     spp: u32,
     whole: Accumulator,
     /// The halves' statistics (A = the snapshot, B = the whole less A) with their spp.
     halves: Option<[(Accumulator, u32); 2]>,
-    pending: Vec<PendingDenoise>,
+    /// Inputs not submitted yet, the run in flight, and the results.
+    inputs: Vec<DenoiseInput>,
+    pending: Option<PendingDenoise>,
     done: Vec<RgbImage32>,
     started: Instant,
 }
@@ -85,9 +89,10 @@ pub struct DenoiseView {
     estimate: Option<DenoiseEstimate>,
     /// Refreshes since the viewer started (tests and statistics read it).
     pub refreshes: u64,
-    /// Wall seconds spent in this module's own work on the CPU (building the inputs, the
-    /// estimate, the texture), summed since the viewer started.
-    pub cpu_seconds: f64,
+    /// Wall seconds the frames spent in this module (submitting the guides and the filter
+    /// runs, which on lavapipe run them, collecting them, the estimate, the texture), summed
+    /// since the viewer started: what the denoiser takes from the frames.
+    pub seconds: f64,
     pub error: Option<String>,
     /// A refresh was due at the last frame (so the window must draw another one).
     due: bool,
@@ -99,7 +104,7 @@ impl DenoiseView {
         *self = DenoiseView {
             filter: self.filter.take(),
             refreshes: self.refreshes,
-            cpu_seconds: self.cpu_seconds,
+            seconds: self.seconds,
             ..DenoiseView::default()
         };
     }
@@ -149,7 +154,10 @@ impl DenoiseView {
             self.clear();
             self.scene = Some(tracer.scene().clone());
         }
-        if let Err(e) = self.step(gpu, ctx, tracer, stopped) {
+        let clock = Instant::now();
+        let stepped = self.step(gpu, ctx, tracer, exposure, stopped);
+        self.seconds += clock.elapsed().as_secs_f64();
+        if let Err(e) = stepped {
             self.error = Some(e);
             self.job = None;
             self.pending_guides = None;
@@ -167,6 +175,7 @@ impl DenoiseView {
         gpu: &GpuContext,
         ctx: &egui::Context,
         tracer: &PathTracer,
+        exposure: f32,
         stopped: bool,
     ) -> Result<(), String> {
         if self.guides.is_none() {
@@ -186,7 +195,7 @@ impl DenoiseView {
             }
         }
         if self.job.is_some() {
-            return self.collect(gpu, ctx);
+            return self.collect(gpu, ctx, exposure);
         }
         let spp = tracer.spp_done();
         let due = match &self.snapshot {
@@ -195,52 +204,62 @@ impl DenoiseView {
         };
         self.due = due && self.error.is_none();
         if due && accumulator_complete(tracer.accumulator(), spp) {
-            self.start(gpu, tracer.accumulator().clone(), spp)?;
+            self.start(tracer.accumulator().clone(), spp)?;
+            return self.collect(gpu, ctx, exposure);
         }
         Ok(())
     }
 
-    /// Submits the filter runs of a refresh at `spp`.
-    fn start(&mut self, gpu: &GpuContext, whole: Accumulator, spp: u32) -> Result<(), String> {
-        let clock = Instant::now();
+    /// Prepares the filter runs of a refresh at `spp`.
+    fn start(&mut self, whole: Accumulator, spp: u32) -> Result<(), String> {
         let guides = self.guides.as_ref().ok_or("no guide buffers")?;
-        if self.filter.is_none() {
-            self.filter = Some(AtrousDenoiser::new(gpu).map_err(|e| e.to_string())?);
-        }
-        let filter = self.filter.as_ref().expect("made above");
-        let settings = AtrousSettings::default();
         let halves = match &self.snapshot {
             Some((a, a_spp)) if *a_spp >= 2 && spp - a_spp >= 2 => {
                 Some([(a.clone(), *a_spp), (difference(&whole, a)?, spp - a_spp)])
             }
             _ => None,
         };
-        let mut pending = vec![];
-        for accumulator in std::iter::once(&whole).chain(halves.iter().flat_map(|h| h.iter().map(|(a, _)| a)))
-        {
-            let input = DenoiseInput::from_render(accumulator, guides);
-            pending.push(filter.start(&input, &settings).map_err(|e| e.to_string())?);
-        }
-        self.job = Some(Job { spp, whole, halves, pending, done: vec![], started: Instant::now() });
-        self.cpu_seconds += clock.elapsed().as_secs_f64();
+        let mut inputs: Vec<DenoiseInput> = std::iter::once(&whole)
+            .chain(halves.iter().flat_map(|h| h.iter().map(|(a, _)| a)))
+            .map(|accumulator| DenoiseInput::from_render(accumulator, guides))
+            .collect();
+        // Submitted from the back.
+        inputs.reverse();
+        self.job =
+            Some(Job { spp, whole, halves, inputs, pending: None, done: vec![], started: Instant::now() });
         Ok(())
     }
 
-    /// Collects the filter runs that finished; with all of them, shows the denoised whole and
-    /// estimates its error.
-    fn collect(&mut self, gpu: &GpuContext, ctx: &egui::Context) -> Result<(), String> {
+    /// Collects the filter run in flight and submits the next: one per frame, because on a
+    /// software device (lavapipe) a submission runs the filter before it returns, and three in
+    /// one frame would freeze the window for the time of three. The denoised whole is shown as
+    /// soon as it is back; with the halves back too, the error is estimated.
+    fn collect(&mut self, gpu: &GpuContext, ctx: &egui::Context, exposure: f32) -> Result<(), String> {
+        if self.filter.is_none() {
+            self.filter = Some(AtrousDenoiser::new(gpu).map_err(|e| e.to_string())?);
+        }
         let job = self.job.as_mut().expect("called with a job");
-        while let Some(next) = job.pending.get(job.done.len()) {
-            match next.poll(gpu) {
+        if let Some(pending) = &job.pending {
+            match pending.poll(gpu) {
                 None => return Ok(()),
-                Some(result) => job.done.push(result.map_err(|e| e.to_string())?.0),
+                Some(result) => {
+                    job.done.push(result.map_err(|e| e.to_string())?.0);
+                    job.pending = None;
+                    if job.done.len() == 1 {
+                        let image = job.done[0].clone();
+                        self.show(ctx, image, exposure);
+                    }
+                }
             }
         }
-        let clock = Instant::now();
+        let job = self.job.as_mut().expect("still there");
+        if let Some(input) = job.inputs.pop() {
+            let filter = self.filter.as_ref().expect("made above");
+            job.pending = Some(filter.start(&input, &AtrousSettings::default()).map_err(|e| e.to_string())?);
+            return Ok(());
+        }
         let job = self.job.take().expect("present");
-        let seconds = job.started.elapsed().as_secs_f64();
-        let mut images = job.done.into_iter();
-        let image = images.next().expect("the whole is always denoised");
+        let mut images = job.done.into_iter().skip(1);
         let denoised = job.halves.as_ref().map(|[(a, _), (b, _)]| {
             let (da, db) = (images.next().expect("half A"), images.next().expect("half B"));
             HalvesError::new(
@@ -255,25 +274,28 @@ impl DenoiseView {
             noisy: noisy.is_finite().then_some(noisy),
             denoised: denoised.filter(|e| e.is_finite()),
             halves: job.halves.as_ref().map(|[(_, a), (_, b)]| (*a, *b)),
-            seconds,
+            seconds: job.started.elapsed().as_secs_f64(),
         });
-        let exposure = self.shown.as_ref().map_or(f32::NAN, |s| s.exposure);
-        let colours = colour_image(&image, if exposure.is_nan() { 0.0 } else { exposure });
+        self.snapshot = Some((job.whole, job.spp));
+        self.refreshes += 1;
+        self.error = None;
+        Ok(())
+    }
+
+    /// Shows the denoised `image` with `exposure` stops.
+    fn show(&mut self, ctx: &egui::Context, image: RgbImage32, exposure: f32) {
+        let colours = colour_image(&image, exposure);
         match &mut self.shown {
             Some(shown) => {
                 shown.texture.set(colours, egui::TextureOptions::LINEAR);
                 shown.image = image;
+                shown.exposure = exposure;
             }
             None => {
                 let texture = ctx.load_texture("path tracer denoised", colours, egui::TextureOptions::LINEAR);
-                self.shown = Some(Shown { image, exposure: 0.0, texture });
+                self.shown = Some(Shown { image, exposure, texture });
             }
         }
-        self.snapshot = Some((job.whole, job.spp));
-        self.refreshes += 1;
-        self.error = None;
-        self.cpu_seconds += clock.elapsed().as_secs_f64();
-        Ok(())
     }
 
     /// The panel's line: "estimated error: noisy X%, denoised Y%".
@@ -299,14 +321,14 @@ impl DenoiseView {
 
 impl DenoiseView {
     /// What a `--screenshot` run prints of the denoiser: its line in the panel, the refreshes,
-    /// the last refresh's wall time and the CPU time of this module's own work.
+    /// the last refresh's wall time and the frames' time spent in this module.
     pub fn statistics(&self) -> String {
         format!(
-            "denoise: {}, {} refreshes, last {:.0} ms from submission to result, {:.0} ms of CPU in the viewer",
+            "denoise: {}, {} refreshes, last {:.0} ms from start to estimate, {:.2} s of the frames in the denoiser",
             self.summary(),
             self.refreshes,
             self.estimate.map_or(0.0, |e| 1e3 * e.seconds),
-            1e3 * self.cpu_seconds
+            self.seconds
         )
     }
 }
@@ -358,4 +380,30 @@ pub fn difference(whole: &Accumulator, earlier: &Accumulator) -> Result<Accumula
 pub fn colour_image(image: &RgbImage32, exposure: f32) -> egui::ColorImage {
     let rgba = illum_image::tonemap::to_rgba8(image, exposure, Encoding::Gamma22);
     egui::ColorImage::from_rgba_unmultiplied([image.width as usize, image.height as usize], rgba.as_raw())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The second half is exactly the samples folded after the snapshot.
+    #[test]
+    fn the_difference_of_accumulations_is_the_later_samples() {
+        let first = [[1.0, 2.0, 3.0, 2.0], [0.5, 0.5, 0.5, 1.0]];
+        let first_sq = [[0.5, 2.5, 4.5, 0.0], [0.25, 0.25, 0.25, 0.0]];
+        let later = [[4.0, 1.0, 0.0, 3.0], [2.0, 2.0, 2.0, 2.0]];
+        let later_sq = [[6.0, 0.5, 0.0, 0.0], [2.5, 2.5, 2.5, 0.0]];
+        let mut whole = Accumulator::new(2, 1);
+        whole.fold(0, &first, &first_sq);
+        let snapshot = whole.clone();
+        whole.fold(0, &later, &later_sq);
+        let mut expected = Accumulator::new(2, 1);
+        expected.fold(0, &later, &later_sq);
+        let b = difference(&whole, &snapshot).unwrap();
+        assert_eq!(b.state().count, expected.state().count);
+        assert_eq!(b.state().sum, expected.state().sum);
+        assert_eq!(b.state().sum_sq, expected.state().sum_sq);
+        assert_eq!(b.total_samples(), 5);
+        assert!(difference(&whole, &Accumulator::new(1, 1)).is_err());
+    }
 }
