@@ -3,10 +3,12 @@
 //! but a bias, and this shows where the bias is.
 //!
 //! The truth is either a file given with `--reference FILE.exr` (desktop; an illum EXR of the
-//! same scene content, `illum.scene_hash`, and size), or the path tracer's own accumulation in
-//! this session when it shows the same scene from the same camera at the same size (in the
-//! browser too). A file that does not match the view is refused by name, and the panel says
-//! which truth is used and how converged it is (its spp and estimated error).
+//! same scene content, `illum.scene_hash`, and size), or without one the path tracer's own
+//! accumulation in this session when it shows the same scene from the same camera at the same
+//! size (in the browser too). A truth that does not match the view is refused by name (a file
+//! given is not replaced by the path tracer's image), and the panel says which truth is used
+//! and how converged it is (its spp and estimated error). The truth's own noise shows in the
+//! map too: at a few spp it sets the scale.
 //!
 //! The map shows the luminance of the difference, image minus truth: blue where the image is
 //! darker than the truth, white where they agree, red where it is brighter. Its scale (the
@@ -154,7 +156,8 @@ impl DifferenceView {
                 }
             }
         }
-        if chosen.is_none() {
+        // A file given is the truth: when it does not fit, that is said, not replaced.
+        if self.reference.is_none() {
             match path_tracer {
                 None => refusals.push(
                     "no truth: show this scene in the path tracer's mode first (its accumulation is the truth), \
@@ -239,8 +242,8 @@ fn path_tracer_refusal(pt: PathTracerTruth<'_>, scene: &Scene) -> Option<String>
     }
     if scene_hash(pt.scene) != scene_hash(scene) {
         return Some(format!(
-            "the path tracer shows {:?} from another camera or with other content: show the same scene, \
-             and move the camera in one mode only (switching modes carries it)",
+            "the path tracer's image is of {:?} from another camera or with other content: show this view \
+             in the path tracer's mode (switching modes carries the camera) and let it accumulate",
             pt.scene.name
         ));
     }

@@ -138,6 +138,11 @@ impl WhittedMode {
         self.texture.as_ref().map(egui::TextureHandle::id)
     }
 
+    /// The last frame's image (linear RGB) and the scene it is of, camera at its size.
+    pub fn image(&self) -> Option<(&RgbImage32, &Scene)> {
+        self.last.as_ref().map(|(image, scene)| (image, scene))
+    }
+
     /// True while a frame is being read back (the window must keep repainting to finish it).
     pub fn is_busy(&self) -> bool {
         self.pending.is_some()

@@ -193,3 +193,125 @@ fn a_drag_gives_a_fresh_denoised_image_at_low_spp() {
     );
     assert!(mode.denoise.refreshes > before);
 }
+
+/// The path tracer's accumulation of the Whitted scene at 8 spp, then the Whitted mode with the
+/// Difference view on (its image is half the view's size, as the path tracer's at scale 0.5).
+fn whitted_beside_the_path_tracer() -> Harness<'static, ViewerApp> {
+    let mut harness = harness("scenes/whitted.toml", RendererKind::PathTrace);
+    let mode = harness.state_mut().pathtrace_mut().unwrap();
+    mode.settings.stop.spp = Some(8);
+    mode.settings.resolution_scale = 0.5;
+    let stopped = run_until(&mut harness, 400, |app| app.pathtrace().unwrap().stop_reason().is_some());
+    assert!(stopped, "{}", harness.state().pathtrace().unwrap().summary());
+    harness.state_mut().switch_to(RendererKind::Whitted);
+    harness.run_steps(2);
+    harness.get_by_label("Difference").click();
+    run_until(&mut harness, 20, |app| app.whitted().unwrap().difference.summary().is_some());
+    // The panel is drawn before the image: one more frame shows the new summary in it.
+    harness.run_steps(1);
+    harness
+}
+
+fn luminance(p: [f32; 3]) -> f64 {
+    p.iter().zip(illum_image::rgb_image::REC709_LUMINANCE).map(|(&c, w)| f64::from(c) * w).sum()
+}
+
+/// The Whitted image's signed difference from the path tracer's accumulation of the same view,
+/// pixel by pixel, with its scale and how converged the truth is; moving the camera in the
+/// Whitted mode alone leaves no truth for the new view, which the panel says, and the image is
+/// shown again.
+#[test]
+fn the_whitted_difference_from_the_path_tracers_accumulation() {
+    let mut harness = whitted_beside_the_path_tracer();
+    let app = harness.state();
+    let whitted = app.whitted().unwrap();
+    let summary = whitted
+        .difference
+        .summary()
+        .unwrap_or_else(|| panic!("no difference: {:?}", whitted.difference.refusal));
+    let (image, _) = whitted.image().unwrap();
+    let truth = app.pathtrace().unwrap().accumulator().unwrap().mean_image();
+    assert_eq!((image.width, image.height), (truth.width, truth.height));
+    for (p, ((a, t), d)) in image.pixels.iter().zip(&truth.pixels).zip(&summary.values).enumerate() {
+        let expected = luminance(*a) - luminance(*t);
+        assert!((f64::from(*d) - expected).abs() <= 1e-6, "pixel {p}: {d} against {expected}");
+    }
+    let beyond = summary.values.iter().filter(|v| f64::from(v.abs()) > summary.scale).count();
+    println!(
+        "scale {}, mean difference {:+.4} of truth mean {:.4}, {beyond} of {} pixels beyond the scale; {}",
+        summary.scale,
+        summary.mean_difference,
+        summary.truth_mean,
+        summary.values.len(),
+        summary.truth
+    );
+    assert!(beyond <= summary.values.len() / 100 + 1, "{beyond} pixels beyond the scale");
+    assert!(summary.truth.contains("8 spp"), "{}", summary.truth);
+    let panel = format!("+{}", summary.scale);
+    assert!(harness.query_by_label(&panel).is_some(), "the panel does not show the scale {panel}");
+    assert_eq!(whitted.difference.texture(), harness.state().whitted().unwrap().difference.texture());
+    let shown_difference = whitted.difference.texture();
+    assert!(shown_difference.is_some());
+    let path = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("whitted_difference.png");
+    let map: Vec<u8> = summary
+        .values
+        .iter()
+        .flat_map(|&d| {
+            let [r, g, b] = illum_viewer::difference_view::diverging_colour(d, summary.scale as f32);
+            [r, g, b, 255]
+        })
+        .collect();
+    image::RgbaImage::from_raw(image.width, image.height, map).unwrap().save(&path).unwrap();
+    println!("saved {}", path.display());
+
+    // Orbit the Whitted camera only: the path tracer's image is of the old view.
+    harness.state_mut().whitted_mut().unwrap().camera.orbit(0.2, 0.0);
+    run_until(&mut harness, 20, |app| app.whitted().unwrap().difference.summary().is_none());
+    let whitted = harness.state().whitted().unwrap();
+    let refusal = whitted.difference.refusal.clone().expect("a refusal");
+    println!("{refusal}");
+    assert!(refusal.contains("another camera"), "{refusal}");
+    assert!(whitted.difference.texture().is_none());
+}
+
+/// `--reference`: an EXR of the same view is the truth (the same difference as from the path
+/// tracer it was saved from); one of another scene is refused naming both scenes.
+#[test]
+fn a_reference_file_is_the_truth_or_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut harness = whitted_beside_the_path_tracer();
+    let from_path_tracer =
+        harness.state().whitted().unwrap().difference.summary().cloned().expect("a difference");
+    let mode = harness.state_mut().pathtrace_mut().unwrap();
+    mode.save_path = dir.path().join("truth.exr").display().to_string();
+    let truth = mode.save("exr").unwrap_or_else(|e| panic!("{e}"));
+    harness.state_mut().whitted_mut().unwrap().difference.load_reference(&truth).unwrap();
+    harness.run_steps(2);
+    let summary = harness.state().whitted().unwrap().difference.summary().cloned().expect("a difference");
+    assert!(summary.truth.contains("truth.exr") && summary.truth.contains("8 spp"), "{}", summary.truth);
+    assert_eq!(summary.values, from_path_tracer.values);
+
+    // The Cornell box saved at the same size is of another scene.
+    let mut cornell = harness_sized_cornell();
+    let mode = cornell.state_mut().pathtrace_mut().unwrap();
+    mode.save_path = dir.path().join("cornell.exr").display().to_string();
+    let other = mode.save("exr").unwrap_or_else(|e| panic!("{e}"));
+    harness.state_mut().whitted_mut().unwrap().difference.load_reference(&other).unwrap();
+    harness.run_steps(2);
+    let whitted = harness.state().whitted().unwrap();
+    let refusal = whitted.difference.refusal.clone().expect("a refusal");
+    println!("{refusal}");
+    for part in ["cornell.exr", "\"cornell\"", "\"whitted\"", "illum.scene_hash"] {
+        assert!(refusal.contains(part), "{part:?} not in {refusal}");
+    }
+    assert!(whitted.difference.summary().is_none() && whitted.difference.texture().is_none());
+}
+
+/// A Cornell box path-traced at 2 spp.
+fn harness_sized_cornell() -> Harness<'static, ViewerApp> {
+    let mut harness = harness("scenes/cornell.toml", RendererKind::PathTrace);
+    harness.state_mut().pathtrace_mut().unwrap().settings.stop.spp = Some(2);
+    let stopped = run_until(&mut harness, 200, |app| app.pathtrace().unwrap().stop_reason().is_some());
+    assert!(stopped);
+    harness
+}
