@@ -124,7 +124,7 @@ async function cornellExtras(page) {
   // Save EXR (the button's place in this 960 x 600 layout, left panel): a download.
   const [download] = await Promise.all([
     page.waitForEvent('download', { timeout }),
-    click(page, 118, 535),
+    click(page, 118, 558),
   ]);
   await download.saveAs(join(out, 'download.exr'));
   writeFileSync(join(out, 'download.name'), download.suggestedFilename());
