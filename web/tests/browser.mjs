@@ -118,8 +118,8 @@ const done = {
   refusal: ['the refusal and a frame', (s) => s.modeRefusal && Number(s.windowFps) > 0],
 };
 
-// The Cornell box's path-tracer page goes on with what a user does next: Save EXR, and a bad
-// scene file dropped on the window.
+// The Cornell box's path-tracer page goes on with what a user does next: Save EXR, Denoise,
+// and a bad scene file dropped on the window.
 async function cornellExtras(page) {
   // Save EXR (the button's place in this 960 x 600 layout, left panel): a download.
   const [download] = await Promise.all([
@@ -129,6 +129,14 @@ async function cornellExtras(page) {
   await download.saveAs(join(out, 'download.exr'));
   writeFileSync(join(out, 'download.name'), download.suggestedFilename());
   console.log(`[download] ${download.suggestedFilename()}`);
+
+  // Denoise (the checkbox under Error view): the guides and the à-trous filter run on
+  // SwiftShader, read back without waiting, and the panel shows the estimated errors.
+  await click(page, 15, 237);
+  const denoised = await waitFor(page, 'denoise', 'the denoised image',
+    (s) => (s.pathtraceDenoise || '').startsWith('estimated error: noisy'));
+  await shoot(page, 'denoise', denoised);
+  await click(page, 15, 237);
 
   // A bad scene file dropped on the window: its error shows and the Cornell box stays.
   const transfer = await page.evaluateHandle(() => {

@@ -318,6 +318,10 @@ impl ViewerApp {
                 "pathtrace-caustics",
                 text(pathtrace.and_then(PathTraceMode::caustics_running).map(|on| on_off(on).to_owned())),
             ),
+            (
+                "pathtrace-denoise",
+                text(pathtrace.filter(|p| p.settings.denoise).map(|p| p.denoise.summary())),
+            ),
             ("raster-message", text(self.raster().and_then(|r| r.message.clone()))),
             ("view-rect", text(self.view_rect.map(|[x, y, w, h]| format!("{x} {y} {w} {h}")))),
             ("whitted-frames", text(self.whitted().map(|w| w.frames.to_string()))),
