@@ -4,10 +4,11 @@
 //!
 //! The halves without a second tracer: the samples of a pixel are indices 0, 1, 2, ..., so the
 //! accumulation at an earlier spp (a snapshot, A) and what came after it (the whole less A, B)
-//! are two independent sets of samples. A refresh at spp n, with the snapshot taken at the
-//! previous refresh's spp s, denoises A (s spp), B (n - s spp) and the whole (n spp), estimates
-//! the denoised error from A and B ([`HalvesError`]), shows the denoised whole, and keeps the
-//! whole as the next snapshot.
+//! are two independent sets of samples. While the toggle is on, the accumulation is copied
+//! each time its spp has doubled (from 2 spp on; the last two copies are kept, a few MB each),
+//! whether or not the guides are back yet. A refresh at spp n denoises the whole (n spp), and
+//! with the newest snapshot A of s <= n - 2 spp (s >= 2) also A and B (n - s spp), estimates
+//! the denoised error from A and B ([`HalvesError`]) and shows the denoised whole.
 //!
 //! When: every refresh costs three filter runs, each on lavapipe as much as 10 to 16 spp of
 //! path tracing (docs/denoising.md, "Cost"). So the image is denoised again when the spp has
@@ -82,8 +83,12 @@ pub struct DenoiseView {
     scene: Option<Scene>,
     guides: Option<Guides>,
     pending_guides: Option<PendingGuides>,
-    /// The accumulation at the last refresh and its spp: the next refresh's first half.
-    snapshot: Option<(Accumulator, u32)>,
+    /// The accumulation at its last two doublings of spp, oldest first: the first halves.
+    snapshots: Vec<(Accumulator, u32)>,
+    /// The last refresh's spp.
+    refreshed: Option<u32>,
+    /// The render took no more samples at the last frame.
+    stopped: bool,
     job: Option<Job>,
     shown: Option<Shown>,
     estimate: Option<DenoiseEstimate>,
@@ -148,7 +153,7 @@ impl DenoiseView {
     ) {
         let accumulator = tracer.accumulator();
         let restarted = self.scene.as_ref() != Some(tracer.scene())
-            || self.snapshot.as_ref().is_some_and(|(s, _)| s.total_samples() > accumulator.total_samples())
+            || self.snapshots.last().is_some_and(|(s, _)| s.total_samples() > accumulator.total_samples())
             || self.job.as_ref().is_some_and(|j| j.whole.total_samples() > accumulator.total_samples());
         if restarted {
             self.clear();
@@ -178,6 +183,18 @@ impl DenoiseView {
         exposure: f32,
         stopped: bool,
     ) -> Result<(), String> {
+        self.stopped = stopped;
+        let spp = tracer.spp_done();
+        let accumulator = tracer.accumulator();
+        if spp >= 2
+            && accumulator_complete(accumulator, spp)
+            && self.snapshots.last().is_none_or(|(_, s)| spp >= s.saturating_mul(2))
+        {
+            self.snapshots.push((accumulator.clone(), spp));
+            if self.snapshots.len() > 2 {
+                self.snapshots.remove(0);
+            }
+        }
         if self.guides.is_none() {
             match &self.pending_guides {
                 None => {
@@ -197,10 +214,9 @@ impl DenoiseView {
         if self.job.is_some() {
             return self.collect(gpu, ctx, exposure);
         }
-        let spp = tracer.spp_done();
-        let due = match &self.snapshot {
+        let due = match self.refreshed {
             None => spp >= FIRST_SPP,
-            Some((_, last)) => spp >= last.saturating_mul(REFRESH_FACTOR) || (stopped && spp > *last),
+            Some(last) => spp >= last.saturating_mul(REFRESH_FACTOR) || (stopped && spp > last),
         };
         self.due = due && self.error.is_none();
         if due && accumulator_complete(tracer.accumulator(), spp) {
@@ -213,11 +229,9 @@ impl DenoiseView {
     /// Prepares the filter runs of a refresh at `spp`.
     fn start(&mut self, whole: Accumulator, spp: u32) -> Result<(), String> {
         let guides = self.guides.as_ref().ok_or("no guide buffers")?;
-        let halves = match &self.snapshot {
-            Some((a, a_spp)) if *a_spp >= 2 && spp - a_spp >= 2 => {
-                Some([(a.clone(), *a_spp), (difference(&whole, a)?, spp - a_spp)])
-            }
-            _ => None,
+        let halves = match self.snapshots.iter().rev().find(|(_, a_spp)| *a_spp >= 2 && a_spp + 2 <= spp) {
+            Some((a, a_spp)) => Some([(a.clone(), *a_spp), (difference(&whole, a)?, spp - a_spp)]),
+            None => None,
         };
         let mut inputs: Vec<DenoiseInput> = std::iter::once(&whole)
             .chain(halves.iter().flat_map(|h| h.iter().map(|(a, _)| a)))
@@ -276,7 +290,7 @@ impl DenoiseView {
             halves: job.halves.as_ref().map(|[(_, a), (_, b)]| (*a, *b)),
             seconds: job.started.elapsed().as_secs_f64(),
         });
-        self.snapshot = Some((job.whole, job.spp));
+        self.refreshed = Some(job.spp);
         self.refreshes += 1;
         self.error = None;
         Ok(())
@@ -307,6 +321,9 @@ impl DenoiseView {
             (None, Some(est)) => {
                 let denoised = match (est.denoised, est.halves) {
                     (Some(e), _) => percent(Some(e)),
+                    (None, _) if self.stopped => {
+                        "n/a (the render stopped before it had two halves)".to_owned()
+                    }
                     (None, _) => format!("n/a until {} spp", (est.spp * REFRESH_FACTOR).max(4)),
                 };
                 format!(
