@@ -12,9 +12,11 @@
 //!
 //! When: every refresh costs three filter runs, each on lavapipe as much as 10 to 16 spp of
 //! path tracing (docs/denoising.md, "Cost"). So the image is denoised again when the spp has
-//! doubled since the last time ([`REFRESH_FACTOR`]), which keeps the filter's share of the
-//! work bounded whatever the spp (one refresh per doubling: at most three filter runs per
-//! doubling of the work), and once more when the render stops. The first image of an
+//! doubled since the last time ([`REFRESH_FACTOR`]), which makes the filter's share of the
+//! work fall as the render goes on (one refresh per doubling), and the path tracer has had
+//! [`PATIENCE`] times the frames' time of the last refresh since it ended, which caps that share
+//! near a third at low spp, where the spp doubles faster than a refresh runs; and once more
+//! when the render stops. The first image of an
 //! accumulation (after a drag, a reset) is denoised as soon as it has [`FIRST_SPP`] samples
 //! per pixel, without an estimate (the halves need 2 samples each). The guide buffers
 //! (albedo, normal) are rendered once per accumulation, when the toggle is on.
@@ -33,6 +35,10 @@ use illum_scene::Scene;
 
 /// The image is denoised again once the spp reached this factor times the last refresh's.
 pub const REFRESH_FACTOR: u32 = 2;
+/// After a refresh, the next waits until the path tracer has had this many times the frame
+/// time the refresh took (so the denoiser takes at most a third of the frames' time, also at
+/// low spp, where the spp doubles in less time than a refresh takes on lavapipe).
+pub const PATIENCE: f64 = 2.0;
 /// The spp at which an accumulation's first denoised image is made.
 pub const FIRST_SPP: u32 = 2;
 
@@ -85,8 +91,10 @@ pub struct DenoiseView {
     pending_guides: Option<PendingGuides>,
     /// The accumulation at its last two doublings of spp, oldest first: the first halves.
     snapshots: Vec<(Accumulator, u32)>,
-    /// The last refresh's spp.
-    refreshed: Option<u32>,
+    /// The last refresh's spp, when it ended, and the frames' time it took.
+    refreshed: Option<(u32, Instant, f64)>,
+    /// `seconds` when the refresh under way started.
+    job_seconds: f64,
     /// The render took no more samples at the last frame.
     stopped: bool,
     job: Option<Job>,
@@ -216,7 +224,10 @@ impl DenoiseView {
         }
         let due = match self.refreshed {
             None => spp >= FIRST_SPP,
-            Some(last) => spp >= last.saturating_mul(REFRESH_FACTOR) || (stopped && spp > last),
+            Some((last, _, _)) if stopped => spp > last,
+            Some((last, ended, cost)) => {
+                spp >= last.saturating_mul(REFRESH_FACTOR) && ended.elapsed().as_secs_f64() >= PATIENCE * cost
+            }
         };
         self.due = due && self.error.is_none();
         if due && accumulator_complete(tracer.accumulator(), spp) {
@@ -241,6 +252,7 @@ impl DenoiseView {
         inputs.reverse();
         self.job =
             Some(Job { spp, whole, halves, inputs, pending: None, done: vec![], started: Instant::now() });
+        self.job_seconds = self.seconds;
         Ok(())
     }
 
@@ -290,7 +302,7 @@ impl DenoiseView {
             halves: job.halves.as_ref().map(|[(_, a), (_, b)]| (*a, *b)),
             seconds: job.started.elapsed().as_secs_f64(),
         });
-        self.refreshed = Some(job.spp);
+        self.refreshed = Some((job.spp, Instant::now(), self.seconds - self.job_seconds));
         self.refreshes += 1;
         self.error = None;
         Ok(())

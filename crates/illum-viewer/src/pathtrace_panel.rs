@@ -312,6 +312,8 @@ impl PathTraceMode {
         self.stats = Stats { width: self.stats.width, height: self.stats.height, ..Stats::default() };
         self.shown_samples = u64::MAX;
         self.work = WorkLog { smallest_submission: u64::MAX, ..WorkLog::default() };
+        // Its snapshots and denoised image are of the samples just discarded.
+        self.denoise.clear();
     }
 
     /// The scene to render at `width` x `height`: the file's geometry with the panel's settings
@@ -499,7 +501,8 @@ impl PathTraceMode {
                 self.tracer = Some(tracer);
             }
         }
-        // A fresh accumulation: the stop rules and the clock start over too.
+        // A fresh accumulation: the stop rules, the clock and the denoised image start over too.
+        self.denoise.clear();
         self.progressive.restart();
         self.sync_clock();
         self.shown_samples = u64::MAX;

@@ -146,7 +146,7 @@ fn denoise_shows_the_filtered_accumulation_and_its_estimated_error() {
 }
 
 /// A drag restarts the accumulation: the denoised image of the old view is dropped at once and
-/// a new one, of a few spp, follows within a few frames.
+/// a new one, of a few spp, follows within a few frames. Reset drops it too.
 #[test]
 fn a_drag_gives_a_fresh_denoised_image_at_low_spp() {
     let mut harness = harness("scenes/cornell.toml", RendererKind::PathTrace);
@@ -192,6 +192,12 @@ fn a_drag_gives_a_fresh_denoised_image_at_low_spp() {
         estimate.unwrap().spp
     );
     assert!(mode.denoise.refreshes > before);
+
+    // Reset discards the samples, and the denoised image and halves made of them.
+    harness.get_by_label("Reset").click();
+    harness.run_steps(1);
+    let mode = harness.state().pathtrace().unwrap();
+    assert!(mode.denoise.estimate().is_none() && mode.denoise.image().is_none(), "{}", mode.summary());
 }
 
 /// The path tracer's accumulation of the Whitted scene at 8 spp, then the Whitted mode with the
