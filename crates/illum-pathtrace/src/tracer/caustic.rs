@@ -35,8 +35,10 @@
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use illum_gpu::readback::PendingRead;
+use illum_gpu::timing::PassTimer;
 use illum_gpu::{GpuContext, wgpu};
 use illum_scene::{MaterialKind, Scene};
+use web_time::Instant;
 
 use crate::accumulator::Accumulator;
 use illum_rtcore::GpuShape;
@@ -195,9 +197,22 @@ impl CausticPass {
 /// A dispatch of frames whose readback is under way (polled).
 struct InFlight {
     read: PendingRead,
+    bytes: DispatchBytes,
     /// The frames it traced.
     count: u32,
+    launched: Instant,
 }
+
+/// What a dispatch's staging copy holds: its frames' bytes, then the timestamps (if timed).
+#[derive(Clone, Copy)]
+struct DispatchBytes {
+    frames: u64,
+    total: u64,
+}
+
+/// The timer's names of the light tracer's and the photon gather's passes.
+const CAUSTIC_PASS: &str = "caustic";
+const GATHER_PASS: &str = "photon gather";
 
 /// The photon gather's pipeline and grid (shader def CAUSTIC_GATHER).
 struct Gather {
@@ -225,7 +240,13 @@ pub(crate) struct CausticTracer {
     splat_size: u64,
     bind_group: wgpu::BindGroup,
     base: CausticParams,
-    frames_per_dispatch: u32,
+    /// The most frames one dispatch may carry (the splat and photon buffers' size).
+    max_frames_per_dispatch: u32,
+    /// What one frame cost in the last dispatch, in seconds: sizes the next dispatch when the
+    /// caller aims at a time per step (see [`Self::dispatch_frames`]).
+    seconds_per_frame: Option<f64>,
+    /// Times the light tracer's and the gather's passes, where the device has timestamps.
+    timer: PassTimer,
     groups: (u32, u32),
     pixels: usize,
     /// What a fixed-point unit is worth in true radiance: 2^radiance_exponent / S.
@@ -272,7 +293,7 @@ impl CausticTracer {
                 ),
             });
         }
-        let frames_per_dispatch =
+        let max_frames_per_dispatch =
             (SPLAT_BYTES.min(max_binding) / largest_frame_bytes).clamp(1, crate::CHUNK_SAMPLES as u64) as u32;
 
         let specular = |material: u32| {
@@ -350,7 +371,7 @@ impl CausticTracer {
             "caustic light-tracing",
         )?;
         let device = &gpu.device;
-        let splat_size = frame_bytes * u64::from(frames_per_dispatch);
+        let splat_size = frame_bytes * u64::from(max_frames_per_dispatch);
         let (params_buffer, discs_buffer, splat) = gpu.scoped("allocating the caustic's buffers", || {
             (
                 device.create_buffer(&wgpu::BufferDescriptor {
@@ -374,7 +395,7 @@ impl CausticTracer {
         let [params, objects, materials] = scene_buffers;
         // The photon maps: (photons, heads), the photons not cleared (only the heads lead to them).
         let photon_buffers = if gather {
-            let frames = u64::from(frames_per_dispatch);
+            let frames = u64::from(max_frames_per_dispatch);
             Some(gpu.scoped("allocating the photon maps", || {
                 let storage = |label, size| {
                     device.create_buffer(&wgpu::BufferDescriptor {
@@ -413,6 +434,7 @@ impl CausticTracer {
                 entries: &entries,
             })
         })?;
+        let timer = PassTimer::new(gpu, if gather { &[CAUSTIC_PASS, GATHER_PASS] } else { &[CAUSTIC_PASS] });
         let gather = match &photon_buffers {
             Some((_, heads)) => {
                 let pipeline = shaders::companion_pipeline(
@@ -446,7 +468,9 @@ impl CausticTracer {
             splat_size,
             bind_group,
             base,
-            frames_per_dispatch,
+            max_frames_per_dispatch,
+            seconds_per_frame: None,
+            timer,
             groups: (gx, gy),
             pixels,
             unit: 2f64.powi(gpu_scene.radiance_exponent) / f64::from(fixed_scale),
@@ -483,28 +507,56 @@ impl CausticTracer {
     }
 
     /// Traces the frames of pass `key` (absolute sample indices `key.first_sample..`, grouped
-    /// in chunks of `key.chunk`) and folds them, waiting for each dispatch's readback; nothing
-    /// to do when they are the ones already held.
+    /// in chunks of `key.chunk`) and folds them, waiting for each dispatch's readback. Without
+    /// `target_seconds` all of them, and it returns true; with it, one dispatch sized to that
+    /// time (a viewer's share of a frame), and it returns true only when the pass's frames were
+    /// all folded before this call (so a step is one dispatch or one band, never both).
     #[cfg(not(target_arch = "wasm32"))]
-    pub(crate) fn prepare_pass(&mut self, gpu: &GpuContext, key: PassKey) -> Result<(), PathTraceError> {
+    pub(crate) fn prepare_pass(
+        &mut self,
+        gpu: &GpuContext,
+        key: PassKey,
+        target_seconds: Option<f64>,
+    ) -> Result<bool, PathTraceError> {
         let mut pass = self.take_pass(key);
         // A polled read left in flight is abandoned: its frames are traced again here.
         pass.in_flight = None;
+        let ready = pass.complete();
         let (pixels, unit) = (self.pixels, self.unit);
-        while let Some((staging, bytes, count)) = self.launch_dispatch(gpu, &pass)? {
-            illum_gpu::readback::with_mapped(gpu, &staging, bytes, "reading back caustic frames", |data| {
-                pass.fold_frames(bytemuck::cast_slice(data), count, pixels, unit)
-            })?;
+        loop {
+            let started = Instant::now();
+            let Some((staging, read, count)) = self.launch_dispatch(gpu, &pass, target_seconds)? else {
+                break;
+            };
+            illum_gpu::readback::with_mapped(
+                gpu,
+                &staging,
+                read.total,
+                "reading back caustic frames",
+                |data| {
+                    pass.fold_frames(bytemuck::cast_slice(&data[..read.frames as usize]), count, pixels, unit)
+                },
+            )?;
             self.staging = Some(staging);
+            // What the step waited for: the frames, their readback and their fold.
+            self.seconds_per_frame = Some(started.elapsed().as_secs_f64() / f64::from(count));
+            if target_seconds.is_some() {
+                break;
+            }
         }
         self.pass = Some(pass);
-        Ok(())
+        Ok(ready)
     }
 
     /// The polled form of [`Self::prepare_pass`]: true once the frames of pass `key` are all
     /// folded. Each call folds the dispatch in flight if its mapping is done and then submits
     /// the next one; it never waits.
-    pub(crate) fn poll_pass(&mut self, gpu: &GpuContext, key: PassKey) -> Result<bool, PathTraceError> {
+    pub(crate) fn poll_pass(
+        &mut self,
+        gpu: &GpuContext,
+        key: PassKey,
+        target_seconds: Option<f64>,
+    ) -> Result<bool, PathTraceError> {
         let mut pass = self.take_pass(key);
         if let Some(flight) = pass.in_flight.take() {
             let Some(result) = flight.read.poll(gpu) else {
@@ -512,30 +564,55 @@ impl CausticTracer {
                 self.pass = Some(pass);
                 return Ok(false);
             };
-            pass.fold_frames(bytemuck::cast_slice(&result?), flight.count, self.pixels, self.unit);
+            let data = result?;
+            let frames = flight.bytes.frames as usize;
+            pass.fold_frames(bytemuck::cast_slice(&data[..frames]), flight.count, self.pixels, self.unit);
+            // The GPU's time where the device has timestamps; else the time until the mapping
+            // was seen done, which counts the frames drawn meanwhile (so dispatches stay short).
+            let gpu_ms =
+                self.timer.decode(&data[frames..]).map(|passes| passes.iter().map(|p| p.1).sum::<f64>());
+            let seconds = gpu_ms.map_or_else(|| flight.launched.elapsed().as_secs_f64(), |ms| ms * 1e-3);
+            self.seconds_per_frame = Some(seconds / f64::from(flight.count));
             self.staging = Some(flight.read.into_buffer());
         }
-        let launched = self.launch_dispatch(gpu, &pass)?;
+        let launched = self.launch_dispatch(gpu, &pass, target_seconds)?;
         let complete = launched.is_none();
         pass.in_flight = launched.map(|(staging, bytes, count)| InFlight {
-            read: PendingRead::start(staging, bytes, "reading back caustic frames"),
+            read: PendingRead::start(staging, bytes.total, "reading back caustic frames"),
+            bytes,
             count,
+            launched: Instant::now(),
         });
         self.pass = Some(pass);
         Ok(complete)
     }
 
-    /// Submits the next dispatch of `pass` and its copy into the staging buffer: (the staging
-    /// buffer, the bytes to read, the frames traced), or `None` when the pass is complete.
+    /// Frames for the next dispatch: as many as the buffers hold without a `target_seconds`,
+    /// else the target's worth at the last measured cost (one before any measurement, and at
+    /// least one).
+    fn dispatch_frames(&self, target_seconds: Option<f64>) -> u32 {
+        match (target_seconds, self.seconds_per_frame) {
+            (None, _) => self.max_frames_per_dispatch,
+            (Some(_), None) => 1,
+            (Some(target), Some(cost)) => {
+                (target / cost.max(1e-9)).floor().clamp(1.0, f64::from(self.max_frames_per_dispatch)) as u32
+            }
+        }
+    }
+
+    /// Submits the next dispatch of `pass` (sized by [`Self::dispatch_frames`]) and its copy
+    /// into the staging buffer: (the staging buffer, what to read, the frames traced), or
+    /// `None` when the pass is complete.
     fn launch_dispatch(
         &mut self,
         gpu: &GpuContext,
         pass: &CausticPass,
-    ) -> Result<Option<(wgpu::Buffer, u64, u32)>, PathTraceError> {
+        target_seconds: Option<f64>,
+    ) -> Result<Option<(wgpu::Buffer, DispatchBytes, u32)>, PathTraceError> {
         if pass.complete() {
             return Ok(None);
         }
-        let count = self.frames_per_dispatch.min(pass.key.spp - pass.frames_done);
+        let count = self.dispatch_frames(target_seconds).min(pass.key.spp - pass.frames_done);
         let params = CausticParams {
             frame_base: pass.key.first_sample + pass.frames_done,
             frame_count: count,
@@ -548,7 +625,7 @@ impl CausticTracer {
             None => gpu.scoped("allocating the caustic's staging buffer", || {
                 gpu.device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some("caustic staging"),
-                    size: self.splat_size,
+                    size: self.splat_size + self.timer.result_size(),
                     usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
                     mapped_at_creation: false,
                 })
@@ -566,7 +643,7 @@ impl CausticTracer {
         {
             let mut compute = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("caustic"),
-                timestamp_writes: None,
+                timestamp_writes: self.timer.compute_writes(CAUSTIC_PASS),
             });
             compute.set_pipeline(&self.pipeline);
             compute.set_bind_group(0, &self.bind_group, &[]);
@@ -576,15 +653,17 @@ impl CausticTracer {
         if let Some(gather) = &self.gather {
             let mut compute = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("photon gather"),
-                timestamp_writes: None,
+                timestamp_writes: self.timer.compute_writes(GATHER_PASS),
             });
             compute.set_pipeline(&gather.pipeline);
             compute.set_bind_group(0, &gather.bind_group, &[]);
             compute.dispatch_workgroups(self.groups.0, self.groups.1, count);
         }
         encoder.copy_buffer_to_buffer(&self.splat, 0, &staging, 0, bytes);
+        self.timer.copy_results(&mut encoder, &staging, bytes);
         gpu.queue.submit([encoder.finish()]);
-        Ok(Some((staging, bytes, count)))
+        let timestamps = if self.timer.enabled() { self.timer.result_size() } else { 0 };
+        Ok(Some((staging, DispatchBytes { frames: bytes, total: bytes + timestamps }, count)))
     }
 
     /// Adds the held pass's chunk `k` for the band's pixels `first_pixel..` to the accumulator,
