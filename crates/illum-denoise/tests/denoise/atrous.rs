@@ -78,3 +78,21 @@ fn the_gpu_filter_matches_its_f64_copy_on_a_render() {
     let guides = tracer.guides(8).expect("guides");
     assert_matches_f64(&DenoiseInput::from_render(tracer.accumulator(), &guides), "Cornell 64 x 64, 8 spp");
 }
+
+/// The filter read back without waiting (`AtrousDenoiser::start`, the viewer's) gives the
+/// blocking readback's image and variances, bit for bit.
+#[test]
+fn the_polled_filter_is_the_blocking_one() {
+    let input = synthetic(23, 17, 9);
+    let filter = AtrousDenoiser::new(common::gpu()).expect("compiles");
+    let settings = AtrousSettings::default();
+    let blocking = filter.denoise(&input, &settings).expect("denoises");
+    let pending = filter.start(&input, &settings).expect("submitted");
+    let polled = loop {
+        if let Some(result) = pending.poll(common::gpu()) {
+            break result.expect("read back");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(1));
+    };
+    assert!(polled == blocking, "the polled filter differs from the blocking one");
+}

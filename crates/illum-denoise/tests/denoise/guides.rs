@@ -72,3 +72,19 @@ fn guides_follow_mirrors_and_glass_to_the_next_diffuse_surface() {
     let a = glass.albedo[centre];
     assert!(a.iter().all(|&v| (0.6 - 1e-6..=0.8 + 1e-6).contains(&v)), "glass: albedo {a:?}");
 }
+
+/// The guides read back without waiting (`start_guides`, the viewer's) are the blocking
+/// readback's, bit for bit.
+#[test]
+fn polled_guides_are_the_blocking_ones() {
+    let tracer = common::render(&common::cornell(2, 5));
+    let blocking = tracer.guides(GUIDE_SAMPLES).expect("guides");
+    let pending = tracer.start_guides(GUIDE_SAMPLES).expect("submitted");
+    let polled = loop {
+        if let Some(result) = pending.poll(common::gpu()) {
+            break result.expect("read back");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(1));
+    };
+    assert!(polled == blocking, "the polled guides differ from the blocking ones");
+}
