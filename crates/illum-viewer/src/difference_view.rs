@@ -39,13 +39,14 @@ pub fn diverging_colour(d: f32, scale: f32) -> [u8; 3] {
     ramp(&DIVERGING, 0.5 + 0.5 * d / scale)
 }
 
-/// The smallest of 1, 2, 5 times a power of ten that is at least `x` (a positive value).
+/// The smallest of 1, 2, 5 times a power of ten that is at least `x` (a positive value), within
+/// f32 rounding (a difference of f32 luminances 0.1 apart is 0.1 to 1e-7 relative).
 pub fn round_up_125(x: f64) -> f64 {
     let decade = 10f64.powf(x.log10().floor());
     [1.0, 2.0, 5.0, 10.0]
         .into_iter()
         .map(|m| m * decade)
-        .find(|&v| v >= x * (1.0 - 1e-12))
+        .find(|&v| v >= x * (1.0 - 1e-6))
         .unwrap_or(10.0 * decade)
 }
 
