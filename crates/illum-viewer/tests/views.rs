@@ -134,6 +134,14 @@ fn denoise_shows_the_filtered_accumulation_and_its_estimated_error() {
     let expected_png =
         illum_image::to_rgba8(mode.denoise.image().unwrap(), 0.0, illum_image::Encoding::Gamma22);
     assert!(png == expected_png, "the saved PNG is not the denoised image");
+    // Save EXR stays the raw samples' checkpoint and records the denoised image's estimate.
+    let exr = mode.save("exr").unwrap_or_else(|e| panic!("{e}"));
+    let (raw, attributes) = illum_image::load_exr(&exr).unwrap();
+    let metadata = illum_image::ExrMetadata::from_attributes(&exr, &attributes).unwrap().expect("metadata");
+    assert!(raw == mode.accumulator().unwrap().mean_image(), "the EXR is not the raw mean");
+    assert_eq!(metadata.get("denoised_spp"), Some("64"));
+    let recorded: f64 = metadata.get("denoised_estimated_relative_error").expect("recorded").parse().unwrap();
+    assert_eq!(recorded, denoised);
     let path = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("denoised.png");
     std::fs::copy(&saved, &path).unwrap();
     println!("saved {}", path.display());
