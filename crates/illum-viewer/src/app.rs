@@ -394,9 +394,17 @@ impl ViewerApp {
             ];
             if compact {
                 let shown = modes.iter().find(|(m, _)| *m == chosen).map_or("", |(_, name)| name);
+                let shown = if self.auto_shown { "Auto" } else { shown };
                 egui::ComboBox::from_id_salt("mode").selected_text(shown).show_ui(ui, |ui| {
                     for (mode, name) in modes {
-                        ui.selectable_value(&mut chosen, mode, name);
+                        if ui.selectable_label(!self.auto_shown && chosen == mode, name).clicked() {
+                            chosen = mode;
+                            self.auto_shown = false;
+                        }
+                    }
+                    #[cfg(not(target_arch = "wasm32"))]
+                    if ui.selectable_label(self.auto_shown, "Auto").clicked() {
+                        self.auto_shown = true;
                     }
                 });
             } else {
@@ -434,10 +442,15 @@ impl ViewerApp {
             }
             #[cfg(target_arch = "wasm32")]
             self.web_open_buttons(ui);
-            // After the buttons that open files, so that they keep their places.
-            ui.separator();
-            if ui.selectable_label(self.auto_shown, "Auto").clicked() {
-                self.auto_shown = true;
+            // After the buttons that open files, so that they keep their places (a compact bar
+            // has Auto in its drop-down). Not in the browser: the pilot reads images back with
+            // blocking waits (auto_pilot.rs).
+            #[cfg(not(target_arch = "wasm32"))]
+            if !compact {
+                ui.separator();
+                if ui.selectable_label(self.auto_shown, "Auto").clicked() {
+                    self.auto_shown = true;
+                }
             }
             if compact {
                 return;

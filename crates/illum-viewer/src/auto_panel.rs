@@ -197,15 +197,6 @@ impl AutoMode {
             )
             .labelled_by(label.id);
         });
-        if cfg!(target_arch = "wasm32") {
-            ui.colored_label(
-                ui.visuals().warn_fg_color,
-                "Not in the browser: the pilot reads the rasterizer's and the object-ID images back with \
-                 blocking waits, which a web page cannot do. `render --renderer auto` or the desktop viewer \
-                 offer it.",
-            );
-            return;
-        }
         if let Some((done, what)) = self.progress() {
             ui.add(egui::ProgressBar::new(done).show_percentage());
             ui.label(format!("Pilot: {what}"));
