@@ -9,15 +9,19 @@
 //! - every setting of `illum_auto::settings::settings` at that size against it, one per frame
 //!   (a path-tracer setting over several frames to [`PilotOptions::pilot_spp`]): its bias, its
 //!   noise per sample and its worst region;
-//! - the throughput at the size each mode renders in the view: the rasterizer's set-up and one
-//!   frame at the view's size; the Whitted ray tracer's set-up and frame at the pilot's size,
-//!   the frame scaled by the ratio of pixel counts; the path tracer's set-up and time per spp
-//!   at the pilot's size, scaled likewise to the path tracer's resolution. The viewer's device
-//!   is already set up, so no device time is added.
+//! - the throughput, every setting at the size its mode renders the view at: the rasterizer's
+//!   set-up and one frame, the Whitted ray tracer's set-up and frame, the path tracer's set-up
+//!   with its first sample per pixel and its time per spp over [`PilotOptions::timing_spp`]
+//!   more, times the wall time per second of path tracing that the window's frames leave
+//!   ([`FramePacer`]: the pilot's path tracing is paced as the path-tracer mode's is, so the
+//!   rest of each frame is measured while it runs). The viewer's device is already set up, so
+//!   no device time is added.
 //!
 //! Native only: the rasterizer's image and the object-ID image are read back with a blocking
 //! wait, which a web page cannot do (the browser's Auto panel says so).
 
+#[cfg(doc)]
+use crate::pacer::FramePacer;
 #[cfg(not(target_arch = "wasm32"))]
 pub use native::ViewerPilot;
 
@@ -30,15 +34,16 @@ pub struct PilotOptions {
     pub truth_spp: u32,
     /// Samples per pixel of each path-tracer setting.
     pub pilot_spp: u32,
-    /// Wall seconds of path tracing per frame while the pilot runs.
-    pub slice_seconds: f64,
+    /// Samples per pixel of each path-tracer setting's throughput at the view's size (after
+    /// the first, which counts in its set-up).
+    pub timing_spp: u32,
 }
 
 impl Default for PilotOptions {
     /// Half the CLI's pilot side and a quarter of its truth's spp: on lavapipe (2 cores) the
     /// Whitted scene's pilot takes about 15 s, so it is run while the user watches.
     fn default() -> Self {
-        PilotOptions { longer_side: 64, truth_spp: 2048, pilot_spp: 64, slice_seconds: 0.1 }
+        PilotOptions { longer_side: 64, truth_spp: 2048, pilot_spp: 64, timing_spp: 4 }
     }
 }
 
@@ -53,7 +58,7 @@ pub struct ViewSizes {
 /// The pilot itself, native only (see the module's comment).
 #[cfg(not(target_arch = "wasm32"))]
 mod native {
-    use std::time::Instant;
+    use web_time::Instant;
 
     use illum_auto::measure::measured;
     use illum_auto::plan::{Candidate, Setting};
@@ -62,6 +67,7 @@ mod native {
     use illum_gpu::GpuContext;
 
     use super::{PilotOptions, ViewSizes};
+    use crate::pacer::FramePacer;
     use illum_image::RgbImage32;
     use illum_pathtrace::PathTracer;
     use illum_raster::{Options, RasterRenderer, RasterScene};
@@ -79,10 +85,10 @@ mod native {
     }
 
     impl Running {
-        fn start(gpu: &GpuContext, scene: &Scene, slice_seconds: f64) -> Result<Running, String> {
+        fn start(gpu: &GpuContext, scene: &Scene) -> Result<Running, String> {
             let started = Instant::now();
             let mut tracer = PathTracer::new(gpu, scene).map_err(|e| e.to_string())?;
-            tracer.set_target_seconds(slice_seconds);
+            tracer.set_target_seconds(crate::pacer::MOVING_SECONDS);
             while tracer.spp_done() < 1 {
                 tracer.render_step(Some(1)).map_err(|e| e.to_string())?;
             }
@@ -94,11 +100,12 @@ mod native {
             })
         }
 
-        /// One submission toward `spp`; true once it is reached.
-        fn step(&mut self, spp: u32) -> Result<bool, String> {
+        /// One submission of about `seconds` toward `spp`; true once it is reached.
+        fn step(&mut self, spp: u32, seconds: f64) -> Result<bool, String> {
             if self.tracer.spp_done() >= spp {
                 return Ok(true);
             }
+            self.tracer.set_target_seconds(seconds);
             let before = self.tracer.spp_done();
             let started = Instant::now();
             self.tracer.render_step(Some(spp)).map_err(|e| e.to_string())?;
@@ -126,8 +133,14 @@ mod native {
         options: PilotOptions,
         /// The scene at the pilot's size.
         small: Scene,
-        /// The scene at the raster's size in the view.
+        /// The scene at the raster's size in the view, at the Whitted mode's and at the path
+        /// tracer's.
         view_scene: Scene,
+        whitted_scene: Scene,
+        pathtrace_scene: Scene,
+        /// A path-tracer setting's image and estimated relMSE at the pilot's size, while its
+        /// throughput is being measured.
+        measured: Option<(RgbImage32, f64)>,
         sizes: ViewSizes,
         settings: Vec<Setting>,
         truth: Option<Truth>,
@@ -139,31 +152,43 @@ mod native {
         raster: Option<(RasterRenderer, f64)>,
         /// Wall seconds spent in the pilot's steps.
         seconds: f64,
+        /// Paces the path tracing as the path-tracer mode's frames are, and measures the rest
+        /// of each frame; this frame's share.
+        pacer: FramePacer,
+        slice: f64,
         error: Option<String>,
     }
 
     impl ViewerPilot {
         /// A pilot of `scene` (its camera at the raster's size in the view) for views of `sizes`.
         pub fn new(scene: &Scene, sizes: ViewSizes, options: PilotOptions) -> Result<ViewerPilot, String> {
-            let size = pilot_size(scene, options.longer_side);
-            let mut small = scene.clone();
-            small
-                .apply_overrides(
-                    &Overrides { width: Some(size.0), height: Some(size.1), ..Default::default() },
-                    "the Auto pilot",
-                )
-                .map_err(|e| e.to_string())?;
+            let sized = |(width, height): (u32, u32)| {
+                let mut sized = scene.clone();
+                sized
+                    .apply_overrides(
+                        &Overrides { width: Some(width), height: Some(height), ..Default::default() },
+                        "the Auto pilot",
+                    )
+                    .map(|()| sized)
+                    .map_err(|e| e.to_string())
+            };
+            let pair = |[w, h]: [u32; 2]| (w, h);
             Ok(ViewerPilot {
                 options,
                 settings: settings(scene),
-                small,
-                view_scene: scene.clone(),
+                small: sized(pilot_size(scene, options.longer_side))?,
+                view_scene: sized(pair(sizes.raster))?,
+                whitted_scene: sized(pair(sizes.whitted))?,
+                pathtrace_scene: sized(pair(sizes.pathtrace))?,
+                measured: None,
                 sizes,
                 truth: None,
                 running: None,
                 candidates: Vec::new(),
                 raster: None,
                 seconds: 0.0,
+                pacer: FramePacer::default(),
+                slice: crate::pacer::MOVING_SECONDS,
                 error: None,
             })
         }
@@ -221,12 +246,16 @@ mod native {
             if self.error.is_some() || self.candidates().is_some() {
                 return;
             }
+            // The view is still while the pilot runs (it shows the progress).
+            self.slice = self.pacer.submission_seconds(false);
             let started = Instant::now();
             if let Err(e) = self.try_step(gpu) {
                 self.error = Some(e);
                 self.running = None;
             }
-            self.seconds += started.elapsed().as_secs_f64();
+            let took = started.elapsed().as_secs_f64();
+            self.pacer.stepped(started, took);
+            self.seconds += took;
         }
 
         fn try_step(&mut self, gpu: &GpuContext) -> Result<(), String> {
@@ -235,21 +264,13 @@ mod native {
             }
             let setting = self.settings[self.candidates.len()].clone();
             let variant = apply(&self.small, &setting);
-            let ratio = |size: [u32; 2]| {
-                f64::from(size[0]) * f64::from(size[1])
-                    / (f64::from(self.small.camera.width) * f64::from(self.small.camera.height))
-            };
             let (image, own_noise, fixed_seconds, seconds_per_spp) = match &setting {
                 Setting::Raster { look, effects } => {
                     let options = Options { look: *look, effects: *effects };
-                    let mut small = RasterRenderer::new(
-                        gpu,
-                        &raster_scene(&variant)?,
-                        variant.camera.width,
-                        variant.camera.height,
-                    )
-                    .map_err(|e| e.to_string())?;
-                    let image = small.render(&options).map_err(|e| e.to_string())?;
+                    let (w, h) = (variant.camera.width, variant.camera.height);
+                    let image = RasterRenderer::new(gpu, &raster_scene(&variant)?, w, h)
+                        .and_then(|mut small| small.render(&options))
+                        .map_err(|e| e.to_string())?;
                     if self.raster.is_none() {
                         let scene = raster_scene(&self.view_scene)?;
                         let [w, h] = self.sizes.raster;
@@ -263,32 +284,41 @@ mod native {
                     (image, None, *setup + t.elapsed().as_secs_f64(), 0.0)
                 }
                 Setting::Whitted { .. } => {
+                    let image = WhittedTracer::new(gpu, &variant)
+                        .and_then(|t| t.render())
+                        .map_err(|e| e.to_string())?;
+                    // Timed at the size the Whitted mode renders the view at.
                     let t = Instant::now();
-                    let tracer = WhittedTracer::new(gpu, &variant).map_err(|e| e.to_string())?;
-                    let setup = t.elapsed().as_secs_f64();
-                    let t = Instant::now();
-                    let image = tracer.render().map_err(|e| e.to_string())?;
-                    (image, None, setup + t.elapsed().as_secs_f64() * ratio(self.sizes.whitted), 0.0)
+                    let tracer = WhittedTracer::new(gpu, &apply(&self.whitted_scene, &setting))
+                        .map_err(|e| e.to_string())?;
+                    tracer.render().map_err(|e| e.to_string())?;
+                    (image, None, t.elapsed().as_secs_f64(), 0.0)
                 }
                 Setting::PathTrace { .. } => {
+                    // First the bias and noise at the pilot's size, then the throughput at the
+                    // size the path-tracer mode renders the view at.
+                    let (scene, spp) = match &self.measured {
+                        None => (variant, self.options.pilot_spp),
+                        Some(_) => (apply(&self.pathtrace_scene, &setting), self.options.timing_spp + 1),
+                    };
                     let running = match &mut self.running {
                         Some(running) => running,
                         None => {
-                            self.running = Some(Running::start(gpu, &variant, self.options.slice_seconds)?);
+                            self.running = Some(Running::start(gpu, &scene)?);
                             return Ok(());
                         }
                     };
-                    if !running.step(self.options.pilot_spp)? {
+                    if !running.step(spp, self.slice)? {
                         return Ok(());
                     }
                     let running = self.running.take().expect("running above");
-                    let accumulator = running.tracer.accumulator();
-                    (
-                        accumulator.mean_image(),
-                        Some(accumulator.estimated_rel_mse()),
-                        running.setup_seconds,
-                        running.seconds_per_spp() * ratio(self.sizes.pathtrace),
-                    )
+                    let Some((image, noise)) = self.measured.take() else {
+                        let accumulator = running.tracer.accumulator();
+                        self.measured = Some((accumulator.mean_image(), accumulator.estimated_rel_mse()));
+                        return Ok(());
+                    };
+                    let wall = self.pacer.wall_per_traced_second().unwrap_or(1.0);
+                    (image, Some(noise), running.setup_seconds, running.seconds_per_spp() * wall)
                 }
             };
             let truth = self.truth.as_ref().expect("checked above");
@@ -313,11 +343,11 @@ mod native {
                     let mut truth_scene = self.small.clone();
                     truth_scene.pathtrace.bounces = Bounces::Unbounded;
                     truth_scene.pathtrace.caustics = has_caustic(&self.small);
-                    self.running = Some(Running::start(gpu, &truth_scene, self.options.slice_seconds)?);
+                    self.running = Some(Running::start(gpu, &truth_scene)?);
                     return Ok(());
                 }
             };
-            if !running.step(self.options.truth_spp)? {
+            if !running.step(self.options.truth_spp, self.slice)? {
                 return Ok(());
             }
             let running = self.running.take().expect("running above");

@@ -53,7 +53,7 @@ fn harness(scene: &'static str) -> Harness<'static, ViewerApp> {
     let app = harness.state_mut();
     app.pathtrace_mut().expect("path tracer loaded").settings.resolution_scale = 0.1;
     app.auto_mut().pilot_options =
-        PilotOptions { longer_side: 32, truth_spp: 512, pilot_spp: 32, slice_seconds: 0.05 };
+        PilotOptions { longer_side: 32, truth_spp: 512, pilot_spp: 32, timing_spp: 2 };
     harness
 }
 
