@@ -173,12 +173,26 @@ impl AutoMode {
             None => format!("auto: target {target}, no plan"),
             Some(Err(why)) => format!("auto: target {target}, refused: {}", why.replace('\n', " ")),
             Some(Ok(plan)) => format!(
-                "auto: target {target}, choice {} (predicted error {}, {:.2} s)",
+                "auto: target {target}, choice {} (predicted error {}, {:.2} s){}",
                 plan.choice.describe(),
                 percent(plan.choice.predicted_error),
-                plan.choice.predicted_seconds
+                plan.choice.predicted_seconds,
+                self.pilot_summary()
             ),
         }
+    }
+
+    /// ", pilot N s wall, longest frame step M s", once the pilot is done.
+    fn pilot_summary(&self) -> String {
+        #[cfg(not(target_arch = "wasm32"))]
+        if let Some(pilot) = &self.pilot {
+            return format!(
+                ", pilot {:.1} s wall, longest frame step {:.2} s",
+                pilot.seconds(),
+                pilot.longest_step()
+            );
+        }
+        String::new()
     }
 
     /// The panel: the slider, the pilot's state, the choice and why.
@@ -207,10 +221,11 @@ impl AutoMode {
             let (w, h) = pilot.size();
             let options = pilot.options();
             ui.weak(format!(
-                "Pilot: {} settings at {w} x {h} against a {} spp truth, {:.1} s",
+                "Pilot: {} settings at {w} x {h} against a {} spp truth, {:.1} s (longest frame step {:.2} s)",
                 pilot.candidates().map_or(0, <[Candidate]>::len),
                 options.truth_spp,
-                pilot.seconds()
+                pilot.seconds(),
+                pilot.longest_step()
             ));
         }
         if ui.button("Measure again").on_hover_text("Run the pilot again for the current view").clicked() {

@@ -9,10 +9,11 @@
 //! - every setting of `illum_auto::settings::settings` at that size against it, one per frame
 //!   (a path-tracer setting over several frames to [`PilotOptions::pilot_spp`]): its bias, its
 //!   noise per sample and its worst region;
-//! - the throughput, every setting at the size its mode renders the view at: the rasterizer's
-//!   set-up and one frame, the Whitted ray tracer's set-up and frame, the path tracer's set-up
-//!   with its first sample per pixel and its time per spp over [`PilotOptions::timing_spp`]
-//!   more, times the wall time per second of path tracing that the window's frames leave
+//! - the throughput at the size each mode renders the view at: the rasterizer's set-up and one
+//!   frame; the Whitted ray tracer's set-up and frame at the pilot's size, the frame scaled by
+//!   the ratio of pixel counts (a 4x4-ray frame at the view's size held the window for 3 s);
+//!   the path tracer's set-up with its first sample per pixel and its time per spp over
+//!   [`PilotOptions::timing_spp`] more at its own resolution, times the wall time per second of path tracing that the window's frames leave
 //!   ([`FramePacer`]: the pilot's path tracing is paced as the path-tracer mode's is, so the
 //!   rest of each frame is measured while it runs). The viewer's device is already set up, so
 //!   no device time is added.
@@ -133,10 +134,8 @@ mod native {
         options: PilotOptions,
         /// The scene at the pilot's size.
         small: Scene,
-        /// The scene at the raster's size in the view, at the Whitted mode's and at the path
-        /// tracer's.
+        /// The scene at the raster's size in the view, and at the path tracer's.
         view_scene: Scene,
-        whitted_scene: Scene,
         pathtrace_scene: Scene,
         /// A path-tracer setting's image and estimated relMSE at the pilot's size, while its
         /// throughput is being measured.
@@ -150,8 +149,11 @@ mod native {
         candidates: Vec<Candidate>,
         /// The rasterizer at the view's size and its set-up seconds (made once).
         raster: Option<(RasterRenderer, f64)>,
-        /// Wall seconds spent in the pilot's steps.
-        seconds: f64,
+        /// When the pilot started, and its wall seconds once done.
+        started: Instant,
+        wall_seconds: Option<f64>,
+        /// The longest a frame's step took: how long the window waited at most.
+        longest_step: f64,
         /// Paces the path tracing as the path-tracer mode's frames are, and measures the rest
         /// of each frame; this frame's share.
         pacer: FramePacer,
@@ -178,7 +180,6 @@ mod native {
                 settings: settings(scene),
                 small: sized(pilot_size(scene, options.longer_side))?,
                 view_scene: sized(pair(sizes.raster))?,
-                whitted_scene: sized(pair(sizes.whitted))?,
                 pathtrace_scene: sized(pair(sizes.pathtrace))?,
                 measured: None,
                 sizes,
@@ -186,7 +187,9 @@ mod native {
                 running: None,
                 candidates: Vec::new(),
                 raster: None,
-                seconds: 0.0,
+                started: Instant::now(),
+                wall_seconds: None,
+                longest_step: 0.0,
                 pacer: FramePacer::default(),
                 slice: crate::pacer::MOVING_SECONDS,
                 error: None,
@@ -206,9 +209,15 @@ mod native {
             self.options
         }
 
-        /// Wall seconds the pilot has spent so far.
+        /// Wall seconds from the pilot's start to its end (so far, while it runs), the window's
+        /// frames included.
         pub fn seconds(&self) -> f64 {
-            self.seconds
+            self.wall_seconds.unwrap_or_else(|| self.started.elapsed().as_secs_f64())
+        }
+
+        /// The longest a frame spent in the pilot's work, in seconds.
+        pub fn longest_step(&self) -> f64 {
+            self.longest_step
         }
 
         /// Why the pilot stopped, when it failed.
@@ -248,6 +257,7 @@ mod native {
             }
             // The view is still while the pilot runs (it shows the progress).
             self.slice = self.pacer.submission_seconds(false);
+            let what = self.progress().1;
             let started = Instant::now();
             if let Err(e) = self.try_step(gpu) {
                 self.error = Some(e);
@@ -255,7 +265,11 @@ mod native {
             }
             let took = started.elapsed().as_secs_f64();
             self.pacer.stepped(started, took);
-            self.seconds += took;
+            self.longest_step = self.longest_step.max(took);
+            log::debug!("auto pilot: {took:.3} s on {what}");
+            if self.candidates().is_some() {
+                self.wall_seconds = Some(self.started.elapsed().as_secs_f64());
+            }
         }
 
         fn try_step(&mut self, gpu: &GpuContext) -> Result<(), String> {
@@ -284,15 +298,18 @@ mod native {
                     (image, None, *setup + t.elapsed().as_secs_f64(), 0.0)
                 }
                 Setting::Whitted { .. } => {
-                    let image = WhittedTracer::new(gpu, &variant)
-                        .and_then(|t| t.render())
-                        .map_err(|e| e.to_string())?;
-                    // Timed at the size the Whitted mode renders the view at.
+                    // Timed at the pilot's size, the frame scaled by the ratio of pixel counts to
+                    // the Whitted mode's size: at that size a 4x4-ray, depth-8 frame holds the
+                    // window for seconds, where a pilot frame holds it for a fraction of one.
                     let t = Instant::now();
-                    let tracer = WhittedTracer::new(gpu, &apply(&self.whitted_scene, &setting))
-                        .map_err(|e| e.to_string())?;
-                    tracer.render().map_err(|e| e.to_string())?;
-                    (image, None, t.elapsed().as_secs_f64(), 0.0)
+                    let tracer = WhittedTracer::new(gpu, &variant).map_err(|e| e.to_string())?;
+                    let setup = t.elapsed().as_secs_f64();
+                    let t = Instant::now();
+                    let image = tracer.render().map_err(|e| e.to_string())?;
+                    let [w, h] = self.sizes.whitted;
+                    let ratio = f64::from(w) * f64::from(h)
+                        / (f64::from(variant.camera.width) * f64::from(variant.camera.height));
+                    (image, None, setup + t.elapsed().as_secs_f64() * ratio, 0.0)
                 }
                 Setting::PathTrace { .. } => {
                     // First the bias and noise at the pilot's size, then the throughput at the
