@@ -3,6 +3,8 @@
 //!
 //! - [`app`]: the application state, the mode switch and the scene field;
 //! - [`pathtrace_panel`] / [`raster_panel`]: each mode's settings, renderer and panel;
+//! - [`auto_panel`] / [`auto_pilot`]: the Auto mode (the accuracy slider and the choice) and
+//!   its pilot, run across frames;
 //! - [`camera`]: orbit / pan / zoom with the mouse, shared by both modes;
 //! - [`denoise_view`]: the path tracer's Denoise toggle (the denoised image and its estimated
 //!   error);
@@ -24,6 +26,8 @@
 //! and `browser`, none of which depends back.
 
 pub mod app;
+pub mod auto_panel;
+pub mod auto_pilot;
 #[cfg(target_arch = "wasm32")]
 pub mod browser;
 pub mod camera;

@@ -21,13 +21,15 @@ use illum_gpu::GpuContext;
 use illum_image::RgbImage32;
 use illum_pathtrace::PathTracer;
 use illum_raster::{Options, RasterRenderer, RasterScene};
-use illum_scene::{Bounces, Effects, Look, MaterialKind, Overrides, Scene};
+use illum_scene::{Bounces, Overrides, Scene};
 use illum_whitted::WhittedTracer;
 
 use super::plan::{Candidate, Setting};
 use crate::reference::{cached_reference, reference_settings};
 use crate::regions::{Regions, compare};
 use crate::report::{csv_text, write_text};
+use illum_auto::measure::{Measured, measured};
+pub use illum_auto::settings::{apply, has_caustic, pilot_size, settings};
 
 /// How the pilot measures.
 #[derive(Clone, Debug)]
@@ -82,85 +84,6 @@ impl Pilot {
     }
 }
 
-/// Every setting `auto` chooses among for `scene`: the rasterizer's two looks and the enhanced
-/// look with each effect off (where it can draw the scene), the Whitted ray tracer at depths 1,
-/// 2, 4, 8 (depth 1 alone without a mirror or glass, where depth changes nothing) and 1 to 4
-/// rays per pixel a side, and the path tracer at bounces 1, 2, 4, 8 and unbounded, with and
-/// (where the scene has a caustic) without its light tracer.
-pub fn settings(scene: &Scene) -> Vec<Setting> {
-    let mut all = Vec::new();
-    if RasterScene::from_scene(scene).is_ok() {
-        all.push(Setting::Raster { look: Look::Figure, effects: Effects::ALL_ON });
-        all.push(Setting::Raster { look: Look::Enhanced, effects: Effects::ALL_ON });
-        for (_, off) in Effects::TOGGLES {
-            let mut effects = Effects::ALL_ON;
-            off(&mut effects);
-            all.push(Setting::Raster { look: Look::Enhanced, effects });
-        }
-    }
-    let depths: &[u32] = if has_specular(scene) { &[1, 2, 4, 8] } else { &[1] };
-    for &depth in depths {
-        for aa in 1..=4 {
-            all.push(Setting::Whitted { depth, aa });
-        }
-    }
-    let caustics: &[bool] = if has_caustic(scene) { &[false, true] } else { &[false] };
-    for &caustics in caustics {
-        for bounces in
-            [Bounces::Fixed(1), Bounces::Fixed(2), Bounces::Fixed(4), Bounces::Fixed(8), Bounces::Unbounded]
-        {
-            all.push(Setting::PathTrace { bounces, caustics });
-        }
-    }
-    all
-}
-
-fn has_specular(scene: &Scene) -> bool {
-    scene
-        .materials
-        .iter()
-        .any(|m| matches!(m.kind, MaterialKind::Dielectric { .. } | MaterialKind::Mirror { .. }))
-}
-
-/// Whether the path tracer's caustic light tracer has anything to trace in `scene`.
-pub fn has_caustic(scene: &Scene) -> bool {
-    let mut with = scene.clone();
-    with.pathtrace.caustics = true;
-    illum_pathtrace::gpu_scene::caustics_active(&with)
-}
-
-/// `scene` with `setting` applied (its renderer's section), at the scene's size.
-pub fn apply(scene: &Scene, setting: &Setting) -> Scene {
-    let mut scene = scene.clone();
-    match setting {
-        Setting::Raster { look, effects } => {
-            scene.raster.look = *look;
-            scene.raster.effects = *effects;
-        }
-        Setting::Whitted { depth, aa } => {
-            scene.whitted.depth = *depth;
-            scene.whitted.aa = *aa;
-        }
-        Setting::PathTrace { bounces, caustics } => {
-            scene.pathtrace.bounces = *bounces;
-            scene.pathtrace.caustics = *caustics;
-        }
-    }
-    scene
-}
-
-/// The pilot's size: the scene's aspect, `longer_side` pixels on the longer side, never more
-/// than the scene's own.
-pub fn pilot_size(scene: &Scene, longer_side: u32) -> (u32, u32) {
-    let (w, h) = (scene.camera.width, scene.camera.height);
-    if w.max(h) <= longer_side {
-        return (w, h);
-    }
-    let scale = f64::from(longer_side) / f64::from(w.max(h));
-    let side = |v: u32| ((f64::from(v) * scale).round() as u32).max(1);
-    (side(w), side(h))
-}
-
 fn resized(scene: &Scene, (width, height): (u32, u32)) -> anyhow::Result<Scene> {
     let mut small = scene.clone();
     small.apply_overrides(
@@ -168,14 +91,6 @@ fn resized(scene: &Scene, (width, height): (u32, u32)) -> anyhow::Result<Scene> 
         "auto pilot",
     )?;
     Ok(small)
-}
-
-/// One setting's bias and noise, as cached.
-#[derive(Clone, Debug, PartialEq)]
-struct Measured {
-    bias_rel_mse: f64,
-    noise_per_sample: Option<f64>,
-    worst_region: Option<(String, f64)>,
 }
 
 /// Measures every setting of [`settings`] for `scene` (at the size it will be rendered) on
@@ -318,19 +233,7 @@ fn measure_bias(
 ) -> anyhow::Result<Measured> {
     let (image, own_noise) = render(gpu, &apply(small, setting), setting, options.pilot_spp)?;
     let errors = compare(&image, truth, regions);
-    let bias_rel_mse = (errors.overall.rel_mse - truth_rel_mse - own_noise.unwrap_or(0.0)).max(0.0);
-    let worst_region = regions
-        .names
-        .iter()
-        .zip(&errors.regions)
-        .filter(|(_, e)| e.pixels > 0 && e.luminance_ratio.is_finite())
-        .max_by(|a, b| (a.1.luminance_ratio - 1.0).abs().total_cmp(&(b.1.luminance_ratio - 1.0).abs()))
-        .map(|(name, e)| (name.clone(), e.luminance_ratio));
-    Ok(Measured {
-        bias_rel_mse,
-        noise_per_sample: own_noise.map(|n| n * f64::from(options.pilot_spp)),
-        worst_region,
-    })
+    Ok(measured(&errors, regions, truth_rel_mse, own_noise, options.pilot_spp))
 }
 
 /// Renders `scene` (with `setting` applied, see [`apply`]) by the setting's renderer, the path
@@ -425,15 +328,5 @@ mod tests {
         assert_eq!(read_cache(&path, "key 2", 2), None);
         assert_eq!(read_cache(&path, "key 1", 3), None);
         std::fs::remove_dir_all(&folder).unwrap();
-    }
-
-    #[test]
-    fn the_pilot_keeps_the_aspect_and_never_upsamples() {
-        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/whitted.toml");
-        let mut scene = Scene::load(Path::new(path)).unwrap();
-        assert_eq!(pilot_size(&scene, 128), (128, 72));
-        scene.camera.width = 100;
-        scene.camera.height = 50;
-        assert_eq!(pilot_size(&scene, 128), (100, 50));
     }
 }
