@@ -66,7 +66,8 @@ pub struct CausticParams {
     pub gather_radius: f32,
     /// Photon-grid buckets per frame (a power of two; 1 without the gather).
     pub buckets: u32,
-    pub padding_a: u32,
+    /// a_1 of the glint's kernel, radians (0 without the gather).
+    pub glint_angle: f32,
     pub padding_b: u32,
     pub padding_c: u32,
 }
@@ -85,6 +86,10 @@ const PHOTON_BYTES: u64 = 48;
 /// r_1 of the photon gather as a fraction of the largest specular object's bounding radius
 /// (docs/caustics.md, "The caustic seen through a specular surface").
 pub const GATHER_RADIUS_FRACTION: f32 = 0.02;
+/// a_1 of the glint's kernel, the sun seen as a disc of this angular radius at sample index 0
+/// (docs/caustics.md, "The sun's glint"): 1 degree, whose image in a ball of radius 1 seen from
+/// a few units is already under a pixel at 320 x 180.
+pub const GLINT_ANGLE_DEG: f32 = 1.0;
 /// Host bytes per pixel and chunk of a pass: S1 and S2, three f64 each.
 pub(crate) const PASS_BYTES_PER_PIXEL_CHUNK: u64 = 48;
 /// The most host memory one pass's caustic statistics may take.
@@ -337,7 +342,7 @@ impl CausticTracer {
             disc_area,
             gather_radius: if gather { GATHER_RADIUS_FRACTION * largest_radius } else { 0.0 },
             buckets: buckets as u32,
-            padding_a: 0,
+            glint_angle: if gather { GLINT_ANGLE_DEG.to_radians() } else { 0.0 },
             padding_b: 0,
             padding_c: 0,
         };
