@@ -133,9 +133,12 @@ fn caustic_view(bounces: u32) -> Scene {
 
 #[test]
 fn the_caustic_agrees_with_the_oracle_at_bounces_3_and_8() {
-    for bounces in [3, 8] {
-        compare_scene(&format!("whitted caustic view, bounces {bounces}"), &caustic_view(bounces));
-    }
+    // At bounces 3 the whole-image blue (0.09: the floor has none) is the sky's through the
+    // balls and the glint's, whose rare samples leave its mean too noisy for the 2% power
+    // check (z = 2.8 for a 2% bias); the pixel criterion, each pixel against its own variance,
+    // keeps its power (400 of 400 positions).
+    compare_scene_pixels("whitted caustic view, bounces 3", &caustic_view(3));
+    compare_scene("whitted caustic view, bounces 8", &caustic_view(8));
 }
 
 /// The mirror ball from the side of the glass ball's caustic: its lower half reflects the
