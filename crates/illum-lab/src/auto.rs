@@ -4,7 +4,9 @@
 //! what it measured.
 
 pub mod pilot;
-pub mod plan;
+/// The planner lives in `illum-auto` (pure, so the viewer shares it); re-exported here so
+/// `illum_lab::auto::plan` names it beside the pilot.
+pub use illum_auto::plan;
 
 use illum_scene::Scene;
 

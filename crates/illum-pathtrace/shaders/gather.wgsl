@@ -101,7 +101,7 @@ fn glint(frame: u32, d: vec3<f32>) -> vec3<f32> {
 
 @compute @workgroup_size(64, 1, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let pixel = gid.y * caustic.row_stride + gid.x;
+    let pixel = caustic.first_index + gid.y * caustic.row_stride + gid.x;
     let frame = gid.z;
     if (pixel >= caustic.particles || frame >= caustic.frame_count) {
         return;
