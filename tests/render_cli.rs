@@ -967,7 +967,10 @@ fn caustics_on_off_is_recorded_and_a_checkpoint_of_the_other_setting_is_refused(
     // A file rendered before the photon gather (the light tracer alone, no estimators key)
     // holds other light in the metal sphere: resuming it with the gather is refused.
     let mut before_gather = illum::pathtrace::checkpoint::load_checkpoint(&exr).unwrap();
-    assert!(field(&metadata(&exr), "caustic_estimators").starts_with("light tracer, photon gather at every diffuse"));
+    assert!(
+        field(&metadata(&exr), "caustic_estimators")
+            .starts_with("light tracer, photon gather at every diffuse")
+    );
     let mut gather_only = before_gather.clone();
     before_gather.metadata.fields.retain(|(k, _)| k != "caustic_estimators");
     let old = dir.path().join("before-gather.exr");
@@ -992,7 +995,8 @@ fn caustics_on_off_is_recorded_and_a_checkpoint_of_the_other_setting_is_refused(
     );
     // A file rendered with the gather at the first diffuse vertex after a specular one alone
     // and no glint lacks E S* L and E (S|D)* D S* D S+ L: refused as well.
-    let first_gather = "light tracer and photon gather (r_1 = 0.02 x the largest specular radius, r_k = r_1 (k + 1)^(-1/6))";
+    let first_gather =
+        "light tracer and photon gather (r_1 = 0.02 x the largest specular radius, r_k = r_1 (k + 1)^(-1/6))";
     for (k, v) in &mut gather_only.metadata.fields {
         if k == "caustic_estimators" {
             *v = first_gather.to_owned();

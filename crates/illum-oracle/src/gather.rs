@@ -135,7 +135,8 @@ impl Oracle {
     }
 
     /// Turns the photon gather off (`false`) or back on; it runs only where [`Self::gathers`]
-    /// allows. Off, the image misses E S+ D S+ L as the light tracer alone does.
+    /// allows. Off, the image misses E (S|D)* D S+ L (but E D S+ L) and the glint E S* L, as the
+    /// light tracer alone does.
     pub fn with_gather(mut self, on: bool) -> Oracle {
         self.gather = on;
         self

@@ -24,7 +24,7 @@
 // / r^2) to the pixel through which the eye sees x, if nothing hides x from the eye.
 //
 // Photons (shader def CAUSTIC_GATHER, a delta sun): the same point and weight are also stored
-// as frame k's photon for the gather of E S+ D S+ L (gather.wgsl).
+// as frame k's photon for the gather of E (S|D)* D S+ L (gather.wgsl).
 //
 // Splatting (caustic_buffers.wgsl): WGSL has no float atomics, so each value is rounded to a 64-bit fixed-point
 // integer q = round(v S) (S = caustic.fixed_scale, a power of two) added as two u32 words with
