@@ -89,7 +89,7 @@ const SPLAT_BYTES: u64 = 64 << 20;
 /// Bytes per photon: three vec4 (caustic_buffers.wgsl).
 const PHOTON_BYTES: u64 = 48;
 /// r_1 of the photon gather as a fraction of the largest specular object's bounding radius
-/// (docs/caustics.md, "The caustic seen through a specular surface").
+/// (docs/caustics.md, "The photon gather").
 pub const GATHER_RADIUS_FRACTION: f32 = 0.02;
 /// a_1 of the glint's kernel, the sun seen as a disc of this angular radius at sample index 0
 /// (docs/caustics.md, "The sun's glint"). Its variance falls as 1 / a_1^2, and its blur stays
