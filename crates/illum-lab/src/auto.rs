@@ -3,8 +3,10 @@
 //! scene on this machine (bias, noise, throughput of every setting); the [`plan`] chooses from
 //! what it measured.
 
+mod cache;
 pub mod pilot;
 pub mod plan;
+mod render;
 
 use illum_scene::Scene;
 

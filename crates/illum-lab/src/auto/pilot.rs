@@ -5,29 +5,37 @@
 //!   [`PilotOptions::longer_side`] pixels on the longer side) and compared with a path-traced
 //!   truth at that size, as the ladder compares (relMSE, per region). A deterministic renderer's
 //!   bias² is its relMSE less the truth's own estimated noise; a path tracer's is its relMSE less
-//!   its own and the truth's estimated noise, and its noise per sample is its estimated relMSE
-//!   times its spp. The truth and these figures are cached in the pilot's folder under a key of
-//!   the scene's content hash and every pilot setting, like the ladder's truth.
+//!   its own and the truth's estimated noise, and its noise curve ([`super::plan::NoiseCurve`])
+//!   comes from its own estimate: at the pilot's spp with the 1/N law for independent samples
+//!   and adaptive sampling; at a quarter of it and at it, with the exponent between them, for
+//!   the low-discrepancy sequence (its estimate from independently randomised replicates); and
+//!   for a denoised render, the denoised image's relMSE against the truth at 4, 16, 64 and the
+//!   pilot's spp, less the bias. The truth and these figures are cached in the pilot's folder
+//!   under a key of the scene's content hash and every pilot setting, like the ladder's truth.
 //! - Throughput: measured now, every run, per setting. The rasterizer draws one frame at the
 //!   size asked for (set-up and first frame, as `render` pays them); the Whitted ray tracer and
 //!   the path tracer run at the pilot's size, their set-up counted once and their per-pixel
-//!   time scaled by the ratio of pixel counts.
+//!   time scaled by the ratio of pixel counts; adaptive sampling's own pilot and a denoised
+//!   render's guides and three filter runs are timed at the pilot's size and scaled the same way.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Context as _;
+use illum_denoise::{DenoiseInput, Denoiser, OIDN_BUILT};
 use illum_gpu::GpuContext;
 use illum_image::RgbImage32;
-use illum_pathtrace::PathTracer;
+use illum_pathtrace::{GUIDE_SAMPLES, PathTracer, SampleAllocation};
 use illum_raster::{Options, RasterRenderer, RasterScene};
-use illum_scene::{Bounces, Effects, Look, MaterialKind, Overrides, Scene};
+use illum_scene::{Bounces, DenoiserKind, Effects, Look, MaterialKind, Overrides, Scene, Sequence};
 use illum_whitted::WhittedTracer;
 
-use super::plan::{Candidate, Setting};
+use super::cache::{Measured, read_cache, write_cache};
+use super::plan::{Candidate, NoiseCurve, Setting};
+pub use super::render::render;
+use super::render::{path_tracer_throughput, spp_multiple, tracer_options};
 use crate::reference::{cached_reference, reference_settings};
 use crate::regions::{Regions, compare};
-use crate::report::{csv_text, write_text};
 
 /// How the pilot measures.
 #[derive(Clone, Debug)]
@@ -86,7 +94,10 @@ impl Pilot {
 /// look with each effect off (where it can draw the scene), the Whitted ray tracer at depths 1,
 /// 2, 4, 8 (depth 1 alone without a mirror or glass, where depth changes nothing) and 1 to 4
 /// rays per pixel a side, and the path tracer at bounces 1, 2, 4, 8 and unbounded, with and
-/// (where the scene has a caustic) without its light tracer.
+/// (where the scene has a caustic) without its light tracer, each with independent samples,
+/// the low-discrepancy sequence, adaptive sampling, and denoised by à-trous (and by Open Image
+/// Denoise in builds that have it). Not measured, to keep the pilot's cost down: adaptive
+/// sampling or denoising with the low-discrepancy sequence, and both together.
 pub fn settings(scene: &Scene) -> Vec<Setting> {
     let mut all = Vec::new();
     if RasterScene::from_scene(scene).is_ok() {
@@ -109,7 +120,20 @@ pub fn settings(scene: &Scene) -> Vec<Setting> {
         for bounces in
             [Bounces::Fixed(1), Bounces::Fixed(2), Bounces::Fixed(4), Bounces::Fixed(8), Bounces::Unbounded]
         {
-            all.push(Setting::PathTrace { bounces, caustics });
+            let setting = |sequence, adaptive, denoise| Setting::PathTrace {
+                bounces,
+                caustics,
+                sequence,
+                adaptive,
+                denoise,
+            };
+            all.push(setting(Sequence::Independent, false, None));
+            all.push(setting(Sequence::LowDiscrepancy, false, None));
+            all.push(setting(Sequence::Independent, true, None));
+            all.push(setting(Sequence::Independent, false, Some(DenoiserKind::Atrous)));
+            if OIDN_BUILT {
+                all.push(setting(Sequence::Independent, false, Some(DenoiserKind::Oidn)));
+            }
         }
     }
     all
@@ -141,9 +165,10 @@ pub fn apply(scene: &Scene, setting: &Setting) -> Scene {
             scene.whitted.depth = *depth;
             scene.whitted.aa = *aa;
         }
-        Setting::PathTrace { bounces, caustics } => {
+        Setting::PathTrace { bounces, caustics, sequence, .. } => {
             scene.pathtrace.bounces = *bounces;
             scene.pathtrace.caustics = *caustics;
+            scene.pathtrace.sequence = *sequence;
         }
     }
     scene
@@ -168,14 +193,6 @@ fn resized(scene: &Scene, (width, height): (u32, u32)) -> anyhow::Result<Scene> 
         "auto pilot",
     )?;
     Ok(small)
-}
-
-/// One setting's bias and noise, as cached.
-#[derive(Clone, Debug, PartialEq)]
-struct Measured {
-    bias_rel_mse: f64,
-    noise_per_sample: Option<f64>,
-    worst_region: Option<(String, f64)>,
 }
 
 /// Measures every setting of [`settings`] for `scene` (at the size it will be rendered) on
@@ -210,7 +227,7 @@ pub fn measure(
     let all = settings(scene);
     let (_, truth_key) = reference_settings(&truth_scene, options.truth_spp);
     let key = format!(
-        "auto pilot 2; truth: {truth_key}; pilot spp {}; seed {}; sampling {}; settings: {}",
+        "auto pilot 3; truth: {truth_key}; pilot spp {}; seed {}; sampling {}; settings: {}",
         options.pilot_spp,
         small.pathtrace.seed,
         small.pathtrace.sampling,
@@ -273,22 +290,16 @@ pub fn measure(
                 (setup + t.elapsed().as_secs_f64() * pixel_ratio, 0.0)
             }
             Setting::PathTrace { .. } => {
-                let variant = apply(&small, setting);
-                let t = Instant::now();
-                let mut tracer = PathTracer::new(gpu, &variant)?;
-                tracer.render_to_spp(1)?; // the first pass also sets up buffers
-                let setup = t.elapsed().as_secs_f64();
-                tracer.reset();
-                let t = Instant::now();
-                tracer.render_to_spp(options.timing_spp)?;
-                let per_spp = t.elapsed().as_secs_f64() / f64::from(options.timing_spp) * pixel_ratio;
-                (setup, per_spp)
+                let (setup, per_pixel_fixed, per_spp) =
+                    path_tracer_throughput(gpu, &small, setting, options)?;
+                (setup + per_pixel_fixed * pixel_ratio, per_spp * pixel_ratio)
             }
         };
         candidates.push(Candidate {
             setting: setting.clone(),
             bias_rel_mse: m.bias_rel_mse,
-            noise_per_sample: m.noise_per_sample,
+            noise: m.noise,
+            spp_multiple: spp_multiple(setting),
             fixed_seconds: overhead_seconds + fixed_seconds,
             seconds_per_spp,
             worst_region: m.worst_region,
@@ -316,87 +327,80 @@ fn measure_bias(
     regions: &Regions,
     options: &PilotOptions,
 ) -> anyhow::Result<Measured> {
-    let (image, own_noise) = render(gpu, &apply(small, setting), setting, options.pilot_spp)?;
-    let errors = compare(&image, truth, regions);
-    let bias_rel_mse = (errors.overall.rel_mse - truth_rel_mse - own_noise.unwrap_or(0.0)).max(0.0);
-    let worst_region = regions
-        .names
-        .iter()
-        .zip(&errors.regions)
-        .filter(|(_, e)| e.pixels > 0 && e.luminance_ratio.is_finite())
-        .max_by(|a, b| (a.1.luminance_ratio - 1.0).abs().total_cmp(&(b.1.luminance_ratio - 1.0).abs()))
-        .map(|(name, e)| (name.clone(), e.luminance_ratio));
-    Ok(Measured {
-        bias_rel_mse,
-        noise_per_sample: own_noise.map(|n| n * f64::from(options.pilot_spp)),
-        worst_region,
-    })
-}
-
-/// Renders `scene` (with `setting` applied, see [`apply`]) by the setting's renderer, the path
-/// tracer at `spp`; returns the image and, for the path tracer, its estimated relMSE from noise.
-pub fn render(
-    gpu: &GpuContext,
-    scene: &Scene,
-    setting: &Setting,
-    spp: u32,
-) -> anyhow::Result<(RgbImage32, Option<f64>)> {
-    let (w, h) = (scene.camera.width, scene.camera.height);
-    Ok(match setting {
-        Setting::Raster { look, effects } => {
-            let mut renderer = RasterRenderer::new(gpu, &RasterScene::from_scene(scene)?, w, h)?;
-            (renderer.render(&Options { look: *look, effects: *effects })?, None)
+    let variant = apply(small, setting);
+    let spp = options.pilot_spp;
+    let worst = |image: &RgbImage32| {
+        let errors = compare(image, truth, regions);
+        let worst_region = regions
+            .names
+            .iter()
+            .zip(&errors.regions)
+            .filter(|(_, e)| e.pixels > 0 && e.luminance_ratio.is_finite())
+            .max_by(|a, b| (a.1.luminance_ratio - 1.0).abs().total_cmp(&(b.1.luminance_ratio - 1.0).abs()))
+            .map(|(name, e)| (name.clone(), e.luminance_ratio));
+        (errors.overall.rel_mse - truth_rel_mse, worst_region)
+    };
+    let Setting::PathTrace { sequence, adaptive, denoise, .. } = setting else {
+        let (image, _) = render(gpu, &variant, setting, spp)?;
+        let (rel_mse, worst_region) = worst(&image);
+        return Ok(Measured { bias_rel_mse: rel_mse.max(0.0), noise: None, worst_region });
+    };
+    let mut tracer = if *adaptive {
+        let (w, h) = (variant.camera.width, variant.camera.height);
+        let unlimited = SampleAllocation::uniform(w, h, u32::MAX);
+        let mut tracer =
+            PathTracer::with_sample_allocation(gpu, &variant, tracer_options(setting), unlimited)?;
+        illum_pathtrace::allocation::plan_adaptive(&mut tracer, spp)?;
+        tracer
+    } else {
+        PathTracer::with_options(gpu, &variant, tracer_options(setting))?
+    };
+    // The denoised image's relMSE at these spp (and the pilot's), from one render continued.
+    let denoised_at: Vec<u32> = [4, 16, 64].into_iter().filter(|&n| n < spp).chain([spp]).collect();
+    let (filter, guides) = match denoise {
+        Some(kind) => (Some(Denoiser::new(gpu, *kind)?), Some(tracer.guides(GUIDE_SAMPLES)?)),
+        None => (None, None),
+    };
+    let mut denoised_points = Vec::new();
+    let mut quarter = None;
+    for &n in &denoised_at {
+        let until = match tracer.sample_allocation() {
+            Some(allocation) => allocation.max(),
+            None => n,
+        };
+        tracer.render_to_spp(until)?;
+        if n == spp / 4 {
+            quarter = Some(tracer.accumulator().estimated_rel_mse());
         }
-        Setting::Whitted { .. } => (WhittedTracer::new(gpu, scene)?.render()?, None),
-        Setting::PathTrace { .. } => {
-            let mut tracer = PathTracer::new(gpu, scene)?;
-            tracer.render_to_spp(spp)?;
-            let accumulator = tracer.accumulator();
-            (accumulator.mean_image(), Some(accumulator.estimated_rel_mse()))
+        if let (Some(filter), Some(guides)) = (&filter, &guides) {
+            let image = filter.denoise(&DenoiseInput::from_render(tracer.accumulator(), guides))?;
+            denoised_points.push((f64::from(n), image));
         }
-    })
-}
-
-/// The cached measurements, if `path` holds them for exactly `key`.
-fn read_cache(path: &Path, key: &str, expected: usize) -> Option<Vec<Measured>> {
-    let text = std::fs::read_to_string(path).ok()?;
-    let (first, rest) = text.split_once('\n')?;
-    if first.strip_prefix("# ")? != key {
-        return None;
     }
-    let mut reader = csv::Reader::from_reader(rest.as_bytes());
-    let mut measured = Vec::new();
-    for record in reader.records() {
-        let record = record.ok()?;
-        let number = |i: usize| record.get(i)?.parse::<f64>().ok();
-        let noise = record.get(2)?;
-        let region = record.get(3)?;
-        measured.push(Measured {
-            bias_rel_mse: number(1)?,
-            noise_per_sample: if noise.is_empty() { None } else { Some(noise.parse().ok()?) },
-            worst_region: if region.is_empty() { None } else { Some((region.to_owned(), number(4)?)) },
-        });
-    }
-    (measured.len() == expected).then_some(measured)
-}
-
-fn write_cache(path: &Path, key: &str, settings: &[Setting], measured: &[Measured]) -> anyhow::Result<()> {
-    let rows: Vec<Vec<String>> = settings
-        .iter()
-        .zip(measured)
-        .map(|(s, m)| {
-            vec![
-                s.to_string(),
-                format!("{:e}", m.bias_rel_mse),
-                m.noise_per_sample.map_or(String::new(), |n| format!("{n:e}")),
-                m.worst_region.as_ref().map_or(String::new(), |(r, _)| r.clone()),
-                m.worst_region.as_ref().map_or(String::new(), |(_, ratio)| format!("{ratio:e}")),
-            ]
-        })
-        .collect();
-    let header =
-        ["setting", "bias_rel_mse", "noise_per_sample", "worst_region", "worst_region_luminance_ratio"];
-    write_text(path, &format!("# {key}\n{}", csv_text(&header, &rows)?))
+    let accumulator = tracer.accumulator();
+    let own = accumulator.estimated_rel_mse();
+    let (raw_rel_mse, raw_worst) = worst(&accumulator.mean_image());
+    let bias_rel_mse = (raw_rel_mse - own).max(0.0);
+    let n = f64::from(spp);
+    let (noise, worst_region) = match (sequence, denoise) {
+        (_, Some(_)) => {
+            let mut points = Vec::new();
+            let mut last_worst = raw_worst;
+            for (n, image) in &denoised_points {
+                let (rel_mse, region) = worst(image);
+                points.push((*n, rel_mse - bias_rel_mse));
+                last_worst = region;
+            }
+            (NoiseCurve::new(points, 0.0), last_worst)
+        }
+        (Sequence::LowDiscrepancy, None) => {
+            let early = quarter.unwrap_or(own);
+            let exponent = (early / own).ln() / 4f64.ln();
+            (NoiseCurve::new(vec![(n / 4.0, early), (n, own)], exponent), raw_worst)
+        }
+        (Sequence::Independent, None) => (NoiseCurve::independent(own, n), raw_worst),
+    };
+    Ok(Measured { bias_rel_mse, noise, worst_region })
 }
 
 #[cfg(test)]
@@ -404,33 +408,9 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_cache_reads_back_what_it_wrote_and_refuses_another_key() {
-        let folder = std::env::temp_dir().join(format!("illum-auto-cache-{}", std::process::id()));
-        std::fs::create_dir_all(&folder).unwrap();
-        let path = folder.join("pilot.csv");
-        let settings = [
-            Setting::Whitted { depth: 8, aa: 2 },
-            Setting::PathTrace { bounces: Bounces::Unbounded, caustics: true },
-        ];
-        let measured = vec![
-            Measured {
-                bias_rel_mse: 0.06,
-                noise_per_sample: None,
-                worst_region: Some(("floor in the glass sphere's shadow, a \"quoted\" name".into(), 0.27)),
-            },
-            Measured { bias_rel_mse: 1.5e-6, noise_per_sample: Some(0.11), worst_region: None },
-        ];
-        write_cache(&path, "key 1", &settings, &measured).unwrap();
-        assert_eq!(read_cache(&path, "key 1", 2), Some(measured));
-        assert_eq!(read_cache(&path, "key 2", 2), None);
-        assert_eq!(read_cache(&path, "key 1", 3), None);
-        std::fs::remove_dir_all(&folder).unwrap();
-    }
-
-    #[test]
     fn the_pilot_keeps_the_aspect_and_never_upsamples() {
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/whitted.toml");
-        let mut scene = Scene::load(Path::new(path)).unwrap();
+        let mut scene = Scene::load(std::path::Path::new(path)).unwrap();
         assert_eq!(pilot_size(&scene, 128), (128, 72));
         scene.camera.width = 100;
         scene.camera.height = 50;
