@@ -96,7 +96,8 @@ impl Pilot {
 /// rays per pixel a side, and the path tracer at bounces 1, 2, 4, 8 and unbounded, with and
 /// (where the scene has a caustic) without its light tracer, each with independent samples,
 /// the low-discrepancy sequence, adaptive sampling, and denoised by à-trous (and by Open Image
-/// Denoise in builds that have it). Not measured, to keep the pilot's cost down: adaptive
+/// Denoise in builds that have it); adaptive sampling only without the light tracer (the path
+/// tracer refuses the two together). Not measured, to keep the pilot's cost down: adaptive
 /// sampling or denoising with the low-discrepancy sequence, and both together.
 pub fn settings(scene: &Scene) -> Vec<Setting> {
     let mut all = Vec::new();
@@ -129,7 +130,11 @@ pub fn settings(scene: &Scene) -> Vec<Setting> {
             };
             all.push(setting(Sequence::Independent, false, None));
             all.push(setting(Sequence::LowDiscrepancy, false, None));
-            all.push(setting(Sequence::Independent, true, None));
+            // Adaptive sampling spreads the spp over blocks; the caustic's light tracer covers
+            // the whole image at one spp per pass, so the path tracer refuses the two together.
+            if !caustics {
+                all.push(setting(Sequence::Independent, true, None));
+            }
             all.push(setting(Sequence::Independent, false, Some(DenoiserKind::Atrous)));
             if OIDN_BUILT {
                 all.push(setting(Sequence::Independent, false, Some(DenoiserKind::Oidn)));
