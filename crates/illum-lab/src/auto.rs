@@ -5,7 +5,9 @@
 
 mod cache;
 pub mod pilot;
-pub mod plan;
+/// The planner lives in `illum-auto` (pure, so the viewer shares it); re-exported here so
+/// `illum_lab::auto::plan` names it beside the pilot.
+pub use illum_auto::plan;
 mod render;
 
 use illum_scene::Scene;

@@ -112,7 +112,7 @@ fn may_scatter(scatterings: u32, throughput: ptr<function, vec3<f32>>, weight: v
 
 @compute @workgroup_size(64, 1, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let particle = gid.y * caustic.row_stride + gid.x;
+    let particle = caustic.first_index + gid.y * caustic.row_stride + gid.x;
     let frame = gid.z;
     if (particle >= caustic.particles || frame >= caustic.frame_count) {
         return;

@@ -48,7 +48,9 @@ struct CausticParams {
     gather_radius: f32,
     // Grid buckets per frame: a power of two.
     buckets: u32,
-    padding_a: u32,
+    // The first particle (or, in the gather, pixel) of this dispatch: a frame may be traced in
+    // pieces, each a range of them (tracer/caustic.rs, FramePieces).
+    first_index: u32,
     padding_b: u32,
     padding_c: u32,
 }

@@ -81,7 +81,7 @@ fn photon_sum(frame: u32, x: vec3<f32>, n: vec3<f32>, r: f32, specular: u32) -> 
 
 @compute @workgroup_size(64, 1, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let pixel = gid.y * caustic.row_stride + gid.x;
+    let pixel = caustic.first_index + gid.y * caustic.row_stride + gid.x;
     let frame = gid.z;
     if (pixel >= caustic.particles || frame >= caustic.frame_count) {
         return;

@@ -305,7 +305,7 @@ mod tests {
             size_of::<crate::CausticParams>(),
             &members!(crate::CausticParams: particles, row_stride, frame_base, frame_count, num_discs, seed,
                 pixel_area, area_per_particle, scene_centre, scene_radius, fixed_scale, fixed_cap, disc_area, gather_radius,
-                buckets, padding_a, padding_b, padding_c),
+                buckets, first_index, padding_b, padding_c),
         );
         wgsl("Light").assert_matches(
             size_of::<GpuLight>(),

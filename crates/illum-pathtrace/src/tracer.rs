@@ -234,9 +234,11 @@ impl PathTracer {
     }
 
     /// Sets the wall time aimed at per submission (default 0.15 s). The cost of a sample learnt
-    /// so far is kept, so a viewer may change it every frame.
+    /// so far is kept, so a viewer may change it every frame. From the first call on, a step
+    /// that traces the caustic's frames traces one dispatch of them, sized to this time too.
     pub fn set_target_seconds(&mut self, seconds: f64) {
         self.bands.planner.set_target_seconds(seconds);
+        self.bands.caustic_target_seconds = Some(seconds);
     }
 
     /// With `Some(cap)`, a pass over the whole image is one submission whenever it traces at

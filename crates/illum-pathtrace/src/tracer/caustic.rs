@@ -35,8 +35,12 @@
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use illum_gpu::readback::PendingRead;
+use illum_gpu::timing::PassTimer;
 use illum_gpu::{GpuContext, wgpu};
 use illum_scene::{MaterialKind, Scene};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use web_time::Instant;
 
 use crate::accumulator::Accumulator;
 use illum_rtcore::GpuShape;
@@ -66,7 +70,8 @@ pub struct CausticParams {
     pub gather_radius: f32,
     /// Photon-grid buckets per frame (a power of two; 1 without the gather).
     pub buckets: u32,
-    pub padding_a: u32,
+    /// The dispatch's first particle (or pixel, in the gather): nonzero for a frame's pieces.
+    pub first_index: u32,
     pub padding_b: u32,
     pub padding_c: u32,
 }
@@ -148,6 +153,8 @@ struct CausticPass {
     frames_done: u32,
     /// The dispatch of the pass's next frames whose polled readback is under way.
     in_flight: Option<InFlight>,
+    /// The pass's next frame, while it is traced in pieces.
+    pieces: Option<FramePieces>,
 }
 
 impl CausticPass {
@@ -160,6 +167,7 @@ impl CausticPass {
             dropped: 0,
             frames_done: 0,
             in_flight: None,
+            pieces: None,
         }
     }
 
@@ -195,9 +203,62 @@ impl CausticPass {
 /// A dispatch of frames whose readback is under way (polled).
 struct InFlight {
     read: PendingRead,
+    bytes: DispatchBytes,
     /// The frames it traced.
     count: u32,
+    launched: Instant,
+    /// Whether it is the last piece of a frame traced in pieces (not timed).
+    pieced: bool,
 }
+
+/// A frame traced in pieces, one submission per call, for a caller whose time target is
+/// shorter than a frame: its particles in `count` ranges, then (with the gather) its pixels in
+/// `count` ranges, the last read back. Integer atomics add in any order, so the frame's values
+/// are those of one dispatch, bit for bit.
+struct FramePieces {
+    /// Pieces of the particles and of the gather (0 without it).
+    counts: [u32; 2],
+    /// Submissions made so far (of `counts[0] + counts[1]`).
+    submitted: u32,
+    /// Set when the last submitted piece's work is done (polled).
+    done: Arc<AtomicBool>,
+    /// Seconds the waited pieces of each stage took so far.
+    seconds: [f64; 2],
+    /// Whether its pieces were waited for (a waiting caller restarts a frame begun by polling).
+    waited: bool,
+}
+
+/// What [`CausticTracer::launch`] submitted.
+enum Launched {
+    /// A piece of a frame, not read back.
+    Piece,
+    /// Frames to read back: whole ones, or a frame's last piece (`pieces_seconds`: what its
+    /// waited pieces of each stage took).
+    Frames { staging: wgpu::Buffer, bytes: DispatchBytes, count: u32, pieces_seconds: Option<[f64; 2]> },
+}
+
+/// What one submission of caustic work does.
+#[derive(Clone, Copy)]
+enum Stage {
+    /// Whole frames: clear, particles, gather, read back.
+    Whole,
+    /// A range of a frame's particles (the first clears the frame; the last, without the
+    /// gather, reads it back).
+    Particles { first: bool, last: bool },
+    /// A range of a frame's gathering pixels (the last reads the frame back).
+    Gather { last: bool },
+}
+
+/// What a dispatch's staging copy holds: its frames' bytes, then the timestamps (if timed).
+#[derive(Clone, Copy)]
+struct DispatchBytes {
+    frames: u64,
+    total: u64,
+}
+
+/// The timer's names of the light tracer's and the photon gather's passes.
+const CAUSTIC_PASS: &str = "caustic";
+const GATHER_PASS: &str = "photon gather";
 
 /// The photon gather's pipeline and grid (shader def CAUSTIC_GATHER).
 struct Gather {
@@ -225,7 +286,16 @@ pub(crate) struct CausticTracer {
     splat_size: u64,
     bind_group: wgpu::BindGroup,
     base: CausticParams,
-    frames_per_dispatch: u32,
+    /// The most frames one dispatch may carry (the splat and photon buffers' size).
+    max_frames_per_dispatch: u32,
+    /// What one frame cost in the last dispatch, in seconds: sizes the next dispatch when the
+    /// caller aims at a time per step (see [`Self::dispatch_frames`]).
+    seconds_per_frame: Option<f64>,
+    /// What a frame's particles and its gather cost, from the last frame traced in waited
+    /// pieces: how the next frame is cut (see [`Self::frame_pieces`]).
+    stage_seconds: Option<[f64; 2]>,
+    /// Times the light tracer's and the gather's passes, where the device has timestamps.
+    timer: PassTimer,
     groups: (u32, u32),
     pixels: usize,
     /// What a fixed-point unit is worth in true radiance: 2^radiance_exponent / S.
@@ -272,7 +342,7 @@ impl CausticTracer {
                 ),
             });
         }
-        let frames_per_dispatch =
+        let max_frames_per_dispatch =
             (SPLAT_BYTES.min(max_binding) / largest_frame_bytes).clamp(1, crate::CHUNK_SAMPLES as u64) as u32;
 
         let specular = |material: u32| {
@@ -337,7 +407,7 @@ impl CausticTracer {
             disc_area,
             gather_radius: if gather { GATHER_RADIUS_FRACTION * largest_radius } else { 0.0 },
             buckets: buckets as u32,
-            padding_a: 0,
+            first_index: 0,
             padding_b: 0,
             padding_c: 0,
         };
@@ -350,7 +420,7 @@ impl CausticTracer {
             "caustic light-tracing",
         )?;
         let device = &gpu.device;
-        let splat_size = frame_bytes * u64::from(frames_per_dispatch);
+        let splat_size = frame_bytes * u64::from(max_frames_per_dispatch);
         let (params_buffer, discs_buffer, splat) = gpu.scoped("allocating the caustic's buffers", || {
             (
                 device.create_buffer(&wgpu::BufferDescriptor {
@@ -374,7 +444,7 @@ impl CausticTracer {
         let [params, objects, materials] = scene_buffers;
         // The photon maps: (photons, heads), the photons not cleared (only the heads lead to them).
         let photon_buffers = if gather {
-            let frames = u64::from(frames_per_dispatch);
+            let frames = u64::from(max_frames_per_dispatch);
             Some(gpu.scoped("allocating the photon maps", || {
                 let storage = |label, size| {
                     device.create_buffer(&wgpu::BufferDescriptor {
@@ -413,6 +483,7 @@ impl CausticTracer {
                 entries: &entries,
             })
         })?;
+        let timer = PassTimer::new(gpu, if gather { &[CAUSTIC_PASS, GATHER_PASS] } else { &[CAUSTIC_PASS] });
         let gather = match &photon_buffers {
             Some((_, heads)) => {
                 let pipeline = shaders::companion_pipeline(
@@ -446,7 +517,10 @@ impl CausticTracer {
             splat_size,
             bind_group,
             base,
-            frames_per_dispatch,
+            max_frames_per_dispatch,
+            seconds_per_frame: None,
+            stage_seconds: None,
+            timer,
             groups: (gx, gy),
             pixels,
             unit: 2f64.powi(gpu_scene.radiance_exponent) / f64::from(fixed_scale),
@@ -483,28 +557,80 @@ impl CausticTracer {
     }
 
     /// Traces the frames of pass `key` (absolute sample indices `key.first_sample..`, grouped
-    /// in chunks of `key.chunk`) and folds them, waiting for each dispatch's readback; nothing
-    /// to do when they are the ones already held.
+    /// in chunks of `key.chunk`) and folds them, waiting for each submission. Without
+    /// `target_seconds` all of them, and it returns true; with it, one submission sized to that
+    /// time (a viewer's share of a frame: some frames, or a piece of one), and it returns true
+    /// only when the pass's frames were all folded before this call (so a step is one
+    /// submission of caustic work or one band, never both).
     #[cfg(not(target_arch = "wasm32"))]
-    pub(crate) fn prepare_pass(&mut self, gpu: &GpuContext, key: PassKey) -> Result<(), PathTraceError> {
+    pub(crate) fn prepare_pass(
+        &mut self,
+        gpu: &GpuContext,
+        key: PassKey,
+        target_seconds: Option<f64>,
+    ) -> Result<bool, PathTraceError> {
         let mut pass = self.take_pass(key);
-        // A polled read left in flight is abandoned: its frames are traced again here.
-        pass.in_flight = None;
+        // A polled read left in flight is abandoned, and so is a frame begun in pieces by
+        // polling (its pieces may not all be done): their frames are traced again here.
+        if pass.in_flight.take().is_some() || pass.pieces.as_ref().is_some_and(|p| !p.waited) {
+            pass.pieces = None;
+        }
+        let ready = pass.complete();
         let (pixels, unit) = (self.pixels, self.unit);
-        while let Some((staging, bytes, count)) = self.launch_dispatch(gpu, &pass)? {
-            illum_gpu::readback::with_mapped(gpu, &staging, bytes, "reading back caustic frames", |data| {
-                pass.fold_frames(bytemuck::cast_slice(data), count, pixels, unit)
-            })?;
-            self.staging = Some(staging);
+        loop {
+            let started = Instant::now();
+            match self.launch(gpu, &mut pass, target_seconds, true)? {
+                None => break,
+                Some(Launched::Piece) => {
+                    gpu.wait_idle("tracing a piece of a caustic frame")?;
+                    if let Some(pieces) = &mut pass.pieces {
+                        let stage = usize::from(pieces.submitted > pieces.counts[0]);
+                        pieces.seconds[stage] += started.elapsed().as_secs_f64();
+                    }
+                }
+                Some(Launched::Frames { staging, bytes, count, pieces_seconds }) => {
+                    illum_gpu::readback::with_mapped(
+                        gpu,
+                        &staging,
+                        bytes.total,
+                        "reading back caustic frames",
+                        |data| {
+                            let words = bytemuck::cast_slice(&data[..bytes.frames as usize]);
+                            pass.fold_frames(words, count, pixels, unit)
+                        },
+                    )?;
+                    self.staging = Some(staging);
+                    // What the steps waited for: the frames (or the frame's pieces), their
+                    // readback and their fold.
+                    let elapsed = started.elapsed().as_secs_f64();
+                    let seconds = match pieces_seconds {
+                        Some(mut stages) => {
+                            stages[usize::from(self.gather.is_some())] += elapsed;
+                            self.stage_seconds = Some(stages);
+                            stages[0] + stages[1]
+                        }
+                        None => elapsed,
+                    };
+                    self.seconds_per_frame = Some(seconds / f64::from(count));
+                }
+            }
+            if target_seconds.is_some() {
+                break;
+            }
         }
         self.pass = Some(pass);
-        Ok(())
+        Ok(ready)
     }
 
     /// The polled form of [`Self::prepare_pass`]: true once the frames of pass `key` are all
-    /// folded. Each call folds the dispatch in flight if its mapping is done and then submits
-    /// the next one; it never waits.
-    pub(crate) fn poll_pass(&mut self, gpu: &GpuContext, key: PassKey) -> Result<bool, PathTraceError> {
+    /// folded. Each call folds the frames in flight if their mapping is done, or sees whether
+    /// the piece in flight is done, and then submits the next work; it never waits.
+    pub(crate) fn poll_pass(
+        &mut self,
+        gpu: &GpuContext,
+        key: PassKey,
+        target_seconds: Option<f64>,
+    ) -> Result<bool, PathTraceError> {
         let mut pass = self.take_pass(key);
         if let Some(flight) = pass.in_flight.take() {
             let Some(result) = flight.read.poll(gpu) else {
@@ -512,79 +638,232 @@ impl CausticTracer {
                 self.pass = Some(pass);
                 return Ok(false);
             };
-            pass.fold_frames(bytemuck::cast_slice(&result?), flight.count, self.pixels, self.unit);
+            let data = result?;
+            let frames = flight.bytes.frames as usize;
+            pass.fold_frames(bytemuck::cast_slice(&data[..frames]), flight.count, self.pixels, self.unit);
+            // Whole frames: the GPU's time where the device has timestamps; else the time until
+            // the mapping was seen done, which counts the frames drawn meanwhile (so dispatches
+            // stay short). A frame traced in pieces keeps the cost that cut it.
+            if !flight.pieced {
+                let gpu_ms =
+                    self.timer.decode(&data[frames..]).map(|passes| passes.iter().map(|p| p.1).sum::<f64>());
+                let seconds = gpu_ms.map_or_else(|| flight.launched.elapsed().as_secs_f64(), |ms| ms * 1e-3);
+                self.seconds_per_frame = Some(seconds / f64::from(flight.count));
+            }
             self.staging = Some(flight.read.into_buffer());
+        } else if let Some(pieces) = &pass.pieces {
+            // One piece on the GPU at a time: the queue never holds more than a step's work.
+            if let Err(e) = gpu.device.poll(wgpu::PollType::Poll) {
+                return Err(illum_gpu::GpuError::DeviceLost { message: e.to_string() }.into());
+            }
+            if !pieces.done.load(Ordering::Acquire) {
+                self.pass = Some(pass);
+                return Ok(false);
+            }
         }
-        let launched = self.launch_dispatch(gpu, &pass)?;
+        let launched = self.launch(gpu, &mut pass, target_seconds, false)?;
         let complete = launched.is_none();
-        pass.in_flight = launched.map(|(staging, bytes, count)| InFlight {
-            read: PendingRead::start(staging, bytes, "reading back caustic frames"),
-            count,
-        });
+        match launched {
+            Some(Launched::Frames { staging, bytes, count, pieces_seconds }) => {
+                pass.in_flight = Some(InFlight {
+                    read: PendingRead::start(staging, bytes.total, "reading back caustic frames"),
+                    bytes,
+                    count,
+                    launched: Instant::now(),
+                    pieced: pieces_seconds.is_some(),
+                });
+            }
+            Some(Launched::Piece) => {
+                let done = pass.pieces.as_ref().map(|p| p.done.clone()).expect("a piece belongs to a frame");
+                gpu.queue.on_submitted_work_done(move || done.store(true, Ordering::Release));
+            }
+            None => {}
+        }
         self.pass = Some(pass);
         Ok(complete)
     }
 
-    /// Submits the next dispatch of `pass` and its copy into the staging buffer: (the staging
-    /// buffer, the bytes to read, the frames traced), or `None` when the pass is complete.
-    fn launch_dispatch(
-        &mut self,
-        gpu: &GpuContext,
-        pass: &CausticPass,
-    ) -> Result<Option<(wgpu::Buffer, u64, u32)>, PathTraceError> {
-        if pass.complete() {
-            return Ok(None);
+    /// Frames for the next dispatch: as many as the buffers hold without a `target_seconds`,
+    /// else the target's worth at the last measured cost (one before any measurement, and at
+    /// least one).
+    fn dispatch_frames(&self, target_seconds: Option<f64>) -> u32 {
+        match (target_seconds, self.seconds_per_frame) {
+            (None, _) => self.max_frames_per_dispatch,
+            (Some(_), None) => 1,
+            (Some(target), Some(cost)) => {
+                (target / cost.max(1e-9)).floor().clamp(1.0, f64::from(self.max_frames_per_dispatch)) as u32
+            }
         }
-        let count = self.frames_per_dispatch.min(pass.key.spp - pass.frames_done);
-        let params = CausticParams {
-            frame_base: pass.key.first_sample + pass.frames_done,
-            frame_count: count,
-            ..self.base
+    }
+
+    /// Pieces of the next frame's particles and of its gather: `None` (a whole frame) unless
+    /// a `target_seconds` is shorter than the last measured frame; then each stage in pieces
+    /// of about the target, by the stages' measured costs (half the frame's each before they
+    /// are measured), at most one per workgroup row or column of the dispatch, none empty.
+    fn frame_pieces(&self, target_seconds: Option<f64>) -> Option<[u32; 2]> {
+        let (target, cost) = (target_seconds?, self.seconds_per_frame?);
+        if cost <= target {
+            return None;
+        }
+        let split = match (self.stage_seconds, self.gather.is_some()) {
+            (Some(stages), _) => stages,
+            (None, true) => [cost / 2.0, cost / 2.0],
+            (None, false) => [cost, 0.0],
         };
-        let words_per_frame = WORDS_PER_PIXEL * self.pixels as u64;
-        let bytes = (words_per_frame + 1) * 4 * u64::from(count);
-        let staging = match self.staging.take() {
-            Some(staging) => staging,
-            None => gpu.scoped("allocating the caustic's staging buffer", || {
+        let units = self.piece_units();
+        let pieces = |seconds: f64| {
+            let wanted = (seconds / target.max(1e-9)).ceil().clamp(1.0, f64::from(units)) as u32;
+            units.div_ceil(units.div_ceil(wanted))
+        };
+        Some([pieces(split[0]), if self.gather.is_some() { pieces(split[1]) } else { 0 }])
+    }
+
+    /// The units a frame's dispatch is cut along: its workgroups along x when it has one row
+    /// of them, else its rows.
+    fn piece_units(&self) -> u32 {
+        let (gx, gy) = self.groups;
+        if gy == 1 { gx } else { gy }
+    }
+
+    /// Piece `i` of `count` of a frame's dispatch: its workgroups and its first particle (or
+    /// pixel). The pieces cover the dispatch once, in order.
+    fn piece(&self, i: u32, count: u32) -> ((u32, u32), u32) {
+        let (gx, gy) = self.groups;
+        let units = self.piece_units();
+        let per = units.div_ceil(count);
+        let first = (i * per).min(units);
+        let n = per.min(units - first);
+        if gy == 1 { ((n, 1), first * WORKGROUP) } else { ((gx, n), first * self.base.row_stride) }
+    }
+
+    /// The staging buffer for a dispatch's frames (the one read last, or a new one).
+    fn take_staging(&mut self, gpu: &GpuContext) -> Result<wgpu::Buffer, PathTraceError> {
+        match self.staging.take() {
+            Some(staging) => Ok(staging),
+            None => Ok(gpu.scoped("allocating the caustic's staging buffer", || {
                 gpu.device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some("caustic staging"),
-                    size: self.splat_size,
+                    size: self.splat_size + self.timer.result_size(),
                     usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
                     mapped_at_creation: false,
                 })
-            })?,
+            })?),
+        }
+    }
+
+    /// Submits the next work of `pass`: whole frames (sized by [`Self::dispatch_frames`]), or
+    /// the next piece of a frame cut by [`Self::frame_pieces`] (the frame's particles piece by
+    /// piece, then its gather piece by piece, its copy for readback with the last piece).
+    /// `None` when the pass is complete. `waited`: the caller waits for each piece.
+    fn launch(
+        &mut self,
+        gpu: &GpuContext,
+        pass: &mut CausticPass,
+        target_seconds: Option<f64>,
+        waited: bool,
+    ) -> Result<Option<Launched>, PathTraceError> {
+        if pass.complete() {
+            return Ok(None);
+        }
+        let frame = pass.key.first_sample + pass.frames_done;
+        if pass.pieces.is_none()
+            && let Some(counts) = self.frame_pieces(target_seconds)
+        {
+            pass.pieces =
+                Some(FramePieces { counts, submitted: 0, done: Arc::default(), seconds: [0.0; 2], waited });
+        }
+        let Some(pieces) = &mut pass.pieces else {
+            let count = self.dispatch_frames(target_seconds).min(pass.key.spp - pass.frames_done);
+            let groups = (self.groups.0, self.groups.1, count);
+            let (staging, bytes) =
+                self.submit(gpu, frame, count, groups, 0, Stage::Whole)?.expect("whole frames are read back");
+            return Ok(Some(Launched::Frames { staging, bytes, count, pieces_seconds: None }));
         };
+        let (k, [particles, gathers]) = (pieces.submitted, pieces.counts);
+        let last = k + 1 == particles + gathers;
+        pieces.submitted += 1;
+        pieces.done.store(false, Ordering::Release);
+        let (((gx, gy), first), stage) = if k < particles {
+            (self.piece(k, particles), Stage::Particles { first: k == 0, last })
+        } else {
+            (self.piece(k - particles, gathers), Stage::Gather { last })
+        };
+        match self.submit(gpu, frame, 1, (gx, gy, 1), first, stage)? {
+            None => Ok(Some(Launched::Piece)),
+            Some((staging, bytes)) => {
+                let seconds = pass.pieces.take().map_or([0.0; 2], |p| p.seconds);
+                Ok(Some(Launched::Frames { staging, bytes, count: 1, pieces_seconds: Some(seconds) }))
+            }
+        }
+    }
+
+    /// Records and submits one dispatch of `frames` frames from sample index `frame`, over
+    /// `groups` workgroups from particle (or pixel) `first`, as `stage` says. Returns the
+    /// staging buffer and what to read from it when the frames are complete (whole frames, or
+    /// a frame's last piece).
+    fn submit(
+        &mut self,
+        gpu: &GpuContext,
+        frame: u32,
+        frames: u32,
+        groups: (u32, u32, u32),
+        first: u32,
+        stage: Stage,
+    ) -> Result<Option<(wgpu::Buffer, DispatchBytes)>, PathTraceError> {
+        let params =
+            CausticParams { frame_base: frame, frame_count: frames, first_index: first, ..self.base };
+        let words_per_frame = WORDS_PER_PIXEL * self.pixels as u64;
+        let bytes = (words_per_frame + 1) * 4 * u64::from(frames);
+        let (clear, particles, gather, read) = match stage {
+            Stage::Whole => (true, true, true, true),
+            Stage::Particles { first, last } => (first, true, false, last),
+            Stage::Gather { last } => (false, false, true, last),
+        };
+        // Whole frames are timed; a piece is timed by its caller's wait.
+        let timed = matches!(stage, Stage::Whole);
+        let staging = if read { Some(self.take_staging(gpu)?) } else { None };
         gpu.queue.write_buffer(&self.scene_params_buffer, 0, bytemuck::bytes_of(&self.scene_params));
         gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&params));
         let mut encoder = gpu
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("caustic frames") });
-        encoder.clear_buffer(&self.splat, 0, Some(bytes));
-        if let Some(gather) = &self.gather {
-            encoder.clear_buffer(&gather.heads, 0, Some(gather.heads_frame_bytes * u64::from(count)));
+        if clear {
+            encoder.clear_buffer(&self.splat, 0, Some(bytes));
+            if let Some(gather) = &self.gather {
+                encoder.clear_buffer(&gather.heads, 0, Some(gather.heads_frame_bytes * u64::from(frames)));
+            }
         }
-        {
+        if particles {
             let mut compute = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("caustic"),
-                timestamp_writes: None,
+                timestamp_writes: if timed { self.timer.compute_writes(CAUSTIC_PASS) } else { None },
             });
             compute.set_pipeline(&self.pipeline);
             compute.set_bind_group(0, &self.bind_group, &[]);
-            compute.dispatch_workgroups(self.groups.0, self.groups.1, count);
+            compute.dispatch_workgroups(groups.0, groups.1, groups.2);
         }
         // Its own pass: the gather reads what every particle of the frames stored.
-        if let Some(gather) = &self.gather {
+        if let Some(gather) = self.gather.as_ref().filter(|_| gather) {
             let mut compute = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("photon gather"),
-                timestamp_writes: None,
+                timestamp_writes: if timed { self.timer.compute_writes(GATHER_PASS) } else { None },
             });
             compute.set_pipeline(&gather.pipeline);
             compute.set_bind_group(0, &gather.bind_group, &[]);
-            compute.dispatch_workgroups(self.groups.0, self.groups.1, count);
+            compute.dispatch_workgroups(groups.0, groups.1, groups.2);
         }
-        encoder.copy_buffer_to_buffer(&self.splat, 0, &staging, 0, bytes);
+        let result = staging.map(|staging| {
+            encoder.copy_buffer_to_buffer(&self.splat, 0, &staging, 0, bytes);
+            let timestamps = if timed && self.timer.enabled() {
+                self.timer.copy_results(&mut encoder, &staging, bytes);
+                self.timer.result_size()
+            } else {
+                0
+            };
+            (staging, DispatchBytes { frames: bytes, total: bytes + timestamps })
+        });
         gpu.queue.submit([encoder.finish()]);
-        Ok(Some((staging, bytes, count)))
+        Ok(result)
     }
 
     /// Adds the held pass's chunk `k` for the band's pixels `first_pixel..` to the accumulator,

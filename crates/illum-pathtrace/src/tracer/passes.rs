@@ -183,7 +183,7 @@ impl PathTracer {
     fn next_band(&mut self, pass: ActivePass) -> Result<Option<StepReport>, PathTraceError> {
         match self.bands.readback() {
             Readback::Polled => self.poll_band(pass),
-            Readback::Staging | Readback::Mapped => self.submit_band(pass).map(Some),
+            Readback::Staging | Readback::Mapped => self.submit_band(pass),
         }
     }
 
@@ -220,8 +220,9 @@ impl PathTracer {
             let plan = self.fit(PassPlan { spp: remaining, rows });
             self.bands.start_pass(ActivePass { plan, sample_base: self.accumulation.spp_done, next_row: 0 });
             while let Some(pass) = self.bands.pass().copied() {
-                let report = self.submit_band(pass)?;
-                self.bands.planner.record(report.samples, report.wall_seconds);
+                if let Some(report) = self.submit_band(pass)? {
+                    self.bands.planner.record(report.samples, report.wall_seconds);
+                }
             }
             remaining -= plan.spp;
         }

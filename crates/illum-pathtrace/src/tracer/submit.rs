@@ -67,9 +67,10 @@ impl PathTracer {
 
     /// Traces one band of `pass` and folds it, waiting for the readback (of the band launched
     /// ahead by the previous call, if there is one), and launches the pass's next band before
-    /// folding.
+    /// folding. `None`: the call traced caustic frames of the pass instead (a caller that aims
+    /// at a time per step gets one dispatch of them per call, see `CausticTracer::prepare_pass`).
     #[cfg(not(target_arch = "wasm32"))]
-    pub(super) fn submit_band(&mut self, pass: ActivePass) -> Result<StepReport, PathTraceError> {
+    pub(super) fn submit_band(&mut self, pass: ActivePass) -> Result<Option<StepReport>, PathTraceError> {
         let readback = self.bands.readback().waited();
         let (band, results) = match self.bands.take_submitted() {
             Submitted::Ahead { band, results } => (band, results),
@@ -77,8 +78,11 @@ impl PathTracer {
             Submitted::Nothing | Submitted::Polled { .. } => {
                 // The caustic's frames of this pass, traced once, before its first band.
                 let key = self.caustic_key(&pass);
-                if let Some(caustic) = &mut self.pipeline.caustic {
-                    caustic.prepare_pass(&self.pipeline.gpu, key)?;
+                let target = self.bands.caustic_target_seconds;
+                if let Some(caustic) = &mut self.pipeline.caustic
+                    && !caustic.prepare_pass(&self.pipeline.gpu, key, target)?
+                {
+                    return Ok(None);
                 }
                 self.begin_band(&pass, pass.next_row, readback)?
             }
@@ -125,7 +129,7 @@ impl PathTracer {
             // traced again from the pass's `next_row`.
             self.bands.take_submitted();
         }
-        folded
+        folded.map(Some)
     }
 
     /// Launches the pass's next band, then folds `band` from its read-back bytes.
@@ -178,8 +182,9 @@ impl PathTracer {
                 // The caustic's frames of this pass come first, read back dispatch by dispatch
                 // over as many calls as it takes.
                 let key = self.caustic_key(&pass);
+                let target = self.bands.caustic_target_seconds;
                 if let Some(caustic) = &mut self.pipeline.caustic
-                    && !caustic.poll_pass(&self.pipeline.gpu, key)?
+                    && !caustic.poll_pass(&self.pipeline.gpu, key, target)?
                 {
                     return Ok(None);
                 }

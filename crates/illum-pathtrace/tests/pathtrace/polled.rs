@@ -141,8 +141,21 @@ const CAUSTIC_SPP: u32 = 40;
 /// tracer is reset after its first step (polling, the first pass's caustic frames are then in
 /// flight). Returns the tracer and the steps that returned before their results were back.
 fn render_caustic(scene: &Scene, polled: bool, reset_after_first_step: bool) -> (PathTracer, u64) {
+    render_caustic_aiming_at(scene, polled, reset_after_first_step, None)
+}
+
+/// [`render_caustic`], with `set_target_seconds(target)` when given.
+fn render_caustic_aiming_at(
+    scene: &Scene,
+    polled: bool,
+    reset_after_first_step: bool,
+    target: Option<f64>,
+) -> (PathTracer, u64) {
     let mut tracer = PathTracer::new(common::gpu(), scene).expect("path tracer builds");
     tracer.set_chunk_aligned_passes(true);
+    if let Some(target) = target {
+        tracer.set_target_seconds(target);
+    }
     if polled {
         tracer.set_readback(Readback::Polled);
     }
@@ -201,4 +214,28 @@ fn polled_caustic_frames_give_the_blocking_image_bit_for_bit() {
     let mean = |t: &PathTracer| t.accumulator().mean_image().mean_luminance();
     println!("image mean luminance: {:.6} with the caustic, {:.6} without", mean(&waited), mean(&plain));
     assert_ne!(mean(&waited), mean(&plain), "the caustic's frames changed nothing");
+}
+
+/// What the desktop viewer does with the Whitted scene: it aims at a share of each frame, and a
+/// step then traces one submission of caustic work sized to it, never a whole pass's frames at
+/// once, so the window keeps drawing. Here the target is shorter than any frame: the first
+/// frame is traced whole (its cost is not known yet), every later one in pieces (its particles
+/// and its gather in one piece per workgroup, 15 each at this size). The image is the one of a
+/// render without the target, bit for bit.
+#[test]
+fn a_time_target_traces_the_caustic_in_pieces_with_the_same_image() {
+    let scene = caustic_scene(true);
+    let (whole, whole_waits) = render_caustic(&scene, false, false);
+    let (waited, waits) = render_caustic_aiming_at(&scene, false, false, Some(1e-9));
+    println!("steps without samples: {whole_waits} without a target, {waits} with one");
+    assert!(whole_waits < u64::from(CAUSTIC_SPP), "without a target a step traces a pass's frames at once");
+    assert!(waits > 2 * u64::from(CAUSTIC_SPP), "with it, several steps per caustic frame");
+    assert_identical(&whole, &waited, "one frame per step against whole passes");
+    let (polled, polled_waits) = render_caustic_aiming_at(&scene, true, false, Some(1e-9));
+    println!("polled with a target: {polled_waits} steps without samples");
+    assert!(
+        polled_waits > 2 * u64::from(CAUSTIC_SPP),
+        "{polled_waits} polled steps for {CAUSTIC_SPP} frames"
+    );
+    assert_identical(&whole, &polled, "polled, one frame per dispatch, against whole passes");
 }
