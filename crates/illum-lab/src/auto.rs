@@ -80,10 +80,16 @@ pub fn reached(choice: &Planned, noise: Option<f64>, seconds: f64) -> String {
     match noise {
         Some(noise) => format!(
             "auto: {timing}; estimated relative error {:.4} (predicted {:.4}): the pilot's bias {:.4} and the \
-             render's own noise estimate {noise:.4}",
+             render's own estimate {noise:.4} ({})",
             (bias + noise * noise).sqrt(),
             choice.predicted_error,
-            bias.sqrt()
+            bias.sqrt(),
+            match choice.candidate.setting {
+                plan::Setting::PathTrace { denoise: Some(_), .. } => {
+                    "the denoised error from its two halves, of a denoised half: above the written image's"
+                }
+                _ => "of its noise",
+            }
         ),
         None => format!(
             "auto: {timing}; a deterministic image: its relative error is the one the pilot measured, {:.4}",
