@@ -6,14 +6,7 @@ use std::path::Path;
 
 use super::plan::{NoiseCurve, Setting};
 use crate::report::{csv_text, write_text};
-
-/// One setting's bias and noise, as cached.
-#[derive(Clone, Debug, PartialEq)]
-pub(super) struct Measured {
-    pub(super) bias_rel_mse: f64,
-    pub(super) noise: Option<NoiseCurve>,
-    pub(super) worst_region: Option<(String, f64)>,
-}
+use illum_auto::measure::Measured;
 
 /// The cached measurements, if `path` holds them for exactly `key`.
 pub(super) fn read_cache(path: &Path, key: &str, expected: usize) -> Option<Vec<Measured>> {

@@ -27,15 +27,17 @@ use illum_gpu::GpuContext;
 use illum_image::RgbImage32;
 use illum_pathtrace::{GUIDE_SAMPLES, PathTracer, SampleAllocation};
 use illum_raster::{Options, RasterRenderer, RasterScene};
-use illum_scene::{Bounces, DenoiserKind, Effects, Look, MaterialKind, Overrides, Scene, Sequence};
+use illum_scene::{Bounces, DenoiserKind, Overrides, Scene, Sequence};
 use illum_whitted::WhittedTracer;
 
-use super::cache::{Measured, read_cache, write_cache};
+use super::cache::{read_cache, write_cache};
 use super::plan::{Candidate, NoiseCurve, Setting};
 pub use super::render::render;
 use super::render::{path_tracer_throughput, spp_multiple, tracer_options};
 use crate::reference::{cached_reference, reference_settings};
 use crate::regions::{Regions, compare};
+use illum_auto::measure::{Measured, measured};
+pub use illum_auto::settings::{apply, has_caustic, pilot_size, settings, settings_with_variants};
 
 /// How the pilot measures.
 #[derive(Clone, Debug)]
@@ -90,107 +92,6 @@ impl Pilot {
     }
 }
 
-/// Every setting `auto` chooses among for `scene`: the rasterizer's two looks and the enhanced
-/// look with each effect off (where it can draw the scene), the Whitted ray tracer at depths 1,
-/// 2, 4, 8 (depth 1 alone without a mirror or glass, where depth changes nothing) and 1 to 4
-/// rays per pixel a side, and the path tracer at bounces 1, 2, 4, 8 and unbounded, with and
-/// (where the scene has a caustic) without its light tracer, each with independent samples,
-/// the low-discrepancy sequence, adaptive sampling, and denoised by à-trous (and by Open Image
-/// Denoise in builds that have it); adaptive sampling only without the light tracer (the path
-/// tracer refuses the two together). Not measured, to keep the pilot's cost down: adaptive
-/// sampling or denoising with the low-discrepancy sequence, and both together.
-pub fn settings(scene: &Scene) -> Vec<Setting> {
-    let mut all = Vec::new();
-    if RasterScene::from_scene(scene).is_ok() {
-        all.push(Setting::Raster { look: Look::Figure, effects: Effects::ALL_ON });
-        all.push(Setting::Raster { look: Look::Enhanced, effects: Effects::ALL_ON });
-        for (_, off) in Effects::TOGGLES {
-            let mut effects = Effects::ALL_ON;
-            off(&mut effects);
-            all.push(Setting::Raster { look: Look::Enhanced, effects });
-        }
-    }
-    let depths: &[u32] = if has_specular(scene) { &[1, 2, 4, 8] } else { &[1] };
-    for &depth in depths {
-        for aa in 1..=4 {
-            all.push(Setting::Whitted { depth, aa });
-        }
-    }
-    let caustics: &[bool] = if has_caustic(scene) { &[false, true] } else { &[false] };
-    for &caustics in caustics {
-        for bounces in
-            [Bounces::Fixed(1), Bounces::Fixed(2), Bounces::Fixed(4), Bounces::Fixed(8), Bounces::Unbounded]
-        {
-            let setting = |sequence, adaptive, denoise| Setting::PathTrace {
-                bounces,
-                caustics,
-                sequence,
-                adaptive,
-                denoise,
-            };
-            all.push(setting(Sequence::Independent, false, None));
-            all.push(setting(Sequence::LowDiscrepancy, false, None));
-            // Adaptive sampling spreads the spp over blocks; the caustic's light tracer covers
-            // the whole image at one spp per pass, so the path tracer refuses the two together.
-            if !caustics {
-                all.push(setting(Sequence::Independent, true, None));
-            }
-            all.push(setting(Sequence::Independent, false, Some(DenoiserKind::Atrous)));
-            if OIDN_BUILT {
-                all.push(setting(Sequence::Independent, false, Some(DenoiserKind::Oidn)));
-            }
-        }
-    }
-    all
-}
-
-fn has_specular(scene: &Scene) -> bool {
-    scene
-        .materials
-        .iter()
-        .any(|m| matches!(m.kind, MaterialKind::Dielectric { .. } | MaterialKind::Mirror { .. }))
-}
-
-/// Whether the path tracer's caustic light tracer has anything to trace in `scene`.
-pub fn has_caustic(scene: &Scene) -> bool {
-    let mut with = scene.clone();
-    with.pathtrace.caustics = true;
-    illum_pathtrace::gpu_scene::caustics_active(&with)
-}
-
-/// `scene` with `setting` applied (its renderer's section), at the scene's size.
-pub fn apply(scene: &Scene, setting: &Setting) -> Scene {
-    let mut scene = scene.clone();
-    match setting {
-        Setting::Raster { look, effects } => {
-            scene.raster.look = *look;
-            scene.raster.effects = *effects;
-        }
-        Setting::Whitted { depth, aa } => {
-            scene.whitted.depth = *depth;
-            scene.whitted.aa = *aa;
-        }
-        Setting::PathTrace { bounces, caustics, sequence, .. } => {
-            scene.pathtrace.bounces = *bounces;
-            scene.pathtrace.caustics = *caustics;
-            scene.pathtrace.sequence = *sequence;
-        }
-    }
-    scene
-}
-
-/// The pilot's size: the scene's aspect, `longer_side` pixels on the longer side, never more
-/// than the scene's own.
-pub fn pilot_size(scene: &Scene, longer_side: u32) -> (u32, u32) {
-    let (w, h) = (scene.camera.width, scene.camera.height);
-    if w.max(h) <= longer_side {
-        return (w, h);
-    }
-    let scale = f64::from(longer_side) / f64::from(w.max(h));
-    let side = |v: u32| ((f64::from(v) * scale).round() as u32).max(1);
-    (side(w), side(h))
-}
-
 fn resized(scene: &Scene, (width, height): (u32, u32)) -> anyhow::Result<Scene> {
     let mut small = scene.clone();
     small.apply_overrides(
@@ -229,7 +130,9 @@ pub fn measure(
         };
     let truth_rel_mse = if truth.estimated_rel_mse.is_finite() { truth.estimated_rel_mse } else { 0.0 };
 
-    let all = settings(scene);
+    let denoisers: &[DenoiserKind] =
+        if OIDN_BUILT { &[DenoiserKind::Atrous, DenoiserKind::Oidn] } else { &[DenoiserKind::Atrous] };
+    let all = settings_with_variants(scene, denoisers);
     let (_, truth_key) = reference_settings(&truth_scene, options.truth_spp);
     let key = format!(
         "auto pilot 3; truth: {truth_key}; pilot spp {}; seed {}; sampling {}; settings: {}",
@@ -334,21 +237,9 @@ fn measure_bias(
 ) -> anyhow::Result<Measured> {
     let variant = apply(small, setting);
     let spp = options.pilot_spp;
-    let worst = |image: &RgbImage32| {
-        let errors = compare(image, truth, regions);
-        let worst_region = regions
-            .names
-            .iter()
-            .zip(&errors.regions)
-            .filter(|(_, e)| e.pixels > 0 && e.luminance_ratio.is_finite())
-            .max_by(|a, b| (a.1.luminance_ratio - 1.0).abs().total_cmp(&(b.1.luminance_ratio - 1.0).abs()))
-            .map(|(name, e)| (name.clone(), e.luminance_ratio));
-        (errors.overall.rel_mse - truth_rel_mse, worst_region)
-    };
     let Setting::PathTrace { sequence, adaptive, denoise, .. } = setting else {
         let (image, _) = render(gpu, &variant, setting, spp)?;
-        let (rel_mse, worst_region) = worst(&image);
-        return Ok(Measured { bias_rel_mse: rel_mse.max(0.0), noise: None, worst_region });
+        return Ok(measured(&compare(&image, truth, regions), regions, truth_rel_mse, None, spp));
     };
     let mut tracer = if *adaptive {
         let (w, h) = (variant.camera.width, variant.camera.height);
@@ -366,7 +257,7 @@ fn measure_bias(
         Some(kind) => (Some(Denoiser::new(gpu, *kind)?), Some(tracer.guides(GUIDE_SAMPLES)?)),
         None => (None, None),
     };
-    let mut denoised_points = Vec::new();
+    let mut denoised = Vec::new();
     let mut quarter = None;
     for &n in &denoised_at {
         let until = match tracer.sample_allocation() {
@@ -379,46 +270,28 @@ fn measure_bias(
         }
         if let (Some(filter), Some(guides)) = (&filter, &guides) {
             let image = filter.denoise(&DenoiseInput::from_render(tracer.accumulator(), guides))?;
-            denoised_points.push((f64::from(n), image));
+            // As a deterministic image: its relMSE less the truth's noise, and its worst region.
+            denoised.push((n, measured(&compare(&image, truth, regions), regions, truth_rel_mse, None, n)));
         }
     }
     let accumulator = tracer.accumulator();
     let own = accumulator.estimated_rel_mse();
-    let (raw_rel_mse, raw_worst) = worst(&accumulator.mean_image());
-    let bias_rel_mse = (raw_rel_mse - own).max(0.0);
+    let raw =
+        measured(&compare(&accumulator.mean_image(), truth, regions), regions, truth_rel_mse, Some(own), spp);
     let n = f64::from(spp);
-    let (noise, worst_region) = match (sequence, denoise) {
+    Ok(match (sequence, denoise) {
         (_, Some(_)) => {
-            let mut points = Vec::new();
-            let mut last_worst = raw_worst;
-            for (n, image) in &denoised_points {
-                let (rel_mse, region) = worst(image);
-                points.push((*n, rel_mse - bias_rel_mse));
-                last_worst = region;
-            }
-            (NoiseCurve::new(points, 0.0), last_worst)
+            let points =
+                denoised.iter().map(|(n, m)| (f64::from(*n), m.bias_rel_mse - raw.bias_rel_mse)).collect();
+            let worst_region =
+                denoised.last().map_or(raw.worst_region.clone(), |(_, m)| m.worst_region.clone());
+            Measured { noise: NoiseCurve::new(points, 0.0), worst_region, ..raw }
         }
         (Sequence::LowDiscrepancy, None) => {
             let early = quarter.unwrap_or(own);
             let exponent = (early / own).ln() / 4f64.ln();
-            (NoiseCurve::new(vec![(n / 4.0, early), (n, own)], exponent), raw_worst)
+            Measured { noise: NoiseCurve::new(vec![(n / 4.0, early), (n, own)], exponent), ..raw }
         }
-        (Sequence::Independent, None) => (NoiseCurve::independent(own, n), raw_worst),
-    };
-    Ok(Measured { bias_rel_mse, noise, worst_region })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_pilot_keeps_the_aspect_and_never_upsamples() {
-        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/whitted.toml");
-        let mut scene = Scene::load(std::path::Path::new(path)).unwrap();
-        assert_eq!(pilot_size(&scene, 128), (128, 72));
-        scene.camera.width = 100;
-        scene.camera.height = 50;
-        assert_eq!(pilot_size(&scene, 128), (100, 50));
-    }
+        (Sequence::Independent, None) => raw,
+    })
 }
