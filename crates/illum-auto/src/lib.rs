@@ -1,5 +1,10 @@
-//! Choosing how to render a scene: the planner that `render --renderer auto` and the viewer's
-//! Auto mode share. It is pure (no GPU, no files): the measurements come from a pilot, which
-//! each front end runs its own way (the CLI blocking, the viewer across frames).
+//! Choosing how to render a scene: what `render --renderer auto` and the viewer's Auto mode
+//! share. The planner ([`plan`]) is pure; [`settings`] lists what Auto chooses among and
+//! applies a choice to a scene; [`regions`] and [`measure`] turn a pilot's images into the
+//! planner's measurements. Running the pilot is each front end's own: the CLI's blocks
+//! (`illum_lab::auto::pilot`), the viewer's runs across frames.
 
+pub mod measure;
 pub mod plan;
+pub mod regions;
+pub mod settings;

@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 use illum_gpu::GpuContext;
 use illum_scene::RendererKind;
 
+use crate::auto_panel::AutoMode;
 use crate::camera::OrbitCamera;
 use crate::frame_rate::FrameRate;
 use crate::pathtrace_panel::PathTraceMode;
@@ -44,6 +45,9 @@ pub struct ViewerApp {
     pathtrace: Result<PathTraceMode, String>,
     raster: Result<RasterMode, String>,
     whitted: Result<WhittedMode, String>,
+    /// The Auto mode (`auto_panel.rs`) and whether it is shown: it then shows its choice's mode.
+    auto: AutoMode,
+    auto_shown: bool,
     /// The "open scene" text field: the shown mode's scene file (or a path being typed).
     pub scene_field: String,
     /// Whether the settings panel is shown (the top bar's "Hide settings" / "Show settings").
@@ -91,6 +95,8 @@ impl ViewerApp {
             pathtrace: Err("no path-tracer scene loaded".to_owned()),
             raster: Err("no raster scene loaded".to_owned()),
             whitted: Err("no Whitted scene loaded".to_owned()),
+            auto: AutoMode::default(),
+            auto_shown: false,
             scene_field: options.scene.display().to_string(),
             show_panel: true,
             panel_fitted: false,
@@ -203,6 +209,24 @@ impl ViewerApp {
 
     pub fn raster(&self) -> Option<&RasterMode> {
         self.raster.as_ref().ok()
+    }
+
+    pub fn auto(&self) -> &AutoMode {
+        &self.auto
+    }
+
+    pub fn auto_mut(&mut self) -> &mut AutoMode {
+        &mut self.auto
+    }
+
+    /// Whether the Auto mode is shown (with its choice's mode).
+    pub fn auto_shown(&self) -> bool {
+        self.auto_shown
+    }
+
+    /// Shows the Auto mode, as its top-bar button does (`--mode auto`).
+    pub fn show_auto(&mut self) {
+        self.auto_shown = true;
     }
 
     /// Opens a scene file in every mode that can render it and returns the mode to show (the
@@ -345,7 +369,8 @@ impl ViewerApp {
             }),
         };
         let fps = self.frame_rate.fps().map_or("n/a".to_owned(), |f| format!("{f:.1} fps"));
-        format!("{}, window {fps}", mode.unwrap_or_else(|| format!("{}: no scene", self.mode)))
+        let auto = if self.auto_shown { format!("{}; ", self.auto.summary()) } else { String::new() };
+        format!("{auto}{}, window {fps}", mode.unwrap_or_else(|| format!("{}: no scene", self.mode)))
     }
 
     fn top_bar(&mut self, ui: &mut egui::Ui) {
@@ -369,14 +394,25 @@ impl ViewerApp {
             ];
             if compact {
                 let shown = modes.iter().find(|(m, _)| *m == chosen).map_or("", |(_, name)| name);
+                let shown = if self.auto_shown { "Auto" } else { shown };
                 egui::ComboBox::from_id_salt("mode").selected_text(shown).show_ui(ui, |ui| {
                     for (mode, name) in modes {
-                        ui.selectable_value(&mut chosen, mode, name);
+                        if ui.selectable_label(!self.auto_shown && chosen == mode, name).clicked() {
+                            chosen = mode;
+                            self.auto_shown = false;
+                        }
+                    }
+                    #[cfg(not(target_arch = "wasm32"))]
+                    if ui.selectable_label(self.auto_shown, "Auto").clicked() {
+                        self.auto_shown = true;
                     }
                 });
             } else {
                 for (mode, name) in modes {
-                    ui.selectable_value(&mut chosen, mode, name);
+                    if ui.selectable_label(!self.auto_shown && chosen == mode, name).clicked() {
+                        chosen = mode;
+                        self.auto_shown = false;
+                    }
                 }
                 ui.separator();
             }
@@ -406,6 +442,16 @@ impl ViewerApp {
             }
             #[cfg(target_arch = "wasm32")]
             self.web_open_buttons(ui);
+            // After the buttons that open files, so that they keep their places (a compact bar
+            // has Auto in its drop-down). Not in the browser: the pilot reads images back with
+            // blocking waits (auto_pilot.rs).
+            #[cfg(not(target_arch = "wasm32"))]
+            if !compact {
+                ui.separator();
+                if ui.selectable_label(self.auto_shown, "Auto").clicked() {
+                    self.auto_shown = true;
+                }
+            }
             if compact {
                 return;
             }
@@ -444,6 +490,10 @@ impl ViewerApp {
 
     fn side_panel(&mut self, ui: &mut egui::Ui) {
         egui::ScrollArea::vertical().show(ui, |ui| {
+            if self.auto_shown {
+                self.auto.panel(ui);
+                ui.separator();
+            }
             let result = match self.mode {
                 RendererKind::Raster => self.raster.as_mut().map(|m| m.panel(ui)),
                 RendererKind::PathTrace => self.pathtrace.as_mut().map(|m| m.panel(ui)),
@@ -459,8 +509,8 @@ impl ViewerApp {
 
     /// The image of the shown mode, filling `ui`; `fill` where there is none yet.
     fn view(&mut self, ui: &mut egui::Ui, fill: egui::Color32) {
-        let (gpu, render_state) = match &self.gpu {
-            Ok(pair) => pair,
+        let gpu = match &self.gpu {
+            Ok((gpu, _)) => gpu,
             Err(error) => {
                 ui.painter().rect_filled(ui.max_rect(), 0.0, fill);
                 ui.colored_label(ui.visuals().error_fg_color, error.as_str());
@@ -471,6 +521,16 @@ impl ViewerApp {
         let pixels_per_point = ui.ctx().pixels_per_point();
         let view_pixels =
             [(size.x * pixels_per_point).round() as u32, (size.y * pixels_per_point).round() as u32];
+        if self.auto_shown {
+            let gpu = gpu.clone();
+            if !self.auto_frame(ui, &gpu, view_pixels) {
+                return;
+            }
+        }
+        let (gpu, render_state) = match &self.gpu {
+            Ok(pair) => pair,
+            Err(_) => return,
+        };
         let texture = match self.mode {
             RendererKind::Raster => {
                 self.raster.as_mut().ok().and_then(|m| m.frame(gpu, render_state, view_pixels))
@@ -514,6 +574,41 @@ impl ViewerApp {
         if busy {
             ui.ctx().request_repaint();
         }
+    }
+}
+
+impl ViewerApp {
+    /// The Auto mode's part of a frame: runs its pilot's slice on the path tracer's scene and
+    /// view, hands a new choice to its mode, and while the pilot measures shows its progress
+    /// in the view. Returns whether the view should show the chosen mode's image.
+    fn auto_frame(&mut self, ui: &mut egui::Ui, gpu: &GpuContext, view_pixels: [u32; 2]) -> bool {
+        let Ok(pathtrace) = &self.pathtrace else { return true };
+        let sizes = crate::auto_pilot::ViewSizes {
+            raster: view_pixels.map(|v| v.max(1)),
+            whitted: WhittedMode::render_size(view_pixels),
+            pathtrace: pathtrace.render_size(view_pixels),
+        };
+        let [width, height] = sizes.raster;
+        let scene = pathtrace.desired_scene(width, height);
+        let path = pathtrace.scene_path().to_path_buf();
+        if let Some(choice) = self.auto.frame(gpu, &path, &scene, sizes) {
+            let kind = crate::auto_panel::apply_choice(
+                &choice,
+                self.raster.as_mut().ok(),
+                self.whitted.as_mut().ok(),
+                self.pathtrace.as_mut().ok(),
+            );
+            self.switch_to(kind);
+        }
+        let Some((done, what)) = self.auto.progress() else { return true };
+        let rect = ui.available_rect_before_wrap();
+        ui.scope_builder(egui::UiBuilder::new().max_rect(rect.shrink(24.0)), |ui| {
+            ui.label("Auto: measuring this scene with every renderer and setting");
+            ui.add(egui::ProgressBar::new(done).show_percentage());
+            ui.label(what);
+        });
+        ui.ctx().request_repaint();
+        false
     }
 }
 
@@ -564,7 +659,8 @@ impl eframe::App for ViewerApp {
             self.open_dropped(ui.ctx(), file);
         }
         // The path tracer's wall clock runs only while its mode is shown.
-        let showing_pathtrace = self.mode == RendererKind::PathTrace;
+        let showing_pathtrace =
+            self.mode == RendererKind::PathTrace && !(self.auto_shown && self.auto.measuring());
         if let Ok(pathtrace) = &mut self.pathtrace {
             pathtrace.set_active(showing_pathtrace);
         }

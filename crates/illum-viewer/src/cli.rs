@@ -1,4 +1,4 @@
-//! The command line: `illum-viewer [SCENE] [--mode raster|pathtrace|whitted] [--screenshot FILE --frames N]`.
+//! The command line: `illum-viewer [SCENE] [--mode raster|pathtrace|whitted|auto] [--screenshot FILE --frames N]`.
 
 use std::path::PathBuf;
 
@@ -16,9 +16,10 @@ pub struct Args {
     /// its `renderer`; a mode that cannot render it keeps its default scene.
     #[arg(default_value = crate::scene_file::DEFAULT_PATHTRACE_SCENE)]
     pub scene: PathBuf,
-    /// The mode shown first. Default: the mode of SCENE.
-    #[arg(long, value_parser = parse_mode)]
-    pub mode: Option<RendererKind>,
+    /// The mode shown first: a renderer, or `auto` (the Auto mode, which shows the renderer it
+    /// picks). Default: the mode of SCENE.
+    #[arg(long, value_parser = parse_start_mode)]
+    pub mode: Option<StartMode>,
     /// Render `--frames` frames, save a screenshot of the window to this PNG file and exit.
     #[arg(long)]
     pub screenshot: Option<PathBuf>,
@@ -39,6 +40,31 @@ pub fn parse_mode(text: &str) -> Result<RendererKind, String> {
     text.parse::<RendererKind>().map_err(|e| format!("unknown mode {text:?}: {}", e.allowed))
 }
 
+/// The command line's first mode: one of the renderers, or Auto.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StartMode {
+    Renderer(RendererKind),
+    Auto,
+}
+
+impl StartMode {
+    /// The renderer shown first (Auto starts from the scene's and then shows its choice's).
+    pub fn renderer(self) -> Option<RendererKind> {
+        match self {
+            StartMode::Renderer(kind) => Some(kind),
+            StartMode::Auto => None,
+        }
+    }
+}
+
+/// `auto`, or a renderer as [`parse_mode`] reads it.
+pub fn parse_start_mode(text: &str) -> Result<StartMode, String> {
+    if text == "auto" {
+        return Ok(StartMode::Auto);
+    }
+    parse_mode(text).map(StartMode::Renderer).map_err(|e| format!("{e}, or auto"))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -55,10 +81,12 @@ mod tests {
             "3",
         ])
         .unwrap();
-        assert_eq!(args.mode, Some(RendererKind::Raster));
+        assert_eq!(args.mode, Some(StartMode::Renderer(RendererKind::Raster)));
+        let auto = Args::try_parse_from(["illum-viewer", "--mode", "auto"]).unwrap();
+        assert_eq!(auto.mode, Some(StartMode::Auto));
         assert_eq!(args.frames, 3);
         assert_eq!(args.screenshot, Some(PathBuf::from("a.png")));
         let err = Args::try_parse_from(["illum-viewer", "--mode", "xyz"]).unwrap_err().to_string();
-        assert!(err.contains("raster") && err.contains("pathtrace"), "{err}");
+        assert!(err.contains("raster") && err.contains("pathtrace") && err.contains("auto"), "{err}");
     }
 }

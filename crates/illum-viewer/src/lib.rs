@@ -3,6 +3,8 @@
 //!
 //! - [`app`]: the application state, the mode switch and the scene field;
 //! - [`pathtrace_panel`] / [`raster_panel`]: each mode's settings, renderer and panel;
+//! - [`auto_panel`] / [`auto_pilot`]: the Auto mode (the accuracy slider and the choice) and
+//!   its pilot, run across frames;
 //! - [`camera`]: orbit / pan / zoom with the mouse, shared by both modes;
 //! - [`display`]: the path tracer's GPU tone-mapping pass from its display sum (a GPU buffer)
 //!   into the texture egui shows;
@@ -21,6 +23,8 @@
 //! and `browser`, none of which depends back.
 
 pub mod app;
+pub mod auto_panel;
+pub mod auto_pilot;
 #[cfg(target_arch = "wasm32")]
 pub mod browser;
 pub mod camera;

@@ -1,4 +1,4 @@
-//! `cargo run --release -p illum-viewer -- [SCENE] [--mode raster|pathtrace|whitted]
+//! `cargo run --release -p illum-viewer -- [SCENE] [--mode raster|pathtrace|whitted|auto]
 //! [--screenshot FILE --frames N]`
 //!
 //! Built for `wasm32-unknown-unknown` it is the web viewer instead (`scripts/build-web.sh`):
@@ -39,8 +39,13 @@ mod native {
         let outcome: Outcome = Arc::default();
         let screenshot =
             args.screenshot.clone().map(|path| ScreenshotJob::new(path, args.frames, outcome.clone()));
-        let start =
-            StartOptions { scene: args.scene.clone(), mode: args.mode, screenshot, clear_is_backdrop: true };
+        let start = StartOptions {
+            scene: args.scene.clone(),
+            mode: args.mode.and_then(illum_viewer::cli::StartMode::renderer),
+            screenshot,
+            clear_is_backdrop: true,
+        };
+        let auto = args.mode == Some(illum_viewer::cli::StartMode::Auto);
 
         let mut native = eframe::NativeOptions {
             viewport: egui::ViewportBuilder::default()
@@ -57,7 +62,13 @@ mod native {
         let result = eframe::run_native(
             "illum viewer",
             native,
-            Box::new(|cc| Ok(Box::new(ViewerApp::new(cc, start)))),
+            Box::new(move |cc| {
+                let mut app = ViewerApp::new(cc, start);
+                if auto {
+                    app.show_auto();
+                }
+                Ok(Box::new(app))
+            }),
         );
         if let Err(e) = result {
             eprintln!("error: the window could not run: {e}");

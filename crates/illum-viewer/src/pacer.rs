@@ -57,6 +57,15 @@ impl FramePacer {
         share(self.other_seconds, self.still_frames >= SETTLE_FRAMES)
     }
 
+    /// Wall seconds per second of path tracing once the view is still: a frame is the path
+    /// tracer's share plus the rest of the frame as measured so far (`None` before two frames).
+    /// What a prediction of the viewer's time to some spp multiplies the GPU's time by.
+    pub fn wall_per_traced_second(&self) -> Option<f64> {
+        let other = self.other_seconds?;
+        let share = share(Some(other), true);
+        Some((share + other) / share)
+    }
+
     /// Records that this frame's step began at `started` and took `seconds`.
     pub fn stepped(&mut self, started: Instant, seconds: f64) {
         self.last_step = Some((started, seconds));
@@ -86,6 +95,9 @@ mod tests {
         assert!((share(Some(0.03), true) - (TARGET_FRAME_SECONDS - 0.03)).abs() < 1e-12);
         assert!(share(Some(0.005), true) > 0.07, "a cheap frame leaves most of it to the path tracer");
         assert_eq!(share(Some(0.06), true), 0.06, "at least as much as the rest of the frame");
+        let pacer = FramePacer { other_seconds: Some(0.06), ..FramePacer::default() };
+        assert_eq!(pacer.wall_per_traced_second(), Some(2.0), "the rest of the frame doubles the time");
+        assert_eq!(FramePacer::default().wall_per_traced_second(), None);
         assert_eq!(share(Some(0.5), true), LONGEST_SHARE, "a loaded machine still repaints");
         assert_eq!(share(Some(0.0), false), MOVING_SECONDS);
     }

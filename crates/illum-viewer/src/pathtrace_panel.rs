@@ -307,7 +307,7 @@ impl PathTraceMode {
 
     /// The scene to render at `width` x `height`: the file's geometry with the panel's settings
     /// and the interactive camera.
-    fn desired_scene(&self, width: u32, height: u32) -> Scene {
+    pub fn desired_scene(&self, width: u32, height: u32) -> Scene {
         let mut scene = self.scene.clone();
         scene.camera = self.camera.camera(width, height);
         scene.pathtrace.bounces = self.settings.bounces;
@@ -320,6 +320,12 @@ impl PathTraceMode {
         scene
     }
 
+    /// The size the tracer renders a view of `view_pixels` at (the resolution scale applied).
+    pub fn render_size(&self, view_pixels: [u32; 2]) -> [u32; 2] {
+        let scale = self.settings.resolution_scale.clamp(0.05, 2.0);
+        view_pixels.map(|v| ((v as f32 * scale).round() as u32).max(1))
+    }
+
     /// Brings the tracer in line with the settings, camera and `view_pixels` size, runs this
     /// frame's slice of work and refreshes the displayed texture.
     pub fn frame(
@@ -329,9 +335,7 @@ impl PathTraceMode {
         render_state: &egui_wgpu::RenderState,
         view_pixels: [u32; 2],
     ) {
-        let scale = self.settings.resolution_scale.clamp(0.05, 2.0);
-        let width = ((view_pixels[0] as f32 * scale).round() as u32).max(1);
-        let height = ((view_pixels[1] as f32 * scale).round() as u32).max(1);
+        let [width, height] = self.render_size(view_pixels);
         let wanted = self.desired_scene(width, height);
         if self.failed.as_ref() == Some(&wanted) {
             return;

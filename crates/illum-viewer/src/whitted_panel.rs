@@ -69,6 +69,12 @@ impl WhittedMode {
         &self.scene_path
     }
 
+    /// The size the mode renders a view of `view_pixels` at: a quarter of its pixels (half each
+    /// way), since Whitted at depth 8 costs more per pixel than the rasterizer.
+    pub fn render_size(view_pixels: [u32; 2]) -> [u32; 2] {
+        view_pixels.map(|v| (v / 2).max(1))
+    }
+
     /// The image for a view of `view_pixels`, rendered again only when it changed.
     pub fn frame(
         &mut self,
@@ -76,9 +82,7 @@ impl WhittedMode {
         ctx: &egui::Context,
         view_pixels: [u32; 2],
     ) -> Option<egui::TextureId> {
-        // A quarter of the view's pixels (half each way): Whitted at depth 8 costs more per
-        // pixel than the rasterizer.
-        let (width, height) = ((view_pixels[0] / 2).max(1), (view_pixels[1] / 2).max(1));
+        let [width, height] = Self::render_size(view_pixels);
         let key = FrameKey { camera: self.camera.camera(width, height), depth: self.depth, aa: self.aa };
         if let Some((pending_key, started, pending)) = &self.pending {
             match pending.poll(gpu) {

@@ -231,7 +231,9 @@ struct FramePieces {
     done: Arc<AtomicBool>,
     /// Seconds the waited pieces of each stage took so far.
     seconds: [f64; 2],
-    /// Whether its pieces were waited for (a waiting caller restarts a frame begun by polling).
+    /// Whether its pieces were waited for (a waiting caller restarts a frame begun by polling;
+    /// a web page only polls).
+    #[cfg_attr(target_arch = "wasm32", allow(dead_code))]
     waited: bool,
 }
 

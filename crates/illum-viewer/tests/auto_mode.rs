@@ -1,0 +1,170 @@
+//! The viewer's Auto mode, driven through the real UI with egui_kittest on lavapipe: its pilot
+//! runs across frames with the viewer's renderers, the planner's choice is shown in its own
+//! mode with its settings, the path tracer stops at the planned spp, and a target no renderer
+//! can meet is refused in the panel with each renderer's reason.
+//!
+//! The pilot here is smaller than the window's default (32 pixels on the longer side, a 512 spp
+//! truth) and the path tracer renders at a tenth of the view's size each way, so that a test
+//! takes seconds; the rules are the same.
+
+use std::sync::OnceLock;
+
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use illum_auto::plan::{Goal, Plan, Setting, plan};
+use illum_scene::RendererKind;
+use illum_viewer::auto_pilot::PilotOptions;
+use illum_viewer::gpu_setup::wgpu_setup;
+use illum_viewer::{StartOptions, ViewerApp};
+
+/// Most frames a pilot may take here (each runs a slice of it).
+const PILOT_FRAMES: usize = 2000;
+
+/// The one device of this test process (lavapipe when present), created with the viewer's
+/// setup, as tests/ui.rs makes its own.
+fn shared_device() -> egui_wgpu::WgpuSetupExisting {
+    static STATE: OnceLock<egui_wgpu::RenderState> = OnceLock::new();
+    let state = STATE.get_or_init(|| {
+        egui_kittest::wgpu::create_render_state(wgpu_setup(true), egui_wgpu::RendererOptions::PREDICTABLE)
+    });
+    egui_wgpu::WgpuSetupExisting {
+        instance: state.instance.clone(),
+        adapter: state.adapter.clone(),
+        device: state.device.clone(),
+        queue: state.queue.clone(),
+    }
+}
+
+fn harness(scene: &'static str) -> Harness<'static, ViewerApp> {
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(900.0, 560.0))
+        .wgpu_setup(egui_wgpu::WgpuSetup::Existing(shared_device()))
+        .build_eframe(move |cc| {
+            ViewerApp::new(
+                cc,
+                StartOptions {
+                    scene: scene.into(),
+                    mode: Some(RendererKind::PathTrace),
+                    screenshot: None,
+                    clear_is_backdrop: false,
+                },
+            )
+        });
+    let app = harness.state_mut();
+    app.pathtrace_mut().expect("path tracer loaded").settings.resolution_scale = 0.1;
+    app.auto_mut().pilot_options =
+        PilotOptions { longer_side: 32, truth_spp: 512, pilot_spp: 32, timing_spp: 2 };
+    harness
+}
+
+/// Clicks Auto and runs frames until its pilot is done; returns the frames it took.
+fn run_pilot(harness: &mut Harness<'_, ViewerApp>) -> usize {
+    harness.get_by_label("Auto").click();
+    for frame in 1..=PILOT_FRAMES {
+        harness.step();
+        let auto = harness.state().auto();
+        if !auto.measuring() && auto.plan().is_some() {
+            // The plan is made in the view, after the panel was drawn: one more frame shows it.
+            harness.step();
+            return frame;
+        }
+    }
+    panic!("the pilot did not finish in {PILOT_FRAMES} frames");
+}
+
+/// The plan shown, and the plan the shared planner makes from the same candidates.
+fn shown_and_expected(harness: &Harness<'_, ViewerApp>, target: f64) -> (Plan, Plan) {
+    let auto = harness.state().auto();
+    let shown = auto.plan().expect("planned").clone().expect("a choice");
+    let expected = plan(auto.candidates().expect("measured"), Goal::Error(target)).expect("a choice");
+    (shown, expected)
+}
+
+#[test]
+fn a_tighter_target_takes_the_path_tracer_at_the_planned_spp_and_a_loose_one_something_faster() {
+    let mut harness = harness("scenes/cornell.toml");
+    harness.state_mut().auto_mut().target = 0.1;
+    let frames = run_pilot(&mut harness);
+    let candidates = harness.state().auto().candidates().unwrap().to_vec();
+    eprintln!("pilot: {frames} frames, {} candidates", candidates.len());
+    // The Cornell box has no caustic and the rasterizer cannot draw it: Whitted and the path
+    // tracer's bounces.
+    assert!(candidates.iter().all(|c| c.setting.renderer() != "raster"), "{candidates:?}");
+    // Whitted misses the indirect light: its measured bias is far above 10%.
+    let whitted_floor = candidates
+        .iter()
+        .filter(|c| c.setting.renderer() == "whitted")
+        .map(|c| c.bias_rel_mse.sqrt())
+        .fold(f64::INFINITY, f64::min);
+    assert!(whitted_floor > 0.15, "Whitted's smallest bias {whitted_floor}");
+
+    let (tight, expected) = shown_and_expected(&harness, 0.1);
+    assert_eq!(tight.choice, expected.choice);
+    let Setting::PathTrace { bounces, caustics, .. } = tight.choice.candidate.setting.clone() else {
+        panic!("10% on the Cornell box is the path tracer's: {:?}", tight.choice)
+    };
+    let spp = tight.choice.spp.expect("the path tracer's plan has an spp");
+    assert!(tight.choice.predicted_error <= 0.1, "{:?}", tight.choice);
+    assert_eq!(harness.state().mode(), RendererKind::PathTrace);
+    let settings = harness.state().pathtrace().unwrap().settings;
+    assert_eq!((settings.bounces, settings.caustics, settings.stop.spp), (bounces, caustics, Some(spp)));
+    // The panel names the choice and why Whitted was not picked.
+    harness.get_by_label_contains(&format!("Choice: {}", tight.choice.describe()));
+    harness.get_by_label_contains("whatever the settings allow it");
+    // The path tracer renders the plan and stops at its spp.
+    for _ in 0..PILOT_FRAMES {
+        harness.step();
+        if harness.state().pathtrace().unwrap().stop_reason().is_some() {
+            break;
+        }
+    }
+    let pathtrace = harness.state().pathtrace().unwrap();
+    assert_eq!(pathtrace.stop_reason(), Some(illum_pathtrace::StopReason::SppReached));
+    assert_eq!(pathtrace.stats().spp, spp);
+    let reached = pathtrace.stats().relative_error.unwrap();
+    eprintln!("planned {spp} spp for 10%: the path tracer's own noise estimate {reached:.4}");
+
+    // A loose target: the planner's cheapest choice, faster than the tight one, in its mode.
+    harness.state_mut().auto_mut().target = 0.5;
+    harness.run_steps(2);
+    let (loose, expected) = shown_and_expected(&harness, 0.5);
+    assert_eq!(loose.choice, expected.choice);
+    assert!(loose.choice.predicted_seconds < tight.choice.predicted_seconds, "{loose:?} {tight:?}");
+    let shown: RendererKind = loose.choice.candidate.setting.renderer().parse().unwrap();
+    assert_eq!(harness.state().mode(), shown);
+    match loose.choice.candidate.setting {
+        Setting::Whitted { depth, aa } => {
+            let whitted = harness.state().whitted().unwrap();
+            assert_eq!((whitted.depth, whitted.aa), (depth, aa));
+        }
+        Setting::PathTrace { bounces, .. } => {
+            let settings = harness.state().pathtrace().unwrap().settings;
+            assert_eq!((settings.bounces, settings.stop.spp), (bounces, loose.choice.spp));
+        }
+        Setting::Raster { .. } => panic!("the rasterizer cannot draw the Cornell box"),
+    }
+    eprintln!(
+        "0.5: {} ({:.2} s); 0.1: {} ({:.2} s)",
+        loose.choice.describe(),
+        loose.choice.predicted_seconds,
+        tight.choice.describe(),
+        tight.choice.predicted_seconds
+    );
+}
+
+#[test]
+fn a_target_no_renderer_can_meet_is_refused_in_the_panel_with_each_renderers_reason() {
+    let mut harness = harness("scenes/whitted.toml");
+    harness.state_mut().auto_mut().target = illum_viewer::auto_panel::MIN_TARGET;
+    run_pilot(&mut harness);
+    let why = harness.state().auto().plan().unwrap().clone().unwrap_err();
+    assert!(why.contains("no renderer is predicted to reach a relative error of 0.00001"), "{why}");
+    // Each renderer's closest setting and what holds it back: the deterministic ones their
+    // bias (the glass's shadow), the path tracer the samples it would need.
+    assert!(why.contains("rasterizer") && why.contains("Whitted ray tracer"), "{why}");
+    assert!(why.contains("glass sphere's shadow"), "{why}");
+    assert!(why.contains("path tracer") && why.contains("samples per pixel"), "{why}");
+    harness.get_by_label_contains("no renderer is predicted to reach");
+    // The mode shown stays as it was: nothing was applied.
+    assert_eq!(harness.state().mode(), RendererKind::PathTrace);
+}
