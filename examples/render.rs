@@ -259,7 +259,6 @@ fn run_auto(mut args: Args) -> anyhow::Result<()> {
         (args.resume.is_some(), "--resume"),
         (args.sample_range.is_some(), "--sample-range"),
         (args.checkpoint_seconds.is_some(), "--checkpoint-seconds"),
-        // Its plans predict raw images' errors; a denoised one's is another (docs/denoising.md).
         (args.denoise.is_some(), "--denoise"),
     ]);
     chosen.extend(args.raster.given());
@@ -305,10 +304,13 @@ fn run_auto(mut args: Args) -> anyhow::Result<()> {
             args.whitted.depth = Some(*depth);
             args.whitted.aa = Some(*aa);
         }
-        Setting::PathTrace { bounces, caustics } => {
+        Setting::PathTrace { bounces, caustics, sequence, adaptive, denoise } => {
             args.renderer = Some(RendererChoice::Kind(RendererKind::PathTrace));
             args.settings.spp = choice.spp;
             args.settings.bounces = Some(*bounces);
+            args.sequence = Some(*sequence);
+            args.adaptive = *adaptive;
+            args.denoise = *denoise;
             // Named only where the scene has a caustic: elsewhere `--caustics` is refused.
             args.caustics = illum_lab::auto::pilot::has_caustic(&scene).then_some(*caustics);
         }

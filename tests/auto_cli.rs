@@ -10,7 +10,7 @@ use binary::{render, text};
 
 #[test]
 fn bad_goals_and_settings_auto_chooses_are_refused_by_name() {
-    let cases: [(&str, &[&str]); 12] = [
+    let cases: [(&str, &[&str]); 13] = [
         ("--target-error 0", &["--target-error", "0", "above 0"]),
         ("--target-error -0.1", &["--target-error", "-0.1", "above 0"]),
         ("--target-error nan", &["--target-error", "NaN", "finite"]),
@@ -26,6 +26,7 @@ fn bad_goals_and_settings_auto_chooses_are_refused_by_name() {
         ),
         ("--target-error 0.1 --caustics on --no-shadows", &["--caustics, --no-shadows"]),
         ("--target-error 0.1 --resume x.exr", &["--resume"]),
+        ("--target-error 0.1 --denoise atrous --adaptive", &["--adaptive, --denoise"]),
     ];
     for (flags, expected) in cases {
         let mut args = vec!["scenes/whitted.toml", "--renderer", "auto"];

@@ -1,6 +1,7 @@
-//! What a pilot's measurement of one setting means for the planner: its bias, its noise per
-//! sample and its worst region, from its image compared with the pilot's truth.
+//! What a pilot's measurement of one setting means for the planner: its bias, its noise curve
+//! and its worst region, from its image compared with the pilot's truth.
 
+use crate::plan::NoiseCurve;
 use crate::regions::{Comparison, Regions};
 
 /// One setting's bias and noise as a pilot measured them.
@@ -8,8 +9,8 @@ use crate::regions::{Comparison, Regions};
 pub struct Measured {
     /// relMSE against the truth that no number of samples removes (>= 0).
     pub bias_rel_mse: f64,
-    /// relMSE of one sample per pixel from noise alone (the path tracer's; `None` otherwise).
-    pub noise_per_sample: Option<f64>,
+    /// How the relMSE from noise falls with the spp (the path tracer's; `None` otherwise).
+    pub noise: Option<NoiseCurve>,
     /// The region whose mean brightness is furthest from the truth's, and that brightness
     /// relative to the truth's.
     pub worst_region: Option<(String, f64)>,
@@ -20,8 +21,8 @@ pub struct Measured {
 /// setting's (a path tracer's estimated relMSE at `spp` samples per pixel, `None` for a
 /// deterministic renderer). Expected relMSE against a noisy truth = bias² + own noise + the
 /// truth's noise (the three are independent), so the bias² is the measured relMSE less both
-/// noises, never below 0; the noise per sample is the own noise times `spp` (1/N, as
-/// [`crate::plan::noise_rel_mse`] models it).
+/// noises, never below 0; the noise curve is the own noise at `spp` falling as 1/N (independent
+/// samples; a pilot that measures another law replaces it).
 pub fn measured(
     errors: &Comparison,
     regions: &Regions,
@@ -37,5 +38,6 @@ pub fn measured(
         .filter(|(_, e)| e.pixels > 0 && e.luminance_ratio.is_finite())
         .max_by(|a, b| (a.1.luminance_ratio - 1.0).abs().total_cmp(&(b.1.luminance_ratio - 1.0).abs()))
         .map(|(name, e)| (name.clone(), e.luminance_ratio));
-    Measured { bias_rel_mse, noise_per_sample: own_noise.map(|n| n * f64::from(spp)), worst_region }
+    let noise = own_noise.and_then(|n| NoiseCurve::independent(n, f64::from(spp)));
+    Measured { bias_rel_mse, noise, worst_region }
 }

@@ -1,30 +1,51 @@
 //! The planner of `--renderer auto`: from what the pilot measured for every way of rendering
-//! the scene (its bias, its noise per sample, its cost), the cheapest one predicted to meet an
-//! error target, or the most accurate one predicted to finish within a time budget.
+//! the scene (its bias, how its noise falls with the samples, its cost), the cheapest one
+//! predicted to meet an error target, or the most accurate one predicted to finish within a time
+//! budget.
 //!
 //! The model of a render's error is the expected relMSE against the truth (the ladder's and
 //! `--target-error`'s measure: relative error = its square root):
 //!
 //! ```text
-//! relMSE(setting, N spp) = bias²(setting) + noise_rel_mse(noise per sample, N)
+//! relMSE(setting, N spp) = bias²(setting) + noise_rel_mse(noise curve(setting), N)
 //! seconds(setting, N spp) = fixed seconds + N · seconds per spp
 //! ```
 //!
 //! where bias² is what the setting keeps however long it runs (a rasterizer's missing light
 //! paths, a path tracer's cut bounces) and the noise term is zero for the deterministic
-//! renderers. The noise model is [`noise_rel_mse`], one function, so that a better estimate
-//! (low-discrepancy sequences, whose error falls faster than 1/N) replaces it alone.
+//! renderers. A path tracer's noise curve is what the pilot measured at a few spp, with the law
+//! beyond them: 1/N for independent samples (and adaptive sampling, which spreads N over the
+//! pixels in fixed proportions), the exponent measured between two spp for the low-discrepancy
+//! sequence, and for a denoised image its measured error at each spp (the denoiser's bias
+//! included), held beyond the last. [`noise_rel_mse`] is the one place the curve is read.
+//!
+//! Over 450 lines: the model, the search for the fewest spp and the refusal are one unit, and
+//! over a third of the file is their unit tests on made-up candidates.
 
 use std::fmt;
 
-use illum_scene::{Bounces, Effects, Look};
+use illum_scene::{Bounces, DenoiserKind, Effects, Look, Sequence};
 
 /// Every setting but the samples per pixel: what the pilot measures once.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Setting {
-    Raster { look: Look, effects: Effects },
-    Whitted { depth: u32, aa: u32 },
-    PathTrace { bounces: Bounces, caustics: bool },
+    Raster {
+        look: Look,
+        effects: Effects,
+    },
+    Whitted {
+        depth: u32,
+        aa: u32,
+    },
+    PathTrace {
+        bounces: Bounces,
+        caustics: bool,
+        sequence: Sequence,
+        /// Adaptive sampling: the spp spread over the image's blocks by a pilot of their noise.
+        adaptive: bool,
+        /// The denoiser run on the render (kept as two halves for its error estimate).
+        denoise: Option<DenoiserKind>,
+    },
 }
 
 impl Setting {
@@ -64,11 +85,24 @@ impl fmt::Display for Setting {
             Setting::Whitted { depth, aa } => {
                 write!(f, "Whitted ray tracer, depth {depth}, {aa}x{aa} rays per pixel")
             }
-            Setting::PathTrace { bounces, caustics } => write!(
-                f,
-                "path tracer, bounces {bounces}, caustic light tracer {}",
-                if *caustics { "on" } else { "off" }
-            ),
+            Setting::PathTrace { bounces, caustics, sequence, adaptive, denoise } => {
+                write!(
+                    f,
+                    "path tracer, bounces {bounces}, caustic light tracer {}",
+                    if *caustics { "on" } else { "off" }
+                )?;
+                if *sequence != Sequence::Independent {
+                    write!(f, ", {sequence} sequence")?;
+                }
+                if *adaptive {
+                    f.write_str(", adaptive")?;
+                }
+                match denoise {
+                    Some(DenoiserKind::Atrous) => f.write_str(", denoised by à-trous"),
+                    Some(DenoiserKind::Oidn) => f.write_str(", denoised by OIDN"),
+                    None => Ok(()),
+                }
+            }
         }
     }
 }
@@ -79,9 +113,12 @@ pub struct Candidate {
     pub setting: Setting,
     /// relMSE against the truth that no number of samples removes (>= 0).
     pub bias_rel_mse: f64,
-    /// The path tracer's relMSE at one sample per pixel from noise alone, the input of
-    /// [`noise_rel_mse`]; `None` for the deterministic renderers.
-    pub noise_per_sample: Option<f64>,
+    /// How the path tracer's relMSE beyond its bias falls with the spp (the input of
+    /// [`noise_rel_mse`]); `None` for the deterministic renderers.
+    pub noise: Option<NoiseCurve>,
+    /// The path tracer's spp is a multiple of this (2 for a denoised render's two halves, the
+    /// replicate run for the low-discrepancy sequence); 1 otherwise.
+    pub spp_multiple: u32,
     /// Seconds that do not depend on the samples: device and pipeline setup, and for a
     /// deterministic renderer its whole image.
     pub fixed_seconds: f64,
@@ -90,6 +127,48 @@ pub struct Candidate {
     /// The region whose mean brightness is furthest from the truth's, and that brightness
     /// relative to the truth's, to say why a setting cannot meet a target.
     pub worst_region: Option<(String, f64)>,
+}
+
+/// A path tracer's relMSE beyond its bias against the spp, as measured: log-log linear between
+/// the measured points, and falling as N^-exponent beyond the last (before the first, as the
+/// first segment falls, or as N^-exponent with one point).
+#[derive(Clone, Debug, PartialEq)]
+pub struct NoiseCurve {
+    /// (spp, relMSE), spp increasing and relMSE not increasing, every value above 0.
+    points: Vec<(f64, f64)>,
+    exponent: f64,
+}
+
+impl NoiseCurve {
+    /// A curve through `points` (any order) with `exponent` beyond them. Each relMSE is kept
+    /// at least 1e-12 and at most the one before it, and the exponent at least 0, so that the
+    /// curve never rises with the spp (the planner's search for the fewest spp relies on it:
+    /// more samples never predict a larger error). `None` without a finite point.
+    pub fn new(mut points: Vec<(f64, f64)>, exponent: f64) -> Option<Self> {
+        points.retain(|(n, v)| *n > 0.0 && n.is_finite() && v.is_finite());
+        points.sort_by(|a, b| a.0.total_cmp(&b.0));
+        points.dedup_by(|b, a| a.0 == b.0);
+        let mut lowest = f64::INFINITY;
+        for point in &mut points {
+            lowest = lowest.min(point.1.max(1e-12));
+            point.1 = lowest;
+        }
+        let exponent = if exponent.is_finite() { exponent.max(0.0) } else { 1.0 };
+        (!points.is_empty()).then_some(NoiseCurve { points, exponent })
+    }
+
+    /// The 1/N law of independent samples, from the relMSE `rel_mse` measured at `spp`.
+    pub fn independent(rel_mse: f64, spp: f64) -> Option<Self> {
+        Self::new(vec![(spp, rel_mse)], 1.0)
+    }
+
+    pub fn points(&self) -> &[(f64, f64)] {
+        &self.points
+    }
+
+    pub fn exponent(&self) -> f64 {
+        self.exponent
+    }
 }
 
 /// What the user asks for.
@@ -138,16 +217,27 @@ pub const MAX_SECONDS: f64 = 30.0 * 86_400.0;
 /// How many runners-up a plan lists.
 pub const RUNNERS_UP: usize = 4;
 
-/// The relMSE that noise adds after `spp` samples per pixel, given that of one sample: the
-/// variance of a mean of independent samples falls as 1/N. This is the one place the noise
-/// model is written (see the module's comment).
-pub fn noise_rel_mse(noise_per_sample: f64, spp: f64) -> f64 {
-    noise_per_sample / spp
+/// The relMSE beyond the bias after `spp` samples per pixel, read off the measured curve (see
+/// [`NoiseCurve`]). This is the one place the noise model is written (see the module's comment).
+pub fn noise_rel_mse(curve: &NoiseCurve, spp: f64) -> f64 {
+    let points = &curve.points;
+    let at = |(n0, v0): (f64, f64), slope: f64| v0 * (n0 / spp).powf(slope);
+    let first = points[0];
+    let last = points[points.len() - 1];
+    let slope = |(n0, v0): (f64, f64), (n1, v1): (f64, f64)| (v0 / v1).ln() / (n1 / n0).ln();
+    if spp >= last.0 {
+        return at(last, curve.exponent);
+    }
+    if spp <= first.0 {
+        return at(first, if points.len() > 1 { slope(first, points[1]) } else { curve.exponent });
+    }
+    let i = points.iter().position(|p| p.0 > spp).expect("spp is below the last point");
+    at(points[i - 1], slope(points[i - 1], points[i]))
 }
 
 /// The relative error of `candidate` at `spp` (ignored by deterministic renderers).
 pub fn predicted_error(candidate: &Candidate, spp: u32) -> f64 {
-    let noise = candidate.noise_per_sample.map_or(0.0, |v| noise_rel_mse(v, f64::from(spp)));
+    let noise = candidate.noise.as_ref().map_or(0.0, |curve| noise_rel_mse(curve, f64::from(spp)));
     (candidate.bias_rel_mse + noise).sqrt()
 }
 
@@ -184,7 +274,8 @@ fn plan_one(candidate: &Candidate, goal: Goal) -> Result<Planned, String> {
         predicted_seconds: predicted_seconds(candidate, spp.unwrap_or(0)),
     };
     let floor = error_floor(candidate);
-    match (goal, candidate.noise_per_sample) {
+    let multiple = candidate.spp_multiple.max(1);
+    match (goal, &candidate.noise) {
         (Goal::Error(target), None) => {
             if floor <= target {
                 Ok(planned(None))
@@ -192,17 +283,20 @@ fn plan_one(candidate: &Candidate, goal: Goal) -> Result<Planned, String> {
                 Err(format!("its error is {floor:.3} whatever the settings allow it"))
             }
         }
-        (Goal::Error(target), Some(per_sample)) => {
+        (Goal::Error(target), Some(curve)) => {
             let room = target * target - candidate.bias_rel_mse;
             if room <= 0.0 {
                 return Err(format!("its bias alone is {floor:.3} however many samples it takes"));
             }
             // The fewest samples whose noise fits in the room the bias leaves: the model's
-            // inverse, ceil(per_sample / room) for 1/N, found by doubling then bisection so
-            // that it holds for any decreasing noise model.
-            let meets =
-                |n: u32| candidate.bias_rel_mse + noise_rel_mse(per_sample, f64::from(n)) <= target * target;
-            if !meets(MAX_SPP) {
+            // inverse (ceil(per sample / room) for 1/N), found by doubling then bisection over
+            // multiples of the setting's spp step; it holds for any curve that never rises.
+            let meets = |k: u32| {
+                let n = f64::from(k) * f64::from(multiple);
+                candidate.bias_rel_mse + noise_rel_mse(curve, n) <= target * target
+            };
+            let max_steps = MAX_SPP / multiple;
+            if !meets(max_steps) {
                 return Err(format!("it would need more than {MAX_SPP} samples per pixel"));
             }
             let (mut low, mut high) = (0u32, 1u32);
@@ -214,6 +308,7 @@ fn plan_one(candidate: &Candidate, goal: Goal) -> Result<Planned, String> {
                 let mid = low + (high - low) / 2;
                 if meets(mid) { high = mid } else { low = mid }
             }
+            let high = high * multiple;
             let plan = planned(Some(high));
             if plan.predicted_seconds > MAX_SECONDS {
                 return Err(format!(
@@ -233,13 +328,15 @@ fn plan_one(candidate: &Candidate, goal: Goal) -> Result<Planned, String> {
         (Goal::Seconds(budget), Some(_)) => {
             let spare = budget - candidate.fixed_seconds;
             let spp = if candidate.seconds_per_spp > 0.0 { spare / candidate.seconds_per_spp } else { 0.0 };
-            if spp < 1.0 {
+            let spp = (spp.min(f64::from(MAX_SPP)) / f64::from(multiple)).floor() as u32 * multiple;
+            if spp < 1 {
                 return Err(format!(
-                    "its setup and one sample per pixel take {:.2} s",
-                    predicted_seconds(candidate, 1)
+                    "its setup and {multiple} sample{} per pixel take {:.2} s",
+                    if multiple == 1 { "" } else { "s" },
+                    predicted_seconds(candidate, multiple)
                 ));
             }
-            Ok(planned(Some(spp.min(f64::from(MAX_SPP)).floor() as u32)))
+            Ok(planned(Some(spp)))
         }
     }
 }
@@ -283,7 +380,7 @@ fn refusal(goal: Goal, reasons: &[(&Candidate, String)]) -> String {
         let closest = reasons.iter().filter(|(c, _)| c.setting.renderer() == renderer).min_by(|a, b| {
             let measure = |c: &Candidate| match goal {
                 Goal::Error(_) => error_floor(c),
-                Goal::Seconds(_) => predicted_seconds(c, 1),
+                Goal::Seconds(_) => predicted_seconds(c, c.spp_multiple.max(1)),
             };
             measure(a.0).partial_cmp(&measure(b.0)).unwrap_or(std::cmp::Ordering::Equal)
         });
@@ -308,7 +405,8 @@ mod tests {
         Candidate {
             setting: Setting::Whitted { depth, aa: 2 },
             bias_rel_mse,
-            noise_per_sample: None,
+            noise: None,
+            spp_multiple: 1,
             fixed_seconds: seconds,
             seconds_per_spp: 0.0,
             worst_region: Some(("floor in the glass sphere's shadow".into(), 0.27)),
@@ -317,9 +415,16 @@ mod tests {
 
     fn path_tracer(caustics: bool, bias_rel_mse: f64, per_sample: f64, per_spp: f64) -> Candidate {
         Candidate {
-            setting: Setting::PathTrace { bounces: Bounces::Fixed(8), caustics },
+            setting: Setting::PathTrace {
+                bounces: Bounces::Fixed(8),
+                caustics,
+                sequence: Sequence::Independent,
+                adaptive: false,
+                denoise: None,
+            },
             bias_rel_mse,
-            noise_per_sample: Some(per_sample),
+            noise: NoiseCurve::independent(per_sample, 1.0),
+            spp_multiple: 1,
             fixed_seconds: 0.5,
             seconds_per_spp: per_spp,
             worst_region: None,
@@ -368,6 +473,56 @@ mod tests {
         assert!(why.contains("caustic light tracer off: its bias alone is 0.063"), "{why}");
         let why = plan(&all, Goal::Seconds(0.1)).unwrap_err();
         assert!(why.contains("within 0.1 s") && why.contains("one image takes 0.20 s"), "{why}");
+    }
+
+    #[test]
+    fn the_noise_curve_is_log_log_linear_between_its_points_and_follows_its_law_beyond() {
+        // Two points a quarter apart with relMSE falling 8 times: exponent 1.5 between them.
+        let ld = NoiseCurve::new(vec![(256.0, 1e-3), (64.0, 8e-3)], 1.5).unwrap();
+        assert!((noise_rel_mse(&ld, 128.0) - 8e-3 / 2f64.powf(1.5)).abs() < 1e-15);
+        assert!((noise_rel_mse(&ld, 1024.0) - 1e-3 / 8.0).abs() < 1e-15);
+        assert!((noise_rel_mse(&ld, 16.0) - 8e-3 * 8.0).abs() < 1e-12);
+        // One point and the 1/N law: the independent model, rel_mse x spp / N.
+        let independent = NoiseCurve::independent(0.02, 256.0).unwrap();
+        assert!((noise_rel_mse(&independent, 64.0) - 0.08).abs() < 1e-15);
+        // A denoised curve is held flat beyond its last point, and never rises: a point above
+        // the one before is lowered to it; an exponent below 0 is taken as 0.
+        let denoised = NoiseCurve::new(vec![(4.0, 0.01), (16.0, 0.004), (64.0, 0.005)], -0.5).unwrap();
+        assert_eq!(denoised.points()[2], (64.0, 0.004));
+        assert_eq!(noise_rel_mse(&denoised, 1e6), 0.004);
+        assert!((noise_rel_mse(&denoised, 8.0) - (0.01f64 * 0.004).sqrt()).abs() < 1e-15);
+        assert_eq!(NoiseCurve::new(vec![(64.0, f64::NAN)], 1.0), None);
+    }
+
+    #[test]
+    fn a_setting_renders_in_multiples_of_its_step_and_a_denoised_one_wins_where_cheaper() {
+        // Raw: 0.1 per sample, 0.05 s per spp. Denoised: its measured error 0.002 at 16 spp,
+        // 0.0012 from 64 on, one second of guides and filter; both unbiased.
+        let raw = path_tracer(false, 0.0, 0.1, 0.05);
+        let mut denoised = path_tracer(false, 0.0, 0.1, 0.05);
+        if let Setting::PathTrace { denoise, .. } = &mut denoised.setting {
+            *denoise = Some(DenoiserKind::Atrous);
+        }
+        denoised.noise = NoiseCurve::new(vec![(4.0, 0.008), (16.0, 0.002), (64.0, 0.0012)], 0.0);
+        denoised.spp_multiple = 2;
+        denoised.fixed_seconds = 1.5;
+        assert_eq!(
+            denoised.setting.to_string(),
+            "path tracer, bounces 8, caustic light tracer off, denoised by à-trous"
+        );
+        let both = [raw.clone(), denoised.clone()];
+        // 0.05 (relMSE 0.0025): raw needs 40 spp (2.5 s); denoised 4 < N < 16 on the curve,
+        // 0.008 (4/N)^1 <= 0.0025 -> N >= 12.8 -> 14 (even): 1.5 + 0.7 = 2.2 s.
+        let p = plan(&both, Goal::Error(0.05)).unwrap();
+        assert_eq!((p.choice.candidate.setting.clone(), p.choice.spp), (denoised.setting.clone(), Some(14)));
+        assert_eq!(p.runners_up[0].spp, Some(40));
+        // 0.03 (relMSE 0.0009): below the denoised curve's floor 0.0012: raw only, 112 spp.
+        let p = plan(&both, Goal::Error(0.03)).unwrap();
+        assert_eq!((p.choice.candidate.setting.clone(), p.choice.spp), (raw.setting.clone(), Some(112)));
+        assert_eq!(p.runners_up.len(), 0);
+        // A budget of 2.25 s: the denoised gets 0.75 s / 0.05 = 15 spp, floored to 14 (even).
+        let denoised_alone = std::slice::from_ref(&denoised);
+        assert_eq!(plan(denoised_alone, Goal::Seconds(2.25)).unwrap().choice.spp, Some(14));
     }
 
     #[test]

@@ -3,7 +3,7 @@
 //! share.
 
 use illum_raster::RasterScene;
-use illum_scene::{Bounces, Effects, Look, MaterialKind, Scene};
+use illum_scene::{Bounces, DenoiserKind, Effects, Look, MaterialKind, Scene, Sequence};
 
 use crate::plan::Setting;
 
@@ -34,7 +34,44 @@ pub fn settings(scene: &Scene) -> Vec<Setting> {
         for bounces in
             [Bounces::Fixed(1), Bounces::Fixed(2), Bounces::Fixed(4), Bounces::Fixed(8), Bounces::Unbounded]
         {
-            all.push(Setting::PathTrace { bounces, caustics });
+            all.push(Setting::PathTrace {
+                bounces,
+                caustics,
+                sequence: Sequence::Independent,
+                adaptive: false,
+                denoise: None,
+            });
+        }
+    }
+    all
+}
+
+/// [`settings`] and, after each path-tracer setting, the same with the low-discrepancy
+/// sequence, with adaptive sampling (only without the caustic's light tracer: the path tracer
+/// refuses the two together) and denoised by each of `denoisers`: what `render --renderer auto`
+/// chooses among (the viewer's pilot measures [`settings`] alone). Not among them, to keep the
+/// pilot's cost down: adaptive sampling or denoising with the low-discrepancy sequence.
+pub fn settings_with_variants(scene: &Scene, denoisers: &[DenoiserKind]) -> Vec<Setting> {
+    let mut all = Vec::new();
+    for setting in settings(scene) {
+        let Setting::PathTrace { bounces, caustics, .. } = setting else {
+            all.push(setting);
+            continue;
+        };
+        let variant = |sequence, adaptive, denoise| Setting::PathTrace {
+            bounces,
+            caustics,
+            sequence,
+            adaptive,
+            denoise,
+        };
+        all.push(setting);
+        all.push(variant(Sequence::LowDiscrepancy, false, None));
+        if !caustics {
+            all.push(variant(Sequence::Independent, true, None));
+        }
+        for &denoiser in denoisers {
+            all.push(variant(Sequence::Independent, false, Some(denoiser)));
         }
     }
     all
@@ -66,9 +103,10 @@ pub fn apply(scene: &Scene, setting: &Setting) -> Scene {
             scene.whitted.depth = *depth;
             scene.whitted.aa = *aa;
         }
-        Setting::PathTrace { bounces, caustics } => {
+        Setting::PathTrace { bounces, caustics, sequence, .. } => {
             scene.pathtrace.bounces = *bounces;
             scene.pathtrace.caustics = *caustics;
+            scene.pathtrace.sequence = *sequence;
         }
     }
     scene

@@ -27,35 +27,9 @@ pub use atrous::{ATROUS_SHADER, AtrousDenoiser, AtrousSettings, PendingDenoise};
 pub use denoiser::{Denoiser, OIDN_BUILT};
 pub use error::DenoiseError;
 pub use estimate::{HalvesError, halves_rel_mse};
+/// The denoisers `render --denoise` knows; named in illum-scene beside the other render
+/// settings, so that the planner of `--renderer auto` can name them without this crate.
+pub use illum_scene::DenoiserKind;
 pub use input::DenoiseInput;
 #[cfg(not(target_arch = "wasm32"))]
 pub use split::SplitRender;
-
-/// The denoisers `render --denoise` knows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum DenoiserKind {
-    /// The edge-avoiding à-trous filter ([`atrous`]): runs wherever illum runs.
-    Atrous,
-    /// Intel Open Image Denoise's RT filter (only in builds with the cargo feature `oidn`).
-    Oidn,
-}
-
-impl std::str::FromStr for DenoiserKind {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "atrous" => Ok(DenoiserKind::Atrous),
-            "oidn" => Ok(DenoiserKind::Oidn),
-            other => Err(format!("'{other}' is not a denoiser: use atrous or oidn")),
-        }
-    }
-}
-
-impl std::fmt::Display for DenoiserKind {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            DenoiserKind::Atrous => "atrous",
-            DenoiserKind::Oidn => "oidn",
-        })
-    }
-}

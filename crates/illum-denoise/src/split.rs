@@ -89,6 +89,7 @@ impl SplitRender {
         let estimate = HalvesError::new(
             (&a.mean_image(), &a.variance_image(), &da),
             (&b.mean_image(), &b.variance_image(), &db),
+            &image,
         );
         Ok(Denoised { image, estimate, raw, guides, filter_seconds, guide_seconds })
     }

@@ -3,10 +3,12 @@
 //! scene on this machine (bias, noise, throughput of every setting); the [`plan`] chooses from
 //! what it measured.
 
+mod cache;
 pub mod pilot;
 /// The planner lives in `illum-auto` (pure, so the viewer shares it); re-exported here so
 /// `illum_lab::auto::plan` names it beside the pilot.
 pub use illum_auto::plan;
+mod render;
 
 use illum_scene::Scene;
 
@@ -78,10 +80,16 @@ pub fn reached(choice: &Planned, noise: Option<f64>, seconds: f64) -> String {
     match noise {
         Some(noise) => format!(
             "auto: {timing}; estimated relative error {:.4} (predicted {:.4}): the pilot's bias {:.4} and the \
-             render's own noise estimate {noise:.4}",
+             render's own estimate {noise:.4} ({})",
             (bias + noise * noise).sqrt(),
             choice.predicted_error,
-            bias.sqrt()
+            bias.sqrt(),
+            match choice.candidate.setting {
+                plan::Setting::PathTrace { denoise: Some(_), .. } => {
+                    "the denoised error from its two halves, of a denoised half: above the written image's"
+                }
+                _ => "of its noise",
+            }
         ),
         None => format!(
             "auto: {timing}; a deterministic image: its relative error is the one the pilot measured, {:.4}",

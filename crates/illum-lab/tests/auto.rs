@@ -57,8 +57,7 @@ fn predicted_errors_are_within_a_factor_1_5_of_the_measured_ones() {
         "{choice:?}"
     );
     // 1% is beyond every deterministic setting: refused by them, met by the path tracer alone.
-    let raster_and_whitted: Vec<_> =
-        pilot.candidates.iter().filter(|c| c.noise_per_sample.is_none()).cloned().collect();
+    let raster_and_whitted: Vec<_> = pilot.candidates.iter().filter(|c| c.noise.is_none()).cloned().collect();
     let why = plan(&raster_and_whitted, Goal::Error(0.01)).unwrap_err();
     assert!(why.contains("rasterizer") && why.contains("Whitted ray tracer"), "{why}");
     println!("renderers chosen: {renderers:?}\n{why}");

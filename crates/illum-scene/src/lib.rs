@@ -61,8 +61,9 @@ pub use lights::{DirectionalLight, Environment};
 pub use materials::{Checker, Material, MaterialKind};
 pub use paths::resolve_scene_path;
 pub use renderers::{
-    Bounces, DielectricShading, Effects, Look, MAX_BOUNCES, MAX_WHITTED_AA, MAX_WHITTED_DEPTH, MirrorShading,
-    PathTraceSettings, RasterSettings, RendererKind, Sampling, Sequence, Shading, WhittedSettings,
+    Bounces, DenoiserKind, DielectricShading, Effects, Look, MAX_BOUNCES, MAX_WHITTED_AA, MAX_WHITTED_DEPTH,
+    MirrorShading, PathTraceSettings, RasterSettings, RendererKind, Sampling, Sequence, Shading,
+    WhittedSettings,
 };
 pub use scene::{Object, Overrides, Scene};
 pub use shapes::{BoxShape, Quad, Shape, Sphere};

@@ -76,6 +76,35 @@ pub enum Sequence {
     LowDiscrepancy,
 }
 
+/// The denoisers `render --denoise` knows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum DenoiserKind {
+    /// The edge-avoiding à-trous filter (illum-denoise's `atrous`): runs wherever illum runs.
+    Atrous,
+    /// Intel Open Image Denoise's RT filter (only in builds with the cargo feature `oidn`).
+    Oidn,
+}
+
+impl std::str::FromStr for DenoiserKind {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "atrous" => Ok(DenoiserKind::Atrous),
+            "oidn" => Ok(DenoiserKind::Oidn),
+            other => Err(format!("'{other}' is not a denoiser: use atrous or oidn")),
+        }
+    }
+}
+
+impl std::fmt::Display for DenoiserKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            DenoiserKind::Atrous => "atrous",
+            DenoiserKind::Oidn => "oidn",
+        })
+    }
+}
+
 /// `[pathtrace]`: the path tracer's settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PathTraceSettings {

@@ -323,7 +323,9 @@ pub fn apply_choice(
             }
             RendererKind::Whitted
         }
-        Setting::PathTrace { bounces, caustics } => {
+        // The viewer's pilot measures illum_auto::settings alone: independent samples, neither
+        // adaptive nor denoised, so those fields are the defaults here.
+        Setting::PathTrace { bounces, caustics, .. } => {
             if let Some(mode) = pathtrace {
                 mode.settings.bounces = *bounces;
                 mode.settings.caustics = *caustics;

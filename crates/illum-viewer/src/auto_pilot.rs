@@ -344,7 +344,8 @@ mod native {
             self.candidates.push(Candidate {
                 setting,
                 bias_rel_mse: m.bias_rel_mse,
-                noise_per_sample: m.noise_per_sample,
+                noise: m.noise,
+                spp_multiple: 1,
                 fixed_seconds,
                 seconds_per_spp,
                 worst_region: m.worst_region,

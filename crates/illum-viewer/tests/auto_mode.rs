@@ -100,7 +100,7 @@ fn a_tighter_target_takes_the_path_tracer_at_the_planned_spp_and_a_loose_one_som
 
     let (tight, expected) = shown_and_expected(&harness, 0.1);
     assert_eq!(tight.choice, expected.choice);
-    let Setting::PathTrace { bounces, caustics } = tight.choice.candidate.setting.clone() else {
+    let Setting::PathTrace { bounces, caustics, .. } = tight.choice.candidate.setting.clone() else {
         panic!("10% on the Cornell box is the path tracer's: {:?}", tight.choice)
     };
     let spp = tight.choice.spp.expect("the path tracer's plan has an spp");

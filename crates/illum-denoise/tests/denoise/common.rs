@@ -13,10 +13,15 @@ pub const BOUNCES: u32 = 2;
 
 /// The Cornell box at SIZE x SIZE, BOUNCES bounces, `spp`, `seed`.
 pub fn cornell(spp: u32, seed: u32) -> Scene {
+    cornell_sized(SIZE, spp, seed)
+}
+
+/// The Cornell box at `size` x `size`, BOUNCES bounces, `spp`, `seed`.
+pub fn cornell_sized(size: u32, spp: u32, seed: u32) -> Scene {
     let mut scene = Scene::load(&workspace_path("scenes/cornell.toml")).expect("scene loads");
     let overrides = Overrides {
-        width: Some(SIZE),
-        height: Some(SIZE),
+        width: Some(size),
+        height: Some(size),
         spp: Some(spp),
         seed: Some(seed),
         bounces: Some(Bounces::Fixed(BOUNCES)),

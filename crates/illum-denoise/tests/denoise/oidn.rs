@@ -81,17 +81,16 @@ fn at_16_spp_oidn_beside_atrous() {
     assert!(gain >= 2.5, "relMSE raw {} / OIDN {} = {gain:.2}", whole.0, whole.1);
 }
 
-/// The halves' estimate of OIDN's error against its true error, from 4 to 256 spp in total.
-/// The estimate averages two directions (D(A) against B, D(B) against A), so it is compared
-/// with the mean true relMSE of the two denoised halves against the converged reference.
+/// The halves' estimate of OIDN's error against its true error, from 4 to 1024 spp in total
+/// (4: the fewest that give each half the 2 samples its variance needs). The estimate averages
+/// two directions (D(A) against B, D(B) against A), so it is compared with the mean true relMSE
+/// of the two denoised halves against the converged reference. It must be within a factor 1.6
+/// of it at every spp (as the à-trous estimate), and not below the true error of the denoised
+/// whole, the image a render writes.
 ///
-/// From 64 spp on it is within a factor 1.5, the bound the à-trous estimate is held to. Below,
-/// it overstates OIDN's error (3 to 15 times, measured), never understates it by more than
-/// 1.5: OIDN restores pixels at the light's edge whose few samples all missed the light, and the
-/// estimate divides each pixel's term by the raw mean of both halves, dark there, where the true
-/// relMSE divides by the reference's bright value. The same terms divided by the reference's
-/// values instead are within 1.5 at every spp, which shows it is that denominator and not the
-/// halves' difference that strays.
+/// Beside it, the cause of the former 3-to-13-fold overstatement below 64 spp: the same terms
+/// divided by the raw mean of both halves alone (the former denominator, correlated with the
+/// other half: see `illum_denoise::estimate`) and by the reference's values.
 #[test]
 fn the_halves_estimate_of_oidns_error() {
     let (reference, reference_variance) = common::reference();
@@ -100,11 +99,12 @@ fn the_halves_estimate_of_oidns_error() {
     let mut split = SplitRender::new(common::gpu(), &common::cornell(1, 11), TracerOptions::default())
         .expect("two tracers");
     println!(
-        "| spp | raw relMSE | OIDN halves, true | estimate | estimate / true | reference denominator / true | OIDN whole, true |"
+        "| spp | raw relMSE | OIDN halves, true | estimate | estimate / true | raw-mean denominator / true | \
+         reference denominator / true | OIDN whole, true |"
     );
-    println!("|---|---|---|---|---|---|---|");
-    let (mut worst_converged, mut worst_low, mut worst_reference): (f64, f64, f64) = (1.0, 1.0, 1.0);
-    for spp in [4u32, 8, 16, 32, 64, 128, 256] {
+    println!("|---|---|---|---|---|---|---|---|");
+    let mut worst: f64 = 1.0;
+    for spp in [4u32, 8, 16, 32, 64, 128, 256, 512, 1024] {
         assert!(split.advance(spp / 2, &cancel).expect("renders"));
         let result = split.denoise(&filter).expect("denoises");
         let (a, b) = (split.a.accumulator(), split.b.accumulator());
@@ -112,28 +112,37 @@ fn the_halves_estimate_of_oidns_error() {
         let db = filter.denoise(&DenoiseInput::from_render(b, &result.guides)).expect("denoises");
         let true_error = |image: &RgbImage32| common::true_rel_mse(image, &reference, &reference_variance);
         let halves_true = 0.5 * (true_error(&da) + true_error(&db));
-        let with_reference = 0.5
-            * (halves_rel_mse(&da, &b.mean_image(), &b.variance_image(), &reference)
-                + halves_rel_mse(&db, &a.mean_image(), &a.variance_image(), &reference));
+        let whole_true = true_error(&result.image);
+        let with = |den: &RgbImage32| {
+            0.5 * (halves_rel_mse(&da, &b.mean_image(), &b.variance_image(), den)
+                + halves_rel_mse(&db, &a.mean_image(), &a.variance_image(), den))
+        };
+        let raw_mean = result.raw.mean_image();
         let ratio = result.estimate.rel_mse / halves_true;
-        let reference_ratio = with_reference / halves_true;
         println!(
-            "| {spp} | {:.5} | {halves_true:.5} | {:.5} | {ratio:.2} | {reference_ratio:.2} | {:.5} |",
-            true_error(&result.raw.mean_image()),
+            "| {spp} | {:.5} | {halves_true:.5} | {:.5} | {ratio:.2} | {:.2} | {:.2} | {whole_true:.5} |",
+            true_error(&raw_mean),
             result.estimate.rel_mse,
-            true_error(&result.image)
+            with(&raw_mean) / halves_true,
+            with(&reference) / halves_true,
         );
         // A ratio of 0 or below (an estimate of no error or less) strays infinitely.
-        let stray = |r: f64| if r > 0.0 { r.max(1.0 / r) } else { f64::INFINITY };
-        let understates = |r: f64| if r > 0.0 { 1.0 / r } else { f64::INFINITY };
-        if spp >= 64 {
-            worst_converged = worst_converged.max(stray(ratio));
-        } else {
-            worst_low = worst_low.max(understates(ratio));
-        }
-        worst_reference = worst_reference.max(stray(reference_ratio));
+        worst = worst.max(if ratio > 0.0 { ratio.max(1.0 / ratio) } else { f64::INFINITY });
+        assert!(
+            result.estimate.rel_mse >= whole_true,
+            "{spp} spp: estimate {} below the denoised whole's true error {whole_true}",
+            result.estimate.rel_mse
+        );
     }
-    assert!(worst_converged <= 1.5, "from 64 spp the estimate strays by a factor {worst_converged:.2}");
-    assert!(worst_low <= 1.5, "below 64 spp the estimate understates by a factor {worst_low:.2}");
-    assert!(worst_reference <= 1.5, "with the reference's denominator it strays by {worst_reference:.2}");
+    assert!(worst <= 1.6, "the estimate strays from the true error by a factor {worst:.2}");
+}
+
+/// Fails: Open Image Denoise moves a converged image (65536 spp at 32 x 32: 213 of 1024
+/// pixels beyond |z| = 4.90 in luminance, mean z^2 12.9; it writes about 1e-4 into the black
+/// outside the box and moves the walls' edges by 5 to 15%; docs/denoising.md). Run it with
+/// `--ignored`.
+#[test]
+#[ignore = "Open Image Denoise moves a converged image beyond its noise (docs/denoising.md)"]
+fn oidn_does_not_move_a_converged_image() {
+    crate::quality::a_converged_image_is_not_moved(DenoiserKind::Oidn);
 }

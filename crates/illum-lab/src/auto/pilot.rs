@@ -5,31 +5,39 @@
 //!   [`PilotOptions::longer_side`] pixels on the longer side) and compared with a path-traced
 //!   truth at that size, as the ladder compares (relMSE, per region). A deterministic renderer's
 //!   bias² is its relMSE less the truth's own estimated noise; a path tracer's is its relMSE less
-//!   its own and the truth's estimated noise, and its noise per sample is its estimated relMSE
-//!   times its spp. The truth and these figures are cached in the pilot's folder under a key of
-//!   the scene's content hash and every pilot setting, like the ladder's truth.
+//!   its own and the truth's estimated noise, and its noise curve ([`super::plan::NoiseCurve`])
+//!   comes from its own estimate: at the pilot's spp with the 1/N law for independent samples
+//!   and adaptive sampling; at a quarter of it and at it, with the exponent between them, for
+//!   the low-discrepancy sequence (its estimate from independently randomised replicates); and
+//!   for a denoised render, the denoised image's relMSE against the truth at 4, 16, 64 and the
+//!   pilot's spp, less the bias. The truth and these figures are cached in the pilot's folder
+//!   under a key of the scene's content hash and every pilot setting, like the ladder's truth.
 //! - Throughput: measured now, every run, per setting. The rasterizer draws one frame at the
 //!   size asked for (set-up and first frame, as `render` pays them); the Whitted ray tracer and
 //!   the path tracer run at the pilot's size, their set-up counted once and their per-pixel
-//!   time scaled by the ratio of pixel counts.
+//!   time scaled by the ratio of pixel counts; adaptive sampling's own pilot and a denoised
+//!   render's guides and three filter runs are timed at the pilot's size and scaled the same way.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Context as _;
+use illum_denoise::{DenoiseInput, Denoiser, OIDN_BUILT};
 use illum_gpu::GpuContext;
 use illum_image::RgbImage32;
-use illum_pathtrace::PathTracer;
+use illum_pathtrace::{GUIDE_SAMPLES, PathTracer, SampleAllocation};
 use illum_raster::{Options, RasterRenderer, RasterScene};
-use illum_scene::{Bounces, Overrides, Scene};
+use illum_scene::{Bounces, DenoiserKind, Overrides, Scene, Sequence};
 use illum_whitted::WhittedTracer;
 
-use super::plan::{Candidate, Setting};
+use super::cache::{read_cache, write_cache};
+use super::plan::{Candidate, NoiseCurve, Setting};
+pub use super::render::render;
+use super::render::{path_tracer_throughput, spp_multiple, tracer_options};
 use crate::reference::{cached_reference, reference_settings};
 use crate::regions::{Regions, compare};
-use crate::report::{csv_text, write_text};
 use illum_auto::measure::{Measured, measured};
-pub use illum_auto::settings::{apply, has_caustic, pilot_size, settings};
+pub use illum_auto::settings::{apply, has_caustic, pilot_size, settings, settings_with_variants};
 
 /// How the pilot measures.
 #[derive(Clone, Debug)]
@@ -122,10 +130,12 @@ pub fn measure(
         };
     let truth_rel_mse = if truth.estimated_rel_mse.is_finite() { truth.estimated_rel_mse } else { 0.0 };
 
-    let all = settings(scene);
+    let denoisers: &[DenoiserKind] =
+        if OIDN_BUILT { &[DenoiserKind::Atrous, DenoiserKind::Oidn] } else { &[DenoiserKind::Atrous] };
+    let all = settings_with_variants(scene, denoisers);
     let (_, truth_key) = reference_settings(&truth_scene, options.truth_spp);
     let key = format!(
-        "auto pilot 2; truth: {truth_key}; pilot spp {}; seed {}; sampling {}; settings: {}",
+        "auto pilot 3; truth: {truth_key}; pilot spp {}; seed {}; sampling {}; settings: {}",
         options.pilot_spp,
         small.pathtrace.seed,
         small.pathtrace.sampling,
@@ -188,22 +198,16 @@ pub fn measure(
                 (setup + t.elapsed().as_secs_f64() * pixel_ratio, 0.0)
             }
             Setting::PathTrace { .. } => {
-                let variant = apply(&small, setting);
-                let t = Instant::now();
-                let mut tracer = PathTracer::new(gpu, &variant)?;
-                tracer.render_to_spp(1)?; // the first pass also sets up buffers
-                let setup = t.elapsed().as_secs_f64();
-                tracer.reset();
-                let t = Instant::now();
-                tracer.render_to_spp(options.timing_spp)?;
-                let per_spp = t.elapsed().as_secs_f64() / f64::from(options.timing_spp) * pixel_ratio;
-                (setup, per_spp)
+                let (setup, per_pixel_fixed, per_spp) =
+                    path_tracer_throughput(gpu, &small, setting, options)?;
+                (setup + per_pixel_fixed * pixel_ratio, per_spp * pixel_ratio)
             }
         };
         candidates.push(Candidate {
             setting: setting.clone(),
             bias_rel_mse: m.bias_rel_mse,
-            noise_per_sample: m.noise_per_sample,
+            noise: m.noise,
+            spp_multiple: spp_multiple(setting),
             fixed_seconds: overhead_seconds + fixed_seconds,
             seconds_per_spp,
             worst_region: m.worst_region,
@@ -231,102 +235,63 @@ fn measure_bias(
     regions: &Regions,
     options: &PilotOptions,
 ) -> anyhow::Result<Measured> {
-    let (image, own_noise) = render(gpu, &apply(small, setting), setting, options.pilot_spp)?;
-    let errors = compare(&image, truth, regions);
-    Ok(measured(&errors, regions, truth_rel_mse, own_noise, options.pilot_spp))
-}
-
-/// Renders `scene` (with `setting` applied, see [`apply`]) by the setting's renderer, the path
-/// tracer at `spp`; returns the image and, for the path tracer, its estimated relMSE from noise.
-pub fn render(
-    gpu: &GpuContext,
-    scene: &Scene,
-    setting: &Setting,
-    spp: u32,
-) -> anyhow::Result<(RgbImage32, Option<f64>)> {
-    let (w, h) = (scene.camera.width, scene.camera.height);
-    Ok(match setting {
-        Setting::Raster { look, effects } => {
-            let mut renderer = RasterRenderer::new(gpu, &RasterScene::from_scene(scene)?, w, h)?;
-            (renderer.render(&Options { look: *look, effects: *effects })?, None)
+    let variant = apply(small, setting);
+    let spp = options.pilot_spp;
+    let Setting::PathTrace { sequence, adaptive, denoise, .. } = setting else {
+        let (image, _) = render(gpu, &variant, setting, spp)?;
+        return Ok(measured(&compare(&image, truth, regions), regions, truth_rel_mse, None, spp));
+    };
+    let mut tracer = if *adaptive {
+        let (w, h) = (variant.camera.width, variant.camera.height);
+        let unlimited = SampleAllocation::uniform(w, h, u32::MAX);
+        let mut tracer =
+            PathTracer::with_sample_allocation(gpu, &variant, tracer_options(setting), unlimited)?;
+        illum_pathtrace::allocation::plan_adaptive(&mut tracer, spp)?;
+        tracer
+    } else {
+        PathTracer::with_options(gpu, &variant, tracer_options(setting))?
+    };
+    // The denoised image's relMSE at these spp (and the pilot's), from one render continued.
+    let denoised_at: Vec<u32> = [4, 16, 64].into_iter().filter(|&n| n < spp).chain([spp]).collect();
+    let (filter, guides) = match denoise {
+        Some(kind) => (Some(Denoiser::new(gpu, *kind)?), Some(tracer.guides(GUIDE_SAMPLES)?)),
+        None => (None, None),
+    };
+    let mut denoised = Vec::new();
+    let mut quarter = None;
+    for &n in &denoised_at {
+        let until = match tracer.sample_allocation() {
+            Some(allocation) => allocation.max(),
+            None => n,
+        };
+        tracer.render_to_spp(until)?;
+        if n == spp / 4 {
+            quarter = Some(tracer.accumulator().estimated_rel_mse());
         }
-        Setting::Whitted { .. } => (WhittedTracer::new(gpu, scene)?.render()?, None),
-        Setting::PathTrace { .. } => {
-            let mut tracer = PathTracer::new(gpu, scene)?;
-            tracer.render_to_spp(spp)?;
-            let accumulator = tracer.accumulator();
-            (accumulator.mean_image(), Some(accumulator.estimated_rel_mse()))
+        if let (Some(filter), Some(guides)) = (&filter, &guides) {
+            let image = filter.denoise(&DenoiseInput::from_render(tracer.accumulator(), guides))?;
+            // As a deterministic image: its relMSE less the truth's noise, and its worst region.
+            denoised.push((n, measured(&compare(&image, truth, regions), regions, truth_rel_mse, None, n)));
         }
+    }
+    let accumulator = tracer.accumulator();
+    let own = accumulator.estimated_rel_mse();
+    let raw =
+        measured(&compare(&accumulator.mean_image(), truth, regions), regions, truth_rel_mse, Some(own), spp);
+    let n = f64::from(spp);
+    Ok(match (sequence, denoise) {
+        (_, Some(_)) => {
+            let points =
+                denoised.iter().map(|(n, m)| (f64::from(*n), m.bias_rel_mse - raw.bias_rel_mse)).collect();
+            let worst_region =
+                denoised.last().map_or(raw.worst_region.clone(), |(_, m)| m.worst_region.clone());
+            Measured { noise: NoiseCurve::new(points, 0.0), worst_region, ..raw }
+        }
+        (Sequence::LowDiscrepancy, None) => {
+            let early = quarter.unwrap_or(own);
+            let exponent = (early / own).ln() / 4f64.ln();
+            Measured { noise: NoiseCurve::new(vec![(n / 4.0, early), (n, own)], exponent), ..raw }
+        }
+        (Sequence::Independent, None) => raw,
     })
-}
-
-/// The cached measurements, if `path` holds them for exactly `key`.
-fn read_cache(path: &Path, key: &str, expected: usize) -> Option<Vec<Measured>> {
-    let text = std::fs::read_to_string(path).ok()?;
-    let (first, rest) = text.split_once('\n')?;
-    if first.strip_prefix("# ")? != key {
-        return None;
-    }
-    let mut reader = csv::Reader::from_reader(rest.as_bytes());
-    let mut measured = Vec::new();
-    for record in reader.records() {
-        let record = record.ok()?;
-        let number = |i: usize| record.get(i)?.parse::<f64>().ok();
-        let noise = record.get(2)?;
-        let region = record.get(3)?;
-        measured.push(Measured {
-            bias_rel_mse: number(1)?,
-            noise_per_sample: if noise.is_empty() { None } else { Some(noise.parse().ok()?) },
-            worst_region: if region.is_empty() { None } else { Some((region.to_owned(), number(4)?)) },
-        });
-    }
-    (measured.len() == expected).then_some(measured)
-}
-
-fn write_cache(path: &Path, key: &str, settings: &[Setting], measured: &[Measured]) -> anyhow::Result<()> {
-    let rows: Vec<Vec<String>> = settings
-        .iter()
-        .zip(measured)
-        .map(|(s, m)| {
-            vec![
-                s.to_string(),
-                format!("{:e}", m.bias_rel_mse),
-                m.noise_per_sample.map_or(String::new(), |n| format!("{n:e}")),
-                m.worst_region.as_ref().map_or(String::new(), |(r, _)| r.clone()),
-                m.worst_region.as_ref().map_or(String::new(), |(_, ratio)| format!("{ratio:e}")),
-            ]
-        })
-        .collect();
-    let header =
-        ["setting", "bias_rel_mse", "noise_per_sample", "worst_region", "worst_region_luminance_ratio"];
-    write_text(path, &format!("# {key}\n{}", csv_text(&header, &rows)?))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_cache_reads_back_what_it_wrote_and_refuses_another_key() {
-        let folder = std::env::temp_dir().join(format!("illum-auto-cache-{}", std::process::id()));
-        std::fs::create_dir_all(&folder).unwrap();
-        let path = folder.join("pilot.csv");
-        let settings = [
-            Setting::Whitted { depth: 8, aa: 2 },
-            Setting::PathTrace { bounces: Bounces::Unbounded, caustics: true },
-        ];
-        let measured = vec![
-            Measured {
-                bias_rel_mse: 0.06,
-                noise_per_sample: None,
-                worst_region: Some(("floor in the glass sphere's shadow, a \"quoted\" name".into(), 0.27)),
-            },
-            Measured { bias_rel_mse: 1.5e-6, noise_per_sample: Some(0.11), worst_region: None },
-        ];
-        write_cache(&path, "key 1", &settings, &measured).unwrap();
-        assert_eq!(read_cache(&path, "key 1", 2), Some(measured));
-        assert_eq!(read_cache(&path, "key 2", 2), None);
-        assert_eq!(read_cache(&path, "key 1", 3), None);
-        std::fs::remove_dir_all(&folder).unwrap();
-    }
 }
