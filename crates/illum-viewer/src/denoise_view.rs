@@ -285,12 +285,14 @@ impl DenoiseView {
             return Ok(());
         }
         let job = self.job.take().expect("present");
-        let mut images = job.done.into_iter().skip(1);
+        let mut images = job.done.into_iter();
+        let denoised_whole = images.next().expect("the whole is denoised first");
         let denoised = job.halves.as_ref().map(|[(a, _), (b, _)]| {
             let (da, db) = (images.next().expect("half A"), images.next().expect("half B"));
             HalvesError::new(
                 (&a.mean_image(), &a.variance_image(), &da),
                 (&b.mean_image(), &b.variance_image(), &db),
+                &denoised_whole,
             )
             .relative_error()
         });
