@@ -7,49 +7,21 @@
 //! truth) and the path tracer renders at a tenth of the view's size each way, so that a test
 //! takes seconds; the rules are the same.
 
-use std::sync::OnceLock;
-
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use illum_auto::plan::{Goal, Plan, Setting, plan};
 use illum_scene::RendererKind;
+use illum_viewer::ViewerApp;
 use illum_viewer::auto_pilot::PilotOptions;
-use illum_viewer::gpu_setup::wgpu_setup;
-use illum_viewer::{StartOptions, ViewerApp};
+
+mod common;
+use common::harness_sized;
 
 /// Most frames a pilot may take here (each runs a slice of it).
 const PILOT_FRAMES: usize = 2000;
 
-/// The one device of this test process (lavapipe when present), created with the viewer's
-/// setup, as tests/ui.rs makes its own.
-fn shared_device() -> egui_wgpu::WgpuSetupExisting {
-    static STATE: OnceLock<egui_wgpu::RenderState> = OnceLock::new();
-    let state = STATE.get_or_init(|| {
-        egui_kittest::wgpu::create_render_state(wgpu_setup(true), egui_wgpu::RendererOptions::PREDICTABLE)
-    });
-    egui_wgpu::WgpuSetupExisting {
-        instance: state.instance.clone(),
-        adapter: state.adapter.clone(),
-        device: state.device.clone(),
-        queue: state.queue.clone(),
-    }
-}
-
 fn harness(scene: &'static str) -> Harness<'static, ViewerApp> {
-    let mut harness = Harness::builder()
-        .with_size(egui::vec2(900.0, 560.0))
-        .wgpu_setup(egui_wgpu::WgpuSetup::Existing(shared_device()))
-        .build_eframe(move |cc| {
-            ViewerApp::new(
-                cc,
-                StartOptions {
-                    scene: scene.into(),
-                    mode: Some(RendererKind::PathTrace),
-                    screenshot: None,
-                    clear_is_backdrop: false,
-                },
-            )
-        });
+    let mut harness = harness_sized(scene, RendererKind::PathTrace, egui::vec2(900.0, 560.0));
     let app = harness.state_mut();
     app.pathtrace_mut().expect("path tracer loaded").settings.resolution_scale = 0.1;
     app.auto_mut().pilot_options =

@@ -10,27 +10,13 @@
 //!
 //! Over 450 lines: each test drives the same app through one user action, on one shared harness.
 
-use std::sync::OnceLock;
-
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use illum_scene::{Bounces, RendererKind};
-use illum_viewer::gpu_setup::wgpu_setup;
-use illum_viewer::{StartOptions, ViewerApp};
+use illum_viewer::ViewerApp;
 
-/// The one device of this test process (lavapipe when present), created with the viewer's setup.
-fn shared_device() -> egui_wgpu::WgpuSetupExisting {
-    static STATE: OnceLock<egui_wgpu::RenderState> = OnceLock::new();
-    let state = STATE.get_or_init(|| {
-        egui_kittest::wgpu::create_render_state(wgpu_setup(true), egui_wgpu::RendererOptions::PREDICTABLE)
-    });
-    egui_wgpu::WgpuSetupExisting {
-        instance: state.instance.clone(),
-        adapter: state.adapter.clone(),
-        device: state.device.clone(),
-        queue: state.queue.clone(),
-    }
-}
+mod common;
+use common::{harness_sized, shared_device};
 
 fn harness(mode: RendererKind) -> Harness<'static, ViewerApp> {
     harness_with("scenes/cornell.toml", mode)
@@ -38,24 +24,6 @@ fn harness(mode: RendererKind) -> Harness<'static, ViewerApp> {
 
 fn harness_with(scene: &'static str, mode: RendererKind) -> Harness<'static, ViewerApp> {
     harness_sized(scene, mode, egui::vec2(900.0, 560.0))
-}
-
-fn harness_sized(scene: &'static str, mode: RendererKind, size: egui::Vec2) -> Harness<'static, ViewerApp> {
-    Harness::builder()
-        .with_size(size)
-        .wgpu_setup(egui_wgpu::WgpuSetup::Existing(shared_device()))
-        .build_eframe(move |cc| {
-            ViewerApp::new(
-                cc,
-                StartOptions {
-                    scene: scene.into(),
-                    mode: Some(mode),
-                    screenshot: None,
-                    // The harness clears to transparent: the panels paint their own fill.
-                    clear_is_backdrop: false,
-                },
-            )
-        })
 }
 
 /// Clicks the widget labelled `label` and runs the frame that reacts to it.

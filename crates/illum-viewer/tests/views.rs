@@ -2,45 +2,18 @@
 //! tracer's Denoise toggle (`denoise_view.rs`) and the Difference view of the rasterizer and
 //! the Whitted tracer (`difference_view.rs`), driven through the real UI on lavapipe.
 
-use std::sync::OnceLock;
-
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use illum_denoise::input::DenoiseInput;
 use illum_denoise::{AtrousSettings, reference};
 use illum_scene::RendererKind;
-use illum_viewer::gpu_setup::wgpu_setup;
-use illum_viewer::{StartOptions, ViewerApp};
+use illum_viewer::ViewerApp;
 
-/// The one device of this test process, as the real window has one.
-fn shared_device() -> egui_wgpu::WgpuSetupExisting {
-    static STATE: OnceLock<egui_wgpu::RenderState> = OnceLock::new();
-    let state = STATE.get_or_init(|| {
-        egui_kittest::wgpu::create_render_state(wgpu_setup(true), egui_wgpu::RendererOptions::PREDICTABLE)
-    });
-    egui_wgpu::WgpuSetupExisting {
-        instance: state.instance.clone(),
-        adapter: state.adapter.clone(),
-        device: state.device.clone(),
-        queue: state.queue.clone(),
-    }
-}
+mod common;
+use common::harness_sized;
 
 fn harness(scene: &'static str, mode: RendererKind) -> Harness<'static, ViewerApp> {
-    Harness::builder()
-        .with_size(egui::vec2(900.0, 560.0))
-        .wgpu_setup(egui_wgpu::WgpuSetup::Existing(shared_device()))
-        .build_eframe(move |cc| {
-            ViewerApp::new(
-                cc,
-                StartOptions {
-                    scene: scene.into(),
-                    mode: Some(mode),
-                    screenshot: None,
-                    clear_is_backdrop: false,
-                },
-            )
-        })
+    harness_sized(scene, mode, egui::vec2(900.0, 560.0))
 }
 
 /// Runs frames until `done` holds (at most `frames`); returns whether it did.
