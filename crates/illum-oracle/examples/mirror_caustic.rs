@@ -1,17 +1,21 @@
-//! The light a delta sun's kernels own (`gather.rs`: the photon gather of E (S|D)* D S+ L but
-//! E D S+ L, and the glint E S* L), measured with the f64 oracle on the Whitted view at 64 x 36,
-//! bounces 8, in the pixels whose camera ray (through the pixel's centre) first meets the metal
-//! sphere, and those that first meet the glass:
+//! The caustic seen in the mirror ball and through the glass (paths E S+ D S+ L), measured with
+//! the f64 oracle on the Whitted view at 64 x 36, bounces 8, in the pixels whose camera ray
+//! (through the pixel's centre) first meets the metal sphere, and those that first meet the glass:
 //!
-//! - delta sun, camera paths alone (the truth before the kernels, where the light tracer's
-//!   connections land only on the floor seen directly);
-//! - delta sun with the kernels' estimates (the camera paths plus `Oracle::gather_at`);
-//! - a sun disc of RADIUS degrees, where the camera paths find all those paths by chance (a
-//!   bounce that reaches the disc through the glass or off the mirror, and the disc seen in
-//!   them): the independent cross-check, with no photon and no kernel.
+//! - delta sun, light tracer alone (what the truth had before the photon gather);
+//! - delta sun with the photon gather (`gather.rs`);
+//! - a sun disc of RADIUS degrees, where the camera paths find those paths by chance (a bounce
+//!   from the floor that reaches the disc through the glass or off the mirror): the independent
+//!   cross-check. The disc also adds the sun's glint E S+ L, which neither delta estimate has:
+//!   the floor's blue albedo is 0, so E S+ D S+ L has no blue and the blue difference is the
+//!   glint (with what the disc's blur moves in the sky's reflection: nothing, the sky is
+//!   uniform). Pixels where the disc adds blue beyond 4 sigma are left out of the comparison.
 //!
 //! Printed per region and channel: the means and the differences with their standard errors,
-//! and the per-pixel z-scores of disc - kernels.
+//! and the per-pixel z-scores of disc - gather; and, with the delta sun, the light no estimator
+//! owns: the caustic scattered again by a diffuse surface through a mirror or glass
+//! (E S* D S+ D S+ L, `Oracle::rescattered_at`). A third region, the floor seen directly, is
+//! where that light lands.
 //!
 //!     cargo run --release -p illum-oracle --example mirror_caustic [SPP] [RADIUS]
 
@@ -84,25 +88,32 @@ fn main() {
             .map(|(_, name)| name)
     };
     let threads = illum_oracle::default_threads();
-    for name in spheres.iter().map(|s| &s.0) {
+    let mut regions: Vec<String> = spheres.iter().map(|s| s.0.clone()).collect();
+    regions.push("floor".to_owned());
+    for name in &regions {
         let pixels: Vec<(u32, u32)> = (0..36)
             .flat_map(|y| (0..64).map(move |x| (x, y)))
-            .filter(|&(x, y)| first_sphere(x, y).as_ref() == Some(name))
+            .filter(|&(x, y)| match first_sphere(x, y) {
+                Some(sphere) => &sphere == name,
+                None => name == "floor" && camera.direction(x, y, 0.5, 0.5).y < 0.0,
+            })
             .collect();
-        // Per pixel: delta camera alone, delta camera + kernels, disc camera.
-        let partial: Vec<Vec<[Sums; 3]>> = std::thread::scope(|scope| {
+        // Per pixel: delta camera alone, delta camera + gather, disc camera, the remainder.
+        let partial: Vec<Vec<[Sums; 4]>> = std::thread::scope(|scope| {
             let workers: Vec<_> = (0..threads as u32)
                 .map(|t| {
                     let (delta, disc, pixels) = (&delta, &disc, &pixels);
                     scope.spawn(move || {
-                        let mut sums = vec![[Sums::default(); 3]; pixels.len()];
+                        let mut sums = vec![[Sums::default(); 4]; pixels.len()];
                         for k in (t..spp).step_by(threads) {
                             let gather = delta.gather_at(11, k, pixels);
+                            let rescattered = delta.rescattered_at(11, k, pixels);
                             for (i, &(x, y)) in pixels.iter().enumerate() {
                                 let camera = delta.pixel_sample(x, y, 11, k);
                                 sums[i][0].add(camera);
                                 sums[i][1].add(camera + gather[i]);
                                 sums[i][2].add(disc.pixel_sample(x, y, 12, k));
+                                sums[i][3].add(rescattered[i]);
                             }
                         }
                         sums
@@ -111,49 +122,62 @@ fn main() {
                 .collect();
             workers.into_iter().map(|w| w.join().expect("worker")).collect()
         });
-        let mut sums = vec![[Sums::default(); 3]; pixels.len()];
+        let mut sums = vec![[Sums::default(); 4]; pixels.len()];
         for part in &partial {
             for (s, p) in sums.iter_mut().zip(part) {
-                for e in 0..3 {
+                for e in 0..4 {
                     s[e].merge(&p[e]);
                 }
             }
         }
         let n = f64::from(spp);
-        let stats: Vec<[(DVec3, DVec3); 3]> =
-            sums.iter().map(|s| [s[0].stats(n), s[1].stats(n), s[2].stats(n)]).collect();
-        println!("{name}: {} pixels; {spp} spp, disc {radius} deg", pixels.len());
-        let m = stats.len() as f64;
-        let mean = |e: usize| stats.iter().map(|s| s[e].0).sum::<DVec3>() / m;
-        let var = |e: usize| stats.iter().map(|s| s[e].1).sum::<DVec3>() / (m * m);
-        let (before, kernels, finite) = (mean(0), mean(1), mean(2));
-        let (vb, vk, vf) = (var(0), var(1), var(2));
+        let stats: Vec<[(DVec3, DVec3); 4]> =
+            sums.iter().map(|s| [s[0].stats(n), s[1].stats(n), s[2].stats(n), s[3].stats(n)]).collect();
+        // Glint pixels: the disc adds blue beyond 4 sigma.
+        let glint = |s: &[(DVec3, DVec3); 4]| (s[2].0.z - s[1].0.z) / (s[2].1.z + s[1].1.z).sqrt() > 4.0;
+        let kept: Vec<&[(DVec3, DVec3); 4]> = stats.iter().filter(|s| !glint(s)).collect();
+        println!(
+            "{name}: {} pixels, {} with the disc's glint left out; {spp} spp, disc {radius} deg",
+            pixels.len(),
+            pixels.len() - kept.len()
+        );
+        let m = kept.len() as f64;
+        let mean = |e: usize| kept.iter().map(|s| s[e].0).sum::<DVec3>() / m;
+        let var = |e: usize| kept.iter().map(|s| s[e].1).sum::<DVec3>() / (m * m);
+        let (before, gathered, finite, rest) = (mean(0), mean(1), mean(2), mean(3));
+        let (vb, vg, vf, vr) = (var(0), var(1), var(2), var(3));
         for (c, label) in ["red", "green", "blue"].iter().enumerate() {
             println!(
-                "  {label:5}: camera paths alone {:.5} +- {:.5}, with the kernels {:.5} +- {:.5} ({:+.2}%), \
-                 disc {:.5} +- {:.5}, disc - kernels {:+.5} +- {:.5} ({:+.2}%)",
+                "  {label:5}: light tracer alone {:.5} +- {:.5}, with gather {:.5} +- {:.5} (gather adds {:+.2}%), \
+                 disc {:.5} +- {:.5}, disc - gather {:+.5} +- {:.5} ({:+.2}%)",
                 before[c],
                 vb[c].sqrt(),
-                kernels[c],
-                vk[c].sqrt(),
-                100.0 * (kernels[c] - before[c]) / before[c],
+                gathered[c],
+                vg[c].sqrt(),
+                100.0 * (gathered[c] - before[c]) / before[c],
                 finite[c],
                 vf[c].sqrt(),
-                finite[c] - kernels[c],
-                (vf[c] + vk[c]).sqrt(),
-                100.0 * (finite[c] - kernels[c]) / kernels[c],
+                finite[c] - gathered[c],
+                (vf[c] + vg[c]).sqrt(),
+                100.0 * (finite[c] - gathered[c]) / gathered[c],
+            );
+            println!(
+                "         unowned E S* D S+ D S+ L {:.6} +- {:.6} ({:+.3}% of the gathered mean)",
+                rest[c],
+                vr[c].sqrt(),
+                100.0 * rest[c] / gathered[c]
             );
         }
-        // Per-pixel z of disc - kernels, every channel.
-        let mut z: Vec<f64> = stats
+        // Per-pixel z of disc - gather, red and green, the kept pixels.
+        let mut z: Vec<f64> = kept
             .iter()
-            .flat_map(|s| (0..3).map(move |c| (s[2].0[c] - s[1].0[c]) / (s[2].1[c] + s[1].1[c]).sqrt()))
+            .flat_map(|s| (0..2).map(move |c| (s[2].0[c] - s[1].0[c]) / (s[2].1[c] + s[1].1[c]).sqrt()))
             .filter(|z| z.is_finite())
             .collect();
         z.sort_by(f64::total_cmp);
         let over = |t: f64| z.iter().filter(|v| v.abs() > t).count();
         println!(
-            "  per-pixel z ({} values): mean {:+.3}, |z| > 3: {}, |z| > 4: {}, max |z| {:.2}",
+            "  per-pixel z (red, green; {} values): mean {:+.3}, |z| > 3: {}, |z| > 4: {}, max |z| {:.2}",
             z.len(),
             z.iter().sum::<f64>() / z.len() as f64,
             over(3.0),

@@ -1,14 +1,11 @@
-//! The caustic's estimators that join a camera path to a delta sun with a kernel, in f64 and
-//! written independently of the GPU's (`crates/illum-pathtrace/shaders/gather.wgsl`): the
-//! photon gather of E (S|D)* D S+ L (all but E D S+ L, the light tracer's connection), by
-//! probabilistic progressive photon mapping (Knaus and Zwicker 2011), and the sun's glint
-//! E S* L, by a kernel in direction space.
+//! The caustic seen through a specular surface, paths E S+ D S+ L with a delta sun, by
+//! probabilistic progressive photon mapping (Knaus and Zwicker 2011), in f64 and written
+//! independently of the GPU's (`crates/illum-pathtrace/shaders/gather.wgsl`).
 //!
 //! Neither the camera paths nor the light tracer's connection to the pinhole can find these
-//! paths with a delta sun: a camera path never reaches a light of zero size, and a particle
-//! leaving D through a mirror, glass or another diffuse bounce never reaches a pinhole. Photon
-//! mapping joins the two halves at D with a kernel of radius r instead of an exact connection;
-//! the glint widens the sun to a disc of angle a instead.
+//! paths with a delta sun: a camera path leaving D never reaches a light of zero size, and a
+//! particle leaving D through a mirror or glass never reaches a pinhole. Photon mapping joins
+//! the two halves at D with a kernel of radius r instead of an exact connection.
 //!
 //! Photons. Frame k's particles (`caustic.rs`) stop at their first diffuse point after s >= 1
 //! specular scatterings; there each is a photon of weight Phi rho(x_p) / pi (its flux Phi, the
@@ -16,30 +13,25 @@
 //! through the specular objects, so the photons' weights within r of x, divided by pi r^2,
 //! estimate the radiance rho / pi E(x) leaving x, blurred over the disc of radius r.
 //!
-//! Gathering paths. Sample k of a pixel adds one camera path, traced with its own random
-//! numbers, through mirrors (weight the reflectance), glass (the Fresnel choice, weight 1) and
-//! diffuse surfaces (a cosine bounce, weight the albedo). At each diffuse vertex D after m >= 1
-//! continuation rays its throughput multiplies
+//! Gather. Sample k of a pixel adds one camera path E S^j D (j >= 1 specular scatterings, D the
+//! first diffuse vertex), traced with its own random numbers, whose throughput to D multiplies
 //!     L(D) = sum over photons p of frame k with |x_p - D| < r_k and n_p . n_D > 0 of
 //!            weight_p / (pi r_k^2)
-//! (n_p faces the side the particle arrived from, n_D the side the path arrived from). Under
-//! `Bounces::Fixed(n)` a photon of s scatterings counts when m + s + 1 <= n, the continuation
-//! rays of the path E ... D S^s L; unbounded, both halves play Russian roulette as their
-//! estimators do. The camera ray's own hit (m = 0) gathers nothing: E D S+ L is the light
-//! tracer's connection. When a path with no diffuse vertex leaves the scene within a_k of the
-//! sun's direction it adds the glint: the radiance E / (pi sin^2 a_k) of a sun disc of radius
-//! a_k (the irradiance E at normal incidence, as a finite sun has). Every other path with a
-//! delta sun starts L D (next-event estimation's) or L S+ D E (the light tracer's), so no path
-//! is counted twice and none is missed. With a sun disc the camera paths find all of these
-//! themselves (a bounce that reaches the disc) and the gather is off.
+//! (n_p faces the side the particle arrived from, n_D the side the camera path arrived from: a
+//! photon on the other side of a surface is not counted). Under `Bounces::Fixed(n)` a photon of
+//! s scatterings counts when j + s + 1 <= n, the continuation rays the camera path
+//! E S^j D S^s L would take; unbounded, both halves play Russian roulette as their estimators
+//! do. A path whose first diffuse vertex is the camera ray's own hit (j = 0) belongs to the
+//! light tracer's connection, and E S+ D S+ L to no other estimator with a delta sun, so no
+//! path is counted twice. With a sun disc the camera paths find these paths themselves (a bounce
+//! from D that reaches the disc) and the gather is off.
 //!
-//! Radii. Frame k (sample index k, from 0) has its own photon map, radius and angle
-//!     r_k = r_1 (k + 1)^((alpha - 1) / 2),   a_k = a_1 (k + 1)^((alpha - 1) / 2),   alpha = 2/3,
-//! r_1 = RADIUS_FRACTION R_max (R_max the largest specular object's bounding radius), a_1 =
-//! GLINT_ANGLE_DEG. Frames are independent, so the per-pixel mean and variance of the samples
-//! stay valid; each kernel's bias falls as its area, k^(alpha - 1), and its variance grows as
-//! k^(1 - alpha), so the mean over K frames converges (bias ~ K^(alpha - 1), variance ~
-//! K^(-alpha)).
+//! Radius. Frame k (sample index k, from 0) has its own photon map and radius
+//!     r_k = r_1 (k + 1)^((alpha - 1) / 2),   alpha = 2/3,   r_1 = RADIUS_FRACTION R_max
+//! (R_max the largest specular object's bounding radius). Frames are independent, so the
+//! per-pixel mean and variance of the samples stay valid; the kernel's bias falls as r_k^2 and
+//! its variance grows as 1 / r_k^2 ~ k^(1 - alpha), so the mean over K frames converges
+//! (bias ~ K^(alpha - 1), variance ~ K^(-alpha)).
 
 use std::collections::HashMap;
 use std::f64::consts::PI;
@@ -55,8 +47,6 @@ use crate::rng::Rng;
 pub const RADIUS_FRACTION: f64 = 0.02;
 /// Knaus and Zwicker's alpha: the kernel's area shrinks as k^(alpha - 1).
 pub const ALPHA: f64 = 2.0 / 3.0;
-/// a_1, the glint's kernel angle at sample index 0, in degrees.
-pub const GLINT_ANGLE_DEG: f64 = 5.0;
 /// Key mixed into the gather paths' seed, so that they share no random numbers with the camera
 /// paths or the particles.
 const GATHER_SEED_KEY: u64 = 0x9a7e_e4ca_0571_c0de;
@@ -75,7 +65,7 @@ pub(crate) struct Photon {
     pub(crate) scatterings: u32,
 }
 
-/// The kernel radius (or the glint's angle) of frame `frame` for r_1 (a_1) = `first`.
+/// The kernel radius of frame `frame` for r_1 = `first`.
 pub fn radius(first: f64, frame: u32) -> f64 {
     first * (f64::from(frame) + 1.0).powf((ALPHA - 1.0) / 2.0)
 }
@@ -135,8 +125,7 @@ impl Oracle {
     }
 
     /// Turns the photon gather off (`false`) or back on; it runs only where [`Self::gathers`]
-    /// allows. Off, the image misses E (S|D)* D S+ L (but E D S+ L) and the glint E S* L, as the
-    /// light tracer alone does.
+    /// allows. Off, the image misses E S+ D S+ L as the light tracer alone does.
     pub fn with_gather(mut self, on: bool) -> Oracle {
         self.gather = on;
         self
@@ -170,6 +159,72 @@ impl Oracle {
         }
     }
 
+    /// A measurement of light no estimator owns (docs/caustics.md): the paths
+    /// E S* D S+ D S+ L, the caustic scattered again by a diffuse surface through a mirror or
+    /// glass, at `pixels` (x, y) for frame `frame`'s photons: one camera path per pixel through
+    /// specular scatterings to a diffuse point D1, a cosine bounce there, one or more specular
+    /// scatterings to D2, and the photon estimate at D2 (zeros when the gather is off).
+    pub fn rescattered_at(&self, seed: u64, frame: u32, pixels: &[(u32, u32)]) -> Vec<DVec3> {
+        let n = u64::from(self.camera.width) * u64::from(self.camera.height);
+        let photons = (0..n)
+            .filter_map(|particle| {
+                let mut rng =
+                    Rng::for_sample(seed ^ crate::caustic::PARTICLE_SEED_KEY, particle, u64::from(frame));
+                self.trace_particle(n, &mut rng)
+            })
+            .collect();
+        let Some(map) = self.photon_map(photons, frame) else { return vec![DVec3::ZERO; pixels.len()] };
+        pixels
+            .iter()
+            .map(|&(x, y)| {
+                let pixel = u64::from(y) * u64::from(self.camera.width) + u64::from(x);
+                let mut rng = Rng::for_sample(seed ^ GATHER_SEED_KEY ^ 1, pixel, u64::from(frame));
+                let (jx, jy) = (rng.uniform(), rng.uniform());
+                let mut d = self.camera.direction(x, y, jx, jy);
+                let mut o = self.camera.eye;
+                let mut throughput = DVec3::ONE;
+                // Continuation rays taken; specular scatterings since the diffuse bounce.
+                let (mut taken, mut specular, mut bounced) = (0u32, 0u32, false);
+                loop {
+                    let Some(hit) = self.closest_hit(o, d) else { return DVec3::ZERO };
+                    if hit.primitive.emitter || !self.may_continue(taken) {
+                        return DVec3::ZERO;
+                    }
+                    let Contact { point, front, normal, lift } = hit.contact(o, d);
+                    match hit.primitive.material {
+                        MaterialKind::Mirror { reflectance } => {
+                            throughput *= reflectance.as_dvec3();
+                            d = reflect(d, normal);
+                            o = point + normal * lift;
+                            specular += 1;
+                        }
+                        MaterialKind::Dielectric { ior } => {
+                            (o, d) = scatter_dielectric(d, normal, point, front, ior, lift, &mut rng);
+                            specular += 1;
+                        }
+                        MaterialKind::Lambertian { .. } | MaterialKind::Checker(_) => {
+                            if bounced {
+                                if specular == 0 {
+                                    return DVec3::ZERO;
+                                }
+                                // `taken` continuation rays so far; the photon's side adds s + 1.
+                                return throughput * map.radiance(point, normal, taken, self.bounces);
+                            }
+                            throughput *= hit.diffuse_albedo(point);
+                            let local = crate::sampling::cosine_hemisphere(rng.uniform(), rng.uniform());
+                            d = crate::sampling::local_to_world(normal, local).normalize();
+                            o = point + normal * lift;
+                            bounced = true;
+                            specular = 0;
+                        }
+                        MaterialKind::Emitter { .. } => unreachable!("emitters are handled above"),
+                    }
+                    taken += 1;
+                }
+            })
+            .collect()
+    }
+
     fn photon_map(&self, photons: Vec<Photon>, frame: u32) -> Option<PhotonMap> {
         let emitter = self.caustic.as_ref().filter(|_| self.gathers())?;
         Some(PhotonMap::new(photons, radius(emitter.gather_radius, frame)))
@@ -178,90 +233,55 @@ impl Oracle {
     fn gather_pixel(&self, map: &PhotonMap, x: u32, y: u32, seed: u64, frame: u32) -> DVec3 {
         let pixel = u64::from(y) * u64::from(self.camera.width) + u64::from(x);
         let mut rng = Rng::for_sample(seed ^ GATHER_SEED_KEY, pixel, u64::from(frame));
-        self.gather_path(map, x, y, frame, &mut rng)
+        self.gather_path(map, x, y, &mut rng)
     }
 
-    /// The glint of frame `frame` seen along d: the radiance of a sun disc of angle a_k where d
-    /// lies within it.
-    fn glint(&self, frame: u32, d: DVec3) -> DVec3 {
-        let Some(sun) = self.scene.sun else { return DVec3::ZERO };
-        let cos_a = radius(GLINT_ANGLE_DEG.to_radians(), frame).cos();
-        if d.dot(sun.to_light) < cos_a {
-            return DVec3::ZERO;
-        }
-        sun.irradiance / (PI * (1.0 - cos_a * cos_a))
-    }
-
-    /// One gathering camera path through pixel (x, y), jittered: the photon estimates at its
-    /// diffuse vertices after the camera ray's own hit and, if it has none, the glint where it
-    /// leaves the scene, each times the throughput there.
-    fn gather_path(&self, map: &PhotonMap, x: u32, y: u32, frame: u32, rng: &mut Rng) -> DVec3 {
+    /// One camera path E S^j D through pixel (x, y), jittered, and the photon estimate at D
+    /// times its throughput (zero when it reaches no diffuse point after j >= 1 scatterings).
+    fn gather_path(&self, map: &PhotonMap, x: u32, y: u32, rng: &mut Rng) -> DVec3 {
         let (jx, jy) = (rng.uniform(), rng.uniform());
         let mut d = self.camera.direction(x, y, jx, jy);
         let mut o = self.camera.eye;
         let mut throughput = DVec3::ONE;
-        let mut sum = DVec3::ZERO;
-        // Continuation rays taken so far, and whether a diffuse vertex was among them.
-        let mut taken = 0u32;
-        let mut diffuse = false;
+        let mut specular = 0u32;
         loop {
-            let Some(hit) = self.closest_hit(o, d) else {
-                if !diffuse {
-                    sum += throughput * self.glint(frame, d);
-                }
-                return sum;
-            };
+            let Some(hit) = self.closest_hit(o, d) else { return DVec3::ZERO };
             if hit.primitive.emitter {
-                return sum;
+                return DVec3::ZERO;
             }
             let Contact { point, front, normal, lift } = hit.contact(o, d);
             match hit.primitive.material {
                 MaterialKind::Mirror { reflectance } => {
                     let reflectance = reflectance.as_dvec3();
-                    if !self.may_continue(taken)
-                        || !self.roulette(taken, throughput * reflectance, &mut throughput, rng)
+                    if !self.may_continue(specular)
+                        || !self.roulette(specular, throughput * reflectance, &mut throughput, rng)
                     {
-                        return sum;
+                        return DVec3::ZERO;
                     }
                     throughput *= reflectance;
                     d = reflect(d, normal);
                     o = point + normal * lift;
                 }
                 MaterialKind::Dielectric { ior } => {
-                    if !self.may_continue(taken) || !self.roulette(taken, throughput, &mut throughput, rng) {
-                        return sum;
+                    if !self.may_continue(specular)
+                        || !self.roulette(specular, throughput, &mut throughput, rng)
+                    {
+                        return DVec3::ZERO;
                     }
                     (o, d) = scatter_dielectric(d, normal, point, front, ior, lift, rng);
                 }
                 MaterialKind::Lambertian { .. } | MaterialKind::Checker(_) => {
-                    if taken > 0 {
-                        sum += throughput * map.radiance(point, normal, taken, self.bounces);
+                    if specular == 0 {
+                        return DVec3::ZERO;
                     }
-                    let albedo = hit.diffuse_albedo(point);
-                    // A later diffuse vertex joins photons of s >= 1 scatterings after at least
-                    // taken + 1 rays: nothing counts under a limit below taken + 3.
-                    let useful = match self.bounces {
-                        Bounces::Fixed(n) => taken + 3 <= n,
-                        Bounces::Unbounded => true,
-                    };
-                    if !useful
-                        || !self.may_continue(taken)
-                        || !self.roulette(taken, throughput * albedo, &mut throughput, rng)
-                    {
-                        return sum;
-                    }
-                    throughput *= albedo;
-                    let local = crate::sampling::cosine_hemisphere(rng.uniform(), rng.uniform());
-                    d = crate::sampling::local_to_world(normal, local).normalize();
-                    o = point + normal * lift;
-                    diffuse = true;
+                    return throughput * map.radiance(point, normal, specular, self.bounces);
                 }
                 MaterialKind::Emitter { .. } => unreachable!("emitters are handled above"),
             }
             if !throughput.cmpgt(DVec3::ZERO).any() {
-                return sum;
+                return DVec3::ZERO;
             }
-            taken += 1;
+            specular += 1;
         }
     }
 }

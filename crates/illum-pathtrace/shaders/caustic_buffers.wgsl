@@ -1,7 +1,7 @@
 #define_import_path illum::pathtrace::caustic_buffers
 
 // What the caustic's two passes share (shader def CAUSTIC): the light tracer (caustic.wgsl) and,
-// with a delta sun, the photon gather and the glint (gather.wgsl, shader def CAUSTIC_GATHER): their parameters,
+// with a delta sun, the photon gather (gather.wgsl, shader def CAUSTIC_GATHER): their parameters,
 // the frames' fixed-point splat buffer, and the photon maps with their hash grid.
 //
 // Splatting: WGSL has no float atomics, so each value is rounded to a 64-bit fixed-point
@@ -51,8 +51,7 @@ struct CausticParams {
     // The first particle (or, in the gather, pixel) of this dispatch: a frame may be traced in
     // pieces, each a range of them (tracer/caustic.rs, FramePieces).
     first_index: u32,
-    // a_1, the glint's kernel angle in radians at sample index 0 (0 without the gather).
-    glint_angle: f32,
+    padding_b: u32,
     padding_c: u32,
 }
 
@@ -110,12 +109,6 @@ const RADIUS_EXPONENT: f32 = -0.16666667;
 // The kernel radius of frame `frame` of this dispatch (sample index frame_base + frame).
 fn gather_radius(frame: u32) -> f32 {
     return caustic.gather_radius * pow(f32(caustic.frame_base + frame + 1u), RADIUS_EXPONENT);
-}
-
-// The glint's kernel angle of frame `frame`: a_k = a_1 (k + 1)^(-1/6), the gather's rule (a
-// kernel over a 2-D set of directions, as the gather's over a surface).
-fn glint_angle(frame: u32) -> f32 {
-    return caustic.glint_angle * pow(f32(caustic.frame_base + frame + 1u), RADIUS_EXPONENT);
 }
 
 // The grid cell (cubes of side `side` from the scene's centre) holding p. Clamped far beyond

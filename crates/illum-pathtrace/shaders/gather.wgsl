@@ -1,52 +1,44 @@
-// The caustic's estimators that join a camera path to the sun with a kernel (shader def
-// CAUSTIC_GATHER, a delta sun): the photon gather, paths E (S|D)* D S+ L other than E D S+ L,
-// by probabilistic progressive photon mapping (Knaus and Zwicker 2011), and the sun's glint,
-// paths E S* L, by a kernel in direction space. One invocation traces one camera path of one
-// pixel and frame, after the light tracer (caustic.wgsl) has stored that frame's photons; its
-// estimate goes into the frame's splat like a particle's, so frame k's sample of the pixel pairs
-// with the camera's sample k (tracer/caustic.rs). The mathematics is in docs/caustics.md; in
-// short:
+// The photon gather (shader def CAUSTIC_GATHER): the caustic seen through a specular surface,
+// paths E S+ D S+ L with a delta sun, by probabilistic progressive photon mapping (Knaus and
+// Zwicker 2011). One invocation traces one camera path of one pixel and frame, after the light
+// tracer (caustic.wgsl) has stored that frame's photons; the estimate goes into the frame's
+// splat like a particle's, so frame k's sample of the pixel pairs with the camera's sample k
+// (tracer/caustic.rs). The mathematics is in docs/caustics.md; in short:
 //
 // The path: a camera ray through the pixel, jittered, followed through mirrors and glass (the
-// camera path tracer's weights: reflectance; 1 with the Fresnel choice) and diffuse surfaces
-// (a cosine-distributed bounce, weight the albedo), with the camera paths' length rule and
-// roulette (caustic_walk.wgsl). A path that reaches an emitter ends.
+// camera path tracer's weights: reflectance; 1 with the Fresnel choice) to its first diffuse
+// point D after j >= 1 specular scatterings. j = 0 is the light tracer's connection (L S+ D E);
+// a path that leaves the scene or meets an emitter adds nothing.
 //
-// The gather at each diffuse vertex D of depth m >= 1 (m scatterings before it; m = 0, the
-// camera ray's own hit, is the light tracer's connection L S+ D E): the photons of the frame
-// within r_k of D on the same side (photon normal . D's normal > 0) whose s scatterings let the
-// path E ... D S^s L count under `bounces` = n (m + s + 1 <= n continuation rays), weight
-// (flux x albedo / pi) summed and divided by pi r_k^2: the radiance leaving D toward the path,
-// blurred over the kernel. Each frame has its own photons and radius r_k = r_1 (k + 1)^(-1/6)
-// (sample index k), so frames are independent and the mean over frames converges.
-//
-// The glint where a path with no diffuse vertex leaves the scene along d: the delta sun seen as
-// a disc of angular radius a_k = a_1 (k + 1)^(-1/6) and radiance E / (pi sin^2 a_k), so that it
-// gives the sun's irradiance E at normal incidence, as a sun disc does (surfaces.wgsl). The
-// same 2-D kernel argument as the gather's, in the directions about the sun's: bias ~ a_k^2,
-// variance of one frame ~ 1 / a_k^2.
+// The estimate at D: the photons of the frame within r_k of D on the same side (photon normal
+// . D's normal > 0) whose s scatterings let the path E S^j D S^s L count under `bounces` = n
+// (j + s + 1 <= n continuation rays), weight (flux x albedo / pi) summed and divided by pi r_k^2:
+// the radiance leaving D toward the path, blurred over the kernel. Each frame has its own
+// photons and radius r_k = r_1 (k + 1)^(-1/6) (sample index k), so frames are independent and
+// the mean over frames converges to the true radiance.
 
 #import illum::constants::PI
-#import illum::sampler::{sampler_new, sample_2d}
-#import illum::sampling::{sample_cosine_hemisphere, to_world}
+#import illum::sampler::{Sampler, sampler_new, sample_1d, sample_2d}
 #import illum::rtcore::spawn::spawn_point
+#import illum::rtcore::codes::{MATERIAL_DIELECTRIC, MATERIAL_MIRROR}
+#import illum::rtcore::geometry::NO_HIT
 #import illum::rtcore::camera::camera_ray
-#import illum::pathtrace::scene::params
-#import illum::pathtrace::surfaces::{UNBOUNDED, max3}
-#import illum::pathtrace::caustic_buffers::{caustic, photons, heads, fits, splat_add, drop_particle, gather_radius, glint_angle, photon_cell, photon_bucket}
-#import illum::pathtrace::caustic_walk::{next_vertex, is_specular, specular_weight, diffuse_albedo, may_continue, scatter_specular}
+#import illum::pathtrace::scene::{params, objects, materials}
+#import illum::rtcore::traversal::{closest_hit, scattering_surface_at}
+#import illum::pathtrace::surfaces::{UNBOUNDED, RR_START, RR_MAX_SURVIVAL, UNBOUNDED_DEPTH_CAP, max3, scatter_dielectric}
+#import illum::pathtrace::caustic_buffers::{caustic, photons, heads, fits, splat_add, drop_particle, gather_radius, photon_cell, photon_bucket}
 
 // Mixed into the caustic's seed for the gathering paths, so that they draw no numbers a particle
 // or a camera path draws.
 const GATHER_SEED_KEY: u32 = 0x6a7e4ca5u;
 
 // The sum of the weights of frame `frame`'s photons within r of x (normal n) that a path of
-// `depth` scatterings may join. The disc of radius r about x meets at most two cells of side
+// `specular` scatterings may join. The disc of radius r about x meets at most two cells of side
 // 2 r per axis; each bucket they hash to is walked once (two cells may share one), and a photon
 // of any other cell in it lies farther than r or belongs to a visited cell: the distance alone
 // decides, and no photon is counted twice. Most photons walked are farther than r (the cells
 // cover 16 r^2 of a plane, the disc pi r^2): only their positions are read.
-fn photon_sum(frame: u32, x: vec3<f32>, n: vec3<f32>, r: f32, depth: u32) -> vec3<f32> {
+fn photon_sum(frame: u32, x: vec3<f32>, n: vec3<f32>, r: f32, specular: u32) -> vec3<f32> {
     let side = 2.0 * r;
     let lo = photon_cell(x - vec3<f32>(r), side);
     let hi = photon_cell(x + vec3<f32>(r), side);
@@ -75,7 +67,7 @@ fn photon_sum(frame: u32, x: vec3<f32>, n: vec3<f32>, r: f32, depth: u32) -> vec
                     let d = a.xyz - x;
                     if (dot(d, d) < r * r) {
                         let b = photons[3u * slot + 1u];
-                        let joins = params.bounces == UNBOUNDED || depth + u32(b.w) + 1u <= params.bounces;
+                        let joins = params.bounces == UNBOUNDED || specular + u32(b.w) + 1u <= params.bounces;
                         if (joins && dot(photons[3u * slot + 2u].xyz, n) > 0.0) {
                             sum += b.xyz;
                         }
@@ -85,18 +77,6 @@ fn photon_sum(frame: u32, x: vec3<f32>, n: vec3<f32>, r: f32, depth: u32) -> vec
         }
     }
     return sum;
-}
-
-// The glint's kernel for a ray leaving the scene along d in frame `frame`: the radiance of a
-// sun disc of angular radius a_k where d lies in it. sin^2 of the angle to the sun from the
-// cross product, exact for small angles (1 - cos in f32 would lose a percent at a_k ~ 0.2 deg).
-fn glint(frame: u32, d: vec3<f32>) -> vec3<f32> {
-    let sin_a = sin(glint_angle(frame));
-    let c = cross(d, params.sun.xyz);
-    if (dot(d, params.sun.xyz) > 0.0 && dot(c, c) <= sin_a * sin_a) {
-        return params.sun_irradiance.xyz / (PI * sin_a * sin_a);
-    }
-    return vec3<f32>(0.0);
 }
 
 @compute @workgroup_size(64, 1, 1)
@@ -114,52 +94,69 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var d = camera_ray(params.camera, vec2<f32>(f32(x) + jitter.x, f32(y) + jitter.y), inv_size);
     var o = params.camera.eye;
     var throughput = vec3<f32>(1.0);
-    // Scatterings so far: the next vertex's depth.
-    var depth = 0u;
-    // Whether the path has a diffuse vertex (then it has no glint).
-    var diffuse = false;
-    var total = vec3<f32>(0.0);
+    var specular = 0u;
     loop {
-        let v = next_vertex(o, d);
-        if (v.missed) {
-            if (!diffuse) {
-                total += throughput * glint(frame, d);
-            }
-            break;
-        }
-        if (v.emitter) {
-            break;
-        }
-        if (is_specular(v)) {
-            if (!may_continue(depth + 1u, depth, &throughput, specular_weight(v), &sampler)) {
-                break;
-            }
-            let next = scatter_specular(v, d, &sampler);
-            o = next.o;
-            d = next.d;
-        } else {
-            if (depth > 0u) {
-                let r = gather_radius(frame);
-                total += throughput * photon_sum(frame, v.s.p, v.s.n, r, depth) / (PI * r * r);
-            }
-            // A gather after this bounce is at depth m + 1 or more and joins photons of s >= 1
-            // scatterings: it needs m + 3 <= n continuation rays. A path with a diffuse vertex
-            // has no glint.
-            if (!may_continue(depth + 3u, depth, &throughput, diffuse_albedo(v), &sampler)) {
-                break;
-            }
-            let u = sample_2d(&sampler);
-            d = to_world(v.s.n, sample_cosine_hemisphere(u.x, u.y));
-            o = spawn_point(v.s.p, v.s.n, v.s.err);
-            diffuse = true;
-        }
-        depth += 1u;
-    }
-    if (max3(total) > 0.0) {
-        if (!fits(total)) {
-            drop_particle(frame);
+        let hit = closest_hit(o, d);
+        if (hit.index == NO_HIT) {
             return;
         }
-        splat_add(frame, pixel, total);
+        let obj = objects[hit.index];
+        if (obj.emitter != 0u) {
+            return;
+        }
+        var s = scattering_surface_at(obj, o + hit.t * d);
+        let front = dot(s.n, d) < 0.0;
+        if (!front) {
+            s.n = -s.n;
+        }
+        let m = materials[obj.material];
+        let kind = m.kind;
+        if (kind != MATERIAL_MIRROR && kind != MATERIAL_DIELECTRIC) {
+            if (specular == 0u) {
+                return;
+            }
+            let r = gather_radius(frame);
+            let v = throughput * photon_sum(frame, s.p, s.n, r, specular) / (PI * r * r);
+            if (max3(v) > 0.0) {
+                if (!fits(v)) {
+                    drop_particle(frame);
+                    return;
+                }
+                splat_add(frame, pixel, v);
+            }
+            return;
+        }
+        // The specular continuation: the camera path tracer's length rule and roulette.
+        if (params.bounces != UNBOUNDED) {
+            if (specular + 1u > params.bounces) {
+                return;
+            }
+        } else if (specular >= UNBOUNDED_DEPTH_CAP) {
+            return;
+        }
+        var weight = vec3<f32>(1.0);
+        if (kind == MATERIAL_MIRROR) {
+            weight = m.a.xyz;
+        }
+        if (params.bounces == UNBOUNDED && specular >= RR_START) {
+            let q = min(max3(throughput * weight), RR_MAX_SURVIVAL);
+            if (!(sample_1d(&sampler) < q)) {
+                return;
+            }
+            throughput /= q;
+        }
+        throughput *= weight;
+        if (kind == MATERIAL_MIRROR) {
+            d = reflect(d, s.n);
+            o = spawn_point(s.p, s.n, s.err);
+        } else {
+            let next = scatter_dielectric(s, d, m.a.w, front, &sampler);
+            o = next.o;
+            d = next.d;
+        }
+        if (!(max3(throughput) > 0.0)) {
+            return;
+        }
+        specular += 1u;
     }
 }

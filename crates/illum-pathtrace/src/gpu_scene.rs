@@ -168,21 +168,17 @@ pub fn caustics_active(scene: &Scene) -> bool {
         })
 }
 
-/// Which estimators beyond the camera paths `scene`'s image has, and the kernels' radius rules:
-/// what a cached image of the scene (the ladder's truth) must have been made with to be reused,
-/// as an image made before the photon gather lacks the caustic seen in the mirror, and one made
-/// before the gather at every diffuse vertex and the glint lacks those paths.
+/// Which estimators beyond the camera paths `scene`'s image has, and the photon gather's
+/// radius rule: what a cached image of the scene (the ladder's truth) must have been made with
+/// to be reused, as an image made before the gather lacks the caustic seen in the mirror.
 pub fn caustic_estimators(scene: &Scene) -> String {
     let code = SceneCode::new(scene, 0);
     match (code.caustic, code.caustic_gather) {
         (false, _) => "none".to_owned(),
         (true, false) => "light tracer".to_owned(),
         (true, true) => format!(
-            "light tracer, photon gather at every diffuse vertex but the camera's own hit (r_1 = {} x the \
-             largest specular radius, r_k = r_1 (k + 1)^(-1/6)) and glint kernel (a_1 = {} deg, a_k = a_1 \
-             (k + 1)^(-1/6))",
-            crate::tracer::GATHER_RADIUS_FRACTION,
-            crate::tracer::GLINT_ANGLE_DEG
+            "light tracer and photon gather (r_1 = {} x the largest specular radius, r_k = r_1 (k + 1)^(-1/6))",
+            crate::tracer::GATHER_RADIUS_FRACTION
         ),
     }
 }

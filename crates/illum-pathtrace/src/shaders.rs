@@ -27,10 +27,7 @@ pub const CAUSTIC_SHADER: ShaderFile = shader_file!("shaders/caustic.wgsl");
 pub const GUIDES_SHADER: ShaderFile = shader_file!("shaders/guides.wgsl");
 /// What the light tracer and the photon gather share: parameters, splats, photon maps.
 pub const CAUSTIC_BUFFERS_MODULE: ShaderFile = shader_file!("shaders/caustic_buffers.wgsl");
-/// How the light tracer and the photon gather walk through the scene.
-pub const CAUSTIC_WALK_MODULE: ShaderFile = shader_file!("shaders/caustic_walk.wgsl");
-/// The photon gather of E (S|D)* D S+ L and the glint E S* L (entry point `main`; shader def
-/// CAUSTIC_GATHER).
+/// The photon gather of E S+ D S+ L (entry point `main`; shader def CAUSTIC_GATHER).
 pub const GATHER_SHADER: ShaderFile = shader_file!("shaders/gather.wgsl");
 /// The generic material lookup (a read of the material buffer).
 pub const GENERIC_MATERIALS: ShaderFile = shader_file!("shaders/materials.wgsl");
@@ -62,7 +59,6 @@ pub fn shader_modules(scene: &Scene, gpu_scene: &GpuScene, traversal: Traversal)
     }
     modules.push(SURFACES_MODULE);
     modules.push(CAUSTIC_BUFFERS_MODULE);
-    modules.push(CAUSTIC_WALK_MODULE);
     modules
 }
 
@@ -309,7 +305,7 @@ mod tests {
             size_of::<crate::CausticParams>(),
             &members!(crate::CausticParams: particles, row_stride, frame_base, frame_count, num_discs, seed,
                 pixel_area, area_per_particle, scene_centre, scene_radius, fixed_scale, fixed_cap, disc_area, gather_radius,
-                buckets, first_index, glint_angle, padding_c),
+                buckets, first_index, padding_b, padding_c),
         );
         wgsl("Light").assert_matches(
             size_of::<GpuLight>(),

@@ -32,9 +32,9 @@ pub struct SceneCode {
     pub checker: bool,
     /// The caustic's light tracer ([`caustics_active`]).
     pub caustic: bool,
-    /// ... with the photon gather (E (S|D)* D S+ L but E D S+ L) and the glint (E S* L),
-    /// `shaders/gather.wgsl`: the caustic with a delta sun. With a sun disc the camera paths
-    /// find those paths themselves.
+    /// ... with the photon gather of the caustic seen through a specular surface (E S+ D S+ L,
+    /// `shaders/gather.wgsl`): the caustic with a delta sun and a diffuse surface to gather on.
+    /// With a sun disc the camera paths find those paths themselves.
     pub caustic_gather: bool,
     /// `sampling = "uniform"` hemisphere sampling instead of cosine.
     pub uniform_sampling: bool,
@@ -55,8 +55,9 @@ impl SceneCode {
             specular: features.any(&[Feature::Mirror, Feature::Dielectric]),
             checker: features.contains(Feature::Checker),
             caustic: caustics_active(scene),
-            // The glint needs no diffuse surface: a scene of mirrors and glass has it too.
-            caustic_gather: caustics_active(scene) && features.contains(Feature::DeltaDirectionalLight),
+            caustic_gather: caustics_active(scene)
+                && features.contains(Feature::DeltaDirectionalLight)
+                && features.any(&[Feature::Lambertian, Feature::Checker]),
             uniform_sampling: scene.pathtrace.sampling == Sampling::Uniform,
             unbounded_bounces: scene.pathtrace.bounces == Bounces::Unbounded,
         }

@@ -33,7 +33,7 @@ mod runner;
 mod submit;
 
 use accumulation::Accumulation;
-pub use caustic::{CausticParams, GATHER_RADIUS_FRACTION, GLINT_ANGLE_DEG, bounding_sphere, fixed_point};
+pub use caustic::{CausticParams, GATHER_RADIUS_FRACTION, bounding_sphere, fixed_point};
 pub use guides::{GUIDE_SAMPLES, Guides, PendingGuides};
 use pipeline::ScenePipeline;
 use runner::BandRunner;

@@ -221,7 +221,7 @@ fn the_whitted_difference_from_the_path_tracers_accumulation() {
     assert_eq!((image.width, image.height), (truth.width, truth.height));
     for (p, ((a, t), d)) in image.pixels.iter().zip(&truth.pixels).zip(&summary.values).enumerate() {
         let expected = luminance(*a) - luminance(*t);
-        // The map holds f32 (6e-8 relative rounding); the sun's glints reach luminance 90.
+        // The map holds f32 (6e-8 relative rounding) of differences that may be large.
         assert!(
             (f64::from(*d) - expected).abs() <= 1e-6 * (1.0 + expected.abs()),
             "pixel {p}: {d} against {expected}"

@@ -72,8 +72,7 @@ pub struct CausticParams {
     pub buckets: u32,
     /// The dispatch's first particle (or pixel, in the gather): nonzero for a frame's pieces.
     pub first_index: u32,
-    /// a_1 of the glint's kernel, radians (0 without the gather).
-    pub glint_angle: f32,
+    pub padding_b: u32,
     pub padding_c: u32,
 }
 
@@ -89,14 +88,8 @@ const SPLAT_BYTES: u64 = 64 << 20;
 /// Bytes per photon: three vec4 (caustic_buffers.wgsl).
 const PHOTON_BYTES: u64 = 48;
 /// r_1 of the photon gather as a fraction of the largest specular object's bounding radius
-/// (docs/caustics.md, "The photon gather").
+/// (docs/caustics.md, "The caustic seen through a specular surface").
 pub const GATHER_RADIUS_FRACTION: f32 = 0.02;
-/// a_1 of the glint's kernel, the sun seen as a disc of this angular radius at sample index 0
-/// (docs/caustics.md, "The sun's glint"). Its variance falls as 1 / a_1^2, and its blur stays
-/// small: a ball of radius 1 seen from a few units shows a disc of angle a as a spot of about
-/// a / 7 (5 degrees: 0.7 degree, two pixels of the 320 x 180 Whitted view, 0.14 degree at
-/// 16384 spp), and blurring moves light within a region without making any.
-pub const GLINT_ANGLE_DEG: f32 = 5.0;
 /// Host bytes per pixel and chunk of a pass: S1 and S2, three f64 each.
 pub(crate) const PASS_BYTES_PER_PIXEL_CHUNK: u64 = 48;
 /// The most host memory one pass's caustic statistics may take.
@@ -417,7 +410,7 @@ impl CausticTracer {
             gather_radius: if gather { GATHER_RADIUS_FRACTION * largest_radius } else { 0.0 },
             buckets: buckets as u32,
             first_index: 0,
-            glint_angle: if gather { GLINT_ANGLE_DEG.to_radians() } else { 0.0 },
+            padding_b: 0,
             padding_c: 0,
         };
         let pipeline = shaders::companion_pipeline(

@@ -76,17 +76,6 @@ pub(crate) fn compare_scene_with(label: &str, scene: &illum_scene::Scene, oracle
 /// The image `gpu` has rendered (SIZE x SIZE, of its scene) against the oracle's at
 /// `oracle_spp`: the per-pixel Z-test and the whole-image means, each with its power check.
 pub(crate) fn compare_render(label: &str, gpu: &illum_pathtrace::PathTracer, oracle_spp: u32) {
-    compare_render_with(label, gpu, oracle_spp, true);
-}
-
-/// The pixel criterion alone, with its power check, on `scene` at GPU_SPP and ORACLE_SPP: for a
-/// view whose whole-image mean is too noisy for the 2% power check (a glint: rare samples of
-/// large radiance), where the per-pixel test, which uses each pixel's own variance, still holds.
-pub(crate) fn compare_scene_pixels(label: &str, scene: &illum_scene::Scene) {
-    compare_render_with(label, &common::render(scene), ORACLE_SPP, false);
-}
-
-fn compare_render_with(label: &str, gpu: &illum_pathtrace::PathTracer, oracle_spp: u32, whole_image: bool) {
     let scene = gpu.scene().clone();
     let oracle = illum_oracle::render(&scene, oracle_spp, 99).expect("the oracle renders this scene");
     assert_eq!(oracle.dropped, 0);
@@ -112,9 +101,6 @@ fn compare_render_with(label: &str, gpu: &illum_pathtrace::PathTracer, oracle_sp
         );
     }
     local_bias_power(label, &mean, &variance, &oracle_mean, &oracle_variance);
-    if !whole_image {
-        return;
-    }
 
     // Whole-image mean per channel over the pixels that do not see the light (whose
     // partial coverage of a radiance-30 emitter would swamp the variance): the pixel means are
