@@ -16,7 +16,7 @@ use illum_scene::{Bounces, RendererKind};
 use illum_viewer::ViewerApp;
 
 mod common;
-use common::{harness_sized, shared_device};
+use common::{drag_across_the_image, harness_sized, shared_device};
 
 fn harness(mode: RendererKind) -> Harness<'static, ViewerApp> {
     harness_with("scenes/cornell.toml", mode)
@@ -330,32 +330,6 @@ fn switching_modes_keeps_the_camera_on_the_same_scene() {
     click(&mut harness, "Path tracer");
     assert!(harness.state().pathtrace().unwrap().camera.is_home());
     assert_eq!(harness.state().raster().unwrap().camera, moved);
-}
-
-/// A left drag across the middle of the image, in steps (the image fills the central panel,
-/// right of the settings panel).
-fn drag_across_the_image(harness: &mut Harness<'_, ViewerApp>) {
-    let start = egui::pos2(600.0, 300.0);
-    harness.event(egui::Event::PointerMoved(start));
-    harness.event(egui::Event::PointerButton {
-        pos: start,
-        button: egui::PointerButton::Primary,
-        pressed: true,
-        modifiers: egui::Modifiers::NONE,
-    });
-    harness.run_steps(1);
-    for step in 1..=5 {
-        harness.event(egui::Event::PointerMoved(start + egui::vec2(12.0 * step as f32, 4.0 * step as f32)));
-        harness.run_steps(1);
-    }
-    let end = start + egui::vec2(60.0, 20.0);
-    harness.event(egui::Event::PointerButton {
-        pos: end,
-        button: egui::PointerButton::Primary,
-        pressed: false,
-        modifiers: egui::Modifiers::NONE,
-    });
-    harness.run_steps(2);
 }
 
 #[test]

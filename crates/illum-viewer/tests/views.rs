@@ -10,7 +10,7 @@ use illum_scene::RendererKind;
 use illum_viewer::ViewerApp;
 
 mod common;
-use common::harness_sized;
+use common::{drag_across_the_image, harness_sized};
 
 fn harness(scene: &'static str, mode: RendererKind) -> Harness<'static, ViewerApp> {
     harness_sized(scene, mode, egui::vec2(900.0, 560.0))
@@ -139,24 +139,7 @@ fn a_drag_gives_a_fresh_denoised_image_at_low_spp() {
     });
     assert!(denoised_at_32, "{}", harness.state().pathtrace().unwrap().summary());
     let before = harness.state().pathtrace().unwrap().denoise.refreshes;
-    let start = egui::pos2(600.0, 300.0);
-    harness.event(egui::Event::PointerMoved(start));
-    harness.event(egui::Event::PointerButton {
-        pos: start,
-        button: egui::PointerButton::Primary,
-        pressed: true,
-        modifiers: egui::Modifiers::NONE,
-    });
-    harness.run_steps(1);
-    harness.event(egui::Event::PointerMoved(start + egui::vec2(40.0, 10.0)));
-    harness.run_steps(1);
-    harness.event(egui::Event::PointerButton {
-        pos: start + egui::vec2(40.0, 10.0),
-        button: egui::PointerButton::Primary,
-        pressed: false,
-        modifiers: egui::Modifiers::NONE,
-    });
-    harness.run_steps(1);
+    drag_across_the_image(&mut harness);
     let mode = harness.state().pathtrace().unwrap();
     assert!(
         mode.denoise.estimate().is_none_or(|e| e.spp < 32),

@@ -1,4 +1,6 @@
 //! What the viewer's kittest tests share: one device per test process, as the real window has.
+// Each test binary compiles this module and uses a part of it.
+#![allow(dead_code)]
 
 use std::sync::OnceLock;
 
@@ -42,4 +44,30 @@ pub fn harness_sized(
                 },
             )
         })
+}
+
+/// A left drag across the middle of the image, in steps (the image fills the central panel,
+/// right of the settings panel).
+pub fn drag_across_the_image(harness: &mut Harness<'_, ViewerApp>) {
+    let start = egui::pos2(600.0, 300.0);
+    harness.event(egui::Event::PointerMoved(start));
+    harness.event(egui::Event::PointerButton {
+        pos: start,
+        button: egui::PointerButton::Primary,
+        pressed: true,
+        modifiers: egui::Modifiers::NONE,
+    });
+    harness.run_steps(1);
+    for step in 1..=5 {
+        harness.event(egui::Event::PointerMoved(start + egui::vec2(12.0 * step as f32, 4.0 * step as f32)));
+        harness.run_steps(1);
+    }
+    let end = start + egui::vec2(60.0, 20.0);
+    harness.event(egui::Event::PointerButton {
+        pos: end,
+        button: egui::PointerButton::Primary,
+        pressed: false,
+        modifiers: egui::Modifiers::NONE,
+    });
+    harness.run_steps(2);
 }
