@@ -93,8 +93,9 @@ struct Args {
     /// Samples per pixel of the rows by bounce count (0 skips them).
     #[arg(long, default_value_t = 1024)]
     bounce_spp: u32,
-    /// The path tracer + à-trous rows: samples per pixel (comma-separated; empty skips them).
-    #[arg(long, value_delimiter = ',', default_value = "1,4,16,64,256")]
+    /// The path tracer + à-trous rows: samples per pixel (comma-separated; the flag with no value
+    /// skips them).
+    #[arg(long, value_delimiter = ',', num_args = 0.., default_value = "1,4,16,64,256")]
     denoise_spp_list: Vec<u32>,
     /// Frames timed per row (the median is reported).
     #[arg(long, default_value_t = 5)]
