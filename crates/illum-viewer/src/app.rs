@@ -211,6 +211,10 @@ impl ViewerApp {
         self.raster.as_ref().ok()
     }
 
+    pub fn raster_mut(&mut self) -> Option<&mut RasterMode> {
+        self.raster.as_mut().ok()
+    }
+
     pub fn auto(&self) -> &AutoMode {
         &self.auto
     }
@@ -286,9 +290,9 @@ impl ViewerApp {
             Err(reason) => refusals.push((RendererKind::PathTrace, reason)),
         }
         match loaded.raster {
-            Ok(scene) => match &mut self.raster {
-                Ok(mode) => mode.set_scene(given.clone(), scene),
-                Err(_) => self.raster = Ok(RasterMode::new(given.clone(), scene)),
+            Ok((raster, scene)) => match &mut self.raster {
+                Ok(mode) => mode.set_scene(given.clone(), raster, scene),
+                Err(_) => self.raster = Ok(RasterMode::new(given.clone(), raster, scene)),
             },
             Err(reason) => refusals.push((RendererKind::Raster, reason)),
         }
@@ -537,7 +541,11 @@ impl ViewerApp {
         };
         let texture = match self.mode {
             RendererKind::Raster => {
-                self.raster.as_mut().ok().and_then(|m| m.frame(gpu, render_state, view_pixels))
+                let truth = self.pathtrace.as_ref().ok().and_then(PathTraceMode::truth);
+                self.raster
+                    .as_mut()
+                    .ok()
+                    .and_then(|m| m.frame(gpu, ui.ctx(), render_state, view_pixels, truth))
             }
             RendererKind::PathTrace => self.pathtrace.as_mut().ok().and_then(|m| {
                 m.frame(gpu, ui.ctx(), render_state, view_pixels);
@@ -634,7 +642,8 @@ fn load_pathtrace(path: &Path) -> Result<PathTraceMode, String> {
 }
 
 fn load_raster(path: &Path) -> Result<RasterMode, String> {
-    Ok(RasterMode::new(path.to_path_buf(), scene_file::load(path)?.raster?))
+    let (raster, scene) = scene_file::load(path)?.raster?;
+    Ok(RasterMode::new(path.to_path_buf(), raster, scene))
 }
 
 fn load_whitted(path: &Path) -> Result<WhittedMode, String> {
