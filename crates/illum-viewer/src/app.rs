@@ -410,7 +410,6 @@ impl ViewerApp {
                             self.auto_shown = false;
                         }
                     }
-                    #[cfg(not(target_arch = "wasm32"))]
                     if ui.selectable_label(self.auto_shown, "Auto").clicked() {
                         self.auto_shown = true;
                     }
@@ -451,9 +450,7 @@ impl ViewerApp {
             #[cfg(target_arch = "wasm32")]
             self.web_open_buttons(ui);
             // After the buttons that open files, so that they keep their places (a compact bar
-            // has Auto in its drop-down). Not in the browser: the pilot reads images back with
-            // blocking waits (auto_pilot.rs).
-            #[cfg(not(target_arch = "wasm32"))]
+            // has Auto in its drop-down).
             if !compact {
                 ui.separator();
                 if ui.selectable_label(self.auto_shown, "Auto").clicked() {
