@@ -61,6 +61,6 @@ pub use limits::check_device_limits;
 pub use options::Options;
 pub use pass_times::{Frame, PassTimes};
 pub use plan::FramePlan;
-pub use renderer::{MIN_MOVING_CUBE_SIZE, RasterRenderer, moving_cube_size};
+pub use renderer::{MIN_MOVING_CUBE_SIZE, PendingFrame, RasterRenderer, moving_cube_size};
 pub use scene::{CheckerFloor, GlassSphere, MetalSphere, RasterLight, RasterQuality, RasterScene};
 pub use shaders::{MODULES, SHADERS};

@@ -7,11 +7,9 @@ use std::ops::ControlFlow;
 
 use crate::scene::RasterScene;
 use glam::Vec3;
-#[cfg(not(target_arch = "wasm32"))]
 use illum_gpu::readback;
 use illum_gpu::timing::PassTimer;
 use illum_gpu::{GpuContext, wgpu};
-#[cfg(not(target_arch = "wasm32"))]
 use illum_image::RgbImage32;
 
 use crate::RasterError;
@@ -341,12 +339,53 @@ impl RasterRenderer {
         let bytes =
             readback::read_mapped(&self.gpu, &staging, staging.size(), "reading back a raster frame")?;
         let (pixels, timestamps) = bytes.split_at(image_bytes as usize);
-        let image = RgbImage32::from_fn(self.width, self.height, |x, y| {
-            let i = (y * row + x * BYTES_PER_PIXEL) as usize;
-            [0, 1, 2].map(|c| f32::from(pixels[i + c]) / 255.0)
-        });
+        let image = decode_frame(self.width, self.height, pixels);
         let pass_times = self.timer.decode(timestamps).map(|named| PassTimes::from_named(&named));
         Ok(Frame { image, pass_times })
+    }
+
+    /// Starts reading back the last frame drawn ([`Self::draw`]) without waiting, as a web page
+    /// must: [`PendingFrame::poll`], called on later frames, returns the image [`Self::render`]
+    /// returns for the same frame. The copy has a staging buffer of its own, so frames drawn
+    /// meanwhile neither wait for it nor change it.
+    pub fn read_polled(&self) -> Result<PendingFrame, RasterError> {
+        let main = self.main.as_ref().ok_or_else(|| {
+            RasterError::Unsupported("no raster frame to read back: draw one first".to_owned())
+        })?;
+        let row = (self.width * BYTES_PER_PIXEL).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+        let bytes = u64::from(row) * u64::from(self.height);
+        let staging = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("raster polled staging"),
+            size: bytes,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("raster polled readback"),
+        });
+        encoder.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture: &main.output,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &staging,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(row),
+                    rows_per_image: None,
+                },
+            },
+            wgpu::Extent3d { width: self.width, height: self.height, depth_or_array_layers: 1 },
+        );
+        self.gpu.queue.submit([encoder.finish()]);
+        Ok(PendingFrame {
+            read: readback::PendingRead::start(staging, bytes, "reading back a raster frame"),
+            width: self.width,
+            height: self.height,
+        })
     }
 
     /// Renders one frame into [`Self::output_view`] without reading it back, waits for the GPU
@@ -555,4 +594,34 @@ impl RasterRenderer {
         views[SHADOW_VIEW] = uniforms::shadow_view(&self.shadow_fit);
         self.uniforms.write(&self.gpu, &uniforms::scene_uniform(scene, &self.shadow_fit), &views);
     }
+}
+
+/// A raster frame whose readback is under way ([`RasterRenderer::read_polled`]).
+pub struct PendingFrame {
+    read: readback::PendingRead,
+    width: u32,
+    height: u32,
+}
+
+impl PendingFrame {
+    /// `None` while the frame is still being read back; never waits.
+    pub fn poll(&self, gpu: &GpuContext) -> Option<Result<RgbImage32, RasterError>> {
+        let bytes = self.read.poll(gpu)?;
+        Some(bytes.map_err(RasterError::from).map(|bytes| decode_frame(self.width, self.height, &bytes)))
+    }
+
+    /// The frame's size in pixels.
+    pub fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+}
+
+/// The output's RGBA8 rows (each padded to the copy alignment) as linear RGB: each value one of
+/// the 256 levels k / 255.
+fn decode_frame(width: u32, height: u32, pixels: &[u8]) -> RgbImage32 {
+    let row = (width * BYTES_PER_PIXEL).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+    RgbImage32::from_fn(width, height, |x, y| {
+        let i = (y * row + x * BYTES_PER_PIXEL) as usize;
+        [0, 1, 2].map(|c| f32::from(pixels[i + c]) / 255.0)
+    })
 }

@@ -211,6 +211,10 @@ impl ViewerApp {
         self.raster.as_ref().ok()
     }
 
+    pub fn raster_mut(&mut self) -> Option<&mut RasterMode> {
+        self.raster.as_mut().ok()
+    }
+
     pub fn auto(&self) -> &AutoMode {
         &self.auto
     }
@@ -286,9 +290,9 @@ impl ViewerApp {
             Err(reason) => refusals.push((RendererKind::PathTrace, reason)),
         }
         match loaded.raster {
-            Ok(scene) => match &mut self.raster {
-                Ok(mode) => mode.set_scene(given.clone(), scene),
-                Err(_) => self.raster = Ok(RasterMode::new(given.clone(), scene)),
+            Ok((raster, scene)) => match &mut self.raster {
+                Ok(mode) => mode.set_scene(given.clone(), raster, scene),
+                Err(_) => self.raster = Ok(RasterMode::new(given.clone(), raster, scene)),
             },
             Err(reason) => refusals.push((RendererKind::Raster, reason)),
         }
@@ -406,7 +410,6 @@ impl ViewerApp {
                             self.auto_shown = false;
                         }
                     }
-                    #[cfg(not(target_arch = "wasm32"))]
                     if ui.selectable_label(self.auto_shown, "Auto").clicked() {
                         self.auto_shown = true;
                     }
@@ -447,9 +450,7 @@ impl ViewerApp {
             #[cfg(target_arch = "wasm32")]
             self.web_open_buttons(ui);
             // After the buttons that open files, so that they keep their places (a compact bar
-            // has Auto in its drop-down). Not in the browser: the pilot reads images back with
-            // blocking waits (auto_pilot.rs).
-            #[cfg(not(target_arch = "wasm32"))]
+            // has Auto in its drop-down).
             if !compact {
                 ui.separator();
                 if ui.selectable_label(self.auto_shown, "Auto").clicked() {
@@ -537,7 +538,11 @@ impl ViewerApp {
         };
         let texture = match self.mode {
             RendererKind::Raster => {
-                self.raster.as_mut().ok().and_then(|m| m.frame(gpu, render_state, view_pixels))
+                let truth = self.pathtrace.as_ref().ok().and_then(PathTraceMode::truth);
+                self.raster
+                    .as_mut()
+                    .ok()
+                    .and_then(|m| m.frame(gpu, ui.ctx(), render_state, view_pixels, truth))
             }
             RendererKind::PathTrace => self.pathtrace.as_mut().ok().and_then(|m| {
                 m.frame(gpu, ui.ctx(), render_state, view_pixels);
@@ -634,7 +639,8 @@ fn load_pathtrace(path: &Path) -> Result<PathTraceMode, String> {
 }
 
 fn load_raster(path: &Path) -> Result<RasterMode, String> {
-    Ok(RasterMode::new(path.to_path_buf(), scene_file::load(path)?.raster?))
+    let (raster, scene) = scene_file::load(path)?.raster?;
+    Ok(RasterMode::new(path.to_path_buf(), raster, scene))
 }
 
 fn load_whitted(path: &Path) -> Result<WhittedMode, String> {

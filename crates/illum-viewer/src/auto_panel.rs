@@ -8,15 +8,12 @@
 //! The pilot ([`crate::auto_pilot`]) runs once per scene file and view size, when Auto is
 //! first shown; **Measure again** runs it again (after the camera or the window changed).
 
-use std::path::Path;
-#[cfg(not(target_arch = "wasm32"))]
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use illum_auto::plan::{Candidate, Goal, Plan, Planned, Setting, error_floor, plan};
 use illum_pathtrace::StopRules;
 use illum_scene::RendererKind;
 
-#[cfg(not(target_arch = "wasm32"))]
 use crate::auto_pilot::ViewerPilot;
 use crate::auto_pilot::{PilotOptions, ViewSizes};
 use crate::pathtrace_panel::PathTraceMode;
@@ -35,10 +32,8 @@ pub struct AutoMode {
     pub target: f64,
     /// How the next pilot measures (tests make it smaller).
     pub pilot_options: PilotOptions,
-    #[cfg(not(target_arch = "wasm32"))]
     pilot: Option<ViewerPilot>,
     /// The scene file the pilot measured.
-    #[cfg(not(target_arch = "wasm32"))]
     measured_path: Option<PathBuf>,
     /// Set by **Measure again**.
     remeasure: bool,
@@ -54,9 +49,7 @@ impl Default for AutoMode {
         AutoMode {
             target: DEFAULT_TARGET,
             pilot_options: PilotOptions::default(),
-            #[cfg(not(target_arch = "wasm32"))]
             pilot: None,
-            #[cfg(not(target_arch = "wasm32"))]
             measured_path: None,
             remeasure: false,
             plan: None,
@@ -74,33 +67,23 @@ impl AutoMode {
 
     /// The candidates the pilot measured, once it is done.
     pub fn candidates(&self) -> Option<&[Candidate]> {
-        #[cfg(not(target_arch = "wasm32"))]
-        return self.pilot.as_ref().and_then(ViewerPilot::candidates);
-        #[cfg(target_arch = "wasm32")]
-        None
+        self.pilot.as_ref().and_then(ViewerPilot::candidates)
     }
 
     /// Whether the pilot is still measuring (the window keeps repainting, and shows its progress).
     pub fn measuring(&self) -> bool {
-        #[cfg(not(target_arch = "wasm32"))]
-        return self.pilot.as_ref().is_some_and(|p| p.error().is_none() && p.candidates().is_none());
-        #[cfg(target_arch = "wasm32")]
-        false
+        self.pilot.as_ref().is_some_and(|p| p.error().is_none() && p.candidates().is_none())
     }
 
     /// The pilot's progress (share done, what it measures now) while it measures.
     pub fn progress(&self) -> Option<(f32, String)> {
-        #[cfg(not(target_arch = "wasm32"))]
-        return self.measuring().then(|| self.pilot.as_ref().expect("measuring").progress());
-        #[cfg(target_arch = "wasm32")]
-        None
+        self.measuring().then(|| self.pilot.as_ref().expect("measuring").progress())
     }
 
     /// Starts a pilot of `scene` (the file at `path`, its camera at the raster's size `sizes`)
     /// when none has measured this file yet or **Measure again** was pressed; then runs a slice
     /// of it, and once it is done plans for the target. Returns a choice to hand to its mode
     /// when the plan's choice changed.
-    #[cfg(not(target_arch = "wasm32"))]
     pub fn frame(
         &mut self,
         gpu: &illum_gpu::GpuContext,
@@ -129,19 +112,6 @@ impl AutoMode {
             self.plan = Some(Err(format!("the pilot failed: {e}")));
             return None;
         }
-        self.replan()
-    }
-
-    /// In the browser there is no pilot (see [`crate::auto_pilot`]), so no candidates and no
-    /// plan.
-    #[cfg(target_arch = "wasm32")]
-    pub fn frame(
-        &mut self,
-        _gpu: &illum_gpu::GpuContext,
-        _path: &Path,
-        _scene: &illum_scene::Scene,
-        _sizes: ViewSizes,
-    ) -> Option<Planned> {
         self.replan()
     }
 
@@ -184,7 +154,6 @@ impl AutoMode {
 
     /// ", pilot N s wall, longest frame step M s", once the pilot is done.
     fn pilot_summary(&self) -> String {
-        #[cfg(not(target_arch = "wasm32"))]
         if let Some(pilot) = &self.pilot {
             return format!(
                 ", pilot {:.1} s wall, longest frame step {:.2} s",
@@ -216,7 +185,6 @@ impl AutoMode {
             ui.label(format!("Pilot: {what}"));
             return;
         }
-        #[cfg(not(target_arch = "wasm32"))]
         if let Some(pilot) = &self.pilot {
             let (w, h) = pilot.size();
             let options = pilot.options();

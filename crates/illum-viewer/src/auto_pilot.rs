@@ -18,13 +18,20 @@
 //!   rest of each frame is measured while it runs). The viewer's device is already set up, so
 //!   no device time is added.
 //!
-//! Native only: the rasterizer's image and the object-ID image are read back with a blocking
-//! wait, which a web page cannot do (the browser's Auto panel says so).
+//! Nothing in it waits for the GPU where a web page cannot: each step submits work or polls a
+//! readback under way ([`RasterRenderer::read_polled`], [`WhittedTracer::render_polled`],
+//! [`WhittedTracer::object_ids_polled`], the path tracer's polled bands), so the same state
+//! machine runs natively and in the browser. Natively the Whitted frame and the raster's view-size
+//! frame are waited for, so that their time is the GPU's; in a web page their time runs from the
+//! submission to the frame the image is back in, and so includes the rest of that frame.
 
 #[cfg(doc)]
 use crate::pacer::FramePacer;
-#[cfg(not(target_arch = "wasm32"))]
-pub use native::ViewerPilot;
+#[cfg(doc)]
+use illum_raster::RasterRenderer;
+#[cfg(doc)]
+use illum_whitted::WhittedTracer;
+pub use polled::ViewerPilot;
 
 /// How the viewer's pilot measures.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -56,9 +63,8 @@ pub struct ViewSizes {
     pub pathtrace: [u32; 2],
 }
 
-/// The pilot itself, native only (see the module's comment).
-#[cfg(not(target_arch = "wasm32"))]
-mod native {
+/// The pilot itself: a state machine advanced one step per frame (see the module's comment).
+mod polled {
     use web_time::Instant;
 
     use illum_auto::measure::measured;
@@ -70,17 +76,18 @@ mod native {
     use super::{PilotOptions, ViewSizes};
     use crate::pacer::FramePacer;
     use illum_image::RgbImage32;
-    use illum_pathtrace::PathTracer;
-    use illum_raster::{Options, RasterRenderer, RasterScene};
+    use illum_pathtrace::{PathTracer, Readback};
+    use illum_raster::{Options, PendingFrame, RasterRenderer, RasterScene};
     use illum_scene::{Bounces, Overrides, Scene};
-    use illum_whitted::WhittedTracer;
+    use illum_whitted::{PendingImage, PendingObjectIds, WhittedTracer};
 
     /// A path tracer being run to a number of samples over frames, with its timing.
     struct Running {
         tracer: PathTracer,
-        /// Seconds to create it and run its first sample per pixel (pipeline, buffers).
-        setup_seconds: f64,
-        /// Seconds of the steps after the first sample, and the spp they added.
+        started: Instant,
+        /// Seconds to create it and have its first sample per pixel back (pipeline, buffers).
+        setup_seconds: Option<f64>,
+        /// Seconds of the bands after the first sample, and the spp they added.
         step_seconds: f64,
         step_spp: u32,
     }
@@ -90,27 +97,31 @@ mod native {
             let started = Instant::now();
             let mut tracer = PathTracer::new(gpu, scene).map_err(|e| e.to_string())?;
             tracer.set_target_seconds(crate::pacer::MOVING_SECONDS);
-            while tracer.spp_done() < 1 {
-                tracer.render_step(Some(1)).map_err(|e| e.to_string())?;
-            }
-            Ok(Running {
-                tracer,
-                setup_seconds: started.elapsed().as_secs_f64(),
-                step_seconds: 0.0,
-                step_spp: 0,
-            })
+            Ok(Running { tracer, started, setup_seconds: None, step_seconds: 0.0, step_spp: 0 })
         }
 
-        /// One submission of about `seconds` toward `spp`; true once it is reached.
+        /// One submission of about `seconds` toward `spp` (the first sample per pixel first),
+        /// or a poll of the one under way; true once `spp` is reached.
         fn step(&mut self, spp: u32, seconds: f64) -> Result<bool, String> {
+            if self.setup_seconds.is_none() {
+                self.tracer.render_step(Some(1)).map_err(|e| e.to_string())?;
+                if self.tracer.spp_done() >= 1 {
+                    self.setup_seconds = Some(self.started.elapsed().as_secs_f64());
+                }
+                return Ok(false);
+            }
             if self.tracer.spp_done() >= spp {
                 return Ok(true);
             }
             self.tracer.set_target_seconds(seconds);
             let before = self.tracer.spp_done();
-            let started = Instant::now();
-            self.tracer.render_step(Some(spp)).map_err(|e| e.to_string())?;
-            self.step_seconds += started.elapsed().as_secs_f64();
+            let report = self.tracer.render_step(Some(spp)).map_err(|e| e.to_string())?;
+            // As the tracer's own planner counts a band: a polled band's wall time includes the
+            // frames drawn while it was read back, its GPU time (where there is one) does not.
+            self.step_seconds += match self.tracer.readback() {
+                Readback::Polled => report.gpu_seconds.unwrap_or(report.wall_seconds),
+                _ => report.wall_seconds,
+            };
             self.step_spp += self.tracer.spp_done() - before;
             Ok(self.tracer.spp_done() >= spp)
         }
@@ -118,7 +129,8 @@ mod native {
         /// Seconds per spp over the whole pilot image (the first sample, counted in the set-up,
         /// aside).
         fn seconds_per_spp(&self) -> f64 {
-            if self.step_spp == 0 { self.setup_seconds } else { self.step_seconds / f64::from(self.step_spp) }
+            let setup = self.setup_seconds.unwrap_or(0.0);
+            if self.step_spp == 0 { setup } else { self.step_seconds / f64::from(self.step_spp) }
         }
     }
 
@@ -127,6 +139,17 @@ mod native {
         image: RgbImage32,
         rel_mse: f64,
         regions: Regions,
+    }
+
+    /// A readback under way, polled on later frames.
+    enum Pending {
+        /// The truth's object-ID image, with the truth's image and estimated relMSE.
+        Regions { ids: PendingObjectIds, image: RgbImage32, rel_mse: f64 },
+        /// A raster setting's frame at the pilot's size.
+        Raster(PendingFrame),
+        /// A Whitted setting's image at the pilot's size, its set-up seconds and when its
+        /// frame was submitted.
+        Whitted { image: PendingImage, setup: f64, submitted: Instant },
     }
 
     /// The pilot of one view.
@@ -145,6 +168,7 @@ mod native {
         truth: Option<Truth>,
         /// The truth's tracer, then each path-tracer setting's, while it runs.
         running: Option<Running>,
+        pending: Option<Pending>,
         /// One candidate per setting measured so far, in the order of `settings`.
         candidates: Vec<Candidate>,
         /// The rasterizer at the view's size and its set-up seconds (made once).
@@ -185,6 +209,7 @@ mod native {
                 sizes,
                 truth: None,
                 running: None,
+                pending: None,
                 candidates: Vec::new(),
                 raster: None,
                 started: Instant::now(),
@@ -250,7 +275,8 @@ mod native {
             }
         }
 
-        /// Runs the next slice of work; does nothing once done or failed.
+        /// Runs the next slice of work (or polls the readback under way); does nothing once
+        /// done or failed.
         pub fn step(&mut self, gpu: &GpuContext) {
             if self.error.is_some() || self.candidates().is_some() {
                 return;
@@ -262,6 +288,7 @@ mod native {
             if let Err(e) = self.try_step(gpu) {
                 self.error = Some(e);
                 self.running = None;
+                self.pending = None;
             }
             let took = started.elapsed().as_secs_f64();
             self.pacer.stepped(started, took);
@@ -273,72 +300,138 @@ mod native {
         }
 
         fn try_step(&mut self, gpu: &GpuContext) -> Result<(), String> {
+            if let Some(pending) = self.pending.take() {
+                return self.poll(gpu, pending);
+            }
             if self.truth.is_none() {
                 return self.step_truth(gpu);
             }
             let setting = self.settings[self.candidates.len()].clone();
             let variant = apply(&self.small, &setting);
-            let (image, own_noise, fixed_seconds, seconds_per_spp) = match &setting {
+            match &setting {
                 Setting::Raster { look, effects } => {
                     let options = Options { look: *look, effects: *effects };
                     let (w, h) = (variant.camera.width, variant.camera.height);
-                    let image = RasterRenderer::new(gpu, &raster_scene(&variant)?, w, h)
-                        .and_then(|mut small| small.render(&options))
+                    let mut small = RasterRenderer::new(gpu, &raster_scene(&variant)?, w, h)
                         .map_err(|e| e.to_string())?;
-                    if self.raster.is_none() {
-                        let scene = raster_scene(&self.view_scene)?;
-                        let [w, h] = self.sizes.raster;
-                        let t = Instant::now();
-                        let renderer = RasterRenderer::new(gpu, &scene, w, h).map_err(|e| e.to_string())?;
-                        self.raster = Some((renderer, t.elapsed().as_secs_f64()));
-                    }
-                    let (renderer, setup) = self.raster.as_mut().expect("made above");
-                    let t = Instant::now();
-                    renderer.render(&options).map_err(|e| e.to_string())?;
-                    (image, None, *setup + t.elapsed().as_secs_f64(), 0.0)
+                    small.draw(&options).map_err(|e| e.to_string())?;
+                    self.pending = Some(Pending::Raster(small.read_polled().map_err(|e| e.to_string())?));
+                    Ok(())
                 }
                 Setting::Whitted { .. } => {
-                    // Timed at the pilot's size, the frame scaled by the ratio of pixel counts to
-                    // the Whitted mode's size: at that size a 4x4-ray, depth-8 frame holds the
-                    // window for seconds, where a pilot frame holds it for a fraction of one.
                     let t = Instant::now();
                     let tracer = WhittedTracer::new(gpu, &variant).map_err(|e| e.to_string())?;
                     let setup = t.elapsed().as_secs_f64();
-                    let t = Instant::now();
-                    let image = tracer.render().map_err(|e| e.to_string())?;
-                    let [w, h] = self.sizes.whitted;
-                    let ratio = f64::from(w) * f64::from(h)
-                        / (f64::from(variant.camera.width) * f64::from(variant.camera.height));
-                    (image, None, setup + t.elapsed().as_secs_f64() * ratio, 0.0)
+                    let submitted = Instant::now();
+                    let image = tracer.render_polled();
+                    wait_natively(gpu)?;
+                    self.pending = Some(Pending::Whitted { image, setup, submitted });
+                    Ok(())
                 }
-                Setting::PathTrace { .. } => {
-                    // First the bias and noise at the pilot's size, then the throughput at the
-                    // size the path-tracer mode renders the view at.
-                    let (scene, spp) = match &self.measured {
-                        None => (variant, self.options.pilot_spp),
-                        Some(_) => (apply(&self.pathtrace_scene, &setting), self.options.timing_spp + 1),
-                    };
-                    let running = match &mut self.running {
-                        Some(running) => running,
-                        None => {
-                            self.running = Some(Running::start(gpu, &scene)?);
-                            return Ok(());
-                        }
-                    };
-                    if !running.step(spp, self.slice)? {
-                        return Ok(());
+                Setting::PathTrace { .. } => self.step_path_tracer(gpu, setting, variant),
+            }
+        }
+
+        /// Polls `pending`; once its image is back, measures what it is of.
+        fn poll(&mut self, gpu: &GpuContext, pending: Pending) -> Result<(), String> {
+            match pending {
+                Pending::Regions { ids, image, rel_mse } => match ids.poll(gpu) {
+                    None => self.pending = Some(Pending::Regions { ids, image, rel_mse }),
+                    Some(ids) => {
+                        let ids = ids.map_err(|e| e.to_string())?;
+                        let regions = Regions::from_ids(&self.small, &ids);
+                        self.truth = Some(Truth { image, rel_mse, regions });
                     }
-                    let running = self.running.take().expect("running above");
-                    let Some((image, noise)) = self.measured.take() else {
-                        let accumulator = running.tracer.accumulator();
-                        self.measured = Some((accumulator.mean_image(), accumulator.estimated_rel_mse()));
-                        return Ok(());
-                    };
-                    let wall = self.pacer.wall_per_traced_second().unwrap_or(1.0);
-                    (image, Some(noise), running.setup_seconds, running.seconds_per_spp() * wall)
+                },
+                Pending::Raster(frame) => match frame.poll(gpu) {
+                    None => self.pending = Some(Pending::Raster(frame)),
+                    Some(image) => {
+                        let image = image.map_err(|e| e.to_string())?;
+                        let Setting::Raster { look, effects } = self.settings[self.candidates.len()] else {
+                            unreachable!("a raster frame is read for a raster setting")
+                        };
+                        let fixed = self.raster_frame_seconds(gpu, Options { look, effects })?;
+                        self.push(image, None, fixed, 0.0);
+                    }
+                },
+                Pending::Whitted { image, setup, submitted } => match image.poll(gpu) {
+                    None => self.pending = Some(Pending::Whitted { image, setup, submitted }),
+                    Some(result) => {
+                        let frame = submitted.elapsed().as_secs_f64();
+                        let image = result.map_err(|e| e.to_string())?;
+                        // Timed at the pilot's size, the frame scaled by the ratio of pixel
+                        // counts to the Whitted mode's size: at that size a 4x4-ray, depth-8
+                        // frame holds the GPU for seconds, a pilot frame for a fraction of one.
+                        let [w, h] = self.sizes.whitted;
+                        let (sw, sh) = (image.width, image.height);
+                        let ratio = f64::from(w) * f64::from(h) / (f64::from(sw) * f64::from(sh));
+                        self.push(image, None, setup + frame * ratio, 0.0);
+                    }
+                },
+            }
+            Ok(())
+        }
+
+        /// The raster's set-up (once) and one frame at the view's size, in seconds.
+        fn raster_frame_seconds(&mut self, gpu: &GpuContext, options: Options) -> Result<f64, String> {
+            if self.raster.is_none() {
+                let scene = raster_scene(&self.view_scene)?;
+                let [w, h] = self.sizes.raster;
+                let t = Instant::now();
+                let renderer = RasterRenderer::new(gpu, &scene, w, h).map_err(|e| e.to_string())?;
+                self.raster = Some((renderer, t.elapsed().as_secs_f64()));
+            }
+            let (renderer, setup) = self.raster.as_mut().expect("made above");
+            let t = Instant::now();
+            // Natively `draw` waits for the GPU; in a web page this is the submission's time.
+            renderer.draw(&options).map_err(|e| e.to_string())?;
+            Ok(*setup + t.elapsed().as_secs_f64())
+        }
+
+        /// A path-tracer setting: first its bias and noise at the pilot's size, then its
+        /// throughput at the size the path-tracer mode renders the view at.
+        fn step_path_tracer(
+            &mut self,
+            gpu: &GpuContext,
+            setting: Setting,
+            variant: Scene,
+        ) -> Result<(), String> {
+            let (scene, spp) = match &self.measured {
+                None => (variant, self.options.pilot_spp),
+                Some(_) => (apply(&self.pathtrace_scene, &setting), self.options.timing_spp + 1),
+            };
+            let running = match &mut self.running {
+                Some(running) => running,
+                None => {
+                    self.running = Some(Running::start(gpu, &scene)?);
+                    return Ok(());
                 }
             };
-            let truth = self.truth.as_ref().expect("checked above");
+            if !running.step(spp, self.slice)? {
+                return Ok(());
+            }
+            let running = self.running.take().expect("running above");
+            let Some((image, noise)) = self.measured.take() else {
+                let accumulator = running.tracer.accumulator();
+                self.measured = Some((accumulator.mean_image(), accumulator.estimated_rel_mse()));
+                return Ok(());
+            };
+            let wall = self.pacer.wall_per_traced_second().unwrap_or(1.0);
+            let setup = running.setup_seconds.unwrap_or(0.0);
+            self.push(image, Some(noise), setup, running.seconds_per_spp() * wall);
+            Ok(())
+        }
+
+        /// The candidate of the setting being measured, from its image at the pilot's size.
+        fn push(
+            &mut self,
+            image: RgbImage32,
+            own_noise: Option<f64>,
+            fixed_seconds: f64,
+            seconds_per_spp: f64,
+        ) {
+            let setting = self.settings[self.candidates.len()].clone();
+            let truth = self.truth.as_ref().expect("settings are measured after the truth");
             let errors = compare_with_map(&image, &truth.image, &truth.regions, Vec::new());
             let m = measured(&errors, &truth.regions, truth.rel_mse, own_noise, self.options.pilot_spp);
             self.candidates.push(Candidate {
@@ -350,10 +443,9 @@ mod native {
                 seconds_per_spp,
                 worst_region: m.worst_region,
             });
-            Ok(())
         }
 
-        /// The truth: the converged solution, as the CLI's pilot renders it.
+        /// The truth: the converged solution, as the CLI's pilot renders it; then its regions.
         fn step_truth(&mut self, gpu: &GpuContext) -> Result<(), String> {
             let running = match &mut self.running {
                 Some(running) => running,
@@ -371,13 +463,11 @@ mod native {
             let running = self.running.take().expect("running above");
             let accumulator = running.tracer.accumulator();
             let rel_mse = accumulator.estimated_rel_mse();
-            let ids = WhittedTracer::new(gpu, &self.small)
-                .and_then(|t| t.object_ids())
-                .map_err(|e| e.to_string())?;
-            self.truth = Some(Truth {
+            let ids = WhittedTracer::new(gpu, &self.small).map_err(|e| e.to_string())?.object_ids_polled();
+            self.pending = Some(Pending::Regions {
+                ids,
                 image: accumulator.mean_image(),
                 rel_mse: if rel_mse.is_finite() { rel_mse } else { 0.0 },
-                regions: Regions::from_ids(&self.small, &ids),
             });
             Ok(())
         }
@@ -385,5 +475,15 @@ mod native {
 
     fn raster_scene(scene: &Scene) -> Result<RasterScene, String> {
         RasterScene::from_scene(scene).map_err(|e| e.to_string())
+    }
+
+    /// Natively, waits for the GPU (so that a frame's time is the GPU's); in a web page nothing
+    /// may wait, and the readback is polled on later frames.
+    fn wait_natively(gpu: &GpuContext) -> Result<(), String> {
+        #[cfg(not(target_arch = "wasm32"))]
+        gpu.wait_idle("the Auto pilot's frame").map_err(|e| e.to_string())?;
+        #[cfg(target_arch = "wasm32")]
+        let _ = gpu;
+        Ok(())
     }
 }

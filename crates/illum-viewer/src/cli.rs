@@ -26,11 +26,12 @@ pub struct Args {
     /// Frames drawn before the screenshot is taken (with `--screenshot`).
     #[arg(long, default_value_t = 30)]
     pub frames: u32,
-    /// A truth for the Whitted mode's Difference view: an EXR that illum wrote of the same scene
-    /// (`illum.scene_hash`) at the Whitted image's size (half the view's, each way).
+    /// A truth for the Difference view of the raster and Whitted modes: an EXR that illum wrote
+    /// of the same scene (`illum.scene_hash`) at the mode's image size (the raster's is the
+    /// view's, the Whitted image's half the view's each way).
     #[arg(long, value_name = "FILE.exr")]
     pub reference: Option<PathBuf>,
-    /// Start the Whitted mode with the Difference view on.
+    /// Start the raster and Whitted modes with the Difference view on.
     #[arg(long)]
     pub difference: bool,
     /// Start the path tracer with Denoise on (the panel's toggle).

@@ -1,4 +1,4 @@
-//! The Difference view of a noise-free renderer (the Whitted ray tracer): the signed difference
+//! The Difference view of a noise-free renderer (the rasterizer, the Whitted ray tracer): the signed difference
 //! of its image from a truth, per pixel, in a diverging colour map. Such a renderer has no noise
 //! but a bias, and this shows where the bias is.
 //!
@@ -122,14 +122,15 @@ impl DifferenceView {
     }
 
     /// Brings the map up to date with `image` (frame number `frame`, rendered of `scene` at its
-    /// camera's size) and the truths at hand: the `--reference` file first, else the path
-    /// tracer's accumulation.
+    /// camera's size, `view_scale` times the view's size each way) and the truths at hand: the
+    /// `--reference` file first, else the path tracer's accumulation.
     pub fn update(
         &mut self,
         ctx: &egui::Context,
         image: &RgbImage32,
         frame: u64,
         scene: &Scene,
+        view_scale: f32,
         path_tracer: Option<PathTracerTruth<'_>>,
     ) {
         if !self.on {
@@ -138,10 +139,12 @@ impl DifferenceView {
         let mut refusals = vec![];
         let mut chosen: Option<(String, LazyTruth<'_>)> = None;
         if let Some(file) = &self.reference {
-            let advice = "the image is half the view's size each way: resize the window to match, or give \
-                          a reference of this size";
+            let advice = format!(
+                "the image is {view_scale} times the view's size each way: resize the window to match, or \
+                 give a reference of this size"
+            );
             let size = [file.image.width, file.image.height];
-            match reference_refusal(&file.path, file.metadata.as_ref(), size, scene, advice) {
+            match reference_refusal(&file.path, file.metadata.as_ref(), size, scene, &advice) {
                 Some(why) => refusals.push(why),
                 None => {
                     let field =
@@ -165,7 +168,7 @@ impl DifferenceView {
                      or start the viewer with --reference FILE.exr"
                         .to_owned(),
                 ),
-                Some(pt) => match path_tracer_refusal(pt, scene) {
+                Some(pt) => match path_tracer_refusal(pt, scene, view_scale) {
                     Some(why) => refusals.push(why),
                     None => {
                         let id = format!("path tracer {} {}", pt.accumulator.total_samples(), scene_hash(pt.scene));
@@ -237,7 +240,7 @@ impl DifferenceView {
 }
 
 /// Why the path tracer's accumulation cannot be the truth of `scene` (at its camera's size).
-fn path_tracer_refusal(pt: PathTracerTruth<'_>, scene: &Scene) -> Option<String> {
+fn path_tracer_refusal(pt: PathTracerTruth<'_>, scene: &Scene, view_scale: f32) -> Option<String> {
     if pt.accumulator.total_samples() == 0 || pt.accumulator.min_samples() == 0 {
         return Some("the path tracer has not covered the image yet".to_owned());
     }
@@ -251,7 +254,7 @@ fn path_tracer_refusal(pt: PathTracerTruth<'_>, scene: &Scene) -> Option<String>
     let (a, b) = ((pt.scene.camera.width, pt.scene.camera.height), (scene.camera.width, scene.camera.height));
     (a != b).then(|| {
         format!(
-            "the path tracer's image is {} x {}, this one {} x {}: set its resolution scale to 0.5",
+            "the path tracer's image is {} x {}, this one {} x {}: set its resolution scale to {view_scale}",
             a.0, a.1, b.0, b.1
         )
     })

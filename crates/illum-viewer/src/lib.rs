@@ -8,7 +8,7 @@
 //! - [`camera`]: orbit / pan / zoom with the mouse, shared by both modes;
 //! - [`denoise_view`]: the path tracer's Denoise toggle (the denoised image and its estimated
 //!   error);
-//! - [`difference_view`]: the Whitted mode's signed difference from a truth;
+//! - [`difference_view`]: the raster and Whitted modes' signed difference from a truth;
 //! - [`display`]: the path tracer's GPU tone-mapping pass from its display sum (a GPU buffer)
 //!   into the texture egui shows;
 //! - [`gpu_setup`]: how eframe creates the device the renderers share;

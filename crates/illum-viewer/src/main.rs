@@ -70,10 +70,19 @@ mod native {
                 if let Some(pathtrace) = app.pathtrace_mut() {
                     pathtrace.settings.denoise = args.denoise;
                 }
+                // Both noise-free modes: each takes the file as its truth when the sizes fit
+                // (its panel says why not otherwise).
+                let on = args.difference || args.reference.is_some();
                 if let Some(whitted) = app.whitted_mut() {
-                    whitted.difference.on = args.difference || args.reference.is_some();
+                    whitted.difference.on = on;
                     if let Some(path) = &args.reference {
                         whitted.difference.load_reference(path).map_err(|e| format!("error: {e}"))?;
+                    }
+                }
+                if let Some(raster) = app.raster_mut() {
+                    raster.difference.on = on;
+                    if let Some(path) = &args.reference {
+                        raster.difference.load_reference(path).map_err(|e| format!("error: {e}"))?;
                     }
                 }
                 Ok(Box::new(app))

@@ -16,7 +16,9 @@ pub const DEFAULT_RASTER_SCENE: &str = "scenes/whitted.toml";
 #[derive(Clone, Debug)]
 pub struct LoadedScene {
     pub pathtrace: Result<Scene, String>,
-    pub raster: Result<RasterScene, String>,
+    /// The raster's scene, with the scene file's own (what the Difference view compares a
+    /// truth's scene with).
+    pub raster: Result<(RasterScene, Scene), String>,
     pub whitted: Result<Scene, String>,
     /// The file's `renderer`.
     pub preferred: RendererKind,
@@ -57,7 +59,7 @@ fn split(scene: Scene) -> Result<LoadedScene, String> {
         .require(RendererKind::PathTrace.noun(), illum_pathtrace::implements)
         .map(|()| scene.clone())
         .map_err(|e| e.to_string());
-    let raster = RasterScene::from_scene(&scene).map_err(|e| e.to_string());
+    let raster = RasterScene::from_scene(&scene).map(|r| (r, scene.clone())).map_err(|e| e.to_string());
     let whitted = scene
         .require(RendererKind::Whitted.noun(), illum_whitted::implements)
         .map(|()| scene.clone())

@@ -95,7 +95,7 @@ impl WhittedMode {
     ) -> Option<egui::TextureId> {
         let image = self.render_frame(gpu, ctx, view_pixels);
         if let Some((last, scene)) = &self.last {
-            self.difference.update(ctx, last, self.frames, scene, path_tracer);
+            self.difference.update(ctx, last, self.frames, scene, 0.5, path_tracer);
         }
         self.difference.texture().or(image)
     }

@@ -248,6 +248,66 @@ fn the_whitted_difference_from_the_path_tracers_accumulation() {
     assert!(whitted.difference.texture().is_none());
 }
 
+/// The rasterizer's frame, read back without waiting, and its signed difference from the path
+/// tracer's accumulation of the same view (at scale 1: the raster draws the whole view), pixel by
+/// pixel; another look is read back again and changes the difference.
+#[test]
+fn the_raster_difference_from_the_path_tracers_accumulation() {
+    let mut harness = harness("scenes/whitted.toml", RendererKind::PathTrace);
+    let mode = harness.state_mut().pathtrace_mut().unwrap();
+    mode.settings.stop.spp = Some(4);
+    mode.settings.resolution_scale = 1.0;
+    let stopped = run_until(&mut harness, 400, |app| app.pathtrace().unwrap().stop_reason().is_some());
+    assert!(stopped, "{}", harness.state().pathtrace().unwrap().summary());
+    harness.state_mut().switch_to(RendererKind::Raster);
+    harness.run_steps(2);
+    harness.get_by_label("Difference").click();
+    let shown = run_until(&mut harness, 40, |app| app.raster().unwrap().difference.summary().is_some());
+    let raster = harness.state().raster().unwrap();
+    assert!(shown, "no difference: {:?}", raster.difference.refusal);
+    let summary = raster.difference.summary().unwrap().clone();
+    let (image, scene) = raster.image().unwrap();
+    let truth = harness.state().pathtrace().unwrap().accumulator().unwrap().mean_image();
+    assert_eq!((image.width, image.height), (truth.width, truth.height));
+    assert_eq!((scene.camera.width, scene.camera.height), (image.width, image.height));
+    // The frame read back is the raster's 8-bit output: every value a level k / 255.
+    assert!(
+        image.pixels.iter().flatten().all(|&v| ((v * 255.0).round() - v * 255.0).abs() < 1e-3),
+        "a value off the 8-bit levels"
+    );
+    for (p, ((a, t), d)) in image.pixels.iter().zip(&truth.pixels).zip(&summary.values).enumerate() {
+        let expected = luminance(*a) - luminance(*t);
+        assert!(
+            (f64::from(*d) - expected).abs() <= 1e-6 * (1.0 + expected.abs()),
+            "pixel {p}: {d} against {expected}"
+        );
+    }
+    println!(
+        "raster: scale {}, mean difference {:+.4} of truth mean {:.4}; {}",
+        summary.scale, summary.mean_difference, summary.truth_mean, summary.truth
+    );
+    assert!(summary.truth.contains("4 spp"), "{}", summary.truth);
+    assert!(raster.difference.texture().is_some());
+
+    // Another look: read back again, another difference.
+    let before = image.clone();
+    let mode = harness.state_mut().raster_mut().unwrap();
+    mode.options.look = match mode.options.look {
+        illum_raster::Look::Figure => illum_raster::Look::Enhanced,
+        _ => illum_raster::Look::Figure,
+    };
+    let read_again =
+        run_until(&mut harness, 40, |app| app.raster().unwrap().image().is_some_and(|(i, _)| *i != before));
+    assert!(read_again, "the new look was not read back");
+    harness.run_steps(1);
+    let raster = harness.state().raster().unwrap();
+    let (image, _) = raster.image().unwrap();
+    let again = raster.difference.summary().unwrap();
+    let expected = luminance(image.pixels[0]) - luminance(truth.pixels[0]);
+    assert!((f64::from(again.values[0]) - expected).abs() <= 1e-6 * (1.0 + expected.abs()));
+    assert_ne!(again.values, summary.values);
+}
+
 /// `--reference`: an EXR of the same view is the truth (the same difference as from the path
 /// tracer it was saved from); one of another scene is refused naming both scenes.
 #[test]

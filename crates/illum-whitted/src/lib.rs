@@ -30,5 +30,6 @@ mod tracer;
 
 pub use encode::{Specialisation, implements};
 pub use tracer::{
-    ObjectIds, PendingImage, Shadow, WHITTED_SHADER, WhittedError, WhittedTracer, shader_defs, shader_modules,
+    ObjectIds, PendingImage, PendingObjectIds, Shadow, WHITTED_SHADER, WhittedError, WhittedTracer,
+    shader_defs, shader_modules,
 };

@@ -48,14 +48,10 @@ pub fn shader_modules(scene: &Scene, geometry: &Geometry) -> Vec<ShaderFile> {
 
 /// What the pipeline writes (`params.counts.w`, OUTPUT_* in the shader).
 const OUTPUT_RADIANCE: u32 = 0;
-#[cfg(not(target_arch = "wasm32"))]
 const OUTPUT_OBJECT_IDS: u32 = 1;
 /// The shader's markers in the shadow channel of the object-ID image.
-#[cfg(not(target_arch = "wasm32"))]
 const SHADOW_LIT: u32 = 0xffff_fffe;
-#[cfg(not(target_arch = "wasm32"))]
 const SHADOW_FACING_AWAY: u32 = 0xffff_fffd;
-#[cfg(not(target_arch = "wasm32"))]
 const NO_HIT: u32 = u32::MAX;
 
 /// Whitted's algorithm on one scene, at the scene's resolution, depth and anti-aliasing.
@@ -70,7 +66,6 @@ pub struct WhittedTracer {
     image: wgpu::Buffer,
     /// The index in `scene.objects` of each object in the GPU's order (for the object-ID
     /// image, which only native tools read).
-    #[cfg(not(target_arch = "wasm32"))]
     scene_index: Vec<usize>,
 }
 
@@ -120,7 +115,6 @@ impl WhittedTracer {
         let lights = encode::lights(scene);
         let radiance_params =
             encode::params(scene, geometry.first_emitter, lights.len() as u32, OUTPUT_RADIANCE);
-        #[cfg(not(target_arch = "wasm32"))]
         let scene_index = {
             let (ordered, _) = illum_rtcore::ordered_objects(scene);
             ordered.iter().map(|(i, _)| *i).collect()
@@ -168,7 +162,6 @@ impl WhittedTracer {
             params,
             radiance_params,
             image,
-            #[cfg(not(target_arch = "wasm32"))]
             scene_index,
         })
     }
@@ -182,6 +175,21 @@ impl WhittedTracer {
     /// its readback; [`PendingImage::poll`] on later frames returns the image.
     pub fn render_polled(&self) -> PendingImage {
         self.dispatch(OUTPUT_RADIANCE, 0, self.width, self.height);
+        self.start_read("reading the Whitted image")
+    }
+
+    /// [`Self::object_ids`] without waiting (what a web page needs): submits the dispatch and
+    /// starts its readback; [`PendingObjectIds::poll`] on later frames returns the image.
+    pub fn object_ids_polled(&self) -> PendingObjectIds {
+        self.dispatch(OUTPUT_OBJECT_IDS, 0, self.width, self.height);
+        PendingObjectIds {
+            image: self.start_read("reading the object-ID image"),
+            scene_index: self.scene_index.clone(),
+        }
+    }
+
+    /// Copies the image buffer to a staging buffer of its own and starts mapping it.
+    fn start_read(&self, reading: &str) -> PendingImage {
         let bytes = u64::from(self.width) * u64::from(self.height) * PIXEL_BYTES;
         let staging = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("whitted staging"),
@@ -196,7 +204,7 @@ impl WhittedTracer {
         encoder.copy_buffer_to_buffer(&self.image, 0, &staging, 0, bytes);
         self.gpu.queue.submit([encoder.finish()]);
         PendingImage {
-            read: readback::PendingRead::start(staging, bytes, "reading the Whitted image"),
+            read: readback::PendingRead::start(staging, bytes, reading),
             width: self.width,
             height: self.height,
         }
@@ -279,21 +287,7 @@ impl WhittedTracer {
     pub fn object_ids(&self) -> Result<ObjectIds, WhittedError> {
         self.dispatch(OUTPUT_OBJECT_IDS, 0, self.width, self.height);
         let data = self.read("reading the object-ID image")?;
-        // Two u32 per pixel, in a vec4 of f32 bits (the copy has no alignment guarantee).
-        let words: Vec<u32> =
-            data.chunks_exact(4).map(|c| u32::from_le_bytes(c.try_into().expect("4 bytes"))).collect();
-        let texels: Vec<&[u32]> = words.chunks_exact(4).collect();
-        let scene_object = |gpu_index: u32| self.scene_index.get(gpu_index as usize).copied();
-        let hit = texels.iter().map(|t| scene_object(t[0])).collect();
-        let shadow = texels
-            .iter()
-            .map(|t| match t[1] {
-                SHADOW_LIT | NO_HIT => Shadow::Lit,
-                SHADOW_FACING_AWAY => Shadow::FacingAway,
-                i => scene_object(i).map_or(Shadow::Lit, Shadow::BlockedBy),
-            })
-            .collect();
-        Ok(ObjectIds { width: self.width, height: self.height, hit, shadow })
+        Ok(decode_object_ids(self.width, self.height, &self.scene_index, &data))
     }
 
     /// The image buffer, read back with a wait (one vec4 per pixel).
@@ -321,6 +315,44 @@ impl PendingImage {
             Ok(decode_image(self.width, self.height, &data))
         }))
     }
+}
+
+/// An object-ID image whose readback is under way ([`WhittedTracer::object_ids_polled`]).
+pub struct PendingObjectIds {
+    image: PendingImage,
+    /// The scene's object index of each GPU object index.
+    scene_index: Vec<usize>,
+}
+
+impl PendingObjectIds {
+    /// `None` while the image is still being read back; never waits.
+    pub fn poll(&self, gpu: &GpuContext) -> Option<Result<ObjectIds, WhittedError>> {
+        let data = self.image.read.poll(gpu)?;
+        Some(data.map_err(WhittedError::from).and_then(|data| {
+            gpu.check()?;
+            Ok(decode_object_ids(self.image.width, self.image.height, &self.scene_index, &data))
+        }))
+    }
+}
+
+/// The object-ID image's texels: per pixel the GPU index of the object hit and of the one that
+/// blocks the light (or a marker), as two u32 in a vec4 of f32 bits.
+fn decode_object_ids(width: u32, height: u32, scene_index: &[usize], data: &[u8]) -> ObjectIds {
+    // The copy has no alignment guarantee: read the words one by one.
+    let words: Vec<u32> =
+        data.chunks_exact(4).map(|c| u32::from_le_bytes(c.try_into().expect("4 bytes"))).collect();
+    let texels: Vec<&[u32]> = words.chunks_exact(4).collect();
+    let scene_object = |gpu_index: u32| scene_index.get(gpu_index as usize).copied();
+    let hit = texels.iter().map(|t| scene_object(t[0])).collect();
+    let shadow = texels
+        .iter()
+        .map(|t| match t[1] {
+            SHADOW_LIT | NO_HIT => Shadow::Lit,
+            SHADOW_FACING_AWAY => Shadow::FacingAway,
+            i => scene_object(i).map_or(Shadow::Lit, Shadow::BlockedBy),
+        })
+        .collect();
+    ObjectIds { width, height, hit, shadow }
 }
 
 /// The image buffer's RGBA f32 texels as linear RGB.

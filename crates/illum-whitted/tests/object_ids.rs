@@ -102,3 +102,25 @@ fn object_ids_match_ray_casting_and_shadows_are_the_balls_projections_along_the_
     }
     assert!(checked + skipped == total);
 }
+
+/// The object-ID image read back without waiting (as a web page must) is the one read with a
+/// wait, and a radiance frame rendered while it is under way does not change it.
+#[test]
+fn the_polled_object_ids_are_the_waited_ones() {
+    let scene: Scene = illum_scene::testing::shipped_scene("whitted.toml", 160, 90);
+    let tracer = WhittedTracer::new(gpu(), &scene).unwrap();
+    let waited = tracer.object_ids().unwrap();
+    let pending = tracer.object_ids_polled();
+    tracer.render().unwrap();
+    let mut polls = 0;
+    let polled = loop {
+        polls += 1;
+        if let Some(result) = pending.poll(gpu()) {
+            break result.unwrap();
+        }
+        assert!(polls < 100_000, "the readback never completed");
+        std::thread::yield_now();
+    };
+    assert_eq!(polled, waited);
+    assert!(polled.hit.iter().any(Option::is_some) && polled.shadow.contains(&Shadow::Lit));
+}

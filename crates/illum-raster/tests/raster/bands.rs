@@ -57,3 +57,34 @@ fn bands_draw_the_whole_frames_pixels_and_can_stop() {
     assert!(stopped.is_none(), "a stopped render returns no frame");
     assert_eq!(bands, 1, "no band after the one that stopped it");
 }
+
+/// A frame read back without waiting (polled, as a web page must) is the frame `render` returns,
+/// pixel for pixel, and frames drawn while it is under way do not change it.
+#[test]
+fn a_polled_readback_is_the_rendered_frame() {
+    let s = scene();
+    let mut r = renderer();
+    if r.size() != (WIDTH, HEIGHT) {
+        r.resize(WIDTH, HEIGHT).unwrap_or_else(|e| panic!("{e}"));
+    }
+    r.set_scene(&s).unwrap_or_else(|e| panic!("{e}"));
+    let figure = Options::all_on(Look::Figure);
+    let enhanced = Options::all_on(Look::Enhanced);
+    let whole = r.render(&enhanced).unwrap_or_else(|e| panic!("{e}"));
+    r.draw(&enhanced).unwrap_or_else(|e| panic!("{e}"));
+    let pending = r.read_polled().unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(pending.size(), (WIDTH, HEIGHT));
+    // Another look drawn after the copy was submitted: the copy keeps the enhanced frame.
+    let other = r.render(&figure).unwrap_or_else(|e| panic!("{e}"));
+    assert_ne!(other, whole, "the two looks draw the same frame, so the check below proves nothing");
+    let mut polls = 0;
+    let polled = loop {
+        polls += 1;
+        if let Some(result) = pending.poll(illum_gpu::testing::gpu()) {
+            break result.unwrap_or_else(|e| panic!("{e}"));
+        }
+        assert!(polls < 100_000, "the readback never completed");
+        std::thread::yield_now();
+    };
+    assert_eq!(polled, whole);
+}

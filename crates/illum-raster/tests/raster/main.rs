@@ -10,7 +10,8 @@
 //!   planes, the horizon, refraction ratio 1, total internal reflection), tabulated in
 //!   docs/accuracy.md;
 //! - `passes`: a frame records only the passes its scene needs, and skipping one changes nothing;
-//! - `bands`: a large frame drawn in bands of rows is the frame drawn whole.
+//! - `bands`: a large frame drawn in bands of rows is the frame drawn whole, and a frame read
+//!   back without waiting is the frame rendered.
 //!
 //! The render example's raster path is tested beside it, in illum-cli's `tests/raster.rs`.
 //!
