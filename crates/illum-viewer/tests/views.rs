@@ -288,6 +288,17 @@ fn the_raster_difference_from_the_path_tracers_accumulation() {
     );
     assert!(summary.truth.contains("4 spp"), "{}", summary.truth);
     assert!(raster.difference.texture().is_some());
+    let path = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("raster_difference.png");
+    let map: Vec<u8> = summary
+        .values
+        .iter()
+        .flat_map(|&d| {
+            let [r, g, b] = illum_viewer::difference_view::diverging_colour(d, summary.scale as f32);
+            [r, g, b, 255]
+        })
+        .collect();
+    image::RgbaImage::from_raw(image.width, image.height, map).unwrap().save(&path).unwrap();
+    println!("saved {}", path.display());
 
     // Another look: read back again, another difference.
     let before = image.clone();
