@@ -16,8 +16,9 @@
 //!   scene has a caustic: a sun and a mirror or glass) with the caustic estimator, and at each
 //!   bounce count of `--bounce-list` with `--bounce-spp` samples (on the Cornell box this is
 //!   the classic "Whitted against path tracing, bounce by bounce");
-//! - the path tracer at each spp of `--denoise-spp-list` followed by the à-trous denoiser
-//!   (illum-denoise; the guide pass and the filter are part of its time).
+//! - the path tracer at each spp of `--denoise-spp-list` followed by the à-trous denoiser, and
+//!   by Open Image Denoise in builds with `--features illum-denoise/oidn` (illum-denoise, with
+//!   its bound on every denoised pixel; the guide pass and the filter are part of its time).
 //!
 //! Each row's time is the median of `--frames` frames: the rasterizer's wall time per frame as
 //! a viewer pays it (no readback) and its GPU time from timestamp queries; the Whitted ray
@@ -51,6 +52,7 @@ use illum::pathtrace::PathTracer;
 use illum::raster::{Options, RasterRenderer, RasterScene};
 use illum::scene::{Bounces, Effects, Look, MAX_WHITTED_DEPTH, MaterialKind, Scene};
 use illum::whitted::WhittedTracer;
+use illum_denoise::{DenoiseInput, Denoiser, DenoiserKind};
 use illum_lab::plot::{self, Line, Style};
 use illum_lab::reference::{Reference, cached_reference, load_reference};
 use illum_lab::regions::{Comparison, Regions, compare, flip_heat_map};
@@ -119,6 +121,8 @@ enum Series {
     PathTraceBounces,
     /// The path tracer at the scene's bounces followed by the à-trous denoiser, more spp each rung.
     PathTraceAtrous,
+    /// The same followed by Open Image Denoise (builds with the feature `oidn`).
+    PathTraceOidn,
 }
 
 /// One rung: an image made by one renderer with one setting, and how long it took.
@@ -221,10 +225,15 @@ fn run(args: Args) -> anyhow::Result<()> {
         rungs.push(pathtrace_rung(&gpu, &with_caustic, setting, Series::PathTraceBounces, 1)?);
         print_rung(rungs.last().expect("pushed"));
     }
-    if !args.denoise_spp_list.is_empty() {
-        let filter = illum_denoise::AtrousDenoiser::new(&gpu)?;
+    let denoisers: &[DenoiserKind] = if illum_denoise::OIDN_BUILT {
+        &[DenoiserKind::Atrous, DenoiserKind::Oidn]
+    } else {
+        &[DenoiserKind::Atrous]
+    };
+    for &kind in denoisers.iter().filter(|_| !args.denoise_spp_list.is_empty()) {
+        let filter = Denoiser::new(&gpu, kind)?;
         for &spp in &args.denoise_spp_list {
-            rungs.push(atrous_rung(&gpu, &with_caustic, spp, &filter, args.frames.min(3))?);
+            rungs.push(denoised_rung(&gpu, &with_caustic, spp, &filter, args.frames.min(3))?);
             print_rung(rungs.last().expect("pushed"));
         }
     }
@@ -250,24 +259,23 @@ fn run(args: Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The path tracer at `spp` (the scene's bounces and caustic estimator) followed by the
-/// à-trous denoiser with its default settings: the time is the render's, the guide pass's and
-/// the filter's (median of `runs`, after a warm-up that compiles the pipelines).
-fn atrous_rung(
+/// The path tracer at `spp` (the scene's bounces and caustic estimator) followed by `filter`
+/// with its default settings and the bound of every denoised image: the time is the render's,
+/// the guide pass's and the filter's (median of `runs`, after a warm-up that compiles the
+/// pipelines).
+fn denoised_rung(
     gpu: &GpuContext,
     scene: &Scene,
     spp: u32,
-    filter: &illum_denoise::AtrousDenoiser,
+    filter: &Denoiser,
     runs: u32,
 ) -> anyhow::Result<Rung> {
     let mut scene = scene.clone();
     scene.pathtrace.spp = spp;
     let mut tracer = PathTracer::new(gpu, &scene)?;
-    let settings = illum_denoise::AtrousSettings::default();
     let denoise = |tracer: &PathTracer| -> anyhow::Result<RgbImage32> {
         let guides = tracer.guides(illum::pathtrace::GUIDE_SAMPLES)?;
-        let input = illum_denoise::DenoiseInput::from_render(tracer.accumulator(), &guides);
-        Ok(filter.denoise(&input, &settings)?.0)
+        Ok(filter.denoise(&DenoiseInput::from_render(tracer.accumulator(), &guides))?)
     };
     tracer.render_to_spp(1)?; // warm-up: the pipelines and buffers
     denoise(&tracer)?;
@@ -280,11 +288,15 @@ fn atrous_rung(
         image = Some(denoise(&tracer)?);
         ms.push(started.elapsed().as_secs_f64() * 1e3);
     }
+    let (renderer, series, name) = match filter.kind() {
+        DenoiserKind::Atrous => ("pathtrace + à-trous", Series::PathTraceAtrous, "à-trous"),
+        DenoiserKind::Oidn => ("pathtrace + OIDN", Series::PathTraceOidn, "OIDN"),
+    };
     Ok(Rung {
-        renderer: "pathtrace + à-trous",
-        series: Series::PathTraceAtrous,
+        renderer,
+        series,
         settings: format!(
-            "{spp} spp, bounces {}{}, à-trous",
+            "{spp} spp, bounces {}{}, {name}",
             scene.pathtrace.bounces,
             if scene.pathtrace.caustics { ", caustic estimator" } else { "" }
         ),
@@ -547,6 +559,7 @@ fn write_outputs(
             ("path tracer + caustic estimator, more spp", Series::PathTraceCaustics, Style::Joined),
             ("path tracer, more bounces", Series::PathTraceBounces, Style::Joined),
             ("path tracer + à-trous, more spp", Series::PathTraceAtrous, Style::Joined),
+            ("path tracer + OIDN, more spp", Series::PathTraceOidn, Style::Joined),
         ];
         let lines: Vec<Line> = series
             .iter()

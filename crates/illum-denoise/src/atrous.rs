@@ -42,8 +42,9 @@ pub fn unit_normals(normals: &[[f32; 3]]) -> Vec<[f32; 4]> {
 pub struct AtrousSettings {
     /// Iterations: the kernel's taps reach 2 x (2^iterations - 1) pixels away.
     pub iterations: u32,
-    /// The luminance stop's width in standard errors of the pixel's luminance (SVGF's sigma_l).
-    pub sigma_luminance: f32,
+    /// The colour stop's width in standard errors of the pixel's channel (SVGF's sigma_l,
+    /// applied to each channel instead of the luminance).
+    pub sigma_colour: f32,
     /// The albedo stop's width (a Gaussian in the albedo's Euclidean distance).
     pub sigma_albedo: f32,
 }
@@ -53,9 +54,15 @@ impl Default for AtrousSettings {
     /// difference of 0.05 weighing e^-1: of iterations 4 and 5, sigma_l 2, 4, 8 and 16 and
     /// sigma_a 0.05 and 0.1, the lowest relMSE on the 16-spp Cornell box (docs/denoising.md).
     fn default() -> Self {
-        AtrousSettings { iterations: 4, sigma_luminance: 4.0, sigma_albedo: 0.05 }
+        AtrousSettings { iterations: 4, sigma_colour: 4.0, sigma_albedo: 0.05 }
     }
 }
+
+/// The filter's output: the image, and each pixel's channel variances after the filter.
+pub type Filtered = (RgbImage32, Vec<[f32; 3]>);
+
+/// Bytes of one pixel in the filter's ping-pong buffers: the WGSL `Pixel`, two vec4<f32>.
+pub const PIXEL_BYTES: u64 = 32;
 
 /// Mirrors the WGSL `Params`.
 #[repr(C)]
@@ -65,7 +72,7 @@ pub struct GpuParams {
     pub height: u32,
     pub step: u32,
     pub padding: u32,
-    pub sigma_luminance: f32,
+    pub sigma_colour: f32,
     pub sigma_albedo: f32,
     pub padding_b: f32,
     pub padding_c: f32,
@@ -83,15 +90,11 @@ impl AtrousDenoiser {
         Ok(AtrousDenoiser { gpu: gpu.clone(), pipeline })
     }
 
-    /// The filtered image, and the variance of each pixel's luminance after the filter. Blocks
+    /// The filtered image, and the variance of each pixel's channels after the filter. Blocks
     /// until the GPU is done. Fails, naming the limit, for an image whose buffers do not fit
     /// one storage binding of the device.
     #[cfg(not(target_arch = "wasm32"))]
-    pub fn denoise(
-        &self,
-        input: &DenoiseInput,
-        settings: &AtrousSettings,
-    ) -> Result<(RgbImage32, Vec<f32>), DenoiseError> {
+    pub fn denoise(&self, input: &DenoiseInput, settings: &AtrousSettings) -> Result<Filtered, DenoiseError> {
         let (result, bytes) = self.submit(input, settings)?;
         let bytes = readback::read_buffer(&self.gpu, &result, 0, bytes, "reading back the denoised image")?;
         Ok(decode(input.width(), input.height(), &bytes))
@@ -125,7 +128,7 @@ impl AtrousDenoiser {
     }
 
     /// Encodes and submits the filter's iterations; returns the buffer holding the result
-    /// (RGB and the luminance variance per pixel) and its size in bytes.
+    /// (colour and channel variances per pixel, [`PIXEL_BYTES`]) and its size in bytes.
     fn submit(
         &self,
         input: &DenoiseInput,
@@ -134,20 +137,26 @@ impl AtrousDenoiser {
         let (gpu, device) = (&self.gpu, &self.gpu.device);
         let (width, height) = (input.width(), input.height());
         let pixels = width as usize * height as usize;
-        let bytes = pixels as u64 * 16;
+        let bytes = pixels as u64 * PIXEL_BYTES;
         let limits = device.limits();
         let max_binding = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
         if bytes > max_binding {
             return Err(DenoiseError::Unsupported(format!(
-                "denoising a {width} x {height} image needs {bytes}-byte buffers (16 bytes per pixel), over the \
+                "denoising a {width} x {height} image needs {bytes}-byte buffers ({PIXEL_BYTES} bytes per pixel), over the \
                  device's storage binding limit of {max_binding}"
             )));
         }
         let vec4 = |rows: &mut dyn Iterator<Item = [f32; 4]>| -> Vec<u8> {
             rows.flat_map(|v| v.map(f32::to_le_bytes)).flatten().collect()
         };
-        let colour =
-            vec4(&mut input.image.pixels.iter().zip(&input.variance).map(|(c, &v)| [c[0], c[1], c[2], v]));
+        let colour = vec4(
+            &mut input
+                .image
+                .pixels
+                .iter()
+                .zip(&input.variance)
+                .flat_map(|(c, v)| [[c[0], c[1], c[2], 0.0], [v[0], v[1], v[2], 0.0]]),
+        );
         let albedo = vec4(&mut input.albedo.iter().map(|a| [a[0], a[1], a[2], 0.0]));
         let normal = vec4(&mut unit_normals(&input.normal).into_iter());
         let iterations = settings.iterations.max(1);
@@ -166,7 +175,7 @@ impl AtrousDenoiser {
                         height,
                         step: 1 << i,
                         padding: 0,
-                        sigma_luminance: settings.sigma_luminance,
+                        sigma_colour: settings.sigma_colour,
                         sigma_albedo: settings.sigma_albedo,
                         padding_b: 0.0,
                         padding_c: 0.0,
@@ -214,20 +223,20 @@ pub struct PendingDenoise {
 
 impl PendingDenoise {
     /// `None` while the readback is under way, then the filtered image and the variance of each
-    /// pixel's luminance after the filter, or the mapping's error. Never waits.
-    pub fn poll(&self, gpu: &GpuContext) -> Option<Result<(RgbImage32, Vec<f32>), DenoiseError>> {
+    /// pixel's channels after the filter, or the mapping's error. Never waits.
+    pub fn poll(&self, gpu: &GpuContext) -> Option<Result<Filtered, DenoiseError>> {
         Some(self.read.poll(gpu)?.map(|bytes| decode(self.width, self.height, &bytes)).map_err(Into::into))
     }
 }
 
-/// The filter's output buffer (RGB and luminance variance per pixel, f32) as an image and the
-/// variances.
-fn decode(width: u32, height: u32, bytes: &[u8]) -> (RgbImage32, Vec<f32>) {
+/// The filter's output buffer (per pixel the WGSL `Pixel`: colour and channel variances, f32)
+/// as an image and the variances.
+fn decode(width: u32, height: u32, bytes: &[u8]) -> Filtered {
     let values: Vec<f32> =
         bytes.chunks_exact(4).map(|b| f32::from_le_bytes(b.try_into().expect("4 bytes"))).collect();
     let image =
-        RgbImage32 { width, height, pixels: values.chunks_exact(4).map(|v| [v[0], v[1], v[2]]).collect() };
-    let variance = values.chunks_exact(4).map(|v| v[3]).collect();
+        RgbImage32 { width, height, pixels: values.chunks_exact(8).map(|v| [v[0], v[1], v[2]]).collect() };
+    let variance = values.chunks_exact(8).map(|v| [v[4], v[5], v[6]]).collect();
     (image, variance)
 }
 
@@ -235,16 +244,19 @@ fn decode(width: u32, height: u32, bytes: &[u8]) -> (RgbImage32, Vec<f32>) {
 mod tests {
     use super::*;
 
-    /// The shader validates without a GPU, and its `Params` has the Rust mirror's layout.
+    /// The shader validates without a GPU, its `Params` has the Rust mirror's layout, and its
+    /// `Pixel` the size the buffers are made with.
     #[test]
     fn the_shader_validates_and_its_params_match() {
         let module = shader::compose(&[], &ATROUS_SHADER, &[]).unwrap_or_else(|e| panic!("{e}"));
         shader::validate(&module, &ATROUS_SHADER.path).unwrap_or_else(|e| panic!("{e}"));
         shader::wgsl_struct(&module, "", "Params").expect("struct Params").assert_matches(
             size_of::<GpuParams>(),
-            &illum_gpu::members!(GpuParams: width, height, step, padding, sigma_luminance, sigma_albedo,
+            &illum_gpu::members!(GpuParams: width, height, step, padding, sigma_colour, sigma_albedo,
                 padding_b, padding_c),
         );
+        let pixel = shader::wgsl_struct(&module, "", "Pixel").expect("struct Pixel");
+        assert_eq!(u64::from(pixel.size), PIXEL_BYTES, "size of the WGSL Pixel");
     }
 
     /// The WGSL constants are the ones the f64 copy (reference.rs) uses.

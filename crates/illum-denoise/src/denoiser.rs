@@ -1,5 +1,6 @@
 //! The denoisers `render --denoise` can run, behind one call, so that the halves' error
-//! estimate ([`crate::split`]) treats them alike. Open Image Denoise exists only in builds with
+//! estimate ([`crate::split`]) treats them alike, and so that every output passes through the
+//! same bound ([`crate::bound`]). Open Image Denoise exists only in builds with
 //! the cargo feature `oidn`; without it, asking for it is an error that says how to build it.
 
 use illum_gpu::GpuContext;
@@ -52,13 +53,16 @@ impl Denoiser {
         }
     }
 
-    /// The denoised image of `input`. Waits for the GPU: native only.
+    /// The denoised image of `input`, each channel bounded to its noisy value +- 3.29 standard
+    /// errors ([`crate::bound`]). Waits for the GPU: native only.
     #[cfg(not(target_arch = "wasm32"))]
     pub fn denoise(&self, input: &DenoiseInput) -> Result<RgbImage32, DenoiseError> {
-        match self {
-            Denoiser::Atrous { filter, settings } => Ok(filter.denoise(input, settings)?.0),
+        let mut image = match self {
+            Denoiser::Atrous { filter, settings } => filter.denoise(input, settings)?.0,
             #[cfg(feature = "oidn")]
-            Denoiser::Oidn(filter) => filter.denoise(input),
-        }
+            Denoiser::Oidn(filter) => filter.denoise(input)?,
+        };
+        crate::bound::bound(input, &mut image);
+        Ok(image)
     }
 }

@@ -5,7 +5,9 @@
 //! images: albedo in [0, 1] and the mean normal, zero where the pixel's rays left the scene
 //! (OIDN's "no surface"). The guides average a few samples and are not noise-free, so
 //! `clean_aux` stays off and OIDN denoises them itself. It ignores the per-pixel variance: what
-//! it removes is judged by its network, not by illum's statistics.
+//! it removes is judged by its network, not by illum's statistics; the bound
+//! ([`crate::bound`], applied by [`crate::Denoiser`]) is what keeps its output within the
+//! pixels' noise.
 
 use illum_image::RgbImage32;
 

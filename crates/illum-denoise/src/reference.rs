@@ -2,26 +2,26 @@
 //! output is tested against (tests/atrous.rs), and the definition in plain Rust.
 
 use illum_image::RgbImage32;
-use illum_image::rgb_image::REC709_LUMINANCE;
 
 use crate::atrous::{AtrousSettings, NORMAL_POWER, TINY, unit_normals};
 use crate::input::DenoiseInput;
 
-/// One pixel of a pass: its colour and its luminance's variance.
-type Pixel = ([f64; 3], f64);
+/// One pixel of a pass: its colour and its channels' variances.
+type Pixel = ([f64; 3], [f64; 3]);
 
-/// The filtered image and the variance of each pixel's luminance after the last iteration.
-pub fn denoise(input: &DenoiseInput, settings: &AtrousSettings) -> (RgbImage32, Vec<f64>) {
+/// The filtered image and the variance of each pixel's channels after the last iteration.
+pub fn denoise(input: &DenoiseInput, settings: &AtrousSettings) -> (RgbImage32, Vec<[f64; 3]>) {
     let (width, height) = (input.width() as i64, input.height() as i64);
     let mut current: Vec<Pixel> = input
         .image
         .pixels
         .iter()
         .zip(&input.variance)
-        .map(|(c, &v)| (c.map(f64::from), f64::from(v)))
+        .map(|(c, v)| (c.map(f64::from), v.map(f64::from)))
         .collect();
     let albedo: Vec<[f64; 3]> = input.albedo.iter().map(|a| a.map(f64::from)).collect();
     let normal: Vec<[f64; 4]> = unit_normals(&input.normal).iter().map(|n| n.map(f64::from)).collect();
+    let sigma_albedo = f64::from(settings.sigma_albedo);
     for iteration in 0..settings.iterations {
         let step = 1i64 << iteration;
         let index = |x: i64, y: i64| (y * width + x) as usize;
@@ -29,17 +29,21 @@ pub fn denoise(input: &DenoiseInput, settings: &AtrousSettings) -> (RgbImage32, 
         for y in 0..height {
             for x in 0..width {
                 let p = index(x, y);
-                let lp = luminance(current[p].0);
-                let mut blurred = 0.0;
+                let (cp, vp) = current[p];
+                let mut blurred = [0.0; 3];
                 for dy in -1i64..=1 {
                     for dx in -1i64..=1 {
                         let q = index((x + dx).clamp(0, width - 1), (y + dy).clamp(0, height - 1));
-                        blurred += ((2 - dx.abs()) * (2 - dy.abs())) as f64 / 16.0 * current[q].1;
+                        let w = ((2 - dx.abs()) * (2 - dy.abs())) as f64 / 16.0;
+                        for (b, v) in blurred.iter_mut().zip(current[q].1) {
+                            *b += w * v;
+                        }
                     }
                 }
-                let scale = f64::from(settings.sigma_luminance) * current[p].1.min(blurred).sqrt() + TINY;
-                let sigma_albedo = f64::from(settings.sigma_albedo);
-                let (mut sum, mut weights, mut variance) = ([0.0; 3], 0.0, 0.0);
+                let scale: [f64; 3] = std::array::from_fn(|k| {
+                    f64::from(settings.sigma_colour) * vp[k].min(blurred[k]).sqrt() + TINY
+                });
+                let (mut sum, mut weights, mut variance) = ([0.0; 3], [0.0; 3], [0.0; 3]);
                 for j in -2i64..=2 {
                     for i in -2i64..=2 {
                         let (qx, qy) = (x + i * step, y + j * step);
@@ -49,19 +53,22 @@ pub fn denoise(input: &DenoiseInput, settings: &AtrousSettings) -> (RgbImage32, 
                         let q = index(qx, qy);
                         let (c, v) = current[q];
                         let da: f64 = (0..3).map(|k| (albedo[p][k] - albedo[q][k]).powi(2)).sum();
-                        let w = kernel(i)
+                        let shared = kernel(i)
                             * kernel(j)
-                            * (-(lp - luminance(c)).abs() / scale).exp()
                             * normal_weight(normal[p], normal[q])
                             * (-da / (sigma_albedo * sigma_albedo)).exp();
                         for k in 0..3 {
+                            let w = shared * (-(cp[k] - c[k]).abs() / scale[k]).exp();
                             sum[k] += w * c[k];
+                            weights[k] += w;
+                            variance[k] += w * w * v[k];
                         }
-                        weights += w;
-                        variance += w * w * v;
                     }
                 }
-                next.push((sum.map(|s| s / weights), variance / (weights * weights)));
+                next.push((
+                    std::array::from_fn(|k| sum[k] / weights[k]),
+                    std::array::from_fn(|k| variance[k] / (weights[k] * weights[k])),
+                ));
             }
         }
         current = next;
@@ -72,10 +79,6 @@ pub fn denoise(input: &DenoiseInput, settings: &AtrousSettings) -> (RgbImage32, 
         pixels: current.iter().map(|(c, _)| c.map(|v| v as f32)).collect(),
     };
     (image, current.iter().map(|&(_, v)| v).collect())
-}
-
-fn luminance(c: [f64; 3]) -> f64 {
-    c.iter().zip(REC709_LUMINANCE).map(|(v, w)| v * w).sum()
 }
 
 /// The B3 spline's taps at offsets -2..2.

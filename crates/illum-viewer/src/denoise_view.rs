@@ -1,6 +1,7 @@
 //! The path tracer's Denoise toggle: the accumulation denoised with illum-denoise's à-trous
-//! filter (WGSL, on the viewer's own device), and the halves' estimate of the denoised image's
-//! error beside the noisy image's (docs/denoising.md).
+//! filter (WGSL, on the viewer's own device) and bounded as every denoised image is
+//! (`illum_denoise::bound`), and the halves' estimate of the denoised image's error beside the
+//! noisy image's (docs/denoising.md).
 //!
 //! The halves without a second tracer: the samples of a pixel are indices 0, 1, 2, ..., so the
 //! accumulation at an earlier spp (a snapshot, A) and what came after it (the whole less A, B)
@@ -27,7 +28,7 @@
 use web_time::Instant;
 
 use illum_denoise::input::DenoiseInput;
-use illum_denoise::{AtrousDenoiser, AtrousSettings, HalvesError, PendingDenoise};
+use illum_denoise::{AtrousDenoiser, AtrousSettings, HalvesError, PendingDenoise, bound};
 use illum_gpu::GpuContext;
 use illum_image::{Encoding, RgbImage32};
 use illum_pathtrace::{Accumulator, GUIDE_SAMPLES, Guides, PathTracer, PendingGuides};
@@ -67,9 +68,10 @@ struct Job {
     whole: Accumulator,
     /// The halves' statistics (A = the snapshot, B = the whole less A) with their spp.
     halves: Option<[(Accumulator, u32); 2]>,
-    /// Inputs not submitted yet, the run in flight, and the results.
+    /// Inputs not submitted yet, the run in flight with its input (which the bound reads),
+    /// and the results.
     inputs: Vec<DenoiseInput>,
-    pending: Option<PendingDenoise>,
+    pending: Option<(PendingDenoise, DenoiseInput)>,
     done: Vec<RgbImage32>,
     started: Instant,
 }
@@ -265,11 +267,13 @@ impl DenoiseView {
             self.filter = Some(AtrousDenoiser::new(gpu).map_err(|e| e.to_string())?);
         }
         let job = self.job.as_mut().expect("called with a job");
-        if let Some(pending) = &job.pending {
+        if let Some((pending, input)) = &job.pending {
             match pending.poll(gpu) {
                 None => return Ok(()),
                 Some(result) => {
-                    job.done.push(result.map_err(|e| e.to_string())?.0);
+                    let mut image = result.map_err(|e| e.to_string())?.0;
+                    bound(input, &mut image);
+                    job.done.push(image);
                     job.pending = None;
                     if job.done.len() == 1 {
                         let image = job.done[0].clone();
@@ -281,7 +285,8 @@ impl DenoiseView {
         let job = self.job.as_mut().expect("still there");
         if let Some(input) = job.inputs.pop() {
             let filter = self.filter.as_ref().expect("made above");
-            job.pending = Some(filter.start(&input, &AtrousSettings::default()).map_err(|e| e.to_string())?);
+            job.pending =
+                Some((filter.start(&input, &AtrousSettings::default()).map_err(|e| e.to_string())?, input));
             return Ok(());
         }
         let job = self.job.take().expect("present");

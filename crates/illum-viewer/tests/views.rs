@@ -5,7 +5,7 @@
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use illum_denoise::input::DenoiseInput;
-use illum_denoise::{AtrousSettings, reference};
+use illum_denoise::{AtrousSettings, bound, reference};
 use illum_scene::RendererKind;
 use illum_viewer::ViewerApp;
 
@@ -74,11 +74,13 @@ fn denoise_shows_the_filtered_accumulation_and_its_estimated_error() {
     assert_ne!(mode.texture(), noisy_texture, "the window still shows the noisy image");
     assert_eq!(mode.texture(), view.texture());
 
-    // The image shown is the filter of this accumulation with these guides (f32 GPU against
-    // f64: docs/denoising.md states 1e-4 relative; the tolerance here adds 1e-6 absolute).
+    // The image shown is the filter of this accumulation with these guides, bounded (f32 GPU
+    // against f64: docs/denoising.md states 1e-4 relative; the tolerance here adds 1e-6
+    // absolute).
     let accumulator = mode.accumulator().unwrap();
     let input = DenoiseInput::from_render(accumulator, view.guides().expect("guides"));
-    let (expected, _) = reference::denoise(&input, &AtrousSettings::default());
+    let (mut expected, _) = reference::denoise(&input, &AtrousSettings::default());
+    bound(&input, &mut expected);
     let shown = view.image().unwrap();
     assert_eq!((shown.width, shown.height), (accumulator.width, accumulator.height));
     for (p, (g, c)) in shown.pixels.iter().zip(&expected.pixels).enumerate() {

@@ -137,12 +137,10 @@ fn the_halves_estimate_of_oidns_error() {
     assert!(worst <= 1.6, "the estimate strays from the true error by a factor {worst:.2}");
 }
 
-/// Fails: Open Image Denoise moves a converged image (65536 spp at 32 x 32: 213 of 1024
-/// pixels beyond |z| = 4.90 in luminance, mean z^2 12.9; it writes about 1e-4 into the black
-/// outside the box and moves the walls' edges by 5 to 15%; docs/denoising.md). Run it with
-/// `--ignored`.
+/// Open Image Denoise, bounded as every denoiser is (`illum_denoise::bound`), leaves a
+/// converged image within its noise (without the bound it moved 213 of 1024 pixels beyond
+/// |z| = 4.90: docs/denoising.md).
 #[test]
-#[ignore = "Open Image Denoise moves a converged image beyond its noise (docs/denoising.md)"]
 fn oidn_does_not_move_a_converged_image() {
     crate::quality::a_converged_image_is_not_moved(DenoiserKind::Oidn);
 }

@@ -43,9 +43,16 @@ fn luminance_variance_bound(variance: [f32; 3]) -> f64 {
 /// image alone fails with probability at most CONVERGED_ALPHA = 1e-3 whatever the correlation
 /// between neighbouring pixels the filter makes (a binomial count of failures would assume them
 /// independent). Power: the same D(A) 5% brighter in one 4 x 4 block must fail at 12 of its 16
-/// pixels or more. The same test
-/// per channel (printed, not asserted) shows the filter moving colour between neighbours of one
-/// luminance (docs/denoising.md).
+/// pixels or more. The same test per channel (`z_test_pass_fraction`: each channel at level
+/// CONVERGED_ALPHA / (3 pixels), |z| <= 5.10) must pass at every pixel too, with the same
+/// false-alarm rate: a filter that moved colour between neighbours of one luminance would fail
+/// it.
+///
+/// The denoised image is bounded (`illum_denoise::bound`): each channel of D(A) within 3.29
+/// standard errors sigma_A of A. A denoiser that sat at that bound in a channel would make
+/// |D(A) - B| up to 3.29 sigma_A + |A - B|, and so fail there with probability
+/// P(z > 5.10 - 3.29 / sqrt 2) = 0.3% (sigma_A = sigma_B); the test prints how many channels
+/// are at the bound, which says how much of the pass is the bound's and how much the filter's.
 pub(crate) fn a_converged_image_is_not_moved(kind: DenoiserKind) {
     let started = std::time::Instant::now();
     let filter = Denoiser::new(common::gpu(), kind).expect("denoiser");
@@ -76,6 +83,16 @@ pub(crate) fn a_converged_image_is_not_moved(kind: DenoiserKind) {
         }
         (failures, z2 / terms.max(1) as f64)
     };
+    let at_bound = (0..pixels)
+        .flat_map(|p| (0..3).map(move |c| (p, c)))
+        .filter(|&(p, c)| {
+            // Within f32 rounding of the noisy value (the bound clamps around the f32 mean).
+            let x = a.pixel_mean(p)[c];
+            let moved = (f64::from(da.pixels[p][c]) - x).abs();
+            let radius = illum_denoise::BOUND_Z * a.pixel_variance_of_mean(p)[c].max(0.0).sqrt();
+            radius > 0.0 && moved >= radius * (1.0 - 1e-3) - 1e-6 * x.abs()
+        })
+        .count();
     let channel_failures = pixels
         - (illum_image::z_test_pass_fraction(&da, &var_a, &b_mean, &var_b, alpha).expect("sizes")
             * pixels as f64)
@@ -91,10 +108,13 @@ pub(crate) fn a_converged_image_is_not_moved(kind: DenoiserKind) {
     println!(
         "{kind}, converged ({CONVERGED_SPP} spp at {CONVERGED_SIZE} x {CONVERGED_SIZE}, {:.1} s): {failures} of {pixels} \
          pixels beyond |z| = {z_critical:.2} in luminance (mean z^2 {mean_z2:.3}); per channel {channel_failures} \
-         pixels; 5% brighter in a 4 x 4 block: {biased_failures} of 16 beyond",
+         pixels; {at_bound} of {} channels at the bound; 5% brighter in a 4 x 4 block: {biased_failures} of 16 \
+         beyond",
         started.elapsed().as_secs_f64(),
+        3 * pixels,
     );
     assert_eq!(failures, 0, "{kind} moved a converged image's luminance beyond its noise");
+    assert_eq!(channel_failures, 0, "{kind} moved a converged image's colour beyond its noise");
     assert!(biased_failures >= 12, "{kind}: a 5% bias in a 4 x 4 block passes: no power");
 }
 
