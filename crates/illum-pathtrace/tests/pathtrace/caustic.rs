@@ -179,11 +179,11 @@ fn the_caustic_seen_in_the_mirror_agrees_with_the_oracle() {
     compare_scene("whitted mirror view, bounces 8", &scene);
 }
 
-/// A glass ball focusing a low sun onto a white wall beside a grey floor, seen from above the ball: the
-/// floor by the wall is lit by the wall's caustic, paths E D D S+ L (and E D S+ D S+ L off the
-/// ball) that only the gather at a diffuse vertex after the camera ray's own hit owns with the
-/// delta sun. The ball's focus lies 1.5 radii beyond its centre, 0.7 units before the wall, so the
-/// wall's caustic is a bright spot a little wider than the ball's focus.
+/// A glass ball focusing a low sun onto a white wall beside a grey floor, seen from above the
+/// ball: the floor by the wall is lit by the wall's caustic, paths E D D S+ L (and E D S+ D S+ L
+/// off the ball) that only the gather at a diffuse vertex after the camera ray's own hit owns
+/// with the delta sun. The ball's focus lies 1.5 radii beyond its centre, 0.7 units before the
+/// wall, so the wall's caustic is a bright spot a little wider than the ball's focus.
 fn wall_view() -> Scene {
     let text = "[camera]\neye = [1.6, 3.5, 3.0]\ntarget = [0.3, 0.3, 0.0]\nup = [0.0, 1.0, 0.0]\nvfov = 35.0\n\
                 width = 24\nheight = 24\n[pathtrace]\nbounces = 8\ncaustics = true\nseed = 17\nspp = 4096\n\
@@ -201,8 +201,9 @@ fn wall_view() -> Scene {
 #[test]
 fn the_light_of_a_caustic_scattered_again_agrees_with_the_oracle() {
     let scene = wall_view();
-    // Every diffuse surface here is seen directly, so the camera ray's own hit gathers nothing
-    // and all the gather adds is light scattered again after the caustic (E (S|D)* D S* D S+ L).
+    // The ball sits at the view's right edge; elsewhere each diffuse surface is seen directly,
+    // where the camera ray's own hit gathers nothing, so what the gather adds there is light
+    // scattered again after the caustic (E (S|D)* D S* D S+ L).
     // The oracle with and without it must fail the pixel criterion against each other: the
     // gather matters pixel by pixel, beyond what its noise explains.
     let oracle = |gather: bool| {
@@ -241,8 +242,8 @@ fn the_light_of_a_caustic_scattered_again_agrees_with_the_oracle() {
     crate::oracle_agreement::compare_render("wall view, bounces 8", &gpu, 4096);
 
     // Power against the error this estimator exists to remove: the GPU's image must fail the same
-    // criterion against the oracle's image without the gather, as a renderer that gathers at the
-    // first diffuse vertex alone would (here it would add nothing).
+    // criterion against the oracle's image without the gather. (A GPU build gathering at the
+    // first diffuse vertex alone fails the comparison above: docs/caustics.md has the count.)
     let (failures, critical) = crate::oracle_agreement::pixel_criterion(
         &gpu.accumulator().mean_image(),
         &gpu.accumulator().variance_image(),
