@@ -965,13 +965,18 @@ fn caustics_on_off_is_recorded_and_a_checkpoint_of_the_other_setting_is_refused(
     ]);
     assert_refused(&out, "--caustics off on a resume", &["caustics: on in the file, off now"]);
     // A file rendered before the photon gather (the light tracer alone, no estimators key)
-    // holds other light in the metal sphere: resuming it with the gather is refused.
-    let mut before_gather = illum::pathtrace::checkpoint::load_checkpoint(&exr).unwrap();
-    assert!(field(&metadata(&exr), "caustic_estimators").starts_with("light tracer and photon gather"));
-    before_gather.metadata.fields.retain(|(k, _)| k != "caustic_estimators");
-    let old = dir.path().join("before-gather.exr");
-    illum::pathtrace::checkpoint::save_loaded(&old, &before_gather).unwrap();
-    let out = run(&[
+    // holds other light in the metal sphere, and one rendered with the gather at the first
+    // diffuse vertex alone lacks E (S|D)* D S* D S+ L: resuming either with today's estimators
+    // is refused, and so is merging it with a part rendered today.
+    let rendered = illum::pathtrace::checkpoint::load_checkpoint(&exr).unwrap();
+    assert!(
+        field(&metadata(&exr), "caustic_estimators")
+            .starts_with("light tracer and photon gather at every diffuse")
+    );
+    let first_vertex =
+        "light tracer and photon gather (r_1 = 0.02 x the largest specular radius, r_k = r_1 (k + 1)^(-1/6))";
+    let part = dir.path().join("part.exr");
+    let args = [
         "scenes/whitted.toml",
         "--renderer",
         "pathtrace",
@@ -979,16 +984,47 @@ fn caustics_on_off_is_recorded_and_a_checkpoint_of_the_other_setting_is_refused(
         "16",
         "--height",
         "16",
-        "--resume",
-        old.to_str().unwrap(),
-        "--spp",
-        "32",
-    ]);
-    assert_refused(
-        &out,
-        "resuming a file from before the gather",
-        &["caustic_estimators: light tracer in the file"],
-    );
+        "--sample-range",
+        "16..32",
+        "-o",
+        part.to_str().unwrap(),
+    ];
+    let out = run(&args);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    for (case, estimators, refusal) in [
+        ("before-gather", None, "caustic_estimators: light tracer in the file".to_owned()),
+        (
+            "first-vertex-gather",
+            Some(first_vertex),
+            format!("caustic_estimators: {first_vertex} in the file"),
+        ),
+    ] {
+        let mut older = rendered.clone();
+        older.metadata.fields.retain(|(k, _)| k != "caustic_estimators");
+        if let Some(value) = estimators {
+            older.metadata.fields.push(("caustic_estimators".to_owned(), value.to_owned()));
+        }
+        let old = dir.path().join(format!("{case}.exr"));
+        illum::pathtrace::checkpoint::save_loaded(&old, &older).unwrap();
+        let out = run(&[
+            "scenes/whitted.toml",
+            "--renderer",
+            "pathtrace",
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--resume",
+            old.to_str().unwrap(),
+            "--spp",
+            "32",
+        ]);
+        assert_refused(&out, &format!("resuming a file {case}"), &[&refusal]);
+        let merged = dir.path().join("never.exr");
+        let out = merge(&[old.to_str().unwrap(), part.to_str().unwrap(), "-o", merged.to_str().unwrap()]);
+        assert_refused(&out, &format!("merging a file {case}"), &["caustic_estimators"]);
+        assert!(!merged.exists());
+    }
 
     // A bad value and the raster renderer are refused by name.
     let out = run(&["scenes/whitted.toml", "--renderer", "pathtrace", "--caustics", "maybe"]);

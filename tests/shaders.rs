@@ -40,6 +40,7 @@ fn every_wgsl_file_is_validated_by_its_crate() {
             &SURFACES_MODULE,
             &CAUSTIC_SHADER,
             &pathtrace::CAUSTIC_BUFFERS_MODULE,
+            &pathtrace::CAUSTIC_WALK_MODULE,
             &pathtrace::GATHER_SHADER,
             &pathtrace::GUIDES_SHADER,
             &pathtrace::DISPLAY_SUM_SHADER,

@@ -1,7 +1,8 @@
 //! How much light the camera paths and the light tracer alone miss with the Whitted scene's
 //! delta sun (the photon gather off): the sun's glint (E S+ L), the caustic seen in the mirror or
-//! through the glass (E S+ D S+ L, the gather's when it is on; `mirror_caustic` measures it
-//! region by region) and light the caustic sends on to other diffuse surfaces (E .. D S* D S+ L).
+//! through the glass (E S+ D S+ L) and light the caustic sends on to other diffuse surfaces
+//! (E .. D S* D S+ L), the last two the gather's when it is on (`mirror_caustic` measures them
+//! region by region).
 //!
 //! With a sun disc the camera paths find those paths too (a bounce or a specular chain that
 //! happens to reach the disc), so the image with a disc of radius RADIUS degrees minus the image

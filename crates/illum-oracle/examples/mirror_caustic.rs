@@ -1,6 +1,9 @@
-//! The caustic seen in the mirror ball and through the glass (paths E S+ D S+ L), measured with
-//! the f64 oracle on the Whitted view at 64 x 36, bounces 8, in the pixels whose camera ray
-//! (through the pixel's centre) first meets the metal sphere, and those that first meet the glass:
+//! What the photon gather owns (paths E (S|D)* D S+ L but E D S+ L: the caustic seen in the mirror
+//! ball and through the glass, and the caustic's light scattered again by the floor), measured
+//! with the f64 oracle on the Whitted view at 64 x 36, bounces 8, in the pixels whose camera ray
+//! (through the pixel's centre) first meets the metal sphere, those that first meet the glass,
+//! and the floor seen directly (where the gather finds only light the floor receives from the
+//! caustic's image in the mirror ball, E D S+ D S+ L):
 //!
 //! - delta sun, light tracer alone (what the truth had before the photon gather);
 //! - delta sun with the photon gather (`gather.rs`);
@@ -12,10 +15,7 @@
 //!   uniform). Pixels where the disc adds blue beyond 4 sigma are left out of the comparison.
 //!
 //! Printed per region and channel: the means and the differences with their standard errors,
-//! and the per-pixel z-scores of disc - gather; and, with the delta sun, the light no estimator
-//! owns: the caustic scattered again by a diffuse surface through a mirror or glass
-//! (E S* D S+ D S+ L, `Oracle::rescattered_at`). A third region, the floor seen directly, is
-//! where that light lands.
+//! and the per-pixel z-scores of disc - gather.
 //!
 //!     cargo run --release -p illum-oracle --example mirror_caustic [SPP] [RADIUS]
 
@@ -98,22 +98,20 @@ fn main() {
                 None => name == "floor" && camera.direction(x, y, 0.5, 0.5).y < 0.0,
             })
             .collect();
-        // Per pixel: delta camera alone, delta camera + gather, disc camera, the remainder.
-        let partial: Vec<Vec<[Sums; 4]>> = std::thread::scope(|scope| {
+        // Per pixel: delta camera alone, delta camera + gather, disc camera.
+        let partial: Vec<Vec<[Sums; 3]>> = std::thread::scope(|scope| {
             let workers: Vec<_> = (0..threads as u32)
                 .map(|t| {
                     let (delta, disc, pixels) = (&delta, &disc, &pixels);
                     scope.spawn(move || {
-                        let mut sums = vec![[Sums::default(); 4]; pixels.len()];
+                        let mut sums = vec![[Sums::default(); 3]; pixels.len()];
                         for k in (t..spp).step_by(threads) {
                             let gather = delta.gather_at(11, k, pixels);
-                            let rescattered = delta.rescattered_at(11, k, pixels);
                             for (i, &(x, y)) in pixels.iter().enumerate() {
                                 let camera = delta.pixel_sample(x, y, 11, k);
                                 sums[i][0].add(camera);
                                 sums[i][1].add(camera + gather[i]);
                                 sums[i][2].add(disc.pixel_sample(x, y, 12, k));
-                                sums[i][3].add(rescattered[i]);
                             }
                         }
                         sums
@@ -122,20 +120,20 @@ fn main() {
                 .collect();
             workers.into_iter().map(|w| w.join().expect("worker")).collect()
         });
-        let mut sums = vec![[Sums::default(); 4]; pixels.len()];
+        let mut sums = vec![[Sums::default(); 3]; pixels.len()];
         for part in &partial {
             for (s, p) in sums.iter_mut().zip(part) {
-                for e in 0..4 {
+                for e in 0..3 {
                     s[e].merge(&p[e]);
                 }
             }
         }
         let n = f64::from(spp);
-        let stats: Vec<[(DVec3, DVec3); 4]> =
-            sums.iter().map(|s| [s[0].stats(n), s[1].stats(n), s[2].stats(n), s[3].stats(n)]).collect();
+        let stats: Vec<[(DVec3, DVec3); 3]> =
+            sums.iter().map(|s| [s[0].stats(n), s[1].stats(n), s[2].stats(n)]).collect();
         // Glint pixels: the disc adds blue beyond 4 sigma.
-        let glint = |s: &[(DVec3, DVec3); 4]| (s[2].0.z - s[1].0.z) / (s[2].1.z + s[1].1.z).sqrt() > 4.0;
-        let kept: Vec<&[(DVec3, DVec3); 4]> = stats.iter().filter(|s| !glint(s)).collect();
+        let glint = |s: &[(DVec3, DVec3); 3]| (s[2].0.z - s[1].0.z) / (s[2].1.z + s[1].1.z).sqrt() > 4.0;
+        let kept: Vec<&[(DVec3, DVec3); 3]> = stats.iter().filter(|s| !glint(s)).collect();
         println!(
             "{name}: {} pixels, {} with the disc's glint left out; {spp} spp, disc {radius} deg",
             pixels.len(),
@@ -144,8 +142,8 @@ fn main() {
         let m = kept.len() as f64;
         let mean = |e: usize| kept.iter().map(|s| s[e].0).sum::<DVec3>() / m;
         let var = |e: usize| kept.iter().map(|s| s[e].1).sum::<DVec3>() / (m * m);
-        let (before, gathered, finite, rest) = (mean(0), mean(1), mean(2), mean(3));
-        let (vb, vg, vf, vr) = (var(0), var(1), var(2), var(3));
+        let (before, gathered, finite) = (mean(0), mean(1), mean(2));
+        let (vb, vg, vf) = (var(0), var(1), var(2));
         for (c, label) in ["red", "green", "blue"].iter().enumerate() {
             println!(
                 "  {label:5}: light tracer alone {:.5} +- {:.5}, with gather {:.5} +- {:.5} (gather adds {:+.2}%), \
@@ -160,12 +158,6 @@ fn main() {
                 finite[c] - gathered[c],
                 (vf[c] + vg[c]).sqrt(),
                 100.0 * (finite[c] - gathered[c]) / gathered[c],
-            );
-            println!(
-                "         unowned E S* D S+ D S+ L {:.6} +- {:.6} ({:+.3}% of the gathered mean)",
-                rest[c],
-                vr[c].sqrt(),
-                100.0 * rest[c] / gathered[c]
             );
         }
         // Per-pixel z of disc - gather, red and green, the kept pixels.

@@ -7,9 +7,8 @@
 //! The light tracer here owns exactly the paths L S+ D E whose diffuse vertex D is the camera
 //! ray's first hit: with it on, the camera path tracer stops counting the sun disc on such
 //! paths (`caustic_owned` there), so no path is counted twice. With a delta sun the caustic
-//! seen through a specular surface (E S+ D S+ L) is the photon gather's (`gather.rs`, from
-//! these particles); light scattered from the caustic onto other diffuse surfaces
-//! (E S* D S* D S+ L) is counted by no estimator (docs/caustics.md measures it).
+//! seen through a specular surface or scattered again by another diffuse surface
+//! (E (S|D)* D S+ L but E D S+ L) is the photon gather's (`gather.rs`, from these particles).
 //!
 //! Emission. The sun's light crosses any plane perpendicular to a direction w of its disc with
 //! radiance L (a delta sun: irradiance E along one direction). Only lines that meet a specular

@@ -1,11 +1,14 @@
-//! The caustic seen through a specular surface, paths E S+ D S+ L with a delta sun, by
-//! probabilistic progressive photon mapping (Knaus and Zwicker 2011), in f64 and written
-//! independently of the GPU's (`crates/illum-pathtrace/shaders/gather.wgsl`).
+//! The photon gather of a delta sun's caustic, paths E (S|D)* D S+ L other than E D S+ L (the
+//! light tracer's connection): the caustic seen in a mirror or through glass, and the caustic's
+//! light scattered again by diffuse surfaces, by probabilistic progressive photon mapping (Knaus
+//! and Zwicker 2011), in f64 and written independently of the GPU's
+//! (`crates/illum-pathtrace/shaders/gather.wgsl`).
 //!
 //! Neither the camera paths nor the light tracer's connection to the pinhole can find these
-//! paths with a delta sun: a camera path leaving D never reaches a light of zero size, and a
-//! particle leaving D through a mirror or glass never reaches a pinhole. Photon mapping joins
-//! the two halves at D with a kernel of radius r instead of an exact connection.
+//! paths with a delta sun: a camera path never reaches a light of zero size (and next-event
+//! estimation's shadow ray from D meets the specular object), and a particle leaving D through
+//! a mirror, glass or another diffuse bounce never reaches a pinhole. Photon mapping joins the
+//! two halves at D with a kernel of radius r instead of an exact connection.
 //!
 //! Photons. Frame k's particles (`caustic.rs`) stop at their first diffuse point after s >= 1
 //! specular scatterings; there each is a photon of weight Phi rho(x_p) / pi (its flux Phi, the
@@ -13,18 +16,21 @@
 //! through the specular objects, so the photons' weights within r of x, divided by pi r^2,
 //! estimate the radiance rho / pi E(x) leaving x, blurred over the disc of radius r.
 //!
-//! Gather. Sample k of a pixel adds one camera path E S^j D (j >= 1 specular scatterings, D the
-//! first diffuse vertex), traced with its own random numbers, whose throughput to D multiplies
+//! Gathering paths. Sample k of a pixel adds one camera path, traced with its own random
+//! numbers, through mirrors (weight the reflectance), glass (the Fresnel choice, weight 1) and
+//! diffuse surfaces (a cosine bounce, weight the albedo). At each diffuse vertex D after m >= 1
+//! continuation rays its throughput multiplies
 //!     L(D) = sum over photons p of frame k with |x_p - D| < r_k and n_p . n_D > 0 of
 //!            weight_p / (pi r_k^2)
-//! (n_p faces the side the particle arrived from, n_D the side the camera path arrived from: a
-//! photon on the other side of a surface is not counted). Under `Bounces::Fixed(n)` a photon of
-//! s scatterings counts when j + s + 1 <= n, the continuation rays the camera path
-//! E S^j D S^s L would take; unbounded, both halves play Russian roulette as their estimators
-//! do. A path whose first diffuse vertex is the camera ray's own hit (j = 0) belongs to the
-//! light tracer's connection, and E S+ D S+ L to no other estimator with a delta sun, so no
-//! path is counted twice. With a sun disc the camera paths find these paths themselves (a bounce
-//! from D that reaches the disc) and the gather is off.
+//! (n_p faces the side the particle arrived from, n_D the side the path arrived from: a photon
+//! on the other side of a surface is not counted). Under `Bounces::Fixed(n)` a photon of s
+//! scatterings counts when m + s + 1 <= n, the continuation rays of the path E ... D S^s L;
+//! unbounded, both halves play Russian roulette as their estimators do. The camera ray's own hit
+//! (m = 0) gathers nothing: E D S+ L is the light tracer's connection. Every other path with a
+//! delta sun either ends L D (next-event estimation's), L S+ D E (the light tracer's) or
+//! E S+ L (the sun's glint, a point on the film that none of these finds), so no path is
+//! counted twice. With a sun disc the camera paths find all of these themselves (a bounce that
+//! reaches the disc) and the gather is off.
 //!
 //! Radius. Frame k (sample index k, from 0) has its own photon map and radius
 //!     r_k = r_1 (k + 1)^((alpha - 1) / 2),   alpha = 2/3,   r_1 = RADIUS_FRACTION R_max
@@ -125,7 +131,8 @@ impl Oracle {
     }
 
     /// Turns the photon gather off (`false`) or back on; it runs only where [`Self::gathers`]
-    /// allows. Off, the image misses E S+ D S+ L as the light tracer alone does.
+    /// allows. Off, the image misses E (S|D)* D S+ L (but E D S+ L) as the light tracer alone
+    /// does.
     pub fn with_gather(mut self, on: bool) -> Oracle {
         self.gather = on;
         self
@@ -159,72 +166,6 @@ impl Oracle {
         }
     }
 
-    /// A measurement of light no estimator owns (docs/caustics.md): the paths
-    /// E S* D S+ D S+ L, the caustic scattered again by a diffuse surface through a mirror or
-    /// glass, at `pixels` (x, y) for frame `frame`'s photons: one camera path per pixel through
-    /// specular scatterings to a diffuse point D1, a cosine bounce there, one or more specular
-    /// scatterings to D2, and the photon estimate at D2 (zeros when the gather is off).
-    pub fn rescattered_at(&self, seed: u64, frame: u32, pixels: &[(u32, u32)]) -> Vec<DVec3> {
-        let n = u64::from(self.camera.width) * u64::from(self.camera.height);
-        let photons = (0..n)
-            .filter_map(|particle| {
-                let mut rng =
-                    Rng::for_sample(seed ^ crate::caustic::PARTICLE_SEED_KEY, particle, u64::from(frame));
-                self.trace_particle(n, &mut rng)
-            })
-            .collect();
-        let Some(map) = self.photon_map(photons, frame) else { return vec![DVec3::ZERO; pixels.len()] };
-        pixels
-            .iter()
-            .map(|&(x, y)| {
-                let pixel = u64::from(y) * u64::from(self.camera.width) + u64::from(x);
-                let mut rng = Rng::for_sample(seed ^ GATHER_SEED_KEY ^ 1, pixel, u64::from(frame));
-                let (jx, jy) = (rng.uniform(), rng.uniform());
-                let mut d = self.camera.direction(x, y, jx, jy);
-                let mut o = self.camera.eye;
-                let mut throughput = DVec3::ONE;
-                // Continuation rays taken; specular scatterings since the diffuse bounce.
-                let (mut taken, mut specular, mut bounced) = (0u32, 0u32, false);
-                loop {
-                    let Some(hit) = self.closest_hit(o, d) else { return DVec3::ZERO };
-                    if hit.primitive.emitter || !self.may_continue(taken) {
-                        return DVec3::ZERO;
-                    }
-                    let Contact { point, front, normal, lift } = hit.contact(o, d);
-                    match hit.primitive.material {
-                        MaterialKind::Mirror { reflectance } => {
-                            throughput *= reflectance.as_dvec3();
-                            d = reflect(d, normal);
-                            o = point + normal * lift;
-                            specular += 1;
-                        }
-                        MaterialKind::Dielectric { ior } => {
-                            (o, d) = scatter_dielectric(d, normal, point, front, ior, lift, &mut rng);
-                            specular += 1;
-                        }
-                        MaterialKind::Lambertian { .. } | MaterialKind::Checker(_) => {
-                            if bounced {
-                                if specular == 0 {
-                                    return DVec3::ZERO;
-                                }
-                                // `taken` continuation rays so far; the photon's side adds s + 1.
-                                return throughput * map.radiance(point, normal, taken, self.bounces);
-                            }
-                            throughput *= hit.diffuse_albedo(point);
-                            let local = crate::sampling::cosine_hemisphere(rng.uniform(), rng.uniform());
-                            d = crate::sampling::local_to_world(normal, local).normalize();
-                            o = point + normal * lift;
-                            bounced = true;
-                            specular = 0;
-                        }
-                        MaterialKind::Emitter { .. } => unreachable!("emitters are handled above"),
-                    }
-                    taken += 1;
-                }
-            })
-            .collect()
-    }
-
     fn photon_map(&self, photons: Vec<Photon>, frame: u32) -> Option<PhotonMap> {
         let emitter = self.caustic.as_ref().filter(|_| self.gathers())?;
         Some(PhotonMap::new(photons, radius(emitter.gather_radius, frame)))
@@ -236,52 +177,68 @@ impl Oracle {
         self.gather_path(map, x, y, &mut rng)
     }
 
-    /// One camera path E S^j D through pixel (x, y), jittered, and the photon estimate at D
-    /// times its throughput (zero when it reaches no diffuse point after j >= 1 scatterings).
+    /// One gathering camera path through pixel (x, y), jittered: the photon estimates at its
+    /// diffuse vertices after the camera ray's own hit, each times the throughput there.
     fn gather_path(&self, map: &PhotonMap, x: u32, y: u32, rng: &mut Rng) -> DVec3 {
         let (jx, jy) = (rng.uniform(), rng.uniform());
         let mut d = self.camera.direction(x, y, jx, jy);
         let mut o = self.camera.eye;
         let mut throughput = DVec3::ONE;
-        let mut specular = 0u32;
+        let mut sum = DVec3::ZERO;
+        // Continuation rays taken so far.
+        let mut taken = 0u32;
         loop {
-            let Some(hit) = self.closest_hit(o, d) else { return DVec3::ZERO };
+            let Some(hit) = self.closest_hit(o, d) else { return sum };
             if hit.primitive.emitter {
-                return DVec3::ZERO;
+                return sum;
             }
             let Contact { point, front, normal, lift } = hit.contact(o, d);
             match hit.primitive.material {
                 MaterialKind::Mirror { reflectance } => {
                     let reflectance = reflectance.as_dvec3();
-                    if !self.may_continue(specular)
-                        || !self.roulette(specular, throughput * reflectance, &mut throughput, rng)
+                    if !self.may_continue(taken)
+                        || !self.roulette(taken, throughput * reflectance, &mut throughput, rng)
                     {
-                        return DVec3::ZERO;
+                        return sum;
                     }
                     throughput *= reflectance;
                     d = reflect(d, normal);
                     o = point + normal * lift;
                 }
                 MaterialKind::Dielectric { ior } => {
-                    if !self.may_continue(specular)
-                        || !self.roulette(specular, throughput, &mut throughput, rng)
-                    {
-                        return DVec3::ZERO;
+                    if !self.may_continue(taken) || !self.roulette(taken, throughput, &mut throughput, rng) {
+                        return sum;
                     }
                     (o, d) = scatter_dielectric(d, normal, point, front, ior, lift, rng);
                 }
                 MaterialKind::Lambertian { .. } | MaterialKind::Checker(_) => {
-                    if specular == 0 {
-                        return DVec3::ZERO;
+                    if taken > 0 {
+                        sum += throughput * map.radiance(point, normal, taken, self.bounces);
                     }
-                    return throughput * map.radiance(point, normal, specular, self.bounces);
+                    let albedo = hit.diffuse_albedo(point);
+                    // A later diffuse vertex joins photons of s >= 1 scatterings after at least
+                    // taken + 1 rays: nothing counts under a limit below taken + 3.
+                    let useful = match self.bounces {
+                        Bounces::Fixed(n) => taken + 3 <= n,
+                        Bounces::Unbounded => true,
+                    };
+                    if !useful
+                        || !self.may_continue(taken)
+                        || !self.roulette(taken, throughput * albedo, &mut throughput, rng)
+                    {
+                        return sum;
+                    }
+                    throughput *= albedo;
+                    let local = crate::sampling::cosine_hemisphere(rng.uniform(), rng.uniform());
+                    d = crate::sampling::local_to_world(normal, local).normalize();
+                    o = point + normal * lift;
                 }
                 MaterialKind::Emitter { .. } => unreachable!("emitters are handled above"),
             }
             if !throughput.cmpgt(DVec3::ZERO).any() {
-                return DVec3::ZERO;
+                return sum;
             }
-            specular += 1;
+            taken += 1;
         }
     }
 }

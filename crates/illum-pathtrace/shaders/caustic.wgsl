@@ -24,7 +24,7 @@
 // / r^2) to the pixel through which the eye sees x, if nothing hides x from the eye.
 //
 // Photons (shader def CAUSTIC_GATHER, a delta sun): the same point and weight are also stored
-// as frame k's photon for the gather of E S+ D S+ L (gather.wgsl).
+// as frame k's photon for the gather of E (S|D)* D S+ L (gather.wgsl).
 //
 // Splatting (caustic_buffers.wgsl): WGSL has no float atomics, so each value is rounded to a 64-bit fixed-point
 // integer q = round(v S) (S = caustic.fixed_scale, a power of two) added as two u32 words with
@@ -34,21 +34,18 @@
 // once, no pixel's sum can then reach 2^64 (the proof is in docs/caustics.md).
 
 #import illum::constants::{PI, TWO_PI, INV_PI}
-#import illum::sampler::{Sampler, sampler_new, sample_1d}
+#import illum::sampler::{sampler_new, sample_1d}
 #import illum::sampling::sample_disc
 #import illum::rtcore::spawn::spawn_point
-#import illum::rtcore::codes::{MATERIAL_CHECKER, MATERIAL_DIELECTRIC, MATERIAL_MIRROR}
 #import illum::rtcore::geometry::{NO_HIT, Surface}
 #import illum::rtcore::camera::camera_film_point
-#import illum::pathtrace::scene::{params, objects, materials}
-#import illum::rtcore::traversal::{closest_hit, scattering_surface_at}
-#import illum::pathtrace::surfaces::{UNBOUNDED, RR_START, RR_MAX_SURVIVAL, UNBOUNDED_DEPTH_CAP, max3, scatter_dielectric, sample_sun}
+#import illum::pathtrace::scene::params
+#import illum::rtcore::traversal::closest_hit
+#import illum::pathtrace::surfaces::sample_sun
 #import illum::pathtrace::caustic_buffers::{caustic, discs, fits, splat_add, drop_particle}
+#import illum::pathtrace::caustic_walk::{next_vertex, is_specular, specular_weight, diffuse_albedo, may_continue, scatter_specular}
 #ifdef CAUSTIC_GATHER
 #import illum::pathtrace::caustic_buffers::store_photon
-#endif
-#ifdef CHECKER
-#import illum::rtcore::optics::checker_albedo
 #endif
 
 // The particle of outgoing factor `weight` (flux rho / pi) at surface s, seen from the eye.
@@ -84,30 +81,6 @@ fn connect(frame: u32, s: Surface, own: u32, weight: vec3<f32>) {
         return;
     }
     splat_add(frame, iy * params.width + ix, v);
-}
-
-// Whether a particle that has scattered `scatterings` times may scatter again with `weight`:
-// the camera path E D S^k L it mirrors takes k + 1 continuation rays, so with `bounces` = n
-// a particle may scatter k <= n - 1 times. Unbounded: Russian roulette from RR_START on.
-fn may_scatter(scatterings: u32, throughput: ptr<function, vec3<f32>>, weight: vec3<f32>, sampler: ptr<function, Sampler>) -> bool {
-    if (params.bounces != UNBOUNDED) {
-        if (scatterings + 2u > params.bounces) {
-            return false;
-        }
-    } else {
-        if (scatterings >= UNBOUNDED_DEPTH_CAP) {
-            return false;
-        }
-        if (scatterings >= RR_START) {
-            let q = min(max3(*throughput * weight), RR_MAX_SURVIVAL);
-            if (!(sample_1d(sampler) < q)) {
-                return false;
-            }
-            *throughput /= q;
-        }
-    }
-    *throughput *= weight;
-    return max3(*throughput) > 0.0;
 }
 
 @compute @workgroup_size(64, 1, 1)
@@ -155,52 +128,30 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var d = d0;
     var scatterings = 0u;
     loop {
-        let hit = closest_hit(o, d, own);
-        own = hit.index;
-        if (hit.index == NO_HIT) {
+        let v = next_vertex(o, d, own);
+        own = v.index;
+        if (v.missed || v.emitter) {
             return;
         }
-        let obj = objects[hit.index];
-        if (obj.emitter != 0u) {
-            return;
-        }
-        var s = scattering_surface_at(obj, o + hit.t * d);
-        let front = dot(s.n, d) < 0.0;
-        if (!front) {
-            s.n = -s.n;
-        }
-        let m = materials[obj.material];
-        let kind = m.kind;
-        if (kind == MATERIAL_MIRROR) {
-            if (!may_scatter(scatterings, &throughput, m.a.xyz, &sampler)) {
+        if (is_specular(v)) {
+            // The camera path E D S^k L this particle mirrors takes k + 1 continuation rays, so
+            // with `bounces` = n a particle may scatter k <= n - 1 times. Flux crosses glass
+            // without an eta^2 factor (see the top of this file).
+            if (!may_continue(scatterings + 2u, scatterings, &throughput, specular_weight(v), &sampler)) {
                 return;
             }
-            d = reflect(d, s.n);
-            o = spawn_point(s.p, s.n, s.err);
-        } else if (kind == MATERIAL_DIELECTRIC) {
-            if (!may_scatter(scatterings, &throughput, vec3<f32>(1.0), &sampler)) {
-                return;
-            }
-            // Flux crosses without an eta^2 factor (see the top of this file).
-            let next = scatter_dielectric(s, d, m.a.w, front, &sampler);
+            let next = scatter_specular(v, d, &sampler);
             o = next.o;
             d = next.d;
         } else {
             if (scatterings == 0u) {
                 return;
             }
-#ifdef CHECKER
-            var albedo = m.a.xyz;
-            if (kind == MATERIAL_CHECKER) {
-                albedo = checker_albedo(obj, m, s.p);
-            }
-#else
-            let albedo = m.a.xyz;
-#endif
+            let weight = throughput * diffuse_albedo(v) * INV_PI;
 #ifdef CAUSTIC_GATHER
-            store_photon(frame, particle, s, throughput * albedo * INV_PI, scatterings);
+            store_photon(frame, particle, v.s, weight, scatterings);
 #endif
-            connect(frame, s, own, throughput * albedo * INV_PI);
+            connect(frame, v.s, own, weight);
             return;
         }
         scatterings += 1u;

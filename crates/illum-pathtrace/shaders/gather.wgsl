@@ -1,44 +1,50 @@
-// The photon gather (shader def CAUSTIC_GATHER): the caustic seen through a specular surface,
-// paths E S+ D S+ L with a delta sun, by probabilistic progressive photon mapping (Knaus and
-// Zwicker 2011). One invocation traces one camera path of one pixel and frame, after the light
-// tracer (caustic.wgsl) has stored that frame's photons; the estimate goes into the frame's
-// splat like a particle's, so frame k's sample of the pixel pairs with the camera's sample k
+// The photon gather (shader def CAUSTIC_GATHER, a delta sun): paths E (S|D)* D S+ L other than
+// E D S+ L, the caustic seen through mirrors and glass and the caustic's light scattered again by
+// diffuse surfaces, by probabilistic progressive photon mapping (Knaus and Zwicker 2011). One
+// invocation traces one camera path of one pixel and frame, after the light tracer
+// (caustic.wgsl) has stored that frame's photons; its estimate goes into the frame's splat like
+// a particle's, so frame k's sample of the pixel pairs with the camera's sample k
 // (tracer/caustic.rs). The mathematics is in docs/caustics.md; in short:
 //
 // The path: a camera ray through the pixel, jittered, followed through mirrors and glass (the
-// camera path tracer's weights: reflectance; 1 with the Fresnel choice) to its first diffuse
-// point D after j >= 1 specular scatterings. j = 0 is the light tracer's connection (L S+ D E);
-// a path that leaves the scene or meets an emitter adds nothing.
+// camera path tracer's weights: reflectance; 1 with the Fresnel choice) and diffuse surfaces
+// (a cosine-distributed bounce, weight the albedo), with the camera paths' length rule and
+// roulette (caustic_walk.wgsl). A path that leaves the scene or reaches an emitter ends.
 //
-// The estimate at D: the photons of the frame within r_k of D on the same side (photon normal
-// . D's normal > 0) whose s scatterings let the path E S^j D S^s L count under `bounces` = n
-// (j + s + 1 <= n continuation rays), weight (flux x albedo / pi) summed and divided by pi r_k^2:
-// the radiance leaving D toward the path, blurred over the kernel. Each frame has its own
-// photons and radius r_k = r_1 (k + 1)^(-1/6) (sample index k), so frames are independent and
-// the mean over frames converges to the true radiance.
+// The gather at each diffuse vertex D of depth m >= 1 (m scatterings before it; m = 0, the
+// camera ray's own hit, is the light tracer's connection L S+ D E): the photons of the frame
+// within r_k of D on the same side (photon normal . D's normal > 0) whose s scatterings let the
+// path E ... D S^s L count under `bounces` = n (m + s + 1 <= n continuation rays), weight
+// (flux x albedo / pi) summed and divided by pi r_k^2: the radiance leaving D toward the path,
+// blurred over the kernel. Each frame has its own photons and radius r_k = r_1 (k + 1)^(-1/6)
+// (sample index k), so frames are independent and the mean over frames converges.
+//
+// No other estimator counts these paths with a delta sun: next-event estimation's shadow ray
+// from D toward the sun meets the specular object (L S+ D is not L D), and no camera path
+// reaches a light of zero size.
 
 #import illum::constants::PI
-#import illum::sampler::{Sampler, sampler_new, sample_1d, sample_2d}
+#import illum::sampler::{sampler_new, sample_2d}
+#import illum::sampling::{sample_cosine_hemisphere, to_world}
 #import illum::rtcore::spawn::spawn_point
-#import illum::rtcore::codes::{MATERIAL_DIELECTRIC, MATERIAL_MIRROR}
 #import illum::rtcore::geometry::NO_HIT
 #import illum::rtcore::camera::camera_ray
-#import illum::pathtrace::scene::{params, objects, materials}
-#import illum::rtcore::traversal::{closest_hit, scattering_surface_at}
-#import illum::pathtrace::surfaces::{UNBOUNDED, RR_START, RR_MAX_SURVIVAL, UNBOUNDED_DEPTH_CAP, max3, scatter_dielectric}
+#import illum::pathtrace::scene::params
+#import illum::pathtrace::surfaces::{UNBOUNDED, max3}
 #import illum::pathtrace::caustic_buffers::{caustic, photons, heads, fits, splat_add, drop_particle, gather_radius, photon_cell, photon_bucket}
+#import illum::pathtrace::caustic_walk::{next_vertex, is_specular, specular_weight, diffuse_albedo, may_continue, scatter_specular}
 
 // Mixed into the caustic's seed for the gathering paths, so that they draw no numbers a particle
 // or a camera path draws.
 const GATHER_SEED_KEY: u32 = 0x6a7e4ca5u;
 
 // The sum of the weights of frame `frame`'s photons within r of x (normal n) that a path of
-// `specular` scatterings may join. The disc of radius r about x meets at most two cells of side
+// `depth` scatterings may join. The disc of radius r about x meets at most two cells of side
 // 2 r per axis; each bucket they hash to is walked once (two cells may share one), and a photon
 // of any other cell in it lies farther than r or belongs to a visited cell: the distance alone
 // decides, and no photon is counted twice. Most photons walked are farther than r (the cells
 // cover 16 r^2 of a plane, the disc pi r^2): only their positions are read.
-fn photon_sum(frame: u32, x: vec3<f32>, n: vec3<f32>, r: f32, specular: u32) -> vec3<f32> {
+fn photon_sum(frame: u32, x: vec3<f32>, n: vec3<f32>, r: f32, depth: u32) -> vec3<f32> {
     let side = 2.0 * r;
     let lo = photon_cell(x - vec3<f32>(r), side);
     let hi = photon_cell(x + vec3<f32>(r), side);
@@ -67,7 +73,7 @@ fn photon_sum(frame: u32, x: vec3<f32>, n: vec3<f32>, r: f32, specular: u32) -> 
                     let d = a.xyz - x;
                     if (dot(d, d) < r * r) {
                         let b = photons[3u * slot + 1u];
-                        let joins = params.bounces == UNBOUNDED || specular + u32(b.w) + 1u <= params.bounces;
+                        let joins = params.bounces == UNBOUNDED || depth + u32(b.w) + 1u <= params.bounces;
                         if (joins && dot(photons[3u * slot + 2u].xyz, n) > 0.0) {
                             sum += b.xyz;
                         }
@@ -96,70 +102,43 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     // The object whose surface o lies on: closest_hit's `own`.
     var own = NO_HIT;
     var throughput = vec3<f32>(1.0);
-    var specular = 0u;
+    // Scatterings so far: the next vertex's depth.
+    var depth = 0u;
+    var total = vec3<f32>(0.0);
     loop {
-        let hit = closest_hit(o, d, own);
-        own = hit.index;
-        if (hit.index == NO_HIT) {
-            return;
+        let v = next_vertex(o, d, own);
+        own = v.index;
+        if (v.missed || v.emitter) {
+            break;
         }
-        let obj = objects[hit.index];
-        if (obj.emitter != 0u) {
-            return;
-        }
-        var s = scattering_surface_at(obj, o + hit.t * d);
-        let front = dot(s.n, d) < 0.0;
-        if (!front) {
-            s.n = -s.n;
-        }
-        let m = materials[obj.material];
-        let kind = m.kind;
-        if (kind != MATERIAL_MIRROR && kind != MATERIAL_DIELECTRIC) {
-            if (specular == 0u) {
-                return;
+        if (is_specular(v)) {
+            if (!may_continue(depth + 1u, depth, &throughput, specular_weight(v), &sampler)) {
+                break;
             }
-            let r = gather_radius(frame);
-            let v = throughput * photon_sum(frame, s.p, s.n, r, specular) / (PI * r * r);
-            if (max3(v) > 0.0) {
-                if (!fits(v)) {
-                    drop_particle(frame);
-                    return;
-                }
-                splat_add(frame, pixel, v);
-            }
-            return;
-        }
-        // The specular continuation: the camera path tracer's length rule and roulette.
-        if (params.bounces != UNBOUNDED) {
-            if (specular + 1u > params.bounces) {
-                return;
-            }
-        } else if (specular >= UNBOUNDED_DEPTH_CAP) {
-            return;
-        }
-        var weight = vec3<f32>(1.0);
-        if (kind == MATERIAL_MIRROR) {
-            weight = m.a.xyz;
-        }
-        if (params.bounces == UNBOUNDED && specular >= RR_START) {
-            let q = min(max3(throughput * weight), RR_MAX_SURVIVAL);
-            if (!(sample_1d(&sampler) < q)) {
-                return;
-            }
-            throughput /= q;
-        }
-        throughput *= weight;
-        if (kind == MATERIAL_MIRROR) {
-            d = reflect(d, s.n);
-            o = spawn_point(s.p, s.n, s.err);
-        } else {
-            let next = scatter_dielectric(s, d, m.a.w, front, &sampler);
+            let next = scatter_specular(v, d, &sampler);
             o = next.o;
             d = next.d;
+        } else {
+            if (depth > 0u) {
+                let r = gather_radius(frame);
+                total += throughput * photon_sum(frame, v.s.p, v.s.n, r, depth) / (PI * r * r);
+            }
+            // A gather after this bounce is at depth m + 1 or more and joins photons of s >= 1
+            // scatterings: it needs m + 3 <= n continuation rays.
+            if (!may_continue(depth + 3u, depth, &throughput, diffuse_albedo(v), &sampler)) {
+                break;
+            }
+            let u = sample_2d(&sampler);
+            d = to_world(v.s.n, sample_cosine_hemisphere(u.x, u.y));
+            o = spawn_point(v.s.p, v.s.n, v.s.err);
         }
-        if (!(max3(throughput) > 0.0)) {
+        depth += 1u;
+    }
+    if (max3(total) > 0.0) {
+        if (!fits(total)) {
+            drop_particle(frame);
             return;
         }
-        specular += 1u;
+        splat_add(frame, pixel, total);
     }
 }

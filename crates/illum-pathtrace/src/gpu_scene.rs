@@ -169,15 +169,18 @@ pub fn caustics_active(scene: &Scene) -> bool {
 }
 
 /// Which estimators beyond the camera paths `scene`'s image has, and the photon gather's
-/// radius rule: what a cached image of the scene (the ladder's truth) must have been made with
-/// to be reused, as an image made before the gather lacks the caustic seen in the mirror.
+/// radius rule: what a cached image of the scene (the ladder's truth) or a checkpoint must have
+/// been made with to be reused or resumed, as an image made before the gather lacks the caustic
+/// seen in the mirror, and one made with the gather at the first diffuse vertex alone lacks the
+/// caustic's light scattered again by a diffuse surface (E (S|D)* D S* D S+ L).
 pub fn caustic_estimators(scene: &Scene) -> String {
     let code = SceneCode::new(scene, 0);
     match (code.caustic, code.caustic_gather) {
         (false, _) => "none".to_owned(),
         (true, false) => "light tracer".to_owned(),
         (true, true) => format!(
-            "light tracer and photon gather (r_1 = {} x the largest specular radius, r_k = r_1 (k + 1)^(-1/6))",
+            "light tracer and photon gather at every diffuse vertex but the camera's own hit (r_1 = {} x the \
+             largest specular radius, r_k = r_1 (k + 1)^(-1/6))",
             crate::tracer::GATHER_RADIUS_FRACTION
         ),
     }

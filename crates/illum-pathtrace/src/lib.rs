@@ -44,9 +44,9 @@ pub use progressive::{
 #[cfg(not(target_arch = "wasm32"))]
 pub use progressive::{render_progressive, render_progressive_over};
 pub use shaders::{
-    CAUSTIC_BUFFERS_MODULE, CAUSTIC_SHADER, GATHER_SHADER, GENERIC_LIGHT_CHOICE, GENERIC_MATERIALS,
-    GENERIC_TRAVERSAL, GUIDES_SHADER, PATHTRACE_SHADER, SAMPLING_MODULES, SCENE_MODULE, SURFACES_MODULE,
-    shader_modules,
+    CAUSTIC_BUFFERS_MODULE, CAUSTIC_SHADER, CAUSTIC_WALK_MODULE, GATHER_SHADER, GENERIC_LIGHT_CHOICE,
+    GENERIC_MATERIALS, GENERIC_TRAVERSAL, GUIDES_SHADER, PATHTRACE_SHADER, SAMPLING_MODULES, SCENE_MODULE,
+    SURFACES_MODULE, shader_modules,
 };
 pub use tracer::{
     CausticParams, GUIDE_SAMPLES, Guides, PathTracer, PendingGuides, Readback, StepReport, bounding_sphere,

@@ -27,7 +27,10 @@ pub const CAUSTIC_SHADER: ShaderFile = shader_file!("shaders/caustic.wgsl");
 pub const GUIDES_SHADER: ShaderFile = shader_file!("shaders/guides.wgsl");
 /// What the light tracer and the photon gather share: parameters, splats, photon maps.
 pub const CAUSTIC_BUFFERS_MODULE: ShaderFile = shader_file!("shaders/caustic_buffers.wgsl");
-/// The photon gather of E S+ D S+ L (entry point `main`; shader def CAUSTIC_GATHER).
+/// How the light tracer and the photon gather walk through the scene.
+pub const CAUSTIC_WALK_MODULE: ShaderFile = shader_file!("shaders/caustic_walk.wgsl");
+/// The photon gather of E (S|D)* D S+ L but E D S+ L (entry point `main`; shader def
+/// CAUSTIC_GATHER).
 pub const GATHER_SHADER: ShaderFile = shader_file!("shaders/gather.wgsl");
 /// The generic material lookup (a read of the material buffer).
 pub const GENERIC_MATERIALS: ShaderFile = shader_file!("shaders/materials.wgsl");
@@ -59,6 +62,7 @@ pub fn shader_modules(scene: &Scene, gpu_scene: &GpuScene, traversal: Traversal)
     }
     modules.push(SURFACES_MODULE);
     modules.push(CAUSTIC_BUFFERS_MODULE);
+    modules.push(CAUSTIC_WALK_MODULE);
     modules
 }
 

@@ -32,8 +32,8 @@ pub struct SceneCode {
     pub checker: bool,
     /// The caustic's light tracer ([`caustics_active`]).
     pub caustic: bool,
-    /// ... with the photon gather of the caustic seen through a specular surface (E S+ D S+ L,
-    /// `shaders/gather.wgsl`): the caustic with a delta sun and a diffuse surface to gather on.
+    /// ... with the photon gather (E (S|D)* D S+ L but E D S+ L, `shaders/gather.wgsl`): the
+    /// caustic with a delta sun and a diffuse surface to gather on.
     /// With a sun disc the camera paths find those paths themselves.
     pub caustic_gather: bool,
     /// `sampling = "uniform"` hemisphere sampling instead of cosine.

@@ -129,7 +129,7 @@ pub(crate) fn compare_render(label: &str, gpu: &illum_pathtrace::PathTracer, ora
 
 /// The pixel criterion: (failing pixels, critical count); the comparison fails when the first
 /// reaches the second.
-fn pixel_criterion(
+pub(crate) fn pixel_criterion(
     mean: &RgbImage32,
     variance: &RgbImage32,
     oracle_mean: &RgbImage32,
