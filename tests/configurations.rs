@@ -59,9 +59,6 @@ enum Expect {
     Agree,
     /// Refused, the message naming this field.
     Refused(&'static str),
-    /// Finite, but not the oracle's image, for the cause [`expected`] states: the test fails
-    /// when the cell starts to agree, so that it leaves this state when the cause is fixed.
-    KnownDisagreement,
 }
 
 /// The cells: a name and the edit of the shipped Whitted scene.
@@ -94,15 +91,6 @@ fn expected(cell: &str, renderer: Renderer) -> Expect {
             Expect::Refused("objects[2] (\"metal sphere\").sphere.center")
         }
         (c, Renderer::Raster) if c.starts_with("camera") => Expect::Refused("camera.eye"),
-        // Not fixed. The mirror of radius 1e4 meets the floor in a crease across the view, and the
-        // path tracer's failing pixels lie on it (rows 11 and 12 of 16). The likely cause, not
-        // yet confirmed: a ray leaving a sphere starts 2^-18 of its magnitude off it
-        // (crates/illum-rtcore/shaders/spawn.wgsl), 0.04 units here, and f32 places a surface of
-        // radius 1e4 only to about 1e-3, so near the crease rays from the floor and the mirror
-        // can start past the other surface. Measured: the Whitted ray tracer 98.5% of pixels
-        // within 1e-3 (99% needed); the path tracer 3 pixels beyond |z| 4.15 (2 fail) and the
-        // blue whole-image mean 5.2 sigma off.
-        ("sphere of radius 1e-4 next to one of 1e4", _) => Expect::KnownDisagreement,
         _ => Expect::Agree,
     }
 }
@@ -194,15 +182,6 @@ fn check(renderer: Renderer) {
                 println!("{renderer:?}, {cell}: {summary}");
                 if !ok {
                     failures.push(format!("{cell}: {summary}"));
-                }
-            }
-            (Ok((summary, ok)), Expect::KnownDisagreement) => {
-                println!("{renderer:?}, {cell}: {summary} (known disagreement)");
-                if ok {
-                    failures.push(format!("{cell}: agrees now ({summary}): expect Agree"));
-                }
-                if !summary.starts_with("finite true") {
-                    failures.push(format!("{cell}: not finite ({summary})"));
                 }
             }
             (Ok((summary, _)), Expect::Refused(field)) => {

@@ -44,14 +44,14 @@ use illum_lab::regions::{Comparison, Regions, compare};
 /// nudged by (3, -2, 1) units in the file's frame, the Whitted ray tracer's image moves by 3.3e-4
 /// (rays at checker edges, one edge lying along a row of sample points, land on the other tile)
 /// and the path tracer's by 7.7e-6; in the eye's frame, far away, by 4.7e-4 and 5.9e-6; scaled,
-/// by up to 6.8e-4 (the Whitted ray tracer at 1e-3, the same edges). Without the frame, 3e3
-/// units away they measured 7.1e-3 and 2.3e-3, 1e4 units away 1.3e-2 and 9.1e-3.
+/// by up to 6.8e-4 (the Whitted ray tracer at 1e-3, the same edges). Without the frame, 1e4
+/// units away they measure 1.4e-3 and 5.9e-4, 1e5 units away 4.2e-2 and 1.4e-2.
 const MAX_REL_MSE: f64 = 2e-3;
 /// Largest |transformed / home - 1| of a region's mean luminance. The smallest region, the
 /// metal sphere's shadow, is 173 pixels; one of a pixel's 4 Whitted rays moving across its
 /// shadow edge (lit is about 4.5 times as bright) moves that region's mean by about 5e-3, so
 /// the bound allows two. Measured: at most 1.8e-3 (the Whitted ray tracer at scales 1e-3, 1e3
-/// and 1e4), 2.0e-4 moved; without the frame 5.2e-3 and 5.8e-3 at 3e3 units, 1.1e-2 and 2.3e-2 at 1e4.
+/// and 1e4), 2.0e-4 moved; without the frame 1.1e-2 and 4.0e-3 at 1e4 units, 0.20 and 0.094 at 1e5.
 const MAX_LUMINANCE_DIFFERENCE: f64 = 1e-2;
 
 fn gpu() -> &'static GpuContext {
@@ -265,11 +265,12 @@ fn in_world_f32(home: &Scene, offset: Vec3) -> Scene {
 }
 
 /// The criterion can fail: without the frame, the Whitted ray tracer's and the path tracer's
-/// images of the Whitted scene moved by (m, m, m), m = 1e4 and 1e5, differ from home's beyond it
-/// (the glass sphere's refracted checkerboard changes, shadow edges move). m = 1e3 and 3e3 are
-/// printed for the record: already there the images move by 2 to 8 times the nudge's relMSE.
+/// images of the Whitted scene moved by (m, m, m), m = 1e5, differ from home's beyond it (the
+/// glass sphere's refracted checkerboard changes, shadow edges move). m = 1e3, 3e3 and 1e4 are
+/// printed for the record: the images move there too, by less than the criterion allows for the
+/// path tracer since rays leave spheres without an offset (geometry.wgsl, hit_sphere's `own`).
 #[test]
-fn without_the_frame_the_whitted_scene_1e4_units_away_fails_the_criterion() {
+fn without_the_frame_the_whitted_scene_1e5_units_away_fails_the_criterion() {
     let home_scene = scene("whitted.toml", DVec3::ZERO);
     let regions = regions(&home_scene);
     for renderer in [Renderer::Whitted, Renderer::PathTrace] {
@@ -284,7 +285,7 @@ fn without_the_frame_the_whitted_scene_1e4_units_away_fails_the_criterion() {
             );
             let fails = rel_mse > MAX_REL_MSE || worst > MAX_LUMINANCE_DIFFERENCE;
             assert!(
-                fails || magnitude < 1e4,
+                fails || magnitude < 1e5,
                 "{renderer:?}: the criterion does not see the world-f32 render at {magnitude:e} (relMSE {rel_mse:.2e})"
             );
         }

@@ -52,7 +52,7 @@
 #endif
 
 // The particle of outgoing factor `weight` (flux rho / pi) at surface s, seen from the eye.
-fn connect(frame: u32, s: Surface, weight: vec3<f32>) {
+fn connect(frame: u32, s: Surface, own: u32, weight: vec3<f32>) {
     let to_eye = params.camera.eye - s.p;
     let r2 = dot(to_eye, to_eye);
     let w = to_eye / sqrt(r2);
@@ -74,7 +74,7 @@ fn connect(frame: u32, s: Surface, weight: vec3<f32>) {
     let origin = spawn_point(s.p, s.n, s.err);
     let segment = params.camera.eye - origin;
     let distance = length(segment);
-    let hit = closest_hit(origin, segment / distance);
+    let hit = closest_hit(origin, segment / distance, own);
     if (hit.index != NO_HIT && hit.t < distance) {
         return;
     }
@@ -150,10 +150,13 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     // scene's size: an absolute one would put it many scene sizes away in a scene of small units,
     // where its hits lose precision (tests/transforms.rs scales the scene from 1e-4 to 1e4).
     var o = x + d0 * (dot(caustic.scene_centre - x, d0) - 2.0 * caustic.scene_radius);
+    // The object whose surface o lies on: closest_hit's `own`.
+    var own = NO_HIT;
     var d = d0;
     var scatterings = 0u;
     loop {
-        let hit = closest_hit(o, d);
+        let hit = closest_hit(o, d, own);
+        own = hit.index;
         if (hit.index == NO_HIT) {
             return;
         }
@@ -197,7 +200,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 #ifdef CAUSTIC_GATHER
             store_photon(frame, particle, s, throughput * albedo * INV_PI, scatterings);
 #endif
-            connect(frame, s, throughput * albedo * INV_PI);
+            connect(frame, s, own, throughput * albedo * INV_PI);
             return;
         }
         scatterings += 1u;

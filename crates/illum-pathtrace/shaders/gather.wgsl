@@ -93,10 +93,13 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let inv_size = vec2<f32>(1.0 / f32(params.width), 1.0 / f32(params.height));
     var d = camera_ray(params.camera, vec2<f32>(f32(x) + jitter.x, f32(y) + jitter.y), inv_size);
     var o = params.camera.eye;
+    // The object whose surface o lies on: closest_hit's `own`.
+    var own = NO_HIT;
     var throughput = vec3<f32>(1.0);
     var specular = 0u;
     loop {
-        let hit = closest_hit(o, d);
+        let hit = closest_hit(o, d, own);
+        own = hit.index;
         if (hit.index == NO_HIT) {
             return;
         }

@@ -45,11 +45,14 @@ struct Guide {
 // The first non-specular surface along the camera ray from the eye along d.
 fn first_diffuse(d_camera: vec3<f32>, sampler: ptr<function, Sampler>) -> Guide {
     var o = params.camera.eye;
+    // The object whose surface o lies on: closest_hit's `own`.
+    var own = NO_HIT;
     var d = d_camera;
     var weight = vec3<f32>(1.0);
     var depth = 0u;
     loop {
-        let hit = closest_hit(o, d);
+        let hit = closest_hit(o, d, own);
+        own = hit.index;
         if (hit.index == NO_HIT) {
             return Guide(vec3<f32>(0.0), vec3<f32>(0.0));
         }

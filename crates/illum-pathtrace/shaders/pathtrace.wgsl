@@ -52,7 +52,7 @@ const SHADOW_SHORTEN: f32 = 9.5367431640625e-7;
 // arriving from one point sampled on the lights, already divided by its pdf
 // (p(s, t) / A_total) and multiplied by cos(theta_x); the caller multiplies by albedo / pi. The
 // geometry uses the surface point itself; only visibility is tested from the spawned origin.
-fn direct_light(s: Surface, origin: vec3<f32>, sampler: ptr<function, Sampler>) -> vec3<f32> {
+fn direct_light(s: Surface, origin: vec3<f32>, own: u32, sampler: ptr<function, Sampler>) -> vec3<f32> {
 #ifdef LIGHT_CHOICE
     let light = lights[choose_light(sample_1d(sampler) * params.light_area)];
 #else
@@ -86,7 +86,7 @@ fn direct_light(s: Surface, origin: vec3<f32>, sampler: ptr<function, Sampler>) 
     let segment = y - origin;
     let length_to_light = length(segment);
     let t_max = length_to_light * (1.0 - SHADOW_SHORTEN) - err_l / cos_y;
-    let visible = lit && !occluded(origin, segment / length_to_light, t_max);
+    let visible = lit && !occluded(origin, segment / length_to_light, t_max, own);
     return select(vec3<f32>(0.0), light.emission.xyz * (cos_x * cos_y / dist2 * params.light_area * st.z), visible);
 }
 
@@ -95,7 +95,7 @@ fn direct_light(s: Surface, origin: vec3<f32>, sampler: ptr<function, Sampler>) 
 // contribution to the integral of incoming radiance x cos(theta_x), divided by its pdf (see
 // surfaces.wgsl's sample_sun). A sun disc draws two numbers; a delta sun none. Every object
 // blocks it.
-fn sun_light(s: Surface, origin: vec3<f32>, sampler: ptr<function, Sampler>) -> vec3<f32> {
+fn sun_light(s: Surface, origin: vec3<f32>, own: u32, sampler: ptr<function, Sampler>) -> vec3<f32> {
 #ifdef SUN_DISC
     let u = sample_2d(sampler);
     let sun = sample_sun(u.x, u.y);
@@ -105,7 +105,7 @@ fn sun_light(s: Surface, origin: vec3<f32>, sampler: ptr<function, Sampler>) -> 
     let w = sun.w;
     let weight = sun.weight;
     let cos_x = dot(s.n, w);
-    if (cos_x > 0.0 && !occluded(origin, w, FAR)) {
+    if (cos_x > 0.0 && !occluded(origin, w, FAR, own)) {
         return weight * cos_x;
     }
     return vec3<f32>(0.0);
@@ -157,11 +157,13 @@ struct Path {
     // Set at the camera ray's own diffuse hit when the caustic estimator is on, kept through
     // specular scattering: the path E D S+ L it would complete belongs to the light tracer.
     caustic_owned: bool,
+    // The object whose surface o lies on (NO_HIT for the camera ray): closest_hit's `own`.
+    own: u32,
 }
 
 // A path starting with the camera ray from the eye along d.
 fn camera_path(d: vec3<f32>) -> Path {
-    return Path(params.camera.eye, d, vec3<f32>(1.0), vec3<f32>(0.0), 0u, true, true, false);
+    return Path(params.camera.eye, d, vec3<f32>(1.0), vec3<f32>(0.0), 0u, true, true, false, NO_HIT);
 }
 
 // Traces one vertex of the path: its radiance estimate gains what this vertex adds, and the
@@ -193,7 +195,7 @@ fn path_step(path: ptr<function, Path>, sampler: ptr<function, Sampler>) {
     let was_alive = (*path).alive;
     var radiance = (*path).radiance;
 
-    let hit = closest_hit(o, d);
+    let hit = closest_hit(o, d, (*path).own);
     let missed = hit.index == NO_HIT;
     // object_at and material_at: literals in a specialised pipeline (illum-rtcore). A missed
     // ray looks at object 0, whose vertex is never used.
@@ -210,7 +212,7 @@ fn path_step(path: ptr<function, Path>, sampler: ptr<function, Sampler>) {
     s.n = select(-s.n, s.n, front);
     let last = (params.bounces != UNBOUNDED && depth >= params.bounces) || depth >= UNBOUNDED_DEPTH_CAP;
     let at_surface = was_alive && !missed && !emitter;
-    var next = Path(o, d, throughput, radiance, depth + 1u, false, false, caustic_owned);
+    var next = Path(o, d, throughput, radiance, depth + 1u, false, false, caustic_owned, hit.index);
 #ifdef SPECULAR
     let m = material_at(obj.material);
     let kind = m.kind;
@@ -258,7 +260,7 @@ fn diffuse_vertex(material: u32, index: u32, s: Surface, depth: u32, last: bool,
     // Every ray leaving this point (shadow and bounce) starts here, off the surface.
     let spawned = spawn_point(s.p, s.n, s.err);
     var throughput = (*next).throughput;
-    let light = throughput * albedo * INV_PI * direct(s, spawned, sampler);
+    let light = throughput * albedo * INV_PI * direct(s, spawned, index, sampler);
     (*next).radiance += select(vec3<f32>(0.0), light, live);
     let u = sample_2d(sampler);
     // Lambertian f = albedo / pi. Cosine pdf cos/pi: f cos / pdf = albedo.
@@ -284,13 +286,13 @@ fn diffuse_vertex(material: u32, index: u32, s: Surface, depth: u32, last: bool,
 }
 
 // Next-event estimation at a diffuse point: the area lights and the directional light.
-fn direct(s: Surface, origin: vec3<f32>, sampler: ptr<function, Sampler>) -> vec3<f32> {
+fn direct(s: Surface, origin: vec3<f32>, own: u32, sampler: ptr<function, Sampler>) -> vec3<f32> {
     var l = vec3<f32>(0.0);
 #ifdef AREA_LIGHTS
-    l += direct_light(s, origin, sampler);
+    l += direct_light(s, origin, own, sampler);
 #endif
 #ifdef SUN
-    l += sun_light(s, origin, sampler);
+    l += sun_light(s, origin, own, sampler);
 #endif
     return l;
 }

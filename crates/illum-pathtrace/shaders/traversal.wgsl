@@ -10,12 +10,13 @@
 #import illum::pathtrace::scene::{params, objects}
 
 // Closest hit over all objects. `d` must be unit length. Only the fields a shape's test needs are
-// loaded: on a CPU driver each storage-buffer read is a per-lane memory access.
-fn closest_hit(o: vec3<f32>, d: vec3<f32>) -> Hit {
+// loaded: on a CPU driver each storage-buffer read is a per-lane memory access. `own`: the object
+// whose surface the ray leaves (NO_HIT for none); its root at o is never taken (hit_sphere).
+fn closest_hit(o: vec3<f32>, d: vec3<f32>, own: u32) -> Hit {
     var best = Hit(FAR, NO_HIT);
     let inv_d = safe_inverse(d);
     for (var i = 0u; i < params.num_objects; i++) {
-        let t = hit_object_at(o, d, inv_d, i);
+        let t = hit_object_at(o, d, inv_d, i, own);
         // Emitters are stored last; they win ties with the surface they are set into.
         // (Capped at FAR: a missed emitter reports FAR, which must not count as a hit.)
         let limit = select(best.t, min(best.t * (1.0 + EMITTER_TIE), FAR), i >= params.first_emitter);
@@ -31,7 +32,7 @@ fn object_at(index: u32) -> Object {
     return objects[index];
 }
 
-fn hit_object_at(o: vec3<f32>, d: vec3<f32>, inv_d: vec3<f32>, i: u32) -> f32 {
+fn hit_object_at(o: vec3<f32>, d: vec3<f32>, inv_d: vec3<f32>, i: u32, own: u32) -> f32 {
     switch objects[i].kind {
         case KIND_AABB: { return hit_slabs(o, inv_d, objects[i].a.xyz, objects[i].b.xyz); }
         case KIND_BOX: {
@@ -42,15 +43,15 @@ fn hit_object_at(o: vec3<f32>, d: vec3<f32>, inv_d: vec3<f32>, i: u32) -> f32 {
             let obj = objects[i];
             return hit_quad(o, d, obj.a.xyz, obj.b.xyz, obj.c.xyz, obj.d.xyz);
         }
-        default: { return hit_sphere(o, d, objects[i].a.xyz, objects[i].a.w); }
+        default: { return hit_sphere(o, d, objects[i].a.xyz, objects[i].a.w, i == own); }
     }
 }
 
 // True when a non-emitting object lies on the ray strictly between 0 and t_max.
-fn occluded(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> bool {
+fn occluded(o: vec3<f32>, d: vec3<f32>, t_max: f32, own: u32) -> bool {
     let inv_d = safe_inverse(d);
     for (var i = 0u; i < params.first_emitter; i++) {
-        if (hit_object_at(o, d, inv_d, i) < t_max) {
+        if (hit_object_at(o, d, inv_d, i, own) < t_max) {
             return true;
         }
     }

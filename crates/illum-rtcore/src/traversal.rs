@@ -99,8 +99,9 @@ impl Traversal {
     }
 }
 
-/// The WGSL expression for the object's hit distance along (o, d); `inv_d` = 1 / d.
-fn hit_expression(object: &GpuObject) -> String {
+/// The WGSL expression for the hit distance along (o, d) of the object at `index`; `inv_d` =
+/// 1 / d, `own` the index of the object the ray leaves (geometry.wgsl's hit_sphere).
+fn hit_expression(object: &GpuObject, index: usize) -> String {
     match object.shape {
         GpuShape::Aabb { min, max } => format!("hit_slabs(o, inv_d, {}, {})", vec3(min), vec3(max)),
         GpuShape::Box { local_min, local_max, cos, sin, offset } => format!(
@@ -118,7 +119,9 @@ fn hit_expression(object: &GpuObject) -> String {
             vec3(edge_v),
             vec3(edge_u.cross(edge_v))
         ),
-        GpuShape::Sphere { center, radius } => format!("hit_sphere(o, d, {}, {})", vec3(center), lit(radius)),
+        GpuShape::Sphere { center, radius } => {
+            format!("hit_sphere(o, d, {}, {}, own == {index}u)", vec3(center), lit(radius))
+        }
     }
 }
 
@@ -310,7 +313,7 @@ pub fn generate(scene: &Geometry) -> Traversal {
     let mut occluders = Vec::new();
     for (i, object) in scene.objects.iter().enumerate() {
         let name = scene.names[i].replace(['\n', '\r'], " ");
-        let hit = hit_expression(object);
+        let hit = hit_expression(object, i);
         closest.push_str(&format!("    // {i}: {name}\n    t = {hit};\n"));
         if object.emitter {
             // The emitter wins a tie with the surface it is set into (EMITTER_TIE in geometry.wgsl); the cap at
@@ -348,15 +351,18 @@ pub fn generate(scene: &Geometry) -> Traversal {
 #import illum::rtcore::codes::{{KIND_AABB, KIND_BOX, KIND_QUAD, KIND_SPHERE}}
 #import illum::rtcore::geometry::{{Hit, Object, FAR, NO_HIT, EMITTER_TIE, safe_inverse, hit_slabs, hit_box, hit_quad, hit_sphere, Surface, surface_aabb, surface_box, surface_quad, surface_sphere}}
 
-fn closest_hit(o: vec3<f32>, d: vec3<f32>) -> Hit {{
+// The nearest object along the ray from o in the unit direction d. `own`: the index of the object
+// whose surface the ray leaves (NO_HIT for a camera or light ray); its root at o is never taken.
+fn closest_hit(o: vec3<f32>, d: vec3<f32>, own: u32) -> Hit {{
     let inv_d = safe_inverse(d);
     var best = Hit(FAR, NO_HIT);
     var t: f32;
 {closest}    return best;
 }}
 
-// True when an object that can block a light lies on the ray strictly between 0 and t_max.
-fn occluded(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> bool {{
+// True when an object that can block a light lies on the ray strictly between 0 and t_max
+// (`own` as for closest_hit).
+fn occluded(o: vec3<f32>, d: vec3<f32>, t_max: f32, own: u32) -> bool {{
     let inv_d = safe_inverse(d);
 {occluded}    return false;
 }}

@@ -64,9 +64,11 @@ struct Ray {
     d: vec3<f32>,
     weight: vec3<f32>,
     depth: u32,
+    // The object whose surface the ray leaves (NO_HIT for the camera's): closest_hit's `own`.
+    own: u32,
 }
 
-// Light from every light at p (normal n toward the viewer, spawn error err), for a white
+// Light from every light at p on object `own` (normal n toward the viewer, spawn error err), for a white
 // Lambertian surface (sum E_l max(n.l, 0) V_l) and for a Blinn-Phong highlight of `shininess`
 // seen along v (sum E_l max(n.h, 0)^shininess V_l where n.l > 0).
 struct Lit {
@@ -74,7 +76,7 @@ struct Lit {
     highlight: vec3<f32>,
 }
 
-fn light_at(p: vec3<f32>, n: vec3<f32>, err: f32, v: vec3<f32>, shininess: f32) -> Lit {
+fn light_at(p: vec3<f32>, n: vec3<f32>, err: f32, own: u32, v: vec3<f32>, shininess: f32) -> Lit {
     var lit = Lit(vec3<f32>(0.0), vec3<f32>(0.0));
     let origin = spawn_point(p, n, err);
     for (var li = 0u; li < params.counts.x; li++) {
@@ -102,7 +104,7 @@ fn light_at(p: vec3<f32>, n: vec3<f32>, err: f32, v: vec3<f32>, shininess: f32) 
 #endif
         }
         let cos_n = dot(n, l);
-        if (cos_n <= 0.0 || all(e == vec3<f32>(0.0)) || occluded(origin, l, t_max)) {
+        if (cos_n <= 0.0 || all(e == vec3<f32>(0.0)) || occluded(origin, l, t_max, own)) {
             continue;
         }
         lit.diffuse += e * cos_n;
@@ -114,12 +116,12 @@ fn light_at(p: vec3<f32>, n: vec3<f32>, err: f32, v: vec3<f32>, shininess: f32) 
 fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
     var stack: array<Ray, MAX_STACK>;
     var top = 1u;
-    stack[0] = Ray(eye, dir, vec3<f32>(1.0), params.counts.y);
+    stack[0] = Ray(eye, dir, vec3<f32>(1.0), params.counts.y, NO_HIT);
     var colour = vec3<f32>(0.0);
     while (top > 0u) {
         top -= 1u;
         let ray = stack[top];
-        let hit = closest_hit(ray.o, ray.d);
+        let hit = closest_hit(ray.o, ray.d, ray.own);
         if (hit.index == NO_HIT) {
             colour += ray.weight * params.background.rgb;
             continue;
@@ -142,11 +144,11 @@ fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
             case MATERIAL_MIRROR: {
                 let c = m.a.rgb;
                 let w = params.shading.x;
-                let lit = light_at(s.p, n, s.err, v, params.mirror_specular.w);
+                let lit = light_at(s.p, n, s.err, hit.index, v, params.mirror_specular.w);
                 colour += ray.weight
                     * ((1.0 - w) * c * (params.ambient.rgb + lit.diffuse) + params.mirror_specular.rgb * lit.highlight);
                 if (ray.depth > 0u && top < MAX_STACK) {
-                    stack[top] = Ray(spawn_point(s.p, n, s.err), reflect(ray.d, n), ray.weight * w * c, ray.depth - 1u);
+                    stack[top] = Ray(spawn_point(s.p, n, s.err), reflect(ray.d, n), ray.weight * w * c, ray.depth - 1u, hit.index);
                     top += 1u;
                 }
             }
@@ -156,7 +158,7 @@ fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
                 // Entering through the front or leaving.
                 let ior = m.a.w;
                 let eta = select(ior, 1.0 / ior, front);
-                let lit = light_at(s.p, n, s.err, v, params.shading.y);
+                let lit = light_at(s.p, n, s.err, hit.index, v, params.shading.y);
                 colour += ray.weight * lit.highlight;
                 if (ray.depth > 0u) {
                     let cos_i = dot(v, n);
@@ -164,7 +166,7 @@ fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
                     let reflected = reflect(ray.d, n);
                     if (k < 0.0) {
                         if (top < MAX_STACK) {
-                            stack[top] = Ray(spawn_point(s.p, n, s.err), reflected, ray.weight, ray.depth - 1u);
+                            stack[top] = Ray(spawn_point(s.p, n, s.err), reflected, ray.weight, ray.depth - 1u, hit.index);
                             top += 1u;
                         }
                     } else {
@@ -172,9 +174,9 @@ fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
                         let transmitted = refracted(ray.d, n, eta, cos_i, cos_t);
                         let f = fresnel(cos_i, cos_t, eta);
                         if (top + 1u < MAX_STACK) {
-                            stack[top] = Ray(spawn_point(s.p, n, s.err), reflected, ray.weight * f, ray.depth - 1u);
+                            stack[top] = Ray(spawn_point(s.p, n, s.err), reflected, ray.weight * f, ray.depth - 1u, hit.index);
                             stack[top + 1u] =
-                                Ray(spawn_point(s.p, -n, s.err), transmitted, ray.weight * (1.0 - f), ray.depth - 1u);
+                                Ray(spawn_point(s.p, -n, s.err), transmitted, ray.weight * (1.0 - f), ray.depth - 1u, hit.index);
                             top += 2u;
                         }
                     }
@@ -188,7 +190,7 @@ fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
                     c = checker_albedo(obj, m, s.p);
                 }
 #endif
-                let lit = light_at(s.p, n, s.err, v, 1.0);
+                let lit = light_at(s.p, n, s.err, hit.index, v, 1.0);
                 colour += ray.weight * c * (params.ambient.rgb + lit.diffuse);
             }
         }
@@ -206,7 +208,7 @@ const SHADOW_LIT: u32 = 0xfffffffeu;
 const SHADOW_FACING_AWAY: u32 = 0xfffffffdu;
 
 fn object_ids(eye: vec3<f32>, d: vec3<f32>) -> vec2<u32> {
-    let hit = closest_hit(eye, d);
+    let hit = closest_hit(eye, d, NO_HIT);
     if (hit.index == NO_HIT || params.counts.x == 0u) {
         return vec2<u32>(hit.index, SHADOW_LIT);
     }
@@ -223,7 +225,7 @@ fn object_ids(eye: vec3<f32>, d: vec3<f32>) -> vec2<u32> {
     if (dot(n, l) <= 0.0) {
         return vec2<u32>(hit.index, SHADOW_FACING_AWAY);
     }
-    let blocker = closest_hit(spawn_point(s.p, n, s.err), l);
+    let blocker = closest_hit(spawn_point(s.p, n, s.err), l, hit.index);
     let blocks = blocker.index < params.sizes.z && blocker.t < t_max;
     return vec2<u32>(hit.index, select(SHADOW_LIT, blocker.index, blocks));
 }
