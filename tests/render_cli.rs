@@ -989,6 +989,36 @@ fn caustics_on_off_is_recorded_and_a_checkpoint_of_the_other_setting_is_refused(
         "resuming a file from before the gather",
         &["caustic_estimators: light tracer in the file"],
     );
+    // A file rendered without the sun's glint (`illum.glint`, and its estimators without it)
+    // lacks the sun's image in the balls: resuming it is refused by name too.
+    assert_ne!(field(&metadata(&exr), "glint"), "none");
+    let mut before_glint = illum::pathtrace::checkpoint::load_checkpoint(&exr).unwrap();
+    for (key, value) in &mut before_glint.metadata.fields {
+        if key == "caustic_estimators" {
+            *value = value.replace("; glint solved", "");
+        }
+    }
+    before_glint.metadata.fields.retain(|(k, _)| k != "glint");
+    let old = dir.path().join("before-glint.exr");
+    illum::pathtrace::checkpoint::save_loaded(&old, &before_glint).unwrap();
+    let out = run(&[
+        "scenes/whitted.toml",
+        "--renderer",
+        "pathtrace",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--resume",
+        old.to_str().unwrap(),
+        "--spp",
+        "32",
+    ]);
+    assert_refused(
+        &out,
+        "resuming a file from before the glint",
+        &["caustic_estimators:", "glint solved now"],
+    );
 
     // A bad value and the raster renderer are refused by name.
     let out = run(&["scenes/whitted.toml", "--renderer", "pathtrace", "--caustics", "maybe"]);
