@@ -48,6 +48,7 @@ pub mod chi_square;
 pub mod closed_form;
 pub mod gather;
 pub mod geometry;
+pub mod glint;
 mod integrator;
 pub mod optics;
 mod parallel;

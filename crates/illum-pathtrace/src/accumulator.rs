@@ -29,6 +29,10 @@ pub struct Accumulator {
     /// Per-replicate sums of a low-discrepancy render (see `replicates.rs`): when present, the
     /// variance of each pixel's mean comes from their spread instead of s^2 / n.
     replicates: Option<Replicates>,
+    /// The sun's glint (`glint.rs`): (pixel, radiance) sorted by pixel, added to those pixels'
+    /// means and to nothing else. A point mass solved exactly has no variance: the statistics,
+    /// the error estimate and the checkpoints' layers hold the samples alone.
+    glint: Vec<(usize, [f64; 3])>,
 }
 
 /// Largest emitted radiance the GPU traces unscaled: 2^16. Above it the scene's emission is
@@ -123,6 +127,7 @@ impl Accumulator {
             dropped: 0,
             sum_scale: 1.0,
             replicates: None,
+            glint: Vec::new(),
         }
     }
 
@@ -140,7 +145,18 @@ impl Accumulator {
         sum.resize(n, [0.0; 3]);
         sum_sq.resize(n, [0.0; 3]);
         count.resize(n, 0);
-        Ok(Self { width, height, sum, sum_sq, count, total: 0, dropped: 0, sum_scale: 1.0, replicates: None })
+        Ok(Self {
+            width,
+            height,
+            sum,
+            sum_sq,
+            count,
+            total: 0,
+            dropped: 0,
+            sum_scale: 1.0,
+            replicates: None,
+            glint: Vec::new(),
+        })
     }
 
     /// Folds from now on values the GPU computed with radiance scaled by 2^-`exponent` (see
@@ -175,7 +191,18 @@ impl Accumulator {
             ));
         }
         let total = count.iter().sum();
-        Ok(Self { width, height, sum, sum_sq, count, total, dropped, sum_scale: 1.0, replicates: None })
+        Ok(Self {
+            width,
+            height,
+            sum,
+            sum_sq,
+            count,
+            total,
+            dropped,
+            sum_scale: 1.0,
+            replicates: None,
+            glint: Vec::new(),
+        })
     }
 
     /// Keeps per-replicate sums from now on (a low-discrepancy render, see `replicates.rs`); the
@@ -343,9 +370,39 @@ impl Accumulator {
         self.count[pixel]
     }
 
+    /// The pixel's estimate: the mean of its samples, plus the glint solved into it once it has
+    /// a sample (0 before).
     pub fn pixel_mean(&self, pixel: usize) -> [f64; 3] {
-        let n = self.count[pixel].max(1) as f64;
-        self.sum[pixel].map(|s| s / n)
+        let n = self.count[pixel];
+        let mean = self.sum[pixel].map(|s| s / n.max(1) as f64);
+        match self.glint.binary_search_by_key(&pixel, |g| g.0) {
+            Ok(i) if n > 0 => [0, 1, 2].map(|c| mean[c] + self.glint[i].1[c]),
+            _ => mean,
+        }
+    }
+
+    /// Sets the glint added to the pixels' means: (pixel, radiance), at most once per pixel
+    /// Refused for a pixel outside the image.
+    pub fn set_glint(&mut self, glint: &[(usize, [f64; 3])]) -> Result<(), String> {
+        if let Some(&(p, _)) = glint.iter().find(|g| g.0 >= self.count.len()) {
+            return Err(format!("glint pixel {p} is outside the {} x {} image", self.width, self.height));
+        }
+        let mut sorted = glint.to_vec();
+        sorted.sort_by_key(|g| g.0);
+        // Two entries for one pixel add.
+        self.glint = Vec::with_capacity(sorted.len());
+        for (p, v) in sorted {
+            match self.glint.last_mut() {
+                Some((q, w)) if *q == p => (0..3).for_each(|c| w[c] += v[c]),
+                _ => self.glint.push((p, v)),
+            }
+        }
+        Ok(())
+    }
+
+    /// The glint added to the means: (pixel, radiance), sorted by pixel.
+    pub fn glint(&self) -> &[(usize, [f64; 3])] {
+        &self.glint
     }
 
     /// Variance of the pixel's mean, per channel: from the spread of the replicate means when
@@ -534,6 +591,25 @@ mod tests {
         assert_eq!(c.pixel_sum(0), [2.0, 4.0, 6.0]);
         assert_eq!(c.pixel_count(1), 4);
         assert!(Accumulator::from_state(3, 1, vec![], vec![], vec![], 0).unwrap_err().contains("3 x 1"));
+    }
+
+    #[test]
+    fn the_glint_adds_to_the_mean_of_sampled_pixels_and_to_nothing_else() {
+        let mut acc = Accumulator::new(3, 1);
+        acc.set_glint(&[(1, [5.0, 6.0, 7.0]), (1, [1.0, 1.0, 1.0])]).unwrap();
+        assert_eq!(acc.glint(), &[(1, [6.0, 7.0, 8.0])], "entries of one pixel add");
+        assert_eq!(acc.pixel_mean(1), [0.0; 3], "no sample yet: no glint");
+        let sums = [[2.0, 2.0, 2.0, 2.0]; 3];
+        let squares = [[2.0, 2.0, 2.0, 0.0]; 3];
+        acc.fold(0, &sums, &squares);
+        assert_eq!(acc.pixel_mean(0), [1.0; 3]);
+        assert_eq!(acc.pixel_mean(1), [7.0, 8.0, 9.0]);
+        assert_eq!(acc.pixel_variance_of_mean(1), acc.pixel_variance_of_mean(0), "no variance of its own");
+        assert_eq!(acc.pixel_sum(1), [2.0; 3], "the statistics hold the samples alone");
+        acc.reset();
+        acc.fold(0, &sums, &squares);
+        assert_eq!(acc.pixel_mean(1), [7.0, 8.0, 9.0], "kept across a reset");
+        assert!(acc.set_glint(&[(3, [1.0; 3])]).unwrap_err().contains("outside the 3 x 1 image"));
     }
 
     #[test]

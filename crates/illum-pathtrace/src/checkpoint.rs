@@ -188,6 +188,8 @@ impl CheckpointHeader {
                 },
                 str::to_owned,
             )),
+            // A file without the key has no glint in its means.
+            "glint" => Some(self.metadata.get(key).unwrap_or("none").to_owned()),
             _ => self.metadata.get(key).map(str::to_owned),
         }
     }
@@ -294,7 +296,15 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint, CheckpointError> {
     let mut layers = layers.into_iter().map(|layer| {
         layer.map(|layer| statistics_from_layer(&layer, width, height, dropped).map_err(corrupt)).transpose()
     });
-    let accumulator = layers.next().transpose()?.flatten().ok_or_else(|| no_statistics(path))?;
+    let mut accumulator = layers.next().transpose()?.flatten().ok_or_else(|| no_statistics(path))?;
+    let glint = crate::metadata::parse_glint_field(metadata.get("glint").unwrap_or("none"))
+        .and_then(|glint| accumulator.set_glint(&glint).map(|()| glint))
+        .map_err(|reason| CheckpointError::InvalidField {
+            path: path.to_path_buf(),
+            field: "glint",
+            value: metadata.get("glint").unwrap_or_default().chars().take(80).collect(),
+            allowed: format!("none, or pixel:r,g,b entries joined by ';' inside the image ({reason})"),
+        })?;
     check_counts(&accumulator, spp_done, partial_pass).map_err(corrupt)?;
     let aligned_prefix = match layers.next().transpose()?.flatten() {
         Some(prefix) => {
@@ -315,6 +325,8 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint, CheckpointError> {
                 });
             }
             check_counts(&prefix, spp, None).map_err(|e| corrupt(format!("layer {ALIGNED_LAYER}: {e}")))?;
+            let mut prefix = prefix;
+            prefix.set_glint(&glint).map_err(corrupt)?;
             Some((prefix, spp))
         }
         None => None,

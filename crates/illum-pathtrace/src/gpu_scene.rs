@@ -175,7 +175,7 @@ pub fn caustics_active(scene: &Scene) -> bool {
 /// caustic's light scattered again by a diffuse surface (E (S|D)* D S* D S+ L).
 pub fn caustic_estimators(scene: &Scene) -> String {
     let code = SceneCode::new(scene, 0);
-    match (code.caustic, code.caustic_gather) {
+    let estimators = match (code.caustic, code.caustic_gather) {
         (false, _) => "none".to_owned(),
         (true, false) => "light tracer".to_owned(),
         (true, true) => format!(
@@ -183,7 +183,9 @@ pub fn caustic_estimators(scene: &Scene) -> String {
              largest specular radius, r_k = r_1 (k + 1)^(-1/6))",
             crate::tracer::GATHER_RADIUS_FRACTION
         ),
-    }
+    };
+    // The sun's glint E S* L, solved on the host (glint.rs): an image without it lacks that light.
+    if crate::glint::glint_active(scene) { format!("{estimators}; glint solved") } else { estimators }
 }
 
 /// `on` or `off`: [`caustics_active`] as EXR metadata and checkpoints store it.

@@ -18,6 +18,7 @@ pub mod checkpoint;
 pub mod display_sum;
 mod error;
 pub mod error_map;
+pub mod glint;
 pub mod gpu_scene;
 pub mod limits;
 pub mod metadata;

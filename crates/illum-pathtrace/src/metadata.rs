@@ -96,6 +96,7 @@ pub fn exr_metadata(
         ("sequence", tracer.options().sequence.to_string()),
         ("caustics", crate::gpu_scene::caustics_label(scene).to_owned()),
         ("caustic_estimators", crate::gpu_scene::caustic_estimators(scene)),
+        ("glint", glint_field(accumulator.glint())),
         ("estimated_relative_error", accumulator.estimated_relative_error().to_string()),
         ("dropped_samples", accumulator.dropped_samples().to_string()),
         ("stopped_by", stopped_by.map_or("none", StopReason::name).to_owned()),
@@ -117,5 +118,55 @@ pub fn exr_metadata(
         scene: scene.name.clone(),
         render_seconds,
         fields: fields.into_iter().map(|(k, v)| (k.to_owned(), v)).collect(),
+    }
+}
+
+/// The glint an image's means hold (`illum.glint`): `none`, or `pixel:r,g,b` entries joined by
+/// `;`, each value in Rust's shortest form that reads back to the same f64, so a checkpoint
+/// loaded again adds exactly what the render added.
+pub fn glint_field(glint: &[(usize, [f64; 3])]) -> String {
+    if glint.is_empty() {
+        return "none".to_owned();
+    }
+    let entries: Vec<String> = glint.iter().map(|(p, v)| format!("{p}:{},{},{}", v[0], v[1], v[2])).collect();
+    entries.join(";")
+}
+
+/// Reads [`glint_field`] back; the error names the entry that is not `pixel:r,g,b` of finite
+/// numbers.
+pub fn parse_glint_field(field: &str) -> Result<Vec<(usize, [f64; 3])>, String> {
+    if field == "none" {
+        return Ok(Vec::new());
+    }
+    field
+        .split(';')
+        .map(|entry| {
+            let bad = || format!("{entry:?} is not pixel:r,g,b (a pixel index and three finite radiances)");
+            let (pixel, rgb) = entry.split_once(':').ok_or_else(bad)?;
+            let pixel: usize = pixel.parse().map_err(|_| bad())?;
+            let values: Vec<f64> =
+                rgb.split(',').map(str::parse).collect::<Result<_, _>>().map_err(|_| bad())?;
+            match values[..] {
+                [r, g, b] if [r, g, b].iter().all(|v| v.is_finite()) => Ok((pixel, [r, g, b])),
+                _ => Err(bad()),
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_glint_field_reads_back_exactly_and_names_a_bad_entry() {
+        let glint = vec![(3, [0.1, 1.0 / 3.0, 2e-300]), (40, [6.02e23, 0.0, 1.0])];
+        assert_eq!(parse_glint_field(&glint_field(&glint)).unwrap(), glint);
+        assert_eq!(glint_field(&[]), "none");
+        assert!(parse_glint_field("none").unwrap().is_empty());
+        for bad in ["3:1,2", "x:1,2,3", "3:1,2,inf", "3;1,2,3", ""] {
+            let err = parse_glint_field(bad).unwrap_err();
+            assert!(err.contains("pixel:r,g,b"), "{bad}: {err}");
+        }
     }
 }

@@ -66,6 +66,13 @@ pub struct PathTracer {
     accumulation: Accumulation,
 }
 
+/// Solves `scene`'s glint (`glint.rs`) into the accumulator's means: none without a delta sun
+/// and the caustic's estimators.
+fn set_glint(accumulator: &mut Accumulator, scene: &Scene) {
+    let values = crate::glint::pixel_values(&crate::glint::solve(scene));
+    accumulator.set_glint(&values).expect("the solve keeps only pixels inside the image");
+}
+
 impl PathTracer {
     /// Validates `scene` against the device, compiles the (specialised) pipeline and allocates
     /// the buffers.
@@ -137,6 +144,7 @@ impl PathTracer {
         })?;
         let gpu_scene = GpuScene::new(scene)?;
         accumulator.set_radiance_exponent(gpu_scene.radiance_exponent);
+        set_glint(&mut accumulator, scene);
         let pipeline = ScenePipeline::new(gpu, scene, &gpu_scene, options, allocation)?;
         let mut bands = BandRunner::new(gpu, max_slots);
         if options.sequence == Sequence::LowDiscrepancy {
@@ -282,6 +290,7 @@ impl PathTracer {
         }
         self.pipeline.retarget(scene, &gpu_scene)?;
         self.reset();
+        set_glint(&mut self.accumulation.accumulator, scene);
         Ok(())
     }
 

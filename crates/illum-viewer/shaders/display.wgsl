@@ -15,6 +15,9 @@ struct Params {
 // Per pixel: rgb = running sum of finite samples, w = their count.
 @group(0) @binding(0) var<storage, read> display_sum: array<vec4<f32>>;
 @group(0) @binding(1) var<uniform> params: Params;
+// Per pixel: rgb = the sun's glint the path tracer solves on the host and adds to the pixel's
+// mean once it has a sample (crates/illum-pathtrace/src/glint.rs), in the display sum's units.
+@group(0) @binding(2) var<storage, read> glint: array<vec4<f32>>;
 
 // One triangle covering the whole target: vertices (-1,-1), (3,-1), (-1,3).
 @vertex
@@ -28,9 +31,10 @@ fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
     // The target has the image's size, so each fragment (at pixel centre x + 0.5, y + 0.5; row 0
     // at the top, as in the image) reads its own pixel.
     let pixel = vec2<u32>(position.xy);
-    let sum = display_sum[pixel.y * params.width + pixel.x];
-    // The mean of the finite samples; a pixel without any (w = 0, rgb = 0) shows black.
-    let mean = sum.rgb / max(sum.w, 1.0);
+    let index = pixel.y * params.width + pixel.x;
+    let sum = display_sum[index];
+    // The mean of the finite samples and the glint; a pixel without any (w = 0, rgb = 0) shows black.
+    let mean = sum.rgb / max(sum.w, 1.0) + select(vec3<f32>(0.0), glint[index].rgb, sum.w > 0.0);
     let encoded = pow(clamp(mean * params.scale, vec3<f32>(0.0), vec3<f32>(1.0)), vec3<f32>(1.0 / 2.2));
     return vec4<f32>(encoded, 1.0);
 }

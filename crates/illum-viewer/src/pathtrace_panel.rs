@@ -401,7 +401,18 @@ impl PathTraceMode {
             let camera = tracer.scene().camera;
             if let Some(display_sum) = tracer.display_sum_buffer() {
                 let mut renderer = render_state.renderer.write();
-                display.show(gpu, &mut renderer, display_sum, [camera.width, camera.height], stops);
+                // The glint is radiance; the display sum holds radiance / display_scale.
+                let glint_scale = 1.0 / tracer.display_scale();
+                let glint = tracer.accumulator().glint();
+                display.show(
+                    gpu,
+                    &mut renderer,
+                    display_sum,
+                    [camera.width, camera.height],
+                    stops,
+                    glint,
+                    glint_scale,
+                );
             }
             self.shown_exposure = self.settings.exposure;
         } else if self.shown_exposure != self.settings.exposure {

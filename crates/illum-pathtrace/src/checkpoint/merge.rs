@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use super::{Checkpoint, CheckpointError, CheckpointHeader, load_checkpoint, load_checkpoint_header};
 
 /// The keys two partial renders must agree on to be merged.
-const MERGE_KEYS: [&str; 10] = [
+const MERGE_KEYS: [&str; 11] = [
     "scene",
     "scene_hash",
     "width",
@@ -18,6 +18,7 @@ const MERGE_KEYS: [&str; 10] = [
     "sequence",
     "caustics",
     "caustic_estimators",
+    "glint",
 ];
 
 /// Checks that partial renders can be merged, from their headers alone, and sorts them into

@@ -5,6 +5,8 @@
 //! - `adaptive`: adaptive sampling gives each pixel its block's samples and stays unbiased;
 //! - `caustic`: the caustic's light tracer against the oracle, a closed form (an index-1 ball
 //!   vanishes), the error estimate with two estimators, extremes and its fixed point;
+//! - `glint`: a sun disc of 1 degree finds the glint (E S+ L) that the delta sun's host solve
+//!   adds, around its brightest pixels within a z-test, and not without it;
 //! - `closed_form`: direct light at floor points against Lambert's polygon formula;
 //! - `statistics`: the samplers agree, cosine sampling is less noisy, seeds, batching, no NaN;
 //! - `reference`: a small Cornell box against checked-in converged references, per pixel;
@@ -36,6 +38,7 @@ mod display_sum;
 mod error_estimate;
 mod extremes;
 mod furnace;
+mod glint;
 mod oracle_agreement;
 mod overflow;
 mod pacing;

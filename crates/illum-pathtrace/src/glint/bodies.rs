@@ -1,0 +1,243 @@
+//! The scene's geometry and specular materials in f64, for the glint's solve: nearest hits of a
+//! ray, with the surface normal, and how a mirror or a dielectric scatters it.
+
+use glam::DVec3;
+use illum_scene::{MaterialKind, Scene, Shape};
+
+/// How a surface scatters light, as far as the glint is concerned.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Surface {
+    /// Lambertian, checker or emitter: a chain that reaches it carries no glint.
+    Other,
+    Mirror {
+        reflectance: [f64; 3],
+    },
+    Dielectric {
+        ior: f64,
+    },
+}
+
+#[derive(Clone, Copy, Debug)]
+enum Body {
+    Sphere {
+        center: DVec3,
+        radius: f64,
+    },
+    Quad {
+        corner: DVec3,
+        edge_u: DVec3,
+        edge_v: DVec3,
+        normal: DVec3,
+    },
+    /// `world = rotation * local + offset`, local box [min, max].
+    Box {
+        min: DVec3,
+        max: DVec3,
+        rotation: glam::DMat3,
+        offset: DVec3,
+    },
+}
+
+/// A ray's nearest hit: the object, the distance along the (unit) direction and the outward
+/// geometric normal there.
+#[derive(Clone, Copy, Debug)]
+pub struct Hit {
+    pub object: usize,
+    pub t: f64,
+    pub normal: DVec3,
+}
+
+/// Every object of a scene, in f64, with its surface.
+#[derive(Clone, Debug)]
+pub struct Bodies {
+    bodies: Vec<Body>,
+    surfaces: Vec<Surface>,
+    /// Scene size, for the distance below which a ray leaving a flat face ignores hits.
+    scale: f64,
+}
+
+fn d3(v: glam::Vec3) -> DVec3 {
+    v.as_dvec3()
+}
+
+impl Bodies {
+    pub fn new(scene: &Scene) -> Self {
+        let mut scale: f64 = 1.0;
+        let bodies: Vec<Body> = scene
+            .objects
+            .iter()
+            .map(|o| match o.shape {
+                Shape::Sphere(s) => {
+                    scale = scale.max(d3(s.center).abs().max_element() + f64::from(s.radius));
+                    Body::Sphere { center: d3(s.center), radius: f64::from(s.radius) }
+                }
+                Shape::Quad(q) => {
+                    let (u, v) = (d3(q.edge_u), d3(q.edge_v));
+                    scale = scale.max(d3(q.corner).abs().max_element() + u.length() + v.length());
+                    Body::Quad { corner: d3(q.corner), edge_u: u, edge_v: v, normal: u.cross(v).normalize() }
+                }
+                Shape::Box(b) => {
+                    let rotation = glam::DMat3::from_rotation_y(f64::from(b.rotate_y_deg).to_radians());
+                    let offset = d3(b.pivot) + d3(b.translate) - rotation * d3(b.pivot);
+                    scale = scale.max(offset.abs().max_element() + d3(b.max - b.min).length());
+                    Body::Box { min: d3(b.min), max: d3(b.max), rotation, offset }
+                }
+            })
+            .collect();
+        let surfaces = scene
+            .objects
+            .iter()
+            .map(|o| match scene.material_of(o).kind {
+                MaterialKind::Mirror { reflectance } => {
+                    Surface::Mirror { reflectance: d3(reflectance).to_array() }
+                }
+                MaterialKind::Dielectric { ior } => Surface::Dielectric { ior: f64::from(ior) },
+                _ => Surface::Other,
+            })
+            .collect();
+        Self { bodies, surfaces, scale }
+    }
+
+    pub fn surface(&self, object: usize) -> Surface {
+        self.surfaces[object]
+    }
+
+    /// The spheres with a specular surface: (object, centre, radius).
+    pub fn specular_spheres(&self) -> impl Iterator<Item = (usize, DVec3, f64)> + '_ {
+        self.bodies.iter().enumerate().filter_map(|(i, b)| match (b, self.surfaces[i]) {
+            (_, Surface::Other) => None,
+            (Body::Sphere { center, radius }, _) => Some((i, *center, *radius)),
+            _ => None,
+        })
+    }
+
+    /// Whether any object other than a sphere is specular (a flat mirror or a glass box).
+    pub fn has_flat_specular(&self) -> bool {
+        self.bodies
+            .iter()
+            .zip(&self.surfaces)
+            .any(|(b, s)| *s != Surface::Other && !matches!(b, Body::Sphere { .. }))
+    }
+
+    /// The nearest hit of the ray `o + t d` (d a unit vector), `t > 0`, leaving the surface of
+    /// object `own` (None for the camera ray). Leaving a sphere, its root at the origin is
+    /// skipped exactly: the other root is `-2 (o - c).d`. Leaving a flat face, hits nearer than
+    /// 1e-9 of the scene's size are ignored.
+    pub fn nearest(&self, o: DVec3, d: DVec3, own: Option<usize>) -> Option<Hit> {
+        let mut best: Option<Hit> = None;
+        let flat_min = 1e-9 * self.scale;
+        for (i, body) in self.bodies.iter().enumerate() {
+            let hit = match *body {
+                Body::Sphere { center, radius } => sphere_hit(o, d, center, radius, own == Some(i)),
+                Body::Quad { corner, edge_u, edge_v, normal } => {
+                    let t_min = if own == Some(i) { f64::INFINITY } else { 0.0 };
+                    quad_hit(o, d, corner, edge_u, edge_v, normal).filter(|h| h.0 > t_min)
+                }
+                Body::Box { min, max, rotation, offset } => {
+                    let t_min = if own == Some(i) { flat_min } else { 0.0 };
+                    box_hit(o, d, min, max, rotation, offset, t_min)
+                }
+            };
+            if let Some((t, normal)) = hit
+                && best.is_none_or(|b| t < b.t)
+            {
+                best = Some(Hit { object: i, t, normal });
+            }
+        }
+        best
+    }
+}
+
+fn sphere_hit(o: DVec3, d: DVec3, c: DVec3, r: f64, own: bool) -> Option<(f64, DVec3)> {
+    let oc = o - c;
+    let b = oc.dot(d);
+    if own {
+        let t = -2.0 * b;
+        return (t > 0.0).then(|| (t, (o + t * d - c) / r));
+    }
+    // The discriminant as r^2 - |oc - b d|^2: no cancellation between |oc|^2 and r^2 far away.
+    let perp = oc - b * d;
+    let disc = r * r - perp.length_squared();
+    if disc < 0.0 {
+        return None;
+    }
+    let h = disc.sqrt();
+    // Roots -b -+ h; the nearer one from the stable product form.
+    let q = if b > 0.0 { -b - h } else { -b + h };
+    if q == 0.0 {
+        return None;
+    }
+    let dist = oc.length();
+    let other = (dist - r) * (dist + r) / q;
+    let (t1, t2) = (q.min(other), q.max(other));
+    let t = if t1 > 0.0 {
+        t1
+    } else if t2 > 0.0 {
+        t2
+    } else {
+        return None;
+    };
+    Some((t, (o + t * d - c) / r))
+}
+
+fn quad_hit(o: DVec3, d: DVec3, corner: DVec3, u: DVec3, v: DVec3, n: DVec3) -> Option<(f64, DVec3)> {
+    let denom = n.dot(d);
+    if denom == 0.0 {
+        return None;
+    }
+    let t = n.dot(corner - o) / denom;
+    let p = o + t * d - corner;
+    // Coordinates of p in the (u, v) frame through the dual basis.
+    let uv = u.cross(v);
+    let s = p.cross(v).dot(uv) / uv.length_squared();
+    let w = u.cross(p).dot(uv) / uv.length_squared();
+    ((0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&w) && t > 0.0).then_some((t, n))
+}
+
+fn box_hit(
+    o: DVec3,
+    d: DVec3,
+    min: DVec3,
+    max: DVec3,
+    rotation: glam::DMat3,
+    offset: DVec3,
+    t_min: f64,
+) -> Option<(f64, DVec3)> {
+    let inv = rotation.transpose();
+    let lo = inv * (o - offset);
+    let ld = inv * d;
+    // Slabs: every face plane crossing, the nearest beyond t_min inside the box.
+    let mut best: Option<(f64, DVec3)> = None;
+    for axis in 0..3 {
+        if ld[axis] == 0.0 {
+            continue;
+        }
+        for (plane, sign) in [(min[axis], -1.0), (max[axis], 1.0)] {
+            let t = (plane - lo[axis]) / ld[axis];
+            if t <= t_min || best.is_some_and(|b| t >= b.0) {
+                continue;
+            }
+            let p = lo + t * ld;
+            let inside = (0..3).all(|k| k == axis || (min[k]..=max[k]).contains(&p[k]));
+            if inside {
+                let mut n = DVec3::ZERO;
+                n[axis] = sign;
+                best = Some((t, rotation * n));
+            }
+        }
+    }
+    best
+}
+
+/// Unpolarised Fresnel reflectance for a ray meeting an interface at cos_i > 0 with
+/// eta = n_from / n_to, and the transmitted cosine (None: total internal reflection).
+pub fn fresnel(cos_i: f64, eta: f64) -> (f64, Option<f64>) {
+    let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+    if k < 0.0 {
+        return (1.0, None);
+    }
+    let cos_t = k.sqrt();
+    let rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    (0.5 * (rs * rs + rp * rp), Some(cos_t))
+}
