@@ -94,7 +94,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let cp = centre.colour.xyz;
     let ap = albedo[p].xyz;
     let np = normal[p];
-    let scale = params.sigma_colour * sqrt(min(centre.variance.xyz, blurred_variance(x, y))) + vec3<f32>(TINY);
+    // A reciprocal once per pixel: the taps multiply (a division per channel and tap costs as
+    // much as the exp on a CPU device).
+    let inv_scale = 1.0 / (params.sigma_colour * sqrt(min(centre.variance.xyz, blurred_variance(x, y))) + vec3<f32>(TINY));
     let inv_sigma_albedo2 = 1.0 / (params.sigma_albedo * params.sigma_albedo);
     let step = i32(params.step);
     let last = vec2<i32>(i32(params.width) - 1, i32(params.height) - 1);
@@ -112,7 +114,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             let da = ap - albedo[q].xyz;
             let shared_weight = kernel(i) * kernel(j) * normal_weight(np, normal[q]);
             // The colour and albedo stops in one exp per channel.
-            let stops = exp(-abs(cp - c) / scale - vec3<f32>(dot(da, da) * inv_sigma_albedo2));
+            let stops = exp(-abs(cp - c) * inv_scale - vec3<f32>(dot(da, da) * inv_sigma_albedo2));
             let w = select(vec3<f32>(0.0), shared_weight * stops, inside);
             sum += w * c;
             weights += w;

@@ -47,7 +47,7 @@ fn synthetic(width: u32, height: u32, seed: u64) -> DenoiseInput {
 
 /// Tolerance: f32 against f64 through five iterations of sums of 25 weighted terms and exps,
 /// each within a few units of f32 rounding (6e-8) relative; 1e-4 of the pixel's magnitude
-/// (plus 1e-6 absolute) leaves room for the exp of a luminance stop amplifying a rounding of its
+/// (plus 1e-6 absolute) leaves room for the exp of a colour stop amplifying a rounding of its
 /// argument by |dL| / scale, which stays below 20 where the weight is not already negligible.
 fn assert_matches_f64(input: &DenoiseInput, what: &str) {
     let filter = AtrousDenoiser::new(common::gpu()).expect("compiles");
