@@ -41,3 +41,41 @@ pub fn measured(
     let noise = own_noise.and_then(|n| NoiseCurve::independent(n, f64::from(spp)));
     Measured { bias_rel_mse, noise, worst_region }
 }
+
+/// The measurement of a denoised render: `raw`, the raw render's at the last spp of `at`; `at`,
+/// the denoised image's at each spp, measured as a deterministic image's (its relMSE less the
+/// truth's noise). The denoised relMSE beyond the raw render's bias is its noise curve, held
+/// flat beyond the last spp (the denoiser's own bias stays in it), and its worst region the
+/// denoised image's at the last spp. What `render --renderer auto`'s pilot and the viewer's
+/// both use.
+pub fn denoised(raw: Measured, at: &[(u32, Measured)]) -> Measured {
+    let points = at.iter().map(|(n, m)| (f64::from(*n), m.bias_rel_mse - raw.bias_rel_mse)).collect();
+    let worst_region = at.last().map_or(raw.worst_region.clone(), |(_, m)| m.worst_region.clone());
+    Measured { noise: NoiseCurve::new(points, 0.0), worst_region, ..raw }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::plan::noise_rel_mse;
+
+    fn m(bias_rel_mse: f64, region: &str) -> Measured {
+        Measured { bias_rel_mse, noise: None, worst_region: Some((region.to_owned(), 0.9)) }
+    }
+
+    /// The denoised curve is the denoised relMSE less the raw bias at each spp, flat beyond the
+    /// last, with the raw bias kept and the denoised image's worst region.
+    #[test]
+    fn a_denoised_curve_is_its_error_beyond_the_raw_bias() {
+        let raw = m(1e-4, "raw");
+        let at = [(4, m(8e-3, "a")), (16, m(3e-3, "b")), (64, m(1.1e-3, "c"))];
+        let d = denoised(raw, &at);
+        assert_eq!(d.bias_rel_mse, 1e-4);
+        assert_eq!(d.worst_region, Some(("c".to_owned(), 0.9)));
+        let curve = d.noise.expect("a curve");
+        for (n, want) in [(4.0, 7.9e-3), (16.0, 2.9e-3), (64.0, 1e-3), (1024.0, 1e-3)] {
+            let got = noise_rel_mse(&curve, n);
+            assert!((got - want).abs() < 1e-12 * want.max(1.0) + 1e-15, "{n} spp: {got}, want {want}");
+        }
+    }
+}

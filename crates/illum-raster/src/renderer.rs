@@ -46,8 +46,7 @@ struct Keys {
     main_metal: PipelineKey,
 }
 
-/// Bytes per output pixel (RGBA8), for the frame's readback (native only).
-#[cfg(not(target_arch = "wasm32"))]
+/// Bytes per output pixel (RGBA8), for the frame's readback.
 const BYTES_PER_PIXEL: u32 = 4;
 
 /// The rasterizer (Whitted's look, faked): a scene, a fixed output size and the GPU resources for them.

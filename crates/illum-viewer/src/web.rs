@@ -9,7 +9,7 @@ use wasm_bindgen::JsCast;
 
 use crate::app::{StartOptions, ViewerApp};
 use crate::browser::{STATUS_ID, document, js_text};
-use crate::cli::parse_mode;
+use crate::cli::{StartMode, parse_start_mode};
 use crate::pathtrace_panel::{MAX_SCALE, MIN_SCALE};
 use crate::scene_file::DEFAULT_PATHTRACE_SCENE;
 
@@ -54,6 +54,9 @@ async fn run() -> Result<(), String> {
                 if let Some(error) = url_error {
                     app.open_error = Some(error);
                 }
+                if pathtrace.auto {
+                    app.show_auto();
+                }
                 Ok(Box::new(app))
             }),
         )
@@ -70,6 +73,8 @@ struct PathTraceQuery {
     caustics: Option<bool>,
     /// `scale=S`: the resolution scale (the panel's slider, 0.1 to 1).
     scale: Option<f32>,
+    /// `mode=auto`: the Auto mode shown first.
+    auto: bool,
 }
 
 /// The page's URL query as the desktop's command line:
@@ -82,7 +87,9 @@ fn start_options_from_url() -> (StartOptions, PathTraceQuery, Option<String>) {
     let get = |key: &str| params.as_ref().and_then(|p| p.get(key)).filter(|v| !v.is_empty());
     let scene = PathBuf::from(get("scene").unwrap_or_else(|| DEFAULT_PATHTRACE_SCENE.to_owned()));
     let mut errors = Vec::new();
-    let mode = get("mode").and_then(|m| parse_mode(&m).map_err(|e| errors.push(format!("mode: {e}"))).ok());
+    let start_mode =
+        get("mode").and_then(|m| parse_start_mode(&m).map_err(|e| errors.push(format!("mode: {e}"))).ok());
+    let mode = start_mode.and_then(StartMode::renderer);
     let spp = get("spp").and_then(|text| match text.parse::<u32>() {
         Ok(spp) if spp >= 1 => Some(spp),
         _ => {
@@ -109,7 +116,7 @@ fn start_options_from_url() -> (StartOptions, PathTraceQuery, Option<String>) {
     let error = (!errors.is_empty()).then(|| format!("in the page address: {}", errors.join("; ")));
     (
         StartOptions { scene, mode, screenshot: None, clear_is_backdrop: true },
-        PathTraceQuery { spp, caustics, scale },
+        PathTraceQuery { spp, caustics, scale, auto: start_mode == Some(StartMode::Auto) },
         error,
     )
 }

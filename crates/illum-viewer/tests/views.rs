@@ -257,7 +257,7 @@ fn the_whitted_difference_from_the_path_tracers_accumulation() {
 fn the_raster_difference_from_the_path_tracers_accumulation() {
     let mut harness = harness("scenes/whitted.toml", RendererKind::PathTrace);
     let mode = harness.state_mut().pathtrace_mut().unwrap();
-    mode.settings.stop.spp = Some(4);
+    mode.settings.stop.spp = Some(2);
     mode.settings.resolution_scale = 1.0;
     let stopped = run_until(&mut harness, 400, |app| app.pathtrace().unwrap().stop_reason().is_some());
     assert!(stopped, "{}", harness.state().pathtrace().unwrap().summary());
@@ -288,7 +288,7 @@ fn the_raster_difference_from_the_path_tracers_accumulation() {
         "raster: scale {}, mean difference {:+.4} of truth mean {:.4}; {}",
         summary.scale, summary.mean_difference, summary.truth_mean, summary.truth
     );
-    assert!(summary.truth.contains("4 spp"), "{}", summary.truth);
+    assert!(summary.truth.contains("2 spp"), "{}", summary.truth);
     assert!(raster.difference.texture().is_some());
     let path = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("raster_difference.png");
     let map: Vec<u8> = summary

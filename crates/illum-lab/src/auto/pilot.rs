@@ -280,13 +280,7 @@ fn measure_bias(
         measured(&compare(&accumulator.mean_image(), truth, regions), regions, truth_rel_mse, Some(own), spp);
     let n = f64::from(spp);
     Ok(match (sequence, denoise) {
-        (_, Some(_)) => {
-            let points =
-                denoised.iter().map(|(n, m)| (f64::from(*n), m.bias_rel_mse - raw.bias_rel_mse)).collect();
-            let worst_region =
-                denoised.last().map_or(raw.worst_region.clone(), |(_, m)| m.worst_region.clone());
-            Measured { noise: NoiseCurve::new(points, 0.0), worst_region, ..raw }
-        }
+        (_, Some(_)) => illum_auto::measure::denoised(raw, &denoised),
         (Sequence::LowDiscrepancy, None) => {
             let early = quarter.unwrap_or(own);
             let exponent = (early / own).ln() / 4f64.ln();
