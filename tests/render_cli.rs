@@ -1004,7 +1004,11 @@ fn caustics_on_off_is_recorded_and_a_checkpoint_of_the_other_setting_is_refused(
             Some(first_vertex.to_owned()),
             format!("caustic_estimators: {first_vertex} in the file"),
         ),
-        ("before-glint", Some(without_glint.clone()), format!("caustic_estimators: {without_glint} in the file")),
+        (
+            "before-glint",
+            Some(without_glint.clone()),
+            format!("caustic_estimators: {without_glint} in the file"),
+        ),
     ] {
         let mut older = rendered.clone();
         older.metadata.fields.retain(|(k, _)| k != "caustic_estimators" && k != "glint");
