@@ -316,23 +316,7 @@ impl RasterRenderer {
         let image_bytes = u64::from(row) * u64::from(self.height);
         let staging = self.staging(image_bytes + self.timer.result_size());
         let main = self.main.as_ref().expect("record() made the main targets");
-        encoder.copy_texture_to_buffer(
-            wgpu::TexelCopyTextureInfo {
-                texture: &main.output,
-                mip_level: 0,
-                origin: wgpu::Origin3d::ZERO,
-                aspect: wgpu::TextureAspect::All,
-            },
-            wgpu::TexelCopyBufferInfo {
-                buffer: &staging,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(row),
-                    rows_per_image: None,
-                },
-            },
-            wgpu::Extent3d { width: self.width, height: self.height, depth_or_array_layers: 1 },
-        );
+        copy_output(&mut encoder, &main.output, &staging, self.width, self.height, row);
         self.timer.copy_results(&mut encoder, &staging, image_bytes);
         self.gpu.queue.submit([encoder.finish()]);
         let bytes =
@@ -362,23 +346,7 @@ impl RasterRenderer {
         let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("raster polled readback"),
         });
-        encoder.copy_texture_to_buffer(
-            wgpu::TexelCopyTextureInfo {
-                texture: &main.output,
-                mip_level: 0,
-                origin: wgpu::Origin3d::ZERO,
-                aspect: wgpu::TextureAspect::All,
-            },
-            wgpu::TexelCopyBufferInfo {
-                buffer: &staging,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(row),
-                    rows_per_image: None,
-                },
-            },
-            wgpu::Extent3d { width: self.width, height: self.height, depth_or_array_layers: 1 },
-        );
+        copy_output(&mut encoder, &main.output, &staging, self.width, self.height, row);
         self.gpu.queue.submit([encoder.finish()]);
         Ok(PendingFrame {
             read: readback::PendingRead::start(staging, bytes, "reading back a raster frame"),
@@ -623,4 +591,29 @@ fn decode_frame(width: u32, height: u32, pixels: &[u8]) -> RgbImage32 {
         let i = (y * row + x * BYTES_PER_PIXEL) as usize;
         [0, 1, 2].map(|c| f32::from(pixels[i + c]) / 255.0)
     })
+}
+
+/// Records the copy of the output texture (`width` x `height`) into `staging`, rows `row` bytes
+/// apart (a multiple of wgpu's copy alignment).
+fn copy_output(
+    encoder: &mut wgpu::CommandEncoder,
+    output: &wgpu::Texture,
+    staging: &wgpu::Buffer,
+    width: u32,
+    height: u32,
+    row: u32,
+) {
+    encoder.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo {
+            texture: output,
+            mip_level: 0,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
+        wgpu::TexelCopyBufferInfo {
+            buffer: staging,
+            layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: None },
+        },
+        wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+    );
 }
