@@ -9,7 +9,9 @@
 //! the mean radiance over the pixel (box filter, rays jittered uniformly inside it, film
 //! coordinates in pixels so that the pixel's area is 1):
 //!
-//!     I = int_pixel E T delta(d(s) - w) ds = E T / |det(dg / ds)|   at the root s*,
+//! ```text
+//! I = int_pixel E T delta(d(s) - w) ds = E T / |det(dg / ds)|   at the root s*,
+//! ```
 //!
 //! with E the sun's irradiance, T the chain's throughput (mirror reflectances, Fresnel F for a
 //! glass reflection and 1 - F for a refraction, no eta^2: the chain starts and ends outside the
