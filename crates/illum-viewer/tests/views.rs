@@ -228,17 +228,7 @@ fn the_whitted_difference_from_the_path_tracers_accumulation() {
     assert_eq!(whitted.difference.texture(), harness.state().whitted().unwrap().difference.texture());
     let shown_difference = whitted.difference.texture();
     assert!(shown_difference.is_some());
-    let path = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("whitted_difference.png");
-    let map: Vec<u8> = summary
-        .values
-        .iter()
-        .flat_map(|&d| {
-            let [r, g, b] = illum_viewer::difference_view::diverging_colour(d, summary.scale as f32);
-            [r, g, b, 255]
-        })
-        .collect();
-    image::RgbaImage::from_raw(image.width, image.height, map).unwrap().save(&path).unwrap();
-    println!("saved {}", path.display());
+    save_difference_map("whitted_difference.png", &summary.values, summary.scale, image.width, image.height);
 
     // Orbit the Whitted camera only: the path tracer's image is of the old view.
     harness.state_mut().whitted_mut().unwrap().camera.orbit(0.2, 0.0);
@@ -290,17 +280,7 @@ fn the_raster_difference_from_the_path_tracers_accumulation() {
     );
     assert!(summary.truth.contains("2 spp"), "{}", summary.truth);
     assert!(raster.difference.texture().is_some());
-    let path = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("raster_difference.png");
-    let map: Vec<u8> = summary
-        .values
-        .iter()
-        .flat_map(|&d| {
-            let [r, g, b] = illum_viewer::difference_view::diverging_colour(d, summary.scale as f32);
-            [r, g, b, 255]
-        })
-        .collect();
-    image::RgbaImage::from_raw(image.width, image.height, map).unwrap().save(&path).unwrap();
-    println!("saved {}", path.display());
+    save_difference_map("raster_difference.png", &summary.values, summary.scale, image.width, image.height);
 
     // Another look: read back again, another difference.
     let before = image.clone();
@@ -361,4 +341,19 @@ fn harness_sized_cornell() -> Harness<'static, ViewerApp> {
     let stopped = run_until(&mut harness, 200, |app| app.pathtrace().unwrap().stop_reason().is_some());
     assert!(stopped);
     harness
+}
+
+/// Saves a signed difference map (`values`, one per pixel) in the viewer's diverging colours to
+/// `name` in the test's temporary folder, for a person to look at.
+fn save_difference_map(name: &str, values: &[f32], scale: f64, width: u32, height: u32) {
+    let path = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let map: Vec<u8> = values
+        .iter()
+        .flat_map(|&d| {
+            let [r, g, b] = illum_viewer::difference_view::diverging_colour(d, scale as f32);
+            [r, g, b, 255]
+        })
+        .collect();
+    image::RgbaImage::from_raw(width, height, map).unwrap().save(&path).unwrap();
+    println!("saved {}", path.display());
 }
