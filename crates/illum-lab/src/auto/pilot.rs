@@ -25,7 +25,7 @@ use anyhow::Context as _;
 use illum_denoise::{DenoiseInput, Denoiser, OIDN_BUILT};
 use illum_gpu::GpuContext;
 use illum_image::RgbImage32;
-use illum_pathtrace::{GUIDE_SAMPLES, PathTracer, SampleAllocation};
+use illum_pathtrace::{PathTracer, SampleAllocation, guide_samples};
 use illum_raster::{Options, RasterRenderer, RasterScene};
 use illum_scene::{Bounces, DenoiserKind, Overrides, Scene, Sequence};
 use illum_whitted::WhittedTracer;
@@ -253,9 +253,9 @@ fn measure_bias(
     };
     // The denoised image's relMSE at these spp (and the pilot's), from one render continued.
     let denoised_at: Vec<u32> = [4, 16, 64].into_iter().filter(|&n| n < spp).chain([spp]).collect();
-    let (filter, guides) = match denoise {
-        Some(kind) => (Some(Denoiser::new(gpu, *kind)?), Some(tracer.guides(GUIDE_SAMPLES)?)),
-        None => (None, None),
+    let filter = match denoise {
+        Some(kind) => Some(Denoiser::new(gpu, *kind)?),
+        None => None,
     };
     let mut denoised = Vec::new();
     let mut quarter = None;
@@ -268,8 +268,10 @@ fn measure_bias(
         if n == spp / 4 {
             quarter = Some(tracer.accumulator().estimated_rel_mse());
         }
-        if let (Some(filter), Some(guides)) = (&filter, &guides) {
-            let image = filter.denoise(&DenoiseInput::from_render(tracer.accumulator(), guides))?;
+        if let Some(filter) = &filter {
+            // The guides a render of n spp would have (`render --denoise`, illum-denoise's split).
+            let guides = tracer.guides(guide_samples(n))?;
+            let image = filter.denoise(&DenoiseInput::from_render(tracer.accumulator(), &guides))?;
             // As a deterministic image: its relMSE less the truth's noise, and its worst region.
             denoised.push((n, measured(&compare(&image, truth, regions), regions, truth_rel_mse, None, n)));
         }
