@@ -82,7 +82,8 @@ fn kernel(i: i64) -> f64 {
     [0.0625, 0.25, 0.375, 0.25, 0.0625][(i + 2) as usize]
 }
 
-fn normal_weight(p: [f64; 4], q: [f64; 4]) -> f64 {
+/// The normal stop between two unit normals with w = 1 (or zero normals with w = 0).
+pub(crate) fn normal_weight(p: [f64; 4], q: [f64; 4]) -> f64 {
     let cos = p[0] * q[0] + p[1] * q[1] + p[2] * q[2];
     cos.max(0.0).powi(NORMAL_POWER) + (1.0 - p[3]) * (1.0 - q[3])
 }

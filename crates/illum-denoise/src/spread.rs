@@ -14,7 +14,7 @@
 //! Known variances pass through unchanged; the bound ([`crate::bound`]) still reads only the
 //! pixel's own, so a 1-spp pixel stays unbounded.
 
-use crate::atrous::{NORMAL_POWER, unit_normals};
+use crate::atrous::unit_normals;
 use crate::input::{DenoiseInput, UNKNOWN_VARIANCE};
 
 /// Half the side of the neighbourhood: 5 x 5 pixels.
@@ -28,7 +28,7 @@ pub fn filter_variance(input: &DenoiseInput, sigma_albedo: f32) -> Vec<[f32; 3]>
         return input.variance.clone();
     }
     let (width, height) = (i64::from(input.width()), i64::from(input.height()));
-    let normal = unit_normals(&input.normal);
+    let normal: Vec<[f64; 4]> = unit_normals(&input.normal).iter().map(|n| n.map(f64::from)).collect();
     let inv_sigma2 = 1.0 / (f64::from(sigma_albedo) * f64::from(sigma_albedo));
     let mut out = input.variance.clone();
     for y in 0..height {
@@ -41,13 +41,9 @@ pub fn filter_variance(input: &DenoiseInput, sigma_albedo: f32) -> Vec<[f32; 3]>
             for qy in (y - SPREAD_RADIUS).max(0)..=(y + SPREAD_RADIUS).min(height - 1) {
                 for qx in (x - SPREAD_RADIUS).max(0)..=(x + SPREAD_RADIUS).min(width - 1) {
                     let q = (qy * width + qx) as usize;
-                    let (np, nq) = (normal[p], normal[q]);
-                    let cos = f64::from(np[0] * nq[0] + np[1] * nq[1] + np[2] * nq[2]).max(0.0);
-                    let normal_weight =
-                        cos.powi(NORMAL_POWER) + f64::from(1.0 - np[3]) * f64::from(1.0 - nq[3]);
                     let da: f64 =
                         (0..3).map(|k| f64::from(input.albedo[p][k] - input.albedo[q][k]).powi(2)).sum();
-                    let w = normal_weight * (-da * inv_sigma2).exp();
+                    let w = crate::reference::normal_weight(normal[p], normal[q]) * (-da * inv_sigma2).exp();
                     w_sum += w;
                     for k in 0..3 {
                         let v = f64::from(input.image.pixels[q][k]);
