@@ -236,6 +236,14 @@ impl PathTracer {
         self.accumulation.wall_seconds
     }
 
+    /// Seconds the caustic's light tracer and gather have taken since the tracer was built (0
+    /// without them): their GPU time where the device has timestamps, else the wall time until
+    /// their readback was seen done. Not in [`StepReport`]'s times, which are the camera
+    /// bands': a caller that times a render by its steps adds this one's growth.
+    pub fn caustic_seconds(&self) -> f64 {
+        self.pipeline.caustic.as_ref().map_or(0.0, |c| c.seconds_spent())
+    }
+
     /// GPU seconds of the compute passes since the last reset (0 without timestamp queries).
     pub fn gpu_seconds(&self) -> f64 {
         self.accumulation.gpu_seconds

@@ -293,6 +293,10 @@ pub(crate) struct CausticTracer {
     /// What one frame cost in the last dispatch, in seconds: sizes the next dispatch when the
     /// caller aims at a time per step (see [`Self::dispatch_frames`]).
     seconds_per_frame: Option<f64>,
+    /// Seconds the frames folded so far took, each dispatch at the cost that sized the next
+    /// one (its GPU time where the device has timestamps): the light tracer's share of a
+    /// render's time, which the bands' own reports do not hold ([`crate::PathTracer::caustic_seconds`]).
+    seconds_spent: f64,
     /// What a frame's particles and its gather cost, from the last frame traced in waited
     /// pieces: how the next frame is cut (see [`Self::frame_pieces`]).
     stage_seconds: Option<[f64; 2]>,
@@ -521,6 +525,7 @@ impl CausticTracer {
             base,
             max_frames_per_dispatch,
             seconds_per_frame: None,
+            seconds_spent: 0.0,
             stage_seconds: None,
             timer,
             groups: (gx, gy),
@@ -531,6 +536,11 @@ impl CausticTracer {
     }
 
     /// The parameters the shader gets (for the layout test and the overflow tests).
+    /// Seconds the light tracer's frames folded so far took (see `seconds_spent`).
+    pub(crate) fn seconds_spent(&self) -> f64 {
+        self.seconds_spent
+    }
+
     pub(crate) fn params(&self) -> CausticParams {
         self.base
     }
@@ -614,6 +624,7 @@ impl CausticTracer {
                         None => elapsed,
                     };
                     self.seconds_per_frame = Some(seconds / f64::from(count));
+                    self.seconds_spent += seconds;
                 }
             }
             if target_seconds.is_some() {
@@ -652,6 +663,7 @@ impl CausticTracer {
                 let seconds = gpu_ms.map_or_else(|| flight.launched.elapsed().as_secs_f64(), |ms| ms * 1e-3);
                 self.seconds_per_frame = Some(seconds / f64::from(flight.count));
             }
+            self.seconds_spent += self.seconds_per_frame.unwrap_or(0.0) * f64::from(flight.count);
             self.staging = Some(flight.read.into_buffer());
         } else if let Some(pieces) = &pass.pieces {
             // One piece on the GPU at a time: the queue never holds more than a step's work.
