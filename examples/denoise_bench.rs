@@ -12,7 +12,7 @@ use std::time::Instant;
 
 use clap::Parser;
 use illum::image::median;
-use illum::pathtrace::{GUIDE_SAMPLES, PathTracer};
+use illum::pathtrace::{GUIDE_SAMPLES_MIN, PathTracer};
 use illum::scene::{Overrides, Scene};
 use illum_denoise::{AtrousDenoiser, AtrousSettings, DenoiseInput, Denoiser, DenoiserKind};
 
@@ -46,7 +46,7 @@ fn run(args: Args) -> anyhow::Result<()> {
     };
     println!("{} on {}; à-trous {settings:?}", args.scene.display(), gpu.adapter_info.name);
     println!(
-        "| size | à-trous ms | à-trous ms/Mpixel | OIDN ms/Mpixel | guides ({GUIDE_SAMPLES} spp) ms/Mpixel | path tracing ms/Mpixel per spp |"
+        "| size | à-trous ms | à-trous ms/Mpixel | OIDN ms/Mpixel | guides ({GUIDE_SAMPLES_MIN} spp) ms/Mpixel | path tracing ms/Mpixel per spp |"
     );
     println!("|---|---|---|---|---|---|");
     for &size in &args.sizes {
@@ -72,10 +72,10 @@ fn run(args: Args) -> anyhow::Result<()> {
             Ok(())
         })? / 4.0;
         let guides_ms = time(&mut || {
-            tracer.guides(GUIDE_SAMPLES)?;
+            tracer.guides(GUIDE_SAMPLES_MIN)?;
             Ok(())
         })?;
-        let guides = tracer.guides(GUIDE_SAMPLES)?;
+        let guides = tracer.guides(GUIDE_SAMPLES_MIN)?;
         let input = DenoiseInput::from_render(tracer.accumulator(), &guides);
         let filter_ms = time(&mut || {
             filter.denoise(&input, &settings)?;

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Writes the generated blocks of the README and the docs from what scripts/readme-figures.sh measured.
 
-    readme-block.py ladder-summary LADDER.csv   README: selected rows of the ladder, per region
+    readme-block.py ladder-summary LADDER.csv   README and docs/theory-whitted.md: selected rows of the ladder
     readme-block.py headline DIR                README: the headline figures, from the outputs in DIR
     readme-block.py perf-tables DIR             docs/performance*.md: the bench tables, from DIR
 
@@ -58,6 +58,7 @@ LADDER_ROWS = [
     ("pathtrace", "1 spp, bounces 8, caustic estimator"),
     ("pathtrace", "64 spp, bounces 8, caustic estimator"),
     ("pathtrace", "1024 spp, bounces 8, caustic estimator"),
+    ("pathtrace + à-trous", "16 spp, bounces 8, caustic estimator, à-trous"),
 ]
 LADDER_REGIONS = [
     ("floor, lit", "lit floor"),
@@ -91,7 +92,9 @@ def ladder_summary(path):
     out.append(f"*Measured {host()} (lavapipe unless a GPU is present). wall ms: the median time per frame; "
                "for the rasterizer a whole frame with its shadow and cube maps made again, for the path tracer "
                "the time to render that many spp from nothing.*")
-    replace_block("ladder-summary", "\n".join(out))
+    # The README and the Whitted scene's theory page show the same rows.
+    for page in (README, os.path.join(ROOT, "docs", "theory-whitted.md")):
+        replace_block("ladder-summary", "\n".join(out), page)
 
 
 def read(directory, name):

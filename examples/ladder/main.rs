@@ -274,7 +274,7 @@ fn denoised_rung(
     scene.pathtrace.spp = spp;
     let mut tracer = PathTracer::new(gpu, &scene)?;
     let denoise = |tracer: &PathTracer| -> anyhow::Result<RgbImage32> {
-        let guides = tracer.guides(illum::pathtrace::GUIDE_SAMPLES)?;
+        let guides = tracer.guides(illum::pathtrace::guide_samples(tracer.spp_done()))?;
         Ok(filter.denoise(&DenoiseInput::from_render(tracer.accumulator(), &guides))?)
     };
     tracer.render_to_spp(1)?; // warm-up: the pipelines and buffers

@@ -149,12 +149,13 @@ impl AtrousDenoiser {
         let vec4 = |rows: &mut dyn Iterator<Item = [f32; 4]>| -> Vec<u8> {
             rows.flat_map(|v| v.map(f32::to_le_bytes)).flatten().collect()
         };
+        let variance = crate::spread::filter_variance(input, settings.sigma_albedo);
         let colour = vec4(
             &mut input
                 .image
                 .pixels
                 .iter()
-                .zip(&input.variance)
+                .zip(&variance)
                 .flat_map(|(c, v)| [[c[0], c[1], c[2], 0.0], [v[0], v[1], v[2], 0.0]]),
         );
         let albedo = vec4(&mut input.albedo.iter().map(|a| [a[0], a[1], a[2], 0.0]));

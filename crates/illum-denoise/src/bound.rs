@@ -52,6 +52,7 @@ mod tests {
             variance,
             albedo: vec![[0.5; 3]; n],
             normal: vec![[0.0, 0.0, 1.0]; n],
+            exact: Vec::new(),
         }
     }
 

@@ -54,7 +54,8 @@ impl Denoiser {
     }
 
     /// The denoised image of `input`, each channel bounded to its noisy value +- 3.29 standard
-    /// errors ([`crate::bound`]). Waits for the GPU: native only.
+    /// errors ([`crate::bound`]), with the exact radiance added back ([`DenoiseInput::finish`]).
+    /// Waits for the GPU: native only.
     #[cfg(not(target_arch = "wasm32"))]
     pub fn denoise(&self, input: &DenoiseInput) -> Result<RgbImage32, DenoiseError> {
         let mut image = match self {
@@ -62,7 +63,7 @@ impl Denoiser {
             #[cfg(feature = "oidn")]
             Denoiser::Oidn(filter) => filter.denoise(input)?,
         };
-        crate::bound::bound(input, &mut image);
+        input.finish(&mut image);
         Ok(image)
     }
 }

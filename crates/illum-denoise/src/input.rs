@@ -16,12 +16,30 @@ pub struct DenoiseInput {
     pub variance: Vec<[f32; 3]>,
     pub albedo: Vec<[f32; 3]>,
     pub normal: Vec<[f32; 3]>,
+    /// Radiance the renderer solved exactly rather than sampled (the sun's glint: illum-pathtrace's
+    /// `Accumulator::glint`), as (pixel, radiance): left out of `image`, so that no denoiser
+    /// spreads it (a glint pixel can be 10^3 times its neighbours) or bounds it by a noise it
+    /// does not have, and added back by [`Self::finish`].
+    pub exact: Vec<(usize, [f32; 3])>,
 }
 
 impl DenoiseInput {
-    /// The accumulator's mean image and variances, with `guides` of the same size.
+    /// The accumulator's mean image and variances, with `guides` of the same size; its glint
+    /// goes to [`Self::exact`].
     pub fn from_render(accumulator: &Accumulator, guides: &Guides) -> Self {
-        let image = accumulator.mean_image();
+        let mut image = accumulator.mean_image();
+        // The glint is in a pixel's mean once the pixel has samples (Accumulator::pixel_mean).
+        let exact: Vec<(usize, [f32; 3])> = accumulator
+            .glint()
+            .iter()
+            .filter(|&&(p, _)| accumulator.pixel_count(p) > 0)
+            .map(|&(p, g)| (p, g.map(|v| v as f32)))
+            .collect();
+        for &(p, g) in &exact {
+            for (value, glint) in image.pixels[p].iter_mut().zip(g) {
+                *value -= glint;
+            }
+        }
         assert_eq!(
             (image.width, image.height),
             (guides.width, guides.height),
@@ -30,7 +48,19 @@ impl DenoiseInput {
         let variance = (0..image.pixels.len())
             .map(|p| channel_variance(accumulator.pixel_variance_of_mean(p)))
             .collect();
-        DenoiseInput { image, variance, albedo: guides.albedo.clone(), normal: guides.normal.clone() }
+        DenoiseInput { image, variance, albedo: guides.albedo.clone(), normal: guides.normal.clone(), exact }
+    }
+
+    /// What every denoiser's output goes through (`Denoiser::denoise`, the viewer's polled
+    /// filter): the bound to the noisy image ([`crate::bound`]), then the exact radiance added
+    /// back.
+    pub fn finish(&self, denoised: &mut RgbImage32) {
+        crate::bound::bound(self, denoised);
+        for &(p, g) in &self.exact {
+            for (value, glint) in denoised.pixels[p].iter_mut().zip(g) {
+                *value += glint;
+            }
+        }
     }
 
     pub fn width(&self) -> u32 {
@@ -46,4 +76,33 @@ impl DenoiseInput {
 /// samples) as [`UNKNOWN_VARIANCE`], negative rounding as 0.
 pub fn channel_variance(channels: [f64; 3]) -> [f32; 3] {
     channels.map(|v| if v.is_finite() { (v.max(0.0) as f32).min(UNKNOWN_VARIANCE) } else { UNKNOWN_VARIANCE })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The glint is taken out of the image the denoiser reads and put back by `finish`, after
+    /// the bound: a denoiser that returned the noisy image unchanged gives back the render's
+    /// mean, glint included, though the glint is far beyond the pixel's noise.
+    #[test]
+    fn the_glint_is_left_out_of_the_filter_and_added_back() {
+        let mut accumulator = Accumulator::new(3, 1);
+        accumulator.set_glint(&[(1, [500.0, 600.0, 700.0])]).expect("a pixel of the image");
+        // Two samples per pixel, values 1 and 3 in every channel: mean 2, variance of the mean 1.
+        accumulator.fold(0, &[[4.0, 4.0, 4.0, 2.0]; 3], &[[10.0, 10.0, 10.0, 0.0]; 3]);
+        let guides = Guides {
+            width: 3,
+            height: 1,
+            samples: 1,
+            albedo: vec![[0.5; 3]; 3],
+            normal: vec![[0.0, 0.0, 1.0]; 3],
+        };
+        let input = DenoiseInput::from_render(&accumulator, &guides);
+        assert_eq!(input.image.pixels, vec![[2.0; 3]; 3], "the glint is not in the filter's image");
+        assert_eq!(input.exact, vec![(1, [500.0, 600.0, 700.0])]);
+        let mut denoised = input.image.clone();
+        input.finish(&mut denoised);
+        assert_eq!(denoised.pixels, vec![[2.0; 3], [502.0, 602.0, 702.0], [2.0; 3]]);
+    }
 }

@@ -6,6 +6,7 @@
 //!   `PathTracer::guides`).
 //! - [`atrous`]: the edge-avoiding à-trous wavelet filter on the GPU (`shaders/atrous.wgsl`).
 //! - [`reference`]: its f64 CPU copy, which the GPU output is tested against pixel by pixel.
+//! - [`spread`]: the variance its colour stop reads where a pixel's own is unknown (1 spp).
 //! - `oidn` (cargo feature `oidn`): Intel Open Image Denoise's RT filter on the CPU.
 //! - [`bound`]: what any denoiser may do to a pixel: stay within 3.29 standard errors of its
 //!   noisy value, channel by channel (applied to every denoiser's output).
@@ -22,6 +23,7 @@ pub mod input;
 #[cfg(feature = "oidn")]
 pub mod oidn;
 pub mod reference;
+pub mod spread;
 // Waits for the GPU: native only (a web page polls instead).
 #[cfg(not(target_arch = "wasm32"))]
 pub mod split;

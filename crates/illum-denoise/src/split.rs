@@ -7,7 +7,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use illum_gpu::GpuContext;
 use illum_image::RgbImage32;
-use illum_pathtrace::{Accumulator, GUIDE_SAMPLES, Guides, PathTracer, TracerOptions};
+use illum_pathtrace::{Accumulator, Guides, PathTracer, TracerOptions, guide_samples};
 use illum_scene::Scene;
 
 use crate::DenoiseError;
@@ -75,9 +75,9 @@ impl SplitRender {
     /// Denoises both halves and the whole with `filter`, and estimates the error.
     pub fn denoise(&self, filter: &Denoiser) -> Result<Denoised, DenoiseError> {
         let clock = std::time::Instant::now();
-        // The most samples the guides take (the first half's first GUIDE_SAMPLES sample indices,
-        // rendered or not): a guide's noise only blurs less, and the pass is cheap.
-        let guides = self.a.guides(GUIDE_SAMPLES)?;
+        // As many guide samples as the whole image has (within guide_samples' bounds), over the
+        // first half's sample indices, rendered or not: the guides see those camera rays.
+        let guides = self.a.guides(guide_samples(self.spp_done()))?;
         let guide_seconds = clock.elapsed().as_secs_f64();
         let clock = std::time::Instant::now();
         let (a, b) = (self.a.accumulator(), self.b.accumulator());

@@ -3,20 +3,22 @@
 //
 // A path is followed through mirrors and glass the way Open Image Denoise's documentation asks
 // for perfectly specular surfaces: the albedo is the next diffuse surface's, times what the
-// specular chain passed on (a mirror's reflectance; a dielectric's sampled reflection or
-// refraction has weight 1, see scatter_dielectric), and the normal is that surface's. Each sample
-// draws the same numbers in the same order as pathtrace.wgsl's path of the same (seed, pixel,
-// sample index) does before its first diffuse vertex (the pixel jitter, then one number per
-// dielectric crossing), so the guides see the very camera rays and specular choices the image
-// was made of. (Russian roulette, from bounce RR_START on in unbounded mode, draws numbers the
-// guides do not: a chain of more than RR_START specular bounces may then take other turns.)
+// specular chain passed on, and the normal is that surface's. A mirror passes on its
+// reflectance. A dielectric passes on its likelier branch only (likelier_dielectric_branch:
+// the refraction where the Fresnel reflectance is below 1/2), weighted by that branch's
+// probability: the expected guide with the other branch's albedo taken as 0. Deterministic, so
+// that neighbours behind the same glass get the same guide; a guide that sampled the branch
+// the way the image does averages a noisy mix of the reflected and refracted surfaces, and
+// the filter's albedo stop then keeps every such pixel apart (docs/denoising.md measures it).
+// Each sample draws the pixel jitter of pathtrace.wgsl's path of the same (seed, pixel, sample
+// index), so the guides see the image's camera rays.
 //
 // What a path that meets no diffuse surface records: an emitter it sees, albedo 1 and its
 // normal (OIDN: a light's albedo may be 1); a ray that leaves the scene, albedo and normal 0.
 // Normals are world-space unit vectors facing the incoming ray; their average over a pixel's
 // samples is shorter than 1 where the pixel straddles an edge, as OIDN expects.
 
-#import illum::sampler::{Sampler, sampler_new, sample_2d}
+#import illum::sampler::{sampler_new, sample_2d}
 #import illum::rtcore::spawn::spawn_point
 #import illum::rtcore::codes::{MATERIAL_CHECKER, MATERIAL_DIELECTRIC, MATERIAL_MIRROR}
 #import illum::rtcore::geometry::NO_HIT
@@ -26,7 +28,7 @@
 #import illum::rtcore::traversal::{closest_hit, scattering_surface_at, object_at}
 #import illum::pathtrace::surfaces::{UNBOUNDED, UNBOUNDED_DEPTH_CAP}
 #ifdef SPECULAR
-#import illum::pathtrace::surfaces::scatter_dielectric
+#import illum::pathtrace::surfaces::likelier_dielectric_branch
 #endif
 #ifdef CHECKER
 #import illum::rtcore::optics::checker_albedo
@@ -43,7 +45,7 @@ struct Guide {
 }
 
 // The first non-specular surface along the camera ray from the eye along d.
-fn first_diffuse(d_camera: vec3<f32>, sampler: ptr<function, Sampler>) -> Guide {
+fn first_diffuse(d_camera: vec3<f32>) -> Guide {
     var o = params.camera.eye;
     // The object whose surface o lies on: closest_hit's `own`.
     var own = NO_HIT;
@@ -75,9 +77,10 @@ fn first_diffuse(d_camera: vec3<f32>, sampler: ptr<function, Sampler>) -> Guide 
             continue;
         }
         if (!last && m.kind == MATERIAL_DIELECTRIC) {
-            let scattered = scatter_dielectric(s, d, m.a.w, front, sampler);
-            o = scattered.o;
-            d = scattered.d;
+            let branch = likelier_dielectric_branch(s, d, m.a.w, front);
+            weight *= branch.probability;
+            o = branch.scattered.o;
+            d = branch.scattered.d;
             depth += 1u;
             continue;
         }
@@ -113,7 +116,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         // pathtrace.wgsl's pixel_ray: the first two numbers jitter the point in the pixel.
         let jitter = sample_2d(&sampler);
         let d = camera_ray(params.camera, vec2<f32>(f32(gid.x) + jitter.x, f32(gid.y) + jitter.y), inv_size);
-        let g = first_diffuse(d, &sampler);
+        let g = first_diffuse(d);
         albedo += g.albedo;
         normal += g.normal;
     }

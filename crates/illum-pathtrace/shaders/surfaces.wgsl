@@ -73,4 +73,27 @@ fn scatter_dielectric(s: Surface, d: vec3<f32>, ior: f32, front: bool, sampler: 
     }
     return Scattered(spawn_point(s.p, s.n, s.err), reflect(d, s.n));
 }
+
+// scatter_dielectric's likelier choice, taken without a random number, and its probability:
+// the refraction where the Fresnel reflectance is below 1/2, else the reflection (all of it
+// under total internal reflection). The denoiser's guides follow it (guides.wgsl).
+fn likelier_dielectric_branch(s: Surface, d: vec3<f32>, ior: f32, front: bool) -> LikelierBranch {
+    let eta = select(ior, 1.0 / ior, front);
+    let cos_i = -dot(d, s.n);
+    let k = transmitted_cos2(cos_i, eta);
+    if (k >= 0.0) {
+        let cos_t = sqrt(k);
+        let r = fresnel(cos_i, cos_t, eta);
+        if (r < 0.5) {
+            return LikelierBranch(Scattered(spawn_point(s.p, -s.n, s.err), refracted(d, s.n, eta, cos_i, cos_t)), 1.0 - r);
+        }
+        return LikelierBranch(Scattered(spawn_point(s.p, s.n, s.err), reflect(d, s.n)), r);
+    }
+    return LikelierBranch(Scattered(spawn_point(s.p, s.n, s.err), reflect(d, s.n)), 1.0);
+}
+
+struct LikelierBranch {
+    scattered: Scattered,
+    probability: f32,
+}
 #endif

@@ -34,7 +34,7 @@ mod submit;
 
 use accumulation::Accumulation;
 pub use caustic::{CausticParams, GATHER_RADIUS_FRACTION, bounding_sphere, fixed_point};
-pub use guides::{GUIDE_SAMPLES, Guides, PendingGuides};
+pub use guides::{GUIDE_SAMPLES_MAX, GUIDE_SAMPLES_MIN, Guides, PendingGuides, guide_samples};
 use pipeline::ScenePipeline;
 use runner::BandRunner;
 pub use runner::Readback;

@@ -10,8 +10,9 @@
 //!   the à-trous filter ([`SETTINGS`]) at that size against it, one per frame (a path-tracer
 //!   setting over several frames to [`PilotOptions::pilot_spp`]): its bias, its noise per
 //!   sample and its worst region; a denoised setting's curve is its denoised image's error at
-//!   the spp of `illum_auto::measure::denoised_spps` (the filter as the Denoise toggle runs it,
-//!   bounded), read by `illum_auto::measure::denoised` as the CLI's pilot reads it;
+//!   the spp of `illum_auto::measure::denoised_spps` (the filter as the Denoise toggle runs it:
+//!   its guides, then `DenoiseInput::finish`), read by `illum_auto::measure::denoised` as the
+//!   CLI's pilot reads it;
 //! - the throughput at the size each mode renders the view at: the rasterizer's set-up and one
 //!   frame; the Whitted ray tracer's set-up and frame at the pilot's size, the frame scaled by
 //!   the ratio of pixel counts (a 4x4-ray frame at the view's size held the window for 3 s);
@@ -90,13 +91,13 @@ mod polled {
     use illum_auto::plan::{Candidate, Setting};
     use illum_auto::regions::{Regions, compare_with_map};
     use illum_auto::settings::{apply, has_caustic, pilot_size, settings_with_variants};
-    use illum_denoise::{AtrousDenoiser, AtrousSettings, DenoiseInput, PendingDenoise, bound};
+    use illum_denoise::{AtrousDenoiser, AtrousSettings, DenoiseInput, PendingDenoise};
     use illum_gpu::GpuContext;
 
     use super::{FILTER_RUNS, PilotOptions, SETTINGS, ViewSizes};
     use crate::pacer::FramePacer;
     use illum_image::RgbImage32;
-    use illum_pathtrace::{GUIDE_SAMPLES, Guides, PathTracer, PendingGuides, Readback};
+    use illum_pathtrace::{GUIDE_SAMPLES_MIN, Guides, PathTracer, PendingGuides, Readback};
     use illum_raster::{Options, PendingFrame, RasterRenderer, RasterScene};
     use illum_scene::{Bounces, Overrides, Scene};
     use illum_whitted::{PendingImage, PendingObjectIds, WhittedTracer};
@@ -173,7 +174,7 @@ mod polled {
         /// A denoised setting's guides for the running tracer, and when they were submitted.
         Guides { guides: PendingGuides, submitted: Instant },
         /// A denoised setting's filter run on the running tracer's accumulation at `spp`, its
-        /// input (which the bound reads) and when it was submitted.
+        /// input (which `DenoiseInput::finish` reads) and when it was submitted.
         Denoised { pending: PendingDenoise, input: DenoiseInput, spp: u32, submitted: Instant },
     }
 
@@ -422,8 +423,8 @@ mod polled {
                     Some(result) => {
                         let seconds = submitted.elapsed().as_secs_f64();
                         let mut image = result.map_err(|e| e.to_string())?.0;
-                        // Bounded as every denoised image is (the Denoise toggle's, the CLI's).
-                        bound(&input, &mut image);
+                        // Finished as every denoised image is (the Denoise toggle's, the CLI's).
+                        input.finish(&mut image);
                         // As a deterministic image: its relMSE less the truth's noise.
                         let truth = self.truth.as_ref().expect("settings are measured after the truth");
                         let errors = compare_with_map(&image, &truth.image, &truth.regions, Vec::new());
@@ -491,7 +492,8 @@ mod polled {
             if denoise && measuring {
                 let Some(guides) = &self.denoising.guides else {
                     let submitted = Instant::now();
-                    let guides = running.tracer.start_guides(GUIDE_SAMPLES).map_err(|e| e.to_string())?;
+                    // The Denoise toggle's guides (denoise_view.rs), which show the choice.
+                    let guides = running.tracer.start_guides(GUIDE_SAMPLES_MIN).map_err(|e| e.to_string())?;
                     wait_natively(gpu)?;
                     self.pending = Some(Pending::Guides { guides, submitted });
                     return Ok(());

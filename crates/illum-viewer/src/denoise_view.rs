@@ -1,7 +1,7 @@
 //! The path tracer's Denoise toggle: the accumulation denoised with illum-denoise's à-trous
-//! filter (WGSL, on the viewer's own device) and bounded as every denoised image is
-//! (`illum_denoise::bound`), and the halves' estimate of the denoised image's error beside the
-//! noisy image's (docs/denoising.md).
+//! filter (WGSL, on the viewer's own device) and finished as every denoised image is
+//! (`DenoiseInput::finish`: the bound, and the glint added back), and the halves' estimate of
+//! the denoised image's error beside the noisy image's (docs/denoising.md).
 //!
 //! The halves without a second tracer: the samples of a pixel are indices 0, 1, 2, ..., so the
 //! accumulation at an earlier spp (a snapshot, A) and what came after it (the whole less A, B)
@@ -28,10 +28,10 @@
 use web_time::Instant;
 
 use illum_denoise::input::DenoiseInput;
-use illum_denoise::{AtrousDenoiser, AtrousSettings, HalvesError, PendingDenoise, bound};
+use illum_denoise::{AtrousDenoiser, AtrousSettings, HalvesError, PendingDenoise};
 use illum_gpu::GpuContext;
 use illum_image::{Encoding, RgbImage32};
-use illum_pathtrace::{Accumulator, GUIDE_SAMPLES, Guides, PathTracer, PendingGuides};
+use illum_pathtrace::{Accumulator, GUIDE_SAMPLES_MIN, Guides, PathTracer, PendingGuides};
 use illum_scene::Scene;
 
 /// The image is denoised again once the spp reached this factor times the last refresh's.
@@ -208,7 +208,7 @@ impl DenoiseView {
         if self.guides.is_none() {
             match &self.pending_guides {
                 None => {
-                    let pending = tracer.start_guides(GUIDE_SAMPLES).map_err(|e| e.to_string())?;
+                    let pending = tracer.start_guides(GUIDE_SAMPLES_MIN).map_err(|e| e.to_string())?;
                     self.pending_guides = Some(pending);
                     return Ok(());
                 }
@@ -272,7 +272,7 @@ impl DenoiseView {
                 None => return Ok(()),
                 Some(result) => {
                     let mut image = result.map_err(|e| e.to_string())?.0;
-                    bound(input, &mut image);
+                    input.finish(&mut image);
                     job.done.push(image);
                     job.pending = None;
                     if job.done.len() == 1 {

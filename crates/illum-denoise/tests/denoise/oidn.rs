@@ -38,7 +38,7 @@ fn ms_per_megapixel(denoiser: &Denoiser, input: &DenoiseInput) -> f64 {
 fn at_16_spp_oidn_beside_atrous() {
     let (reference, reference_variance) = common::reference();
     let tracer = common::render(&common::cornell(16, 7));
-    let guides = tracer.guides(illum_pathtrace::GUIDE_SAMPLES).expect("guides");
+    let guides = tracer.guides(illum_pathtrace::guide_samples(tracer.spp_done())).expect("guides");
     let input = DenoiseInput::from_render(tracer.accumulator(), &guides);
     let (atrous, oidn) = (denoiser(DenoiserKind::Atrous), denoiser(DenoiserKind::Oidn));
     let atrous_image = atrous.denoise(&input).expect("denoises");

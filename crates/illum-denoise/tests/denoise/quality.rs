@@ -59,7 +59,7 @@ pub(crate) fn a_converged_image_is_not_moved(kind: DenoiserKind) {
     let scene = common::cornell_sized(CONVERGED_SIZE, 1, 5);
     let mut split = SplitRender::new(common::gpu(), &scene, TracerOptions::default()).expect("two tracers");
     assert!(split.advance(CONVERGED_SPP / 2, &AtomicBool::new(false)).expect("renders"));
-    let guides = split.a.guides(illum_pathtrace::GUIDE_SAMPLES).expect("guides");
+    let guides = split.a.guides(illum_pathtrace::guide_samples(split.spp_done())).expect("guides");
     let (a, b) = (split.a.accumulator(), split.b.accumulator());
     let input = DenoiseInput::from_render(a, &guides);
     let da = filter.denoise(&input).expect("denoises");
@@ -230,7 +230,7 @@ pub(crate) fn regions(albedo: &[[f32; 3]], normal: &[[f32; 3]]) -> Vec<(&'static
 fn at_16_spp_the_atrous_error_is_2_5_times_lower() {
     let (reference, reference_variance) = common::reference();
     let tracer = common::render(&common::cornell(16, 7));
-    let guides = tracer.guides(illum_pathtrace::GUIDE_SAMPLES).expect("guides");
+    let guides = tracer.guides(illum_pathtrace::guide_samples(tracer.spp_done())).expect("guides");
     let raw = tracer.accumulator().mean_image();
     let (denoised, _) = filter()
         .denoise(&DenoiseInput::from_render(tracer.accumulator(), &guides), &AtrousSettings::default())

@@ -26,7 +26,7 @@ use anyhow::Context as _;
 use illum_denoise::{DenoiseInput, Denoiser, OIDN_BUILT};
 use illum_gpu::GpuContext;
 use illum_image::RgbImage32;
-use illum_pathtrace::{GUIDE_SAMPLES, PathTracer, SampleAllocation};
+use illum_pathtrace::{PathTracer, SampleAllocation, guide_samples};
 use illum_raster::{Options, RasterRenderer, RasterScene};
 use illum_scene::{Bounces, DenoiserKind, Overrides, Scene, Sequence};
 use illum_whitted::WhittedTracer;
@@ -259,9 +259,9 @@ fn measure_bias(
     let mut stops: Vec<u32> = denoised_at.iter().chain(&estimated_at).copied().collect();
     stops.sort_unstable();
     stops.dedup();
-    let (filter, guides) = match denoise {
-        Some(kind) => (Some(Denoiser::new(gpu, *kind)?), Some(tracer.guides(GUIDE_SAMPLES)?)),
-        None => (None, None),
+    let filter = match denoise {
+        Some(kind) => Some(Denoiser::new(gpu, *kind)?),
+        None => None,
     };
     let mut denoised = Vec::new();
     let mut estimates = Vec::new();
@@ -274,10 +274,12 @@ fn measure_bias(
         if estimated_at.contains(&n) {
             estimates.push((n, tracer.accumulator().estimated_rel_mse()));
         }
-        if let (Some(filter), Some(guides)) = (&filter, &guides)
+        if let Some(filter) = &filter
             && denoised_at.contains(&n)
         {
-            let image = filter.denoise(&DenoiseInput::from_render(tracer.accumulator(), guides))?;
+            // The guides a render of n spp would have (`render --denoise`, illum-denoise's split).
+            let guides = tracer.guides(guide_samples(n))?;
+            let image = filter.denoise(&DenoiseInput::from_render(tracer.accumulator(), &guides))?;
             // As a deterministic image: its relMSE less the truth's noise, and its worst region.
             denoised.push((n, measured(&compare(&image, truth, regions), regions, truth_rel_mse, None, n)));
         }

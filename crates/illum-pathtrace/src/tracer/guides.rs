@@ -2,8 +2,8 @@
 //! surface its camera paths meet, through mirrors and glass (`shaders/guides.wgsl` says how).
 //!
 //! A pass of its own, compiled only when a caller asks for guides, from the path tracer's
-//! modules and shader defs: it follows the same camera rays and specular choices as the
-//! image's samples of the same indices, and adds no code to the integrator. Read back either
+//! modules and shader defs: it follows the same camera rays as the image's samples of the
+//! same indices, and adds no code to the integrator. Read back either
 //! waiting ([`PathTracer::guides`], native) or polled over later frames
 //! ([`PathTracer::start_guides`], the viewer, which must not wait in a web page).
 
@@ -18,11 +18,22 @@ use super::PathTracer;
 use crate::gpu_scene::GpuScene;
 use crate::{PathTraceError, shaders};
 
-/// Samples per pixel the guides average at most: albedo and normal are bounded and mostly
-/// constant over a pixel, so their mean settles long before the radiance's does. On lavapipe a
-/// guide sample costs about a fifth of a path (the camera ray and its specular chain only), so
-/// 16 of them cost about 3 spp of the path tracer (docs/denoising.md).
-pub const GUIDE_SAMPLES: u32 = 16;
+/// Samples per pixel the guides of a denoised image average at least: below about 16 a pixel
+/// that straddles an edge gets a guide far from its image's mix of the two sides.
+pub const GUIDE_SAMPLES_MIN: u32 = 16;
+/// Samples per pixel one guide pass averages at most: one dispatch, so it stays short on any
+/// GPU (256 guide samples cost about 50 spp of the path tracer on lavapipe).
+pub const GUIDE_SAMPLES_MAX: u32 = 256;
+
+/// The guide samples for an image of `image_spp` samples per pixel: as many as the image has,
+/// within [`GUIDE_SAMPLES_MIN`] ..= [`GUIDE_SAMPLES_MAX`]. A pixel across an edge (a checker
+/// square's, an object's) mixes the two sides in the proportion its samples fell; a guide of
+/// the same samples mixes them alike, so the filter's albedo stop compares like with like (the
+/// guides see the image's camera rays: `shaders/guides.wgsl`). With 16 guide samples at every
+/// spp the filter lost to the raw image on the Whitted scene from 64 spp on (docs/denoising.md).
+pub fn guide_samples(image_spp: u32) -> u32 {
+    image_spp.clamp(GUIDE_SAMPLES_MIN, GUIDE_SAMPLES_MAX)
+}
 
 /// The guide buffers of an image, row-major like it.
 #[derive(Clone, Debug, PartialEq)]
@@ -84,7 +95,7 @@ impl PendingGuides {
 
 impl PathTracer {
     /// The guide buffers over this tracer's sample indices `offset .. offset + n`, with
-    /// `offset` its [`Self::sample_offset`] and `n = samples.clamp(1, GUIDE_SAMPLES)`. Blocks
+    /// `offset` its [`Self::sample_offset`] and `n = samples.clamp(1, GUIDE_SAMPLES_MAX)`. Blocks
     /// until the GPU is done (native only: a web page cannot wait). Fails, naming the limit,
     /// for an image whose guides do not fit one storage binding of the device.
     #[cfg(not(target_arch = "wasm32"))]
@@ -138,7 +149,7 @@ impl PathTracer {
                 ),
             });
         }
-        let samples = samples.clamp(1, GUIDE_SAMPLES);
+        let samples = samples.clamp(1, GUIDE_SAMPLES_MAX);
         let gpu_scene = GpuScene::new(scene)?;
         let compute = shaders::companion_pipeline(
             gpu,
