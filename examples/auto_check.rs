@@ -4,8 +4,8 @@
 //! prints predicted against measured.
 //!
 //! ```text
-//! cargo run --release --example auto_check -- [--targets 0.3,0.1,0.03,0.01] [--truth-spp 8192]
-//!     [--out out/auto-check]
+//! cargo run --release --example auto_check -- [--targets 0.3,0.1,0.03,0.01] [--scenes whitted,cornell]
+//!     [--truth-spp 8192] [--out out/auto-check]
 //! ```
 //! Scenes: `scenes/whitted.toml` at 320x180 (the ladder's size) and `scenes/cornell.toml` at
 //! 192x192, both larger than the planner's 128-pixel pilot, so the check covers its scaling
@@ -34,6 +34,9 @@ struct Args {
     /// Target relative errors (comma-separated).
     #[arg(long, value_delimiter = ',', default_value = "0.3,0.1,0.03,0.01")]
     targets: Vec<f64>,
+    /// The scenes to check, by name (comma-separated; `whitted`, `cornell`).
+    #[arg(long, value_delimiter = ',', default_value = "whitted,cornell")]
+    scenes: Vec<String>,
     /// Samples per pixel of each scene's truth.
     #[arg(long, default_value_t = 8192)]
     truth_spp: u32,
@@ -109,10 +112,18 @@ fn run(args: Args) -> anyhow::Result<()> {
     if !render.exists() {
         bail!("{} is missing: build it first (cargo build --release --examples)", render.display());
     }
+    let name = |file: &str| Path::new(file).file_stem().map(|s| s.to_string_lossy().into_owned());
+    let known: Vec<String> = SCENES.iter().filter_map(|(file, _, _)| name(file)).collect();
+    if let Some(unknown) = args.scenes.iter().find(|s| !known.contains(s)) {
+        bail!("--scenes {unknown}: not a scene this check knows; it knows {}", known.join(", "));
+    }
     let mut rows = Vec::new();
     let mut truths = Vec::new();
     let mut adapter = String::new();
     for (file, width, height) in SCENES {
+        if !name(file).is_some_and(|n| args.scenes.contains(&n)) {
+            continue;
+        }
         let mut scene = Scene::load(Path::new(file))?;
         scene.apply_overrides(
             &Overrides { width: Some(width), height: Some(height), ..Default::default() },

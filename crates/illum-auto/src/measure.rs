@@ -54,6 +54,32 @@ pub fn denoised(raw: Measured, at: &[(u32, Measured)]) -> Measured {
     Measured { noise: NoiseCurve::new(points, 0.0), worst_region, ..raw }
 }
 
+/// The spp at which a pilot measures a denoised render, from one render continued: 4, 16 and
+/// 64 where below the pilot's `pilot_spp`, and `pilot_spp` (what the CLI's pilot and the viewer's
+/// both run).
+pub fn denoised_spps(pilot_spp: u32) -> Vec<u32> {
+    [4, 16, 64].into_iter().filter(|&n| n < pilot_spp).chain([pilot_spp]).collect()
+}
+
+/// The spp at which a pilot reads a low-discrepancy render's own estimate: a sixteenth, a
+/// quarter and all of `pilot_spp`, three points a factor 4 apart, so that the curve's law
+/// beyond them ([`NoiseCurve::with_measured_law`]) sees how its exponent changes.
+pub fn low_discrepancy_spps(pilot_spp: u32) -> Vec<u32> {
+    let mut spps: Vec<u32> =
+        [pilot_spp / 16, pilot_spp / 4, pilot_spp].into_iter().filter(|&n| n > 0).collect();
+    spps.dedup();
+    spps
+}
+
+/// The measurement of a low-discrepancy render: `raw`, the render's at its last spp;
+/// `estimates`, its own estimated relMSE (from its replicates) at each spp of
+/// [`low_discrepancy_spps`]. The noise curve goes through the estimates, with the law beyond
+/// them of [`NoiseCurve::with_measured_law`].
+pub fn low_discrepancy(raw: Measured, estimates: &[(u32, f64)]) -> Measured {
+    let points = estimates.iter().map(|(n, v)| (f64::from(*n), *v)).collect();
+    Measured { noise: NoiseCurve::with_measured_law(points).or(raw.noise.clone()), ..raw }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -61,6 +87,23 @@ mod tests {
 
     fn m(bias_rel_mse: f64, region: &str) -> Measured {
         Measured { bias_rel_mse, noise: None, worst_region: Some((region.to_owned(), 0.9)) }
+    }
+
+    /// A low-discrepancy curve goes through its estimates at a sixteenth, a quarter and all of
+    /// the pilot's spp, and beyond them follows the measured law, not the raw 1/N.
+    #[test]
+    fn a_low_discrepancy_curve_is_its_estimates_with_the_measured_law_beyond() {
+        assert_eq!(low_discrepancy_spps(256), vec![16, 64, 256]);
+        assert_eq!(low_discrepancy_spps(8), vec![2, 8]);
+        let mut raw = m(2e-4, "raw");
+        raw.noise = NoiseCurve::independent(1e-3, 256.0);
+        let estimates = [(16, 0.064), (64, 0.064 / 8.0), (256, 0.064 / 8.0 / 4f64.powf(1.4))];
+        let ld = low_discrepancy(raw, &estimates);
+        assert_eq!(ld.bias_rel_mse, 2e-4);
+        let curve = ld.noise.expect("a curve");
+        assert_eq!(curve.points().len(), 3);
+        assert!((curve.exponent() - 1.3).abs() < 1e-12, "{curve:?}");
+        assert!((noise_rel_mse(&curve, 32.0) - 0.064 / 2f64.powf(1.5)).abs() < 1e-12);
     }
 
     /// The denoised curve is the denoised relMSE less the raw bias at each spp, flat beyond the

@@ -15,8 +15,9 @@
 //! paths, a path tracer's cut bounces) and the noise term is zero for the deterministic
 //! renderers. A path tracer's noise curve is what the pilot measured at a few spp, with the law
 //! beyond them: 1/N for independent samples (and adaptive sampling, which spreads N over the
-//! pixels in fixed proportions), the exponent measured between two spp for the low-discrepancy
-//! sequence, and for a denoised image its measured error at each spp (the denoiser's bias
+//! pixels in fixed proportions), for the low-discrepancy sequence the exponent measured between
+//! its last two spp less how much it changed from the segment before
+//! ([`NoiseCurve::with_measured_law`]), and for a denoised image its measured error at each spp (the denoiser's bias
 //! included), held beyond the last. [`noise_rel_mse`] is the one place the curve is read.
 //!
 //! Over 450 lines: the model, the search for the fewest spp and the refusal are one unit, and
@@ -155,6 +156,37 @@ impl NoiseCurve {
         }
         let exponent = if exponent.is_finite() { exponent.max(0.0) } else { 1.0 };
         (!points.is_empty()).then_some(NoiseCurve { points, exponent })
+    }
+
+    /// A curve through relMSE measured at three or more spp (any order), whose law beyond the
+    /// last point is an exponent derived from the points themselves, kept from being optimistic
+    /// where it was not measured (with two points, the exponent between them).
+    ///
+    /// Derivation: let e1 and e2 be the exponents (slopes of log relMSE against log spp) of the
+    /// last two segments. How the exponent changes from one segment to the next, |e2 - e1|,
+    /// is what the curve is measured to bend by (the sequence's advantage growing or fading
+    /// with the spp), plus the statistical error of the two slopes. Beyond the last point the
+    /// exponent is e2 - |e2 - e1|:
+    /// - if it fell from e1 to e2, 2 e2 - e1. With segments of equal width in log spp (the
+    ///   pilot's 16, 64, 256) and a fall linear in log spp, that is the exponent at the middle
+    ///   of a next segment as wide, which is at most the mean exponent from the last point to
+    ///   any spp up to the end of that segment (4 times the last): held flat, it predicts no less
+    ///   noise than the fall would give there. Further on it assumes the fall has stopped.
+    /// - if it rose, the lower e1: the rise is not relied on.
+    ///
+    /// A curve whose exponent stays the same keeps it. [`Self::new`]'s floor of 0 applies.
+    pub fn with_measured_law(points: Vec<(f64, f64)>) -> Option<Self> {
+        let curve = Self::new(points, 1.0)?;
+        let slope = |(n0, v0): (f64, f64), (n1, v1): (f64, f64)| (v0 / v1).ln() / (n1 / n0).ln();
+        let exponent = match curve.points.as_slice() {
+            [.., a, b, c] => {
+                let (e1, e2) = (slope(*a, *b), slope(*b, *c));
+                e2 - (e2 - e1).abs()
+            }
+            [a, b] => slope(*a, *b),
+            _ => 1.0,
+        };
+        Self::new(curve.points, exponent)
     }
 
     /// The 1/N law of independent samples, from the relMSE `rel_mse` measured at `spp`.
@@ -492,6 +524,37 @@ mod tests {
         assert_eq!(noise_rel_mse(&denoised, 1e6), 0.004);
         assert!((noise_rel_mse(&denoised, 8.0) - (0.01f64 * 0.004).sqrt()).abs() < 1e-15);
         assert_eq!(NoiseCurve::new(vec![(64.0, f64::NAN)], 1.0), None);
+    }
+
+    /// The low-discrepancy law beyond the measured points is the last segment's exponent less
+    /// how much it changed from the segment before, never the last exponent alone where the
+    /// exponent fell.
+    #[test]
+    fn beyond_its_points_a_measured_curve_falls_no_faster_than_its_bend_allows() {
+        // Exponents 1.5 (16 to 64) then 1.4 (64 to 256): beyond, 1.4 - 0.1 = 1.3.
+        let v64 = 1e-2 / 4f64.powf(1.5);
+        let v256 = v64 / 4f64.powf(1.4);
+        let falling = NoiseCurve::with_measured_law(vec![(16.0, 1e-2), (64.0, v64), (256.0, v256)]).unwrap();
+        assert!((falling.exponent() - 1.3).abs() < 1e-12, "{falling:?}");
+        let at_512 = noise_rel_mse(&falling, 512.0);
+        assert!((at_512 - v256 / 2f64.powf(1.3)).abs() < 1e-15 * at_512.max(1.0));
+        // The last exponent alone (the rule this replaces) predicts less noise at 512 spp.
+        assert!(at_512 > v256 / 2f64.powf(1.4) * 1.06, "{at_512}");
+        // Between the points, the measured segments.
+        assert!((noise_rel_mse(&falling, 32.0) - 1e-2 / 2f64.powf(1.5)).abs() < 1e-15);
+        // Rising from 1.2 to 1.4: beyond, the lower 1.2.
+        let v64 = 1e-2 / 4f64.powf(1.2);
+        let rising =
+            NoiseCurve::with_measured_law(vec![(256.0, v64 / 4f64.powf(1.4)), (64.0, v64), (16.0, 1e-2)]);
+        assert!((rising.unwrap().exponent() - 1.2).abs() < 1e-12);
+        // A straight line keeps its exponent; two points give theirs; a steep bend stops at 0.
+        let straight = NoiseCurve::with_measured_law(vec![(16.0, 1.0), (64.0, 0.125), (256.0, 0.125 / 8.0)]);
+        assert!((straight.unwrap().exponent() - 1.5).abs() < 1e-12);
+        let two = NoiseCurve::with_measured_law(vec![(64.0, 8e-3), (256.0, 1e-3)]).unwrap();
+        assert!((two.exponent() - 1.5).abs() < 1e-12);
+        let bend =
+            NoiseCurve::with_measured_law(vec![(16.0, 1.0), (64.0, 1.0 / 4096.0), (256.0, 1.0 / 8192.0)]);
+        assert_eq!(bend.unwrap().exponent(), 0.0);
     }
 
     #[test]

@@ -46,12 +46,23 @@ pub fn settings(scene: &Scene) -> Vec<Setting> {
     all
 }
 
-/// [`settings`] and, after each path-tracer setting, the same with the low-discrepancy
-/// sequence, with adaptive sampling (only without the caustic's light tracer: the path tracer
-/// refuses the two together) and denoised by each of `denoisers`: what `render --renderer auto`
-/// chooses among (the viewer's pilot measures [`settings`] alone). Not among them, to keep the
-/// pilot's cost down: adaptive sampling or denoising with the low-discrepancy sequence.
-pub fn settings_with_variants(scene: &Scene, denoisers: &[DenoiserKind]) -> Vec<Setting> {
+/// Which variants of each path-tracer setting a pilot measures besides the setting itself.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Variants<'a> {
+    /// The low-discrepancy sequence.
+    pub low_discrepancy: bool,
+    /// Adaptive sampling (only without the caustic's light tracer: the path tracer refuses
+    /// the two together).
+    pub adaptive: bool,
+    /// Denoised by each of these.
+    pub denoisers: &'a [DenoiserKind],
+}
+
+/// [`settings`] and, after each path-tracer setting, its `variants`, each with independent
+/// samples but the low-discrepancy one: `render --renderer auto` measures all three kinds,
+/// the viewer's Auto mode the à-trous filter alone. Not among them, to keep the pilot's cost
+/// down: adaptive sampling or denoising with the low-discrepancy sequence.
+pub fn settings_with_variants(scene: &Scene, variants: Variants) -> Vec<Setting> {
     let mut all = Vec::new();
     for setting in settings(scene) {
         let Setting::PathTrace { bounces, caustics, .. } = setting else {
@@ -66,11 +77,13 @@ pub fn settings_with_variants(scene: &Scene, denoisers: &[DenoiserKind]) -> Vec<
             denoise,
         };
         all.push(setting);
-        all.push(variant(Sequence::LowDiscrepancy, false, None));
-        if !caustics {
+        if variants.low_discrepancy {
+            all.push(variant(Sequence::LowDiscrepancy, false, None));
+        }
+        if variants.adaptive && !caustics {
             all.push(variant(Sequence::Independent, true, None));
         }
-        for &denoiser in denoisers {
+        for &denoiser in variants.denoisers {
             all.push(variant(Sequence::Independent, false, Some(denoiser)));
         }
     }

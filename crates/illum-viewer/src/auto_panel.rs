@@ -1,8 +1,8 @@
 //! The Auto mode: an accuracy slider, the pilot's progress, and the renderer and settings the
 //! planner (`illum_auto::plan`) picks for the target, with its prediction, the runners-up and
 //! why the other renderers were not picked. The choice is then shown by its own mode (the
-//! rasterizer, Whitted or the path tracer, with their panels below this one); the path tracer
-//! stops at the planned spp, so that the time and error it reaches can be set against the
+//! rasterizer, Whitted or the path tracer, with their panels below this one; a denoised choice
+//! with the path tracer's Denoise toggle on); the path tracer stops at the planned spp, so that the time and error it reaches can be set against the
 //! prediction (its panel's spp target can be raised or set to Unlimited to go on).
 //!
 //! The pilot ([`crate::auto_pilot`]) runs once per scene file and view size, when Auto is
@@ -268,8 +268,9 @@ impl AutoMode {
 }
 
 /// Hands `choice` to its mode: the rasterizer's look and effects, Whitted's depth and rays per
-/// pixel, or the path tracer's bounces, light tracer and spp (as its stop rule, the only one).
-/// Returns the mode to show.
+/// pixel, or the path tracer's bounces, light tracer, spp (as its stop rule, the only one) and
+/// Denoise toggle (on for a denoised choice, which then shows the denoised image; off
+/// otherwise, so that the image shown is the one predicted). Returns the mode to show.
 pub fn apply_choice(
     choice: &Planned,
     raster: Option<&mut RasterMode>,
@@ -291,12 +292,13 @@ pub fn apply_choice(
             }
             RendererKind::Whitted
         }
-        // The viewer's pilot measures illum_auto::settings alone: independent samples, neither
-        // adaptive nor denoised, so those fields are the defaults here.
-        Setting::PathTrace { bounces, caustics, .. } => {
+        // The viewer's pilot measures independent samples, raw or denoised by à-trous
+        // (auto_pilot::SETTINGS), never the sequence or adaptive sampling.
+        Setting::PathTrace { bounces, caustics, denoise, .. } => {
             if let Some(mode) = pathtrace {
                 mode.settings.bounces = *bounces;
                 mode.settings.caustics = *caustics;
+                mode.settings.denoise = denoise.is_some();
                 mode.settings.stop = StopRules { spp: choice.spp, ..StopRules::default() };
                 mode.set_paused(false);
             }

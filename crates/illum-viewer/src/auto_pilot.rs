@@ -6,24 +6,32 @@
 //! - a path-traced truth at [`PilotOptions::longer_side`] pixels on the longer side (the view's
 //!   aspect, bounces unbounded, the caustic's light tracer where there is one), accumulated
 //!   over frames to [`PilotOptions::truth_spp`];
-//! - every setting of `illum_auto::settings::settings` at that size against it, one per frame
-//!   (a path-tracer setting over several frames to [`PilotOptions::pilot_spp`]): its bias, its
-//!   noise per sample and its worst region;
+//! - every setting of `illum_auto::settings::settings` and each path-tracer setting denoised by
+//!   the à-trous filter ([`SETTINGS`]) at that size against it, one per frame (a path-tracer
+//!   setting over several frames to [`PilotOptions::pilot_spp`]): its bias, its noise per
+//!   sample and its worst region; a denoised setting's curve is its denoised image's error at
+//!   the spp of `illum_auto::measure::denoised_spps` (the filter as the Denoise toggle runs it:
+//!   its guides, then `DenoiseInput::finish`), read by `illum_auto::measure::denoised` as the
+//!   CLI's pilot reads it;
 //! - the throughput at the size each mode renders the view at: the rasterizer's set-up and one
 //!   frame; the Whitted ray tracer's set-up and frame at the pilot's size, the frame scaled by
 //!   the ratio of pixel counts (a 4x4-ray frame at the view's size held the window for 3 s);
 //!   the path tracer's set-up with its first sample per pixel and its time per spp over
 //!   [`PilotOptions::timing_spp`] more at its own resolution, times the wall time per second of path tracing that the window's frames leave
 //!   ([`FramePacer`]: the pilot's path tracing is paced as the path-tracer mode's is, so the
-//!   rest of each frame is measured while it runs). The viewer's device is already set up, so
-//!   no device time is added.
+//!   rest of each frame is measured while it runs); a denoised setting's guides and its fastest
+//!   filter run at the pilot's size, scaled by the ratio of pixel counts, the run counted three
+//!   times (a refresh of the Denoise toggle filters the whole and its two halves). The viewer's
+//!   device is already set up, so no device time is added.
 //!
 //! Nothing in it waits for the GPU where a web page cannot: each step submits work or polls a
 //! readback under way ([`RasterRenderer::read_polled`], [`WhittedTracer::render_polled`],
-//! [`WhittedTracer::object_ids_polled`], the path tracer's polled bands), so the same state
-//! machine runs natively and in the browser. Natively the Whitted frame and the raster's view-size
-//! frame are waited for, so that their time is the GPU's; in a web page their time runs from the
-//! submission to the frame the image is back in, and so includes the rest of that frame.
+//! [`WhittedTracer::object_ids_polled`], the path tracer's polled bands and guides,
+//! [`illum_denoise::AtrousDenoiser::start`]), so the same state
+//! machine runs natively and in the browser. Natively the Whitted frame, the raster's view-size
+//! frame, the guides and the filter runs are waited for, so that their time is the GPU's; in a
+//! web page their time runs from the submission to the frame the image is back in, and so
+//! includes the rest of that frame.
 
 #[cfg(doc)]
 use crate::pacer::FramePacer;
@@ -32,6 +40,18 @@ use illum_raster::RasterRenderer;
 #[cfg(doc)]
 use illum_whitted::WhittedTracer;
 pub use polled::ViewerPilot;
+
+use illum_auto::settings::Variants;
+use illum_scene::DenoiserKind;
+
+/// The variants of each path-tracer setting the viewer's pilot measures: denoised by the
+/// à-trous filter, the one the path tracer's Denoise toggle runs (the low-discrepancy sequence
+/// and adaptive sampling are the command line's).
+pub const SETTINGS: Variants<'static> =
+    Variants { low_discrepancy: false, adaptive: false, denoisers: &[DenoiserKind::Atrous] };
+
+/// A refresh of the Denoise toggle runs the filter on the whole and on its two halves.
+pub const FILTER_RUNS: f64 = 3.0;
 
 /// How the viewer's pilot measures.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -67,16 +87,17 @@ pub struct ViewSizes {
 mod polled {
     use web_time::Instant;
 
-    use illum_auto::measure::measured;
+    use illum_auto::measure::{Measured, denoised, denoised_spps, measured};
     use illum_auto::plan::{Candidate, Setting};
     use illum_auto::regions::{Regions, compare_with_map};
-    use illum_auto::settings::{apply, has_caustic, pilot_size, settings};
+    use illum_auto::settings::{apply, has_caustic, pilot_size, settings_with_variants};
+    use illum_denoise::{AtrousDenoiser, AtrousSettings, DenoiseInput, PendingDenoise};
     use illum_gpu::GpuContext;
 
-    use super::{PilotOptions, ViewSizes};
+    use super::{FILTER_RUNS, PilotOptions, SETTINGS, ViewSizes};
     use crate::pacer::FramePacer;
     use illum_image::RgbImage32;
-    use illum_pathtrace::{PathTracer, Readback};
+    use illum_pathtrace::{GUIDE_SAMPLES_MIN, Guides, PathTracer, PendingGuides, Readback};
     use illum_raster::{Options, PendingFrame, RasterRenderer, RasterScene};
     use illum_scene::{Bounces, Overrides, Scene};
     use illum_whitted::{PendingImage, PendingObjectIds, WhittedTracer};
@@ -150,6 +171,22 @@ mod polled {
         /// A Whitted setting's image at the pilot's size, its set-up seconds and when its
         /// frame was submitted.
         Whitted { image: PendingImage, setup: f64, submitted: Instant },
+        /// A denoised setting's guides for the running tracer, and when they were submitted.
+        Guides { guides: PendingGuides, submitted: Instant },
+        /// A denoised setting's filter run on the running tracer's accumulation at `spp`, its
+        /// input (which `DenoiseInput::finish` reads) and when it was submitted.
+        Denoised { pending: PendingDenoise, input: DenoiseInput, spp: u32, submitted: Instant },
+    }
+
+    /// What a denoised setting has measured at the pilot's size.
+    #[derive(Default)]
+    struct Denoising {
+        guides: Option<Guides>,
+        /// Seconds of the guides and of the fastest filter run.
+        guide_seconds: f64,
+        filter_seconds: f64,
+        /// The denoised image's measurement at each spp of `denoised_spps` reached so far.
+        at: Vec<(u32, Measured)>,
     }
 
     /// The pilot of one view.
@@ -163,6 +200,10 @@ mod polled {
         /// A path-tracer setting's image and estimated relMSE at the pilot's size, while its
         /// throughput is being measured.
         measured: Option<(RgbImage32, f64)>,
+        /// A denoised setting's guides, images and filter times at the pilot's size (kept
+        /// while its throughput is measured), and the filter (made once).
+        denoising: Denoising,
+        filter: Option<AtrousDenoiser>,
         sizes: ViewSizes,
         settings: Vec<Setting>,
         truth: Option<Truth>,
@@ -201,11 +242,13 @@ mod polled {
             let pair = |[w, h]: [u32; 2]| (w, h);
             Ok(ViewerPilot {
                 options,
-                settings: settings(scene),
+                settings: settings_with_variants(scene, SETTINGS),
                 small: sized(pilot_size(scene, options.longer_side))?,
                 view_scene: sized(pair(sizes.raster))?,
                 pathtrace_scene: sized(pair(sizes.pathtrace))?,
                 measured: None,
+                denoising: Denoising::default(),
+                filter: None,
                 sizes,
                 truth: None,
                 running: None,
@@ -368,6 +411,31 @@ mod polled {
                         self.push(image, None, setup + frame * ratio, 0.0);
                     }
                 },
+                Pending::Guides { guides, submitted } => match guides.poll(gpu) {
+                    None => self.pending = Some(Pending::Guides { guides, submitted }),
+                    Some(result) => {
+                        self.denoising.guides = Some(result.map_err(|e| e.to_string())?);
+                        self.denoising.guide_seconds = submitted.elapsed().as_secs_f64();
+                    }
+                },
+                Pending::Denoised { pending, input, spp, submitted } => match pending.poll(gpu) {
+                    None => self.pending = Some(Pending::Denoised { pending, input, spp, submitted }),
+                    Some(result) => {
+                        let seconds = submitted.elapsed().as_secs_f64();
+                        let mut image = result.map_err(|e| e.to_string())?.0;
+                        // Finished as every denoised image is (the Denoise toggle's, the CLI's).
+                        input.finish(&mut image);
+                        // As a deterministic image: its relMSE less the truth's noise.
+                        let truth = self.truth.as_ref().expect("settings are measured after the truth");
+                        let errors = compare_with_map(&image, &truth.image, &truth.regions, Vec::new());
+                        let m = measured(&errors, &truth.regions, truth.rel_mse, None, spp);
+                        let denoising = &mut self.denoising;
+                        let first = denoising.at.is_empty();
+                        denoising.filter_seconds =
+                            if first { seconds } else { denoising.filter_seconds.min(seconds) };
+                        denoising.at.push((spp, m));
+                    }
+                },
             }
             Ok(())
         }
@@ -389,16 +457,27 @@ mod polled {
         }
 
         /// A path-tracer setting: first its bias and noise at the pilot's size, then its
-        /// throughput at the size the path-tracer mode renders the view at.
+        /// throughput at the size the path-tracer mode renders the view at. A denoised setting
+        /// also has its guides made and its accumulation filtered at each spp of
+        /// `denoised_spps` at the pilot's size, their time scaled by the ratio of pixel counts
+        /// as the Whitted frame's is (at the view's size one filter run held the window for
+        /// 2.4 s on lavapipe; the filter's work is the same per pixel).
         fn step_path_tracer(
             &mut self,
             gpu: &GpuContext,
             setting: Setting,
             variant: Scene,
         ) -> Result<(), String> {
-            let (scene, spp) = match &self.measured {
-                None => (variant, self.options.pilot_spp),
-                Some(_) => (apply(&self.pathtrace_scene, &setting), self.options.timing_spp + 1),
+            let denoise = matches!(setting, Setting::PathTrace { denoise: Some(_), .. });
+            let pilot_spp = self.options.pilot_spp;
+            let measuring = self.measured.is_none();
+            let (scene, spp) = if measuring {
+                // A denoised setting stops at each spp it is denoised at, the first not yet.
+                let at = &self.denoising.at;
+                let next = denoised_spps(pilot_spp).into_iter().find(|n| !at.iter().any(|(m, _)| m == n));
+                (variant, if denoise { next.unwrap_or(pilot_spp) } else { pilot_spp })
+            } else {
+                (apply(&self.pathtrace_scene, &setting), self.options.timing_spp + 1)
             };
             let running = match &mut self.running {
                 Some(running) => running,
@@ -410,15 +489,51 @@ mod polled {
             if !running.step(spp, self.slice)? {
                 return Ok(());
             }
+            if denoise && measuring {
+                let Some(guides) = &self.denoising.guides else {
+                    let submitted = Instant::now();
+                    // The Denoise toggle's guides (denoise_view.rs), which show the choice.
+                    let guides = running.tracer.start_guides(GUIDE_SAMPLES_MIN).map_err(|e| e.to_string())?;
+                    wait_natively(gpu)?;
+                    self.pending = Some(Pending::Guides { guides, submitted });
+                    return Ok(());
+                };
+                if !self.denoising.at.iter().any(|(n, _)| *n == spp) {
+                    if self.filter.is_none() {
+                        self.filter = Some(AtrousDenoiser::new(gpu).map_err(|e| e.to_string())?);
+                    }
+                    let filter = self.filter.as_ref().expect("made above");
+                    let input = DenoiseInput::from_render(running.tracer.accumulator(), guides);
+                    let submitted = Instant::now();
+                    let pending =
+                        filter.start(&input, &AtrousSettings::default()).map_err(|e| e.to_string())?;
+                    wait_natively(gpu)?;
+                    self.pending = Some(Pending::Denoised { pending, input, spp, submitted });
+                    return Ok(());
+                }
+                if spp < pilot_spp {
+                    return Ok(());
+                }
+            }
             let running = self.running.take().expect("running above");
             let Some((image, noise)) = self.measured.take() else {
                 let accumulator = running.tracer.accumulator();
                 self.measured = Some((accumulator.mean_image(), accumulator.estimated_rel_mse()));
+                // The guides are of the tracer just finished.
+                self.denoising.guides = None;
                 return Ok(());
             };
             let wall = self.pacer.wall_per_traced_second().unwrap_or(1.0);
             let setup = running.setup_seconds.unwrap_or(0.0);
-            self.push(image, Some(noise), setup, running.seconds_per_spp() * wall);
+            let filtering = if denoise {
+                let [w, h] = self.sizes.pathtrace;
+                let (sw, sh) = self.size();
+                let ratio = f64::from(w) * f64::from(h) / (f64::from(sw) * f64::from(sh));
+                (self.denoising.guide_seconds + FILTER_RUNS * self.denoising.filter_seconds) * ratio
+            } else {
+                0.0
+            };
+            self.push(image, Some(noise), setup + filtering, running.seconds_per_spp() * wall);
             Ok(())
         }
 
@@ -433,7 +548,11 @@ mod polled {
             let setting = self.settings[self.candidates.len()].clone();
             let truth = self.truth.as_ref().expect("settings are measured after the truth");
             let errors = compare_with_map(&image, &truth.image, &truth.regions, Vec::new());
-            let m = measured(&errors, &truth.regions, truth.rel_mse, own_noise, self.options.pilot_spp);
+            let mut m = measured(&errors, &truth.regions, truth.rel_mse, own_noise, self.options.pilot_spp);
+            let denoising = std::mem::take(&mut self.denoising);
+            if let Setting::PathTrace { denoise: Some(_), .. } = setting {
+                m = denoised(m, &denoising.at);
+            }
             self.candidates.push(Candidate {
                 setting,
                 bias_rel_mse: m.bias_rel_mse,

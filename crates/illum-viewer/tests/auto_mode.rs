@@ -1,7 +1,8 @@
 //! The viewer's Auto mode, driven through the real UI with egui_kittest on lavapipe: its pilot
-//! runs across frames with the viewer's renderers, the planner's choice is shown in its own
-//! mode with its settings, the path tracer stops at the planned spp, and a target no renderer
-//! can meet is refused in the panel with each renderer's reason.
+//! runs across frames with the viewer's renderers and measures every path-tracer setting raw
+//! and denoised by à-trous, the planner's choice is shown in its own mode with its settings
+//! (a denoised one through the Denoise toggle), the path tracer stops at the planned spp, and
+//! a target no renderer can meet is refused in the panel with each renderer's reason.
 //!
 //! The pilot here is smaller than the window's default (32 pixels on the longer side, a 512 spp
 //! truth) and the path tracer renders at a tenth of the view's size each way, so that a test
@@ -9,8 +10,8 @@
 
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
-use illum_auto::plan::{Goal, Plan, Setting, plan};
-use illum_scene::RendererKind;
+use illum_auto::plan::{Candidate, Goal, Plan, Setting, noise_rel_mse, plan};
+use illum_scene::{DenoiserKind, RendererKind};
 use illum_viewer::ViewerApp;
 use illum_viewer::auto_pilot::PilotOptions;
 
@@ -96,6 +97,30 @@ fn a_tighter_target_takes_the_path_tracer_at_the_planned_spp_and_a_loose_one_som
     let reached = pathtrace.stats().relative_error.unwrap();
     eprintln!("planned {spp} spp for 10%: the path tracer's own noise estimate {reached:.4}");
 
+    check_denoised_candidates(&candidates);
+    // A denoised choice is shown denoised: the path tracer's Denoise toggle on, stopping at its
+    // spp with the denoised image of that spp.
+    let denoised: Vec<Candidate> = candidates.iter().filter(|c| is_denoised(&c.setting)).cloned().collect();
+    let choice = plan(&denoised, Goal::Error(0.1)).expect("a denoised plan for 10%").choice;
+    let spp = choice.spp.expect("an spp");
+    let kind =
+        illum_viewer::auto_panel::apply_choice(&choice, None, None, harness.state_mut().pathtrace_mut());
+    assert_eq!(kind, RendererKind::PathTrace);
+    assert!(harness.state().pathtrace().unwrap().settings.denoise);
+    for _ in 0..PILOT_FRAMES {
+        harness.step();
+        let pathtrace = harness.state().pathtrace().unwrap();
+        if pathtrace.stop_reason().is_some() && pathtrace.denoise.estimate().is_some_and(|e| e.spp == spp) {
+            break;
+        }
+    }
+    let pathtrace = harness.state().pathtrace().unwrap();
+    assert_eq!(pathtrace.stop_reason(), Some(illum_pathtrace::StopReason::SppReached));
+    assert_eq!(pathtrace.stats().spp, spp);
+    assert_eq!(pathtrace.denoise.estimate().map(|e| e.spp), Some(spp), "{}", pathtrace.denoise.summary());
+    assert!(pathtrace.denoise.image().is_some() && pathtrace.denoise.texture().is_some());
+    eprintln!("{}: {}", choice.describe(), pathtrace.denoise.summary());
+
     // A loose target: the planner's cheapest choice, faster than the tight one, in its mode.
     harness.state_mut().auto_mut().target = 0.5;
     harness.run_steps(2);
@@ -122,6 +147,38 @@ fn a_tighter_target_takes_the_path_tracer_at_the_planned_spp_and_a_loose_one_som
         tight.choice.describe(),
         tight.choice.predicted_seconds
     );
+}
+
+fn is_denoised(setting: &Setting) -> bool {
+    matches!(setting, Setting::PathTrace { denoise: Some(DenoiserKind::Atrous), .. })
+}
+
+/// Every raw path-tracer setting has its à-trous variant among the candidates (as the CLI's
+/// pilot measures it), with a curve measured at the spp of `denoised_spps`, below the raw
+/// setting's noise at 4 spp (the filter ran on that setting's samples).
+fn check_denoised_candidates(candidates: &[Candidate]) {
+    let raw: Vec<&Candidate> =
+        candidates.iter().filter(|c| matches!(c.setting, Setting::PathTrace { denoise: None, .. })).collect();
+    let denoised: Vec<&Candidate> = candidates.iter().filter(|c| is_denoised(&c.setting)).collect();
+    assert_eq!(raw.len(), 5, "the Cornell box's path tracer: bounces 1, 2, 4, 8, unbounded");
+    assert_eq!(denoised.len(), raw.len(), "{candidates:#?}");
+    let spps: Vec<f64> = illum_auto::measure::denoised_spps(32).into_iter().map(f64::from).collect();
+    for r in raw {
+        let Setting::PathTrace { bounces, caustics, .. } = r.setting else { unreachable!() };
+        let d = denoised
+            .iter()
+            .find(|d| matches!(d.setting, Setting::PathTrace { bounces: b, caustics: c, .. } if b == bounces && c == caustics))
+            .unwrap_or_else(|| panic!("no denoised variant of {}", r.setting));
+        let curve = d.noise.as_ref().expect("a denoised setting has a noise curve");
+        assert_eq!(curve.points().iter().map(|p| p.0).collect::<Vec<_>>(), spps, "{}", d.setting);
+        let (raw_4, denoised_4) = (noise_rel_mse(r.noise.as_ref().unwrap(), 4.0), noise_rel_mse(curve, 4.0));
+        eprintln!(
+            "{}: relMSE beyond the bias at 4 spp {raw_4:.2e} raw, {denoised_4:.2e} denoised",
+            r.setting
+        );
+        assert!(denoised_4 < raw_4, "{}: denoised {denoised_4} against raw {raw_4}", r.setting);
+        assert!(d.fixed_seconds > 0.0 && d.seconds_per_spp > 0.0, "{d:?}");
+    }
 }
 
 #[test]

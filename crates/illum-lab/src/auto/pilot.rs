@@ -7,8 +7,9 @@
 //!   bias² is its relMSE less the truth's own estimated noise; a path tracer's is its relMSE less
 //!   its own and the truth's estimated noise, and its noise curve ([`super::plan::NoiseCurve`])
 //!   comes from its own estimate: at the pilot's spp with the 1/N law for independent samples
-//!   and adaptive sampling; at a quarter of it and at it, with the exponent between them, for
-//!   the low-discrepancy sequence (its estimate from independently randomised replicates); and
+//!   and adaptive sampling; at a sixteenth, a quarter and all of it for the low-discrepancy
+//!   sequence (its estimate from independently randomised replicates), with the law beyond of
+//!   [`super::plan::NoiseCurve::with_measured_law`]; and
 //!   for a denoised render, the denoised image's relMSE against the truth at 4, 16, 64 and the
 //!   pilot's spp, less the bias. The truth and these figures are cached in the pilot's folder
 //!   under a key of the scene's content hash and every pilot setting, like the ladder's truth.
@@ -31,13 +32,13 @@ use illum_scene::{Bounces, DenoiserKind, Overrides, Scene, Sequence};
 use illum_whitted::WhittedTracer;
 
 use super::cache::{read_cache, write_cache};
-use super::plan::{Candidate, NoiseCurve, Setting};
+use super::plan::{Candidate, Setting};
 pub use super::render::render;
 use super::render::{path_tracer_throughput, spp_multiple, tracer_options};
 use crate::reference::{cached_reference, reference_settings};
 use crate::regions::{Regions, compare};
 use illum_auto::measure::{Measured, measured};
-pub use illum_auto::settings::{apply, has_caustic, pilot_size, settings, settings_with_variants};
+pub use illum_auto::settings::{Variants, apply, has_caustic, pilot_size, settings, settings_with_variants};
 
 /// How the pilot measures.
 #[derive(Clone, Debug)]
@@ -132,10 +133,10 @@ pub fn measure(
 
     let denoisers: &[DenoiserKind] =
         if OIDN_BUILT { &[DenoiserKind::Atrous, DenoiserKind::Oidn] } else { &[DenoiserKind::Atrous] };
-    let all = settings_with_variants(scene, denoisers);
+    let all = settings_with_variants(scene, Variants { low_discrepancy: true, adaptive: true, denoisers });
     let (_, truth_key) = reference_settings(&truth_scene, options.truth_spp);
     let key = format!(
-        "auto pilot 3; truth: {truth_key}; pilot spp {}; seed {}; sampling {}; settings: {}",
+        "auto pilot 4; truth: {truth_key}; pilot spp {}; seed {}; sampling {}; settings: {}",
         options.pilot_spp,
         small.pathtrace.seed,
         small.pathtrace.sampling,
@@ -251,24 +252,31 @@ fn measure_bias(
     } else {
         PathTracer::with_options(gpu, &variant, tracer_options(setting))?
     };
-    // The denoised image's relMSE at these spp (and the pilot's), from one render continued.
-    let denoised_at: Vec<u32> = [4, 16, 64].into_iter().filter(|&n| n < spp).chain([spp]).collect();
+    // From one render continued: the denoised image's relMSE at these spp, and the
+    // low-discrepancy render's own estimate at those.
+    let denoised_at = illum_auto::measure::denoised_spps(spp);
+    let estimated_at = illum_auto::measure::low_discrepancy_spps(spp);
+    let mut stops: Vec<u32> = denoised_at.iter().chain(&estimated_at).copied().collect();
+    stops.sort_unstable();
+    stops.dedup();
     let filter = match denoise {
         Some(kind) => Some(Denoiser::new(gpu, *kind)?),
         None => None,
     };
     let mut denoised = Vec::new();
-    let mut quarter = None;
-    for &n in &denoised_at {
+    let mut estimates = Vec::new();
+    for &n in &stops {
         let until = match tracer.sample_allocation() {
             Some(allocation) => allocation.max(),
             None => n,
         };
         tracer.render_to_spp(until)?;
-        if n == spp / 4 {
-            quarter = Some(tracer.accumulator().estimated_rel_mse());
+        if estimated_at.contains(&n) {
+            estimates.push((n, tracer.accumulator().estimated_rel_mse()));
         }
-        if let Some(filter) = &filter {
+        if let Some(filter) = &filter
+            && denoised_at.contains(&n)
+        {
             // The guides a render of n spp would have (`render --denoise`, illum-denoise's split).
             let guides = tracer.guides(guide_samples(n))?;
             let image = filter.denoise(&DenoiseInput::from_render(tracer.accumulator(), &guides))?;
@@ -280,14 +288,9 @@ fn measure_bias(
     let own = accumulator.estimated_rel_mse();
     let raw =
         measured(&compare(&accumulator.mean_image(), truth, regions), regions, truth_rel_mse, Some(own), spp);
-    let n = f64::from(spp);
     Ok(match (sequence, denoise) {
         (_, Some(_)) => illum_auto::measure::denoised(raw, &denoised),
-        (Sequence::LowDiscrepancy, None) => {
-            let early = quarter.unwrap_or(own);
-            let exponent = (early / own).ln() / 4f64.ln();
-            Measured { noise: NoiseCurve::new(vec![(n / 4.0, early), (n, own)], exponent), ..raw }
-        }
+        (Sequence::LowDiscrepancy, None) => illum_auto::measure::low_discrepancy(raw, &estimates),
         (Sequence::Independent, None) => raw,
     })
 }
