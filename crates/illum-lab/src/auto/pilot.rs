@@ -135,8 +135,10 @@ pub fn measure(
         if OIDN_BUILT { &[DenoiserKind::Atrous, DenoiserKind::Oidn] } else { &[DenoiserKind::Atrous] };
     let all = settings_with_variants(scene, Variants { low_discrepancy: true, adaptive: true, denoisers });
     let (_, truth_key) = reference_settings(&truth_scene, options.truth_spp);
+    // The leading version is raised whenever what a cached measurement holds changes (the pilot's
+    // rules, or the output of a renderer or denoiser it measures): an older cache then misses.
     let key = format!(
-        "auto pilot 4; truth: {truth_key}; pilot spp {}; seed {}; sampling {}; settings: {}",
+        "auto pilot 5; truth: {truth_key}; pilot spp {}; seed {}; sampling {}; settings: {}",
         options.pilot_spp,
         small.pathtrace.seed,
         small.pathtrace.sampling,
