@@ -140,15 +140,13 @@ mod polled {
             let report = self.tracer.render_step(Some(spp)).map_err(|e| e.to_string())?;
             // As the tracer's own planner counts a band: a polled band's wall time includes the
             // frames drawn while it was read back, its GPU time (where there is one) does not.
-            // Polled, the caustic's frames are traced in steps of their own and timed apart from
-            // the bands (PathTracer::caustic_seconds); waited for, they are in the step's wall time.
-            self.step_seconds += match self.tracer.readback() {
-                Readback::Polled => {
-                    report.gpu_seconds.unwrap_or(report.wall_seconds) + self.tracer.caustic_seconds()
-                        - caustic_before
-                }
+            // The caustic's frames are traced in steps of their own, whose reports are empty,
+            // and timed apart from the bands (PathTracer::caustic_seconds), whatever the readback.
+            let band_seconds = match self.tracer.readback() {
+                Readback::Polled => report.gpu_seconds.unwrap_or(report.wall_seconds),
                 _ => report.wall_seconds,
             };
+            self.step_seconds += band_seconds + self.tracer.caustic_seconds() - caustic_before;
             self.step_spp += self.tracer.spp_done() - before;
             Ok(self.tracer.spp_done() >= spp)
         }
