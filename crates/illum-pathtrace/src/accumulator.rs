@@ -117,14 +117,28 @@ pub fn available_host_memory() -> Option<u64> {
 impl Accumulator {
     pub fn new(width: u32, height: u32) -> Self {
         let n = width as usize * height as usize;
+        Self::with_statistics(width, height, vec![[0.0; 3]; n], vec![[0.0; 3]; n], vec![0; n], 0)
+    }
+
+    /// The accumulator of these statistics (of `width x height` entries each), with no glint or
+    /// replicates and unscaled sums; the total is recounted.
+    fn with_statistics(
+        width: u32,
+        height: u32,
+        sum: Vec<[f64; 3]>,
+        sum_sq: Vec<[f64; 3]>,
+        count: Vec<u64>,
+        dropped: u64,
+    ) -> Self {
+        let total = count.iter().sum();
         Self {
             width,
             height,
-            sum: vec![[0.0; 3]; n],
-            sum_sq: vec![[0.0; 3]; n],
-            count: vec![0; n],
-            total: 0,
-            dropped: 0,
+            sum,
+            sum_sq,
+            count,
+            total,
+            dropped,
             sum_scale: 1.0,
             replicates: None,
             glint: Vec::new(),
@@ -145,18 +159,7 @@ impl Accumulator {
         sum.resize(n, [0.0; 3]);
         sum_sq.resize(n, [0.0; 3]);
         count.resize(n, 0);
-        Ok(Self {
-            width,
-            height,
-            sum,
-            sum_sq,
-            count,
-            total: 0,
-            dropped: 0,
-            sum_scale: 1.0,
-            replicates: None,
-            glint: Vec::new(),
-        })
+        Ok(Self::with_statistics(width, height, sum, sum_sq, count, 0))
     }
 
     /// Folds from now on values the GPU computed with radiance scaled by 2^-`exponent` (see
@@ -190,19 +193,7 @@ impl Accumulator {
                 count.len()
             ));
         }
-        let total = count.iter().sum();
-        Ok(Self {
-            width,
-            height,
-            sum,
-            sum_sq,
-            count,
-            total,
-            dropped,
-            sum_scale: 1.0,
-            replicates: None,
-            glint: Vec::new(),
-        })
+        Ok(Self::with_statistics(width, height, sum, sum_sq, count, dropped))
     }
 
     /// Keeps per-replicate sums from now on (a low-discrepancy render, see `replicates.rs`); the
