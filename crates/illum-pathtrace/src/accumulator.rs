@@ -117,32 +117,8 @@ pub fn available_host_memory() -> Option<u64> {
 impl Accumulator {
     pub fn new(width: u32, height: u32) -> Self {
         let n = width as usize * height as usize;
-        Self::with_statistics(width, height, vec![[0.0; 3]; n], vec![[0.0; 3]; n], vec![0; n], 0)
-    }
-
-    /// The accumulator of these statistics (of `width x height` entries each), with no glint or
-    /// replicates and unscaled sums; the total is recounted.
-    fn with_statistics(
-        width: u32,
-        height: u32,
-        sum: Vec<[f64; 3]>,
-        sum_sq: Vec<[f64; 3]>,
-        count: Vec<u64>,
-        dropped: u64,
-    ) -> Self {
-        let total = count.iter().sum();
-        Self {
-            width,
-            height,
-            sum,
-            sum_sq,
-            count,
-            total,
-            dropped,
-            sum_scale: 1.0,
-            replicates: None,
-            glint: Vec::new(),
-        }
+        Self::from_state(width, height, vec![[0.0; 3]; n], vec![[0.0; 3]; n], vec![0; n], 0)
+            .expect("n entries each, as from_state checks")
     }
 
     /// As [`Self::new`], but reports the bytes it needed instead of aborting when the host cannot
@@ -159,7 +135,8 @@ impl Accumulator {
         sum.resize(n, [0.0; 3]);
         sum_sq.resize(n, [0.0; 3]);
         count.resize(n, 0);
-        Ok(Self::with_statistics(width, height, sum, sum_sq, count, 0))
+        Ok(Self::from_state(width, height, sum, sum_sq, count, 0)
+            .expect("n entries each, as from_state checks"))
     }
 
     /// Folds from now on values the GPU computed with radiance scaled by 2^-`exponent` (see
@@ -193,7 +170,19 @@ impl Accumulator {
                 count.len()
             ));
         }
-        Ok(Self::with_statistics(width, height, sum, sum_sq, count, dropped))
+        let total = count.iter().sum();
+        Ok(Self {
+            width,
+            height,
+            sum,
+            sum_sq,
+            count,
+            total,
+            dropped,
+            sum_scale: 1.0,
+            replicates: None,
+            glint: Vec::new(),
+        })
     }
 
     /// Keeps per-replicate sums from now on (a low-discrepancy render, see `replicates.rs`); the
