@@ -328,6 +328,10 @@ fn render(args: Args) -> anyhow::Result<Option<f64>> {
     // First, so that a stop during the (slow on lavapipe) setup is handled like one during the
     // render: a message and the signal's status, never the default silent death.
     let interrupt = Interrupt::install()?;
+    interrupt.set_note(&illum_cli::interrupt::note(
+        "nothing (no file was written yet)",
+        "the render and its setup",
+    ));
     let long = LongRender {
         interrupt: Some(&interrupt),
         progress_period: args.progress_seconds.unwrap_or(illum_cli::progress::DEFAULT_PERIOD),
@@ -416,7 +420,7 @@ fn render(args: Args) -> anyhow::Result<Option<f64>> {
     if let Some(caustics) = caustics {
         scene.pathtrace.caustics = caustics;
     }
-    if args.caustics == Some(true) && !illum::pathtrace::gpu_scene::caustics_active(&scene) {
+    if args.caustics == Some(true) && !illum::pathtrace::Estimators::of(&scene).caustics() {
         anyhow::bail!(
             "{}: --caustics on: this scene has no caustic to light-trace (the light tracer follows a \
              directional light through mirror or glass objects, and the scene lacks one or the other)",
@@ -569,6 +573,10 @@ fn render(args: Args) -> anyhow::Result<Option<f64>> {
     let gpu = illum_cli::gpu()?;
     let options = TracerOptions { sequence, ..Default::default() };
     if let Some(denoiser) = args.denoise {
+        interrupt.set_note(&illum_cli::interrupt::note(
+            "nothing (a denoised render writes its image once, at the end)",
+            "every sample rendered so far",
+        ));
         let outcome = illum_cli::denoise::render_denoised(&illum_cli::denoise::DenoiseRequest {
             gpu: &gpu,
             scene: &scene,
@@ -675,6 +683,12 @@ fn render(args: Args) -> anyhow::Result<Option<f64>> {
     let mut checkpoint_error: Option<illum::pathtrace::checkpoint::CheckpointError> = None;
     let scope = error_scope(&args, &gpu, tracer.scene())?;
     let progress = RenderProgress::with_period(long.progress_period);
+    let outputs_named = illum_cli::describe_outputs(&exr_outputs);
+    interrupt.set_note(&illum_cli::interrupt::note(
+        "nothing (no checkpoint was written yet)",
+        "every sample rendered so far, and the image, which was not written",
+    ));
+    let mut kept = String::from("nothing (no checkpoint was written)");
     let (reason, progressive) =
         render_progressive_over(&mut tracer, &rules, scope, interrupt.flag(), |t, p| {
             progress.update(t, p);
@@ -689,10 +703,25 @@ fn render(args: Args) -> anyhow::Result<Option<f64>> {
                     }
                 }
                 log::info!("checkpoint written at {} spp", t.spp_done());
+                if checkpoint_error.is_none() && !exr_outputs.is_empty() {
+                    kept = format!(
+                        "the checkpoint {outputs_named} ({} spp, {seconds:.1} s of rendering)",
+                        t.spp_done()
+                    );
+                    interrupt.set_note(&illum_cli::interrupt::note(&kept, "the samples rendered after it"));
+                }
                 last_checkpoint = std::time::Instant::now();
             }
         })?;
     progress.finish();
+    interrupt.set_note(&illum_cli::interrupt::note(
+        &kept,
+        &format!(
+            "the final image of {} spp, which was being written (a file being written is replaced only \
+             when complete, so each output holds what is named as kept, or its earlier content)",
+            tracer.spp_done()
+        ),
+    ));
     if let Some(error) = checkpoint_error {
         eprintln!("warning: a checkpoint could not be written: {error}");
     }
@@ -750,7 +779,7 @@ fn render(args: Args) -> anyhow::Result<Option<f64>> {
         },
         scene.pathtrace.bounces,
         scene.pathtrace.sampling,
-        illum::pathtrace::gpu_scene::caustics_label(&scene),
+        illum::pathtrace::Estimators::of(&scene).caustics_label(),
         seconds,
         status.samples_per_second() * 1e-6,
         accumulator.estimated_relative_error(),

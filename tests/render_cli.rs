@@ -964,17 +964,13 @@ fn caustics_on_off_is_recorded_and_a_checkpoint_of_the_other_setting_is_refused(
         "32",
     ]);
     assert_refused(&out, "--caustics off on a resume", &["caustics: on in the file, off now"]);
-    // A file rendered before the photon gather (the light tracer alone, no estimators key)
-    // holds other light in the metal sphere, and one rendered with the gather at the first
-    // diffuse vertex alone lacks E (S|D)* D S* D S+ L: resuming either with today's estimators
-    // is refused, and so is merging it with a part rendered today.
+    // Files name their estimators by a versioned token list (illum.estimators). A file of the
+    // sentence that came before it (illum.caustic_estimators), or of no key, is refused on resume
+    // and merge with that reason; one whose tokens differ (the gather's first radius rule, or no
+    // glint) with the tokens that differ.
     let rendered = illum::pathtrace::checkpoint::load_checkpoint(&exr).unwrap();
-    assert!(
-        field(&metadata(&exr), "caustic_estimators")
-            .starts_with("light tracer and photon gather at every diffuse")
-    );
-    let first_vertex =
-        "light tracer and photon gather (r_1 = 0.02 x the largest specular radius, r_k = r_1 (k + 1)^(-1/6))";
+    let today = field(&metadata(&exr), "estimators");
+    assert_eq!(today, "estimators.v1 camera-paths light-tracer photon-gather.r2 glint-solve");
     let part = dir.path().join("part.exr");
     let args = [
         "scenes/whitted.toml",
@@ -991,29 +987,32 @@ fn caustics_on_off_is_recorded_and_a_checkpoint_of_the_other_setting_is_refused(
     ];
     let out = run(&args);
     assert!(out.status.success(), "{}", text(&out.stderr));
-    // A file rendered without the sun's glint (`illum.glint`, and its estimators without it)
-    // lacks the sun's image in the balls: it is refused by name too.
     assert_ne!(field(&metadata(&exr), "glint"), "none");
-    let today = field(&metadata(&exr), "caustic_estimators");
-    let without_glint = today.replace("; glint solved", "");
-    assert_ne!(without_glint, today, "the estimators name the glint");
-    for (case, estimators, refusal) in [
-        ("before-gather", None, "caustic_estimators: light tracer in the file".to_owned()),
+    let sentence = "light tracer and photon gather at every diffuse vertex but the camera's own hit (r_1 = 0.02 x the \
+                    largest specular radius, r_k = r_1 (k + 1)^(-1/6)); glint solved";
+    let first_rule = today.replace("photon-gather.r2", "photon-gather.r1");
+    let without_glint = today.replace(" glint-solve", "");
+    for (case, estimators, legacy, refusal) in [
         (
-            "first-vertex-gather",
-            Some(first_vertex.to_owned()),
-            format!("caustic_estimators: {first_vertex} in the file"),
+            "sentence",
+            None,
+            Some(sentence),
+            vec!["illum.estimators", "older form", "caustic_estimators", "render it again"],
         ),
-        (
-            "before-glint",
-            Some(without_glint.clone()),
-            format!("caustic_estimators: {without_glint} in the file"),
-        ),
+        ("no-key", None, None, vec!["illum.estimators", "no illum.estimators field", "render it again"]),
+        ("first-radius-rule", Some(first_rule.as_str()), None, vec!["photon-gather.r1 in the file only"]),
+        ("before-glint", Some(without_glint.as_str()), None, vec!["glint-solve in this render only"]),
     ] {
         let mut older = rendered.clone();
-        older.metadata.fields.retain(|(k, _)| k != "caustic_estimators" && k != "glint");
+        older.metadata.fields.retain(|(k, _)| k != "estimators" && k != "caustic_estimators");
+        if case == "before-glint" {
+            older.metadata.fields.retain(|(k, _)| k != "glint");
+        }
         if let Some(value) = estimators {
-            older.metadata.fields.push(("caustic_estimators".to_owned(), value));
+            older.metadata.fields.push(("estimators".to_owned(), value.to_owned()));
+        }
+        if let Some(value) = legacy {
+            older.metadata.fields.push(("caustic_estimators".to_owned(), value.to_owned()));
         }
         let old = dir.path().join(format!("{case}.exr"));
         illum::pathtrace::checkpoint::save_loaded(&old, &older).unwrap();
@@ -1030,10 +1029,10 @@ fn caustics_on_off_is_recorded_and_a_checkpoint_of_the_other_setting_is_refused(
             "--spp",
             "32",
         ]);
-        assert_refused(&out, &format!("resuming a file {case}"), &[&refusal]);
+        assert_refused(&out, &format!("resuming a file {case}"), &refusal);
         let merged = dir.path().join("never.exr");
         let out = merge(&[old.to_str().unwrap(), part.to_str().unwrap(), "-o", merged.to_str().unwrap()]);
-        assert_refused(&out, &format!("merging a file {case}"), &["caustic_estimators"]);
+        assert_refused(&out, &format!("merging a file {case}"), &["estimators"]);
         assert!(!merged.exists());
     }
 

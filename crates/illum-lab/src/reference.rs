@@ -136,7 +136,7 @@ pub fn reference_settings(scene: &Scene, spp: u32) -> (Scene, String) {
     let (camera, settings) = (&reference_scene.camera, &reference_scene.pathtrace);
     let key = format!(
         "scene {} (canonical form {}), {}x{}, spp {}, bounces {}, seed {}, sampling {}, sequence {}, caustics {}, \
-         caustic estimators {}",
+         estimators {}",
         illum_pathtrace::metadata::scene_hash(&reference_scene),
         illum_scene::CONTENT_VERSION,
         camera.width,
@@ -147,7 +147,7 @@ pub fn reference_settings(scene: &Scene, spp: u32) -> (Scene, String) {
         settings.sampling,
         settings.sequence,
         settings.caustics,
-        illum_pathtrace::caustic_estimators(&reference_scene)
+        illum_pathtrace::Estimators::of(&reference_scene).key()
     );
     (reference_scene, key)
 }

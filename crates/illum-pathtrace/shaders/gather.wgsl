@@ -89,7 +89,7 @@ fn photon_sum(frame: u32, x: vec3<f32>, n: vec3<f32>, r: f32, depth: u32) -> vec
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let pixel = caustic.first_index + gid.y * caustic.row_stride + gid.x;
     let frame = gid.z;
-    if (pixel >= caustic.particles || frame >= caustic.frame_count) {
+    if (pixel >= min(caustic.particles, caustic.index_end) || frame >= caustic.frame_count) {
         return;
     }
     var sampler = sampler_new(caustic.seed ^ GATHER_SEED_KEY, pixel, caustic.frame_base + frame);

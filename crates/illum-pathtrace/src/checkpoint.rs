@@ -41,6 +41,7 @@ use std::path::Path;
 use illum_image::{ExrMetadata, F32Layer, U32Layer, load_u32_layers, save_exr_with_float_layers};
 use illum_scene::Scene;
 
+use crate::estimators::{Estimators, KeyMismatch, compare_key};
 use crate::{Accumulator, PathTracer, TracerOptions};
 pub use error::CheckpointError;
 pub use layers::statistics_layer;
@@ -179,15 +180,6 @@ impl CheckpointHeader {
             "scene" => Some(self.metadata.scene.clone()),
             // A file without the key was rendered without the caustic's light tracer.
             "caustics" => Some(self.metadata.get(key).unwrap_or("off").to_owned()),
-            // A file without the key was rendered before the photon gather: with the light
-            // tracer alone where the caustic was on.
-            "caustic_estimators" => Some(self.metadata.get(key).map_or_else(
-                || {
-                    if self.setting("caustics").as_deref() == Some("on") { "light tracer" } else { "none" }
-                        .to_owned()
-                },
-                str::to_owned,
-            )),
             // A file without the key has no glint in its means.
             "glint" => Some(self.metadata.get(key).unwrap_or("none").to_owned()),
             _ => self.metadata.get(key).map(str::to_owned),
@@ -345,10 +337,31 @@ pub fn image_settings(scene: &Scene, options: TracerOptions) -> Vec<(&'static st
         ("seed", scene.pathtrace.seed.to_string()),
         ("sampling", scene.pathtrace.sampling.to_string()),
         ("sequence", options.sequence.to_string()),
-        ("caustics", crate::gpu_scene::caustics_label(scene).to_owned()),
-        // Which estimators own the caustic's paths: samples of another set hold other light.
-        ("caustic_estimators", crate::gpu_scene::caustic_estimators(scene)),
+        ("caustics", Estimators::of(scene).caustics_label().to_owned()),
     ]
+}
+
+/// Checks that the file at `path` (its `header`) was made by the estimators `now` names, by the
+/// same rules (`estimators.rs`): samples of another set hold other light. A file that names its
+/// estimators in an older form (the sentence of `illum.caustic_estimators`, or no key) is
+/// refused with that reason; one whose tokens differ, with the tokens, as a setting that differs.
+pub(crate) fn check_estimators(
+    path: &Path,
+    header: &CheckpointHeader,
+    now: &Estimators,
+) -> Result<(), CheckpointError> {
+    let stored = header.metadata.get(crate::metadata::ESTIMATORS);
+    let legacy = header.metadata.get(crate::metadata::LEGACY_ESTIMATORS);
+    match compare_key(stored, legacy, now) {
+        Ok(()) => Ok(()),
+        Err(mismatch @ KeyMismatch::OlderForm { .. }) => {
+            Err(CheckpointError::OlderEstimators { path: path.to_path_buf(), reason: mismatch.to_string() })
+        }
+        Err(mismatch) => Err(CheckpointError::OtherSettings {
+            path: path.to_path_buf(),
+            differences: vec![format!("{}: {mismatch}", crate::metadata::ESTIMATORS)],
+        }),
+    }
 }
 
 impl Checkpoint {
@@ -374,6 +387,7 @@ impl Checkpoint {
         options: TracerOptions,
     ) -> Result<(), CheckpointError> {
         let header = self.header();
+        check_estimators(path, &header, &Estimators::of(scene))?;
         let mut differences = Vec::new();
         if self.metadata.scene != scene.name {
             differences.push(format!("scene: {:?} in the file, {:?} now", self.metadata.scene, scene.name));

@@ -82,7 +82,7 @@ pub const MIN_THROUGHPUT: f64 = 1e-12;
 /// (`[pathtrace] caustics = true`, a directional light and a specular object) and the sun is a
 /// delta light (a sun disc is found by the camera paths themselves).
 pub fn glint_active(scene: &Scene) -> bool {
-    crate::gpu_scene::caustics_active(scene) && scene.directional_light.is_some_and(|l| l.is_delta())
+    crate::estimators::Estimators::of(scene).glint()
 }
 
 /// The glints of `scene` (empty when [`glint_active`] is false), sorted by pixel.

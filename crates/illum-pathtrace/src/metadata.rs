@@ -5,6 +5,7 @@
 use illum_image::ExrMetadata;
 use illum_scene::Scene;
 
+use crate::estimators::Estimators;
 use crate::{PathTracer, StopReason};
 
 /// The renderer name path-traced images carry (`illum.renderer`).
@@ -13,6 +14,12 @@ pub const RENDERER: &str = "pathtrace";
 /// The metadata key of the end of a `--sample-range` a part was asked to render (one past its
 /// last sample index), written by the `render` example beside `sample_start`.
 pub const SAMPLE_END: &str = "sample_end";
+
+/// The field of the estimators' token list ([`Estimators::key`]).
+pub const ESTIMATORS: &str = "estimators";
+
+/// The field in which files before the token list named their caustic's estimators by a sentence.
+pub const LEGACY_ESTIMATORS: &str = "caustic_estimators";
 
 /// The scene's identity as files store it (`illum.scene_hash`): [`Scene::content_hash`] in 16
 /// hex digits. It covers the scene's physical content, not the settings (resolution, bounces,
@@ -94,8 +101,8 @@ pub fn exr_metadata(
         ("seed", scene.pathtrace.seed.to_string()),
         ("sampling", scene.pathtrace.sampling.to_string()),
         ("sequence", tracer.options().sequence.to_string()),
-        ("caustics", crate::gpu_scene::caustics_label(scene).to_owned()),
-        ("caustic_estimators", crate::gpu_scene::caustic_estimators(scene)),
+        ("caustics", Estimators::of(scene).caustics_label().to_owned()),
+        (ESTIMATORS, Estimators::of(scene).key()),
         ("glint", glint_field(accumulator.glint())),
         ("estimated_relative_error", accumulator.estimated_relative_error().to_string()),
         ("dropped_samples", accumulator.dropped_samples().to_string()),

@@ -51,6 +51,7 @@ pub const SAMPLING_MODULES: &[ShaderFile] = &[
 pub fn shader_modules(scene: &Scene, gpu_scene: &GpuScene, traversal: Traversal) -> Vec<ShaderFile> {
     let mut modules = SAMPLING_MODULES.to_vec();
     modules.extend(illum_rtcore::shaders::core_modules());
+    modules.push(crate::bindings::bindings_module());
     modules.push(SCENE_MODULE);
     match traversal {
         Traversal::Generic => modules.extend([GENERIC_MATERIALS, GENERIC_TRAVERSAL, GENERIC_LIGHT_CHOICE]),
@@ -152,7 +153,58 @@ mod tests {
     ) -> naga::Module {
         let module = shader::compose(modules, entry, defs).unwrap_or_else(|e| panic!("{e}"));
         shader::validate(&module, &entry.path).unwrap_or_else(|e| panic!("{e}"));
+        // Every pipeline composed of the path tracer's modules binds by the table.
+        if !modules.is_empty() {
+            check_bindings(&module, &format!("{} with {defs:?}", entry.path));
+        }
         module
+    }
+
+    /// The composed pipeline's bindings are all in group 0, no two share a number, and each
+    /// variable has the number the table gives it (bindings.rs), which the host binds it at.
+    fn check_bindings(module: &naga::Module, what: &str) {
+        use crate::bindings::Binding;
+        let mut seen = std::collections::HashMap::new();
+        for (_, variable) in module.global_variables.iter() {
+            let Some(binding) = &variable.binding else { continue };
+            // naga_oil names an imported module's items NAME + "X_naga_oil_mod_X" + its path.
+            let full = variable.name.as_deref().unwrap_or_default();
+            let name = full.split("X_naga_oil_mod_X").next().unwrap_or_default();
+            assert_eq!(binding.group, 0, "{what}: {name} is in group {}", binding.group);
+            if let Some(other) = seen.insert(binding.binding, name.to_owned()) {
+                panic!("{what}: {name} and {other} share binding {}", binding.binding);
+            }
+            let expected = Binding::ALL
+                .iter()
+                .find(|b| b.variable() == name)
+                .unwrap_or_else(|| panic!("{what}: {name} is bound but not in the bindings table"));
+            assert_eq!(binding.binding, expected.index(), "{what}: {name}");
+        }
+        assert!(seen.values().any(|n| n == "params"), "{what}: no bindings found (names {seen:?})");
+    }
+
+    /// The check above fails a pipeline whose module declares a binding outside the table, or
+    /// a variable at another number than the table gives it, or two variables at one number
+    /// (as the light tracer's parameters and adaptive sampling's
+    /// counts did, both at 6). naga refuses a collision only between variables one entry point
+    /// uses; here the second is declared and unused, as a module's are under another def.
+    #[test]
+    fn the_binding_check_fails_a_collision_and_an_unknown_binding() {
+        let entry = |body: &str| {
+            ShaderFile::generated(
+                "bindings.wgsl".into(),
+                format!("{body}\n@compute @workgroup_size(1)\nfn main() {{ let x = params; }}\n"),
+            )
+        };
+        for body in [
+            "@group(0) @binding(0) var<uniform> params: u32;\n@group(0) @binding(0) var<storage, read> objects: array<u32>;",
+            "@group(0) @binding(0) var<uniform> params: u32;\n@group(0) @binding(2) var<storage, read> objects: array<u32>;",
+            "@group(0) @binding(0) var<uniform> params: u32;\n@group(0) @binding(20) var<storage, read> other: array<u32>;",
+        ] {
+            let module = shader::compose(&[], &entry(body), &[]).unwrap_or_else(|e| panic!("{e}"));
+            let failed = std::panic::catch_unwind(|| check_bindings(&module, "a broken pipeline")).is_err();
+            assert!(failed, "accepted: {body}");
+        }
     }
 
     /// naga validates each sampling module on its own (as the import of a trivial entry point),
@@ -309,7 +361,7 @@ mod tests {
             size_of::<crate::CausticParams>(),
             &members!(crate::CausticParams: particles, row_stride, frame_base, frame_count, num_discs, seed,
                 pixel_area, area_per_particle, scene_centre, scene_radius, fixed_scale, fixed_cap, disc_area, gather_radius,
-                buckets, first_index, padding_b, padding_c),
+                buckets, first_index, index_end, radius_origin),
         );
         wgsl("Light").assert_matches(
             size_of::<GpuLight>(),

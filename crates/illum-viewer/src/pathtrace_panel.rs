@@ -241,7 +241,7 @@ impl PathTraceMode {
     pub fn caustics_apply(&self) -> bool {
         let mut scene = self.scene.clone();
         scene.pathtrace.caustics = true;
-        illum_pathtrace::gpu_scene::caustics_active(&scene)
+        illum_pathtrace::Estimators::of(&scene).caustics()
     }
 
     /// Wall-clock and GPU seconds of the tracer's submissions since the last reset (the GPU's

@@ -33,6 +33,10 @@ pub enum CheckpointError {
     /// `reason` says which numbers disagree.
     #[error("{}: {reason}", path.display())]
     Corrupt { path: PathBuf, reason: String },
+    /// The file names its estimators in an older form than this build's token list
+    /// (`estimators.rs`): it cannot be resumed or merged, whatever its settings.
+    #[error("{}: illum.estimators: {reason}", path.display())]
+    OlderEstimators { path: PathBuf, reason: String },
     /// Resuming with settings other than the file's: each difference, with both values.
     #[error(
         "{}: rendered with other settings, so its samples cannot be combined with these: {}",

@@ -17,7 +17,7 @@ const MERGE_KEYS: [&str; 11] = [
     "sampling",
     "sequence",
     "caustics",
-    "caustic_estimators",
+    crate::metadata::ESTIMATORS,
     "glint",
 ];
 
@@ -67,6 +67,16 @@ fn check_mergeable<T>(parts: &mut [(PathBuf, CheckpointHeader, T)]) -> Result<u3
                     range.end
                 ),
                 finish: resume(),
+            });
+        }
+        // Parts must name their estimators by this build's tokens (compared between the parts
+        // below): a part of an older form holds light of unknown estimators.
+        let (stored, legacy) =
+            (c.metadata.get(crate::metadata::ESTIMATORS), c.metadata.get(crate::metadata::LEGACY_ESTIMATORS));
+        if let Err(mismatch) = crate::estimators::stored_tokens(stored, legacy) {
+            return Err(CheckpointError::OlderEstimators {
+                path: path.clone(),
+                reason: mismatch.to_string(),
             });
         }
         if !range.start.is_multiple_of(u64::from(crate::CHUNK_SAMPLES)) {

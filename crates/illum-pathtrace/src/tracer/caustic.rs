@@ -3,8 +3,7 @@
 //!
 //! Frame k, N = width x height particles, pairs with sample index k of every pixel: pixel p's
 //! sample k is the camera path's estimate plus frame k's splat at p. Rather than adding the two
-//! per sample on the GPU, each pass traces its frames first (in dispatches of up to
-//! `frames_per_dispatch`), reads each frame back and keeps, per chunk of the pass (the same
+//! per sample on the GPU, each pass traces its frames first, reads each frame back and keeps, per chunk of the pass (the same
 //! groups of sample indices as the camera's f32 chunk sums) and pixel, the f64 sum S1 and sum
 //! of squares S2 of the frames' values. Folding a camera chunk (sum C of n samples) then adds
 //!     sum += S1,   sum of squares += S2 + 2 C S1 / n.
@@ -16,11 +15,12 @@
 //! unchanged. Frames depend only on (seed, particle, frame index), and integer atomics add in
 //! any order to the same result, so the image does not depend on how a render is batched.
 //!
-//! Readback: a pass's frames go to the GPU in dispatches of up to `frames_per_dispatch` frames,
-//! each read back and folded before the next is submitted. Natively the tools wait for each
-//! dispatch ([`CausticTracer::prepare_pass`]); a web page cannot wait, so there each dispatch's
-//! mapping is started and asked again on later frames ([`CausticTracer::poll_pass`]). Both
-//! submit the same dispatches and fold the same frames in the same order, so the pass's
+//! Scheduling: one submission per step, sized like a band to the step's time target
+//! (`caustic/schedule.rs`): whole frames when a frame fits it, else a frame in pieces (ranges of
+//! its particles, then of its gathering pixels), the frame read back and folded with its last.
+//! Natively the tools wait for each submission ([`CausticTracer::prepare_pass`]); a web page
+//! cannot wait, so there each submission's completion or mapping is asked again on later frames
+//! ([`CausticTracer::poll_pass`]). Frames are folded in order whatever the cut, so the pass's
 //! statistics are the same bit for bit.
 //!
 //! Fixed point: see [`fixed_point`].
@@ -28,9 +28,8 @@
 //! With a delta sun each dispatch also runs the photon gather (`shaders/gather.wgsl`) after the
 //! particles, into the same frames: its photon maps and grid are allocated and cleared here.
 //!
-//! Over 600 lines with its tests (about 600 of code): one estimator, from its parameters to its
-//! fold, with the two ways its frames come back (waited for, or polled), and the photon gather
-//! that shares its frames and buffers.
+//! One estimator, from its parameters to its fold, with the two ways its frames come back (waited
+//! for, or polled), and the photon gather that shares its frames and buffers.
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
@@ -45,9 +44,14 @@ use web_time::Instant;
 use crate::accumulator::Accumulator;
 use illum_rtcore::GpuShape;
 
+use crate::bindings::Binding;
+use crate::estimators::GATHER_RADIUS_FRACTION;
 use crate::gpu_scene::{GpuParams, GpuScene};
 use crate::options::TracerOptions;
 use crate::{PathTraceError, shaders};
+use schedule::{Costs, Cursor, FrameShape, Stage, Submission, WORKGROUP, next_submission};
+
+mod schedule;
 
 /// Mirrors `struct CausticParams` in caustic.wgsl.
 #[repr(C)]
@@ -70,16 +74,18 @@ pub struct CausticParams {
     pub gather_radius: f32,
     /// Photon-grid buckets per frame (a power of two; 1 without the gather).
     pub buckets: u32,
-    /// The dispatch's first particle (or pixel, in the gather): nonzero for a frame's pieces.
+    /// The dispatch's particles (or pixels, in the gather): `first_index..index_end` (a frame's
+    /// pieces are ranges of them, see `schedule.rs`).
     pub first_index: u32,
-    pub padding_b: u32,
-    pub padding_c: u32,
+    pub index_end: u32,
+    /// The sample index the gather's radius counts from: the render's first (see
+    /// `gather_radius` in caustic_buffers.wgsl).
+    pub radius_origin: u32,
 }
 
 /// Mixed into the scene's seed for the particles, so that particle i of frame k never draws
 /// the random numbers of sample k of pixel i.
 const PARTICLE_SEED_KEY: u32 = 0x5ca0_571c;
-const WORKGROUP: u32 = 64;
 /// Words per pixel of a frame: (lo, hi) for each of three channels.
 const WORDS_PER_PIXEL: u64 = 6;
 /// The most bytes one dispatch's frames take (and the most host memory one pass's chunk
@@ -87,9 +93,6 @@ const WORDS_PER_PIXEL: u64 = 6;
 const SPLAT_BYTES: u64 = 64 << 20;
 /// Bytes per photon: three vec4 (caustic_buffers.wgsl).
 const PHOTON_BYTES: u64 = 48;
-/// r_1 of the photon gather as a fraction of the largest specular object's bounding radius
-/// (docs/caustics.md, "The caustic seen through a specular surface").
-pub const GATHER_RADIUS_FRACTION: f32 = 0.02;
 /// Host bytes per pixel and chunk of a pass: S1 and S2, three f64 each.
 pub(crate) const PASS_BYTES_PER_PIXEL_CHUNK: u64 = 48;
 /// The most host memory one pass's caustic statistics may take.
@@ -133,13 +136,15 @@ pub fn fixed_point(particles: u64, reference: f64) -> (f32, f32) {
     (2f32.powi(exponent), cap as f32)
 }
 
-/// Which pass a caustic pass belongs to: its first absolute sample index, its spp and the
-/// samples per chunk of the camera's sums that its statistics are grouped by.
+/// Which pass a caustic pass belongs to: its first absolute sample index, its spp, the samples
+/// per chunk of the camera's sums that its statistics are grouped by, and the render's first
+/// sample index (which the gather's radius counts from).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct PassKey {
     pub first_sample: u32,
     pub spp: u32,
     pub chunk: u32,
+    pub origin: u32,
 }
 
 /// One pass's caustic statistics: per chunk and pixel, S1 and S2 of its frames, complete once
@@ -151,10 +156,15 @@ struct CausticPass {
     dropped: u64,
     /// Frames folded so far: frames `key.first_sample..key.first_sample + frames_done`.
     frames_done: u32,
-    /// The dispatch of the pass's next frames whose polled readback is under way.
+    /// Where the next frame stands (traced in pieces, see `schedule.rs`).
+    cursor: Cursor,
+    /// Seconds the pieces of the frame at `cursor` took so far.
+    frame_seconds: f64,
+    /// Whether the frame at `cursor` was begun by polling (a waiting caller starts it again:
+    /// its last polled piece may not be done).
+    polled_frame: bool,
+    /// The submission whose polled readback, or polled completion, is under way.
     in_flight: Option<InFlight>,
-    /// The pass's next frame, while it is traced in pieces.
-    pieces: Option<FramePieces>,
 }
 
 impl CausticPass {
@@ -166,13 +176,22 @@ impl CausticPass {
             sum_sq: vec![[0.0; 3]; chunks * pixels],
             dropped: 0,
             frames_done: 0,
+            cursor: Cursor::FrameStart,
+            frame_seconds: 0.0,
+            polled_frame: false,
             in_flight: None,
-            pieces: None,
         }
     }
 
     fn complete(&self) -> bool {
         self.frames_done >= self.key.spp
+    }
+
+    /// Forgets the pieces of the frame in progress: it is traced again from its start.
+    fn restart_frame(&mut self) {
+        self.cursor = Cursor::FrameStart;
+        self.frame_seconds = 0.0;
+        self.polled_frame = false;
     }
 
     /// Folds `count` frames of `pixels` pixels read back from a dispatch (the splat buffer's
@@ -200,55 +219,26 @@ impl CausticPass {
     }
 }
 
-/// A dispatch of frames whose readback is under way (polled).
+/// A polled submission: frames whose readback is under way, or a piece whose work is.
 struct InFlight {
-    read: PendingRead,
-    bytes: DispatchBytes,
-    /// The frames it traced.
-    count: u32,
+    what: Flight,
+    submission: Submission,
     launched: Instant,
-    /// Whether it is the last piece of a frame traced in pieces (not timed).
-    pieced: bool,
 }
 
-/// A frame traced in pieces, one submission per call, for a caller whose time target is
-/// shorter than a frame: its particles in `count` ranges, then (with the gather) its pixels in
-/// `count` ranges, the last read back. Integer atomics add in any order, so the frame's values
-/// are those of one dispatch, bit for bit.
-struct FramePieces {
-    /// Pieces of the particles and of the gather (0 without it).
-    counts: [u32; 2],
-    /// Submissions made so far (of `counts[0] + counts[1]`).
-    submitted: u32,
-    /// Set when the last submitted piece's work is done (polled).
-    done: Arc<AtomicBool>,
-    /// Seconds the waited pieces of each stage took so far.
-    seconds: [f64; 2],
-    /// Whether its pieces were waited for (a waiting caller restarts a frame begun by polling;
-    /// a web page only polls).
-    #[cfg_attr(target_arch = "wasm32", allow(dead_code))]
-    waited: bool,
+enum Flight {
+    /// Frames to read back (whole ones, or a frame's last piece).
+    Read { read: PendingRead, bytes: DispatchBytes, count: u32 },
+    /// A piece of a frame, set done when the GPU has finished it.
+    Piece(Arc<AtomicBool>),
 }
 
 /// What [`CausticTracer::launch`] submitted.
 enum Launched {
     /// A piece of a frame, not read back.
-    Piece,
-    /// Frames to read back: whole ones, or a frame's last piece (`pieces_seconds`: what its
-    /// waited pieces of each stage took).
-    Frames { staging: wgpu::Buffer, bytes: DispatchBytes, count: u32, pieces_seconds: Option<[f64; 2]> },
-}
-
-/// What one submission of caustic work does.
-#[derive(Clone, Copy)]
-enum Stage {
-    /// Whole frames: clear, particles, gather, read back.
-    Whole,
-    /// A range of a frame's particles (the first clears the frame; the last, without the
-    /// gather, reads it back).
-    Particles { first: bool, last: bool },
-    /// A range of a frame's gathering pixels (the last reads the frame back).
-    Gather { last: bool },
+    Piece(Submission),
+    /// Frames to read back: whole ones, or a frame's last piece.
+    Frames { staging: wgpu::Buffer, bytes: DispatchBytes, count: u32, submission: Submission },
 }
 
 /// What a dispatch's staging copy holds: its frames' bytes, then the timestamps (if timed).
@@ -290,19 +280,16 @@ pub(crate) struct CausticTracer {
     base: CausticParams,
     /// The most frames one dispatch may carry (the splat and photon buffers' size).
     max_frames_per_dispatch: u32,
-    /// What one frame cost in the last dispatch, in seconds: sizes the next dispatch when the
-    /// caller aims at a time per step (see [`Self::dispatch_frames`]).
-    seconds_per_frame: Option<f64>,
+    /// What its submissions were measured to cost: sizes the next (see `schedule.rs`).
+    costs: Costs,
     /// Seconds the frames folded so far took, each dispatch at the cost that sized the next
     /// one (its GPU time where the device has timestamps): the light tracer's share of a
     /// render's time, which the bands' own reports do not hold ([`crate::PathTracer::caustic_seconds`]).
     seconds_spent: f64,
-    /// What a frame's particles and its gather cost, from the last frame traced in waited
-    /// pieces: how the next frame is cut (see [`Self::frame_pieces`]).
-    stage_seconds: Option<[f64; 2]>,
     /// Times the light tracer's and the gather's passes, where the device has timestamps.
     timer: PassTimer,
-    groups: (u32, u32),
+    /// The most workgroups of a dispatch along x (a piece of more is laid out in rows).
+    max_groups_x: u32,
     pixels: usize,
     /// What a fixed-point unit is worth in true radiance: 2^radiance_exponent / S.
     unit: f64,
@@ -394,12 +381,10 @@ impl CausticTracer {
         let (fixed_scale, fixed_cap) = fixed_point(if gather { 2 * particles } else { particles }, reference);
         let largest_radius = discs.iter().map(|d| d[3]).fold(0.0, f32::max);
 
-        let groups_total = (particles as u32).div_ceil(WORKGROUP);
-        let gx = groups_total.min(limits.max_compute_workgroups_per_dimension);
-        let gy = groups_total.div_ceil(gx);
+        let max_groups_x = limits.max_compute_workgroups_per_dimension;
         let base = CausticParams {
             particles: particles as u32,
-            row_stride: gx * WORKGROUP,
+            row_stride: 0,
             frame_base: 0,
             frame_count: 0,
             num_discs: discs.len() as u32,
@@ -414,8 +399,8 @@ impl CausticTracer {
             gather_radius: if gather { GATHER_RADIUS_FRACTION * largest_radius } else { 0.0 },
             buckets: buckets as u32,
             first_index: 0,
-            padding_b: 0,
-            padding_c: 0,
+            index_end: 0,
+            radius_origin: 0,
         };
         let pipeline = shaders::companion_pipeline(
             gpu,
@@ -468,20 +453,23 @@ impl CausticTracer {
         } else {
             None
         };
+        fn entry(binding: Binding, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+            wgpu::BindGroupEntry { binding: binding.index(), resource: buffer.as_entire_binding() }
+        }
         let mut entries = vec![
-            wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 1, resource: objects.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 2, resource: materials.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 6, resource: params_buffer.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 8, resource: splat.as_entire_binding() },
+            entry(Binding::Params, params),
+            entry(Binding::Objects, objects),
+            entry(Binding::Materials, materials),
+            entry(Binding::CausticParams, &params_buffer),
+            entry(Binding::Splat, &splat),
         ];
         if let Some((photons, heads)) = &photon_buffers {
-            entries.push(wgpu::BindGroupEntry { binding: 9, resource: photons.as_entire_binding() });
-            entries.push(wgpu::BindGroupEntry { binding: 10, resource: heads.as_entire_binding() });
+            entries.push(entry(Binding::Photons, photons));
+            entries.push(entry(Binding::Heads, heads));
         }
         // The gather reads no discs.
         let gather_entries = entries.clone();
-        entries.push(wgpu::BindGroupEntry { binding: 7, resource: discs_buffer.as_entire_binding() });
+        entries.push(entry(Binding::Discs, &discs_buffer));
         let bind_group = gpu.scoped("binding the caustic's buffers", || {
             device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("caustic"),
@@ -524,11 +512,10 @@ impl CausticTracer {
             bind_group,
             base,
             max_frames_per_dispatch,
-            seconds_per_frame: None,
+            costs: Costs::default(),
             seconds_spent: 0.0,
-            stage_seconds: None,
             timer,
-            groups: (gx, gy),
+            max_groups_x,
             pixels,
             unit: 2f64.powi(gpu_scene.radiance_exponent) / f64::from(fixed_scale),
             pass: None,
@@ -552,6 +539,25 @@ impl CausticTracer {
         (chunks * u64::from(chunk)).min(u64::from(u32::MAX)) as u32
     }
 
+    /// The share of pass `key`'s frames folded, counting the frame in pieces by the share of its
+    /// invocations traced (0 when another pass, or none, is held).
+    pub(crate) fn pass_share(&self, key: PassKey) -> f64 {
+        let Some(pass) = self.pass.as_ref().filter(|p| p.key == key) else { return 0.0 };
+        let n = f64::from(self.base.particles.max(1));
+        let stages = if self.gather.is_some() { 2.0 } else { 1.0 };
+        let within = match pass.cursor {
+            Cursor::FrameStart => 0.0,
+            Cursor::Within { stage: Stage::Particles, next } => f64::from(next) / n / stages,
+            Cursor::Within { stage: Stage::Gather, next } => (1.0 + f64::from(next) / n) / stages,
+        };
+        ((f64::from(pass.frames_done) + within) / f64::from(pass.key.spp.max(1))).min(1.0)
+    }
+
+    /// What one whole frame was measured to cost, in seconds.
+    pub(crate) fn frame_seconds(&self) -> Option<f64> {
+        self.costs.frame
+    }
+
     /// Whether the frames of pass `key` are all traced and folded.
     pub(crate) fn holds(&self, key: PassKey) -> bool {
         self.pass.as_ref().is_some_and(|p| p.key == key && p.complete())
@@ -569,185 +575,158 @@ impl CausticTracer {
     }
 
     /// Traces the frames of pass `key` (absolute sample indices `key.first_sample..`, grouped
-    /// in chunks of `key.chunk`) and folds them, waiting for each submission. Without
-    /// `target_seconds` all of them, and it returns true; with it, one submission sized to that
-    /// time (a viewer's share of a frame: some frames, or a piece of one), and it returns true
-    /// only when the pass's frames were all folded before this call (so a step is one
-    /// submission of caustic work or one band, never both).
+    /// in chunks of `key.chunk`) and folds them, one submission per call sized to `target`
+    /// seconds (`schedule.rs`), waiting for it. Returns true only when the pass's frames were all
+    /// folded before this call (so a step is one submission of caustic work or one band, never
+    /// both).
     #[cfg(not(target_arch = "wasm32"))]
     pub(crate) fn prepare_pass(
         &mut self,
         gpu: &GpuContext,
         key: PassKey,
-        target_seconds: Option<f64>,
+        target: f64,
     ) -> Result<bool, PathTraceError> {
         let mut pass = self.take_pass(key);
-        // A polled read left in flight is abandoned, and so is a frame begun in pieces by
-        // polling (its pieces may not all be done): their frames are traced again here.
-        if pass.in_flight.take().is_some() || pass.pieces.as_ref().is_some_and(|p| !p.waited) {
-            pass.pieces = None;
+        // A polled submission left in flight is abandoned, and so is a frame begun by polling
+        // (its last piece may not be done): the frame is traced again from its start here.
+        if pass.in_flight.take().is_some() || pass.polled_frame {
+            pass.restart_frame();
         }
         let ready = pass.complete();
         let (pixels, unit) = (self.pixels, self.unit);
-        loop {
-            let started = Instant::now();
-            match self.launch(gpu, &mut pass, target_seconds, true)? {
-                None => break,
-                Some(Launched::Piece) => {
-                    gpu.wait_idle("tracing a piece of a caustic frame")?;
-                    if let Some(pieces) = &mut pass.pieces {
-                        let stage = usize::from(pieces.submitted > pieces.counts[0]);
-                        pieces.seconds[stage] += started.elapsed().as_secs_f64();
-                    }
-                }
-                Some(Launched::Frames { staging, bytes, count, pieces_seconds }) => {
-                    illum_gpu::readback::with_mapped(
-                        gpu,
-                        &staging,
-                        bytes.total,
-                        "reading back caustic frames",
-                        |data| {
-                            let words = bytemuck::cast_slice(&data[..bytes.frames as usize]);
-                            pass.fold_frames(words, count, pixels, unit)
-                        },
-                    )?;
-                    self.staging = Some(staging);
-                    // What the steps waited for: the frames (or the frame's pieces), their
-                    // readback and their fold.
-                    let elapsed = started.elapsed().as_secs_f64();
-                    let seconds = match pieces_seconds {
-                        Some(mut stages) => {
-                            stages[usize::from(self.gather.is_some())] += elapsed;
-                            self.stage_seconds = Some(stages);
-                            stages[0] + stages[1]
-                        }
-                        None => elapsed,
-                    };
-                    self.seconds_per_frame = Some(seconds / f64::from(count));
-                    self.seconds_spent += seconds;
-                }
+        let started = Instant::now();
+        match self.launch(gpu, &mut pass, target)? {
+            None => {}
+            Some(Launched::Piece(submission)) => {
+                gpu.wait_idle("tracing a piece of a caustic frame")?;
+                let seconds = started.elapsed().as_secs_f64();
+                self.record(&mut pass, submission, seconds, seconds);
             }
-            if target_seconds.is_some() {
-                break;
+            Some(Launched::Frames { staging, bytes, count, submission }) => {
+                let mut fold_seconds = 0.0;
+                illum_gpu::readback::with_mapped(
+                    gpu,
+                    &staging,
+                    bytes.total,
+                    "reading back caustic frames",
+                    |data| {
+                        let fold = Instant::now();
+                        pass.fold_frames(
+                            bytemuck::cast_slice(&data[..bytes.frames as usize]),
+                            count,
+                            pixels,
+                            unit,
+                        );
+                        fold_seconds = fold.elapsed().as_secs_f64();
+                    },
+                )?;
+                self.staging = Some(staging);
+                let seconds = started.elapsed().as_secs_f64();
+                self.record(&mut pass, submission, seconds, seconds - fold_seconds);
             }
         }
         self.pass = Some(pass);
         Ok(ready)
     }
 
+    /// Learns from a submission that took `seconds` in all, `work_seconds` of them before its
+    /// fold (the piece's own cost).
+    fn record(&mut self, pass: &mut CausticPass, submission: Submission, seconds: f64, work_seconds: f64) {
+        self.seconds_spent += seconds;
+        match submission {
+            Submission::Frames { count } => self.costs.record_frames(count, seconds),
+            Submission::Piece { stage, count, read, .. } => {
+                self.costs.record_piece(stage, count, work_seconds);
+                pass.frame_seconds += seconds;
+                if read {
+                    self.costs.record_pieced_frame(pass.frame_seconds);
+                    pass.frame_seconds = 0.0;
+                }
+            }
+        }
+    }
+
     /// The polled form of [`Self::prepare_pass`]: true once the frames of pass `key` are all
     /// folded. Each call folds the frames in flight if their mapping is done, or sees whether
-    /// the piece in flight is done, and then submits the next work; it never waits.
+    /// the piece in flight is done, and then submits the next work; it never waits. Times are
+    /// taken from the submission to the call that sees it done (they count the frames a page
+    /// drew meanwhile, so submissions stay short), or from the GPU's timestamps for whole frames
+    /// where the device has them.
     pub(crate) fn poll_pass(
         &mut self,
         gpu: &GpuContext,
         key: PassKey,
-        target_seconds: Option<f64>,
+        target: f64,
     ) -> Result<bool, PathTraceError> {
         let mut pass = self.take_pass(key);
         if let Some(flight) = pass.in_flight.take() {
-            let Some(result) = flight.read.poll(gpu) else {
-                pass.in_flight = Some(flight);
-                self.pass = Some(pass);
-                return Ok(false);
-            };
-            let data = result?;
-            let frames = flight.bytes.frames as usize;
-            pass.fold_frames(bytemuck::cast_slice(&data[..frames]), flight.count, self.pixels, self.unit);
-            // Whole frames: the GPU's time where the device has timestamps; else the time until
-            // the mapping was seen done, which counts the frames drawn meanwhile (so dispatches
-            // stay short). A frame traced in pieces keeps the cost that cut it.
-            if !flight.pieced {
-                let gpu_ms =
-                    self.timer.decode(&data[frames..]).map(|passes| passes.iter().map(|p| p.1).sum::<f64>());
-                let seconds = gpu_ms.map_or_else(|| flight.launched.elapsed().as_secs_f64(), |ms| ms * 1e-3);
-                self.seconds_per_frame = Some(seconds / f64::from(flight.count));
-            }
-            self.seconds_spent += self.seconds_per_frame.unwrap_or(0.0) * f64::from(flight.count);
-            self.staging = Some(flight.read.into_buffer());
-        } else if let Some(pieces) = &pass.pieces {
-            // One piece on the GPU at a time: the queue never holds more than a step's work.
-            if let Err(e) = gpu.device.poll(wgpu::PollType::Poll) {
-                return Err(illum_gpu::GpuError::DeviceLost { message: e.to_string() }.into());
-            }
-            if !pieces.done.load(Ordering::Acquire) {
-                self.pass = Some(pass);
-                return Ok(false);
+            let seconds = flight.launched.elapsed().as_secs_f64();
+            match flight.what {
+                Flight::Read { read, bytes, count } => {
+                    let Some(result) = read.poll(gpu) else {
+                        pass.in_flight =
+                            Some(InFlight { what: Flight::Read { read, bytes, count }, ..flight });
+                        self.pass = Some(pass);
+                        return Ok(false);
+                    };
+                    let data = result?;
+                    let frames = bytes.frames as usize;
+                    pass.fold_frames(bytemuck::cast_slice(&data[..frames]), count, self.pixels, self.unit);
+                    let gpu_seconds = matches!(flight.submission, Submission::Frames { .. })
+                        .then(|| self.timer.decode(&data[frames..]))
+                        .flatten()
+                        .map(|passes| passes.iter().map(|p| p.1).sum::<f64>() * 1e-3);
+                    let seconds = gpu_seconds.unwrap_or(seconds);
+                    self.record(&mut pass, flight.submission, seconds, seconds);
+                    self.staging = Some(read.into_buffer());
+                }
+                Flight::Piece(done) => {
+                    // One piece on the GPU at a time: the queue never holds more than a step's work.
+                    if let Err(e) = gpu.device.poll(wgpu::PollType::Poll) {
+                        return Err(illum_gpu::GpuError::DeviceLost { message: e.to_string() }.into());
+                    }
+                    if !done.load(Ordering::Acquire) {
+                        pass.in_flight = Some(InFlight { what: Flight::Piece(done), ..flight });
+                        self.pass = Some(pass);
+                        return Ok(false);
+                    }
+                    self.record(&mut pass, flight.submission, seconds, seconds);
+                }
             }
         }
-        let launched = self.launch(gpu, &mut pass, target_seconds, false)?;
+        let launched = self.launch(gpu, &mut pass, target)?;
         let complete = launched.is_none();
-        match launched {
-            Some(Launched::Frames { staging, bytes, count, pieces_seconds }) => {
-                pass.in_flight = Some(InFlight {
+        let now = Instant::now();
+        pass.in_flight = match launched {
+            Some(Launched::Frames { staging, bytes, count, submission }) => Some(InFlight {
+                what: Flight::Read {
                     read: PendingRead::start(staging, bytes.total, "reading back caustic frames"),
                     bytes,
                     count,
-                    launched: Instant::now(),
-                    pieced: pieces_seconds.is_some(),
-                });
+                },
+                submission,
+                launched: now,
+            }),
+            Some(Launched::Piece(submission)) => {
+                pass.polled_frame = true;
+                let done = Arc::new(AtomicBool::new(false));
+                let flag = done.clone();
+                gpu.queue.on_submitted_work_done(move || flag.store(true, Ordering::Release));
+                Some(InFlight { what: Flight::Piece(done), submission, launched: now })
             }
-            Some(Launched::Piece) => {
-                let done = pass.pieces.as_ref().map(|p| p.done.clone()).expect("a piece belongs to a frame");
-                gpu.queue.on_submitted_work_done(move || done.store(true, Ordering::Release));
-            }
-            None => {}
-        }
+            None => None,
+        };
         self.pass = Some(pass);
         Ok(complete)
     }
 
-    /// Frames for the next dispatch: as many as the buffers hold without a `target_seconds`,
-    /// else the target's worth at the last measured cost (one before any measurement, and at
-    /// least one).
-    fn dispatch_frames(&self, target_seconds: Option<f64>) -> u32 {
-        match (target_seconds, self.seconds_per_frame) {
-            (None, _) => self.max_frames_per_dispatch,
-            (Some(_), None) => 1,
-            (Some(target), Some(cost)) => {
-                (target / cost.max(1e-9)).floor().clamp(1.0, f64::from(self.max_frames_per_dispatch)) as u32
-            }
+    /// The shape of this tracer's frames, for `schedule.rs`.
+    fn frame_shape(&self) -> FrameShape {
+        FrameShape {
+            invocations: self.base.particles,
+            gather: self.gather.is_some(),
+            max_frames: self.max_frames_per_dispatch,
         }
-    }
-
-    /// Pieces of the next frame's particles and of its gather: `None` (a whole frame) unless
-    /// a `target_seconds` is shorter than the last measured frame; then each stage in pieces
-    /// of about the target, by the stages' measured costs (half the frame's each before they
-    /// are measured), at most one per workgroup row or column of the dispatch, none empty.
-    fn frame_pieces(&self, target_seconds: Option<f64>) -> Option<[u32; 2]> {
-        let (target, cost) = (target_seconds?, self.seconds_per_frame?);
-        if cost <= target {
-            return None;
-        }
-        let split = match (self.stage_seconds, self.gather.is_some()) {
-            (Some(stages), _) => stages,
-            (None, true) => [cost / 2.0, cost / 2.0],
-            (None, false) => [cost, 0.0],
-        };
-        let units = self.piece_units();
-        let pieces = |seconds: f64| {
-            let wanted = (seconds / target.max(1e-9)).ceil().clamp(1.0, f64::from(units)) as u32;
-            units.div_ceil(units.div_ceil(wanted))
-        };
-        Some([pieces(split[0]), if self.gather.is_some() { pieces(split[1]) } else { 0 }])
-    }
-
-    /// The units a frame's dispatch is cut along: its workgroups along x when it has one row
-    /// of them, else its rows.
-    fn piece_units(&self) -> u32 {
-        let (gx, gy) = self.groups;
-        if gy == 1 { gx } else { gy }
-    }
-
-    /// Piece `i` of `count` of a frame's dispatch: its workgroups and its first particle (or
-    /// pixel). The pieces cover the dispatch once, in order.
-    fn piece(&self, i: u32, count: u32) -> ((u32, u32), u32) {
-        let (gx, gy) = self.groups;
-        let units = self.piece_units();
-        let per = units.div_ceil(count);
-        let first = (i * per).min(units);
-        let n = per.min(units - first);
-        if gy == 1 { ((n, 1), first * WORKGROUP) } else { ((gx, n), first * self.base.row_stride) }
     }
 
     /// The staging buffer for a dispatch's frames (the one read last, or a new one).
@@ -765,76 +744,77 @@ impl CausticTracer {
         }
     }
 
-    /// Submits the next work of `pass`: whole frames (sized by [`Self::dispatch_frames`]), or
-    /// the next piece of a frame cut by [`Self::frame_pieces`] (the frame's particles piece by
-    /// piece, then its gather piece by piece, its copy for readback with the last piece).
-    /// `None` when the pass is complete. `waited`: the caller waits for each piece.
+    /// Submits the next work of `pass`, as [`next_submission`] plans it at the measured costs
+    /// and `target` seconds, and moves the pass's cursor past it. `None` when the pass is
+    /// complete.
     fn launch(
         &mut self,
         gpu: &GpuContext,
         pass: &mut CausticPass,
-        target_seconds: Option<f64>,
-        waited: bool,
+        target: f64,
     ) -> Result<Option<Launched>, PathTraceError> {
         if pass.complete() {
             return Ok(None);
         }
+        let shape = self.frame_shape();
+        let submission =
+            next_submission(shape, &self.costs, target, pass.cursor, pass.key.spp - pass.frames_done);
         let frame = pass.key.first_sample + pass.frames_done;
-        if pass.pieces.is_none()
-            && let Some(counts) = self.frame_pieces(target_seconds)
-        {
-            pass.pieces =
-                Some(FramePieces { counts, submitted: 0, done: Arc::default(), seconds: [0.0; 2], waited });
+        let read = self.submit(gpu, frame, pass.key.origin, submission)?;
+        if pass.cursor == Cursor::FrameStart {
+            pass.polled_frame = false;
         }
-        let Some(pieces) = &mut pass.pieces else {
-            let count = self.dispatch_frames(target_seconds).min(pass.key.spp - pass.frames_done);
-            let groups = (self.groups.0, self.groups.1, count);
-            let (staging, bytes) =
-                self.submit(gpu, frame, count, groups, 0, Stage::Whole)?.expect("whole frames are read back");
-            return Ok(Some(Launched::Frames { staging, bytes, count, pieces_seconds: None }));
-        };
-        let (k, [particles, gathers]) = (pieces.submitted, pieces.counts);
-        let last = k + 1 == particles + gathers;
-        pieces.submitted += 1;
-        pieces.done.store(false, Ordering::Release);
-        let (((gx, gy), first), stage) = if k < particles {
-            (self.piece(k, particles), Stage::Particles { first: k == 0, last })
-        } else {
-            (self.piece(k - particles, gathers), Stage::Gather { last })
-        };
-        match self.submit(gpu, frame, 1, (gx, gy, 1), first, stage)? {
-            None => Ok(Some(Launched::Piece)),
-            Some((staging, bytes)) => {
-                let seconds = pass.pieces.take().map_or([0.0; 2], |p| p.seconds);
-                Ok(Some(Launched::Frames { staging, bytes, count: 1, pieces_seconds: Some(seconds) }))
+        pass.cursor = submission.cursor_after(shape.invocations, shape.gather);
+        Ok(Some(match (read, submission) {
+            (Some((staging, bytes)), Submission::Frames { count }) => {
+                Launched::Frames { staging, bytes, count, submission }
             }
-        }
+            (Some((staging, bytes)), Submission::Piece { .. }) => {
+                Launched::Frames { staging, bytes, count: 1, submission }
+            }
+            (None, _) => Launched::Piece(submission),
+        }))
     }
 
-    /// Records and submits one dispatch of `frames` frames from sample index `frame`, over
-    /// `groups` workgroups from particle (or pixel) `first`, as `stage` says. Returns the
-    /// staging buffer and what to read from it when the frames are complete (whole frames, or
-    /// a frame's last piece).
+    /// Workgroups (x, y) and the invocations per row for a dispatch of `count` invocations.
+    fn layout(&self, count: u32) -> (u32, u32, u32) {
+        let groups = count.div_ceil(WORKGROUP).max(1);
+        let gx = groups.min(self.max_groups_x.max(1));
+        (gx, groups.div_ceil(gx), gx * WORKGROUP)
+    }
+
+    /// Records and submits `submission` from sample index `frame` of a render whose first is
+    /// `origin`. Returns the staging buffer and what to read from it when it completes frames
+    /// (whole ones, or a frame's last piece).
     fn submit(
         &mut self,
         gpu: &GpuContext,
         frame: u32,
-        frames: u32,
-        groups: (u32, u32, u32),
-        first: u32,
-        stage: Stage,
+        origin: u32,
+        submission: Submission,
     ) -> Result<Option<(wgpu::Buffer, DispatchBytes)>, PathTraceError> {
-        let params =
-            CausticParams { frame_base: frame, frame_count: frames, first_index: first, ..self.base };
+        let n = self.base.particles;
+        let (frames, first, count, clear, particles, gather, read) = match submission {
+            Submission::Frames { count } => (count, 0, n, true, true, true, true),
+            Submission::Piece { stage, first, count, clear, read } => {
+                let particles = stage == Stage::Particles;
+                (1, first, count, clear, particles, !particles, read)
+            }
+        };
+        let (gx, gy, row_stride) = self.layout(count);
+        let params = CausticParams {
+            frame_base: frame,
+            frame_count: frames,
+            first_index: first,
+            index_end: first + count,
+            row_stride,
+            radius_origin: origin,
+            ..self.base
+        };
         let words_per_frame = WORDS_PER_PIXEL * self.pixels as u64;
         let bytes = (words_per_frame + 1) * 4 * u64::from(frames);
-        let (clear, particles, gather, read) = match stage {
-            Stage::Whole => (true, true, true, true),
-            Stage::Particles { first, last } => (first, true, false, last),
-            Stage::Gather { last } => (false, false, true, last),
-        };
-        // Whole frames are timed; a piece is timed by its caller's wait.
-        let timed = matches!(stage, Stage::Whole);
+        // Whole frames are timed; a piece is timed by its caller.
+        let timed = matches!(submission, Submission::Frames { .. });
         let staging = if read { Some(self.take_staging(gpu)?) } else { None };
         gpu.queue.write_buffer(&self.scene_params_buffer, 0, bytemuck::bytes_of(&self.scene_params));
         gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&params));
@@ -854,7 +834,7 @@ impl CausticTracer {
             });
             compute.set_pipeline(&self.pipeline);
             compute.set_bind_group(0, &self.bind_group, &[]);
-            compute.dispatch_workgroups(groups.0, groups.1, groups.2);
+            compute.dispatch_workgroups(gx, gy, frames);
         }
         // Its own pass: the gather reads what every particle of the frames stored.
         if let Some(gather) = self.gather.as_ref().filter(|_| gather) {
@@ -864,7 +844,7 @@ impl CausticTracer {
             });
             compute.set_pipeline(&gather.pipeline);
             compute.set_bind_group(0, &gather.bind_group, &[]);
-            compute.dispatch_workgroups(groups.0, groups.1, groups.2);
+            compute.dispatch_workgroups(gx, gy, frames);
         }
         let result = staging.map(|staging| {
             encoder.copy_buffer_to_buffer(&self.splat, 0, &staging, 0, bytes);
