@@ -344,23 +344,21 @@ pub fn image_settings(scene: &Scene, options: TracerOptions) -> Vec<(&'static st
 /// Checks that the file at `path` (its `header`) was made by the estimators `now` names, by the
 /// same rules (`estimators.rs`): samples of another set hold other light. A file that names its
 /// estimators in an older form (the sentence of `illum.caustic_estimators`, or no key) is
-/// refused with that reason; one whose tokens differ, with the tokens, as a setting that differs.
+/// refused with that reason; one whose tokens differ gives the difference to report beside the
+/// other settings that differ.
 pub(crate) fn check_estimators(
     path: &Path,
     header: &CheckpointHeader,
     now: &Estimators,
-) -> Result<(), CheckpointError> {
+) -> Result<Option<String>, CheckpointError> {
     let stored = header.metadata.get(crate::metadata::ESTIMATORS);
     let legacy = header.metadata.get(crate::metadata::LEGACY_ESTIMATORS);
     match compare_key(stored, legacy, now) {
-        Ok(()) => Ok(()),
+        Ok(()) => Ok(None),
         Err(mismatch @ KeyMismatch::OlderForm { .. }) => {
             Err(CheckpointError::OlderEstimators { path: path.to_path_buf(), reason: mismatch.to_string() })
         }
-        Err(mismatch) => Err(CheckpointError::OtherSettings {
-            path: path.to_path_buf(),
-            differences: vec![format!("{}: {mismatch}", crate::metadata::ESTIMATORS)],
-        }),
+        Err(mismatch) => Ok(Some(format!("{}: {mismatch}", crate::metadata::ESTIMATORS))),
     }
 }
 
@@ -387,8 +385,8 @@ impl Checkpoint {
         options: TracerOptions,
     ) -> Result<(), CheckpointError> {
         let header = self.header();
-        check_estimators(path, &header, &Estimators::of(scene))?;
-        let mut differences = Vec::new();
+        let mut differences: Vec<String> =
+            check_estimators(path, &header, &Estimators::of(scene))?.into_iter().collect();
         if self.metadata.scene != scene.name {
             differences.push(format!("scene: {:?} in the file, {:?} now", self.metadata.scene, scene.name));
         }
