@@ -177,11 +177,50 @@ struct Solver {
     max_scatterings: usize,
 }
 
-/// A leaf of the specular tree from one seed: its chain and the direction it leaves in.
-struct Leaf {
-    chain: Vec<Step>,
-    seed: [f64; 2],
+/// A seed whose specular tree has a leaf of some chain, and how near the sun that leaf leaves.
+#[derive(Clone, Copy, Debug)]
+struct Start {
     cos_to_sun: f64,
+    /// The seed's index in [`Solver::seeds`]: ties in `cos_to_sun` go to the earlier seed, so
+    /// the starts do not depend on how the seeds were shared among threads.
+    index: usize,
+    seed: [f64; 2],
+}
+
+impl Start {
+    /// Whether `self` is a better start than `other`: leaving nearer the sun, then the earlier seed.
+    fn before(&self, other: &Start) -> bool {
+        other.cos_to_sun.total_cmp(&self.cos_to_sun).then(self.index.cmp(&other.index)).is_lt()
+    }
+}
+
+/// Per chain, its best [`NEWTON_STARTS`] starts, best first, no two from seeds nearer than
+/// [`START_SEPARATION`] on the film (such neighbours converge to the same root, or fail alike).
+#[derive(Default)]
+struct Candidates(std::collections::HashMap<Vec<Step>, Vec<Start>>);
+
+impl Candidates {
+    fn offer(&mut self, chain: &[Step], start: Start) {
+        let starts = match self.0.get_mut(chain) {
+            Some(starts) => starts,
+            None => self.0.entry(chain.to_vec()).or_default(),
+        };
+        if starts.len() == NEWTON_STARTS && !start.before(&starts[NEWTON_STARTS - 1]) {
+            return;
+        }
+        let near =
+            |a: &Start| norm2([a.seed[0] - start.seed[0], a.seed[1] - start.seed[1]]) < START_SEPARATION;
+        if let Some(k) = starts.iter().position(near) {
+            // A neighbour is kept already: the better of the two stays.
+            if !start.before(&starts[k]) {
+                return;
+            }
+            starts.remove(k);
+        }
+        let at = starts.iter().position(|s| start.before(s)).unwrap_or(starts.len());
+        starts.insert(at, start);
+        starts.truncate(NEWTON_STARTS);
+    }
 }
 
 impl Solver {
@@ -205,33 +244,78 @@ impl Solver {
     }
 
     fn solve(&self) -> Vec<GlintPoint> {
-        let mut leaves = Vec::new();
-        for seed in self.seeds() {
-            let mut chain = Vec::new();
-            let d = self.film.direction(seed);
-            self.explore(seed, self.film.eye, d, None, [1.0; 3], &mut chain, &mut leaves);
-        }
-        // The sun seen directly: the empty chain, seeded at the sun's own film point.
-        if let Some(s) = self.film.film_point(self.w) {
-            leaves.push(Leaf { chain: Vec::new(), seed: s, cos_to_sun: 1.0 });
-        }
-        leaves.sort_by(|a, b| a.chain.cmp(&b.chain).then(b.cos_to_sun.total_cmp(&a.cos_to_sun)));
-        let mut points: Vec<GlintPoint> = Vec::new();
-        let mut start = 0;
-        while start < leaves.len() {
-            let end = start + leaves[start..].iter().take_while(|l| l.chain == leaves[start].chain).count();
-            let chain = &leaves[start].chain;
-            // The seeds nearest the sun first; Newton from each of the best few.
-            for leaf in leaves[start..end].iter().take(NEWTON_STARTS) {
-                if let Some(point) = self.newton(leaf.seed, chain)
-                    && !points.iter().any(|p| p.chain == point.chain && same_point(p.film, point.film))
-                {
-                    points.push(point);
+        let seeds = self.seeds();
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(seeds.len().max(1));
+        // Each thread explores a share of the seeds; the shares' candidates merge into one map,
+        // ordered as one thread would have found them (by seed index).
+        let per_thread = seeds.len().div_ceil(threads.max(1)).max(1);
+        let shares: Vec<Candidates> = std::thread::scope(|scope| {
+            let handles: Vec<_> = seeds
+                .chunks(per_thread)
+                .enumerate()
+                .map(|(k, share)| {
+                    scope.spawn(move || {
+                        let mut found = Candidates::default();
+                        let mut chain = Vec::new();
+                        for (i, &seed) in share.iter().enumerate() {
+                            let d = self.film.direction(seed);
+                            let index = k * per_thread + i;
+                            self.explore(
+                                index,
+                                seed,
+                                self.film.eye,
+                                d,
+                                None,
+                                [1.0; 3],
+                                &mut chain,
+                                &mut found,
+                            );
+                        }
+                        found
+                    })
+                })
+                .collect();
+            handles.into_iter().map(|h| h.join().expect("a glint explorer thread")).collect()
+        });
+        let mut candidates = Candidates::default();
+        for share in shares {
+            for (chain, starts) in share.0 {
+                for start in starts {
+                    candidates.offer(&chain, start);
                 }
             }
-            start = end;
         }
+        // The sun seen directly: the empty chain, seeded at the sun's own film point.
+        let mut chains: Vec<(Vec<Step>, Vec<Start>)> = candidates.0.into_iter().collect();
+        if let Some(s) = self.film.film_point(self.w) {
+            chains.push((Vec::new(), vec![Start { cos_to_sun: 1.0, index: 0, seed: s }]));
+        }
+        chains.sort_by(|a, b| a.0.cmp(&b.0));
+        // Newton from each chain's starts, the chains shared among the threads.
+        let per_thread = chains.len().div_ceil(threads.max(1)).max(1);
+        let mut points: Vec<GlintPoint> = std::thread::scope(|scope| {
+            let handles: Vec<_> = chains
+                .chunks(per_thread)
+                .map(|share| {
+                    scope.spawn(move || share.iter().flat_map(|(c, s)| self.roots(c, s)).collect::<Vec<_>>())
+                })
+                .collect();
+            handles.into_iter().flat_map(|h| h.join().expect("a glint solver thread")).collect()
+        });
         points.sort_by(|a, b| a.pixel.cmp(&b.pixel).then(a.chain.cmp(&b.chain)));
+        points
+    }
+
+    /// The distinct roots Newton's method finds for `chain` from its starts, best first.
+    fn roots(&self, chain: &[Step], starts: &[Start]) -> Vec<GlintPoint> {
+        let mut points: Vec<GlintPoint> = Vec::new();
+        for start in starts {
+            if let Some(point) = self.newton(start.seed, chain)
+                && !points.iter().any(|p| same_point(p.film, point.film))
+            {
+                points.push(point);
+            }
+        }
         points
     }
 
@@ -283,17 +367,18 @@ impl Solver {
     #[allow(clippy::too_many_arguments)]
     fn explore(
         &self,
+        index: usize,
         seed: [f64; 2],
         o: DVec3,
         d: DVec3,
         own: Option<usize>,
         throughput: [f64; 3],
         chain: &mut Vec<Step>,
-        leaves: &mut Vec<Leaf>,
+        found: &mut Candidates,
     ) {
         let Some(hit) = self.bodies.nearest(o, d, own) else {
             if !chain.is_empty() {
-                leaves.push(Leaf { chain: chain.clone(), seed, cos_to_sun: d.dot(self.w) });
+                found.offer(chain, Start { cos_to_sun: d.dot(self.w), index, seed });
             }
             return;
         };
@@ -305,7 +390,7 @@ impl Solver {
             if let Some((d2, weight)) = scatter(self.bodies.surface(hit.object), d, hit.normal, event) {
                 chain.push((hit.object, event));
                 let t = [0, 1, 2].map(|c| throughput[c] * weight[c]);
-                self.explore(seed, p, d2, Some(hit.object), t, chain, leaves);
+                self.explore(index, seed, p, d2, Some(hit.object), t, chain, found);
                 chain.pop();
             }
         }
@@ -320,14 +405,18 @@ impl Solver {
         let mut own = None;
         let mut throughput = [1.0; 3];
         for &(object, event) in chain {
-            let hit = self.bodies.nearest(o, d, own).filter(|h| h.object == object)?;
+            // The chain's object, and nothing nearer on the way to it.
+            let hit = self.bodies.hit(object, o, d, own)?;
+            if self.bodies.blocked(o, d, own, hit.t, Some(object)) {
+                return None;
+            }
             let (d2, weight) = scatter(self.bodies.surface(object), d, hit.normal, event)?;
             throughput = [0, 1, 2].map(|c| throughput[c] * weight[c]);
             o += hit.t * d;
             d = d2;
             own = Some(object);
         }
-        self.bodies.nearest(o, d, own).is_none().then_some((d, throughput))
+        (!self.bodies.blocked(o, d, own, f64::INFINITY, None)).then_some((d, throughput))
     }
 
     /// Gnomonic coordinates of the leaving direction about w (None behind the sun's hemisphere).
@@ -337,8 +426,21 @@ impl Solver {
         (z > 1e-6).then(|| ([d.dot(self.t1) / z, d.dot(self.t2) / z], throughput))
     }
 
-    /// dg/ds at s: central differences of step h and h/2, extrapolated (error O(h^4)). Retries
-    /// with smaller steps where a difference leaves the chain.
+    /// dg/ds at s by central differences of step h (error O(h^2), enough to steer Newton's
+    /// method), retrying with smaller steps where a difference leaves the chain.
+    fn newton_jacobian(&self, s: [f64; 2], chain: &[Step]) -> Option<[[f64; 2]; 2]> {
+        let mut h = JACOBIAN_STEP;
+        for _ in 0..6 {
+            if let Some(j) = self.central(s, chain, h) {
+                return Some(j);
+            }
+            h *= 0.1;
+        }
+        None
+    }
+
+    /// dg/ds at s, for the glint's value: central differences of step h and h/2, extrapolated
+    /// (error O(h^4)). Retries with smaller steps where a difference leaves the chain.
     fn jacobian(&self, s: [f64; 2], chain: &[Step]) -> Option<[[f64; 2]; 2]> {
         let mut h = JACOBIAN_STEP;
         for _ in 0..6 {
@@ -379,7 +481,7 @@ impl Solver {
         let mut s = seed;
         let (mut g, _) = self.residual(s, chain)?;
         for _ in 0..NEWTON_ITERATIONS {
-            let j = self.jacobian(s, chain)?;
+            let j = self.newton_jacobian(s, chain)?;
             let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
             if det == 0.0 || !det.is_finite() {
                 return None;
@@ -447,6 +549,8 @@ const SEED_AZIMUTHS: usize = 64;
 const GRID_SEEDS: usize = 96;
 /// Newton starts per chain, from its seeds nearest the sun.
 const NEWTON_STARTS: usize = 6;
+/// Film distance (pixels) below which two seeds count as one start.
+const START_SEPARATION: f64 = 1.0;
 const NEWTON_ITERATIONS: usize = 60;
 /// Film step (pixels) of the Jacobian's differences.
 const JACOBIAN_STEP: f64 = 1e-3;
