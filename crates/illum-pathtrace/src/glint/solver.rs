@@ -17,6 +17,9 @@ pub(super) struct Solver {
     t2: DVec3,
     irradiance: [f64; 3],
     max_scatterings: usize,
+    /// Threads the solve shares its work among: the host's (1 where it has none, as a browser).
+    /// The glints do not depend on it.
+    threads: usize,
 }
 
 /// A seed whose specular tree has a leaf of some chain, and how near the sun that leaf leaves.
@@ -36,12 +39,13 @@ impl Start {
     }
 }
 
-/// Per chain, its best [`NEWTON_STARTS`] starts, best first, no two from seeds nearer than
-/// [`START_SEPARATION`] on the film (such neighbours converge to the same root, or fail alike).
+/// Per chain, its best [`NEWTON_STARTS`] starts, best first.
 #[derive(Default)]
 struct Candidates(std::collections::HashMap<Vec<Step>, Vec<Start>>);
 
 impl Candidates {
+    /// Keeps `start` if it is among the chain's best: the result does not depend on the order
+    /// of the offers ([`Start::before`] is a total order).
     fn offer(&mut self, chain: &[Step], start: Start) {
         let starts = match self.0.get_mut(chain) {
             Some(starts) => starts,
@@ -50,19 +54,33 @@ impl Candidates {
         if starts.len() == NEWTON_STARTS && !start.before(&starts[NEWTON_STARTS - 1]) {
             return;
         }
-        let near =
-            |a: &Start| norm2([a.seed[0] - start.seed[0], a.seed[1] - start.seed[1]]) < START_SEPARATION;
-        if let Some(k) = starts.iter().position(near) {
-            // A neighbour is kept already: the better of the two stays.
-            if !start.before(&starts[k]) {
-                return;
-            }
-            starts.remove(k);
-        }
         let at = starts.iter().position(|s| start.before(s)).unwrap_or(starts.len());
         starts.insert(at, start);
         starts.truncate(NEWTON_STARTS);
     }
+}
+
+/// `work(offset, share)` over shares of `items`, one per thread, the results in the order of the
+/// shares. With one thread it runs on the caller's.
+fn in_shares<T: Sync, R: Send>(
+    items: &[T],
+    threads: usize,
+    work: impl Fn(usize, &[T]) -> R + Sync,
+) -> Vec<R> {
+    let threads = threads.min(items.len());
+    if threads <= 1 {
+        return vec![work(0, items)];
+    }
+    let per_share = items.len().div_ceil(threads);
+    let work = &work;
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = items
+            .chunks(per_share)
+            .enumerate()
+            .map(|(k, share)| scope.spawn(move || work(k * per_share, share)))
+            .collect();
+        handles.into_iter().map(|h| h.join().expect("a glint solver thread")).collect()
+    })
 }
 
 impl Solver {
@@ -82,42 +100,22 @@ impl Solver {
             t2,
             irradiance: light.irradiance.as_dvec3().to_array(),
             max_scatterings,
+            threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
         }
     }
 
     pub(super) fn solve(&self) -> Vec<GlintPoint> {
         let seeds = self.seeds();
-        let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(seeds.len().max(1));
-        // Each thread explores a share of the seeds; the shares' candidates merge into one map,
-        // ordered as one thread would have found them (by seed index).
-        let per_thread = seeds.len().div_ceil(threads.max(1)).max(1);
-        let shares: Vec<Candidates> = std::thread::scope(|scope| {
-            let handles: Vec<_> = seeds
-                .chunks(per_thread)
-                .enumerate()
-                .map(|(k, share)| {
-                    scope.spawn(move || {
-                        let mut found = Candidates::default();
-                        let mut chain = Vec::new();
-                        for (i, &seed) in share.iter().enumerate() {
-                            let d = self.film.direction(seed);
-                            let index = k * per_thread + i;
-                            self.explore(
-                                index,
-                                seed,
-                                self.film.eye,
-                                d,
-                                None,
-                                [1.0; 3],
-                                &mut chain,
-                                &mut found,
-                            );
-                        }
-                        found
-                    })
-                })
-                .collect();
-            handles.into_iter().map(|h| h.join().expect("a glint explorer thread")).collect()
+        // Each share of the seeds is explored apart; their candidates merge into one map. A
+        // chain's starts are its best by (leaving direction, seed index), whatever the shares.
+        let shares = in_shares(&seeds, self.threads, |offset, share| {
+            let mut found = Candidates::default();
+            let mut chain = Vec::new();
+            for (i, &seed) in share.iter().enumerate() {
+                let d = self.film.direction(seed);
+                self.explore(offset + i, seed, self.film.eye, d, None, [1.0; 3], &mut chain, &mut found);
+            }
+            found
         });
         let mut candidates = Candidates::default();
         for share in shares {
@@ -133,17 +131,13 @@ impl Solver {
             chains.push((Vec::new(), vec![Start { cos_to_sun: 1.0, index: 0, seed: s }]));
         }
         chains.sort_by(|a, b| a.0.cmp(&b.0));
-        // Newton from each chain's starts, the chains shared among the threads.
-        let per_thread = chains.len().div_ceil(threads.max(1)).max(1);
-        let mut points: Vec<GlintPoint> = std::thread::scope(|scope| {
-            let handles: Vec<_> = chains
-                .chunks(per_thread)
-                .map(|share| {
-                    scope.spawn(move || share.iter().flat_map(|(c, s)| self.roots(c, s)).collect::<Vec<_>>())
-                })
-                .collect();
-            handles.into_iter().flat_map(|h| h.join().expect("a glint solver thread")).collect()
-        });
+        // Newton from each chain's starts, the chains shared out the same way.
+        let mut points: Vec<GlintPoint> = in_shares(&chains, self.threads, |_, share| {
+            share.iter().flat_map(|(c, s)| self.roots(c, s)).collect::<Vec<_>>()
+        })
+        .into_iter()
+        .flatten()
+        .collect();
         points.sort_by(|a, b| a.pixel.cmp(&b.pixel).then(a.chain.cmp(&b.chain)));
         points
     }
@@ -391,8 +385,6 @@ const SEED_AZIMUTHS: usize = 64;
 const GRID_SEEDS: usize = 96;
 /// Newton starts per chain, from its seeds nearest the sun.
 const NEWTON_STARTS: usize = 6;
-/// Film distance (pixels) below which two seeds count as one start.
-const START_SEPARATION: f64 = 1.0;
 const NEWTON_ITERATIONS: usize = 60;
 /// Film step (pixels) of the Jacobian's differences.
 const JACOBIAN_STEP: f64 = 1e-3;
@@ -422,5 +414,36 @@ fn scatter(surface: Surface, d: DVec3, n: DVec3, event: Event) -> Option<(DVec3,
             }
         }
         _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_glints_do_not_depend_on_how_many_threads_share_the_solve() {
+        // The Whitted scene with a row of small glass and mirror balls before it: hundreds of
+        // chains, whose starts come from shares of the seeds cut where the thread count says.
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/whitted.toml");
+        let mut text = std::fs::read_to_string(&path).expect("scenes/whitted.toml");
+        for k in 0..6 {
+            let material = if k % 2 == 0 { "glass" } else { "metal" };
+            let z = -6.0 + 1.2 * f64::from(k);
+            text += &format!(
+                "\n[[objects]]\nmaterial = \"{material}\"\nsphere = {{ center = [1.0, 0.35, {z:?}], radius = 0.35 }}\n"
+            );
+        }
+        let mut scene = Scene::from_toml_str(&text, "whitted-row.toml").unwrap_or_else(|e| panic!("{e}"));
+        scene.camera.width = 320;
+        scene.camera.height = 180;
+        let mut solver = Solver::new(&scene);
+        solver.threads = 1;
+        let one = solver.solve();
+        assert!(one.len() > 40, "{} glints", one.len());
+        for threads in [2, 3, 7] {
+            solver.threads = threads;
+            assert_eq!(solver.solve(), one, "{threads} threads against 1");
+        }
     }
 }
