@@ -176,22 +176,18 @@ def perf_tables(directory):
     """The bench outputs as they were printed, each with the host it was measured on."""
     measured = f"*Measured {host()}, by `scripts/readme-figures.sh`.*"
     docs = os.path.join(ROOT, "docs")
-    bench = read(directory, "bench-quick.txt").strip()
-    if bench:
-        replace_block("bench-quick", f"{bench}\n\n{measured}", os.path.join(docs, "performance.md"))
-    viewer = read(directory, "bench-viewer.txt").strip()
-    if viewer:
-        replace_block("viewer-bench", f"{viewer}\n\n{measured}", os.path.join(docs, "performance.md"))
-    viewer = read(directory, "bench-viewer-whitted.txt").strip()
-    if viewer:
-        replace_block("viewer-bench-whitted", f"{viewer}\n\n{measured}", os.path.join(docs, "performance.md"))
-    glint = read(directory, "bench-glint.txt").strip()
-    if glint:
-        replace_block("glint-bench", f"{glint}\n\n{measured}", os.path.join(docs, "performance.md"))
-    raster = read(directory, "raster-bench.txt").strip()
-    if raster:
-        replace_block("raster-bench", f"```text\n{raster}\n```\n\n{measured}",
-                      os.path.join(docs, "performance-raster.md"))
+    blocks = [
+        ("bench-quick.txt", "bench-quick", "performance.md", False),
+        ("bench-viewer.txt", "viewer-bench", "performance.md", False),
+        ("bench-viewer-whitted.txt", "viewer-bench-whitted", "performance.md", False),
+        ("bench-glint.txt", "glint-bench", "performance.md", False),
+        ("raster-bench.txt", "raster-bench", "performance-raster.md", True),
+    ]
+    for name, block, page, preformatted in blocks:
+        text = read(directory, name).strip()
+        if text:
+            text = f"```text\n{text}\n```" if preformatted else text
+            replace_block(block, f"{text}\n\n{measured}", os.path.join(docs, page))
 
 
 if __name__ == "__main__":
