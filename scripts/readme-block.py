@@ -88,8 +88,12 @@ def ladder_summary(path):
         cells += [f"{float(regions[name]['luminance_ratio']):.2f}" if name in regions else "n/a"
                   for name, _ in LADDER_REGIONS]
         out.append("| " + " | ".join(cells) + " |")
+    # The truth's settings, from the ladder's own page beside the CSV.
+    truth = re.search(r"Truth: (path traced, .*?its own estimated relMSE [0-9.e+-]+)\.",
+                      read(os.path.dirname(path), "ladder.md"))
+    truth = f" Truth: {truth.group(1)}." if truth else ""
     out.append("")
-    out.append(f"*Measured {host()} (lavapipe unless a GPU is present). wall ms: the median time per frame; "
+    out.append(f"*Measured {host()} (lavapipe unless a GPU is present).{truth} wall ms: the median time per frame; "
                "for the rasterizer a whole frame with its shadow and cube maps made again, for the path tracer "
                "the time to render that many spp from nothing.*")
     # The README and the Whitted scene's theory page show the same rows.
