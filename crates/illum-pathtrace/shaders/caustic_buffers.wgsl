@@ -112,7 +112,7 @@ const RADIUS_EXPONENT: f32 = -0.16666667;
 // r_1 (j + 1)^(-1/6) with j = k - radius_origin, the sample's place in its own render. A render of
 // sample indices A..B (a part of a split render, the denoiser's second half) then has the radii,
 // the bias and the variance of a render of 0..B-A, so its error estimate is as honest as that
-// one's (docs/caustics.md, "Radius"). The absolute index would shrink a part's radius with A,
+// one's (docs/caustics-gather.md, "Radius"). The absolute index would shrink a part's radius with A,
 // and a part's 16 samples at a radius 36 times smaller find a photon so rarely that their
 // spread no longer shows the variance.
 fn gather_radius(frame: u32) -> f32 {

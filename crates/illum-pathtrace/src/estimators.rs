@@ -21,7 +21,7 @@ use illum_scene::{Feature, MaterialKind, Scene};
 pub const KEY_VERSION: &str = "estimators.v1";
 
 /// r_1 of the photon gather as a fraction of the largest specular object's bounding radius
-/// (docs/caustics.md, "Radius"); the oracle's gather uses the same.
+/// (docs/caustics-gather.md, "Radius"); the oracle's gather uses the same.
 pub const GATHER_RADIUS_FRACTION: f32 = 0.02;
 
 /// The photon gather's radius rule, r_j = r_1 (j + 1)^(-1/6) with j counted from the render's first
