@@ -190,7 +190,9 @@ pub fn describe(progressive: &Progressive, tracer: &PathTracer) -> String {
     match (status.relative_error, progressive.rules.target_error) {
         (Some(e), Some(t)) => text += &format!("  error {:.2}% (target {}%)", e * 100.0, t * 100.0),
         (Some(e), None) => text += &format!("  error {:.2}%", e * 100.0),
-        (None, _) => text += "  error (needs 2 spp)",
+        (None, _) => {
+            text += &format!("  error unknown until {} spp", tracer.accumulator().spp_for_error_estimate())
+        }
     }
     if let Some(p) = progressive.progress(tracer) {
         let rule = match p.rule {

@@ -206,7 +206,8 @@ pub struct Status {
     pub run_samples: u64,
     /// Wall-clock time of the render ([`RenderClock`]).
     pub elapsed: Duration,
-    /// The estimated relative error after the last completed pass, once it has 2 spp.
+    /// The estimated relative error after the last completed pass, once there are samples
+    /// enough to estimate it ([`crate::Accumulator::spp_for_error_estimate`]).
     pub relative_error: Option<f64>,
 }
 
@@ -375,10 +376,11 @@ impl Progressive {
 
     fn refresh_error(&mut self, tracer: &PathTracer) {
         let spp = tracer.spp_done();
-        if spp != self.error_at_spp || (self.relative_error.is_none() && spp >= 2) {
+        let accumulator = tracer.accumulator();
+        let known = spp >= accumulator.spp_for_error_estimate();
+        if spp != self.error_at_spp || (self.relative_error.is_none() && known) {
             self.error_at_spp = spp;
-            let accumulator = tracer.accumulator();
-            self.relative_error = (spp >= 2).then(|| match &self.error_scope {
+            self.relative_error = known.then(|| match &self.error_scope {
                 ErrorScope::Image => accumulator.estimated_relative_error(),
                 scope => crate::error_map::ErrorMap::of(accumulator).error(scope),
             });
