@@ -270,7 +270,7 @@ fn check_resume(
     rules: &StopRules,
 ) -> anyhow::Result<Checkpoint> {
     let options = TracerOptions { sequence: scene.pathtrace.sequence, ..Default::default() };
-    checkpoint.check_matches(path, scene, options).map_err(anyhow::Error::msg)?;
+    checkpoint.header().check_matches(path, scene, options).map_err(anyhow::Error::msg)?;
     if let Some(range) = &args.sample_range
         && range.start != checkpoint.sample_start
     {

@@ -428,17 +428,6 @@ impl Checkpoint {
         }
     }
 
-    /// Checks that this checkpoint was rendered from `scene` with `options` (see
-    /// [`CheckpointHeader::check_matches`]).
-    pub fn check_matches(
-        &self,
-        path: &Path,
-        scene: &Scene,
-        options: TracerOptions,
-    ) -> Result<(), CheckpointError> {
-        self.header().check_matches(path, scene, options)
-    }
-
     /// The sample indices this file holds: `sample_start .. sample_start + spp_done`.
     pub fn sample_range(&self) -> std::ops::Range<u64> {
         let start = u64::from(self.sample_start);
