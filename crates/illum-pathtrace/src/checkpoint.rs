@@ -229,8 +229,9 @@ impl CheckpointHeader {
     }
 }
 
-/// Longest value a refusal shows whole.
-const SHOWN_CHARS: usize = 40;
+/// Longest value a refusal shows whole: every setting's but a glint's (the caustic estimators'
+/// description is about 160 characters).
+const SHOWN_CHARS: usize = 200;
 
 /// A setting's value as a refusal shows it: whole when short, else its start and its length
 /// (an `illum.glint` value holds thousands of characters, and only its difference matters).

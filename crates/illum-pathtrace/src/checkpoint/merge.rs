@@ -256,13 +256,13 @@ mod tests {
         let error = check_mergeable(&mut parts).unwrap_err().to_string();
         for part in [
             "scene_hash: 00000000000000aa (\"whitted\") in a.exr, 00000000000000bb (\"cornell\") in b.exr",
-            "glint: 0:0.125,0.25,0.5;1:0.125,0.25,0.5;2:0.12... (",
-            " characters) in a.exr, none in b.exr",
+            "glint: 0:0.125,0.25,0.5;1:0.125,0.25,0.5;2:0.125",
+            "... (3689 characters) in a.exr, none in b.exr",
         ] {
             assert!(error.contains(part), "the refusal lacks {part:?}: {error}");
         }
         assert!(!error.contains("bounces") && !error.contains("seed"), "keys that agree: {error}");
-        assert!(error.len() < 400, "{} characters: {error}", error.len());
+        assert!(error.len() < 600, "{} characters: {error}", error.len());
     }
 
     /// The scene is known by its content: parts of one scene under two names merge.
