@@ -126,7 +126,7 @@ fn the_summary_names_the_sequence_and_an_error_not_yet_known_says_what_it_needs(
     assert!(out.status.success(), "{}", text(&out.stderr));
     let stdout = text(&out.stdout);
     assert!(stdout.contains("cosine sampling, low-discrepancy samples"), "{stdout}");
-    assert!(stdout.contains("estimated relative error unknown (it needs 8 spp)"), "{stdout}");
+    assert!(stdout.contains("estimated relative error unknown until 8 spp"), "{stdout}");
     assert!(!stdout.contains("inf"), "{stdout}");
     let out = run_to("--width 8 --height 8 --spp 8 --sequence low-discrepancy", &[&png]);
     let stdout = text(&out.stdout);

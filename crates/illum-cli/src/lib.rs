@@ -8,7 +8,7 @@
 //! - [`progress`]: progress bars and log lines;
 //! - [`render`]: the `render` command's flags and the choice of renderer; [`pathtrace`],
 //!   [`raster`], [`whitted`]: each renderer's path of it, [`denoise`] the path tracer's with
-//!   `--denoise`, [`auto`] the flags of `--renderer auto`.
+//!   `--denoise`, `resume` its `--resume`, [`auto`] the flags of `--renderer auto`.
 
 pub mod auto;
 pub mod denoise;
@@ -18,6 +18,7 @@ pub mod progress;
 pub mod raster;
 pub mod reference;
 pub mod render;
+mod resume;
 pub mod whitted;
 
 use std::path::{Path, PathBuf};

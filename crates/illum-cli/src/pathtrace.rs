@@ -28,14 +28,14 @@ use illum_image::save_png;
 use illum_pathtrace::checkpoint::{Checkpoint, load_checkpoint, save_checkpoint};
 use illum_pathtrace::error_map::ErrorScope;
 use illum_pathtrace::{
-    PathTracer, SampleAllocation, Sequence, StopReason, StopRules, TracerOptions, render_progressive_over,
+    PathTracer, SampleAllocation, StopReason, StopRules, TracerOptions, render_progressive_over,
 };
 use illum_scene::Scene;
 
 use crate::interrupt::Interrupt;
 use crate::progress::RenderProgress;
 use crate::render::RenderArgs;
-use crate::{LongRender, OutputFormat, SceneArgs, output_format};
+use crate::{LongRender, OutputFormat, output_format};
 
 /// The default stop rules of a render given no stop-rule flag: a clean image in a few seconds
 /// on a 2-core machine without a GPU (the README's headline has what it reaches there).
@@ -46,24 +46,6 @@ const DEFAULT_CHECKPOINT: Duration = Duration::from_secs(60);
 /// Parses `--error-percentile` (see [`illum_pathtrace::error_map::parse_error_percentile`]).
 pub fn error_percentile_arg(text: &str) -> Result<f64, String> {
     illum_pathtrace::error_map::parse_error_percentile("--error-percentile", text)
-}
-
-/// Fills the image-changing settings not given on the command line from a checkpoint's
-/// metadata, so that `--resume FILE` needs only the scene file and the new target.
-fn fill_from_checkpoint(
-    checkpoint: &Checkpoint,
-    settings: &mut SceneArgs,
-    sequence: &mut Option<Sequence>,
-    caustics: &mut Option<bool>,
-) {
-    let get = |key: &str| checkpoint.metadata.get(key);
-    settings.width = settings.width.or(Some(checkpoint.accumulator.width));
-    settings.height = settings.height.or(Some(checkpoint.accumulator.height));
-    settings.bounces = settings.bounces.or_else(|| get("bounces")?.parse().ok());
-    settings.seed = settings.seed.or_else(|| get("seed")?.parse().ok());
-    settings.sampling = settings.sampling.or_else(|| get("sampling")?.parse().ok());
-    *sequence = sequence.or_else(|| get("sequence")?.parse().ok());
-    *caustics = caustics.or_else(|| crate::on_off_arg(get("caustics")?).ok());
 }
 
 /// What `--target-error` is measured over: `--error-percentile`, `--region` (its pixels from
@@ -121,7 +103,7 @@ fn prepare(args: &RenderArgs) -> anyhow::Result<Option<Prepared>> {
     let mut settings = args.settings.clone();
     let (mut sequence, mut caustics) = (args.sequence, args.caustics);
     if let Some(checkpoint) = &checkpoint {
-        fill_from_checkpoint(checkpoint, &mut settings, &mut sequence, &mut caustics);
+        crate::resume::fill_from_checkpoint(checkpoint, &mut settings, &mut sequence, &mut caustics);
     }
     let mut scene = crate::load_scene(&args.scene, &settings)?;
     if let Some(sequence) = sequence {
@@ -140,7 +122,9 @@ fn prepare(args: &RenderArgs) -> anyhow::Result<Option<Prepared>> {
     check_combinations(args)?;
     let rules = stop_rules(args, &scene);
     let resumed = match (&args.resume, checkpoint) {
-        (Some(path), Some(checkpoint)) => Some(check_resume(args, path, checkpoint, &scene, &rules)?),
+        (Some(path), Some(checkpoint)) => {
+            Some(crate::resume::check_resume(args, path, checkpoint, &scene, &rules)?)
+        }
         _ => None,
     };
     // A resume whose file already holds the spp asked for has nothing to render: the file is
@@ -261,53 +245,6 @@ fn stop_rules(args: &RenderArgs, scene: &Scene) -> StopRules {
     StopRules::from_command_line(scene.pathtrace.spp, spp, args.target_error, args.time_budget)
 }
 
-/// Checks that `checkpoint`, read from `path`, can be continued as the flags ask.
-fn check_resume(
-    args: &RenderArgs,
-    path: &std::path::Path,
-    checkpoint: Checkpoint,
-    scene: &Scene,
-    rules: &StopRules,
-) -> anyhow::Result<Checkpoint> {
-    let options = TracerOptions { sequence: scene.pathtrace.sequence, ..Default::default() };
-    checkpoint.header().check_matches(path, scene, options).map_err(anyhow::Error::msg)?;
-    if let Some(range) = &args.sample_range
-        && range.start != checkpoint.sample_start
-    {
-        bail!(
-            "--sample-range {}..{}: {} holds samples from index {}, so a continued range must start there",
-            range.start,
-            range.end,
-            path.display(),
-            checkpoint.sample_start
-        );
-    }
-    if let Some(target) = rules.spp
-        && target < checkpoint.spp_done
-    {
-        let asked = if args.sample_range.is_some() || args.settings.spp.is_some() {
-            "asked for"
-        } else {
-            "of the scene file's [pathtrace] spp"
-        };
-        bail!(
-            "{} already holds {} spp, more than the {target} {asked}: nothing to continue (give a larger --spp{})",
-            path.display(),
-            checkpoint.spp_done,
-            if args.sample_range.is_some() { " or a longer --sample-range" } else { "" }
-        );
-    }
-    if checkpoint.sample_start != 0 && args.sample_range.is_none() {
-        bail!(
-            "{} is a part of a split render (samples from index {}): continue it with --sample-range {}..END",
-            path.display(),
-            checkpoint.sample_start,
-            checkpoint.sample_start
-        );
-    }
-    Ok(checkpoint)
-}
-
 /// Renders with the path tracer as the flags say and writes the outputs; returns the estimated
 /// relative error from noise (`None`: nothing was rendered).
 pub fn render_pathtrace(
@@ -369,7 +306,7 @@ pub fn render_pathtrace(
     if let Some(checkpoint) = resumed {
         let path = args.resume.as_ref().expect("resumed");
         earlier_seconds = checkpoint.metadata.render_seconds;
-        restore(&mut tracer, path, checkpoint, &rules)?;
+        crate::resume::restore(&mut tracer, path, checkpoint, &rules)?;
     } else if let Some(range) = &args.sample_range {
         tracer.set_sample_offset(range.start);
     }
@@ -442,7 +379,11 @@ pub fn render_pathtrace(
     if *scope != ErrorScope::Image
         && let Some(error) = status.relative_error
     {
-        println!("estimated relative error over {}: {:.2}%", scope.describe(), error * 100.0);
+        println!(
+            "estimated relative error over {}: {}",
+            scope.describe(),
+            crate::progress::error_text(Some(error), 0)
+        );
     }
     for output in &outputs {
         println!("wrote {}", output.display());
@@ -452,51 +393,6 @@ pub fn render_pathtrace(
         std::process::exit(code);
     }
     Ok(Some(estimated_error))
-}
-
-/// Loads `checkpoint` (read from `path`) into the tracer, from where the render goes on.
-fn restore(
-    tracer: &mut PathTracer,
-    path: &std::path::Path,
-    checkpoint: Checkpoint,
-    rules: &StopRules,
-) -> anyhow::Result<()> {
-    tracer.set_sample_offset(checkpoint.sample_start);
-    println!(
-        "resuming {}: {} spp done{}",
-        path.display(),
-        checkpoint.spp_done,
-        checkpoint
-            .partial_pass
-            .map_or(String::new(), |(spp, rows)| format!(", and {rows} rows of a pass of {spp} spp"))
-    );
-    // Going on past the file's spp, to an spp target.
-    let continues = rules.spp.is_some_and(|target| target > checkpoint.spp_done);
-    match checkpoint.aligned_prefix {
-        // The samples end inside a chunk: start again from the last chunk boundary, so that the
-        // chunk is summed whole, as a straight render sums it (illum_pathtrace::checkpoint).
-        // Only when the render goes on to more spp: otherwise nothing may be taken away.
-        Some((prefix, spp)) if checkpoint.partial_pass.is_none() && continues => {
-            println!(
-                "  (going on from {spp} spp, the last chunk boundary, so that the result equals a straight render)"
-            );
-            tracer.restore(prefix, spp, None, None)?
-        }
-        prefix => {
-            let chunk = illum_pathtrace::CHUNK_SAMPLES;
-            if continues
-                && prefix.is_none()
-                && !(checkpoint.sample_start + checkpoint.spp_done).is_multiple_of(chunk)
-            {
-                println!(
-                    "  (the file ends inside a chunk of {chunk} samples and has no copy of its statistics at the \
-                     chunk boundary: the result will differ from a straight render by f32 rounding, about 1e-7)"
-                );
-            }
-            tracer.restore(checkpoint.accumulator, checkpoint.spp_done, checkpoint.partial_pass, prefix)?
-        }
-    }
-    Ok(())
 }
 
 /// The line a finished render prints: the scene, size, spp, why it stopped, the settings, its
@@ -513,13 +409,10 @@ fn summary(tracer: &PathTracer, reason: StopReason, seconds: f64, samples_per_se
         ),
         None => format!("{} spp", tracer.spp_done()),
     };
-    let error = accumulator.estimated_relative_error();
-    // In the progress line's form (crate::progress::describe), so the two agree at the same spp.
-    let error = if error.is_finite() {
-        format!("{:.2}%", error * 100.0)
-    } else {
-        format!("unknown (it needs {} spp)", accumulator.spp_for_error_estimate())
-    };
+    let error = crate::progress::error_text(
+        Some(accumulator.estimated_relative_error()).filter(|e| e.is_finite()),
+        accumulator.spp_for_error_estimate(),
+    );
     format!(
         "{}: {}x{}, {} ({}), bounces {}, {} sampling, {} samples, caustics {}, {:.2} s, {:.2} Msamples/s (wall clock), \
          estimated relative error {error}, dropped samples {}",
