@@ -382,7 +382,7 @@ pub fn render_pathtrace(
         println!(
             "estimated relative error over {}: {}",
             scope.describe(),
-            crate::progress::error_text(Some(error), 0)
+            illum_pathtrace::progressive::error_text(Some(error), 0)
         );
     }
     for output in &outputs {
@@ -409,7 +409,7 @@ fn summary(tracer: &PathTracer, reason: StopReason, seconds: f64, samples_per_se
         ),
         None => format!("{} spp", tracer.spp_done()),
     };
-    let error = crate::progress::error_text(
+    let error = illum_pathtrace::progressive::error_text(
         Some(accumulator.estimated_relative_error()).filter(|e| e.is_finite()),
         accumulator.spp_for_error_estimate(),
     );

@@ -189,7 +189,10 @@ pub fn describe(progressive: &Progressive, tracer: &PathTracer) -> String {
     let mut text = format!("{spp}  {:.2} Msamples/s", status.samples_per_second() * 1e-6);
     text += &format!(
         "  error {}",
-        error_text(status.relative_error, tracer.accumulator().spp_for_error_estimate())
+        illum_pathtrace::progressive::error_text(
+            status.relative_error,
+            tracer.accumulator().spp_for_error_estimate()
+        )
     );
     if let (Some(_), Some(target)) = (status.relative_error, progressive.rules.target_error) {
         text += &format!(" (target {}%)", target * 100.0);
@@ -206,16 +209,6 @@ pub fn describe(progressive: &Progressive, tracer: &PathTracer) -> String {
         }
     }
     text
-}
-
-/// An estimated relative error as the progress line and the render's summary both write it, so
-/// that they agree at the same spp: a percentage with 2 decimals, or, when there is none yet,
-/// the spp it needs ([`illum_pathtrace::Accumulator::spp_for_error_estimate`]).
-pub fn error_text(error: Option<f64>, needs_spp: u32) -> String {
-    match error {
-        Some(e) => format!("{:.2}%", e * 100.0),
-        None => format!("unknown until {needs_spp} spp"),
-    }
 }
 
 /// Progress of a render made of parts (the Whitted ray tracer's bands of rows, the
@@ -285,12 +278,6 @@ mod tests {
                 "{bad}: {error}"
             );
         }
-    }
-
-    #[test]
-    fn an_error_is_a_percentage_or_unknown_until_the_spp_it_needs() {
-        assert_eq!(error_text(Some(0.012_345), 2), "1.23%");
-        assert_eq!(error_text(None, 8), "unknown until 8 spp");
     }
 
     #[test]

@@ -388,6 +388,16 @@ impl Progressive {
     }
 }
 
+/// An estimated relative error as every front end writes it (the CLI's progress line and summary,
+/// the viewer's panel), so that they agree at the same spp: a percentage with 2 decimals, or, when there is none yet,
+/// the spp it needs ([`crate::Accumulator::spp_for_error_estimate`]).
+pub fn error_text(error: Option<f64>, needs_spp: u32) -> String {
+    match error {
+        Some(e) => format!("{:.2}%", e * 100.0),
+        None => format!("unknown until {needs_spp} spp"),
+    }
+}
+
 /// Renders until a rule fires or `cancel` is set. `on_step` runs after every submission (for
 /// progress bars). A loop that never returns to its caller until the end: native only (a web
 /// page steps a [`Progressive`] once per frame instead).
@@ -425,6 +435,12 @@ pub fn render_progressive_over(
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn an_error_is_a_percentage_or_unknown_until_the_spp_it_needs() {
+        assert_eq!(super::error_text(Some(0.012_345), 2), "1.23%");
+        assert_eq!(super::error_text(None, 8), "unknown until 8 spp");
+    }
+
     use super::*;
 
     fn status(spp_done: u32, seconds: f64, error: Option<f64>) -> Status {
