@@ -13,7 +13,7 @@ use binary::{assert_refused, field, metadata, run, text, words};
 /// nothing, and the estimate says so); the PNG is written too. For à-trous always, and for
 /// Open Image Denoise in builds that have it (`--features illum-denoise/oidn`), whose
 /// estimate is only required to be finite: the halves' estimate overstates OIDN's error, at
-/// 16 spp beyond the raw image's (docs/denoising.md, "Open Image Denoise").
+/// 16 spp beyond the raw image's (docs/denoising-oidn.md).
 #[test]
 fn denoise_writes_the_image_its_guide_layers_and_its_estimated_error() {
     let denoisers: &[&str] = if illum_denoise::OIDN_BUILT { &["atrous", "oidn"] } else { &["atrous"] };

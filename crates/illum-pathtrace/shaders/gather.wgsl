@@ -4,7 +4,7 @@
 // invocation traces one camera path of one pixel and frame, after the light tracer
 // (caustic.wgsl) has stored that frame's photons; its estimate goes into the frame's splat like
 // a particle's, so frame k's sample of the pixel pairs with the camera's sample k
-// (tracer/caustic.rs). The mathematics is in docs/caustics.md; in short:
+// (tracer/caustic.rs). The mathematics is in docs/caustics-gather.md; in short:
 //
 // The path: a camera ray through the pixel, jittered, followed through mirrors and glass (the
 // camera path tracer's weights: reflectance; 1 with the Fresnel choice) and diffuse surfaces

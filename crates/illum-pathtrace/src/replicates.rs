@@ -30,7 +30,7 @@
 /// Independently randomised copies of the low-discrepancy sequence per pixel. R replicates of
 /// N / R points each have more error than one sequence of N points, since the sequence's
 /// advantage grows with its length; more replicates give a steadier per-pixel estimate (R - 1
-/// degrees of freedom). Measured on the 64 x 64 Cornell box (docs/accuracy.md), relMSE over that
+/// degrees of freedom). Measured on the 64 x 64 Cornell box (docs/accuracy-estimate.md), relMSE over that
 /// of one sequence at 64 / 256 / 1024 / 4096 spp: R = 4: 2.0 / 1.35 / 1.22 / 0.99; R = 8: 2.1 /
 /// 2.1 / 1.56 / 1.16. 4 keeps most of the sequence's gain, with 3 degrees of freedom per pixel
 /// (a per-pixel variance within about 82% relative, one standard deviation; the image's
@@ -41,7 +41,7 @@ pub const REPLICATES: usize = 4;
 /// render). 4: 16 spp reach every replicate. A chunk is one GPU invocation's samples, and
 /// shorter chunks cost throughput on lavapipe (more invocations, more slots read back and
 /// folded): at 256 x 256, 512 spp, low-discrepancy over independent samples/s measured about
-/// 0.4 with runs of 2, 0.6 with runs of 4 and 0.85 with runs of 16 (docs/accuracy.md), while
+/// 0.4 with runs of 2, 0.6 with runs of 4 and 0.85 with runs of 16 (docs/accuracy-estimate.md), while
 /// runs of 16 would need 64 spp to reach every replicate.
 pub const REPLICATE_RUN: u32 = 4;
 

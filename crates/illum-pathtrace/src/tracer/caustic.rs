@@ -88,7 +88,7 @@ const SPLAT_BYTES: u64 = 64 << 20;
 /// Bytes per photon: three vec4 (caustic_buffers.wgsl).
 const PHOTON_BYTES: u64 = 48;
 /// r_1 of the photon gather as a fraction of the largest specular object's bounding radius
-/// (docs/caustics.md, "The caustic seen through a specular surface").
+/// (docs/caustics-gather.md).
 pub const GATHER_RADIUS_FRACTION: f32 = 0.02;
 /// Host bytes per pixel and chunk of a pass: S1 and S2, three f64 each.
 pub(crate) const PASS_BYTES_PER_PIXEL_CHUNK: u64 = 48;

@@ -72,7 +72,7 @@ fn estimated_relative_error_tracks_the_true_error_within_a_factor_of_1_5() {
 }
 
 /// Estimated over true relMSE must lie within this factor either way. Measured (printed by the
-/// test below): see docs/accuracy.md, "How well the estimated error tracks the true error".
+/// test below): see docs/accuracy-estimate.md, "How well the estimated error tracks the true error".
 const HONEST_FACTOR: f64 = 1.5;
 
 /// The checked-in reference and its own relMSE (its variance over its squared mean).
