@@ -407,7 +407,16 @@ fn summary(tracer: &PathTracer, reason: StopReason, seconds: f64, samples_per_se
             accumulator.total_samples() as f64
                 / (f64::from(scene.camera.width) * f64::from(scene.camera.height))
         ),
-        None => format!("{} spp", tracer.spp_done()),
+        // Stopped inside a pass, some rows hold more samples, and the error below is of them
+        // all: said, so that it is not read as the complete passes' alone.
+        None => match tracer.partial_pass() {
+            Some((pass, rows)) => format!(
+                "{} spp and {rows} of {} rows of a pass of {pass} more",
+                tracer.spp_done(),
+                scene.camera.height
+            ),
+            None => format!("{} spp", tracer.spp_done()),
+        },
     };
     let error = illum_pathtrace::progressive::error_text(
         Some(accumulator.estimated_relative_error()).filter(|e| e.is_finite()),

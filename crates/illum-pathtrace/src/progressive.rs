@@ -370,6 +370,13 @@ impl Progressive {
         if self.stopped.is_some() {
             // The render is over: its time stands.
             self.clock.pause();
+            // Stopped inside a pass, the image holds more samples than its complete passes: its
+            // error is that of the image as written (what a summary and the file report), not the
+            // last complete pass's.
+            if tracer.partial_pass().is_some() {
+                self.error_at_spp = u32::MAX;
+                self.refresh_error(tracer);
+            }
         }
         Ok(self.stopped)
     }
