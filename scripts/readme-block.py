@@ -154,9 +154,9 @@ def headline(directory):
         text = read(directory, name)
         spp = number_after(text, r"512x512, (\d+) spp")
         seconds = number_after(text, r", ([0-9.]+) s, ")
-        error = number_after(text, r"estimated relative error ([0-9.]+)")
+        error = number_after(text, r"estimated relative error ([0-9.]+)%")
         if spp is not None and seconds is not None and error is not None:
-            lines.append(f"- {label}: {spp:.0f} spp, estimated relative error {100 * error:.2f}%, "
+            lines.append(f"- {label}: {spp:.0f} spp, estimated relative error {error:.2f}%, "
                          f"{seconds:.1f} s on this host.")
     # The rasterizer (raster_bench).
     raster = read(directory, "raster-bench.txt")

@@ -21,6 +21,11 @@ use illum_scene::Scene;
 
 use crate::{OutputFormat, output_format};
 
+/// Parses `--denoise` (`atrous` or `oidn`).
+pub fn denoiser_arg(text: &str) -> Result<DenoiserKind, String> {
+    text.parse()
+}
+
 /// What a denoised render needs.
 pub struct DenoiseRequest<'a> {
     pub gpu: &'a GpuContext,

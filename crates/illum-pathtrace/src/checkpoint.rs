@@ -172,6 +172,41 @@ impl CheckpointHeader {
         start..start + u64::from(self.spp_done)
     }
 
+    /// Checks that these samples were rendered from `scene` with `options`: an error naming
+    /// every difference (content hash, resolution, bounces, seed, sampling, sequence, caustics
+    /// and their estimators), with both values. The scene is known by its content
+    /// (`illum.scene_hash`), not its name: a scene renamed, or a comment edited, goes on.
+    pub fn check_matches(
+        &self,
+        path: &Path,
+        scene: &Scene,
+        options: TracerOptions,
+    ) -> Result<(), CheckpointError> {
+        let mut differences: Vec<String> =
+            check_estimators(path, self, &Estimators::of(scene))?.into_iter().collect();
+        for (key, now) in image_settings(scene, options) {
+            let then = self.setting(key);
+            if then.as_deref() != Some(now.as_str()) {
+                differences.push(if key == "scene_hash" {
+                    format!(
+                        "scene content (camera, materials, objects, lights; illum.scene_hash): {} ({:?}) in the file, \
+                         {now} ({:?}) now",
+                        shown(then.as_deref()),
+                        self.metadata.scene,
+                        scene.name
+                    )
+                } else {
+                    format!("{key}: {} in the file, {} now", shown(then.as_deref()), shown(Some(&now)))
+                });
+            }
+        }
+        if differences.is_empty() {
+            Ok(())
+        } else {
+            Err(CheckpointError::OtherSettings { path: path.to_path_buf(), differences })
+        }
+    }
+
     /// The value of a setting in the file; width and height come from the image itself.
     fn setting(&self, key: &str) -> Option<String> {
         match key {
@@ -184,6 +219,24 @@ impl CheckpointHeader {
             "glint" => Some(self.metadata.get(key).unwrap_or("none").to_owned()),
             _ => self.metadata.get(key).map(str::to_owned),
         }
+    }
+}
+
+/// Longest value a refusal shows whole: every setting's but a glint's (the caustic estimators'
+/// description is about 160 characters).
+const SHOWN_CHARS: usize = 200;
+
+/// A setting's value as a refusal shows it: whole when short, else its start and its length
+/// (an `illum.glint` value holds thousands of characters, and only its difference matters).
+fn shown(value: Option<&str>) -> String {
+    match value {
+        None => "(missing)".to_owned(),
+        Some(v) if v.chars().count() <= SHOWN_CHARS => v.to_owned(),
+        Some(v) => format!(
+            "{}... ({} characters)",
+            v.chars().take(SHOWN_CHARS).collect::<String>(),
+            v.chars().count()
+        ),
     }
 }
 
@@ -225,6 +278,14 @@ fn header_fields(
             "only path-traced images can be continued",
         ));
     }
+    if let Some(denoiser) = metadata.get("denoiser") {
+        return Err(invalid(
+            "denoiser",
+            denoiser.to_owned(),
+            "a denoised image is not a checkpoint: it holds the denoised pixels, not the sums of the samples a \
+             render goes on from, so it cannot be continued or merged (render again with a larger --spp)",
+        ));
+    }
     if let Some(adaptive) = metadata.get("adaptive").filter(|a| *a != "off") {
         return Err(invalid(
             "adaptive",
@@ -244,7 +305,12 @@ fn header_fields(
 }
 
 fn unreadable(path: &Path, error: &illum_image::ImageError) -> CheckpointError {
-    CheckpointError::Unreadable { path: path.to_path_buf(), reason: with_causes(error) }
+    match error {
+        illum_image::ImageError::BadContent { reason, .. } => {
+            CheckpointError::NotAnExr { path: path.to_path_buf(), reason: reason.clone() }
+        }
+        _ => CheckpointError::Unreadable { path: path.to_path_buf(), reason: with_causes(error) },
+    }
 }
 
 fn no_statistics(path: &Path) -> CheckpointError {
@@ -375,39 +441,6 @@ impl Checkpoint {
         }
     }
 
-    /// Checks that this checkpoint was rendered from `scene` with `options`: an error naming
-    /// every difference (scene name, content hash, resolution, bounces, seed, sampling,
-    /// sequence, caustics and their estimators), with both values.
-    pub fn check_matches(
-        &self,
-        path: &Path,
-        scene: &Scene,
-        options: TracerOptions,
-    ) -> Result<(), CheckpointError> {
-        let header = self.header();
-        let mut differences: Vec<String> =
-            check_estimators(path, &header, &Estimators::of(scene))?.into_iter().collect();
-        if self.metadata.scene != scene.name {
-            differences.push(format!("scene: {:?} in the file, {:?} now", self.metadata.scene, scene.name));
-        }
-        for (key, now) in image_settings(scene, options) {
-            let then = header.setting(key).unwrap_or_else(|| "(missing)".to_owned());
-            if then != now {
-                let what = if key == "scene_hash" {
-                    "scene content (camera, materials, objects: the file was edited)".to_owned()
-                } else {
-                    key.to_owned()
-                };
-                differences.push(format!("{what}: {then} in the file, {now} now"));
-            }
-        }
-        if differences.is_empty() {
-            Ok(())
-        } else {
-            Err(CheckpointError::OtherSettings { path: path.to_path_buf(), differences })
-        }
-    }
-
     /// The sample indices this file holds: `sample_start .. sample_start + spp_done`.
     pub fn sample_range(&self) -> std::ops::Range<u64> {
         let start = u64::from(self.sample_start);
@@ -425,6 +458,41 @@ mod tests {
             scene: "cornell".to_owned(),
             render_seconds: 1.0,
             fields: fields.iter().map(|&(k, v)| (k.to_owned(), v.to_owned())).collect(),
+        }
+    }
+
+    /// A checkpoint is of a scene by content: renamed, it goes on; of edited content, it is
+    /// refused naming both hashes and both names.
+    #[test]
+    fn a_renamed_scene_resumes_and_other_content_is_refused_by_hash_and_name() {
+        let mut scene = Scene::load(&illum_scene::resolve_scene_path(Path::new("scenes/cornell.toml")))
+            .expect("the Cornell box");
+        let options = TracerOptions::default();
+        let header = |scene: &Scene| CheckpointHeader {
+            metadata: ExrMetadata {
+                scene: scene.name.clone(),
+                ..metadata(
+                    &image_settings(scene, options)
+                        .iter()
+                        .map(|(k, v)| (*k, v.as_str()))
+                        .filter(|(k, _)| !matches!(*k, "width" | "height"))
+                        .collect::<Vec<_>>(),
+                )
+            },
+            width: scene.camera.width,
+            height: scene.camera.height,
+            spp_done: 16,
+            sample_start: 0,
+            partial_pass: None,
+        };
+        let file = header(&scene);
+        scene.name = "cornell-renamed".to_owned();
+        assert!(file.check_matches(Path::new("long.exr"), &scene, options).is_ok());
+        scene.camera.vfov_deg += 1.0;
+        let error = file.check_matches(Path::new("long.exr"), &scene, options).unwrap_err().to_string();
+        let (then, now) = (file.metadata.get("scene_hash").unwrap(), crate::metadata::scene_hash(&scene));
+        for part in ["long.exr", "illum.scene_hash", then, &now, "\"cornell\"", "\"cornell-renamed\""] {
+            assert!(error.contains(part), "the refusal lacks {part:?}: {error}");
         }
     }
 
@@ -459,6 +527,15 @@ mod tests {
         let error = header_fields(path, metadata(&adaptive), 4, 4).unwrap_err().to_string();
         assert!(
             error.starts_with("out/part.exr: illum.adaptive = \"8x8 blocks\": must be \"off\""),
+            "{error}"
+        );
+
+        let mut denoised = good.to_vec();
+        denoised.push(("denoiser", "atrous"));
+        denoised[1].1 = "0 and 2147483648 (two halves)";
+        let error = header_fields(path, metadata(&denoised), 4, 4).unwrap_err().to_string();
+        assert!(
+            error.starts_with("out/part.exr: illum.denoiser = atrous: a denoised image is not a checkpoint"),
             "{error}"
         );
 

@@ -28,6 +28,7 @@ pub mod metadata;
 mod options;
 pub mod planner;
 pub mod progressive;
+pub mod reference;
 pub mod replicates;
 pub mod shaders;
 pub mod specialise;

@@ -28,45 +28,6 @@ pub fn scene_hash(scene: &Scene) -> String {
     format!("{:016x}", scene.content_hash())
 }
 
-/// Why an image of `reference_size` pixels with `metadata`, read from `path`, cannot be the
-/// truth of a render of `scene` at its camera's size: no `illum.scene_hash` to tell its scene
-/// by, another scene content (the hash covers the camera, materials, objects and lights, no
-/// settings), or another size (`size_advice` says what to change). `None`: it can.
-pub fn reference_refusal(
-    path: &std::path::Path,
-    metadata: Option<&ExrMetadata>,
-    reference_size: [u32; 2],
-    scene: &Scene,
-    size_advice: &str,
-) -> Option<String> {
-    let Some(hash) = metadata.and_then(|m| m.get("scene_hash")) else {
-        return Some(format!(
-            "--reference {}: the file has no illum.scene_hash, so it cannot be told to be of scene {:?}; \
-             give a path-traced EXR that `render` wrote",
-            path.display(),
-            scene.name
-        ));
-    };
-    let ours = scene_hash(scene);
-    if hash != ours {
-        let theirs = metadata.map_or("?", |m| m.scene.as_str());
-        return Some(format!(
-            "--reference {}: it is of scene {theirs:?} (illum.scene_hash {hash}), but this render is of scene {:?} \
-             (illum.scene_hash {ours}): a reference must show the same camera, materials, objects and lights",
-            path.display(),
-            scene.name
-        ));
-    }
-    let (w, h) = (scene.camera.width, scene.camera.height);
-    let [rw, rh] = reference_size;
-    ((rw, rh) != (w, h)).then(|| {
-        format!(
-            "--reference {}: it is {rw} x {rh} pixels, but this render is {w} x {h}: {size_advice}",
-            path.display()
-        )
-    })
-}
-
 /// Metadata for the tracer's current image. Keys (each stored as `illum.<key>`):
 ///
 /// - `renderer` = `pathtrace`, `scene` = the scene's name, `render_seconds` = `render_seconds`

@@ -220,7 +220,8 @@ pub struct Status {
     pub run_samples: u64,
     /// Wall-clock time of the render ([`RenderClock`]).
     pub elapsed: Duration,
-    /// The estimated relative error after the last completed pass, once it has 2 spp.
+    /// The estimated relative error after the last completed pass, once there are samples
+    /// enough to estimate it ([`crate::Accumulator::spp_for_error_estimate`]).
     pub relative_error: Option<f64>,
     /// Samples per pixel of the pass in progress (0: none), and the share of its work done, in
     /// [0, 1] ([`PathTracer::pass_fraction`]).
@@ -384,20 +385,38 @@ impl Progressive {
         if self.stopped.is_some() {
             // The render is over: its time stands.
             self.clock.pause();
+            // Stopped inside a pass, the image holds more samples than its complete passes: its
+            // error is that of the image as written (what a summary and the file report), not the
+            // last complete pass's.
+            if tracer.partial_pass().is_some() {
+                self.error_at_spp = u32::MAX;
+                self.refresh_error(tracer);
+            }
         }
         Ok(self.stopped)
     }
 
     fn refresh_error(&mut self, tracer: &PathTracer) {
         let spp = tracer.spp_done();
-        if spp != self.error_at_spp || (self.relative_error.is_none() && spp >= 2) {
+        let accumulator = tracer.accumulator();
+        let known = spp >= accumulator.spp_for_error_estimate();
+        if spp != self.error_at_spp || (self.relative_error.is_none() && known) {
             self.error_at_spp = spp;
-            let accumulator = tracer.accumulator();
-            self.relative_error = (spp >= 2).then(|| match &self.error_scope {
+            self.relative_error = known.then(|| match &self.error_scope {
                 ErrorScope::Image => accumulator.estimated_relative_error(),
                 scope => crate::error_map::ErrorMap::of(accumulator).error(scope),
             });
         }
+    }
+}
+
+/// An estimated relative error as every front end writes it (the CLI's progress line and summary,
+/// the viewer's panel), so that they agree at the same spp: a percentage with 2 decimals, or, when there is none yet,
+/// the spp it needs ([`crate::Accumulator::spp_for_error_estimate`]).
+pub fn error_text(error: Option<f64>, needs_spp: u32) -> String {
+    match error {
+        Some(e) => format!("{:.2}%", e * 100.0),
+        None => format!("unknown until {needs_spp} spp"),
     }
 }
 
@@ -438,6 +457,12 @@ pub fn render_progressive_over(
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn an_error_is_a_percentage_or_unknown_until_the_spp_it_needs() {
+        assert_eq!(super::error_text(Some(0.012_345), 2), "1.23%");
+        assert_eq!(super::error_text(None, 8), "unknown until 8 spp");
+    }
+
     use super::*;
 
     fn status(spp_done: u32, seconds: f64, error: Option<f64>) -> Status {

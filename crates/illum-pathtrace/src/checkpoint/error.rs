@@ -17,6 +17,10 @@ pub enum CheckpointError {
     /// Not an EXR, or a truncated or corrupt one: the decoder's error with its causes.
     #[error("{}: cannot be read as an EXR (truncated or corrupt?): {reason}", path.display())]
     Unreadable { path: PathBuf, reason: String },
+    /// Read, but not an image a checkpoint can be (a PNG, an EXR without R, G and B):
+    /// the reader's reason.
+    #[error("{}: {reason}; a checkpoint is an EXR the path tracer wrote", path.display())]
+    NotAnExr { path: PathBuf, reason: String },
     #[error("{}: not written by illum (no illum.* metadata), so it cannot be continued", path.display())]
     NotIllum { path: PathBuf },
     /// illum's metadata is there but an attribute does not parse (the error names the file and
