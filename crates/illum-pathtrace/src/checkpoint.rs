@@ -476,6 +476,7 @@ mod tests {
                         .iter()
                         .map(|(k, v)| (*k, v.as_str()))
                         .filter(|(k, _)| !matches!(*k, "width" | "height"))
+                        .chain([(crate::metadata::ESTIMATORS, Estimators::of(scene).key().as_str())])
                         .collect::<Vec<_>>(),
                 )
             },

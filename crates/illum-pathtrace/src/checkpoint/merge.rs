@@ -238,6 +238,8 @@ mod tests {
             ("seed", "1".to_owned()),
             ("glint", glint),
             ("stopped_by", "spp".to_owned()),
+            // The estimators of a scene with no caustic: both parts name them alike.
+            (crate::metadata::ESTIMATORS, "estimators.v1 camera-paths".to_owned()),
         ];
         CheckpointHeader {
             metadata: ExrMetadata {
