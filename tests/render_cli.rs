@@ -570,9 +570,9 @@ fn two_concurrent_processes_like_gnu_parallel_then_merge_equal_one_render() {
 }
 
 /// A low-discrepancy render keeps its replicates (crates/illum-pathtrace/src/replicates.rs), and
-/// so its error estimate, through a resume and a merge: resumed from 41 spp (inside a chunk of 4)
-/// to 96 its replicate sums are a straight render's bit for bit, and merged from the ranges 0..48
-/// and 48..96 within 1e-12.
+/// so its error estimate, through a resume and a merge: resumed from 41 spp (inside a chunk and a
+/// replicate run) to 96 its replicate sums are a straight render's bit for bit, and merged from
+/// the ranges 0..48 and 48..96 within 1e-12.
 #[test]
 fn a_low_discrepancy_render_keeps_its_replicates_through_resume_and_merge() {
     let dir = tempfile::tempdir().unwrap();

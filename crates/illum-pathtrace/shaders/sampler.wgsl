@@ -48,15 +48,21 @@ struct Sampler {
 // shifts and shuffles (its own pixel key), so the R replicate means are independent and
 // identically distributed, and their spread estimates the variance of the pixel's mean
 // (src/replicates.rs); each replicate's first indices are still a prefix of its padded sequence.
-// Mirrored by src/replicates.rs (checked there by a test).
+// The replicate is a function of the sample index alone, so a chunk of any length and start
+// keeps its replicates apart: pathtrace.wgsl's main sums each replicate's samples into a slot
+// of its own. Mirrored by src/replicates.rs (checked there by a test).
 const REPLICATES: u32 = 4u;
 const REPLICATE_RUN: u32 = 4u;
 
+// The replicate that sample index i of a pixel belongs to.
+fn replicate_of(i: u32) -> u32 {
+    return (i / REPLICATE_RUN) % REPLICATES;
+}
+
 fn sampler_new(seed: u32, pixel: u32, sample_index: u32) -> Sampler {
 #ifdef LOW_DISCREPANCY
-    let run = sample_index / REPLICATE_RUN;
-    let replicate = run % REPLICATES;
-    let index = (run / REPLICATES) * REPLICATE_RUN + sample_index % REPLICATE_RUN;
+    let replicate = replicate_of(sample_index);
+    let index = (sample_index / (REPLICATE_RUN * REPLICATES)) * REPLICATE_RUN + sample_index % REPLICATE_RUN;
     let key = pcg_hash(seed ^ pcg_hash(pixel) ^ pcg_hash(replicate * 0x85ebca6bu + 0x27d4eb2fu));
     return Sampler(rng_seed(seed, pixel, sample_index), key, index, 0u);
 #else
