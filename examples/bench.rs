@@ -1,7 +1,8 @@
 //! Throughput benchmark of the path tracer (and, where built, the raster scene).
 //!
 //! ```text
-//! cargo run --release --example bench -- [--runs N] [--quick | --large [--compare-readback] | --viewer | --sequences]
+//! cargo run --release --example bench -- [--runs N] [--quick | --large [--compare-readback] | --viewer | --sequences
+//!     | --glint SCENE...]
 //! ```
 //! For `scenes/cornell.toml` at each size and bounce count it renders a fixed number of samples
 //! per pixel `runs` times and prints the median of:
@@ -25,6 +26,10 @@
 //! `xvfb-run` with the view still (`illum-viewer --mode pathtrace --screenshot`, which prints its
 //! statistics on exit), and `render`'s loop on the same scene at the viewer's resolution for the
 //! same wall time, run after it, side by side, `runs` times.
+//!
+//! `--glint` times the host's solve of the sun's glint (`illum::pathtrace::glint::solve`, part of
+//! a render's set-up before its first sample) for each scene given, on all the host's threads:
+//! `scripts/many-spheres.py` writes scenes with many specular spheres for it.
 //!
 //! Timings are never asserted in tests; the figures go to docs/performance.md.
 
@@ -68,6 +73,9 @@ struct Args {
     /// With --viewer: frames the window draws before it closes, 10 to 100000.
     #[arg(long, default_value_t = 150, requires = "viewer", value_parser = clap::value_parser!(u32).range(10..=100_000))]
     frames: u32,
+    /// Only the glint's solve on the host, for each of these scenes (see `scripts/many-spheres.py`).
+    #[arg(long, num_args = 1.., conflicts_with_all = ["quick", "large", "viewer"])]
+    glint: Vec<PathBuf>,
 }
 
 struct Config {
@@ -91,6 +99,9 @@ fn rays_per_sample(bounces: u32) -> u64 {
 }
 
 fn run(args: Args) -> anyhow::Result<()> {
+    if !args.glint.is_empty() {
+        return bench_glint(&args.glint, args.runs);
+    }
     let gpu = illum_cli::gpu()?;
     if args.viewer {
         return bench_viewer(&gpu, &args);
@@ -387,5 +398,40 @@ fn bench_viewer(gpu: &illum::gpu::GpuContext, args: &Args) -> anyhow::Result<()>
         );
     }
     println!("\nviewer / render, median of {} runs: {:.2}", ratios.len(), median(&mut ratios));
+    Ok(())
+}
+
+/// The glint's host solve per scene: its median time over `runs`, on every host thread.
+fn bench_glint(scenes: &[PathBuf], runs: u32) -> anyhow::Result<()> {
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    println!("glint solve on the host, {threads} threads, median of {runs} runs");
+    println!("| scene | objects | specular objects | glints | solve s |");
+    println!("|---|---|---|---|---|");
+    for path in scenes {
+        let scene = Scene::load(path)?;
+        let specular = scene
+            .objects
+            .iter()
+            .filter(|o| {
+                matches!(
+                    scene.material_of(o).kind,
+                    illum::scene::MaterialKind::Mirror { .. } | illum::scene::MaterialKind::Dielectric { .. }
+                )
+            })
+            .count();
+        let mut seconds = Vec::new();
+        let mut glints = 0;
+        for _ in 0..runs {
+            let start = std::time::Instant::now();
+            glints = illum::pathtrace::glint::solve(&scene).len();
+            seconds.push(start.elapsed().as_secs_f64());
+        }
+        println!(
+            "| {} | {} | {specular} | {glints} | {:.3} |",
+            path.display(),
+            scene.objects.len(),
+            median(&mut seconds)
+        );
+    }
     Ok(())
 }

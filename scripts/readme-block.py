@@ -191,6 +191,12 @@ def perf_tables(directory):
     viewer = read(directory, "bench-viewer.txt").strip()
     if viewer:
         replace_block("viewer-bench", f"{viewer}\n\n{measured}", os.path.join(docs, "performance.md"))
+    viewer = read(directory, "bench-viewer-whitted.txt").strip()
+    if viewer:
+        replace_block("viewer-bench-whitted", f"{viewer}\n\n{measured}", os.path.join(docs, "performance.md"))
+    glint = read(directory, "bench-glint.txt").strip()
+    if glint:
+        replace_block("glint-bench", f"{glint}\n\n{measured}", os.path.join(docs, "performance.md"))
     raster = read(directory, "raster-bench.txt").strip()
     if raster:
         replace_block("raster-bench", f"```text\n{raster}\n```\n\n{measured}",

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Regenerates every picture the README shows and re-measures every number it quotes, from the
 # code as it is now, and writes the numbers into the generated blocks of the README (`headline`,
-# `ladder-summary`) and of docs/performance*.md (`bench-quick`, `viewer-bench`, `raster-bench`),
+# `ladder-summary`) and of docs/performance*.md (`bench-quick`, `viewer-bench`,
+# `viewer-bench-whitted`, `glint-bench`, `raster-bench`),
 # each with the date and the CPU:
 #
 #     scripts/readme-figures.sh              pictures, the ladder, then the headline figures
@@ -107,7 +108,10 @@ echo "== The headline figures (README, between the headline markers)"
 "$bin/render" -o "$out/cornell-default.exr" | tee "$out/render-default.txt"
 "$bin/bench" --quick --runs 3 | tee "$out/bench-quick.txt"
 "$bin/bench" --viewer --runs 3 | tee "$out/bench-viewer.txt"
+"$bin/bench" --viewer --runs 3 scenes/whitted.toml | tee "$out/bench-viewer-whitted.txt"
 "$bin/raster_bench" --look enhanced | tee "$out/raster-bench.txt"
+for n in 10 50 200; do python3 scripts/many-spheres.py $n -o "$out/spheres-$n.toml"; done
+"$bin/bench" --runs 3 --glint scenes/whitted.toml "$out"/spheres-{10,50,200}.toml | tee "$out/bench-glint.txt"
 if "$python" -c "import mitsuba" 2> /dev/null; then
     "$python" bench/vs_mitsuba.py --bounces 2 | tee "$out/vs-mitsuba.txt"
     "$python" bench/vs_mitsuba.py --bounces 8 | tee "$out/vs-mitsuba-b8.txt"

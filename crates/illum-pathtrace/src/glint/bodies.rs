@@ -4,6 +4,8 @@
 use glam::DVec3;
 use illum_scene::{MaterialKind, Scene, Shape};
 
+use super::tree::{Node, build_tree, slab_hit};
+
 /// How a surface scatters light, as far as the glint is concerned.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Surface {
@@ -18,7 +20,7 @@ pub enum Surface {
 }
 
 #[derive(Clone, Copy, Debug)]
-enum Body {
+pub(super) enum Body {
     Sphere {
         center: DVec3,
         radius: f64,
@@ -54,6 +56,11 @@ pub struct Bodies {
     surfaces: Vec<Surface>,
     /// Scene size, for the distance below which a ray leaving a flat face ignores hits.
     scale: f64,
+    /// A bounding-volume hierarchy over the bodies: the solve follows each chain many thousands
+    /// of times, and without it a scene of n objects costs n ray tests per segment.
+    tree: Vec<Node>,
+    /// Scene indices of the bodies in the hierarchy's order: a leaf holds `order[first..][..count]`.
+    order: Vec<usize>,
 }
 
 fn d3(v: glam::Vec3) -> DVec3 {
@@ -95,7 +102,8 @@ impl Bodies {
                 _ => Surface::Other,
             })
             .collect();
-        Self { bodies, surfaces, scale }
+        let (tree, order) = build_tree(&bodies, scale);
+        Self { bodies, surfaces, scale, tree, order }
     }
 
     pub fn surface(&self, object: usize) -> Surface {
@@ -122,29 +130,85 @@ impl Bodies {
     /// The nearest hit of the ray `o + t d` (d a unit vector), `t > 0`, leaving the surface of
     /// object `own` (None for the camera ray). Leaving a sphere, its root at the origin is
     /// skipped exactly: the other root is `-2 (o - c).d`. Leaving a flat face, hits nearer than
-    /// 1e-9 of the scene's size are ignored.
+    /// 1e-9 of the scene's size are ignored. The same hit as testing every body in turn (ties to
+    /// the lower index), found through the hierarchy.
     pub fn nearest(&self, o: DVec3, d: DVec3, own: Option<usize>) -> Option<Hit> {
         let mut best: Option<Hit> = None;
-        let flat_min = 1e-9 * self.scale;
-        for (i, body) in self.bodies.iter().enumerate() {
-            let hit = match *body {
-                Body::Sphere { center, radius } => sphere_hit(o, d, center, radius, own == Some(i)),
-                Body::Quad { corner, edge_u, edge_v, normal } => {
-                    let t_min = if own == Some(i) { f64::INFINITY } else { 0.0 };
-                    quad_hit(o, d, corner, edge_u, edge_v, normal).filter(|h| h.0 > t_min)
+        let inv = d.recip();
+        let mut stack = [0usize; 64];
+        let mut depth = 1;
+        while depth > 0 {
+            depth -= 1;
+            let node = self.tree[stack[depth]];
+            let far = best.map_or(f64::INFINITY, |b| b.t);
+            if !slab_hit(o, inv, node.lo, node.hi, far) {
+                continue;
+            }
+            if node.count == 0 {
+                stack[depth] = node.first;
+                stack[depth + 1] = node.first + 1;
+                depth += 2;
+                continue;
+            }
+            for &i in &self.order[node.first..node.first + node.count] {
+                if let Some((t, normal)) = self.hit_body(i, o, d, own)
+                    && best.is_none_or(|b| t < b.t || (t == b.t && i < b.object))
+                {
+                    best = Some(Hit { object: i, t, normal });
                 }
-                Body::Box { min, max, rotation, offset } => {
-                    let t_min = if own == Some(i) { flat_min } else { 0.0 };
-                    box_hit(o, d, min, max, rotation, offset, t_min)
-                }
-            };
-            if let Some((t, normal)) = hit
-                && best.is_none_or(|b| t < b.t)
-            {
-                best = Some(Hit { object: i, t, normal });
             }
         }
         best
+    }
+
+    /// Object `object`'s own hit of the ray, as [`Self::nearest`] defines hits, whatever else
+    /// is in the way.
+    pub fn hit(&self, object: usize, o: DVec3, d: DVec3, own: Option<usize>) -> Option<Hit> {
+        self.hit_body(object, o, d, own).map(|(t, normal)| Hit { object, t, normal })
+    }
+
+    /// Whether any object but `except` has a hit of the ray (as [`Self::nearest`] defines
+    /// hits) nearer than `far`: the ray from o does not reach `far` unobstructed. It stops at
+    /// the first such hit, so it costs less than [`Self::nearest`].
+    pub fn blocked(&self, o: DVec3, d: DVec3, own: Option<usize>, far: f64, except: Option<usize>) -> bool {
+        let inv = d.recip();
+        let mut stack = [0usize; 64];
+        let mut depth = 1;
+        while depth > 0 {
+            depth -= 1;
+            let node = self.tree[stack[depth]];
+            if !slab_hit(o, inv, node.lo, node.hi, far) {
+                continue;
+            }
+            if node.count == 0 {
+                stack[depth] = node.first;
+                stack[depth + 1] = node.first + 1;
+                depth += 2;
+                continue;
+            }
+            let found = self.order[node.first..node.first + node.count]
+                .iter()
+                .any(|&i| Some(i) != except && self.hit_body(i, o, d, own).is_some_and(|(t, _)| t < far));
+            if found {
+                return true;
+            }
+        }
+        false
+    }
+
+    /// Body `i`'s hit of the ray, as [`Self::nearest`] defines it.
+    fn hit_body(&self, i: usize, o: DVec3, d: DVec3, own: Option<usize>) -> Option<(f64, DVec3)> {
+        match self.bodies[i] {
+            Body::Sphere { center, radius } => sphere_hit(o, d, center, radius, own == Some(i)),
+            Body::Quad { corner, edge_u, edge_v, normal } => {
+                let t_min = if own == Some(i) { f64::INFINITY } else { 0.0 };
+                quad_hit(o, d, corner, edge_u, edge_v, normal).filter(|h| h.0 > t_min)
+            }
+            Body::Box { min, max, rotation, offset } => {
+                let t_min = if own == Some(i) { 1e-9 * self.scale } else { 0.0 };
+                box_hit(o, d, min, max, rotation, offset, t_min)
+            }
+        }
     }
 }
 
@@ -240,4 +304,98 @@ pub fn fresnel(cos_i: f64, eta: f64) -> (f64, Option<f64>) {
     let rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
     let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
     (0.5 * (rs * rs + rp * rp), Some(cos_t))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `nearest` by testing every body in turn, ties to the lower index: what the hierarchy
+    /// must reproduce.
+    fn brute_nearest(bodies: &Bodies, o: DVec3, d: DVec3, own: Option<usize>) -> Option<(usize, f64)> {
+        let mut best: Option<(usize, f64)> = None;
+        for i in 0..bodies.bodies.len() {
+            if let Some((t, _)) = bodies.hit_body(i, o, d, own)
+                && best.is_none_or(|b| t < b.1)
+            {
+                best = Some((i, t));
+            }
+        }
+        best
+    }
+
+    /// A scene of 60 spheres of many sizes, a floor quad and a rotated box: enough bodies for a
+    /// hierarchy several levels deep.
+    fn crowded() -> Scene {
+        let mut text = String::from(
+            "[camera]\neye = [0.0, 2.0, 20.0]\ntarget = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]\nvfov = 40.0\n\
+             width = 64\nheight = 64\n[materials.glass]\ndielectric = { ior = 1.5 }\n\
+             [materials.white]\nalbedo = [0.5, 0.5, 0.5]\n\
+             [[objects]]\nmaterial = \"white\"\n\
+             quad = { corner = [-10.0, 0.0, -10.0], edge_u = [0.0, 0.0, 20.0], edge_v = [20.0, 0.0, 0.0] }\n\
+             [[objects]]\nmaterial = \"white\"\n\
+             box = { min = [0.0, 0.0, 0.0], max = [1.0, 2.0, 1.5], rotate_y = 30.0, pivot = [0.5, 0.0, 0.5], translate = [3.0, 0.0, -2.0] }\n",
+        );
+        let mut state = 12345u64;
+        let mut next = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..60 {
+            let (x, y, z, r) = (next() * 16.0 - 8.0, next() * 4.0, next() * 16.0 - 8.0, 0.05 + next() * 0.8);
+            text += &format!(
+                "[[objects]]\nmaterial = \"glass\"\nsphere = {{ center = [{x:?}, {y:?}, {z:?}], radius = {r:?} }}\n"
+            );
+        }
+        Scene::from_toml_str(&text, "crowded.toml").unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    #[test]
+    fn the_hierarchy_finds_the_hit_that_testing_every_body_finds() {
+        let scene = crowded();
+        let bodies = Bodies::new(&scene);
+        assert!(bodies.tree.len() > 15, "a hierarchy of {} nodes", bodies.tree.len());
+        let mut state = 99u64;
+        let mut next = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut hits, mut checked) = (0, 0);
+        for k in 0..20000 {
+            // Rays from outside and from the surface of a body (as the chains' continuation rays
+            // leave one), including directions along the axes, where 1 / d is infinite.
+            let own = (k % 3 == 0).then(|| 2 + (k / 3) % 60);
+            let o = match own {
+                Some(i) => match bodies.bodies[i] {
+                    Body::Sphere { center, radius } => {
+                        let v = DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize();
+                        center + radius * v
+                    }
+                    _ => unreachable!("objects from 2 on are spheres"),
+                },
+                None => DVec3::new(next() * 24.0 - 12.0, next() * 6.0 - 1.0, next() * 24.0 - 12.0),
+            };
+            let d = if k % 7 == 0 {
+                let mut a = DVec3::ZERO;
+                a[k % 3] = if k % 2 == 0 { 1.0 } else { -1.0 };
+                a
+            } else {
+                DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize()
+            };
+            let want = brute_nearest(&bodies, o, d, own);
+            let got = bodies.nearest(o, d, own).map(|h| (h.object, h.t));
+            assert_eq!(got, want, "ray {k} from {o} along {d}, leaving {own:?}");
+            // blocked(far) is whether the nearest hit is nearer than far.
+            for far in [0.5, 3.0, f64::INFINITY] {
+                assert_eq!(
+                    bodies.blocked(o, d, own, far, None),
+                    want.is_some_and(|w| w.1 < far),
+                    "ray {k}, far {far}"
+                );
+            }
+            hits += usize::from(want.is_some());
+            checked += 1;
+        }
+        assert!(hits > checked / 4 && hits < checked, "{hits} of {checked} rays hit something");
+    }
 }
