@@ -24,7 +24,7 @@ use clap::Parser;
 use illum::image::{load_exr, rel_mse};
 use illum::scene::{Bounces, Overrides, Scene};
 use illum_lab::reference::{Reference, cached_reference, load_reference};
-use illum_lab::report::{markdown_table, write_text};
+use illum_lab::report::{host_cpu, markdown_table, write_text};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -92,15 +92,6 @@ fn given_truth(files: &[PathBuf], truth_scene: &Scene) -> anyhow::Result<Option<
         return Ok(Some(reference));
     }
     Ok(None)
-}
-
-/// "Intel(R) Xeon(R) Processor, 2 vCPUs" from /proc/cpuinfo ("unknown CPU" elsewhere).
-fn cpu() -> String {
-    let info = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
-    let model =
-        info.lines().find_map(|l| Some(l.strip_prefix("model name")?.split_once(':')?.1.trim().to_owned()));
-    let count = info.lines().filter(|l| l.starts_with("processor")).count();
-    model.map_or("unknown CPU".to_owned(), |m| format!("{m}, {count} vCPUs"))
 }
 
 fn run(args: Args) -> anyhow::Result<()> {
@@ -231,7 +222,7 @@ fn run(args: Args) -> anyhow::Result<()> {
          estimated relMSE. Render seconds: the rendering step as `render` timed it (device, set-up, samples, \
          files), against the plan's prediction; wall seconds: the whole command, pilot included (its truth \
          and biases cached, its throughput measured every run).\n\n",
-        cpu(),
+        host_cpu(),
         truths.join("; ")
     );
     md.push_str(&markdown_table(

@@ -397,14 +397,16 @@ fn bench_viewer(gpu: &illum::gpu::GpuContext, args: &Args) -> anyhow::Result<()>
             ratio
         );
     }
-    println!("\nviewer / render, median of {} runs: {:.2}", ratios.len(), median(&mut ratios));
+    let load = load_average().map_or(String::new(), |l| format!(" (load average {l} at the end)"));
+    println!("\nviewer / render, median of {} runs: {:.2}{load}", ratios.len(), median(&mut ratios));
     Ok(())
 }
 
 /// The glint's host solve per scene: its median time over `runs`, on every host thread.
 fn bench_glint(scenes: &[PathBuf], runs: u32) -> anyhow::Result<()> {
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-    println!("glint solve on the host, {threads} threads, median of {runs} runs");
+    let load = load_average().map_or(String::new(), |l| format!(", load average {l} at the start"));
+    println!("glint solve on the host, {threads} threads, median of {runs} runs{load}\n");
     println!("| scene | objects | specular objects | glints | solve s |");
     println!("|---|---|---|---|---|");
     for path in scenes {
@@ -434,4 +436,11 @@ fn bench_glint(scenes: &[PathBuf], runs: u32) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+/// The host's one-minute load average, where the system tells it (Linux): other work on the host
+/// slows every figure here, and a table quoted without it cannot be judged.
+fn load_average() -> Option<String> {
+    let text = std::fs::read_to_string("/proc/loadavg").ok()?;
+    text.split(' ').next().map(str::to_owned)
 }

@@ -88,8 +88,12 @@ def ladder_summary(path):
         cells += [f"{float(regions[name]['luminance_ratio']):.2f}" if name in regions else "n/a"
                   for name, _ in LADDER_REGIONS]
         out.append("| " + " | ".join(cells) + " |")
+    # The truth's settings, from the ladder's own page beside the CSV.
+    truth = re.search(r"Truth: (path traced, .*?its own estimated relMSE [0-9.e+-]+)\.",
+                      read(os.path.dirname(path), "ladder.md"))
+    truth = f" Truth: {truth.group(1)}." if truth else ""
     out.append("")
-    out.append(f"*Measured {host()} (lavapipe unless a GPU is present). wall ms: the median time per frame; "
+    out.append(f"*Measured {host()} (lavapipe unless a GPU is present).{truth} wall ms: the median time per frame; "
                "for the rasterizer a whole frame with its shadow and cube maps made again, for the path tracer "
                "the time to render that many spp from nothing.*")
     # The README and the Whitted scene's theory page show the same rows.
@@ -159,9 +163,9 @@ def headline(directory):
         text = read(directory, name)
         spp = number_after(text, r"512x512, (\d+) spp")
         seconds = number_after(text, r", ([0-9.]+) s, ")
-        error = number_after(text, r"estimated relative error ([0-9.]+)")
+        error = number_after(text, r"estimated relative error ([0-9.]+)%")
         if spp is not None and seconds is not None and error is not None:
-            lines.append(f"- {label}: {spp:.0f} spp, estimated relative error {100 * error:.2f}%, "
+            lines.append(f"- {label}: {spp:.0f} spp, estimated relative error {error:.2f}%, "
                          f"{seconds:.1f} s on this host.")
     # The rasterizer (raster_bench).
     raster = read(directory, "raster-bench.txt")
@@ -185,22 +189,18 @@ def perf_tables(directory):
     """The bench outputs as they were printed, each with the host it was measured on."""
     measured = f"*Measured {host()}, by `scripts/readme-figures.sh`.*"
     docs = os.path.join(ROOT, "docs")
-    bench = read(directory, "bench-quick.txt").strip()
-    if bench:
-        replace_block("bench-quick", f"{bench}\n\n{measured}", os.path.join(docs, "performance.md"))
-    viewer = read(directory, "bench-viewer.txt").strip()
-    if viewer:
-        replace_block("viewer-bench", f"{viewer}\n\n{measured}", os.path.join(docs, "performance.md"))
-    viewer = read(directory, "bench-viewer-whitted.txt").strip()
-    if viewer:
-        replace_block("viewer-bench-whitted", f"{viewer}\n\n{measured}", os.path.join(docs, "performance.md"))
-    glint = read(directory, "bench-glint.txt").strip()
-    if glint:
-        replace_block("glint-bench", f"{glint}\n\n{measured}", os.path.join(docs, "performance.md"))
-    raster = read(directory, "raster-bench.txt").strip()
-    if raster:
-        replace_block("raster-bench", f"```text\n{raster}\n```\n\n{measured}",
-                      os.path.join(docs, "performance-raster.md"))
+    blocks = [
+        ("bench-quick.txt", "bench-quick", "performance.md", False),
+        ("bench-viewer.txt", "viewer-bench", "performance.md", False),
+        ("bench-viewer-whitted.txt", "viewer-bench-whitted", "performance.md", False),
+        ("bench-glint.txt", "glint-bench", "performance.md", False),
+        ("raster-bench.txt", "raster-bench", "performance-raster.md", True),
+    ]
+    for name, block, page, preformatted in blocks:
+        text = read(directory, name).strip()
+        if text:
+            text = f"```text\n{text}\n```" if preformatted else text
+            replace_block(block, f"{text}\n\n{measured}", os.path.join(docs, page))
 
 
 if __name__ == "__main__":

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs what illum's tests need on Debian or Ubuntu, from one list each, so that the README's
-# set-up line and CI cannot drift apart (tests/render_cli.rs checks that the README's line is
+# set-up line and CI cannot drift apart (tests/render_cli/docs.rs checks that the README's line is
 # BASE_PACKAGES):
 #
 #     scripts/setup.sh              the default test run: lavapipe and a virtual display

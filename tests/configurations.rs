@@ -1,4 +1,4 @@
-//! The extremes matrix's configuration rows (docs/accuracy.md, "Every renderer at the scene's
+//! The extremes matrix's configuration rows (docs/extremes.md, "Every renderer at the scene's
 //! extremes"): the Whitted scene with its sun grazing (elevation under 1 degree) and straight
 //! down; its spheres touching the floor, touching each other, intersecting, one inside the other,
 //! and a sphere of radius 1e-4 next to one of 1e4; its camera inside the glass sphere, on its

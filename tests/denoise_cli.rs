@@ -1,25 +1,10 @@
 //! `render --denoise` as a user runs it: the files it writes, the error it reports and stops
 //! at, and the flags it refuses.
 
-use std::process::Output;
-
 #[path = "common/binary.rs"]
 mod binary;
 
-use binary::{field, metadata, render, text};
-
-fn run(args: &[&str]) -> Output {
-    render(args).output().expect("the render example starts")
-}
-
-fn assert_refused(out: &Output, case: &str, expected: &[&str]) {
-    let stderr = text(&out.stderr);
-    assert!(!out.status.success(), "{case}: accepted, expected a refusal naming {expected:?}: {stderr}");
-    assert!(!stderr.contains("panicked"), "{case}: {stderr}");
-    for part in expected {
-        assert!(stderr.contains(part), "{case}: the refusal lacks {part:?}: {stderr}");
-    }
-}
+use binary::{assert_refused, field, metadata, run, text, words};
 
 /// The EXR holds the denoised image with layers `noisy`, `albedo` and `normal`, and metadata
 /// saying which denoiser ran, the total spp (an odd target rounded up to even) and the
@@ -28,27 +13,17 @@ fn assert_refused(out: &Output, case: &str, expected: &[&str]) {
 /// nothing, and the estimate says so); the PNG is written too. For à-trous always, and for
 /// Open Image Denoise in builds that have it (`--features illum-denoise/oidn`), whose
 /// estimate is only required to be finite: the halves' estimate overstates OIDN's error, at
-/// 16 spp beyond the raw image's (docs/denoising.md, "Open Image Denoise").
+/// 16 spp beyond the raw image's (docs/denoising-oidn.md).
 #[test]
 fn denoise_writes_the_image_its_guide_layers_and_its_estimated_error() {
     let denoisers: &[&str] = if illum_denoise::OIDN_BUILT { &["atrous", "oidn"] } else { &["atrous"] };
     for &denoiser in denoisers {
         let dir = tempfile::tempdir().unwrap();
         let (exr, png) = (dir.path().join("d.exr"), dir.path().join("d.png"));
-        let out = run(&[
-            "--width",
-            "64",
-            "--height",
-            "64",
-            "--spp",
-            "15",
-            "--denoise",
-            denoiser,
-            "-o",
-            exr.to_str().unwrap(),
-            "-o",
-            png.to_str().unwrap(),
-        ]);
+        let out = run(&words(
+            "--width 64 --height 64 --spp 15 --denoise",
+            &[denoiser, "-o", exr.to_str().unwrap(), "-o", png.to_str().unwrap()],
+        ));
         assert!(out.status.success(), "{denoiser}: {}", text(&out.stderr));
         assert!(png.exists());
         let meta = metadata(&exr);
@@ -72,18 +47,10 @@ fn denoise_writes_the_image_its_guide_layers_and_its_estimated_error() {
 fn the_error_target_applies_to_the_denoised_image() {
     let dir = tempfile::tempdir().unwrap();
     let exr = dir.path().join("t.exr");
-    let out = run(&[
-        "--width",
-        "64",
-        "--height",
-        "64",
-        "--target-error",
-        "0.09",
-        "--denoise",
-        "atrous",
-        "-o",
-        exr.to_str().unwrap(),
-    ]);
+    let out = run(&words(
+        "--width 64 --height 64 --target-error 0.09 --denoise atrous -o",
+        &[exr.to_str().unwrap()],
+    ));
     assert!(out.status.success(), "{}", text(&out.stderr));
     let meta = metadata(&exr);
     assert_eq!(field(&meta, "stopped_by"), "target_error");

@@ -120,7 +120,7 @@ fn in_the_glass_shadow_only_the_path_tracer_with_the_caustic_estimator_is_right(
 /// Task 1 (c): Whitted's recursion depth limits what the glass shows: at depth 1 the refracted
 /// ray that enters the ball cannot leave it (the ball is 0.1 of the truth's brightness); at
 /// depth 8 the ball is within 5% of the truth's samples. The truth also holds the sun's glint
-/// (`docs/caustics.md`), points far brighter than white that Whitted's highlights do not
+/// (`docs/glint.md`), points far brighter than white that Whitted's highlights do not
 /// reproduce: against it the ball at depth 8 is 10% too dark (0.898 measured at 80 x 45). The
 /// path tracer without bounces sees no light through it.
 #[test]

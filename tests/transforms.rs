@@ -2,7 +2,7 @@
 //! Cornell box, their files moved by up to 1e6 units along each axis and diagonally, or scaled
 //! as a whole by 1e-4 to 1e4, drawn by the rasterizer, the Whitted ray tracer and the path tracer
 //! (same seed), against the image at home: the translation and scale rows of the extremes
-//! matrix (docs/accuracy.md), one test per scene and renderer, every cell printed. A renderer that refuses a scene at home must
+//! matrix (docs/extremes.md), one test per scene and renderer, every cell printed. A renderer that refuses a scene at home must
 //! refuse it moved too.
 //!
 //! The loader measures a far scene's positions from its eye in f64 (crates/illum-scene/src/
@@ -18,7 +18,7 @@
 //! file's own f32 coordinates (what the renderers got before the frame) and must fail that
 //! criterion. Every
 //! figure is printed (`cargo test --workspace --test transforms -- --nocapture`);
-//! docs/accuracy.md records them, and the images (with diffs against home) are written under
+//! docs/extremes.md records them, and the images (with diffs against home) are written under
 //! target/transforms/ to look at.
 //!
 //! The rotation row (`check_rotated`) turns each scene as a whole about an axis; its criterion

@@ -56,7 +56,7 @@ use illum_denoise::{DenoiseInput, Denoiser, DenoiserKind};
 use illum_lab::plot::{self, Line, Style};
 use illum_lab::reference::{Reference, cached_reference, load_reference};
 use illum_lab::regions::{Comparison, Regions, compare, flip_heat_map};
-use illum_lab::report::{csv_text, markdown_table, write_text};
+use illum_lab::report::{csv_text, host_cpu, markdown_table, write_text};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -492,14 +492,30 @@ fn write_outputs(
 
     // Markdown: the overall table, then one table per metric with a column per region.
     let s = header.scene;
+    // The command that made the page, less where its files went.
+    let mut command = vec!["cargo run --release --example ladder --".to_owned()];
+    let mut given = std::env::args().skip(1);
+    while let Some(arg) = given.next() {
+        match arg.as_str() {
+            "--out" => _ = given.next(),
+            a if a.starts_with("--out=") => {}
+            _ => command.push(arg),
+        }
+    }
     let mut md = format!(
-        "Scene `{}` at {}x{}, {}. Truth: path traced, {} spp, bounces {}, its own estimated relMSE {}. \
+        "# The ladder: `{}`\n\n\
+         Every renderer and setting on one scene, timed, and compared with a converged path-traced \
+         truth, overall and per region. Made by `{}`.\n\n\
+         Scene `{}` at {}x{}, {} on {}. Truth: path traced, {} spp, bounces {}, its own estimated relMSE {}. \
          Times are medians over frames; errors are against the truth (relMSE with epsilon 0.01; \
          luminance ratio = mean luminance / the truth's; FLIP = mean LDR-FLIP, sRGB, exposure 0).\n\n",
+        s.name,
+        command.join(" "),
         s.name,
         s.camera.width,
         s.camera.height,
         header.adapter,
+        host_cpu(),
         header.truth_spp,
         header.truth_bounces,
         number(header.truth_error)

@@ -1,5 +1,5 @@
 //! Running the `render` example's executable as a user does, and reading what it wrote. For the
-//! test binaries that run it and the other examples (`tests/render_cli.rs`, `tests/jobs.rs`,
+//! test binaries that run it and the other examples (`tests/render_cli/`, `tests/denoise_cli.rs`, `tests/jobs.rs`,
 //! `tests/slurm.rs`).
 #![allow(dead_code)] // each test binary uses a different subset
 
@@ -26,6 +26,35 @@ pub fn render(args: &[&str]) -> Command {
     let mut command = Command::new(example_binary("render"));
     command.args(args).current_dir(env!("CARGO_MANIFEST_DIR"));
     command
+}
+
+/// Runs the render example with `args` to its end.
+pub fn run(args: &[&str]) -> std::process::Output {
+    render(args).output().expect("the render example starts")
+}
+
+/// A command line written as one line: `line`'s words (split at spaces), then `more` as given
+/// (paths, names with spaces).
+pub fn words<'a>(line: &'a str, more: &[&'a str]) -> Vec<&'a str> {
+    line.split_whitespace().chain(more.iter().copied()).collect()
+}
+
+/// Asserts that a run of `case` (what the test tried, for the failure message) failed without a
+/// panic and that its message names every one of `expected`; the message is shown when either
+/// does not hold.
+pub fn assert_refused(out: &std::process::Output, case: &str, expected: &[&str]) {
+    let stderr = text(&out.stderr);
+    assert!(!out.status.success(), "{case}: accepted, expected a refusal naming {expected:?}: {stderr}");
+    assert_no_panic(out);
+    for part in expected {
+        assert!(stderr.contains(part), "{case}: the refusal lacks {part:?}: {stderr}");
+    }
+}
+
+/// Asserts that a run ended without a panic (which exits with status 101).
+pub fn assert_no_panic(output: &std::process::Output) {
+    let stderr = text(&output.stderr);
+    assert!(!stderr.contains("panicked") && output.status.code() != Some(101), "{stderr}");
 }
 
 pub fn text(bytes: &[u8]) -> String {

@@ -101,7 +101,7 @@ fn has_specular(scene: &Scene) -> bool {
 pub fn has_caustic(scene: &Scene) -> bool {
     let mut with = scene.clone();
     with.pathtrace.caustics = true;
-    illum_pathtrace::gpu_scene::caustics_active(&with)
+    illum_pathtrace::Estimators::of(&with).caustics()
 }
 
 /// `scene` with `setting` applied (its renderer's section), at the scene's size.

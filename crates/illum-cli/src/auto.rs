@@ -1,10 +1,14 @@
-//! The `render` example's `--renderer` value: one of the renderers, or `auto` (the planner of
-//! `illum_lab::auto` chooses the renderer and its settings), and what `auto` refuses.
+//! The `render` command's `--renderer` value: one of the renderers, or `auto` (the planner of
+//! `illum_auto::plan`, on the pilot's measurements, chooses the renderer and its settings), what
+//! `auto` refuses, and how the flags follow its choice.
 
 use std::fmt;
 use std::str::FromStr;
 
-use illum_scene::RendererKind;
+use illum_auto::plan::{Goal, Planned, Setting};
+use illum_scene::{RendererKind, Scene};
+
+use crate::render::RenderArgs;
 
 /// `--renderer pathtrace|raster|whitted|auto`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -62,6 +66,67 @@ pub fn check_auto_flags(
     }
 }
 
+impl RenderArgs {
+    /// `--renderer auto`'s goal, once its flags are checked ([`check_auto_flags`],
+    /// [`illum_auto::plan::check_goal`]): before anything is measured.
+    pub fn auto_goal(&self) -> anyhow::Result<Goal> {
+        let mut chosen = crate::given_flags(&[
+            (self.settings.spp.is_some(), "--spp"),
+            (self.settings.bounces.is_some(), "--bounces"),
+            (self.sequence.is_some(), "--sequence"),
+            (self.caustics.is_some(), "--caustics"),
+            (self.adaptive, "--adaptive"),
+            (self.resume.is_some(), "--resume"),
+            (self.sample_range.is_some(), "--sample-range"),
+            (self.checkpoint_seconds.is_some(), "--checkpoint-seconds"),
+            (self.denoise.is_some(), "--denoise"),
+        ]);
+        chosen.extend(self.raster.given());
+        chosen.extend(self.whitted.given());
+        check_auto_flags(self.target_error, self.time_budget, &chosen).map_err(anyhow::Error::msg)?;
+        let goal = match (self.target_error, self.time_budget) {
+            (Some(error), _) => Goal::Error(error),
+            (None, budget) => Goal::Seconds(budget.expect("one goal (checked)").as_secs_f64()),
+        };
+        illum_auto::plan::check_goal(goal).map_err(anyhow::Error::msg)?;
+        Ok(goal)
+    }
+
+    /// Sets the flags that name the planned renderer and settings, as a user would type them,
+    /// in place of the goal (`scene`: the scene planned for).
+    pub fn follow(&mut self, choice: &Planned, scene: &Scene) {
+        self.target_error = None;
+        self.time_budget = None;
+        match &choice.candidate.setting {
+            Setting::Raster { look, effects } => {
+                self.renderer = Some(RendererChoice::Kind(RendererKind::Raster));
+                self.raster.look = Some(*look);
+                self.raster.no_shadows = !effects.shadows;
+                self.raster.no_pcf = !effects.pcf;
+                self.raster.no_refraction = !effects.refraction;
+                self.raster.no_reflection = !effects.reflection;
+                self.raster.no_fresnel = !effects.fresnel;
+                self.raster.no_antialiasing = !effects.antialiasing;
+            }
+            Setting::Whitted { depth, aa } => {
+                self.renderer = Some(RendererChoice::Kind(RendererKind::Whitted));
+                self.whitted.depth = Some(*depth);
+                self.whitted.aa = Some(*aa);
+            }
+            Setting::PathTrace { bounces, caustics, sequence, adaptive, denoise } => {
+                self.renderer = Some(RendererChoice::Kind(RendererKind::PathTrace));
+                self.settings.spp = choice.spp;
+                self.settings.bounces = Some(*bounces);
+                self.sequence = Some(*sequence);
+                self.adaptive = *adaptive;
+                self.denoise = *denoise;
+                // Named only where the scene has a caustic: elsewhere `--caustics` is refused.
+                self.caustics = illum_auto::settings::has_caustic(scene).then_some(*caustics);
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -75,6 +140,49 @@ mod tests {
         }
         let error = "opengl".parse::<RendererChoice>().unwrap_err();
         assert!(error.contains("\"opengl\"") && error.contains("\"auto\""), "{error}");
+    }
+
+    /// `render --renderer auto` as typed: every bad goal and every flag that sets what auto
+    /// chooses is refused by [`RenderArgs::auto_goal`] (which the example calls before anything
+    /// is measured), or by the flag's parser, naming the flag, the value and what is allowed.
+    #[test]
+    fn bad_goals_and_settings_auto_chooses_are_refused_by_name() {
+        use clap::Parser as _;
+        let cases: [(&str, &[&str]); 13] = [
+            ("--target-error 0", &["--target-error", "0", "above 0"]),
+            ("--target-error -0.1", &["--target-error", "-0.1", "above 0"]),
+            ("--target-error nan", &["--target-error", "NaN", "finite"]),
+            ("--target-error inf", &["--target-error", "finite"]),
+            ("--time-budget 0", &["--time-budget", "0", "above 0"]),
+            ("--time-budget -5", &["--time-budget", "-5", "above 0"]),
+            ("--time-budget 1e12", &["--time-budget", "1000000000000", "30 days"]),
+            ("", &["--renderer auto needs a goal", "--target-error", "--time-budget"]),
+            ("--target-error 0.1 --time-budget 5", &["one goal", "not both"]),
+            (
+                "--target-error 0.1 --spp 16 --depth 2",
+                &["--spp, --depth", "chooses the renderer and its settings"],
+            ),
+            ("--target-error 0.1 --caustics on --no-shadows", &["--caustics, --no-shadows"]),
+            ("--target-error 0.1 --resume x.exr", &["--resume"]),
+            ("--target-error 0.1 --denoise atrous --adaptive", &["--adaptive, --denoise"]),
+        ];
+        for (flags, expected) in cases {
+            let mut words = vec!["render", "scenes/whitted.toml", "--renderer", "auto"];
+            words.extend(flags.split_whitespace());
+            let refusal = match RenderArgs::try_parse_from(&words) {
+                Err(error) => error.to_string(),
+                Ok(args) => format!("{:#}", args.auto_goal().expect_err(flags)),
+            };
+            for part in expected {
+                assert!(refusal.contains(part), "{flags}: the refusal lacks {part:?}: {refusal}");
+            }
+        }
+        let goal =
+            RenderArgs::try_parse_from(["render", "--renderer", "auto", "--time-budget", "2"]).unwrap();
+        assert_eq!(goal.auto_goal().unwrap(), Goal::Seconds(2.0));
+        let error =
+            RenderArgs::try_parse_from(["render", "--renderer", "automatic"]).unwrap_err().to_string();
+        assert!(error.contains("\"automatic\" is not a renderer") && error.contains("\"auto\""), "{error}");
     }
 
     #[test]

@@ -21,6 +21,11 @@ use illum_scene::Scene;
 
 use crate::{OutputFormat, output_format};
 
+/// Parses `--denoise` (`atrous` or `oidn`).
+pub fn denoiser_arg(text: &str) -> Result<DenoiserKind, String> {
+    text.parse()
+}
+
 /// What a denoised render needs.
 pub struct DenoiseRequest<'a> {
     pub gpu: &'a GpuContext,
@@ -43,10 +48,12 @@ pub fn render_denoised(request: &DenoiseRequest) -> anyhow::Result<Option<(StopR
     let filter = Denoiser::new(gpu, *denoiser).map_err(|e| anyhow::anyhow!("--denoise {denoiser}: {e}"))?;
     let mut split = SplitRender::new(gpu, scene, *options)?;
     let half_target = rules.spp.map(|spp| spp.div_ceil(2).max(1));
-    // Rounds are for the error and time rules; an spp target alone is one round.
+    // Rounds are for the error and time rules; an spp target alone is one round. The first
+    // round has 2 samples per half: with 1 the halves' estimate is unknown (infinite), and a time
+    // budget spent in that round would write an image whose error is "inf".
     let mut half = match half_target {
         Some(target) if rules.target_error.is_none() && rules.time_budget.is_none() => target,
-        _ => 1u32,
+        _ => 2u32,
     };
     let mut last: Option<Denoised> = None;
     let reason = loop {
@@ -62,6 +69,7 @@ pub fn render_denoised(request: &DenoiseRequest) -> anyhow::Result<Option<(StopR
             run_samples: denoised.raw.total_samples(),
             elapsed: clock.elapsed(),
             relative_error: denoised.estimate.rel_mse.is_finite().then_some(error),
+            ..Status::default()
         };
         eprintln!(
             "progress: {:.1} s  {} spp  denoised error {}  (raw {:.4})",

@@ -1,7 +1,9 @@
 //! Ctrl-C (SIGINT) and SIGTERM for long renders: the first one asks the render to stop, so that
 //! what has accumulated is still written. Repeats of either signal within
 //! [`REPEAT_WINDOW`] of the first are the same request; one later than that ends the process at
-//! once (a user pressing Ctrl-C again because the render does not stop).
+//! once (a user pressing Ctrl-C again because the render does not stop), never silently: it
+//! prints one line saying what was kept (the last checkpoint, or nothing) and what was
+//! abandoned, as the render last told [`Interrupt::set_note`].
 //!
 //! Why a window: GNU `timeout` signals the child and then its whole process group, Slurm and
 //! systemd signal every process of a job or unit, and a shell's Ctrl-C reaches every process
@@ -12,8 +14,8 @@
 //! number of the first request: 130 for SIGINT, 143 for SIGTERM, so that `render && next-step`
 //! does not go on with a partial image.
 
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicPtr, AtomicU64, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use anyhow::Context;
@@ -43,6 +45,66 @@ struct Shared {
     signal: AtomicUsize,
     /// CLOCK_MONOTONIC time of the first request in nanoseconds, plus one (0: none yet).
     first: AtomicU64,
+    /// The line a later signal prints before it ends the process (null: none set). It points
+    /// into `notes`, which keeps every line ever set alive, since a handler may be reading an
+    /// older one while a new one is set.
+    note: AtomicPtr<Vec<u8>>,
+    // Boxed so that each line's Vec stays at one address as `notes` grows: `note` is a thin
+    // pointer to it, which an atomic can hold (a pointer to a slice is two words).
+    #[allow(clippy::vec_box)]
+    notes: Mutex<Vec<Box<Vec<u8>>>>,
+}
+
+/// The line a signal that ends the process at once prints: which signal, what was kept and what
+/// was abandoned.
+pub fn exit_line(signal: &str, note: &str) -> String {
+    format!("{}{signal}{}{note}\n", EXIT_LINE_HEAD, EXIT_LINE_MIDDLE)
+}
+
+/// [`exit_line`]'s fixed parts, which the handler writes around the signal's name.
+const EXIT_LINE_HEAD: &str = "error: a second ";
+const EXIT_LINE_MIDDLE: &str = " ended the render at once; ";
+
+/// The note of [`Interrupt::set_note`]: "kept: ...; abandoned: ...".
+pub fn note(kept: &str, abandoned: &str) -> String {
+    format!("kept: {kept}; abandoned: {abandoned}")
+}
+
+/// Writes `bytes` to standard error with `write(2)`, which a signal handler may call.
+#[cfg(unix)]
+fn write_stderr(bytes: &[u8]) {
+    let mut rest = bytes;
+    while !rest.is_empty() {
+        // SAFETY: a valid buffer of rest.len() bytes; write(2) is async-signal-safe.
+        let written = unsafe { libc::write(2, rest.as_ptr().cast(), rest.len()) };
+        if written <= 0 {
+            return;
+        }
+        rest = &rest[written as usize..];
+    }
+}
+
+#[cfg(not(unix))]
+fn write_stderr(bytes: &[u8]) {
+    use std::io::Write;
+    let _ = std::io::stderr().write_all(bytes);
+}
+
+/// What a signal that ends the process prints: [`exit_line`], from the parts a handler can
+/// reach without allocating.
+fn say_exit(shared: &Shared, sig: i32) {
+    let name: &[u8] = if sig == SIGTERM { b"SIGTERM" } else { b"SIGINT" };
+    write_stderr(EXIT_LINE_HEAD.as_bytes());
+    write_stderr(name);
+    write_stderr(EXIT_LINE_MIDDLE.as_bytes());
+    let note = shared.note.load(Ordering::SeqCst);
+    // SAFETY: a non-null note points into `shared.notes`, whose boxes are never dropped while
+    // `shared` lives (the handler holds an Arc of it).
+    match unsafe { note.as_ref() } {
+        Some(note) => write_stderr(note),
+        None => write_stderr(b"kept: nothing; abandoned: the render"),
+    }
+    write_stderr(b"\n");
 }
 
 /// Classifies a signal arriving at `now_ns` (CLOCK_MONOTONIC nanoseconds), recording it in
@@ -98,14 +160,29 @@ impl Interrupt {
                     state.requested.store(true, Ordering::SeqCst);
                 }
                 Arrival::Repeat => {}
-                Arrival::Exit => signal_hook::low_level::exit(128 + sig),
+                Arrival::Exit => {
+                    say_exit(&state, sig);
+                    signal_hook::low_level::exit(128 + sig)
+                }
             };
-            // SAFETY: the action only loads and stores atomics, reads the monotonic clock and
-            // calls _exit, all async-signal-safe; it neither allocates nor locks.
+            // SAFETY: the action only loads and stores atomics, reads the monotonic clock, writes
+            // bytes that outlive it with write(2) and calls _exit, all async-signal-safe; it
+            // neither allocates nor locks.
             unsafe { signal_hook::low_level::register(sig, action) }
                 .with_context(|| format!("installing the handler for signal {sig}"))?;
         }
         Ok(Interrupt { shared })
+    }
+
+    /// Sets what a signal that ends the process at once says was kept and abandoned (see
+    /// [`note`]); the render calls it as that changes (a checkpoint written, the image being
+    /// written). Each note is kept until the process ends, so a render sets a few.
+    pub fn set_note(&self, note: &str) {
+        let mut boxed = Box::new(note.as_bytes().to_vec());
+        let pointer: *mut Vec<u8> = &mut *boxed;
+        let mut notes = self.shared.notes.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        notes.push(boxed);
+        self.shared.note.store(pointer, Ordering::SeqCst);
     }
 
     /// Set once a stop was asked for; the render polls it between submissions.
@@ -165,6 +242,53 @@ mod tests {
         assert_eq!(arrive(&first, 0), Arrival::Request);
         assert_eq!(arrive(&first, 0), Arrival::Repeat);
         assert_eq!(arrive(&first, 2 * SECOND), Arrival::Exit);
+    }
+
+    /// The environment variable that makes [`a_child_that_is_signalled_twice`] act.
+    const CHILD: &str = "ILLUM_INTERRUPT_TEST_CHILD";
+
+    /// The process this test runs (its own test binary, the test below only) is signalled, and
+    /// again after the first was answered and the window has passed: it ends at once with the
+    /// first signal's status, and its one line says what was kept and what was abandoned.
+    #[cfg(unix)]
+    #[test]
+    fn a_second_signal_ends_the_process_with_a_line_of_what_was_kept() {
+        let out = std::process::Command::new(std::env::current_exe().expect("the test binary"))
+            .args([
+                "--exact",
+                "interrupt::tests::a_child_that_is_signalled_twice",
+                "--nocapture",
+                "--test-threads=1",
+            ])
+            .env(CHILD, "1")
+            .output()
+            .expect("the test binary runs");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(143), "{stderr}");
+        let expected =
+            exit_line("SIGTERM", &note("the checkpoint out/w.exr (48 spp)", "the samples after it"));
+        assert!(stderr.contains(&expected), "expected {expected:?} in:\n{stderr}");
+        assert_eq!(stderr.matches("ended the render at once").count(), 1, "{stderr}");
+        assert!(!String::from_utf8_lossy(&out.stdout).contains("child survived"));
+    }
+
+    /// The child of the test above: does nothing unless [`CHILD`] is set.
+    #[cfg(unix)]
+    #[test]
+    fn a_child_that_is_signalled_twice() {
+        if std::env::var_os(CHILD).is_none() {
+            return;
+        }
+        let interrupt = Interrupt::install().expect("handlers");
+        interrupt.set_note(&note("nothing yet", "everything"));
+        interrupt.set_note(&note("the checkpoint out/w.exr (48 spp)", "the samples after it"));
+        // SAFETY: raising a signal this process handles.
+        unsafe { libc::raise(SIGTERM) };
+        assert!(interrupt.requested(), "the first signal asks for a stop");
+        // Beyond the window of repeats: the next one is a second request.
+        std::thread::sleep(REPEAT_WINDOW + Duration::from_millis(200));
+        unsafe { libc::raise(SIGTERM) };
+        println!("child survived");
     }
 
     /// The handler's clock counts nanoseconds: a sleep of 2 ms (which lasts at least that) moves

@@ -6,15 +6,19 @@
 //!   [`main_with`], which runs an example's `run` and prints its error;
 //! - [`interrupt`]: Ctrl-C and SIGTERM for long renders;
 //! - [`progress`]: progress bars and log lines;
-//! - [`raster`], [`whitted`]: each renderer's path of the `render` example (the path tracer's
-//!   is in `examples/render.rs`).
+//! - [`render`]: the `render` command's flags and the choice of renderer; [`pathtrace`],
+//!   [`raster`], [`whitted`]: each renderer's path of it, [`denoise`] the path tracer's with
+//!   `--denoise`, `resume` its `--resume`, [`auto`] the flags of `--renderer auto`.
 
 pub mod auto;
 pub mod denoise;
 pub mod interrupt;
+pub mod pathtrace;
 pub mod progress;
 pub mod raster;
 pub mod reference;
+pub mod render;
+mod resume;
 pub mod whitted;
 
 use std::path::{Path, PathBuf};

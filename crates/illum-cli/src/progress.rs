@@ -187,10 +187,15 @@ pub fn describe(progressive: &Progressive, tracer: &PathTracer) -> String {
         None => format!("{} spp", status.spp_done),
     };
     let mut text = format!("{spp}  {:.2} Msamples/s", status.samples_per_second() * 1e-6);
-    match (status.relative_error, progressive.rules.target_error) {
-        (Some(e), Some(t)) => text += &format!("  error {:.2}% (target {}%)", e * 100.0, t * 100.0),
-        (Some(e), None) => text += &format!("  error {:.2}%", e * 100.0),
-        (None, _) => text += "  error (needs 2 spp)",
+    text += &format!(
+        "  error {}",
+        illum_pathtrace::progressive::error_text(
+            status.relative_error,
+            tracer.accumulator().spp_for_error_estimate()
+        )
+    );
+    if let (Some(_), Some(target)) = (status.relative_error, progressive.rules.target_error) {
+        text += &format!(" (target {}%)", target * 100.0);
     }
     if let Some(p) = progressive.progress(tracer) {
         let rule = match p.rule {

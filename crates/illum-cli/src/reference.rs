@@ -3,34 +3,27 @@
 //! image minus reference per pixel and channel, as the f32 layer [`DIFFERENCE_LAYER`]. These
 //! renderers have no noise but a bias; the layer shows where it is.
 //!
-//! The reference must be an illum render of the same scene content (`illum.scene_hash`, which
-//! covers the camera, materials, objects and lights but no settings) and of the same size; either
-//! mismatch is refused before anything is rendered, naming both sides.
+//! The reference is checked before anything is rendered, by the rule every reader of a
+//! reference shares ([`Reference`]): the same size, and the same scene where the file says
+//! which (`illum.scene_hash`).
 
 use std::path::Path;
 
-use anyhow::bail;
-use illum_image::{ExrMetadata, F32Layer, RgbImage32, load_exr};
+use illum_image::{F32Layer, RgbImage32};
+use illum_pathtrace::reference::{Reference, SizePolicy};
 use illum_scene::Scene;
 
 /// The EXR layer of the signed difference from the reference (channels R, G, B).
 pub const DIFFERENCE_LAYER: &str = "illum.difference";
 
-/// Reads the reference at `path` and checks that it is of `scene` (by content hash) and of the
-/// scene's camera size.
+/// Reads the reference at `path` and checks it against `scene` at its camera's size (see
+/// [`Reference`]); prints the note of a file whose scene could not be checked.
 pub fn load_reference(path: &Path, scene: &Scene) -> anyhow::Result<RgbImage32> {
-    let (image, attributes) =
-        load_exr(path).map_err(|e| anyhow::anyhow!("--reference {}: {e}", path.display()))?;
-    let metadata = ExrMetadata::from_attributes(path, &attributes)?;
-    let advice =
-        format!("give --width {} --height {} or a reference of this size", image.width, image.height);
-    let size = [image.width, image.height];
-    if let Some(why) =
-        illum_pathtrace::metadata::reference_refusal(path, metadata.as_ref(), size, scene, &advice)
-    {
-        bail!("{why}");
+    let (reference, note) = Reference::load(path, scene, SizePolicy::Flags)?;
+    if let Some(note) = note {
+        println!("{note}");
     }
-    Ok(image)
+    Ok(reference.image)
 }
 
 /// The signed difference `image - reference` (same size), as the [`DIFFERENCE_LAYER`].

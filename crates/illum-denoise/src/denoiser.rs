@@ -15,7 +15,7 @@ use crate::{DenoiseError, DenoiserKind};
 /// How to get a build with Open Image Denoise (the refusal's advice).
 pub const OIDN_BUILD_HINT: &str = "this build has no Open Image Denoise: build with \
     `--features illum-denoise/oidn` and OIDN_DIR set to a libOpenImageDenoise 2.5 \
-    (docs/denoising.md, \"Open Image Denoise\"), or use --denoise atrous";
+    (docs/denoising-oidn.md), or use --denoise atrous";
 
 /// Whether this build has Open Image Denoise (the cargo feature `oidn`).
 pub const OIDN_BUILT: bool = cfg!(feature = "oidn");

@@ -1,5 +1,5 @@
 //! Intel Open Image Denoise's RT filter on its CPU device (cargo feature `oidn`; the library is
-//! not part of illum: docs/denoising.md says where to get it and how to link it).
+//! not part of illum: docs/denoising-oidn.md says where to get it and how to link it).
 //!
 //! The filter reads the mean image as HDR colour and the path tracer's guides as its auxiliary
 //! images: albedo in [0, 1] and the mean normal, zero where the pixel's rays left the scene

@@ -376,6 +376,29 @@ pub fn load_u32_layer(path: impl AsRef<Path>, name: &str) -> Result<Option<U32La
     Ok(load_u32_layers(path, &[name])?.pop().flatten())
 }
 
+/// The first bytes of every OpenEXR file.
+const EXR_MAGIC: [u8; 4] = [0x76, 0x2f, 0x31, 0x01];
+
+/// Opens the file at `path` for reading as an EXR, refusing one that is not (by its first
+/// bytes) and naming what it is when it is a PNG, so that a PNG given where an EXR is needed
+/// (`--resume`, `--reference`, `merge`) is not reported as a corrupt EXR.
+fn open_exr(path: &Path) -> Result<File, ImageError> {
+    use std::io::{Read as _, Seek as _};
+    let mut file = File::open(path).map_err(|e| ImageError::io(path, "opening the EXR file", e))?;
+    let mut magic = [0u8; 8];
+    let read = file.read(&mut magic).map_err(|e| ImageError::io(path, "reading the EXR file", e))?;
+    if read < 4 || magic[..4] != EXR_MAGIC {
+        let what = if magic.starts_with(b"\x89PNG") {
+            "a PNG image, not an OpenEXR file"
+        } else {
+            "not an OpenEXR file (its first bytes are not OpenEXR's magic number 76 2f 31 01)"
+        };
+        return Err(ImageError::BadContent { path: path.to_path_buf(), reason: what.to_owned() });
+    }
+    file.rewind().map_err(|e| ImageError::io(path, "reading the EXR file", e))?;
+    Ok(file)
+}
+
 /// Every layer of the EXR file at `path`, with all channels and attributes (the layer loaders'
 /// one read).
 fn read_all_layers(
@@ -385,7 +408,7 @@ fn read_all_layers(
     ImageError,
 > {
     use exr::prelude::ReadLayers as _;
-    let file = File::open(path).map_err(|e| ImageError::io(path, "opening the EXR file", e))?;
+    let file = open_exr(path)?;
     exr::prelude::read()
         .no_deep_data()
         .largest_resolution_level()
@@ -476,7 +499,7 @@ pub struct ExrHeader {
 /// not an EXR, or without a layer of R, G and B channels.
 pub fn load_exr_header(path: impl AsRef<Path>) -> Result<ExrHeader, ImageError> {
     let path = path.as_ref();
-    let file = File::open(path).map_err(|e| ImageError::io(path, "opening the EXR file", e))?;
+    let file = open_exr(path)?;
     let meta = exr::meta::MetaData::read_from_buffered(BufReader::new(file), false)
         .map_err(|e| ImageError::Decode { path: path.to_path_buf(), format: "EXR", source: Box::new(e) })?;
     let is_rgb = |header: &&exr::meta::header::Header| {
@@ -530,7 +553,7 @@ struct ReadPixels {
 /// illum's settings.
 pub fn load_exr(path: impl AsRef<Path>) -> Result<(RgbImage32, Vec<(String, String)>), ImageError> {
     let path = path.as_ref();
-    let file = File::open(path).map_err(|e| ImageError::io(path, "opening the EXR file", e))?;
+    let file = open_exr(path)?;
     let decode_err = |e: exr::error::Error| ImageError::Decode {
         path: path.to_path_buf(),
         format: "EXR",
@@ -707,7 +730,24 @@ mod tests {
         let garbage = dir.path().join("garbage.exr");
         std::fs::write(&garbage, b"this is not an EXR file").unwrap();
         let err = load_exr(&garbage).unwrap_err();
-        assert!(matches!(err, ImageError::Decode { .. }) && err.to_string().contains("garbage.exr"), "{err}");
+        assert!(
+            err.to_string().contains("garbage.exr") && err.to_string().contains("not an OpenEXR file"),
+            "{err}"
+        );
+
+        // A PNG is named as one, by every reader, whatever its name.
+        let png = dir.path().join("image.png");
+        crate::save_png(&png, &RgbImage32::new(2, 2), 0.0, crate::Encoding::Srgb).unwrap();
+        for err in [load_exr(&png).unwrap_err(), load_exr_header(&png).unwrap_err()] {
+            assert_eq!(err.to_string(), format!("'{}': a PNG image, not an OpenEXR file", png.display()));
+        }
+
+        // An EXR cut short is still read as one (and refused by the decoder).
+        let exr = dir.path().join("whole.exr");
+        save_exr(&exr, &RgbImage32::new(2, 2), &ExrMetadata::default()).unwrap();
+        let bytes = std::fs::read(&exr).unwrap();
+        std::fs::write(&exr, &bytes[..bytes.len() / 2]).unwrap();
+        assert!(matches!(load_exr(&exr).unwrap_err(), ImageError::Decode { .. }));
     }
 
     #[test]

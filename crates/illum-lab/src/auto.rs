@@ -60,14 +60,29 @@ pub fn describe(scene: &Scene, pilot: &Pilot, goal: Goal, plan: &Plan) -> String
     }
     let c = &plan.choice;
     text.push_str(&format!(
-        "auto plan: renderer={} spp={} predicted_error={:e} predicted_seconds={:e} pilot_seconds={:e}\n",
+        "auto plan: renderer={} spp={} predicted_error={} predicted_seconds={} pilot_seconds={}\n",
         c.candidate.setting.renderer(),
         c.spp.map_or("-".to_owned(), |n| n.to_string()),
-        c.predicted_error,
-        c.predicted_seconds,
-        pilot.seconds()
+        significant(c.predicted_error),
+        significant(c.predicted_seconds),
+        significant(pilot.seconds())
     ));
     text
+}
+
+/// `x` to 4 significant digits, as plain decimals (`0.04855`, `12.30`) from 1e-4 to 1e4, else in
+/// scientific notation: what the `auto plan:` line shows, readable and exact enough for the
+/// tools that read it.
+fn significant(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return x.to_string();
+    }
+    let magnitude = x.abs().log10().floor();
+    if (-4.0..4.0).contains(&magnitude) {
+        format!("{x:.*}", (3.0 - magnitude) as usize)
+    } else {
+        format!("{x:.3e}")
+    }
 }
 
 /// What `render --renderer auto` prints after it rendered: the time and the error reached
@@ -95,5 +110,18 @@ pub fn reached(choice: &Planned, noise: Option<f64>, seconds: f64) -> String {
             "auto: {timing}; a deterministic image: its relative error is the one the pilot measured, {:.4}",
             choice.predicted_error
         ),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn plan_numbers_show_four_significant_digits() {
+        assert_eq!(super::significant(4.855354961257205e-2), "0.04855");
+        assert_eq!(super::significant(12.3), "12.30");
+        assert_eq!(super::significant(3210.4), "3210");
+        assert_eq!(super::significant(2.5e-7), "2.500e-7");
+        assert_eq!(super::significant(0.0), "0");
+        assert_eq!("0.04855".parse::<f64>(), Ok(0.04855), "the tools read it back");
     }
 }

@@ -4,10 +4,10 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::bail;
 use illum_gpu::GpuContext;
 use illum_image::{ExrMetadata, RgbImage32, load_exr, save_exr};
 use illum_pathtrace::PathTracer;
+use illum_pathtrace::reference::SizePolicy;
 use illum_scene::{Sampling, Scene};
 
 /// A reference image and what is known of its own error.
@@ -25,52 +25,21 @@ pub struct Reference {
     pub metadata: ExrMetadata,
 }
 
-/// Loads the user's reference (which must have the scene's size).
+/// Loads the user's reference, checked against `scene` at its camera's size by the rule every
+/// reader of a reference shares ([`illum_pathtrace::reference::Reference`]); prints the note of
+/// a file whose scene could not be checked.
 pub fn load_reference(path: &Path, scene: &Scene) -> anyhow::Result<Reference> {
-    let (image, attributes) = load_exr(path)?;
-    if (image.width, image.height) != (scene.camera.width, scene.camera.height) {
-        bail!(
-            "reference {} is {}x{} but the render is {}x{}: give --width/--height to match",
-            path.display(),
-            image.width,
-            image.height,
-            scene.camera.width,
-            scene.camera.height
-        );
+    let (file, note) = illum_pathtrace::reference::Reference::load(path, scene, SizePolicy::Flags)?;
+    if let Some(note) = note {
+        println!("{note}");
     }
-    let metadata = ExrMetadata::from_attributes(path, &attributes)?;
-    check_same_scene(path, metadata.as_ref(), scene)?;
-    let field = |name: &str| metadata.as_ref().and_then(|m| m.get(name)).and_then(|v| v.parse::<f64>().ok());
     Ok(Reference {
-        image,
-        path: path.to_path_buf(),
-        spp: field("spp").map_or(0, |v| v as u64),
-        estimated_rel_mse: field("estimated_rel_mse").unwrap_or(f64::NAN),
-        metadata: metadata.unwrap_or_default(),
+        spp: file.number("spp").map_or(0, |v| v as u64),
+        estimated_rel_mse: file.number("estimated_rel_mse").unwrap_or(f64::NAN),
+        metadata: file.metadata.unwrap_or_default(),
+        image: file.image,
+        path: file.path,
     })
-}
-
-/// Refuses a reference rendered from another scene: illum's EXRs carry the scene's content hash
-/// (`illum.scene_hash`, a hash of every number that changes the image). A file without it (made
-/// by another program) is taken as it is, and said so.
-fn check_same_scene(path: &Path, metadata: Option<&ExrMetadata>, scene: &Scene) -> anyhow::Result<()> {
-    let Some(stored) = metadata.and_then(|m| m.get("scene_hash")) else {
-        println!(
-            "note: {} does not say which scene it shows (no illum.scene_hash); using it as given",
-            path.display()
-        );
-        return Ok(());
-    };
-    let expected = illum_pathtrace::metadata::scene_hash(scene);
-    if stored != expected {
-        let name = metadata.map_or("(unnamed)", |m| m.scene.as_str());
-        bail!(
-            "reference {} shows another scene: {name:?} (illum.scene_hash {stored}), but this render is of {:?}              (scene hash {expected}); give a reference rendered from the same scene file, or none to render one",
-            path.display(),
-            scene.name
-        );
-    }
-    Ok(())
 }
 
 /// The cached reference of `scene` at `spp` samples per pixel in `folder`, rendered (and
@@ -136,7 +105,7 @@ pub fn reference_settings(scene: &Scene, spp: u32) -> (Scene, String) {
     let (camera, settings) = (&reference_scene.camera, &reference_scene.pathtrace);
     let key = format!(
         "scene {} (canonical form {}), {}x{}, spp {}, bounces {}, seed {}, sampling {}, sequence {}, caustics {}, \
-         caustic estimators {}",
+         estimators {}",
         illum_pathtrace::metadata::scene_hash(&reference_scene),
         illum_scene::CONTENT_VERSION,
         camera.width,
@@ -147,7 +116,7 @@ pub fn reference_settings(scene: &Scene, spp: u32) -> (Scene, String) {
         settings.sampling,
         settings.sequence,
         settings.caustics,
-        illum_pathtrace::caustic_estimators(&reference_scene)
+        illum_pathtrace::Estimators::of(&reference_scene).key()
     );
     (reference_scene, key)
 }

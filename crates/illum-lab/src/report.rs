@@ -1,4 +1,5 @@
-//! Text outputs of the measuring tools: CSV (RFC 4180, by the csv crate), written atomically.
+//! Text outputs of the measuring tools: CSV (RFC 4180, by the csv crate), written atomically,
+//! Markdown tables, and the host a table's times were measured on.
 
 use std::io::Write as _;
 use std::path::Path;
@@ -37,6 +38,16 @@ pub fn markdown_table(header: &[&str], rows: &[Vec<String>]) -> String {
         text.push_str(&format!("| {} |\n", row.iter().map(|f| cell(f)).collect::<Vec<_>>().join(" | ")));
     }
     text
+}
+
+/// "Intel(R) Xeon(R) Processor, 2 vCPUs" from /proc/cpuinfo ("unknown CPU" elsewhere): the
+/// host beside a table's absolute times.
+pub fn host_cpu() -> String {
+    let info = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
+    let model =
+        info.lines().find_map(|l| Some(l.strip_prefix("model name")?.split_once(':')?.1.trim().to_owned()));
+    let count = info.lines().filter(|l| l.starts_with("processor")).count();
+    model.map_or("unknown CPU".to_owned(), |m| format!("{m}, {count} vCPUs"))
 }
 
 #[cfg(test)]

@@ -130,16 +130,28 @@ impl WhittedOracle {
 
     /// The pixel (x, y): the mean of its `aa` x `aa` rays.
     pub fn pixel(&self, x: u32, y: u32) -> [f64; 3] {
+        let rays = self.rays_moved(x, y, 0.0, 0.0);
+        let sum = rays.iter().fold(DVec3::ZERO, |sum, &c| sum + DVec3::from_array(c));
+        (sum / rays.len() as f64).to_array()
+    }
+
+    /// The colour of each of pixel (x, y)'s `aa` x `aa` rays, each moved by (dx, dy) pixels on
+    /// the film. A ray whose colour changes when it moves by a small fraction of a pixel lies at
+    /// an edge (a silhouette, a shadow's boundary, a tile's border, seen directly or after any
+    /// bounce), where f32 rounding may send it to either side. (Per ray, not per pixel: moving
+    /// all of a pixel's rays can carry one ray across an edge one way and another the other,
+    /// leaving the pixel's mean as it was.)
+    pub fn rays_moved(&self, x: u32, y: u32, dx: f64, dy: f64) -> Vec<[f64; 3]> {
         let n = self.aa.max(1);
-        let mut sum = DVec3::ZERO;
+        let mut rays = Vec::with_capacity((n * n) as usize);
         for j in 0..n {
             for i in 0..n {
                 let (jx, jy) = ((f64::from(i) + 0.5) / f64::from(n), (f64::from(j) + 0.5) / f64::from(n));
-                let d = self.camera.direction(x, y, jx, jy);
-                sum += self.trace(self.camera.eye, d, self.depth);
+                let d = self.camera.direction(x, y, jx + dx, jy + dy);
+                rays.push(self.trace(self.camera.eye, d, self.depth).to_array());
             }
         }
-        (sum / f64::from(n * n)).to_array()
+        rays
     }
 
     /// The whole image, row-major from the top-left, on `threads` threads (the result does not

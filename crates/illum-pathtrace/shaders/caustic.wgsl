@@ -87,7 +87,7 @@ fn connect(frame: u32, s: Surface, own: u32, weight: vec3<f32>) {
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let particle = caustic.first_index + gid.y * caustic.row_stride + gid.x;
     let frame = gid.z;
-    if (particle >= caustic.particles || frame >= caustic.frame_count) {
+    if (particle >= min(caustic.particles, caustic.index_end) || frame >= caustic.frame_count) {
         return;
     }
     var sampler = sampler_new(caustic.seed, particle, caustic.frame_base + frame);

@@ -20,6 +20,7 @@
 
 #import illum::rtcore::geometry::Surface
 #import illum::pathtrace::scene::params
+#import illum::pathtrace::bindings::{BINDING_CAUSTIC, BINDING_DISCS, BINDING_SPLAT, BINDING_PHOTONS, BINDING_HEADS}
 
 const TWO_POW_32: f32 = 4294967296.0;
 
@@ -48,25 +49,26 @@ struct CausticParams {
     gather_radius: f32,
     // Grid buckets per frame: a power of two.
     buckets: u32,
-    // The first particle (or, in the gather, pixel) of this dispatch: a frame may be traced in
-    // pieces, each a range of them (tracer/caustic.rs, FramePieces).
+    // The particles (or, in the gather, pixels) of this dispatch: first_index..index_end. A frame
+    // may be traced in pieces, each a range of them (tracer/caustic/schedule.rs).
     first_index: u32,
-    padding_b: u32,
-    padding_c: u32,
+    index_end: u32,
+    // The sample index the gather's radius counts from: the render's first (gather_radius).
+    radius_origin: u32,
 }
 
-@group(0) @binding(6) var<uniform> caustic: CausticParams;
+@group(0) @binding(BINDING_CAUSTIC) var<uniform> caustic: CausticParams;
 // Per specular object: the centre and radius of its bounding sphere.
-@group(0) @binding(7) var<storage, read> discs: array<vec4<f32>>;
+@group(0) @binding(BINDING_DISCS) var<storage, read> discs: array<vec4<f32>>;
 // Frame f's pixel p, channel c: words (lo, hi) at 6 (f N_pixels + p) + 2 c; after the frames,
 // one counter of dropped values per frame.
-@group(0) @binding(8) var<storage, read_write> splat: array<atomic<u32>>;
+@group(0) @binding(BINDING_SPLAT) var<storage, read_write> splat: array<atomic<u32>>;
 #ifdef CAUSTIC_GATHER
 // Photon slot s: photons[3 s] = (position, bitcast next slot + 1, 0 = none), photons[3 s + 1] =
 // (weight = flux x albedo / pi, scatterings), photons[3 s + 2] = (normal on the particle's side, 0).
-@group(0) @binding(9) var<storage, read_write> photons: array<vec4<f32>>;
+@group(0) @binding(BINDING_PHOTONS) var<storage, read_write> photons: array<vec4<f32>>;
 // Frame f's bucket b: the first photon slot + 1 of its list (0 = empty), at f buckets + b.
-@group(0) @binding(10) var<storage, read_write> heads: array<atomic<u32>>;
+@group(0) @binding(BINDING_HEADS) var<storage, read_write> heads: array<atomic<u32>>;
 #endif
 
 // Whether value v >= 0 can be added in fixed point (false if too large or not a number).
@@ -106,9 +108,16 @@ fn drop_particle(frame: u32) {
 // Knaus and Zwicker's (alpha - 1) / 2 with alpha = 2/3: r_k = r_1 (k + 1)^(-1/6).
 const RADIUS_EXPONENT: f32 = -0.16666667;
 
-// The kernel radius of frame `frame` of this dispatch (sample index frame_base + frame).
+// The kernel radius of frame `frame` of this dispatch (sample index k = frame_base + frame):
+// r_1 (j + 1)^(-1/6) with j = k - radius_origin, the sample's place in its own render. A render of
+// sample indices A..B (a part of a split render, the denoiser's second half) then has the radii,
+// the bias and the variance of a render of 0..B-A, so its error estimate is as honest as that
+// one's (docs/caustics-gather.md, "Radius"). The absolute index would shrink a part's radius with A,
+// and a part's 16 samples at a radius 36 times smaller find a photon so rarely that their
+// spread no longer shows the variance.
 fn gather_radius(frame: u32) -> f32 {
-    return caustic.gather_radius * pow(f32(caustic.frame_base + frame + 1u), RADIUS_EXPONENT);
+    let j = caustic.frame_base + frame - caustic.radius_origin;
+    return caustic.gather_radius * pow(f32(j) + 1.0, RADIUS_EXPONENT);
 }
 
 // The grid cell (cubes of side `side` from the scene's centre) holding p. Clamped far beyond

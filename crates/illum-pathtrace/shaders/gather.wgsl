@@ -4,7 +4,7 @@
 // invocation traces one camera path of one pixel and frame, after the light tracer
 // (caustic.wgsl) has stored that frame's photons; its estimate goes into the frame's splat like
 // a particle's, so frame k's sample of the pixel pairs with the camera's sample k
-// (tracer/caustic.rs). The mathematics is in docs/caustics.md; in short:
+// (tracer/caustic.rs). The mathematics is in docs/caustics-gather.md; in short:
 //
 // The path: a camera ray through the pixel, jittered, followed through mirrors and glass (the
 // camera path tracer's weights: reflectance; 1 with the Fresnel choice) and diffuse surfaces
@@ -89,7 +89,7 @@ fn photon_sum(frame: u32, x: vec3<f32>, n: vec3<f32>, r: f32, depth: u32) -> vec
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let pixel = caustic.first_index + gid.y * caustic.row_stride + gid.x;
     let frame = gid.z;
-    if (pixel >= caustic.particles || frame >= caustic.frame_count) {
+    if (pixel >= min(caustic.particles, caustic.index_end) || frame >= caustic.frame_count) {
         return;
     }
     var sampler = sampler_new(caustic.seed ^ GATHER_SEED_KEY, pixel, caustic.frame_base + frame);

@@ -27,6 +27,7 @@
 #import illum::rtcore::materials::material_at
 #import illum::rtcore::traversal::{closest_hit, scattering_surface_at, object_at}
 #import illum::pathtrace::surfaces::{UNBOUNDED, UNBOUNDED_DEPTH_CAP}
+#import illum::pathtrace::bindings::{BINDING_GUIDE_ALBEDO, BINDING_GUIDE_NORMAL}
 #ifdef SPECULAR
 #import illum::pathtrace::surfaces::likelier_dielectric_branch
 #endif
@@ -35,9 +36,9 @@
 #endif
 
 // Per pixel (row-major, the whole image): xyz = the mean albedo, w = the samples averaged.
-@group(0) @binding(8) var<storage, read_write> guide_albedo: array<vec4<f32>>;
+@group(0) @binding(BINDING_GUIDE_ALBEDO) var<storage, read_write> guide_albedo: array<vec4<f32>>;
 // Per pixel: xyz = the mean normal, w = 0.
-@group(0) @binding(9) var<storage, read_write> guide_normal: array<vec4<f32>>;
+@group(0) @binding(BINDING_GUIDE_NORMAL) var<storage, read_write> guide_normal: array<vec4<f32>>;
 
 struct Guide {
     albedo: vec3<f32>,

@@ -3,6 +3,7 @@
 #import illum::rtcore::geometry::Object
 #import illum::rtcore::camera::Camera
 #import illum::rtcore::material::Material
+#import illum::pathtrace::bindings::{BINDING_PARAMS, BINDING_OBJECTS, BINDING_MATERIALS, BINDING_LIGHTS, BINDING_BATCH_SUM, BINDING_BATCH_SUM_SQ, BINDING_BLOCK_SAMPLES}
 
 // The path tracer's scene as the GPU sees it (mirrored by gpu_scene.rs): its parameters, lights
 // and bindings. Objects, materials, the camera and the ray-shape tests are illum-rtcore's.
@@ -46,16 +47,16 @@ struct Light {
     emission: vec4<f32>,
 }
 
-@group(0) @binding(0) var<uniform> params: Params;
-@group(0) @binding(1) var<storage, read> objects: array<Object>;
-@group(0) @binding(2) var<storage, read> materials: array<Material>;
-@group(0) @binding(3) var<storage, read> lights: array<Light>;
+@group(0) @binding(BINDING_PARAMS) var<uniform> params: Params;
+@group(0) @binding(BINDING_OBJECTS) var<storage, read> objects: array<Object>;
+@group(0) @binding(BINDING_MATERIALS) var<storage, read> materials: array<Material>;
+@group(0) @binding(BINDING_LIGHTS) var<storage, read> lights: array<Light>;
 // Per slot (one chunk of samples of one pixel, see pathtrace.wgsl's main): (sum of radiance,
 // number of finite samples) and (sum of squares, number of dropped samples).
-@group(0) @binding(4) var<storage, read_write> batch_sum: array<vec4<f32>>;
-@group(0) @binding(5) var<storage, read_write> batch_sum_sq: array<vec4<f32>>;
+@group(0) @binding(BINDING_BATCH_SUM) var<storage, read_write> batch_sum: array<vec4<f32>>;
+@group(0) @binding(BINDING_BATCH_SUM_SQ) var<storage, read_write> batch_sum_sq: array<vec4<f32>>;
 #ifdef ADAPTIVE
 // Adaptive sampling (allocation.rs): samples per pixel of each block of ADAPTIVE_BLOCK x
 // ADAPTIVE_BLOCK pixels, row-major over blocks; a pixel takes sample indices [0, n) of its block.
-@group(0) @binding(6) var<storage, read> block_samples: array<u32>;
+@group(0) @binding(BINDING_BLOCK_SAMPLES) var<storage, read> block_samples: array<u32>;
 #endif

@@ -452,6 +452,15 @@ impl Accumulator {
         if terms == 0 { f64::INFINITY } else { total / terms as f64 }
     }
 
+    /// Samples per pixel from which [`Self::estimated_rel_mse`] is finite: 2 for independent
+    /// samples (a sample variance needs two), and for a low-discrepancy render two replicates'
+    /// runs (its variance comes from the spread of the replicates' means, and the first
+    /// `REPLICATE_RUN` samples all go to one replicate; a range starts on a chunk, which starts
+    /// a run of replicate 0).
+    pub fn spp_for_error_estimate(&self) -> u32 {
+        if self.replicates.is_some() { 2 * crate::replicates::REPLICATE_RUN } else { 2 }
+    }
+
     /// Relative standard error of the image: the square root of [`Self::estimated_rel_mse`].
     pub fn estimated_relative_error(&self) -> f64 {
         self.estimated_rel_mse().sqrt()

@@ -10,6 +10,7 @@ use illum_gpu::{GpuContext, GpuError, wgpu};
 use illum_scene::Scene;
 
 use crate::PathTraceError;
+use crate::bindings::Binding;
 use crate::replicates::{REPLICATES, replicate_of, samples_in};
 
 /// Bytes of one slot of a batch buffer: a vec4 of f32 (the sum buffer and the sum-of-squares
@@ -122,7 +123,7 @@ impl BatchBuffers {
                 })
             });
             let mut bound: Vec<(u32, &wgpu::Buffer)> = inputs.to_vec();
-            bound.extend([(4, &sum), (5, &sum_sq)]);
+            bound.extend([(Binding::BatchSum.index(), &sum), (Binding::BatchSumSq.index(), &sum_sq)]);
             let bind_group = buffer_bind_group(device, "pathtrace", layout, &bound);
             BatchBuffers { slots, sum, sum_sq, timestamps, bind_group }
         })

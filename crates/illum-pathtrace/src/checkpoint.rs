@@ -41,6 +41,7 @@ use std::path::Path;
 use illum_image::{ExrMetadata, F32Layer, U32Layer, load_u32_layers, save_exr_with_float_layers};
 use illum_scene::Scene;
 
+use crate::estimators::{Estimators, KeyMismatch, compare_key};
 use crate::{Accumulator, PathTracer, TracerOptions};
 pub use error::CheckpointError;
 pub use layers::statistics_layer;
@@ -171,6 +172,41 @@ impl CheckpointHeader {
         start..start + u64::from(self.spp_done)
     }
 
+    /// Checks that these samples were rendered from `scene` with `options`: an error naming
+    /// every difference (content hash, resolution, bounces, seed, sampling, sequence, caustics
+    /// and their estimators), with both values. The scene is known by its content
+    /// (`illum.scene_hash`), not its name: a scene renamed, or a comment edited, goes on.
+    pub fn check_matches(
+        &self,
+        path: &Path,
+        scene: &Scene,
+        options: TracerOptions,
+    ) -> Result<(), CheckpointError> {
+        let mut differences: Vec<String> =
+            check_estimators(path, self, &Estimators::of(scene))?.into_iter().collect();
+        for (key, now) in image_settings(scene, options) {
+            let then = self.setting(key);
+            if then.as_deref() != Some(now.as_str()) {
+                differences.push(if key == "scene_hash" {
+                    format!(
+                        "scene content (camera, materials, objects, lights; illum.scene_hash): {} ({:?}) in the file, \
+                         {now} ({:?}) now",
+                        shown(then.as_deref()),
+                        self.metadata.scene,
+                        scene.name
+                    )
+                } else {
+                    format!("{key}: {} in the file, {} now", shown(then.as_deref()), shown(Some(&now)))
+                });
+            }
+        }
+        if differences.is_empty() {
+            Ok(())
+        } else {
+            Err(CheckpointError::OtherSettings { path: path.to_path_buf(), differences })
+        }
+    }
+
     /// The value of a setting in the file; width and height come from the image itself.
     fn setting(&self, key: &str) -> Option<String> {
         match key {
@@ -179,19 +215,28 @@ impl CheckpointHeader {
             "scene" => Some(self.metadata.scene.clone()),
             // A file without the key was rendered without the caustic's light tracer.
             "caustics" => Some(self.metadata.get(key).unwrap_or("off").to_owned()),
-            // A file without the key was rendered before the photon gather: with the light
-            // tracer alone where the caustic was on.
-            "caustic_estimators" => Some(self.metadata.get(key).map_or_else(
-                || {
-                    if self.setting("caustics").as_deref() == Some("on") { "light tracer" } else { "none" }
-                        .to_owned()
-                },
-                str::to_owned,
-            )),
             // A file without the key has no glint in its means.
             "glint" => Some(self.metadata.get(key).unwrap_or("none").to_owned()),
             _ => self.metadata.get(key).map(str::to_owned),
         }
+    }
+}
+
+/// Longest value a refusal shows whole: every setting's but a glint's (the caustic estimators'
+/// description is about 160 characters).
+const SHOWN_CHARS: usize = 200;
+
+/// A setting's value as a refusal shows it: whole when short, else its start and its length
+/// (an `illum.glint` value holds thousands of characters, and only its difference matters).
+fn shown(value: Option<&str>) -> String {
+    match value {
+        None => "(missing)".to_owned(),
+        Some(v) if v.chars().count() <= SHOWN_CHARS => v.to_owned(),
+        Some(v) => format!(
+            "{}... ({} characters)",
+            v.chars().take(SHOWN_CHARS).collect::<String>(),
+            v.chars().count()
+        ),
     }
 }
 
@@ -233,6 +278,14 @@ fn header_fields(
             "only path-traced images can be continued",
         ));
     }
+    if let Some(denoiser) = metadata.get("denoiser") {
+        return Err(invalid(
+            "denoiser",
+            denoiser.to_owned(),
+            "a denoised image is not a checkpoint: it holds the denoised pixels, not the sums of the samples a \
+             render goes on from, so it cannot be continued or merged (render again with a larger --spp)",
+        ));
+    }
     if let Some(adaptive) = metadata.get("adaptive").filter(|a| *a != "off") {
         return Err(invalid(
             "adaptive",
@@ -252,7 +305,12 @@ fn header_fields(
 }
 
 fn unreadable(path: &Path, error: &illum_image::ImageError) -> CheckpointError {
-    CheckpointError::Unreadable { path: path.to_path_buf(), reason: with_causes(error) }
+    match error {
+        illum_image::ImageError::BadContent { reason, .. } => {
+            CheckpointError::NotAnExr { path: path.to_path_buf(), reason: reason.clone() }
+        }
+        _ => CheckpointError::Unreadable { path: path.to_path_buf(), reason: with_causes(error) },
+    }
 }
 
 fn no_statistics(path: &Path) -> CheckpointError {
@@ -341,10 +399,29 @@ pub fn image_settings(scene: &Scene, options: TracerOptions) -> Vec<(&'static st
         ("seed", scene.pathtrace.seed.to_string()),
         ("sampling", scene.pathtrace.sampling.to_string()),
         ("sequence", options.sequence.to_string()),
-        ("caustics", crate::gpu_scene::caustics_label(scene).to_owned()),
-        // Which estimators own the caustic's paths: samples of another set hold other light.
-        ("caustic_estimators", crate::gpu_scene::caustic_estimators(scene)),
+        ("caustics", Estimators::of(scene).caustics_label().to_owned()),
     ]
+}
+
+/// Checks that the file at `path` (its `header`) was made by the estimators `now` names, by the
+/// same rules (`estimators.rs`): samples of another set hold other light. A file that names its
+/// estimators in an older form (the sentence of `illum.caustic_estimators`, or no key) is
+/// refused with that reason; one whose tokens differ gives the difference to report beside the
+/// other settings that differ.
+pub(crate) fn check_estimators(
+    path: &Path,
+    header: &CheckpointHeader,
+    now: &Estimators,
+) -> Result<Option<String>, CheckpointError> {
+    let stored = header.metadata.get(crate::metadata::ESTIMATORS);
+    let legacy = header.metadata.get(crate::metadata::LEGACY_ESTIMATORS);
+    match compare_key(stored, legacy, now) {
+        Ok(()) => Ok(None),
+        Err(mismatch @ KeyMismatch::OlderForm { .. }) => {
+            Err(CheckpointError::OlderEstimators { path: path.to_path_buf(), reason: mismatch.to_string() })
+        }
+        Err(mismatch) => Ok(Some(format!("{}: {mismatch}", crate::metadata::ESTIMATORS))),
+    }
 }
 
 impl Checkpoint {
@@ -357,38 +434,6 @@ impl Checkpoint {
             spp_done: self.spp_done,
             sample_start: self.sample_start,
             partial_pass: self.partial_pass,
-        }
-    }
-
-    /// Checks that this checkpoint was rendered from `scene` with `options`: an error naming
-    /// every difference (scene name, content hash, resolution, bounces, seed, sampling,
-    /// sequence, caustics and their estimators), with both values.
-    pub fn check_matches(
-        &self,
-        path: &Path,
-        scene: &Scene,
-        options: TracerOptions,
-    ) -> Result<(), CheckpointError> {
-        let header = self.header();
-        let mut differences = Vec::new();
-        if self.metadata.scene != scene.name {
-            differences.push(format!("scene: {:?} in the file, {:?} now", self.metadata.scene, scene.name));
-        }
-        for (key, now) in image_settings(scene, options) {
-            let then = header.setting(key).unwrap_or_else(|| "(missing)".to_owned());
-            if then != now {
-                let what = if key == "scene_hash" {
-                    "scene content (camera, materials, objects: the file was edited)".to_owned()
-                } else {
-                    key.to_owned()
-                };
-                differences.push(format!("{what}: {then} in the file, {now} now"));
-            }
-        }
-        if differences.is_empty() {
-            Ok(())
-        } else {
-            Err(CheckpointError::OtherSettings { path: path.to_path_buf(), differences })
         }
     }
 
@@ -409,6 +454,41 @@ mod tests {
             scene: "cornell".to_owned(),
             render_seconds: 1.0,
             fields: fields.iter().map(|&(k, v)| (k.to_owned(), v.to_owned())).collect(),
+        }
+    }
+
+    /// A checkpoint is of a scene by content: renamed, it goes on; of edited content, it is
+    /// refused naming both hashes and both names.
+    #[test]
+    fn a_renamed_scene_resumes_and_other_content_is_refused_by_hash_and_name() {
+        let mut scene = Scene::load(&illum_scene::resolve_scene_path(Path::new("scenes/cornell.toml")))
+            .expect("the Cornell box");
+        let options = TracerOptions::default();
+        let header = |scene: &Scene| CheckpointHeader {
+            metadata: ExrMetadata {
+                scene: scene.name.clone(),
+                ..metadata(
+                    &image_settings(scene, options)
+                        .iter()
+                        .map(|(k, v)| (*k, v.as_str()))
+                        .filter(|(k, _)| !matches!(*k, "width" | "height"))
+                        .collect::<Vec<_>>(),
+                )
+            },
+            width: scene.camera.width,
+            height: scene.camera.height,
+            spp_done: 16,
+            sample_start: 0,
+            partial_pass: None,
+        };
+        let file = header(&scene);
+        scene.name = "cornell-renamed".to_owned();
+        assert!(file.check_matches(Path::new("long.exr"), &scene, options).is_ok());
+        scene.camera.vfov_deg += 1.0;
+        let error = file.check_matches(Path::new("long.exr"), &scene, options).unwrap_err().to_string();
+        let (then, now) = (file.metadata.get("scene_hash").unwrap(), crate::metadata::scene_hash(&scene));
+        for part in ["long.exr", "illum.scene_hash", then, &now, "\"cornell\"", "\"cornell-renamed\""] {
+            assert!(error.contains(part), "the refusal lacks {part:?}: {error}");
         }
     }
 
@@ -443,6 +523,15 @@ mod tests {
         let error = header_fields(path, metadata(&adaptive), 4, 4).unwrap_err().to_string();
         assert!(
             error.starts_with("out/part.exr: illum.adaptive = \"8x8 blocks\": must be \"off\""),
+            "{error}"
+        );
+
+        let mut denoised = good.to_vec();
+        denoised.push(("denoiser", "atrous"));
+        denoised[1].1 = "0 and 2147483648 (two halves)";
+        let error = header_fields(path, metadata(&denoised), 4, 4).unwrap_err().to_string();
+        assert!(
+            error.starts_with("out/part.exr: illum.denoiser = atrous: a denoised image is not a checkpoint"),
             "{error}"
         );
 

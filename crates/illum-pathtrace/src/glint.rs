@@ -1,5 +1,4 @@
-//! The sun's glint, E S* L with a delta sun, solved on the host in f64 (docs/caustics.md,
-//! "The sun's glint").
+//! The sun's glint, E S* L with a delta sun, solved on the host in f64 (docs/glint.md).
 //!
 //! A delta sun sends radiance only along one direction w (toward the sun). A specular chain
 //! from the eye (mirror reflections, glass reflections and refractions) maps the film point s to
@@ -73,7 +72,7 @@ pub struct GlintPoint {
 
 /// Scatterings a chain may have when the bounces are unbounded (the path tracer's Russian
 /// roulette has no limit; chains beyond this carry less than [`MIN_THROUGHPUT`] in the scenes
-/// measured, docs/caustics.md).
+/// measured, docs/glint.md).
 pub const UNBOUNDED_SCATTERINGS: usize = 32;
 
 /// Branches whose throughput falls below this (in every channel) are not followed: their glint
@@ -84,7 +83,7 @@ pub const MIN_THROUGHPUT: f64 = 1e-12;
 /// (`[pathtrace] caustics = true`, a directional light and a specular object) and the sun is a
 /// delta light (a sun disc is found by the camera paths themselves).
 pub fn glint_active(scene: &Scene) -> bool {
-    crate::gpu_scene::caustics_active(scene) && scene.directional_light.is_some_and(|l| l.is_delta())
+    crate::estimators::Estimators::of(scene).glint()
 }
 
 /// The glints of `scene` (empty when [`glint_active`] is false), sorted by pixel.

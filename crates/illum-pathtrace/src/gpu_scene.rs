@@ -4,7 +4,7 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
-use illum_scene::{Bounces, Feature, MaterialKind, RendererKind, Scene, Shape};
+use illum_scene::{Bounces, Feature, RendererKind, Scene, Shape};
 
 use illum_rtcore::{CameraRecord, Geometry, MaterialRecord, ObjectRecord, ordered_objects};
 
@@ -156,41 +156,6 @@ impl GpuScene {
         let code = SceneCode::new(scene, lights.len());
         Ok(Self { geometry: Geometry::new(scene), materials, lights, light_area, code, radiance_exponent })
     }
-}
-
-/// Whether the caustic's light tracer runs for `scene`: `[pathtrace] caustics = true`, a
-/// directional light, and a mirror or dielectric object that can send its light onward.
-pub fn caustics_active(scene: &Scene) -> bool {
-    scene.pathtrace.caustics
-        && scene.directional_light.is_some()
-        && scene.objects.iter().any(|o| {
-            matches!(scene.material_of(o).kind, MaterialKind::Mirror { .. } | MaterialKind::Dielectric { .. })
-        })
-}
-
-/// Which estimators beyond the camera paths `scene`'s image has, and the photon gather's
-/// radius rule: what a cached image of the scene (the ladder's truth) or a checkpoint must have
-/// been made with to be reused or resumed, as an image made before the gather lacks the caustic
-/// seen in the mirror, and one made with the gather at the first diffuse vertex alone lacks the
-/// caustic's light scattered again by a diffuse surface (E (S|D)* D S* D S+ L).
-pub fn caustic_estimators(scene: &Scene) -> String {
-    let code = SceneCode::new(scene, 0);
-    let estimators = match (code.caustic, code.caustic_gather) {
-        (false, _) => "none".to_owned(),
-        (true, false) => "light tracer".to_owned(),
-        (true, true) => format!(
-            "light tracer and photon gather at every diffuse vertex but the camera's own hit (r_1 = {} x the \
-             largest specular radius, r_k = r_1 (k + 1)^(-1/6))",
-            crate::tracer::GATHER_RADIUS_FRACTION
-        ),
-    };
-    // The sun's glint E S* L, solved on the host (glint.rs): an image without it lacks that light.
-    if crate::glint::glint_active(scene) { format!("{estimators}; glint solved") } else { estimators }
-}
-
-/// `on` or `off`: [`caustics_active`] as EXR metadata and checkpoints store it.
-pub fn caustics_label(scene: &Scene) -> &'static str {
-    if caustics_active(scene) { "on" } else { "off" }
 }
 
 impl GpuScene {

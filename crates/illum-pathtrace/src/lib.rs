@@ -3,7 +3,8 @@
 //! A WGSL compute shader (`shaders/pathtrace.wgsl`) traces paths over the scene's
 //! analytic boxes, quads and spheres with next-event estimation on rectangular lights and the
 //! sun; a second compute shader (`caustic.wgsl`, only with `[pathtrace] caustics = true`) traces
-//! the caustic from the sun (`tracer/caustic.rs`, docs/caustics.md). The host
+//! the caustic from the sun (`tracer/caustic.rs`, docs/caustics.md); which estimators run for a
+//! scene is decided in one place ([`estimators`]). The host
 //! side here uploads the scene ([`gpu_scene`]), composes the pipeline ([`shaders`], with a
 //! traversal generated per scene by [`specialise`]), checks the device's limits ([`limits`]),
 //! plans short GPU submissions ([`planner`]), and folds each batch's f32 sums into f64
@@ -14,10 +15,12 @@
 pub mod accumulator;
 pub mod allocation;
 mod batch;
+pub mod bindings;
 pub mod checkpoint;
 pub mod display_sum;
 mod error;
 pub mod error_map;
+pub mod estimators;
 pub mod glint;
 pub mod gpu_scene;
 pub mod limits;
@@ -25,6 +28,7 @@ pub mod metadata;
 mod options;
 pub mod planner;
 pub mod progressive;
+pub mod reference;
 pub mod replicates;
 pub mod shaders;
 pub mod specialise;
@@ -35,7 +39,8 @@ pub use allocation::SampleAllocation;
 pub use batch::{CHUNK_SAMPLES, SLOT_BYTES};
 pub use display_sum::{DISPLAY_PIXEL_BYTES, DISPLAY_SUM_SHADER};
 pub use error::PathTraceError;
-pub use gpu_scene::{caustic_estimators, implements};
+pub use estimators::{Estimator, Estimators};
+pub use gpu_scene::implements;
 pub use illum_scene::Sequence;
 pub use options::{TracerOptions, Traversal};
 pub use progressive::{

@@ -5,6 +5,7 @@
 use illum_image::ExrMetadata;
 use illum_scene::Scene;
 
+use crate::estimators::Estimators;
 use crate::{PathTracer, StopReason};
 
 /// The renderer name path-traced images carry (`illum.renderer`).
@@ -14,50 +15,17 @@ pub const RENDERER: &str = "pathtrace";
 /// last sample index), written by the `render` example beside `sample_start`.
 pub const SAMPLE_END: &str = "sample_end";
 
+/// The field of the estimators' token list ([`Estimators::key`]).
+pub const ESTIMATORS: &str = "estimators";
+
+/// The field in which files before the token list named their caustic's estimators by a sentence.
+pub const LEGACY_ESTIMATORS: &str = "caustic_estimators";
+
 /// The scene's identity as files store it (`illum.scene_hash`): [`Scene::content_hash`] in 16
 /// hex digits. It covers the scene's physical content, not the settings (resolution, bounces,
 /// seed, ...), which files store and compare one by one.
 pub fn scene_hash(scene: &Scene) -> String {
     format!("{:016x}", scene.content_hash())
-}
-
-/// Why an image of `reference_size` pixels with `metadata`, read from `path`, cannot be the
-/// truth of a render of `scene` at its camera's size: no `illum.scene_hash` to tell its scene
-/// by, another scene content (the hash covers the camera, materials, objects and lights, no
-/// settings), or another size (`size_advice` says what to change). `None`: it can.
-pub fn reference_refusal(
-    path: &std::path::Path,
-    metadata: Option<&ExrMetadata>,
-    reference_size: [u32; 2],
-    scene: &Scene,
-    size_advice: &str,
-) -> Option<String> {
-    let Some(hash) = metadata.and_then(|m| m.get("scene_hash")) else {
-        return Some(format!(
-            "--reference {}: the file has no illum.scene_hash, so it cannot be told to be of scene {:?}; \
-             give a path-traced EXR that `render` wrote",
-            path.display(),
-            scene.name
-        ));
-    };
-    let ours = scene_hash(scene);
-    if hash != ours {
-        let theirs = metadata.map_or("?", |m| m.scene.as_str());
-        return Some(format!(
-            "--reference {}: it is of scene {theirs:?} (illum.scene_hash {hash}), but this render is of scene {:?} \
-             (illum.scene_hash {ours}): a reference must show the same camera, materials, objects and lights",
-            path.display(),
-            scene.name
-        ));
-    }
-    let (w, h) = (scene.camera.width, scene.camera.height);
-    let [rw, rh] = reference_size;
-    ((rw, rh) != (w, h)).then(|| {
-        format!(
-            "--reference {}: it is {rw} x {rh} pixels, but this render is {w} x {h}: {size_advice}",
-            path.display()
-        )
-    })
 }
 
 /// Metadata for the tracer's current image. Keys (each stored as `illum.<key>`):
@@ -94,8 +62,8 @@ pub fn exr_metadata(
         ("seed", scene.pathtrace.seed.to_string()),
         ("sampling", scene.pathtrace.sampling.to_string()),
         ("sequence", tracer.options().sequence.to_string()),
-        ("caustics", crate::gpu_scene::caustics_label(scene).to_owned()),
-        ("caustic_estimators", crate::gpu_scene::caustic_estimators(scene)),
+        ("caustics", Estimators::of(scene).caustics_label().to_owned()),
+        (ESTIMATORS, Estimators::of(scene).key()),
         ("glint", glint_field(accumulator.glint())),
         ("estimated_relative_error", accumulator.estimated_relative_error().to_string()),
         ("dropped_samples", accumulator.dropped_samples().to_string()),

@@ -9,7 +9,7 @@
 pub const DEFAULT_TARGET_SECONDS: f64 = 0.15;
 
 /// Samples in the first, measuring submission (before any cost is known).
-const PROBE_SAMPLES: u64 = 16 * 1024;
+pub(crate) const PROBE_SAMPLES: u64 = 16 * 1024;
 
 #[derive(Clone, Debug)]
 pub struct BatchPlanner {
@@ -38,6 +38,16 @@ impl BatchPlanner {
     /// changes).
     pub fn set_target_seconds(&mut self, seconds: f64) {
         self.target_seconds = seconds;
+    }
+
+    /// The wall time aimed at per submission.
+    pub fn target_seconds(&self) -> f64 {
+        self.target_seconds
+    }
+
+    /// The learnt wall seconds per sample, once measured.
+    pub fn seconds_per_sample(&self) -> Option<f64> {
+        self.seconds_per_sample
     }
 
     /// With `Some(cap)`, a pass of the smallest spp is one submission over the whole image

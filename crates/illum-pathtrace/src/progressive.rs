@@ -75,10 +75,11 @@ impl StopRules {
     /// How far the render is toward the rule that will stop it first: the largest fraction
     /// among the rules given (`None` when no rule is given). For the error rule the fraction is
     /// (target / error)^2, the share of the samples needed that are done, since the error falls
-    /// as 1 / sqrt(samples). The spp rule's fraction is of `pixels` x spp samples, or with
-    /// adaptive sampling of `adaptive_samples`, its allocation's total (the pixels do not all
-    /// take `spp`, which is then the largest block count).
-    pub fn progress(&self, status: &Status, pixels: u64, adaptive_samples: Option<u64>) -> Option<Progress> {
+    /// as 1 / sqrt(samples). The spp rule's fraction is of spp, counting the pass in progress by
+    /// its share done, or with adaptive sampling of `adaptive_samples`, its allocation's total (the
+    /// pixels do not all take `spp`, which is then the largest block count). The time rule's is
+    /// at most the first pass's share until that pass is complete, since the rule waits for it.
+    pub fn progress(&self, status: &Status, adaptive_samples: Option<u64>) -> Option<Progress> {
         let mut best: Option<Progress> = None;
         let mut consider = |rule: Rule, fraction: f64| {
             let fraction = if fraction.is_finite() { fraction.clamp(0.0, 1.0) } else { 0.0 };
@@ -87,9 +88,17 @@ impl StopRules {
             }
         };
         if let Some(spp) = self.spp {
-            // Samples, not complete passes, so the bar moves within a long pass.
-            let planned = adaptive_samples.unwrap_or(pixels.max(1) * u64::from(spp.max(1)));
-            consider(Rule::Spp, status.samples as f64 / planned.max(1) as f64);
+            // Within a long pass, not by complete passes alone, so the bar moves: by the pass's
+            // share done (its caustic frames count, which hold no samples until its bands fold),
+            // or with adaptive sampling by the samples of its allocation.
+            let fraction = match adaptive_samples {
+                Some(planned) => status.samples as f64 / planned.max(1) as f64,
+                None => {
+                    let done = f64::from(status.spp_done) + status.pass_fraction * f64::from(status.pass_spp);
+                    done / f64::from(spp.max(1))
+                }
+            };
+            consider(Rule::Spp, fraction);
         }
         if let Some(target) = self.target_error {
             let fraction =
@@ -97,7 +106,12 @@ impl StopRules {
             consider(Rule::Error, fraction);
         }
         if let Some(budget) = self.time_budget {
-            consider(Rule::Time, status.elapsed.as_secs_f64() / budget.as_secs_f64().max(1e-9));
+            let spent = status.elapsed.as_secs_f64() / budget.as_secs_f64().max(1e-9);
+            // The time rule waits for the first complete pass: until then the render is as far
+            // as that pass, if that is less (a bar at 100% with an ETA of 0 s for a first pass
+            // that still runs would say the render is over).
+            let fraction = if status.spp_done == 0 { spent.min(status.pass_fraction) } else { spent };
+            consider(Rule::Time, fraction);
         }
         best
     }
@@ -206,8 +220,13 @@ pub struct Status {
     pub run_samples: u64,
     /// Wall-clock time of the render ([`RenderClock`]).
     pub elapsed: Duration,
-    /// The estimated relative error after the last completed pass, once it has 2 spp.
+    /// The estimated relative error after the last completed pass, once there are samples
+    /// enough to estimate it ([`crate::Accumulator::spp_for_error_estimate`]).
     pub relative_error: Option<f64>,
+    /// Samples per pixel of the pass in progress (0: none), and the share of its work done, in
+    /// [0, 1] ([`PathTracer::pass_fraction`]).
+    pub pass_spp: u32,
+    pub pass_fraction: f64,
 }
 
 impl Status {
@@ -334,18 +353,15 @@ impl Progressive {
             run_samples: tracer.accumulator().total_samples().saturating_sub(self.start_samples.unwrap_or(0)),
             elapsed: self.clock.elapsed(),
             relative_error: self.relative_error,
+            pass_spp: tracer.partial_pass().map_or(0, |(spp, _)| spp),
+            pass_fraction: tracer.pass_fraction(),
         }
     }
 
     /// Progress toward the nearest rule.
     pub fn progress(&self, tracer: &PathTracer) -> Option<Progress> {
-        let camera = tracer.scene().camera;
         let adaptive_samples = tracer.sample_allocation().map(crate::SampleAllocation::total);
-        self.rules.progress(
-            &self.status(tracer),
-            u64::from(camera.width) * u64::from(camera.height),
-            adaptive_samples,
-        )
+        self.rules.progress(&self.status(tracer), adaptive_samples)
     }
 
     /// Checks the rules, and when none holds runs one submission. Returns why the render
@@ -369,20 +385,38 @@ impl Progressive {
         if self.stopped.is_some() {
             // The render is over: its time stands.
             self.clock.pause();
+            // Stopped inside a pass, the image holds more samples than its complete passes: its
+            // error is that of the image as written (what a summary and the file report), not the
+            // last complete pass's.
+            if tracer.partial_pass().is_some() {
+                self.error_at_spp = u32::MAX;
+                self.refresh_error(tracer);
+            }
         }
         Ok(self.stopped)
     }
 
     fn refresh_error(&mut self, tracer: &PathTracer) {
         let spp = tracer.spp_done();
-        if spp != self.error_at_spp || (self.relative_error.is_none() && spp >= 2) {
+        let accumulator = tracer.accumulator();
+        let known = spp >= accumulator.spp_for_error_estimate();
+        if spp != self.error_at_spp || (self.relative_error.is_none() && known) {
             self.error_at_spp = spp;
-            let accumulator = tracer.accumulator();
-            self.relative_error = (spp >= 2).then(|| match &self.error_scope {
+            self.relative_error = known.then(|| match &self.error_scope {
                 ErrorScope::Image => accumulator.estimated_relative_error(),
                 scope => crate::error_map::ErrorMap::of(accumulator).error(scope),
             });
         }
+    }
+}
+
+/// An estimated relative error as every front end writes it (the CLI's progress line and summary,
+/// the viewer's panel), so that they agree at the same spp: a percentage with 2 decimals, or, when there is none yet,
+/// the spp it needs ([`crate::Accumulator::spp_for_error_estimate`]).
+pub fn error_text(error: Option<f64>, needs_spp: u32) -> String {
+    match error {
+        Some(e) => format!("{:.2}%", e * 100.0),
+        None => format!("unknown until {needs_spp} spp"),
     }
 }
 
@@ -423,6 +457,12 @@ pub fn render_progressive_over(
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn an_error_is_a_percentage_or_unknown_until_the_spp_it_needs() {
+        assert_eq!(super::error_text(Some(0.012_345), 2), "1.23%");
+        assert_eq!(super::error_text(None, 8), "unknown until 8 spp");
+    }
+
     use super::*;
 
     fn status(spp_done: u32, seconds: f64, error: Option<f64>) -> Status {
@@ -432,6 +472,8 @@ mod tests {
             run_samples: 0,
             elapsed: Duration::from_secs_f64(seconds),
             relative_error: error,
+            pass_spp: 0,
+            pass_fraction: 0.0,
         }
     }
 
@@ -470,20 +512,45 @@ mod tests {
             time_budget: Some(Duration::from_secs(4)),
         };
         let s = Status { samples: 10 * 100, ..status(10, 1.0, Some(0.04)) };
-        let p = rules.progress(&s, 100, None).unwrap();
+        let p = rules.progress(&s, None).unwrap();
         assert_eq!(p.rule, Rule::Time);
         assert!((p.fraction - 0.25).abs() < 1e-12);
         assert!((p.eta(s.elapsed).unwrap().as_secs_f64() - 3.0).abs() < 1e-9);
         let s = status(10, 1.0, Some(0.011));
-        let p = rules.progress(&s, 100, None).unwrap();
+        let p = rules.progress(&s, None).unwrap();
         assert_eq!(p.rule, Rule::Error);
         assert!((p.fraction - (0.01f64 / 0.011).powi(2)).abs() < 1e-12);
-        assert_eq!(StopRules::default().progress(&s, 100, None), None);
+        assert_eq!(StopRules::default().progress(&s, None), None);
         // Adaptive sampling: the spp rule's target is the blocks' largest count, and its
         // progress the share of the allocation's samples taken.
         let rules = StopRules { spp: Some(4000), ..Default::default() };
         let s = Status { samples: 50_000, ..status(900, 1.0, None) };
-        assert!((rules.progress(&s, 100, Some(100_000)).unwrap().fraction - 0.5).abs() < 1e-12);
+        assert!((rules.progress(&s, Some(100_000)).unwrap().fraction - 0.5).abs() < 1e-12);
+    }
+
+    /// The bar moves within a pass whose first part holds no samples (the caustic's frames),
+    /// and the time rule, which waits for the first complete pass, is never further along than
+    /// that pass: not at 100% with an ETA of 0 s while the render goes on.
+    #[test]
+    fn progress_moves_within_a_pass_and_the_time_rule_waits_for_the_first() {
+        let first_pass = |seconds: f64, share: f64| Status {
+            pass_spp: 16,
+            pass_fraction: share,
+            ..status(0, seconds, None)
+        };
+        let spp = StopRules { spp: Some(32), ..Default::default() };
+        assert_eq!(spp.progress(&first_pass(3.0, 0.25), None).unwrap().fraction, 0.125);
+        let after = Status { pass_spp: 16, pass_fraction: 0.5, ..status(16, 9.0, None) };
+        assert_eq!(spp.progress(&after, None).unwrap().fraction, 0.75);
+        let time = StopRules { time_budget: Some(Duration::from_secs(5)), ..Default::default() };
+        let p = time.progress(&first_pass(8.0, 0.8), None).unwrap();
+        assert_eq!((p.rule, p.fraction), (Rule::Time, 0.8));
+        assert!((p.eta(Duration::from_secs(8)).unwrap().as_secs_f64() - 2.0).abs() < 1e-9);
+        let p = time.progress(&first_pass(1.0, 0.8), None).unwrap();
+        assert!((p.fraction - 0.2).abs() < 1e-12, "the budget is then the nearer end");
+        // Once a pass is complete the budget alone counts.
+        let p = time.progress(&Status { pass_fraction: 0.1, ..status(16, 4.0, None) }, None).unwrap();
+        assert!((p.fraction - 0.8).abs() < 1e-12);
     }
 
     #[test]

@@ -39,7 +39,7 @@
 /// Independently randomised copies of the low-discrepancy sequence per pixel. R replicates of
 /// N / R points each have more error than one sequence of N points, since the sequence's
 /// advantage grows with its length; more replicates give a steadier per-pixel estimate (R - 1
-/// degrees of freedom). Measured on the 64 x 64 Cornell box (docs/accuracy.md), relMSE over that
+/// degrees of freedom). Measured on the 64 x 64 Cornell box (docs/accuracy-estimate.md), relMSE over that
 /// of one sequence at 64 / 256 / 1024 / 4096 spp: R = 4: 2.0 / 1.35 / 1.22 / 0.99; R = 8: 2.1 /
 /// 2.1 / 1.56 / 1.16. 4 keeps most of the sequence's gain, with 3 degrees of freedom per pixel
 /// (a per-pixel variance within about 82% relative, one standard deviation; the image's

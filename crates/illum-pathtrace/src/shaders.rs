@@ -51,6 +51,7 @@ pub const SAMPLING_MODULES: &[ShaderFile] = &[
 pub fn shader_modules(scene: &Scene, gpu_scene: &GpuScene, traversal: Traversal) -> Vec<ShaderFile> {
     let mut modules = SAMPLING_MODULES.to_vec();
     modules.extend(illum_rtcore::shaders::core_modules());
+    modules.push(crate::bindings::bindings_module());
     modules.push(SCENE_MODULE);
     match traversal {
         Traversal::Generic => modules.extend([GENERIC_MATERIALS, GENERIC_TRAVERSAL, GENERIC_LIGHT_CHOICE]),
@@ -119,7 +120,7 @@ mod tests {
 
     use illum_gpu::members;
     use illum_gpu::shader::wgsl_struct;
-    use illum_scene::{RendererKind, Sequence};
+    use illum_scene::{DirectionalLight, RendererKind, Sequence};
 
     use super::*;
     use crate::display_sum::DISPLAY_SUM_SHADER;
@@ -152,7 +153,58 @@ mod tests {
     ) -> naga::Module {
         let module = shader::compose(modules, entry, defs).unwrap_or_else(|e| panic!("{e}"));
         shader::validate(&module, &entry.path).unwrap_or_else(|e| panic!("{e}"));
+        // Every pipeline composed of the path tracer's modules binds by the table.
+        if !modules.is_empty() {
+            check_bindings(&module, &format!("{} with {defs:?}", entry.path));
+        }
         module
+    }
+
+    /// The composed pipeline's bindings are all in group 0, no two share a number, and each
+    /// variable has the number the table gives it (bindings.rs), which the host binds it at.
+    fn check_bindings(module: &naga::Module, what: &str) {
+        use crate::bindings::Binding;
+        let mut seen = std::collections::HashMap::new();
+        for (_, variable) in module.global_variables.iter() {
+            let Some(binding) = &variable.binding else { continue };
+            // naga_oil names an imported module's items NAME + "X_naga_oil_mod_X" + its path.
+            let full = variable.name.as_deref().unwrap_or_default();
+            let name = full.split("X_naga_oil_mod_X").next().unwrap_or_default();
+            assert_eq!(binding.group, 0, "{what}: {name} is in group {}", binding.group);
+            if let Some(other) = seen.insert(binding.binding, name.to_owned()) {
+                panic!("{what}: {name} and {other} share binding {}", binding.binding);
+            }
+            let expected = Binding::ALL
+                .iter()
+                .find(|b| b.variable() == name)
+                .unwrap_or_else(|| panic!("{what}: {name} is bound but not in the bindings table"));
+            assert_eq!(binding.binding, expected.index(), "{what}: {name}");
+        }
+        assert!(seen.values().any(|n| n == "params"), "{what}: no bindings found (names {seen:?})");
+    }
+
+    /// The check above fails a pipeline whose module declares a binding outside the table, or
+    /// a variable at another number than the table gives it, or two variables at one number
+    /// (as the light tracer's parameters and adaptive sampling's
+    /// counts did, both at 6). naga refuses a collision only between variables one entry point
+    /// uses; here the second is declared and unused, as a module's are under another def.
+    #[test]
+    fn the_binding_check_fails_a_collision_and_an_unknown_binding() {
+        let entry = |body: &str| {
+            ShaderFile::generated(
+                "bindings.wgsl".into(),
+                format!("{body}\n@compute @workgroup_size(1)\nfn main() {{ let x = params; }}\n"),
+            )
+        };
+        for body in [
+            "@group(0) @binding(0) var<uniform> params: u32;\n@group(0) @binding(0) var<storage, read> objects: array<u32>;",
+            "@group(0) @binding(0) var<uniform> params: u32;\n@group(0) @binding(2) var<storage, read> objects: array<u32>;",
+            "@group(0) @binding(0) var<uniform> params: u32;\n@group(0) @binding(20) var<storage, read> other: array<u32>;",
+        ] {
+            let module = shader::compose(&[], &entry(body), &[]).unwrap_or_else(|e| panic!("{e}"));
+            let failed = std::panic::catch_unwind(|| check_bindings(&module, "a broken pipeline")).is_err();
+            assert!(failed, "accepted: {body}");
+        }
     }
 
     /// naga validates each sampling module on its own (as the import of a trivial entry point),
@@ -212,42 +264,154 @@ mod tests {
         compose_and_validate(&[], &DISPLAY_SUM_SHADER, &[]);
     }
 
-    /// Every consistent combination of the scene code's flags composes and validates, for the
-    /// integrator, the guide buffers and (where the caustic is on) the light tracer and the photon gather, without a GPU: the code behind
-    /// each `#ifdef` is checked before any scene file happens to need it. The generic modules
-    /// make the combinations independent of any one scene's geometry.
+    /// A scene with one object of each material kind, two area lights, a sun and a sky: what
+    /// [`scene_variants`] takes subsets of.
+    const EVERY_KIND: &str = r#"
+        name = "every-kind"
+        [camera]
+        eye = [0.0, 1.0, -5.0]
+        target = [0.0, 1.0, 0.0]
+        up = [0.0, 1.0, 0.0]
+        vfov = 45.0
+        width = 8
+        height = 8
+        [environment]
+        radiance = [0.3, 0.5, 0.9]
+        [directional_light]
+        direction = [-1.0, -2.0, 0.5]
+        irradiance = [3.0, 3.0, 3.0]
+        [materials.board]
+        checker = { even = [0.8, 0.8, 0.0], odd = [0.8, 0.0, 0.0], tile = 0.5 }
+        [materials.glass]
+        dielectric = { ior = 1.5 }
+        [materials.grey]
+        albedo = [0.5, 0.5, 0.5]
+        [materials.lamp]
+        emission = [5.0, 5.0, 5.0]
+        [materials.metal]
+        mirror = { reflectance = [0.9, 0.8, 0.7] }
+        [[objects]]
+        name = "floor"
+        material = "board"
+        quad = { corner = [-5.0, 0.0, -5.0], edge_u = [0.0, 0.0, 10.0], edge_v = [10.0, 0.0, 0.0] }
+        [[objects]]
+        name = "wall"
+        material = "grey"
+        quad = { corner = [-5.0, 0.0, 5.0], edge_u = [10.0, 0.0, 0.0], edge_v = [0.0, 10.0, 0.0] }
+        [[objects]]
+        name = "ball"
+        material = "glass"
+        sphere = { center = [0.0, 1.0, 0.0], radius = 1.0 }
+        [[objects]]
+        name = "mirror ball"
+        material = "metal"
+        sphere = { center = [-2.0, 1.0, 1.0], radius = 0.5 }
+        [[objects]]
+        name = "lamp"
+        material = "lamp"
+        quad = { corner = [-0.5, 4.0, -0.5], edge_u = [1.0, 0.0, 0.0], edge_v = [0.0, 0.0, 1.0] }
+        [[objects]]
+        name = "second lamp"
+        material = "lamp"
+        quad = { corner = [1.5, 4.0, -0.5], edge_u = [1.0, 0.0, 0.0], edge_v = [0.0, 0.0, 1.0] }
+    "#;
+
+    /// Every scene the inputs of [`SceneCode::new`] can describe, up to what it reads: each
+    /// subset of the four surface kinds, 0, 1 or 2 area lights, no sun, a delta sun or a sun
+    /// disc, with and without the sky, the caustic setting on and off, both hemisphere samplings
+    /// and fixed or unbounded bounces.
+    fn scene_variants() -> Vec<Scene> {
+        use illum_scene::{Bounces, Sampling};
+        let base = Scene::from_toml_str(EVERY_KIND, "every-kind.toml").unwrap_or_else(|e| panic!("{e}"));
+        let (surfaces, lamps) = base.objects.split_at(4);
+        let mut scenes = Vec::new();
+        for subset in 0u32..1 << surfaces.len() {
+            for lamp_count in 0..=lamps.len() {
+                for sun in [None, Some(0.0), Some(0.25)] {
+                    for sky in [false, true] {
+                        for (caustics, uniform, unbounded) in
+                            (0u32..8).map(|b| (b & 1 != 0, b & 2 != 0, b & 4 != 0))
+                        {
+                            let mut scene = base.clone();
+                            scene.objects = (0..surfaces.len())
+                                .filter(|i| subset & (1 << i) != 0)
+                                .map(|i| surfaces[i].clone())
+                                .chain(lamps[..lamp_count].iter().cloned())
+                                .collect();
+                            scene.directional_light = sun.and_then(|radius| {
+                                base.directional_light
+                                    .map(|l| DirectionalLight { angular_radius_deg: radius, ..l })
+                            });
+                            scene.environment = base.environment.filter(|_| sky);
+                            scene.pathtrace.caustics = caustics;
+                            scene.pathtrace.sampling =
+                                if uniform { Sampling::Uniform } else { Sampling::Cosine };
+                            scene.pathtrace.bounces =
+                                if unbounded { Bounces::Unbounded } else { Bounces::Fixed(4) };
+                            scenes.push(scene);
+                        }
+                    }
+                }
+            }
+        }
+        scenes
+    }
+
+    /// Every combination of the scene code's flags that a scene can give composes and
+    /// validates, for the integrator, the guide buffers and (where the caustic is on) the light
+    /// tracer and the photon gather, without a GPU: the code behind each `#ifdef` is checked
+    /// before any scene file happens to need it. The combinations are those [`GpuScene::new`]
+    /// (through [`SceneCode::new`]) derives from every variant of a scene ([`scene_variants`]);
+    /// a scene it refuses (one with no light) has none. The generic modules make the
+    /// combinations independent of any one scene's geometry.
     #[test]
     fn every_combination_of_the_scene_code_validates() {
         let scene = path_tracer_scenes().remove(0);
         let gpu_scene = GpuScene::new(&scene).unwrap_or_else(|e| panic!("{e}"));
         let modules = shader_modules(&scene, &gpu_scene, Traversal::Generic);
         let options = TracerOptions { traversal: Traversal::Generic, ..TracerOptions::default() };
+        let variants = scene_variants();
+        let codes: std::collections::HashSet<SceneCode> =
+            variants.iter().filter_map(|variant| GpuScene::new(variant).ok().map(|g| g.code)).collect();
+        // Each flag is set by some scene and clear in another: the variants reach all the code.
+        // (Destructured in full, so that a new flag must be listed here.)
+        let flags = |c: &SceneCode| {
+            let SceneCode {
+                area_lights,
+                light_choice,
+                sun,
+                sun_disc,
+                sky,
+                specular,
+                checker,
+                caustic,
+                caustic_gather,
+                uniform_sampling,
+                unbounded_bounces,
+            } = *c;
+            [
+                area_lights,
+                light_choice,
+                sun,
+                sun_disc,
+                sky,
+                specular,
+                checker,
+                caustic,
+                caustic_gather,
+                uniform_sampling,
+                unbounded_bounces,
+            ]
+        };
+        for i in 0..11 {
+            assert!(
+                codes.iter().any(|c| flags(c)[i]) && codes.iter().any(|c| !flags(c)[i]),
+                "flag {i} takes one value only in {} scene codes",
+                codes.len()
+            );
+        }
         let mut composed = 0;
-        for bits in 0u32..1 << 11 {
-            let bit = |i: u32| bits & (1 << i) != 0;
-            let code = SceneCode {
-                area_lights: bit(0),
-                light_choice: bit(1),
-                sun: bit(2),
-                sun_disc: bit(3),
-                sky: bit(4),
-                specular: bit(5),
-                checker: bit(6),
-                caustic: bit(7),
-                uniform_sampling: bit(8),
-                unbounded_bounces: bit(9),
-                caustic_gather: bit(10),
-            };
-            // What SceneCode::new can give: a choice among lights needs lights, a disc is a sun,
-            // the caustic needs a sun and a specular object, and something must give light.
-            let consistent = (!code.light_choice || code.area_lights)
-                && (!code.sun_disc || code.sun)
-                && (!code.caustic || (code.sun && code.specular))
-                && (!code.caustic_gather || (code.caustic && !code.sun_disc))
-                && (code.area_lights || code.sun || code.sky);
-            if !consistent {
-                continue;
-            }
+        for &code in &codes {
             let defs = Specialisation { scene: code, options, adaptive: false }.shader_defs();
             compose_and_validate(&modules, &PATHTRACE_SHADER, &defs);
             composed += 1;
@@ -263,6 +427,7 @@ mod tests {
                 composed += 1;
             }
         }
+        println!("{} scene variants, {} scene codes, {composed} compositions", variants.len(), codes.len());
         assert!(composed > 600, "{composed} compositions");
     }
 
@@ -309,7 +474,7 @@ mod tests {
             size_of::<crate::CausticParams>(),
             &members!(crate::CausticParams: particles, row_stride, frame_base, frame_count, num_discs, seed,
                 pixel_area, area_per_particle, scene_centre, scene_radius, fixed_scale, fixed_cap, disc_area, gather_radius,
-                buckets, first_index, padding_b, padding_c),
+                buckets, first_index, index_end, radius_origin),
         );
         wgsl("Light").assert_matches(
             size_of::<GpuLight>(),

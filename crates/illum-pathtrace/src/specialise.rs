@@ -8,7 +8,8 @@ use illum_gpu::shader::{Def, ShaderFile};
 use illum_rtcore::literal::lit;
 use illum_scene::{Bounces, Feature, Sampling, Scene, Sequence};
 
-use crate::gpu_scene::{GpuScene, caustics_active};
+use crate::estimators::Estimators;
+use crate::gpu_scene::GpuScene;
 use crate::options::{TracerOptions, Traversal};
 
 /// What of the scene model a scene's pipeline contains, derived from [`Scene::features`], its
@@ -30,7 +31,7 @@ pub struct SceneCode {
     /// A mirror or a dielectric.
     pub specular: bool,
     pub checker: bool,
-    /// The caustic's light tracer ([`caustics_active`]).
+    /// The caustic's light tracer ([`Estimators::light_tracer`]).
     pub caustic: bool,
     /// ... with the photon gather (E (S|D)* D S+ L but E D S+ L, `shaders/gather.wgsl`): the
     /// caustic with a delta sun and a diffuse surface to gather on.
@@ -54,10 +55,8 @@ impl SceneCode {
             sky: features.contains(Feature::Environment),
             specular: features.any(&[Feature::Mirror, Feature::Dielectric]),
             checker: features.contains(Feature::Checker),
-            caustic: caustics_active(scene),
-            caustic_gather: caustics_active(scene)
-                && features.contains(Feature::DeltaDirectionalLight)
-                && features.any(&[Feature::Lambertian, Feature::Checker]),
+            caustic: Estimators::of(scene).light_tracer(),
+            caustic_gather: Estimators::of(scene).photon_gather(),
             uniform_sampling: scene.pathtrace.sampling == Sampling::Uniform,
             unbounded_bounces: scene.pathtrace.bounces == Bounces::Unbounded,
         }

@@ -32,7 +32,7 @@ mod runner;
 mod submit;
 
 use accumulation::Accumulation;
-pub use caustic::{CausticParams, GATHER_RADIUS_FRACTION, bounding_sphere, fixed_point};
+pub use caustic::{CausticParams, bounding_sphere, fixed_point};
 pub use guides::{GUIDE_SAMPLES_MAX, GUIDE_SAMPLES_MIN, Guides, PendingGuides, guide_samples};
 use pipeline::ScenePipeline;
 use runner::BandRunner;
@@ -231,6 +231,27 @@ impl PathTracer {
         self.accumulation.spp_done
     }
 
+    /// The share of the pass in progress that is done, in [0, 1] (0 without one): its caustic
+    /// frames and its bands' rows, each weighted by its measured cost (alike before they are
+    /// measured). A pass's caustic frames come first and hold no samples until its bands fold,
+    /// so this, not the samples, is how a progress bar moves through them.
+    pub fn pass_fraction(&self) -> f64 {
+        let Some(pass) = self.bands.pass() else { return 0.0 };
+        let height = f64::from(self.pipeline.scene.camera.height.max(1));
+        let rows = (f64::from(pass.next_row) / height).min(1.0);
+        let Some(caustic) = &self.pipeline.caustic else { return rows };
+        let frames = caustic.pass_share(self.caustic_key(pass));
+        let camera = self.pipeline.scene.camera;
+        let pixels = f64::from(camera.width) * f64::from(camera.height);
+        let spp = f64::from(pass.plan.spp);
+        let (caustic_cost, band_cost) =
+            match (caustic.frame_seconds(), self.bands.planner.seconds_per_sample()) {
+                (Some(frame), Some(sample)) => (frame * spp, sample * pixels * spp),
+                _ => (1.0, 1.0),
+            };
+        (caustic_cost * frames + band_cost * rows) / (caustic_cost + band_cost).max(1e-300)
+    }
+
     /// Wall seconds spent in submissions since the last reset.
     pub fn wall_seconds(&self) -> f64 {
         self.accumulation.wall_seconds
@@ -249,12 +270,11 @@ impl PathTracer {
         self.accumulation.gpu_seconds
     }
 
-    /// Sets the wall time aimed at per submission (default 0.15 s). The cost of a sample learnt
-    /// so far is kept, so a viewer may change it every frame. From the first call on, a step
-    /// that traces the caustic's frames traces one dispatch of them, sized to this time too.
+    /// Sets the wall time aimed at per submission (default 0.15 s): the bands of camera paths
+    /// and the caustic's frames (or pieces of one) alike. The costs learnt so far are kept, so a
+    /// viewer may change it every frame.
     pub fn set_target_seconds(&mut self, seconds: f64) {
         self.bands.planner.set_target_seconds(seconds);
-        self.bands.caustic_target_seconds = Some(seconds);
     }
 
     /// With `Some(cap)`, a pass over the whole image is one submission whenever it traces at

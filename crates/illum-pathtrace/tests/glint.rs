@@ -155,7 +155,7 @@ fn the_host_solve_agrees_with_the_oracles_1d_solve_for_every_chain_up_to_4_scatt
                     5e-9
                 } else {
                     // A grazing chain: beta changes as sqrt(rim distance), and differences of
-                    // step 1e-3 pixel no longer resolve it (docs/caustics.md, limits).
+                    // step 1e-3 pixel no longer resolve it (docs/glint.md, "Limits").
                     grazing += 1;
                     1e-2
                 };

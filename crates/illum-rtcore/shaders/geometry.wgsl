@@ -218,7 +218,7 @@ fn surface_quad(obj: Object, p: vec3<f32>) -> Surface {
 // never takes the root at its origin, so no offset off this sphere is needed. An offset of the
 // sphere's error bound, 2^-18 (|centre| + radius), would move the origin of every reflected and
 // refracted ray by that much: 0.076 units on a sphere of radius 10^4, a visible shift of what the
-// sphere reflects (docs/accuracy.md, "Every renderer at the scene's extremes").
+// sphere reflects (docs/extremes.md, "Every renderer at the scene's extremes").
 fn surface_sphere(obj: Object, p: vec3<f32>) -> Surface {
     let centre = obj.a.xyz;
     let radius = obj.a.w;

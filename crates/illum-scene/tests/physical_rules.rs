@@ -12,8 +12,8 @@
 use glam::Vec3;
 use illum_scene::testing::{Edits, edit_once as edit_text, without};
 use illum_scene::{
-    Checker, Effects, Feature, Look, MaterialKind, RendererKind, Scene, SceneError, Sequence, Shading,
-    WhittedSettings,
+    Checker, DielectricShading, Effects, Feature, Look, MaterialKind, MirrorShading, RasterSettings,
+    RendererKind, Scene, SceneError, Sequence, Shading, WhittedSettings,
 };
 
 const FILE: &str = "scenes/phys.toml";
@@ -189,16 +189,25 @@ fn a_dielectric_takes_any_positive_finite_ior() {
 
 #[test]
 fn a_mirror_takes_any_reflectance_from_nothing_to_everything() {
-    for r in ["[0, 0, 0]", "[1, 1, 1]", "[1.0, 0.0, 0.5]"] {
-        accepted("reflectance = [0.9, 0.8, 0.7]", &format!("reflectance = {r}"));
+    for (r, reflectance) in
+        [("[0, 0, 0]", Vec3::ZERO), ("[1, 1, 1]", Vec3::ONE), ("[1.0, 0.0, 0.5]", Vec3::new(1.0, 0.0, 0.5))]
+    {
+        let s = accepted("reflectance = [0.9, 0.8, 0.7]", &format!("reflectance = {r}"));
+        assert_eq!(s.materials[4].kind, MaterialKind::Mirror { reflectance }, "reflectance = {r}");
     }
 }
 
 #[test]
 fn an_emitter_takes_any_non_negative_emission_but_black() {
-    for e in ["[0, 0, 1e-30]", "[1, 0, 0]", "[1e6, 1e6, 1e6]", &format!("[{F32_MAX}, 0, 0]")] {
+    for (e, radiance) in [
+        ("[0, 0, 1e-30]", Vec3::new(0.0, 0.0, 1e-30)),
+        ("[1, 0, 0]", Vec3::X),
+        ("[1e6, 1e6, 1e6]", Vec3::splat(1e6)),
+        (&format!("[{F32_MAX}, 0, 0]") as &str, Vec3::new(f32::MAX, 0.0, 0.0)),
+    ] {
         let s = accepted("emission = [5.0, 5.0, 5.0]", &format!("emission = {e}"));
-        assert!(s.materials[3].is_emitter());
+        assert!(s.materials[3].is_emitter(), "emission = {e}");
+        assert_eq!(s.materials[3].kind, MaterialKind::Emitter { radiance }, "emission = {e}");
     }
 }
 
@@ -207,8 +216,13 @@ fn an_emitter_takes_any_non_negative_emission_but_black() {
 
 #[test]
 fn the_environment_takes_any_non_negative_radiance() {
-    for r in ["[0, 0, 0]", "[100, 0, 0.5]", &format!("[{F32_MAX}, 0, 0]")] {
-        accepted("radiance = [0.3, 0.5, 0.9]", &format!("radiance = {r}"));
+    for (r, radiance) in [
+        ("[0, 0, 0]", Vec3::ZERO),
+        ("[100, 0, 0.5]", Vec3::new(100.0, 0.0, 0.5)),
+        (&format!("[{F32_MAX}, 0, 0]") as &str, Vec3::new(f32::MAX, 0.0, 0.0)),
+    ] {
+        let s = accepted("radiance = [0.3, 0.5, 0.9]", &format!("radiance = {r}"));
+        assert_eq!(s.environment.unwrap().radiance, radiance, "radiance = {r}");
     }
 }
 
@@ -268,15 +282,28 @@ fn word_settings_take_their_words() {
 
 #[test]
 fn raster_numbers_take_their_whole_ranges() {
-    for (from, to) in [
-        ("pcf_radius = 0.1", "pcf_radius = 1e-30"),
-        ("cube_size = 64", "cube_size = 1"),
-        ("cube_size = 64", "cube_size = 4294967295"),
-        ("glass_color = [0.9, 1.0, 0.9]", "glass_color = [0, 0, 0]"),
-        ("glass_reflectivity = 0.5", "glass_reflectivity = 0"),
-        ("glass_reflectivity = 0.5", "glass_reflectivity = 1"),
+    let base = parse(BASE).unwrap().raster;
+    for (from, to, expected) in [
+        ("pcf_radius = 0.1", "pcf_radius = 1e-30", RasterSettings { pcf_radius: 1e-30, ..base }),
+        ("cube_size = 64", "cube_size = 1", RasterSettings { cube_size: 1, ..base }),
+        ("cube_size = 64", "cube_size = 4294967295", RasterSettings { cube_size: u32::MAX, ..base }),
+        (
+            "glass_color = [0.9, 1.0, 0.9]",
+            "glass_color = [0, 0, 0]",
+            RasterSettings { glass_color: Vec3::ZERO, ..base },
+        ),
+        (
+            "glass_reflectivity = 0.5",
+            "glass_reflectivity = 0",
+            RasterSettings { glass_reflectivity: 0.0, ..base },
+        ),
+        (
+            "glass_reflectivity = 0.5",
+            "glass_reflectivity = 1",
+            RasterSettings { glass_reflectivity: 1.0, ..base },
+        ),
     ] {
-        accepted(from, to);
+        assert_eq!(accepted(from, to).raster, expected, "{to}");
     }
 }
 
@@ -294,16 +321,31 @@ fn whitted_depth_and_aa_take_their_whole_ranges() {
 
 #[test]
 fn shading_values_take_their_whole_ranges() {
-    for (from, to) in [
-        ("ambient = [0.1, 0.1, 0.1]", "ambient = [0, 0, 0]"),
-        ("ambient = [0.1, 0.1, 0.1]", "ambient = [2, 2, 2]"), // radiance, not a reflectance
-        ("shininess = 100.0", "shininess = 1e-30"),
-        ("shininess = 100.0", &format!("shininess = {F32_MAX}")),
-        ("specular = [0.9, 0.9, 0.9]", "specular = [0, 1, 0]"),
-        ("weight = 0.4", "weight = 0"),
-        ("weight = 0.4", "weight = 1"),
+    let base = parse(BASE).unwrap().shading;
+    let mirror = base.mirror;
+    for (from, to, expected) in [
+        ("ambient = [0.1, 0.1, 0.1]", "ambient = [0, 0, 0]", Shading { ambient: Vec3::ZERO, ..base }),
+        // Radiance, not a reflectance: above 1 is allowed.
+        ("ambient = [0.1, 0.1, 0.1]", "ambient = [2, 2, 2]", Shading { ambient: Vec3::splat(2.0), ..base }),
+        (
+            "shininess = 100.0",
+            "shininess = 1e-30",
+            Shading { dielectric: DielectricShading { shininess: 1e-30 }, ..base },
+        ),
+        (
+            "shininess = 100.0",
+            &format!("shininess = {F32_MAX}"),
+            Shading { dielectric: DielectricShading { shininess: f32::MAX }, ..base },
+        ),
+        (
+            "specular = [0.9, 0.9, 0.9]",
+            "specular = [0, 1, 0]",
+            Shading { mirror: MirrorShading { specular: Vec3::Y, ..mirror }, ..base },
+        ),
+        ("weight = 0.4", "weight = 0", Shading { mirror: MirrorShading { weight: 0.0, ..mirror }, ..base }),
+        ("weight = 0.4", "weight = 1", Shading { mirror: MirrorShading { weight: 1.0, ..mirror }, ..base }),
     ] {
-        accepted(from, to);
+        assert_eq!(accepted(from, to).shading, expected, "{to}");
     }
 }
 

@@ -373,7 +373,7 @@ impl ViewerApp {
             }),
             RendererKind::Whitted => self.whitted().map(|w| {
                 let ms = w.frame_ms.map_or("n/a".to_owned(), |ms| format!("{ms:.1} ms"));
-                format!("whitted: {} frames rendered, last frame {ms}", w.frames)
+                format!("whitted: {} rendered, last frame {ms}", count(w.frames, "frame", "frames"))
             }),
         };
         let fps = self.frame_rate.fps().map_or("n/a".to_owned(), |f| format!("{f:.1} fps"));
@@ -747,5 +747,20 @@ impl ViewerApp {
         {
             self.open_error = Some(e);
         }
+    }
+}
+
+/// `n` and the noun in the number it takes ("1 frame", "2 frames").
+pub fn count(n: u64, one: &str, many: &str) -> String {
+    format!("{n} {}", if n == 1 { one } else { many })
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn counts_take_the_nouns_number() {
+        assert_eq!(super::count(1, "frame", "frames"), "1 frame");
+        assert_eq!(super::count(0, "frame", "frames"), "0 frames");
+        assert_eq!(super::count(30, "refresh", "refreshes"), "30 refreshes");
     }
 }

@@ -18,17 +18,18 @@ pub struct Args {
     pub scene: PathBuf,
     /// The mode shown first: a renderer, or `auto` (the Auto mode, which shows the renderer it
     /// picks). Default: the mode of SCENE.
-    #[arg(long, value_parser = parse_start_mode)]
+    #[arg(long, value_parser = StartModeParser)]
     pub mode: Option<StartMode>,
     /// Render `--frames` frames, save a screenshot of the window to this PNG file and exit.
     #[arg(long)]
     pub screenshot: Option<PathBuf>,
-    /// Frames drawn before the screenshot is taken (with `--screenshot`).
-    #[arg(long, default_value_t = 30)]
+    /// Frames drawn before the screenshot is taken (with `--screenshot`), at least 1.
+    #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..))]
     pub frames: u32,
-    /// A truth for the Difference view of the raster and Whitted modes: an EXR that illum wrote
-    /// of the same scene (`illum.scene_hash`) at the mode's image size (the raster's is the
-    /// view's, the Whitted image's half the view's each way).
+    /// A truth for the Difference view of the raster and Whitted modes: an EXR of the same scene
+    /// (by its `illum.scene_hash`; a file without one, from another renderer, is taken as given
+    /// and said so) at the mode's image size (the raster's is the view's, the Whitted image's
+    /// half the view's each way).
     #[arg(long, value_name = "FILE.exr")]
     pub reference: Option<PathBuf>,
     /// Start the raster and Whitted modes with the Difference view on.
@@ -76,6 +77,47 @@ pub fn parse_start_mode(text: &str) -> Result<StartMode, String> {
     parse_mode(text).map(StartMode::Renderer).map_err(|e| format!("{e}, or auto"))
 }
 
+/// Why no window can open, before trying: on Linux, none of the variables through which a
+/// window reaches a display (winit's: `WAYLAND_DISPLAY`, `WAYLAND_SOCKET`, `DISPLAY`) is set
+/// (`env` reads one). The message suggests a virtual display.
+pub fn no_display(env: impl Fn(&str) -> Option<std::ffi::OsString>) -> Option<String> {
+    const DISPLAYS: [&str; 3] = ["WAYLAND_DISPLAY", "WAYLAND_SOCKET", "DISPLAY"];
+    let none =
+        cfg!(target_os = "linux") && DISPLAYS.iter().all(|name| env(name).is_none_or(|v| v.is_empty()));
+    none.then(|| {
+        format!(
+            "no display to open the viewer's window on ({} unset); on a machine without a screen, run it under \
+             a virtual one: xvfb-run -a cargo run --release -p illum-viewer -- [ARGS]",
+            DISPLAYS.join(", ")
+        )
+    })
+}
+
+/// `--mode`'s parser ([`parse_start_mode`]), which lists the values in `--help` and in the
+/// refusal of an unknown one.
+#[derive(Clone, Copy, Debug)]
+struct StartModeParser;
+
+impl clap::builder::TypedValueParser for StartModeParser {
+    type Value = StartMode;
+
+    fn parse_ref(
+        &self,
+        cmd: &clap::Command,
+        arg: Option<&clap::Arg>,
+        value: &std::ffi::OsStr,
+    ) -> Result<StartMode, clap::Error> {
+        let text = clap::builder::StringValueParser::new().parse_ref(cmd, arg, value)?;
+        parse_start_mode(&text)
+            .map_err(|e| clap::Error::raw(clap::error::ErrorKind::InvalidValue, format!("--mode: {e}\n")))
+    }
+
+    fn possible_values(&self) -> Option<Box<dyn Iterator<Item = clap::builder::PossibleValue> + '_>> {
+        let names = RendererKind::ALL.iter().map(|kind| kind.as_str()).chain(["auto"]);
+        Some(Box::new(names.map(clap::builder::PossibleValue::new)))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -99,5 +141,27 @@ mod tests {
         assert_eq!(args.screenshot, Some(PathBuf::from("a.png")));
         let err = Args::try_parse_from(["illum-viewer", "--mode", "xyz"]).unwrap_err().to_string();
         assert!(err.contains("raster") && err.contains("pathtrace") && err.contains("auto"), "{err}");
+    }
+
+    #[test]
+    #[cfg(target_os = "linux")]
+    fn without_a_display_the_viewer_says_so_and_suggests_xvfb_run() {
+        let why = no_display(|_| None).expect("no display");
+        assert!(why.contains("DISPLAY") && why.contains("xvfb-run -a"), "{why}");
+        assert!(no_display(|name| (name == "DISPLAY").then(|| ":99".into())).is_none());
+        assert!(no_display(|name| (name == "DISPLAY").then(|| "".into())).is_some(), "an empty DISPLAY");
+    }
+
+    #[test]
+    fn help_lists_every_mode_and_frames_must_be_at_least_one() {
+        use clap::CommandFactory as _;
+        let help = Args::command().render_long_help().to_string();
+        for mode in RendererKind::ALL.iter().map(|k| k.as_str()).chain(["auto"]) {
+            assert!(help.contains(mode), "--help does not list mode {mode}: {help}");
+        }
+        let err =
+            Args::try_parse_from(["illum-viewer", "--screenshot", "a.png", "--frames", "0"]).unwrap_err();
+        let text = err.to_string();
+        assert!(text.contains("--frames") && text.contains("'0'") && text.contains("1.."), "{text}");
     }
 }

@@ -360,9 +360,9 @@ impl DenoiseView {
     /// the last refresh's wall time and the frames' time spent in this module.
     pub fn statistics(&self) -> String {
         format!(
-            "denoise: {}, {} refreshes, last {:.0} ms from start to estimate, {:.2} s of the frames in the denoiser",
+            "denoise: {}, {}, last {:.0} ms from start to estimate, {:.2} s of the frames in the denoiser",
             self.summary(),
-            self.refreshes,
+            crate::app::count(self.refreshes, "refresh", "refreshes"),
             self.estimate.map_or(0.0, |e| 1e3 * e.seconds),
             self.seconds
         )

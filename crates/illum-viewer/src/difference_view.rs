@@ -2,8 +2,8 @@
 //! of its image from a truth, per pixel, in a diverging colour map. Such a renderer has no noise
 //! but a bias, and this shows where the bias is.
 //!
-//! The truth is either a file given with `--reference FILE.exr` (desktop; an illum EXR of the
-//! same scene content, `illum.scene_hash`, and size), or without one the path tracer's own
+//! The truth is either a file given with `--reference FILE.exr` (desktop; checked against the
+//! view by the rule every reader of a reference shares, `illum_pathtrace::reference`), or without one the path tracer's own
 //! accumulation in this session when it shows the same scene from the same camera at the same
 //! size (in the browser too). A truth that does not match the view is refused by name (a file
 //! given is not replaced by the path tracer's image), and the panel says which truth is used
@@ -16,12 +16,13 @@
 //! rounded up to 1, 2 or 5 times a power of ten, so a few outliers do not wash the rest out;
 //! the panel shows it. The colour-map code is the error view's ([`crate::error_view::ramp`]).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
+use illum_image::RgbImage32;
 use illum_image::rgb_image::REC709_LUMINANCE;
-use illum_image::{ExrMetadata, RgbImage32};
 use illum_pathtrace::Accumulator;
-use illum_pathtrace::metadata::{reference_refusal, scene_hash};
+use illum_pathtrace::metadata::scene_hash;
+use illum_pathtrace::reference::{Reference, SizePolicy};
 use illum_scene::Scene;
 
 use crate::error_view::{colour_map, ramp};
@@ -77,19 +78,13 @@ pub struct DifferenceSummary {
 /// tracer's mean image is computed only when the difference must be drawn again).
 type LazyTruth<'a> = Box<dyn FnOnce() -> (RgbImage32, String) + 'a>;
 
-/// A `--reference` file, read once.
-struct FileReference {
-    path: PathBuf,
-    image: RgbImage32,
-    metadata: Option<ExrMetadata>,
-}
-
 /// The Difference view of one mode.
 #[derive(Default)]
 pub struct DifferenceView {
     /// The panel's toggle.
     pub on: bool,
-    reference: Option<FileReference>,
+    /// The `--reference` file, read once and checked against every view.
+    reference: Option<Reference>,
     texture: Option<egui::TextureHandle>,
     /// What the texture shows: the image's frame number and the truth's identity.
     shown: Option<(u64, String)>,
@@ -99,14 +94,10 @@ pub struct DifferenceView {
 }
 
 impl DifferenceView {
-    /// Reads `path` as the truth (`--reference`): an EXR that illum wrote. Whether it fits the
-    /// view is checked every time the view changes.
+    /// Reads `path` as the truth (`--reference`, an EXR). Whether it fits the view is checked
+    /// every time the view changes.
     pub fn load_reference(&mut self, path: &Path) -> Result<(), String> {
-        let (image, attributes) =
-            illum_image::load_exr(path).map_err(|e| format!("--reference {}: {e}", path.display()))?;
-        let metadata = ExrMetadata::from_attributes(path, &attributes)
-            .map_err(|e| format!("--reference {}: {e}", path.display()))?;
-        self.reference = Some(FileReference { path: path.to_path_buf(), image, metadata });
+        self.reference = Some(Reference::read(path).map_err(|e| e.to_string())?);
         self.shown = None;
         Ok(())
     }
@@ -143,17 +134,16 @@ impl DifferenceView {
                 "the image is {view_scale} times the view's size each way: resize the window to match, or \
                  give a reference of this size"
             );
-            let size = [file.image.width, file.image.height];
-            match reference_refusal(&file.path, file.metadata.as_ref(), size, scene, &advice) {
-                Some(why) => refusals.push(why),
-                None => {
-                    let field =
-                        |key: &str| file.metadata.as_ref().and_then(|m| m.get(key)).unwrap_or("?").to_owned();
+            match file.check(scene, SizePolicy::Advice(&advice)) {
+                Err(why) => refusals.push(why.to_string()),
+                Ok(unchecked) => {
+                    let number = |key: &str| file.number(key);
                     let note = format!(
-                        "truth: {} ({} spp, estimated error {})",
+                        "truth: {} ({} spp, estimated error {}){}",
                         file.path.display(),
-                        field("spp"),
-                        percent(field("estimated_relative_error").parse().ok())
+                        number("spp").map_or("?".to_owned(), |n| n.to_string()),
+                        percent(number("estimated_relative_error")),
+                        unchecked.map_or(String::new(), |n| format!("; {n}"))
                     );
                     let image = &file.image;
                     chosen = Some(("file".to_owned(), Box::new(move || (image.clone(), note))));

@@ -36,6 +36,10 @@ mod native {
             eprintln!("error: {e}");
             std::process::exit(1);
         }
+        if let Some(why) = illum_viewer::cli::no_display(|name| std::env::var_os(name)) {
+            eprintln!("error: {why}");
+            std::process::exit(1);
+        }
         let outcome: Outcome = Arc::default();
         let screenshot =
             args.screenshot.clone().map(|path| ScreenshotJob::new(path, args.frames, outcome.clone()));

@@ -204,6 +204,12 @@ impl PathTraceMode {
         self.work
     }
 
+    /// Samples per pixel before the error can be estimated (2, or 8 with the low-discrepancy
+    /// sequence).
+    fn error_needs_spp(&self) -> u32 {
+        self.tracer.as_ref().map_or(2, |t| t.accumulator().spp_for_error_estimate())
+    }
+
     /// Total samples folded into the current accumulation.
     pub fn total_samples(&self) -> u64 {
         self.tracer.as_ref().map_or(0, |t| t.accumulator().total_samples())
@@ -212,8 +218,7 @@ impl PathTraceMode {
     /// One line of the mode's statistics, as a `--screenshot` run prints them on exit.
     pub fn summary(&self) -> String {
         let st = &self.stats;
-        let error =
-            st.relative_error.map_or("n/a (needs 2 spp)".to_owned(), |e| format!("{:.2}%", e * 100.0));
+        let error = illum_pathtrace::progressive::error_text(st.relative_error, self.error_needs_spp());
         // The share of the wall time in the path tracer's steps: what the window's drawing
         // leaves it (samples/s over that share is the rate while it runs).
         let stepping =
@@ -241,7 +246,7 @@ impl PathTraceMode {
     pub fn caustics_apply(&self) -> bool {
         let mut scene = self.scene.clone();
         scene.pathtrace.caustics = true;
-        illum_pathtrace::gpu_scene::caustics_active(&scene)
+        illum_pathtrace::Estimators::of(&scene).caustics()
     }
 
     /// Wall-clock and GPU seconds of the tracer's submissions since the last reset (the GPU's
@@ -725,7 +730,7 @@ impl PathTraceMode {
             row("Elapsed (wall)", format!("{:.1} s", st.elapsed_seconds));
             row(
                 "Rel. error",
-                st.relative_error.map_or("(needs 2 spp)".to_owned(), |e| format!("{:.2} %", e * 100.0)),
+                illum_pathtrace::progressive::error_text(st.relative_error, self.error_needs_spp()),
             );
             row("Dropped NaN/Inf", st.dropped_samples.to_string());
             let state = match (self.paused, self.progressive.stopped()) {

@@ -44,10 +44,19 @@ pub fn built_in_scene(path: &Path) -> Option<&'static str> {
     BUILT_IN_SCENES.iter().find(|(name, _)| Path::new(name) == wanted).map(|(_, text)| *text)
 }
 
-/// Reads and validates the scene file at `path`: from disk natively.
+/// Reads and validates the scene file at `path`: from disk natively. The error holds its
+/// causes too (for a file that cannot be read, the system's reason).
 #[cfg(not(target_arch = "wasm32"))]
 pub fn read_scene(path: &Path) -> Result<Scene, String> {
-    Scene::load(&illum_scene::resolve_scene_path(path)).map_err(|e| e.to_string())
+    Scene::load(&illum_scene::resolve_scene_path(path)).map_err(|e| {
+        let mut text = e.to_string();
+        let mut cause = std::error::Error::source(&e);
+        while let Some(c) = cause {
+            text += &format!(": {c}");
+            cause = c.source();
+        }
+        text
+    })
 }
 
 /// Reads and validates the scene file at `path`: in the browser, one of the built-in scenes.

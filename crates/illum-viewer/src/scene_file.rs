@@ -93,6 +93,9 @@ mod tests {
     fn bad_files_are_messages() {
         let missing = load(Path::new("no/such/scene.toml")).unwrap_err();
         assert!(missing.contains("no/such/scene.toml"), "{missing}");
+        // The system's reason, as the OS words it.
+        let reason = std::fs::read("no/such/scene.toml").unwrap_err().to_string();
+        assert!(missing.ends_with(&format!(": {reason}")), "{missing}");
         let dir = tempfile::tempdir().unwrap();
         let bad = dir.path().join("bad.toml");
         std::fs::write(&bad, "[camera]\nvfov = \"wide\"\n").unwrap();

@@ -220,7 +220,7 @@ fn matrix() -> Vec<Cell> {
             let caustic_applies = loaded.pathtrace.as_ref().is_ok_and(|s| {
                 let mut on = s.clone();
                 on.pathtrace.caustics = true;
-                illum_pathtrace::gpu_scene::caustics_active(&on)
+                illum_pathtrace::Estimators::of(&on).caustics()
             });
             let variants: &[Option<bool>] = if mode == RendererKind::PathTrace && caustic_applies {
                 &[Some(true), Some(false)]

@@ -61,3 +61,25 @@ pub fn true_rel_mse(image: &RgbImage32, reference: &RgbImage32, reference_varian
     }
     total / (3 * image.pixels.len()) as f64
 }
+
+/// The Whitted scene at `width` x `height` with every caustic estimator, `spp`, `seed`.
+pub fn whitted(width: u32, height: u32, spp: u32, seed: u32) -> Scene {
+    let mut scene = Scene::load(&workspace_path("scenes/whitted.toml")).expect("scene loads");
+    let overrides = Overrides {
+        width: Some(width),
+        height: Some(height),
+        spp: Some(spp),
+        seed: Some(seed),
+        ..Default::default()
+    };
+    scene.apply_overrides(&overrides, "test").expect("valid overrides");
+    scene
+}
+
+/// The Whitted scene's truth at `width` x `height` (mean, variance of the mean): `spp` samples
+/// from index 0 with a seed of its own.
+pub fn whitted_truth(width: u32, height: u32, spp: u32) -> (RgbImage32, RgbImage32) {
+    let tracer = render(&whitted(width, height, spp, 9001));
+    assert!(tracer.caustics(), "the light tracer and the gather run");
+    (tracer.accumulator().mean_image(), tracer.accumulator().variance_image())
+}

@@ -1,5 +1,5 @@
 //! Open Image Denoise beside the à-trous filter, on the same 16-spp Cornell box and the same
-//! guides (only in builds with the cargo feature `oidn`; docs/denoising.md says how to get the
+//! guides (only in builds with the cargo feature `oidn`; docs/denoising-oidn.md says how to get the
 //! library): its true error against the converged reference, per region, its cost in ms per
 //! megapixel measured in the same run as à-trous's, and the halves' estimate of its error.
 
@@ -146,7 +146,7 @@ fn the_halves_estimate_of_oidns_error() {
 
 /// Open Image Denoise, bounded as every denoiser is (`illum_denoise::bound`), leaves a
 /// converged image within its noise (without the bound it moved 213 of 1024 pixels beyond
-/// |z| = 4.90: docs/denoising.md).
+/// |z| = 4.90: docs/denoising.md, docs/denoising-oidn.md).
 #[test]
 fn oidn_does_not_move_a_converged_image() {
     crate::quality::a_converged_image_is_not_moved(DenoiserKind::Oidn);

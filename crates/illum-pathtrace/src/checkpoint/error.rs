@@ -17,6 +17,10 @@ pub enum CheckpointError {
     /// Not an EXR, or a truncated or corrupt one: the decoder's error with its causes.
     #[error("{}: cannot be read as an EXR (truncated or corrupt?): {reason}", path.display())]
     Unreadable { path: PathBuf, reason: String },
+    /// Read, but not an image a checkpoint can be (a PNG, an EXR without R, G and B):
+    /// the reader's reason.
+    #[error("{}: {reason}; a checkpoint is an EXR the path tracer wrote", path.display())]
+    NotAnExr { path: PathBuf, reason: String },
     #[error("{}: not written by illum (no illum.* metadata), so it cannot be continued", path.display())]
     NotIllum { path: PathBuf },
     /// illum's metadata is there but an attribute does not parse (the error names the file and
@@ -33,6 +37,10 @@ pub enum CheckpointError {
     /// `reason` says which numbers disagree.
     #[error("{}: {reason}", path.display())]
     Corrupt { path: PathBuf, reason: String },
+    /// The file names its estimators in an older form than this build's token list
+    /// (`estimators.rs`): it cannot be resumed or merged, whatever its settings.
+    #[error("{}: illum.estimators: {reason}", path.display())]
+    OlderEstimators { path: PathBuf, reason: String },
     /// Resuming with settings other than the file's: each difference, with both values.
     #[error(
         "{}: rendered with other settings, so its samples cannot be combined with these: {}",

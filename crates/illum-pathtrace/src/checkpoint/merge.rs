@@ -4,11 +4,11 @@
 
 use std::path::{Path, PathBuf};
 
-use super::{Checkpoint, CheckpointError, CheckpointHeader, load_checkpoint, load_checkpoint_header};
+use super::{Checkpoint, CheckpointError, CheckpointHeader, load_checkpoint, load_checkpoint_header, shown};
 
-/// The keys two partial renders must agree on to be merged.
-const MERGE_KEYS: [&str; 11] = [
-    "scene",
+/// The keys two partial renders must agree on to be merged. The scene is known by its content
+/// (`scene_hash`), not its name, as a resumed render's is.
+const MERGE_KEYS: [&str; 10] = [
     "scene_hash",
     "width",
     "height",
@@ -17,7 +17,7 @@ const MERGE_KEYS: [&str; 11] = [
     "sampling",
     "sequence",
     "caustics",
-    "caustic_estimators",
+    crate::metadata::ESTIMATORS,
     "glint",
 ];
 
@@ -69,6 +69,16 @@ fn check_mergeable<T>(parts: &mut [(PathBuf, CheckpointHeader, T)]) -> Result<u3
                 finish: resume(),
             });
         }
+        // Parts must name their estimators by this build's tokens (compared between the parts
+        // below): a part of an older form holds light of unknown estimators.
+        let (stored, legacy) =
+            (c.metadata.get(crate::metadata::ESTIMATORS), c.metadata.get(crate::metadata::LEGACY_ESTIMATORS));
+        if let Err(mismatch) = crate::estimators::stored_tokens(stored, legacy) {
+            return Err(CheckpointError::OlderEstimators {
+                path: path.clone(),
+                reason: mismatch.to_string(),
+            });
+        }
         if !range.start.is_multiple_of(u64::from(crate::CHUNK_SAMPLES)) {
             return Err(CheckpointError::OffChunk {
                 path: path.clone(),
@@ -84,14 +94,14 @@ fn check_mergeable<T>(parts: &mut [(PathBuf, CheckpointHeader, T)]) -> Result<u3
             .filter_map(|key| {
                 let (a, b) = (first.setting(key), c.setting(key));
                 (a != b).then(|| {
-                    let show = |v: Option<String>| v.unwrap_or_else(|| "(missing)".to_owned());
-                    format!(
-                        "{key}: {} in {}, {} in {}",
-                        show(a),
-                        first_path.display(),
-                        show(b),
-                        path.display()
-                    )
+                    let (a, b) = (shown(a.as_deref()), shown(b.as_deref()));
+                    let (a_path, b_path) = (first_path.display(), path.display());
+                    if *key == "scene_hash" {
+                        let (a_name, b_name) = (&first.metadata.scene, &c.metadata.scene);
+                        format!("{key}: {a} ({a_name:?}) in {a_path}, {b} ({b_name:?}) in {b_path}")
+                    } else {
+                        format!("{key}: {a} in {a_path}, {b} in {b_path}")
+                    }
                 })
             })
             .collect();
@@ -213,4 +223,69 @@ pub fn merge_checkpoint_files(
         Ok(part)
     });
     fold_parts(loaded, spp_done)
+}
+
+#[cfg(test)]
+mod tests {
+    use illum_image::ExrMetadata;
+
+    use super::*;
+
+    fn header(scene: &str, hash: &str, glint: String, sample_start: u32) -> CheckpointHeader {
+        let fields = [
+            ("scene_hash", hash.to_owned()),
+            ("bounces", "8".to_owned()),
+            ("seed", "1".to_owned()),
+            ("glint", glint),
+            ("stopped_by", "spp".to_owned()),
+        ];
+        CheckpointHeader {
+            metadata: ExrMetadata {
+                renderer: crate::metadata::RENDERER.to_owned(),
+                scene: scene.to_owned(),
+                render_seconds: 1.0,
+                fields: fields.into_iter().map(|(k, v)| (k.to_owned(), v)).collect(),
+            },
+            width: 4,
+            height: 4,
+            spp_done: 16,
+            sample_start,
+            partial_pass: None,
+        }
+    }
+
+    /// Parts of two scenes: the refusal names each key that differs, with values shortened (a
+    /// sun's glint is thousands of characters), and no key that agrees.
+    #[test]
+    fn parts_of_different_scenes_are_refused_naming_only_the_differing_keys_shortened() {
+        let glint: Vec<String> = (0..200).map(|p| format!("{p}:0.125,0.25,0.5")).collect();
+        let mut parts = vec![
+            (PathBuf::from("a.exr"), header("whitted", "00000000000000aa", glint.join(";"), 0), ()),
+            (PathBuf::from("b.exr"), header("cornell", "00000000000000bb", "none".to_owned(), 16), ()),
+        ];
+        let error = check_mergeable(&mut parts).unwrap_err().to_string();
+        for part in [
+            "scene_hash: 00000000000000aa (\"whitted\") in a.exr, 00000000000000bb (\"cornell\") in b.exr",
+            "glint: 0:0.125,0.25,0.5;1:0.125,0.25,0.5;2:0.125",
+            "... (3689 characters) in a.exr, none in b.exr",
+        ] {
+            assert!(error.contains(part), "the refusal lacks {part:?}: {error}");
+        }
+        assert!(!error.contains("bounces") && !error.contains("seed"), "keys that agree: {error}");
+        assert!(error.len() < 600, "{} characters: {error}", error.len());
+    }
+
+    /// The scene is known by its content: parts of one scene under two names merge.
+    #[test]
+    fn parts_of_one_scene_under_two_names_merge() {
+        let mut parts = vec![
+            (PathBuf::from("a.exr"), header("cornell", "00000000000000aa", "none".to_owned(), 0), ()),
+            (
+                PathBuf::from("b.exr"),
+                header("cornell-renamed", "00000000000000aa", "none".to_owned(), 16),
+                (),
+            ),
+        ];
+        assert_eq!(check_mergeable(&mut parts).map_err(|e| e.to_string()), Ok(32));
+    }
 }

@@ -134,30 +134,15 @@ impl Bodies {
     /// the lower index), found through the hierarchy.
     pub fn nearest(&self, o: DVec3, d: DVec3, own: Option<usize>) -> Option<Hit> {
         let mut best: Option<Hit> = None;
-        let inv = d.recip();
-        let mut stack = [0usize; 64];
-        let mut depth = 1;
-        while depth > 0 {
-            depth -= 1;
-            let node = self.tree[stack[depth]];
-            let far = best.map_or(f64::INFINITY, |b| b.t);
-            if !slab_hit(o, inv, node.lo, node.hi, far) {
-                continue;
+        self.visit(o, d, f64::INFINITY, |i, far| {
+            if let Some((t, normal)) = self.hit_body(i, o, d, own)
+                && best.is_none_or(|b| t < b.t || (t == b.t && i < b.object))
+            {
+                best = Some(Hit { object: i, t, normal });
+                *far = t;
             }
-            if node.count == 0 {
-                stack[depth] = node.first;
-                stack[depth + 1] = node.first + 1;
-                depth += 2;
-                continue;
-            }
-            for &i in &self.order[node.first..node.first + node.count] {
-                if let Some((t, normal)) = self.hit_body(i, o, d, own)
-                    && best.is_none_or(|b| t < b.t || (t == b.t && i < b.object))
-                {
-                    best = Some(Hit { object: i, t, normal });
-                }
-            }
-        }
+            false
+        });
         best
     }
 
@@ -171,6 +156,18 @@ impl Bodies {
     /// hits) nearer than `far`: the ray from o does not reach `far` unobstructed. It stops at
     /// the first such hit, so it costs less than [`Self::nearest`].
     pub fn blocked(&self, o: DVec3, d: DVec3, own: Option<usize>, far: f64, except: Option<usize>) -> bool {
+        let mut found = false;
+        self.visit(o, d, far, |i, _| {
+            found = Some(i) != except && self.hit_body(i, o, d, own).is_some_and(|(t, _)| t < far);
+            found
+        });
+        found
+    }
+
+    /// Walks the hierarchy along the ray o + t d through the nodes it meets before `far`:
+    /// `body(i, far)` is called with each body of an entered leaf, may lower `far`, and ends the
+    /// walk by returning true.
+    fn visit(&self, o: DVec3, d: DVec3, mut far: f64, mut body: impl FnMut(usize, &mut f64) -> bool) {
         let inv = d.recip();
         let mut stack = [0usize; 64];
         let mut depth = 1;
@@ -186,14 +183,12 @@ impl Bodies {
                 depth += 2;
                 continue;
             }
-            let found = self.order[node.first..node.first + node.count]
-                .iter()
-                .any(|&i| Some(i) != except && self.hit_body(i, o, d, own).is_some_and(|(t, _)| t < far));
-            if found {
-                return true;
+            for &i in &self.order[node.first..node.first + node.count] {
+                if body(i, &mut far) {
+                    return;
+                }
             }
         }
-        false
     }
 
     /// Body `i`'s hit of the ray, as [`Self::nearest`] defines it.

@@ -3,9 +3,8 @@
 //!
 //! Frame k, N = width x height particles, pairs with sample index k of every pixel: pixel p's
 //! sample k is the camera path's estimate plus frame k's splat at p. Rather than adding the two
-//! per sample on the GPU, each pass traces its frames first (in dispatches of up to
-//! `frames_per_dispatch`), reads each frame back and keeps, per slot layer of the pass (the same
-//! groups of sample indices as the camera's f32 slot sums, `batch::Layers`) and pixel, the f64 sum S1 and sum
+//! per sample on the GPU, each pass traces its frames first, reads each frame back and keeps, per slot layer of the pass
+//! (the same groups of sample indices as the camera's f32 slot sums, `batch::Layers`) and pixel, the f64 sum S1 and sum
 //! of squares S2 of the frames' values. Folding a camera chunk (sum C of n samples) then adds
 //!     sum += S1,   sum of squares += S2 + 2 C S1 / n.
 //! The last term replaces sum_k c_k s_k by its mean over the pairings of the chunk's camera and
@@ -16,11 +15,12 @@
 //! unchanged. Frames depend only on (seed, particle, frame index), and integer atomics add in
 //! any order to the same result, so the image does not depend on how a render is batched.
 //!
-//! Readback: a pass's frames go to the GPU in dispatches of up to `frames_per_dispatch` frames,
-//! each read back and folded before the next is submitted. Natively the tools wait for each
-//! dispatch ([`CausticTracer::prepare_pass`]); a web page cannot wait, so there each dispatch's
-//! mapping is started and asked again on later frames ([`CausticTracer::poll_pass`]). Both
-//! submit the same dispatches and fold the same frames in the same order, so the pass's
+//! Scheduling: one submission per step, sized like a band to the step's time target
+//! (`caustic/schedule.rs`): whole frames when a frame fits it, else a frame in pieces (ranges of
+//! its particles, then of its gathering pixels), the frame read back and folded with its last.
+//! Natively the tools wait for each submission ([`CausticTracer::prepare_pass`]); a web page
+//! cannot wait, so there each submission's completion or mapping is asked again on later frames
+//! ([`CausticTracer::poll_pass`]). Frames are folded in order whatever the cut, so the pass's
 //! statistics are the same bit for bit.
 //!
 //! Fixed point: see [`fixed_point`].
@@ -28,119 +28,41 @@
 //! With a delta sun each dispatch also runs the photon gather (`shaders/gather.wgsl`) after the
 //! particles, into the same frames: its photon maps and grid are allocated and cleared here.
 //!
-//! Over 600 lines with its tests (about 600 of code): one estimator, from its parameters to its
-//! fold, with the two ways its frames come back (waited for, or polled), and the photon gather
-//! that shares its frames and buffers.
+//! This file holds a pass's frames from submission to fold, waited for or polled; its
+//! resources (pipelines, buffers, bind groups) are made in `caustic/resources.rs`, its
+//! parameters and fixed point are `caustic/params.rs`, its scheduling `caustic/schedule.rs`
+//! (both pure, tested without a GPU).
 
-use bytemuck::{Pod, Zeroable};
-use glam::Vec3;
 use illum_gpu::readback::PendingRead;
 use illum_gpu::timing::PassTimer;
 use illum_gpu::{GpuContext, wgpu};
-use illum_scene::{MaterialKind, Scene};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use web_time::Instant;
 
 use crate::accumulator::Accumulator;
 use crate::batch::{self, Layers};
-use illum_rtcore::GpuShape;
 
-use crate::gpu_scene::{GpuParams, GpuScene};
-use crate::options::TracerOptions;
-use crate::{PathTraceError, shaders};
+use crate::PathTraceError;
+use crate::gpu_scene::GpuParams;
+use schedule::{Costs, Cursor, FrameShape, Stage, Submission, WORKGROUP, next_submission};
 
-/// Mirrors `struct CausticParams` in caustic.wgsl.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
-pub struct CausticParams {
-    pub particles: u32,
-    pub row_stride: u32,
-    pub frame_base: u32,
-    pub frame_count: u32,
-    pub num_discs: u32,
-    pub seed: u32,
-    pub pixel_area: f32,
-    pub area_per_particle: f32,
-    pub scene_centre: [f32; 3],
-    pub scene_radius: f32,
-    pub fixed_scale: f32,
-    pub fixed_cap: f32,
-    pub disc_area: f32,
-    /// r_1 of the photon gather (0 without it).
-    pub gather_radius: f32,
-    /// Photon-grid buckets per frame (a power of two; 1 without the gather).
-    pub buckets: u32,
-    /// The dispatch's first particle (or pixel, in the gather): nonzero for a frame's pieces.
-    pub first_index: u32,
-    pub padding_b: u32,
-    pub padding_c: u32,
-}
+mod params;
+mod resources;
+mod schedule;
 
-/// Mixed into the scene's seed for the particles, so that particle i of frame k never draws
-/// the random numbers of sample k of pixel i.
-const PARTICLE_SEED_KEY: u32 = 0x5ca0_571c;
-const WORKGROUP: u32 = 64;
-/// Words per pixel of a frame: (lo, hi) for each of three channels.
-const WORDS_PER_PIXEL: u64 = 6;
-/// The most bytes one dispatch's frames take (and the most host memory one pass's chunk
-/// statistics may take, below).
-const SPLAT_BYTES: u64 = 64 << 20;
-/// Bytes per photon: three vec4 (caustic_buffers.wgsl).
-const PHOTON_BYTES: u64 = 48;
-/// r_1 of the photon gather as a fraction of the largest specular object's bounding radius
-/// (docs/caustics.md, "The caustic seen through a specular surface").
-pub const GATHER_RADIUS_FRACTION: f32 = 0.02;
-/// Host bytes per pixel and slot layer of a pass: S1 and S2, three f64 each.
-pub(crate) const PASS_BYTES_PER_PIXEL_LAYER: u64 = 48;
-/// The most host memory one pass's caustic statistics may take.
-pub(crate) const PASS_BYTES: u64 = 256 << 20;
+pub use params::{CausticParams, bounding_sphere, fixed_point};
+use params::{PASS_BYTES, PASS_BYTES_PER_PIXEL_LAYER, WORDS_PER_PIXEL};
 
-/// The bounding sphere (centre, radius) of a shape, in f32 (what the GPU tests against).
-pub fn bounding_sphere(shape: &GpuShape) -> (Vec3, f32) {
-    match *shape {
-        GpuShape::Aabb { min, max } => (0.5 * (min + max), 0.5 * (max - min).length()),
-        GpuShape::Box { local_min, local_max, cos, sin, offset } => {
-            let c = 0.5 * (local_min + local_max);
-            let centre = Vec3::new(cos * c.x + sin * c.z, c.y, -sin * c.x + cos * c.z) + offset;
-            (centre, 0.5 * (local_max - local_min).length())
-        }
-        GpuShape::Quad { corner, edge_u, edge_v } => {
-            let radius = 0.5 * (edge_u + edge_v).length().max((edge_u - edge_v).length());
-            (corner + 0.5 * (edge_u + edge_v), radius)
-        }
-        GpuShape::Sphere { center, radius } => (center, radius),
-    }
-}
-
-/// The fixed-point scale S (a power of two) and cap for frames of `particles` particles whose
-/// typical splat is `reference` (in the GPU's scaled radiance).
-///
-/// Each particle adds to one pixel once, as q = round(v S) < cap, cap = 2^(64 - ceil(log2 N))
-/// (particles at or above it are dropped and counted). A frame's pixel sum is then below
-/// N cap <= 2^64: the two-word (64-bit) sum cannot overflow, for any scene, sun or particle.
-/// S puts the reference splat at cap / 2^24: a particle may be 2^24 times brighter than the
-/// reference (the floor 4096 times nearer the eye, say) before it is dropped, and the reference
-/// splat has 64 - ceil(log2 N) - 24 bits (22 at 512 x 512: relative rounding 2^-23, below f32's
-/// own). The scale follows the sun's irradiance, so a very bright sun changes nothing but S.
-pub fn fixed_point(particles: u64, reference: f64) -> (f32, f32) {
-    let bits = 64 - (particles.max(1) as f64).log2().ceil() as i32;
-    let cap = 2f64.powi(bits);
-    let exponent = if reference > 0.0 && reference.is_finite() {
-        ((cap / 2f64.powi(24) / reference).log2().floor() as i32).clamp(-120, 120)
-    } else {
-        0
-    };
-    (2f32.powi(exponent), cap as f32)
-}
-
-/// Which pass a caustic pass belongs to: its first absolute sample index, its spp and the
-/// slot layers of the camera's sums that its statistics are grouped by.
+/// Which pass a caustic pass belongs to: its first absolute sample index, its spp, the slot
+/// layers of the camera's sums that its statistics are grouped by, and the render's first
+/// sample index (which the gather's radius counts from).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct PassKey {
     pub first_sample: u32,
     pub spp: u32,
     pub layers: Layers,
+    pub origin: u32,
 }
 
 /// One pass's caustic statistics: per slot layer and pixel, S1 and S2 of its frames, complete once
@@ -152,10 +74,15 @@ struct CausticPass {
     dropped: u64,
     /// Frames folded so far: frames `key.first_sample..key.first_sample + frames_done`.
     frames_done: u32,
-    /// The dispatch of the pass's next frames whose polled readback is under way.
+    /// Where the next frame stands (traced in pieces, see `schedule.rs`).
+    cursor: Cursor,
+    /// Seconds the pieces of the frame at `cursor` took so far.
+    frame_seconds: f64,
+    /// Whether the frame at `cursor` was begun by polling (a waiting caller starts it again:
+    /// its last polled piece may not be done).
+    polled_frame: bool,
+    /// The submission whose polled readback, or polled completion, is under way.
     in_flight: Option<InFlight>,
-    /// The pass's next frame, while it is traced in pieces.
-    pieces: Option<FramePieces>,
 }
 
 impl CausticPass {
@@ -167,13 +94,22 @@ impl CausticPass {
             sum_sq: vec![[0.0; 3]; layers * pixels],
             dropped: 0,
             frames_done: 0,
+            cursor: Cursor::FrameStart,
+            frame_seconds: 0.0,
+            polled_frame: false,
             in_flight: None,
-            pieces: None,
         }
     }
 
     fn complete(&self) -> bool {
         self.frames_done >= self.key.spp
+    }
+
+    /// Forgets the pieces of the frame in progress: it is traced again from its start.
+    fn restart_frame(&mut self) {
+        self.cursor = Cursor::FrameStart;
+        self.frame_seconds = 0.0;
+        self.polled_frame = false;
     }
 
     /// Folds `count` frames of `pixels` pixels read back from a dispatch (the splat buffer's
@@ -201,55 +137,26 @@ impl CausticPass {
     }
 }
 
-/// A dispatch of frames whose readback is under way (polled).
+/// A polled submission: frames whose readback is under way, or a piece whose work is.
 struct InFlight {
-    read: PendingRead,
-    bytes: DispatchBytes,
-    /// The frames it traced.
-    count: u32,
+    what: Flight,
+    submission: Submission,
     launched: Instant,
-    /// Whether it is the last piece of a frame traced in pieces (not timed).
-    pieced: bool,
 }
 
-/// A frame traced in pieces, one submission per call, for a caller whose time target is
-/// shorter than a frame: its particles in `count` ranges, then (with the gather) its pixels in
-/// `count` ranges, the last read back. Integer atomics add in any order, so the frame's values
-/// are those of one dispatch, bit for bit.
-struct FramePieces {
-    /// Pieces of the particles and of the gather (0 without it).
-    counts: [u32; 2],
-    /// Submissions made so far (of `counts[0] + counts[1]`).
-    submitted: u32,
-    /// Set when the last submitted piece's work is done (polled).
-    done: Arc<AtomicBool>,
-    /// Seconds the waited pieces of each stage took so far.
-    seconds: [f64; 2],
-    /// Whether its pieces were waited for (a waiting caller restarts a frame begun by polling;
-    /// a web page only polls).
-    #[cfg_attr(target_arch = "wasm32", allow(dead_code))]
-    waited: bool,
+enum Flight {
+    /// Frames to read back (whole ones, or a frame's last piece).
+    Read { read: PendingRead, bytes: DispatchBytes, count: u32 },
+    /// A piece of a frame, set done when the GPU has finished it.
+    Piece(Arc<AtomicBool>),
 }
 
 /// What [`CausticTracer::launch`] submitted.
 enum Launched {
     /// A piece of a frame, not read back.
-    Piece,
-    /// Frames to read back: whole ones, or a frame's last piece (`pieces_seconds`: what its
-    /// waited pieces of each stage took).
-    Frames { staging: wgpu::Buffer, bytes: DispatchBytes, count: u32, pieces_seconds: Option<[f64; 2]> },
-}
-
-/// What one submission of caustic work does.
-#[derive(Clone, Copy)]
-enum Stage {
-    /// Whole frames: clear, particles, gather, read back.
-    Whole,
-    /// A range of a frame's particles (the first clears the frame; the last, without the
-    /// gather, reads it back).
-    Particles { first: bool, last: bool },
-    /// A range of a frame's gathering pixels (the last reads the frame back).
-    Gather { last: bool },
+    Piece(Submission),
+    /// Frames to read back: whole ones, or a frame's last piece.
+    Frames { staging: wgpu::Buffer, bytes: DispatchBytes, count: u32, submission: Submission },
 }
 
 /// What a dispatch's staging copy holds: its frames' bytes, then the timestamps (if timed).
@@ -291,19 +198,16 @@ pub(crate) struct CausticTracer {
     base: CausticParams,
     /// The most frames one dispatch may carry (the splat and photon buffers' size).
     max_frames_per_dispatch: u32,
-    /// What one frame cost in the last dispatch, in seconds: sizes the next dispatch when the
-    /// caller aims at a time per step (see [`Self::dispatch_frames`]).
-    seconds_per_frame: Option<f64>,
+    /// What its submissions were measured to cost: sizes the next (see `schedule.rs`).
+    costs: Costs,
     /// Seconds the frames folded so far took, each dispatch at the cost that sized the next
     /// one (its GPU time where the device has timestamps): the light tracer's share of a
     /// render's time, which the bands' own reports do not hold ([`crate::PathTracer::caustic_seconds`]).
     seconds_spent: f64,
-    /// What a frame's particles and its gather cost, from the last frame traced in waited
-    /// pieces: how the next frame is cut (see [`Self::frame_pieces`]).
-    stage_seconds: Option<[f64; 2]>,
     /// Times the light tracer's and the gather's passes, where the device has timestamps.
     timer: PassTimer,
-    groups: (u32, u32),
+    /// The most workgroups of a dispatch along x (a piece of more is laid out in rows).
+    max_groups_x: u32,
     pixels: usize,
     /// What a fixed-point unit is worth in true radiance: 2^radiance_exponent / S.
     unit: f64,
@@ -312,236 +216,12 @@ pub(crate) struct CausticTracer {
 }
 
 impl CausticTracer {
-    /// The light tracer for `scene`, or `None` when its scene code has no caustic (caustics
-    /// off, no directional light or no specular object).
-    pub(crate) fn new(
-        gpu: &GpuContext,
-        scene: &Scene,
-        gpu_scene: &GpuScene,
-        options: TracerOptions,
-        scene_buffers: [&wgpu::Buffer; 3],
-        scene_params: GpuParams,
-    ) -> Result<Option<Self>, PathTraceError> {
-        if !gpu_scene.code.caustic {
-            return Ok(None);
-        }
-        let sun = scene.directional_light.expect("CAUSTIC needs a directional light");
-        let camera = scene.camera;
-        let pixels = camera.width as usize * camera.height as usize;
-        let particles = pixels as u64;
-        let frame_bytes = WORDS_PER_PIXEL * 4 * particles + 4;
-        let gather = gpu_scene.code.caustic_gather;
-        // The photon grid: a bucket per particle or more (a power of two), 4 bytes each.
-        let buckets = if gather { particles.next_power_of_two() } else { 1 };
-        let photon_frame_bytes = if gather { PHOTON_BYTES * particles } else { 4 };
-        let largest_frame_bytes = frame_bytes.max(photon_frame_bytes).max(4 * buckets);
-        let limits = gpu.device.limits();
-        let max_binding = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
-        if largest_frame_bytes > max_binding {
-            return Err(PathTraceError::Unsupported {
-                scene: scene.name.clone(),
-                message: format!(
-                    "pathtrace.caustics = true at camera.width x camera.height = {} x {}: one frame of the caustic \
-                     (24 bytes per pixel, and 48 per pixel for the photons with a delta sun) needs \
-                     {largest_frame_bytes} bytes in one buffer, over the device's storage binding limit of \
-                     {max_binding}; render smaller or set caustics = false",
-                    camera.width, camera.height
-                ),
-            });
-        }
-        let max_frames_per_dispatch =
-            (SPLAT_BYTES.min(max_binding) / largest_frame_bytes).clamp(1, crate::CHUNK_SAMPLES as u64) as u32;
-
-        let specular = |material: u32| {
-            matches!(
-                scene.materials[material as usize].kind,
-                MaterialKind::Mirror { .. } | MaterialKind::Dielectric { .. }
-            )
-        };
-        let discs: Vec<[f32; 4]> = gpu_scene
-            .geometry
-            .objects
-            .iter()
-            .filter(|o| !o.emitter && specular(o.material))
-            .map(|o| {
-                let (c, r) = bounding_sphere(&o.shape);
-                [c.x, c.y, c.z, r]
-            })
-            .collect();
-        let disc_area: f32 = discs.iter().map(|d| std::f32::consts::PI * d[3] * d[3]).sum();
-        let spheres: Vec<(Vec3, f32)> =
-            gpu_scene.geometry.objects.iter().map(|o| bounding_sphere(&o.shape)).collect();
-        let scene_centre = spheres.iter().map(|s| s.0).sum::<Vec3>() / spheres.len() as f32;
-        let scene_radius = spheres.iter().map(|(c, r)| (*c - scene_centre).length() + r).fold(0.0, f32::max);
-
-        let basis = scene.camera.basis();
-        let pixel_area = (2.0 * basis.aspect * basis.tan_half_fov / camera.width as f32)
-            * (2.0 * basis.tan_half_fov / camera.height as f32);
-        // The reference splat: a particle of the brightest channel's flux landing at the
-        // distance of the nearest specular object, facing the eye on the axis.
-        let scale = 2f64.powi(-gpu_scene.radiance_exponent);
-        let flux_density = f64::from(sun.irradiance.max_element()) * scale;
-        let nearest = discs
-            .iter()
-            .map(|d| {
-                f64::from((Vec3::new(d[0], d[1], d[2]) - scene.camera.eye).length()).max(f64::from(d[3]))
-            })
-            .fold(f64::INFINITY, f64::min);
-        let reference = flux_density * f64::from(disc_area)
-            / particles as f64
-            / std::f64::consts::PI
-            / (f64::from(pixel_area) * nearest * nearest);
-        // The gather adds one value per pixel and frame beside the particles' (at most N).
-        let (fixed_scale, fixed_cap) = fixed_point(if gather { 2 * particles } else { particles }, reference);
-        let largest_radius = discs.iter().map(|d| d[3]).fold(0.0, f32::max);
-
-        let groups_total = (particles as u32).div_ceil(WORKGROUP);
-        let gx = groups_total.min(limits.max_compute_workgroups_per_dimension);
-        let gy = groups_total.div_ceil(gx);
-        let base = CausticParams {
-            particles: particles as u32,
-            row_stride: gx * WORKGROUP,
-            frame_base: 0,
-            frame_count: 0,
-            num_discs: discs.len() as u32,
-            seed: scene.pathtrace.seed ^ PARTICLE_SEED_KEY,
-            pixel_area,
-            area_per_particle: disc_area / particles as f32,
-            scene_centre: scene_centre.to_array(),
-            scene_radius,
-            fixed_scale,
-            fixed_cap,
-            disc_area,
-            gather_radius: if gather { GATHER_RADIUS_FRACTION * largest_radius } else { 0.0 },
-            buckets: buckets as u32,
-            first_index: 0,
-            padding_b: 0,
-            padding_c: 0,
-        };
-        let pipeline = shaders::companion_pipeline(
-            gpu,
-            scene,
-            gpu_scene,
-            options,
-            &shaders::CAUSTIC_SHADER,
-            "caustic light-tracing",
-        )?;
-        let device = &gpu.device;
-        let splat_size = frame_bytes * u64::from(max_frames_per_dispatch);
-        let (params_buffer, discs_buffer, splat) = gpu.scoped("allocating the caustic's buffers", || {
-            (
-                device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("caustic params"),
-                    size: std::mem::size_of::<CausticParams>() as u64,
-                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                    mapped_at_creation: false,
-                }),
-                illum_gpu::buffers::storage_buffer(device, "caustic discs", bytemuck::cast_slice(&discs)),
-                device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("caustic splats"),
-                    size: splat_size,
-                    usage: wgpu::BufferUsages::STORAGE
-                        | wgpu::BufferUsages::COPY_SRC
-                        | wgpu::BufferUsages::COPY_DST,
-                    mapped_at_creation: false,
-                }),
-            )
-        })?;
-        let layout = pipeline.get_bind_group_layout(0);
-        let [params, objects, materials] = scene_buffers;
-        // The photon maps: (photons, heads), the photons not cleared (only the heads lead to them).
-        let photon_buffers = if gather {
-            let frames = u64::from(max_frames_per_dispatch);
-            Some(gpu.scoped("allocating the photon maps", || {
-                let storage = |label, size| {
-                    device.create_buffer(&wgpu::BufferDescriptor {
-                        label: Some(label),
-                        size,
-                        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-                        mapped_at_creation: false,
-                    })
-                };
-                (
-                    storage("caustic photons", photon_frame_bytes * frames),
-                    storage("photon grid", 4 * buckets * frames),
-                )
-            })?)
-        } else {
-            None
-        };
-        let mut entries = vec![
-            wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 1, resource: objects.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 2, resource: materials.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 6, resource: params_buffer.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 8, resource: splat.as_entire_binding() },
-        ];
-        if let Some((photons, heads)) = &photon_buffers {
-            entries.push(wgpu::BindGroupEntry { binding: 9, resource: photons.as_entire_binding() });
-            entries.push(wgpu::BindGroupEntry { binding: 10, resource: heads.as_entire_binding() });
-        }
-        // The gather reads no discs.
-        let gather_entries = entries.clone();
-        entries.push(wgpu::BindGroupEntry { binding: 7, resource: discs_buffer.as_entire_binding() });
-        let bind_group = gpu.scoped("binding the caustic's buffers", || {
-            device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("caustic"),
-                layout: &layout,
-                entries: &entries,
-            })
-        })?;
-        let timer = PassTimer::new(gpu, if gather { &[CAUSTIC_PASS, GATHER_PASS] } else { &[CAUSTIC_PASS] });
-        let gather = match &photon_buffers {
-            Some((_, heads)) => {
-                let pipeline = shaders::companion_pipeline(
-                    gpu,
-                    scene,
-                    gpu_scene,
-                    options,
-                    &shaders::GATHER_SHADER,
-                    "caustic photon gather",
-                )?;
-                let layout = pipeline.get_bind_group_layout(0);
-                let bind_group = gpu.scoped("binding the photon gather's buffers", || {
-                    device.create_bind_group(&wgpu::BindGroupDescriptor {
-                        label: Some("photon gather"),
-                        layout: &layout,
-                        entries: &gather_entries,
-                    })
-                })?;
-                Some(Gather { pipeline, bind_group, heads: heads.clone(), heads_frame_bytes: 4 * buckets })
-            }
-            None => None,
-        };
-        Ok(Some(CausticTracer {
-            pipeline,
-            gather,
-            params_buffer,
-            scene_params_buffer: params.clone(),
-            scene_params,
-            splat,
-            staging: None,
-            splat_size,
-            bind_group,
-            base,
-            max_frames_per_dispatch,
-            seconds_per_frame: None,
-            seconds_spent: 0.0,
-            stage_seconds: None,
-            timer,
-            groups: (gx, gy),
-            pixels,
-            unit: 2f64.powi(gpu_scene.radiance_exponent) / f64::from(fixed_scale),
-            pass: None,
-        }))
-    }
-
-    /// The parameters the shader gets (for the layout test and the overflow tests).
     /// Seconds the light tracer's frames folded so far took (see `seconds_spent`).
     pub(crate) fn seconds_spent(&self) -> f64 {
         self.seconds_spent
     }
 
+    /// The parameters the shader gets (for the layout test and the overflow tests).
     pub(crate) fn params(&self) -> CausticParams {
         self.base
     }
@@ -552,6 +232,25 @@ impl CausticTracer {
         let per_chunk = PASS_BYTES_PER_PIXEL_LAYER * u64::from(layers.per_chunk()) * self.pixels as u64;
         let chunks = (PASS_BYTES / per_chunk).max(1);
         (chunks * u64::from(layers.chunk)).min(u64::from(u32::MAX)) as u32
+    }
+
+    /// The share of pass `key`'s frames folded, counting the frame in pieces by the share of its
+    /// invocations traced (0 when another pass, or none, is held).
+    pub(crate) fn pass_share(&self, key: PassKey) -> f64 {
+        let Some(pass) = self.pass.as_ref().filter(|p| p.key == key) else { return 0.0 };
+        let n = f64::from(self.base.particles.max(1));
+        let stages = if self.gather.is_some() { 2.0 } else { 1.0 };
+        let within = match pass.cursor {
+            Cursor::FrameStart => 0.0,
+            Cursor::Within { stage: Stage::Particles, next } => f64::from(next) / n / stages,
+            Cursor::Within { stage: Stage::Gather, next } => (1.0 + f64::from(next) / n) / stages,
+        };
+        ((f64::from(pass.frames_done) + within) / f64::from(pass.key.spp.max(1))).min(1.0)
+    }
+
+    /// What one whole frame was measured to cost, in seconds.
+    pub(crate) fn frame_seconds(&self) -> Option<f64> {
+        self.costs.frame
     }
 
     /// Whether the frames of pass `key` are all traced and folded.
@@ -571,185 +270,158 @@ impl CausticTracer {
     }
 
     /// Traces the frames of pass `key` (absolute sample indices `key.first_sample..`, grouped
-    /// in the slot layers `key.layers`) and folds them, waiting for each submission. Without
-    /// `target_seconds` all of them, and it returns true; with it, one submission sized to that
-    /// time (a viewer's share of a frame: some frames, or a piece of one), and it returns true
-    /// only when the pass's frames were all folded before this call (so a step is one
-    /// submission of caustic work or one band, never both).
+    /// in the slot layers `key.layers`) and folds them, one submission per call sized to `target`
+    /// seconds (`schedule.rs`), waiting for it. Returns true only when the pass's frames were all
+    /// folded before this call (so a step is one submission of caustic work or one band, never
+    /// both).
     #[cfg(not(target_arch = "wasm32"))]
     pub(crate) fn prepare_pass(
         &mut self,
         gpu: &GpuContext,
         key: PassKey,
-        target_seconds: Option<f64>,
+        target: f64,
     ) -> Result<bool, PathTraceError> {
         let mut pass = self.take_pass(key);
-        // A polled read left in flight is abandoned, and so is a frame begun in pieces by
-        // polling (its pieces may not all be done): their frames are traced again here.
-        if pass.in_flight.take().is_some() || pass.pieces.as_ref().is_some_and(|p| !p.waited) {
-            pass.pieces = None;
+        // A polled submission left in flight is abandoned, and so is a frame begun by polling
+        // (its last piece may not be done): the frame is traced again from its start here.
+        if pass.in_flight.take().is_some() || pass.polled_frame {
+            pass.restart_frame();
         }
         let ready = pass.complete();
         let (pixels, unit) = (self.pixels, self.unit);
-        loop {
-            let started = Instant::now();
-            match self.launch(gpu, &mut pass, target_seconds, true)? {
-                None => break,
-                Some(Launched::Piece) => {
-                    gpu.wait_idle("tracing a piece of a caustic frame")?;
-                    if let Some(pieces) = &mut pass.pieces {
-                        let stage = usize::from(pieces.submitted > pieces.counts[0]);
-                        pieces.seconds[stage] += started.elapsed().as_secs_f64();
-                    }
-                }
-                Some(Launched::Frames { staging, bytes, count, pieces_seconds }) => {
-                    illum_gpu::readback::with_mapped(
-                        gpu,
-                        &staging,
-                        bytes.total,
-                        "reading back caustic frames",
-                        |data| {
-                            let words = bytemuck::cast_slice(&data[..bytes.frames as usize]);
-                            pass.fold_frames(words, count, pixels, unit)
-                        },
-                    )?;
-                    self.staging = Some(staging);
-                    // What the steps waited for: the frames (or the frame's pieces), their
-                    // readback and their fold.
-                    let elapsed = started.elapsed().as_secs_f64();
-                    let seconds = match pieces_seconds {
-                        Some(mut stages) => {
-                            stages[usize::from(self.gather.is_some())] += elapsed;
-                            self.stage_seconds = Some(stages);
-                            stages[0] + stages[1]
-                        }
-                        None => elapsed,
-                    };
-                    self.seconds_per_frame = Some(seconds / f64::from(count));
-                    self.seconds_spent += seconds;
-                }
+        let started = Instant::now();
+        match self.launch(gpu, &mut pass, target)? {
+            None => {}
+            Some(Launched::Piece(submission)) => {
+                gpu.wait_idle("tracing a piece of a caustic frame")?;
+                let seconds = started.elapsed().as_secs_f64();
+                self.record(&mut pass, submission, seconds, seconds);
             }
-            if target_seconds.is_some() {
-                break;
+            Some(Launched::Frames { staging, bytes, count, submission }) => {
+                let mut fold_seconds = 0.0;
+                illum_gpu::readback::with_mapped(
+                    gpu,
+                    &staging,
+                    bytes.total,
+                    "reading back caustic frames",
+                    |data| {
+                        let fold = Instant::now();
+                        pass.fold_frames(
+                            bytemuck::cast_slice(&data[..bytes.frames as usize]),
+                            count,
+                            pixels,
+                            unit,
+                        );
+                        fold_seconds = fold.elapsed().as_secs_f64();
+                    },
+                )?;
+                self.staging = Some(staging);
+                let seconds = started.elapsed().as_secs_f64();
+                self.record(&mut pass, submission, seconds, seconds - fold_seconds);
             }
         }
         self.pass = Some(pass);
         Ok(ready)
     }
 
+    /// Learns from a submission that took `seconds` in all, `work_seconds` of them before its
+    /// fold (the piece's own cost).
+    fn record(&mut self, pass: &mut CausticPass, submission: Submission, seconds: f64, work_seconds: f64) {
+        self.seconds_spent += seconds;
+        match submission {
+            Submission::Frames { count } => self.costs.record_frames(count, seconds),
+            Submission::Piece { stage, count, read, .. } => {
+                self.costs.record_piece(stage, count, work_seconds);
+                pass.frame_seconds += seconds;
+                if read {
+                    self.costs.record_pieced_frame(pass.frame_seconds);
+                    pass.frame_seconds = 0.0;
+                }
+            }
+        }
+    }
+
     /// The polled form of [`Self::prepare_pass`]: true once the frames of pass `key` are all
     /// folded. Each call folds the frames in flight if their mapping is done, or sees whether
-    /// the piece in flight is done, and then submits the next work; it never waits.
+    /// the piece in flight is done, and then submits the next work; it never waits. Times are
+    /// taken from the submission to the call that sees it done (they count the frames a page
+    /// drew meanwhile, so submissions stay short), or from the GPU's timestamps for whole frames
+    /// where the device has them.
     pub(crate) fn poll_pass(
         &mut self,
         gpu: &GpuContext,
         key: PassKey,
-        target_seconds: Option<f64>,
+        target: f64,
     ) -> Result<bool, PathTraceError> {
         let mut pass = self.take_pass(key);
         if let Some(flight) = pass.in_flight.take() {
-            let Some(result) = flight.read.poll(gpu) else {
-                pass.in_flight = Some(flight);
-                self.pass = Some(pass);
-                return Ok(false);
-            };
-            let data = result?;
-            let frames = flight.bytes.frames as usize;
-            pass.fold_frames(bytemuck::cast_slice(&data[..frames]), flight.count, self.pixels, self.unit);
-            // Whole frames: the GPU's time where the device has timestamps; else the time until
-            // the mapping was seen done, which counts the frames drawn meanwhile (so dispatches
-            // stay short). A frame traced in pieces keeps the cost that cut it.
-            if !flight.pieced {
-                let gpu_ms =
-                    self.timer.decode(&data[frames..]).map(|passes| passes.iter().map(|p| p.1).sum::<f64>());
-                let seconds = gpu_ms.map_or_else(|| flight.launched.elapsed().as_secs_f64(), |ms| ms * 1e-3);
-                self.seconds_per_frame = Some(seconds / f64::from(flight.count));
-            }
-            self.seconds_spent += self.seconds_per_frame.unwrap_or(0.0) * f64::from(flight.count);
-            self.staging = Some(flight.read.into_buffer());
-        } else if let Some(pieces) = &pass.pieces {
-            // One piece on the GPU at a time: the queue never holds more than a step's work.
-            if let Err(e) = gpu.device.poll(wgpu::PollType::Poll) {
-                return Err(illum_gpu::GpuError::DeviceLost { message: e.to_string() }.into());
-            }
-            if !pieces.done.load(Ordering::Acquire) {
-                self.pass = Some(pass);
-                return Ok(false);
+            let seconds = flight.launched.elapsed().as_secs_f64();
+            match flight.what {
+                Flight::Read { read, bytes, count } => {
+                    let Some(result) = read.poll(gpu) else {
+                        pass.in_flight =
+                            Some(InFlight { what: Flight::Read { read, bytes, count }, ..flight });
+                        self.pass = Some(pass);
+                        return Ok(false);
+                    };
+                    let data = result?;
+                    let frames = bytes.frames as usize;
+                    pass.fold_frames(bytemuck::cast_slice(&data[..frames]), count, self.pixels, self.unit);
+                    let gpu_seconds = matches!(flight.submission, Submission::Frames { .. })
+                        .then(|| self.timer.decode(&data[frames..]))
+                        .flatten()
+                        .map(|passes| passes.iter().map(|p| p.1).sum::<f64>() * 1e-3);
+                    let seconds = gpu_seconds.unwrap_or(seconds);
+                    self.record(&mut pass, flight.submission, seconds, seconds);
+                    self.staging = Some(read.into_buffer());
+                }
+                Flight::Piece(done) => {
+                    // One piece on the GPU at a time: the queue never holds more than a step's work.
+                    if let Err(e) = gpu.device.poll(wgpu::PollType::Poll) {
+                        return Err(illum_gpu::GpuError::DeviceLost { message: e.to_string() }.into());
+                    }
+                    if !done.load(Ordering::Acquire) {
+                        pass.in_flight = Some(InFlight { what: Flight::Piece(done), ..flight });
+                        self.pass = Some(pass);
+                        return Ok(false);
+                    }
+                    self.record(&mut pass, flight.submission, seconds, seconds);
+                }
             }
         }
-        let launched = self.launch(gpu, &mut pass, target_seconds, false)?;
+        let launched = self.launch(gpu, &mut pass, target)?;
         let complete = launched.is_none();
-        match launched {
-            Some(Launched::Frames { staging, bytes, count, pieces_seconds }) => {
-                pass.in_flight = Some(InFlight {
+        let now = Instant::now();
+        pass.in_flight = match launched {
+            Some(Launched::Frames { staging, bytes, count, submission }) => Some(InFlight {
+                what: Flight::Read {
                     read: PendingRead::start(staging, bytes.total, "reading back caustic frames"),
                     bytes,
                     count,
-                    launched: Instant::now(),
-                    pieced: pieces_seconds.is_some(),
-                });
+                },
+                submission,
+                launched: now,
+            }),
+            Some(Launched::Piece(submission)) => {
+                pass.polled_frame = true;
+                let done = Arc::new(AtomicBool::new(false));
+                let flag = done.clone();
+                gpu.queue.on_submitted_work_done(move || flag.store(true, Ordering::Release));
+                Some(InFlight { what: Flight::Piece(done), submission, launched: now })
             }
-            Some(Launched::Piece) => {
-                let done = pass.pieces.as_ref().map(|p| p.done.clone()).expect("a piece belongs to a frame");
-                gpu.queue.on_submitted_work_done(move || done.store(true, Ordering::Release));
-            }
-            None => {}
-        }
+            None => None,
+        };
         self.pass = Some(pass);
         Ok(complete)
     }
 
-    /// Frames for the next dispatch: as many as the buffers hold without a `target_seconds`,
-    /// else the target's worth at the last measured cost (one before any measurement, and at
-    /// least one).
-    fn dispatch_frames(&self, target_seconds: Option<f64>) -> u32 {
-        match (target_seconds, self.seconds_per_frame) {
-            (None, _) => self.max_frames_per_dispatch,
-            (Some(_), None) => 1,
-            (Some(target), Some(cost)) => {
-                (target / cost.max(1e-9)).floor().clamp(1.0, f64::from(self.max_frames_per_dispatch)) as u32
-            }
+    /// The shape of this tracer's frames, for `schedule.rs`.
+    fn frame_shape(&self) -> FrameShape {
+        FrameShape {
+            invocations: self.base.particles,
+            gather: self.gather.is_some(),
+            max_frames: self.max_frames_per_dispatch,
         }
-    }
-
-    /// Pieces of the next frame's particles and of its gather: `None` (a whole frame) unless
-    /// a `target_seconds` is shorter than the last measured frame; then each stage in pieces
-    /// of about the target, by the stages' measured costs (half the frame's each before they
-    /// are measured), at most one per workgroup row or column of the dispatch, none empty.
-    fn frame_pieces(&self, target_seconds: Option<f64>) -> Option<[u32; 2]> {
-        let (target, cost) = (target_seconds?, self.seconds_per_frame?);
-        if cost <= target {
-            return None;
-        }
-        let split = match (self.stage_seconds, self.gather.is_some()) {
-            (Some(stages), _) => stages,
-            (None, true) => [cost / 2.0, cost / 2.0],
-            (None, false) => [cost, 0.0],
-        };
-        let units = self.piece_units();
-        let pieces = |seconds: f64| {
-            let wanted = (seconds / target.max(1e-9)).ceil().clamp(1.0, f64::from(units)) as u32;
-            units.div_ceil(units.div_ceil(wanted))
-        };
-        Some([pieces(split[0]), if self.gather.is_some() { pieces(split[1]) } else { 0 }])
-    }
-
-    /// The units a frame's dispatch is cut along: its workgroups along x when it has one row
-    /// of them, else its rows.
-    fn piece_units(&self) -> u32 {
-        let (gx, gy) = self.groups;
-        if gy == 1 { gx } else { gy }
-    }
-
-    /// Piece `i` of `count` of a frame's dispatch: its workgroups and its first particle (or
-    /// pixel). The pieces cover the dispatch once, in order.
-    fn piece(&self, i: u32, count: u32) -> ((u32, u32), u32) {
-        let (gx, gy) = self.groups;
-        let units = self.piece_units();
-        let per = units.div_ceil(count);
-        let first = (i * per).min(units);
-        let n = per.min(units - first);
-        if gy == 1 { ((n, 1), first * WORKGROUP) } else { ((gx, n), first * self.base.row_stride) }
     }
 
     /// The staging buffer for a dispatch's frames (the one read last, or a new one).
@@ -767,76 +439,77 @@ impl CausticTracer {
         }
     }
 
-    /// Submits the next work of `pass`: whole frames (sized by [`Self::dispatch_frames`]), or
-    /// the next piece of a frame cut by [`Self::frame_pieces`] (the frame's particles piece by
-    /// piece, then its gather piece by piece, its copy for readback with the last piece).
-    /// `None` when the pass is complete. `waited`: the caller waits for each piece.
+    /// Submits the next work of `pass`, as [`next_submission`] plans it at the measured costs
+    /// and `target` seconds, and moves the pass's cursor past it. `None` when the pass is
+    /// complete.
     fn launch(
         &mut self,
         gpu: &GpuContext,
         pass: &mut CausticPass,
-        target_seconds: Option<f64>,
-        waited: bool,
+        target: f64,
     ) -> Result<Option<Launched>, PathTraceError> {
         if pass.complete() {
             return Ok(None);
         }
+        let shape = self.frame_shape();
+        let submission =
+            next_submission(shape, &self.costs, target, pass.cursor, pass.key.spp - pass.frames_done);
         let frame = pass.key.first_sample + pass.frames_done;
-        if pass.pieces.is_none()
-            && let Some(counts) = self.frame_pieces(target_seconds)
-        {
-            pass.pieces =
-                Some(FramePieces { counts, submitted: 0, done: Arc::default(), seconds: [0.0; 2], waited });
+        let read = self.submit(gpu, frame, pass.key.origin, submission)?;
+        if pass.cursor == Cursor::FrameStart {
+            pass.polled_frame = false;
         }
-        let Some(pieces) = &mut pass.pieces else {
-            let count = self.dispatch_frames(target_seconds).min(pass.key.spp - pass.frames_done);
-            let groups = (self.groups.0, self.groups.1, count);
-            let (staging, bytes) =
-                self.submit(gpu, frame, count, groups, 0, Stage::Whole)?.expect("whole frames are read back");
-            return Ok(Some(Launched::Frames { staging, bytes, count, pieces_seconds: None }));
-        };
-        let (k, [particles, gathers]) = (pieces.submitted, pieces.counts);
-        let last = k + 1 == particles + gathers;
-        pieces.submitted += 1;
-        pieces.done.store(false, Ordering::Release);
-        let (((gx, gy), first), stage) = if k < particles {
-            (self.piece(k, particles), Stage::Particles { first: k == 0, last })
-        } else {
-            (self.piece(k - particles, gathers), Stage::Gather { last })
-        };
-        match self.submit(gpu, frame, 1, (gx, gy, 1), first, stage)? {
-            None => Ok(Some(Launched::Piece)),
-            Some((staging, bytes)) => {
-                let seconds = pass.pieces.take().map_or([0.0; 2], |p| p.seconds);
-                Ok(Some(Launched::Frames { staging, bytes, count: 1, pieces_seconds: Some(seconds) }))
+        pass.cursor = submission.cursor_after(shape.invocations, shape.gather);
+        Ok(Some(match (read, submission) {
+            (Some((staging, bytes)), Submission::Frames { count }) => {
+                Launched::Frames { staging, bytes, count, submission }
             }
-        }
+            (Some((staging, bytes)), Submission::Piece { .. }) => {
+                Launched::Frames { staging, bytes, count: 1, submission }
+            }
+            (None, _) => Launched::Piece(submission),
+        }))
     }
 
-    /// Records and submits one dispatch of `frames` frames from sample index `frame`, over
-    /// `groups` workgroups from particle (or pixel) `first`, as `stage` says. Returns the
-    /// staging buffer and what to read from it when the frames are complete (whole frames, or
-    /// a frame's last piece).
+    /// Workgroups (x, y) and the invocations per row for a dispatch of `count` invocations.
+    fn layout(&self, count: u32) -> (u32, u32, u32) {
+        let groups = count.div_ceil(WORKGROUP).max(1);
+        let gx = groups.min(self.max_groups_x.max(1));
+        (gx, groups.div_ceil(gx), gx * WORKGROUP)
+    }
+
+    /// Records and submits `submission` from sample index `frame` of a render whose first is
+    /// `origin`. Returns the staging buffer and what to read from it when it completes frames
+    /// (whole ones, or a frame's last piece).
     fn submit(
         &mut self,
         gpu: &GpuContext,
         frame: u32,
-        frames: u32,
-        groups: (u32, u32, u32),
-        first: u32,
-        stage: Stage,
+        origin: u32,
+        submission: Submission,
     ) -> Result<Option<(wgpu::Buffer, DispatchBytes)>, PathTraceError> {
-        let params =
-            CausticParams { frame_base: frame, frame_count: frames, first_index: first, ..self.base };
+        let n = self.base.particles;
+        let (frames, first, count, clear, particles, gather, read) = match submission {
+            Submission::Frames { count } => (count, 0, n, true, true, true, true),
+            Submission::Piece { stage, first, count, clear, read } => {
+                let particles = stage == Stage::Particles;
+                (1, first, count, clear, particles, !particles, read)
+            }
+        };
+        let (gx, gy, row_stride) = self.layout(count);
+        let params = CausticParams {
+            frame_base: frame,
+            frame_count: frames,
+            first_index: first,
+            index_end: first + count,
+            row_stride,
+            radius_origin: origin,
+            ..self.base
+        };
         let words_per_frame = WORDS_PER_PIXEL * self.pixels as u64;
         let bytes = (words_per_frame + 1) * 4 * u64::from(frames);
-        let (clear, particles, gather, read) = match stage {
-            Stage::Whole => (true, true, true, true),
-            Stage::Particles { first, last } => (first, true, false, last),
-            Stage::Gather { last } => (false, false, true, last),
-        };
-        // Whole frames are timed; a piece is timed by its caller's wait.
-        let timed = matches!(stage, Stage::Whole);
+        // Whole frames are timed; a piece is timed by its caller.
+        let timed = matches!(submission, Submission::Frames { .. });
         let staging = if read { Some(self.take_staging(gpu)?) } else { None };
         gpu.queue.write_buffer(&self.scene_params_buffer, 0, bytemuck::bytes_of(&self.scene_params));
         gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&params));
@@ -856,7 +529,7 @@ impl CausticTracer {
             });
             compute.set_pipeline(&self.pipeline);
             compute.set_bind_group(0, &self.bind_group, &[]);
-            compute.dispatch_workgroups(groups.0, groups.1, groups.2);
+            compute.dispatch_workgroups(gx, gy, frames);
         }
         // Its own pass: the gather reads what every particle of the frames stored.
         if let Some(gather) = self.gather.as_ref().filter(|_| gather) {
@@ -866,7 +539,7 @@ impl CausticTracer {
             });
             compute.set_pipeline(&gather.pipeline);
             compute.set_bind_group(0, &gather.bind_group, &[]);
-            compute.dispatch_workgroups(groups.0, groups.1, groups.2);
+            compute.dispatch_workgroups(gx, gy, frames);
         }
         let result = staging.map(|staging| {
             encoder.copy_buffer_to_buffer(&self.splat, 0, &staging, 0, bytes);
@@ -893,7 +566,7 @@ impl CausticTracer {
         camera: &[[f32; 4]],
     ) {
         let pass = self.pass.as_ref().filter(|p| p.complete()).expect("prepare_pass before fold");
-        let PassKey { first_sample, spp, layers } = pass.key;
+        let PassKey { first_sample, spp, layers, .. } = pass.key;
         let frames = layers.samples(first_sample, l, batch::chunk_taken(layers, spp, l));
         let at = l as usize * self.pixels + first_pixel;
         let range = at..at + camera.len();
@@ -917,68 +590,6 @@ impl CausticTracer {
     pub(crate) fn finish_pass(&mut self, accumulator: &mut Accumulator) {
         if let Some(pass) = self.pass.take() {
             accumulator.add_dropped(pass.dropped);
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The no-overflow argument: N particles, each below the cap, sum below 2^64; the reference
-    /// splat sits 2^24 below the cap (within a factor 2, S being a power of two), for one pixel
-    /// up to 2^28 particles and references from a dim to a blinding sun.
-    #[test]
-    fn the_fixed_point_cannot_overflow_and_keeps_headroom() {
-        for particles in [1u64, 2, 3, 1000, 512 * 512, 1 << 24, (1 << 28) - 1] {
-            for reference in [1e-30, 1e-6, 0.37, 3.0, 1e6, 1e20] {
-                let (scale, cap) = fixed_point(particles, reference);
-                assert_eq!(scale.to_bits() & 0x007f_ffff, 0, "{scale} is a power of two");
-                assert_eq!(cap.to_bits() & 0x007f_ffff, 0, "{cap} is a power of two");
-                // N cap <= 2^64: the largest total of a frame's pixel fits the two words.
-                assert!(particles as f64 * f64::from(cap) <= 2f64.powi(64), "N {particles}, cap {cap}");
-                // Every q below the cap splits exactly into two words.
-                assert!(f64::from(cap) <= 2f64.powi(64));
-                let q = reference * f64::from(scale);
-                let target = f64::from(cap) / 2f64.powi(24);
-                // (S is an f32: beyond 2^120 it stops growing, and a light of 1e-30 keeps
-                // fewer bits, still about 20.)
-                let clamped = scale == 2f32.powi(120);
-                assert!(
-                    q <= target && (q > 0.5 * target || clamped),
-                    "N {particles}, reference {reference}: q {q}, target {target}"
-                );
-            }
-        }
-        // A reference of zero (no light) or not a number gives scale 1, not infinity.
-        assert_eq!(fixed_point(100, 0.0).0, 1.0);
-        assert_eq!(fixed_point(100, f64::NAN).0, 1.0);
-    }
-
-    #[test]
-    fn bounding_spheres_contain_their_shapes() {
-        let quad = GpuShape::Quad {
-            corner: Vec3::ZERO,
-            edge_u: Vec3::new(2.0, 0.0, 0.0),
-            edge_v: Vec3::new(1.0, 0.0, 3.0),
-        };
-        let (c, r) = bounding_sphere(&quad);
-        for p in [Vec3::ZERO, Vec3::new(2.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 3.0), Vec3::new(3.0, 0.0, 3.0)] {
-            assert!((p - c).length() <= r * (1.0 + 1e-6), "{p} outside ({c}, {r})");
-        }
-        let (cos, sin) = (0.5f32.sqrt(), 0.5f32.sqrt());
-        let boxed = GpuShape::Box {
-            local_min: Vec3::ZERO,
-            local_max: Vec3::new(1.0, 2.0, 3.0),
-            cos,
-            sin,
-            offset: Vec3::new(5.0, 0.0, 1.0),
-        };
-        let (c, r) = bounding_sphere(&boxed);
-        for i in 0..8 {
-            let l = Vec3::new((i & 1) as f32, 2.0 * ((i >> 1) & 1) as f32, 3.0 * ((i >> 2) & 1) as f32);
-            let p = Vec3::new(cos * l.x + sin * l.z, l.y, -sin * l.x + cos * l.z) + Vec3::new(5.0, 0.0, 1.0);
-            assert!((p - c).length() <= r * (1.0 + 1e-6), "corner {p} outside ({c}, {r})");
         }
     }
 }

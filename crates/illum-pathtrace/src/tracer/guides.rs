@@ -15,6 +15,7 @@ use illum_gpu::wgpu;
 use wgpu::util::DeviceExt;
 
 use super::PathTracer;
+use crate::bindings::Binding;
 use crate::gpu_scene::GpuScene;
 use crate::{PathTraceError, shaders};
 
@@ -183,9 +184,18 @@ impl PathTracer {
         })?;
         // The scene's inputs the guides read: parameters (their own), and with the generic
         // traversal the objects and materials; never the lights or adaptive sampling's counts.
-        let mut bound: Vec<(u32, &wgpu::Buffer)> =
-            pipeline.inputs().into_iter().filter(|&(binding, _)| binding == 1 || binding == 2).collect();
-        bound.extend([(0, &params_buffer), (8, &albedo), (9, &normal)]);
+        let mut bound: Vec<(u32, &wgpu::Buffer)> = pipeline
+            .inputs()
+            .into_iter()
+            .filter(|&(binding, _)| {
+                binding == Binding::Objects.index() || binding == Binding::Materials.index()
+            })
+            .collect();
+        bound.extend([
+            (Binding::Params.index(), &params_buffer),
+            (Binding::GuideAlbedo.index(), &albedo),
+            (Binding::GuideNormal.index(), &normal),
+        ]);
         let layout = compute.get_bind_group_layout(0);
         let bind_group = buffer_bind_group(device, "guide buffers", &layout, &bound);
         let mut encoder = device.create_command_encoder(&Default::default());

@@ -8,6 +8,7 @@ use wgpu::util::DeviceExt;
 
 use super::caustic::CausticTracer;
 use crate::allocation::BLOCK;
+use crate::bindings::Binding;
 use crate::gpu_scene::{self, GpuParams, GpuScene};
 use crate::options::{TracerOptions, Traversal};
 use crate::{PathTraceError, SampleAllocation, shaders, specialise};
@@ -240,18 +241,21 @@ impl ScenePipeline {
 
     /// The buffers the pipeline's bind group takes besides the batch buffers, by binding.
     pub(super) fn inputs(&self) -> Vec<(u32, &wgpu::Buffer)> {
-        let mut inputs = vec![(0, &self.params_buffer)];
+        let mut inputs = vec![(Binding::Params.index(), &self.params_buffer)];
         // A specialised pipeline has its objects and materials as literals (specialise.rs).
         if self.options.traversal == Traversal::Generic {
-            inputs.extend([(1, &self.objects_buffer), (2, &self.materials_buffer)]);
+            inputs.extend([
+                (Binding::Objects.index(), &self.objects_buffer),
+                (Binding::Materials.index(), &self.materials_buffer),
+            ]);
         }
         // A pipeline without area lights does not declare them.
         if self.base_params.num_lights > 0 {
-            inputs.push((3, &self.lights_buffer));
+            inputs.push((Binding::Lights.index(), &self.lights_buffer));
         }
         // Adaptive sampling's block counts (shader def ADAPTIVE).
         if let Some((_, block_samples)) = &self.allocation {
-            inputs.push((6, block_samples));
+            inputs.push((Binding::BlockSamples.index(), block_samples));
         }
         inputs
     }

@@ -225,10 +225,6 @@ pub(super) struct BandRunner {
     pub(super) buffers: BandBuffers,
     pub(super) timer: PassTimer,
     pub(super) pacing: Pacing,
-    /// The time a caller aims at per step (`PathTracer::set_target_seconds`), which sizes the
-    /// caustic's dispatches too; `None` (no caller's aim): a pass's caustic frames are traced
-    /// in one call, in dispatches as large as the buffers allow.
-    pub(super) caustic_target_seconds: Option<f64>,
     /// What the last `render_step` did.
     pub(super) last_step: StepReport,
 }
@@ -247,7 +243,6 @@ impl BandRunner {
             buffers: BandBuffers::default(),
             timer: PassTimer::new(gpu, &[TIMED_PASS]),
             pacing: Pacing::default(),
-            caustic_target_seconds: None,
             last_step: StepReport::default(),
         }
     }
@@ -260,7 +255,6 @@ impl BandRunner {
         self.sample_offset = other.sample_offset;
         self.chunk_aligned = other.chunk_aligned;
         self.readback = other.readback;
-        self.caustic_target_seconds = other.caustic_target_seconds;
     }
 
     pub(super) fn readback(&self) -> Readback {

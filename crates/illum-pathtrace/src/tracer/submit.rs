@@ -66,18 +66,19 @@ impl PathTracer {
     }
 
     /// The caustic's pass that `pass` pairs with (when the light tracer runs).
-    fn caustic_key(&self, pass: &ActivePass) -> PassKey {
+    pub(super) fn caustic_key(&self, pass: &ActivePass) -> PassKey {
         PassKey {
             first_sample: self.bands.sample_offset + pass.sample_base,
             spp: pass.plan.spp,
             layers: self.layers(),
+            origin: self.bands.sample_offset,
         }
     }
 
     /// Traces one band of `pass` and folds it, waiting for the readback (of the band launched
     /// ahead by the previous call, if there is one), and launches the pass's next band before
-    /// folding. `None`: the call traced caustic frames of the pass instead (a caller that aims
-    /// at a time per step gets one dispatch of them per call, see `CausticTracer::prepare_pass`).
+    /// folding. `None`: the call made one submission of the pass's caustic frames instead, sized
+    /// like a band to the step's time target (see `CausticTracer::prepare_pass`).
     #[cfg(not(target_arch = "wasm32"))]
     pub(super) fn submit_band(&mut self, pass: ActivePass) -> Result<Option<StepReport>, PathTraceError> {
         let readback = self.bands.readback().waited();
@@ -87,7 +88,7 @@ impl PathTracer {
             Submitted::Nothing | Submitted::Polled { .. } => {
                 // The caustic's frames of this pass, traced once, before its first band.
                 let key = self.caustic_key(&pass);
-                let target = self.bands.caustic_target_seconds;
+                let target = self.bands.planner.target_seconds();
                 if let Some(caustic) = &mut self.pipeline.caustic
                     && !caustic.prepare_pass(&self.pipeline.gpu, key, target)?
                 {
@@ -191,7 +192,7 @@ impl PathTracer {
                 // The caustic's frames of this pass come first, read back dispatch by dispatch
                 // over as many calls as it takes.
                 let key = self.caustic_key(&pass);
-                let target = self.bands.caustic_target_seconds;
+                let target = self.bands.planner.target_seconds();
                 if let Some(caustic) = &mut self.pipeline.caustic
                     && !caustic.poll_pass(&self.pipeline.gpu, key, target)?
                 {
@@ -318,7 +319,12 @@ impl PathTracer {
         // The caustic's frames of this pass were folded before its first band (`submit_band`,
         // `poll_band`): `finish_band` pairs them with the band's chunks.
         if let Some(caustic) = &self.pipeline.caustic {
-            let key = PassKey { first_sample: band.sample_start, spp: band.spp, layers: band.layers };
+            let key = PassKey {
+                first_sample: band.sample_start,
+                spp: band.spp,
+                layers: band.layers,
+                origin: bands.sample_offset,
+            };
             debug_assert!(caustic.holds(key), "caustic pass {key:?} not ready");
         }
 

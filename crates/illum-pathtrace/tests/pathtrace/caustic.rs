@@ -140,7 +140,7 @@ fn the_caustic_agrees_with_the_oracle_at_bounces_3_and_8() {
 
 /// The mirror ball from the side of the glass ball's caustic: its lower half reflects the
 /// caustic, paths E S+ D S+ L that only the photon gather finds with the delta sun
-/// (docs/caustics.md).
+/// (docs/caustics-gather.md).
 fn mirror_view() -> Scene {
     let mut s = shipped("whitted", 8);
     s.camera.eye = glam::Vec3::new(2.6, 2.4, -7.0);
@@ -243,7 +243,7 @@ fn the_light_of_a_caustic_scattered_again_agrees_with_the_oracle() {
 
     // Power against the error this estimator exists to remove: the GPU's image must fail the same
     // criterion against the oracle's image without the gather. (A GPU build gathering at the
-    // first diffuse vertex alone fails the comparison above: docs/caustics.md has the count.)
+    // first diffuse vertex alone fails the comparison above: docs/caustics-gather.md has the count.)
     let (failures, critical) = crate::oracle_agreement::pixel_criterion(
         &gpu.accumulator().mean_image(),
         &gpu.accumulator().variance_image(),

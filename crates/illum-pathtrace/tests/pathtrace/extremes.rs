@@ -6,7 +6,7 @@
 //! the baseline scene or a closed form. Statistical bounds are 4 standard errors for a single
 //! mean (a false alarm once in about 16 000 runs) and, per pixel, a two-sample Z-test at
 //! alpha = 0.01 that at least 97% of pixels must pass. Every measured number is printed
-//! (`cargo test --workspace --test pathtrace extremes -- --nocapture`); docs/accuracy.md records them.
+//! (`cargo test --workspace --test pathtrace extremes -- --nocapture`); docs/extremes.md records them.
 //!
 //! Long (one test per extreme) but one concept: the path tracer where floats run out.
 

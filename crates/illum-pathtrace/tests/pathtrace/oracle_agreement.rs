@@ -16,7 +16,7 @@
 //! The former criterion (Sidak over all 1 728 channel tests, |z| about 4.5, and 1% of the pixels
 //! allowed to fail) let any error of 5 pixels or fewer through, however large; this one fails on
 //! 3 pixels beyond |z| = 4.15, and a 10% error in a 5 x 5 block fails it at more positions in
-//! every comparison (docs/accuracy.md has the counts).
+//! every comparison (docs/accuracy-estimate.md has the counts).
 //!
 //! Power, checked in every comparison: a 10% bias in one 5 x 5 block of the GPU image must fail
 //! the pixel criterion at half of the block's positions or more (the count is printed); a 2%

@@ -216,21 +216,22 @@ fn polled_caustic_frames_give_the_blocking_image_bit_for_bit() {
     assert_ne!(mean(&waited), mean(&plain), "the caustic's frames changed nothing");
 }
 
-/// What the desktop viewer does with the Whitted scene: it aims at a share of each frame, and a
-/// step then traces one submission of caustic work sized to it, never a whole pass's frames at
-/// once, so the window keeps drawing. Here the target is shorter than any frame: the first
-/// frame is traced whole (its cost is not known yet), every later one in pieces (its particles
-/// and its gather in one piece per workgroup, 15 each at this size). The image is the one of a
-/// render without the target, bit for bit.
+/// Every caller's steps are sized to its time target, the light tracer's too
+/// (`tracer/caustic/schedule.rs`): a target shorter than any frame cuts every frame into pieces
+/// of one workgroup (its particles, then its gather: 15 each at this size), one per step, so a
+/// render's loop, a signal's answer and a viewer's window wait for one piece, never a pass's
+/// frames. A target without limit packs whole frames, as many as the buffers hold, once a
+/// frame's cost is known (the first frame goes in pieces of the probe's size, one per stage at
+/// this size). The image is the same bit for bit.
 #[test]
 fn a_time_target_traces_the_caustic_in_pieces_with_the_same_image() {
     let scene = caustic_scene(true);
-    let (whole, whole_waits) = render_caustic(&scene, false, false);
+    let (whole, whole_waits) = render_caustic_aiming_at(&scene, false, false, Some(f64::INFINITY));
     let (waited, waits) = render_caustic_aiming_at(&scene, false, false, Some(1e-9));
-    println!("steps without samples: {whole_waits} without a target, {waits} with one");
-    assert!(whole_waits < u64::from(CAUSTIC_SPP), "without a target a step traces a pass's frames at once");
+    println!("steps without samples: {whole_waits} without a limit, {waits} with a target of 1 ns");
+    assert!(whole_waits < u64::from(CAUSTIC_SPP), "without a limit a step traces many frames at once");
     assert!(waits > 2 * u64::from(CAUSTIC_SPP), "with it, several steps per caustic frame");
-    assert_identical(&whole, &waited, "one frame per step against whole passes");
+    assert_identical(&whole, &waited, "pieces of one workgroup against whole frames");
     let (polled, polled_waits) = render_caustic_aiming_at(&scene, true, false, Some(1e-9));
     println!("polled with a target: {polled_waits} steps without samples");
     assert!(

@@ -1,6 +1,6 @@
 //! The raster scene at the extremes. Every case checks that the image is
 //! finite and measures a physical property against a value computed here (ray casts in f64, or a
-//! second render that must agree). Each prints what it measured; docs/accuracy.md's table
+//! second render that must agree). Each prints what it measured; docs/raster-extremes.md's table
 //! "Raster extremes" quotes these numbers.
 //!
 //! Long (one test per extreme) but one concept: the rasterizer at the extremes of its inputs.
@@ -799,7 +799,7 @@ fn total_internal_reflection_mirrors_the_environment() {
     }
 }
 
-/// The extremes matrix's sun rows for the rasterizer (docs/accuracy.md): the light grazing at
+/// The extremes matrix's sun rows for the rasterizer (docs/extremes.md): the light grazing at
 /// 0.5 and 0.01 deg and straight down. The closed form is the exact f64 ray-cast shadow mask and
 /// the lit floor's colour x (ambient + N.L): no acne, no pixel of the mask missing or extra, lit
 /// metal unchanged by shadows. At 0.01 deg the shadows run about 1e4 sphere heights, far past

@@ -8,7 +8,7 @@
 //!   only on edges;
 //! - `extremes`: the scene at its extremes (low and high light, near and far
 //!   planes, the horizon, refraction ratio 1, total internal reflection), tabulated in
-//!   docs/accuracy.md;
+//!   docs/raster-extremes.md;
 //! - `passes`: a frame records only the passes its scene needs, and skipping one changes nothing;
 //! - `bands`: a large frame drawn in bands of rows is the frame drawn whole, and a frame read
 //!   back without waiting is the frame rendered.
