@@ -13,14 +13,22 @@ the throughput, the relMSE against a converged reference and the efficiency
     sudo apt-get install libllvm19        # Dr.Jit's LLVM backend; the preinstalled LLVM 15 aborts
     cargo build --release --example render
     venv/bin/python bench/vs_mitsuba.py [--size 256] [--spp 1024] [--bounces 2]
-        [--samplers independent,multijitter,orthogonal,ldsampler] [--reference-spp 16384]
+        [--samplers independent,multijitter,orthogonal,ldsampler] [--reference-spp 32768]
+        [--reference-renderer mitsuba|illum]
+
+(`scripts/readme-figures.sh --mitsuba-venv` makes that venv itself, in out/mitsuba-venv, and
+runs this script at bounces 2 and 8.) Where libLLVM-19 is installed, the script points Dr.Jit
+at it (DRJIT_LIBLLVM_PATH) unless that is already set.
 
 illum renders with independent numbers, the low-discrepancy sequence, and that sequence with
 adaptive sampling (`--adaptive`, the same mean spp).
 
-Run it on an idle machine: a parallel build doubles every time. The reference is an illum render
-with --sequence low-discrepancy at --reference-spp and its own seed, cached in out/vs-mitsuba/; its own relMSE
-adds about spp / reference-spp to every figure.
+Run it on an idle machine: a parallel build doubles every time. The reference is rendered by
+Mitsuba (`--reference-renderer mitsuba`, the default: its multijitter sampler at --reference-spp,
+in passes of --spp samples with seeds 1, 2, ... averaged), so that a difference between the two
+renderers' models of the box counts against illum as much as against Mitsuba; `illum` makes it
+with illum's low-discrepancy sequence, seed 1, instead. It is cached in out/vs-mitsuba/; its own
+relMSE adds about spp / reference-spp of a row's to every figure.
 """
 
 import argparse
@@ -34,6 +42,10 @@ import tomllib
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 OUT = os.path.join(ROOT, "out", "vs-mitsuba")
 RENDER = os.path.join(ROOT, "target", "release", "examples", "render")
+# Debian's libllvm19: Dr.Jit's LLVM backend aborts on the LLVM 15 that Mesa brings.
+LIBLLVM19 = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
+if os.path.exists(LIBLLVM19):
+    os.environ.setdefault("DRJIT_LIBLLVM_PATH", LIBLLVM19)
 
 
 def load_exr(path):
@@ -167,6 +179,46 @@ def mitsuba_child(args):
     mi.util.write_bitmap(path, image)
 
 
+def mitsuba_reference_child(args):
+    """The reference: Mitsuba's multijitter sampler, --reference-spp in passes of --spp samples
+    (one wavefront of every sample at once would not fit in memory), seeds 1, 2, ... so that no
+    pass repeats a measured row's samples (seed 0), averaged in float64."""
+    import mitsuba as mi
+    import numpy as np
+
+    mi.set_variant("llvm_ad_rgb")
+    path = args.mitsuba_reference
+    passes = max(1, args.reference_spp // args.spp)
+    scene = mi.load_dict(mitsuba_scene(args.scene, args.size, args.spp, args.bounces, "multijitter"))
+    total = None
+    for k in range(passes):
+        image = np.array(mi.render(scene, spp=args.spp, seed=1 + k), dtype=np.float64)
+        total = image if total is None else total + image
+    mi.util.write_bitmap(path, mi.Bitmap((total / passes).astype(np.float32)))
+
+
+def reference_image(args, tag):
+    """The converged image every row is compared with, rendered once and cached."""
+    spp = args.reference_spp
+    if args.reference_renderer == "mitsuba":
+        path = os.path.join(OUT, f"reference-mitsuba-multijitter-{tag}-{spp}spp.exr")
+        if not os.path.exists(path):
+            print(f"rendering the reference ({spp} spp, Mitsuba multijitter, seeds from 1) ...", flush=True)
+            subprocess.run(
+                [sys.executable, __file__, "--mitsuba-reference", path, "--size", str(args.size), "--spp",
+                 str(args.spp), "--reference-spp", str(spp), "--bounces", str(args.bounces), "--scene", args.scene],
+                check=True,
+            )
+    else:
+        # Another seed than the measured rows (seed 0): the reference's samples must not include
+        # theirs, or the low-discrepancy row would be compared partly with itself.
+        path = os.path.join(OUT, f"reference-{tag}-{spp}spp-seed1.exr")
+        if not os.path.exists(path):
+            print(f"rendering the reference ({spp} spp, illum, low-discrepancy, seed 1) ...", flush=True)
+            run_illum(args, path, spp, "low-discrepancy", seed=1)
+    return load_exr(path)
+
+
 def run_illum(args, path, spp, sequence, seed=0, extra=()):
     started = time.perf_counter()
     subprocess.run(
@@ -184,23 +236,21 @@ def main():
     parser.add_argument("--spp", type=int, default=1024)
     parser.add_argument("--bounces", type=int, default=2)
     parser.add_argument("--samplers", default="independent,multijitter,orthogonal,ldsampler")
-    parser.add_argument("--reference-spp", type=int, default=16384)
+    parser.add_argument("--reference-spp", type=int, default=32768)
+    parser.add_argument("--reference-renderer", choices=["mitsuba", "illum"], default="mitsuba")
     parser.add_argument("--mitsuba-child", nargs=2, help=argparse.SUPPRESS)
+    parser.add_argument("--mitsuba-reference", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.mitsuba_child:
         return mitsuba_child(args)
+    if args.mitsuba_reference:
+        return mitsuba_reference_child(args)
     if not os.path.exists(RENDER):
         sys.exit(f"{RENDER} is missing: cargo build --release --example render")
     os.makedirs(OUT, exist_ok=True)
 
     tag = f"{os.path.basename(args.scene)}-{args.size}-b{args.bounces}"
-    # Another seed than the measured rows (seed 0): the reference's samples must not include
-    # theirs, or the low-discrepancy row would be compared partly with itself.
-    reference_path = os.path.join(OUT, f"reference-{tag}-{args.reference_spp}spp-seed1.exr")
-    if not os.path.exists(reference_path):
-        print(f"rendering the reference ({args.reference_spp} spp, illum, low-discrepancy, seed 1) ...", flush=True)
-        run_illum(args, reference_path, args.reference_spp, "low-discrepancy", seed=1)
-    reference = load_exr(reference_path)
+    reference = reference_image(args, tag)
 
     rows = []
     # Adaptive sampling (render --adaptive): the same mean spp, spread over the image by a pilot.
@@ -217,7 +267,8 @@ def main():
         rows.append((f"Mitsuba llvm_ad_rgb ({sampler})", seconds, rel_mse(image, reference), image.mean() / reference.mean()))
 
     samples = args.size * args.size * args.spp
-    print(f"\n{args.size} x {args.size}, {args.spp} spp, bounces {args.bounces}, whole process each")
+    print(f"\n{args.size} x {args.size}, {args.spp} spp, bounces {args.bounces}, whole process each; "
+          f"reference: {args.reference_renderer}, {args.reference_spp} spp")
     # The mean ratio shows both renderers compute the same image (1 within the noise).
     print("| renderer | wall s | Msamples/s | relMSE | efficiency 1/(relMSE x s) | mean / reference mean |")
     print("|---|---|---|---|---|---|")

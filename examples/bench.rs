@@ -1,7 +1,8 @@
 //! Throughput benchmark of the path tracer (and, where built, the raster scene).
 //!
 //! ```text
-//! cargo run --release --example bench -- [--runs N] [--quick | --large [--compare-readback] | --viewer | --glint SCENE...]
+//! cargo run --release --example bench -- [--runs N] [--quick | --large [--compare-readback] | --viewer | --sequences
+//!     | --glint SCENE...]
 //! ```
 //! For `scenes/cornell.toml` at each size and bounce count it renders a fixed number of samples
 //! per pixel `runs` times and prints the median of:
@@ -11,6 +12,11 @@
 //! - rays/s: rays traced (camera, bounce and shadow rays) per second of wall time; the count
 //!   comes from the bounce structure (see `rays_per_sample`);
 //! - wall / GPU: the first rate over the second (1: the host adds nothing to the GPU's time).
+//!
+//! `--quick` and the default also time the low-discrepancy sequence against independent numbers
+//! (256 x 256, 256 spp, bounces 2): the two tracers' runs alternate, A B A B, and the ratio of
+//! their samples/s is taken pair by pair, so that the sequence's price per sample is measured
+//! side by side whatever the machine's drift. `--sequences` measures only that.
 //!
 //! `--large` measures only the 1024 x 1024 rows, where the host's share (readback and fold) is
 //! largest; `--compare-readback` adds each of them read through a staging copy, as on a discrete
@@ -34,6 +40,7 @@ use illum::image::median;
 use illum::pathtrace::{PathTracer, Readback, TracerOptions, Traversal};
 use illum::raster::RasterScene;
 use illum::raster::{Look, Motion, Options, bench_frames};
+use illum::scene::Sequence;
 use illum::scene::{Bounces, Scene};
 use illum_cli::SceneArgs;
 
@@ -56,6 +63,9 @@ struct Args {
     /// With --large: each row also read back through a staging copy (see `PathTracer::set_readback`).
     #[arg(long, requires = "large")]
     compare_readback: bool,
+    /// Only the low-discrepancy sequence against independent numbers (runs alternated).
+    #[arg(long, conflicts_with_all = ["quick", "large"])]
+    sequences: bool,
     /// Only the viewer's row: its path tracer's samples/s in a real window under xvfb-run,
     /// beside `render`'s at the same size (needs `cargo build --release -p illum-viewer`).
     #[arg(long, conflicts_with_all = ["quick", "large"])]
@@ -95,6 +105,9 @@ fn run(args: Args) -> anyhow::Result<()> {
     let gpu = illum_cli::gpu()?;
     if args.viewer {
         return bench_viewer(&gpu, &args);
+    }
+    if args.sequences {
+        return bench_sequences(&gpu, &args);
     }
     println!(
         "adapter: {} ({:?}, driver {})",
@@ -179,7 +192,63 @@ fn run(args: Args) -> anyhow::Result<()> {
     if args.large {
         return Ok(());
     }
+    bench_sequences(&gpu, &args)?;
     bench_raster(&gpu, args.runs)
+}
+
+/// Samples/s of the low-discrepancy sequence against independent numbers, the runs alternated
+/// (see the module documentation). Prints each sequence's median rates and the median, lowest
+/// and highest of the per-pair ratios.
+fn bench_sequences(gpu: &illum::gpu::GpuContext, args: &Args) -> anyhow::Result<()> {
+    const SIZE: u32 = 256;
+    const SPP: u32 = 256;
+    const BOUNCES: u32 = 2;
+    let settings = SceneArgs {
+        spp: Some(SPP),
+        bounces: Some(Bounces::Fixed(BOUNCES)),
+        width: Some(SIZE),
+        height: Some(SIZE),
+        ..Default::default()
+    };
+    let scene: Scene = illum_cli::load_scene(&args.scene, &settings)?;
+    let mut tracers = Vec::new();
+    for sequence in [Sequence::Independent, Sequence::LowDiscrepancy] {
+        let mut tracer =
+            PathTracer::with_options(gpu, &scene, TracerOptions { sequence, ..Default::default() })?;
+        // Warm-up, as for the rows above.
+        tracer.render_to_spp(16)?;
+        tracers.push((sequence, tracer, Vec::new(), Vec::new()));
+    }
+    let samples = f64::from(SIZE).powi(2) * f64::from(SPP);
+    let mut ratios = Vec::new();
+    for _ in 0..args.runs {
+        let mut rates = [0.0; 2];
+        for (i, (_, tracer, wall, gpu_rate)) in tracers.iter_mut().enumerate() {
+            tracer.reset();
+            tracer.render_to_spp(SPP)?;
+            rates[i] = samples / tracer.wall_seconds();
+            wall.push(rates[i]);
+            gpu_rate.push(samples / tracer.gpu_seconds());
+        }
+        ratios.push(rates[1] / rates[0]);
+    }
+    println!();
+    println!(
+        "| sequence ({SIZE}x{SIZE}, {SPP} spp, bounces {BOUNCES}, runs alternated) | Msamples/s (wall) | Msamples/s (GPU) |"
+    );
+    println!("|---|---|---|");
+    for (sequence, _, wall, gpu_rate) in &mut tracers {
+        println!("| {sequence} | {:.2} | {:.2} |", median(wall) * 1e-6, median(gpu_rate) * 1e-6);
+    }
+    let (lowest, highest) = ratios.iter().fold((f64::INFINITY, 0f64), |(lo, hi), &r| (lo.min(r), hi.max(r)));
+    let ratio = median(&mut ratios);
+    println!(
+        "\nlow-discrepancy / independent samples/s (wall), {} pairs: median {ratio:.3} ({lowest:.3} to \
+         {highest:.3}); time per sample {:.3}x",
+        ratios.len(),
+        1.0 / ratio
+    );
+    Ok(())
 }
 
 /// The rasterizer on the Whitted scene at 1280 x 720, enhanced look, every effect on: frames per second and

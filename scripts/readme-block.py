@@ -129,6 +129,12 @@ def headline(directory):
             lines.append(f"- **Path tracer, pipeline generated per scene against the generic one** (`bench --quick`, "
                          f"Cornell box 256 x 256, bounces {bounces}): **{s / g:.1f}x** the throughput "
                          f"({s:.1f} against {g:.1f} Msamples/s on this host).")
+    # The low-discrepancy sequence's time per sample against independent numbers (bench --quick).
+    sequence = number_after(bench, r"low-discrepancy / independent samples/s \(wall\), \d+ pairs: median ([0-9.]+)")
+    if sequence:
+        lines.append(f"- **Low-discrepancy sequence against independent numbers** (`bench --quick`, Cornell box "
+                     f"256 x 256, 256 spp, bounces 2, runs alternated): **{1 / sequence:.2f}x** the time per sample, "
+                     "its error estimate from 4 replicates included.")
     # The viewer against render (bench --viewer).
     viewer = read(directory, "bench-viewer.txt")
     ratio = number_after(viewer, r"viewer / render, median of \d+ runs: ([0-9.]+)")
@@ -141,10 +147,13 @@ def headline(directory):
     mitsuba = read(directory, "vs-mitsuba.txt")
     thr = number_after(mitsuba, r"throughput illum / Mitsuba \(fastest sampler\): ([0-9.]+)x")
     eff = number_after(mitsuba, r"efficiency illum / Mitsuba \(best of each\): ([0-9.]+)x")
+    mitsuba8 = read(directory, "vs-mitsuba-b8.txt")
+    eff8 = number_after(mitsuba8, r"efficiency illum / Mitsuba \(best of each\): ([0-9.]+)x")
     if thr is not None and eff is not None:
+        at8 = f"; at bounces 8, **{eff8:.2f}x** its efficiency" if eff8 is not None else ""
         lines.append(f"- **Against Mitsuba 3** (`bench/vs_mitsuba.py`, the same Cornell box, 256 x 256, 1024 spp, "
-                     f"whole processes): **{thr:.2f}x** its throughput and **{eff:.2f}x** its efficiency "
-                     "(1 / (relMSE x time)).")
+                     f"bounces 2, whole processes, against a reference Mitsuba rendered): **{thr:.2f}x** its "
+                     f"throughput and **{eff:.2f}x** its efficiency (1 / (relMSE x time)){at8}.")
     else:
         lines.append("- Against Mitsuba 3: not re-measured in this run (Mitsuba 3 not installed; "
                      "`bench/vs_mitsuba.py` says how); docs/performance.md has the last measured ratios.")

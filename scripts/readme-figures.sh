@@ -7,6 +7,10 @@
 #
 #     scripts/readme-figures.sh              pictures, the ladder, then the headline figures
 #     scripts/readme-figures.sh --headline   only the headline figures
+#     ... --mitsuba-venv                     (with either) first makes out/mitsuba-venv, a venv with
+#                                            Mitsuba 3 from pip, installs Debian's libllvm19 for its
+#                                            LLVM backend where missing, and compares with Mitsuba
+#                                            at bounces 2 and 8 (bench/vs_mitsuba.py)
 #
 # Timings are only meaningful on an idle machine (a parallel build doubles them), and absolute
 # ones only on the host named; the headline leads with ratios measured side by side. Needs the
@@ -15,7 +19,33 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 headline_only=false
-[ "${1:-}" = "--headline" ] && headline_only=true
+mitsuba_venv=false
+for arg in "$@"; do
+    case "$arg" in
+        --headline) headline_only=true ;;
+        --mitsuba-venv) mitsuba_venv=true ;;
+        *) echo "unknown option $arg (allowed: --headline, --mitsuba-venv)" >&2; exit 2 ;;
+    esac
+done
+
+# The Python that imports Mitsuba 3: the venv's when asked for, else the system's.
+python=python3
+if $mitsuba_venv; then
+    venv=out/mitsuba-venv
+    if [ ! -x "$venv/bin/python" ]; then
+        python3 -m venv "$venv"
+        "$venv/bin/pip" install --quiet mitsuba==3.9.1 numpy
+    fi
+    # Dr.Jit's LLVM backend aborts on the LLVM 15 that Mesa brings; bench/vs_mitsuba.py uses 19.
+    if ! dpkg -s libllvm19 > /dev/null 2>&1; then
+        if [ "$(id -u)" = 0 ]; then
+            apt-get install -y libllvm19 || { apt-get update && apt-get install -y libllvm19; }
+        else
+            sudo apt-get install -y libllvm19
+        fi
+    fi
+    python="$venv/bin/python"
+fi
 
 cargo build --release --workspace --examples --bins
 bin=target/release/examples
@@ -82,8 +112,9 @@ echo "== The headline figures (README, between the headline markers)"
 "$bin/raster_bench" --look enhanced | tee "$out/raster-bench.txt"
 for n in 10 50 200; do python3 scripts/many-spheres.py $n -o "$out/spheres-$n.toml"; done
 "$bin/bench" --runs 3 --glint scenes/whitted.toml "$out"/spheres-{10,50,200}.toml | tee "$out/bench-glint.txt"
-if python3 -c "import mitsuba" 2> /dev/null; then
-    python3 bench/vs_mitsuba.py | tee "$out/vs-mitsuba.txt"
+if "$python" -c "import mitsuba" 2> /dev/null; then
+    "$python" bench/vs_mitsuba.py --bounces 2 | tee "$out/vs-mitsuba.txt"
+    "$python" bench/vs_mitsuba.py --bounces 8 | tee "$out/vs-mitsuba-b8.txt"
 else
     echo "Mitsuba 3 is not installed here: the comparison is not re-measured (see bench/vs_mitsuba.py)" \
         | tee "$out/vs-mitsuba.txt"

@@ -16,13 +16,14 @@ struct DisplayParams {
     // Rows in this band, and the image row it starts at.
     rows: u32,
     row_offset: u32,
-    // Chunks in the band's slots (the path-tracing dispatch's z dimension).
-    chunks: u32,
+    // Slot layers in the band's slots (its chunks, times the replicates with the
+    // low-discrepancy sequence: crates/illum-pathtrace/src/batch.rs, `Layers`).
+    layers: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: DisplayParams;
 // The path-tracing pass's slots (pathtrace.wgsl's main): (sum of finite samples, finite count)
-// per chunk and pixel of the band, at chunk * band_pixels + pixel_in_band.
+// per slot layer and pixel of the band, at layer * band_pixels + pixel_in_band.
 @group(0) @binding(1) var<storage, read> batch_sum: array<vec4<f32>>;
 // One per pixel of the whole image, row-major: (running sum of finite samples, running count).
 @group(0) @binding(2) var<storage, read_write> display_sum: array<vec4<f32>>;
@@ -35,9 +36,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let band_pixels = params.rows * params.width;
     let in_band = gid.y * params.width + gid.x;
-    // Sum the chunks first and add once: one rounding of the running sum per band, not per chunk.
+    // Sum the layers first and add once: one rounding of the running sum per band, not per layer.
     var band = vec4<f32>(0.0);
-    for (var k = 0u; k < params.chunks; k++) {
+    for (var k = 0u; k < params.layers; k++) {
         band += batch_sum[k * band_pixels + in_band];
     }
     let pixel = (params.row_offset + gid.y) * params.width + gid.x;

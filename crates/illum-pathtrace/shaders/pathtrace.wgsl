@@ -13,7 +13,7 @@
 // A camera ray that hits a light sees its emitted radiance.
 
 #import illum::constants::{PI, TWO_PI, INV_PI}
-#import illum::sampler::{Sampler, sampler_new, sample_1d, sample_2d}
+#import illum::sampler::{Sampler, sampler_new, sample_1d, sample_2d, REPLICATES, REPLICATE_RUN, replicate_of}
 #import illum::sampling::{sample_cosine_hemisphere, sample_uniform_hemisphere, to_world, sample_parallelogram, sample_light_bilinear}
 #import illum::rtcore::spawn::{spawn_point, spawn_error, max_abs}
 #import illum::rtcore::codes::{MATERIAL_CHECKER, MATERIAL_DIELECTRIC, MATERIAL_MIRROR}
@@ -321,15 +321,66 @@ fn pixel_ray(x: u32, y: u32, inv_size: vec2<f32>, sampler: ptr<function, Sampler
     return camera_ray(params.camera, vec2<f32>(f32(x) + jitter.x, f32(y) + jitter.y), inv_size);
 }
 
+// The sums of a group of samples of one pixel: what one slot holds.
+struct Sums {
+    sum: vec3<f32>,
+    sum_sq: vec3<f32>,
+    finite: u32,
+    dropped: u32,
+}
+
+fn no_sums() -> Sums {
+    return Sums(vec3<f32>(0.0), vec3<f32>(0.0), 0u, 0u);
+}
+
 // Adds a sample's radiance l to the sums when it is finite; counts it as dropped otherwise.
-fn accumulate(l: vec3<f32>, sum: ptr<function, vec3<f32>>, sum_sq: ptr<function, vec3<f32>>, finite: ptr<function, u32>, dropped: ptr<function, u32>) {
+fn accumulate(l: vec3<f32>, sums: ptr<function, Sums>) {
     if (is_finite3(l)) {
-        *sum += l;
-        *sum_sq += l * l;
-        *finite += 1u;
+        (*sums).sum += l;
+        (*sums).sum_sq += l * l;
+        (*sums).finite += 1u;
     } else {
-        *dropped += 1u;
+        (*sums).dropped += 1u;
     }
+}
+
+#ifdef LOW_DISCREPANCY
+// a plus b where `take`, else a: adds a finished run's sums to one replicate's without a branch.
+fn add_if(a: Sums, b: Sums, take: bool) -> Sums {
+    let c = Sums(a.sum + b.sum, a.sum_sq + b.sum_sq, a.finite + b.finite, a.dropped + b.dropped);
+    return Sums(select(a.sum, c.sum, take), select(a.sum_sq, c.sum_sq, take), select(a.finite, c.finite, take), select(a.dropped, c.dropped, take));
+}
+
+// Per replicate (sampler.wgsl), the sums of the chunk's samples: slot layer r holds replicate r.
+struct ReplicateSums {
+    r0: Sums,
+    r1: Sums,
+    r2: Sums,
+    r3: Sums,
+}
+
+// Ends the run of sample index i, the run's sums so far `run`, when i is the run's last index
+// or the chunk's (`last`): the run's sums join its replicate and start again. The sample index
+// is the same for every invocation of a workgroup (gid.z alone sets it), so the branch is
+// uniform; the replicate is picked with selects.
+fn end_run(i: u32, last: bool, run: ptr<function, Sums>, replicates: ptr<function, ReplicateSums>) {
+    if (last || (i + 1u) % REPLICATE_RUN == 0u) {
+        let r = replicate_of(i);
+        let sums = *run;
+        (*replicates).r0 = add_if((*replicates).r0, sums, r == 0u);
+        (*replicates).r1 = add_if((*replicates).r1, sums, r == 1u);
+        (*replicates).r2 = add_if((*replicates).r2, sums, r == 2u);
+        (*replicates).r3 = add_if((*replicates).r3, sums, r == 3u);
+        *run = no_sums();
+    }
+}
+#endif
+
+// Writes the sums to layer `layer` of this invocation's chunk (see main).
+fn write_slot(gid: vec3<u32>, layer: u32, sums: Sums) {
+    let slot = ((gid.z * SLOT_LAYERS + layer) * params.rows + gid.y) * params.width + gid.x;
+    batch_sum[slot] = vec4<f32>(sums.sum, f32(sums.finite));
+    batch_sum_sq[slot] = vec4<f32>(sums.sum_sq, f32(sums.dropped));
 }
 
 // True when no component is Inf or NaN (exponent bits all ones), tested on the bits so no
@@ -339,12 +390,22 @@ fn is_finite3(v: vec3<f32>) -> bool {
     return all(exponent != vec3<u32>(0x7f800000u));
 }
 
+// Slot layers per chunk: one, or one per replicate with the low-discrepancy sequence (whose
+// error comes from the spread of its replicates, src/replicates.rs). Mirrored by
+// src/batch.rs's `Layers` (checked there by a test).
+#ifdef LOW_DISCREPANCY
+const SLOT_LAYERS: u32 = REPLICATES;
+#else
+const SLOT_LAYERS: u32 = 1u;
+#endif
+
 // One invocation traces one chunk of at most `chunk_samples` samples of one pixel and writes
-// their f32 sums to its own slot; the CPU folds the slots in f64. Chunks keep two things small:
+// their f32 sums to its own slots (one per layer, see SLOT_LAYERS); the CPU folds the slots in
+// f64. Chunks keep two things small:
 // the rounding of an f32 sum of n terms, at most (n - 1) u of the sum of their magnitudes
 // (with n = 16: 15 x 2^-24 < 1e-6 relative), and the work of one invocation (lavapipe stops an
 // invocation's loops after 65535 iterations; GPUs have watchdogs). Slot index: chunk-major, then
-// the band's rows, then columns.
+// the chunk's layers, then the band's rows, then columns.
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let first = gid.z * params.chunk_samples;
@@ -354,18 +415,20 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var count = min(params.chunk_samples, params.sample_count - first);
     let x = gid.x;
     let y = gid.y + params.row_offset;
+    let start = params.sample_base + first;
 #ifdef ADAPTIVE
     // The pixel's block ends at sample index `limit`: this chunk takes the part of its samples
     // below it (none once the block is done; the slot then holds zeros, as the fold expects).
     let limit = block_samples[(y / ADAPTIVE_BLOCK) * ((params.width + ADAPTIVE_BLOCK - 1u) / ADAPTIVE_BLOCK) + x / ADAPTIVE_BLOCK];
-    let start = params.sample_base + first;
     count = select(0u, min(count, limit - start), limit > start);
 #endif
     let pixel = y * params.width + x;
-    var sum = vec3<f32>(0.0);
-    var sum_sq = vec3<f32>(0.0);
-    var finite = 0u;
-    var dropped = 0u;
+    // The sums of the samples since the last slot boundary: the whole chunk's, or with
+    // replicates the current run's (end_run moves them to their replicate's).
+    var sums = no_sums();
+#ifdef LOW_DISCREPANCY
+    var replicates = ReplicateSums(no_sums(), no_sums(), no_sums(), no_sums());
+#endif
     let inv_size = vec2<f32>(1.0 / f32(params.width), 1.0 / f32(params.height));
 #ifdef PAIRED_PATHS
     // Two samples at a time, traced in lockstep, vertex by vertex: lavapipe runs each 8-lane
@@ -375,8 +438,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     // "Levers"). Each path keeps its own sampler, so every sample is what it
     // would be traced alone, and the sums take them in order: the image is bit for bit the same.
     for (var i = 0u; i < count; i += 2u) {
-        var first_sampler = sampler_new(params.seed, pixel, params.sample_base + first + i);
-        var second_sampler = sampler_new(params.seed, pixel, params.sample_base + first + i + 1u);
+        var first_sampler = sampler_new(params.seed, pixel, start + i);
+        var second_sampler = sampler_new(params.seed, pixel, start + i + 1u);
         var a = camera_path(pixel_ray(x, y, inv_size, &first_sampler));
         var b = camera_path(pixel_ray(x, y, inv_size, &second_sampler));
         // An odd count: the last pair has no second sample. Its path is traced all the same and
@@ -392,15 +455,21 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 break;
             }
         }
-        accumulate(a.radiance, &sum, &sum_sq, &finite, &dropped);
+        accumulate(a.radiance, &sums);
+#ifdef LOW_DISCREPANCY
+        end_run(start + i, i + 1u == count, &sums, &replicates);
+#endif
         if (second) {
-            accumulate(b.radiance, &sum, &sum_sq, &finite, &dropped);
+            accumulate(b.radiance, &sums);
+#ifdef LOW_DISCREPANCY
+            end_run(start + i + 1u, i + 2u == count, &sums, &replicates);
+#endif
         }
     }
 #else
     // One sample at a time (TracerOptions::paired_paths off: the browser).
     for (var i = 0u; i < count; i++) {
-        var sampler = sampler_new(params.seed, pixel, params.sample_base + first + i);
+        var sampler = sampler_new(params.seed, pixel, start + i);
         var a = camera_path(pixel_ray(x, y, inv_size, &sampler));
         loop {
             path_step(&a, &sampler);
@@ -408,10 +477,18 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 break;
             }
         }
-        accumulate(a.radiance, &sum, &sum_sq, &finite, &dropped);
+        accumulate(a.radiance, &sums);
+#ifdef LOW_DISCREPANCY
+        end_run(start + i, i + 1u == count, &sums, &replicates);
+#endif
     }
 #endif
-    let slot = (gid.z * params.rows + gid.y) * params.width + x;
-    batch_sum[slot] = vec4<f32>(sum, f32(finite));
-    batch_sum_sq[slot] = vec4<f32>(sum_sq, f32(dropped));
+#ifdef LOW_DISCREPANCY
+    write_slot(gid, 0u, replicates.r0);
+    write_slot(gid, 1u, replicates.r1);
+    write_slot(gid, 2u, replicates.r2);
+    write_slot(gid, 3u, replicates.r3);
+#else
+    write_slot(gid, 0u, sums);
+#endif
 }

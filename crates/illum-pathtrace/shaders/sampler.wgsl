@@ -8,15 +8,21 @@
 // two-dimensional Kronecker sequence R_2 of Roberts ("The unreasonable effectiveness of
 // quasirandom sequences", 2018):
 //     x_j = frac(s + j (1 / phi, 1 / phi^2)),  phi = 1.3247... the plastic number (phi^3 = phi + 1),
-// whose points spread evenly over the unit square for any number of samples. Per pixel:
-//   - each dimension gets a random shift s (a Cranley-Patterson rotation), independent between
-//     pairs: every sample is then uniform over all its dimensions, and the estimator unbiased;
-//   - each pair visits the points in its own order j = shuffle(i) ("padding"), a nested random
-//     permutation of the sample index (see `shuffle`). It maps the first 2^m indices onto one
-//     aligned block of 2^m consecutive ones, and a run of consecutive points of a Kronecker
-//     sequence is the sequence shifted: each pair's first 2^m samples stay evenly spread, while
-//     different pairs (a path's light sample, its bounce direction, the next bounce) are
-//     paired at random rather than in lockstep.
+// whose points spread evenly over the unit square for any number of samples. Per pixel, each
+// pair visits the points in its own order j = shuffle(i) ("padding"), a nested random
+// permutation of the sample index with a seed of its own (see `shuffle`). It maps the first 2^m
+// indices onto one aligned block of 2^m consecutive ones, b 2^m + [0, 2^m), and a run of
+// consecutive points of a Kronecker sequence is the sequence shifted: x_(b 2^m + t) = x_t +
+// b 2^m (1 / phi, 1 / phi^2). So
+//   - each pair's first 2^m samples stay evenly spread, while different pairs (a path's light
+//     sample, its bounce direction, the next bounce) are paired at random, not in lockstep;
+//   - the block's random start is the random shift (Cranley-Patterson rotation) that makes the
+//     estimator unbiased: for any fixed i, shuffle(i) is uniform over all 2^32 indices when
+//     its seed is (adding the seed and each round of the shuffle are bijections), so every
+//     sample is uniform over the 2^32 points of the sequence's full period, a rank-1 lattice
+//     whose own integration error (of order 2^-32, up to logarithms) lies far below the f32
+//     sums' rounding. No shift is added on top: it would cost two hashes per pair (about half
+//     of the sequence's arithmetic) and add nothing to that uniformity.
 // Callers draw two-dimensional integrands (pixel, light point, direction) with sample_2d, which
 // starts on an even dimension so that the two numbers are one pair.
 //
@@ -35,9 +41,11 @@ const R2_STEP_Y: u32 = 2447445414u;
 struct Sampler {
     // PCG state for the independent stream.
     state: u32,
-    // Hash of (seed, pixel), the source of the pairs' shuffles and shifts.
+    // LOW_DISCREPANCY: hash of (seed, pixel, replicate), the source of the pairs' shuffles.
     pixel_key: u32,
-    sample_index: u32,
+    // LOW_DISCREPANCY: the sample's index in its replicate's sequence, its bits reversed once
+    // here for every pair's shuffle (which works on reversed bits); unused otherwise.
+    reversed_index: u32,
     dimension: u32,
 }
 
@@ -45,22 +53,28 @@ struct Sampler {
 // REPLICATE_RUN consecutive indices, to REPLICATES independently randomised copies of the
 // sequence: run q = i / REPLICATE_RUN goes to replicate q mod REPLICATES, at index
 // (q / REPLICATES) REPLICATE_RUN + i mod REPLICATE_RUN of that copy. Each replicate has its own
-// shifts and shuffles (its own pixel key), so the R replicate means are independent and
+// shuffles (its own pixel key), so the R replicate means are independent and
 // identically distributed, and their spread estimates the variance of the pixel's mean
 // (src/replicates.rs); each replicate's first indices are still a prefix of its padded sequence.
-// Mirrored by src/replicates.rs (checked there by a test).
+// The replicate is a function of the sample index alone, so a chunk of any length and start
+// keeps its replicates apart: pathtrace.wgsl's main sums each replicate's samples into a slot
+// of its own. Mirrored by src/replicates.rs (checked there by a test).
 const REPLICATES: u32 = 4u;
 const REPLICATE_RUN: u32 = 4u;
 
+// The replicate that sample index i of a pixel belongs to.
+fn replicate_of(i: u32) -> u32 {
+    return (i / REPLICATE_RUN) % REPLICATES;
+}
+
 fn sampler_new(seed: u32, pixel: u32, sample_index: u32) -> Sampler {
 #ifdef LOW_DISCREPANCY
-    let run = sample_index / REPLICATE_RUN;
-    let replicate = run % REPLICATES;
-    let index = (run / REPLICATES) * REPLICATE_RUN + sample_index % REPLICATE_RUN;
+    let replicate = replicate_of(sample_index);
+    let index = (sample_index / (REPLICATE_RUN * REPLICATES)) * REPLICATE_RUN + sample_index % REPLICATE_RUN;
     let key = pcg_hash(seed ^ pcg_hash(pixel) ^ pcg_hash(replicate * 0x85ebca6bu + 0x27d4eb2fu));
-    return Sampler(rng_seed(seed, pixel, sample_index), key, index, 0u);
+    return Sampler(0u, key, reverseBits(index), 0u);
 #else
-    return Sampler(rng_seed(seed, pixel, sample_index), pcg_hash(seed ^ pcg_hash(pixel)), sample_index, 0u);
+    return Sampler(rng_seed(seed, pixel, sample_index), 0u, 0u, 0u);
 #endif
 }
 
@@ -70,8 +84,9 @@ fn sampler_new(seed: u32, pixel: u32, sample_index: u32) -> Sampler {
 // that agree above bit m stay together, and [0, 2^m) maps onto one aligned block. The flips are
 // the Laine-Karras permutation of the reversed bits: adding the seed, and XOR with the product
 // by an even constant, change each bit only as a function of the bits below it.
-fn shuffle(i: u32, seed: u32) -> u32 {
-    var x = reverseBits(i);
+// Takes i with its bits already reversed (`reversed`, see Sampler).
+fn shuffle(reversed: u32, seed: u32) -> u32 {
+    var x = reversed;
     x += seed;
     x ^= x * 0x6c50b47cu;
     x ^= x * 0xb82f1e52u;
@@ -82,12 +97,10 @@ fn shuffle(i: u32, seed: u32) -> u32 {
 
 // Dimensions 2k and 2k + 1 of the sample, in [0, 1)^2 (only the components asked for are used).
 fn pair_values(s: ptr<function, Sampler>, k: u32) -> vec2<f32> {
-    // The pair's seed: the pixel key plus the pair times an odd constant, mixed. The two
-    // dimensions' shifts: that seed hashed once more, differently for each.
+    // The pair's seed: the pixel key plus the pair times an odd constant, mixed.
     let seed = pcg_hash((*s).pixel_key + k * 0x9e3779b9u);
-    let j = shuffle((*s).sample_index, seed);
-    let shift = vec2<u32>(pcg_hash(seed ^ 0x68e31da4u), pcg_hash(seed ^ 0xb5297a4du));
-    let x = shift + j * vec2<u32>(R2_STEP_X, R2_STEP_Y);
+    let j = shuffle((*s).reversed_index, seed);
+    let x = j * vec2<u32>(R2_STEP_X, R2_STEP_Y);
     return vec2<f32>(x >> vec2<u32>(8u)) * 5.9604644775390625e-8;
 }
 

@@ -11,7 +11,7 @@ use illum_image::RgbImage32;
 // relMSE are the same quantity.
 use illum_image::metrics::REL_MSE_EPSILON;
 
-use crate::replicates::{Replicates, replicate_of};
+use crate::replicates::Replicates;
 
 #[derive(Clone, Debug)]
 pub struct Accumulator {
@@ -186,7 +186,7 @@ impl Accumulator {
     }
 
     /// Keeps per-replicate sums from now on (a low-discrepancy render, see `replicates.rs`); the
-    /// accumulator must be empty. Fold its chunks with [`Self::fold_chunks`].
+    /// accumulator must be empty. Fold its slots with [`Self::fold_slots`].
     pub fn enable_replicates(&mut self) {
         debug_assert_eq!(self.total, 0, "replicates enabled on a started accumulator");
         self.replicates = Some(Replicates::new(self.count.len()));
@@ -213,19 +213,22 @@ impl Accumulator {
         self.replicates.as_ref()
     }
 
-    /// [`Self::fold`] for a chunk whose samples start at absolute sample index `chunk_start`:
-    /// with replicates kept, its sums also go to the replicate of that index.
-    pub fn fold_chunk(
+    /// [`Self::fold`] for one layer of slots (`batch::Layers`): with replicates kept, its sums
+    /// also go to `replicate`, the replicate whose samples the layer holds.
+    pub fn fold_slots(
         &mut self,
         first_pixel: usize,
-        chunk_start: u64,
+        replicate: Option<usize>,
         sums: &[[f32; 4]],
         sums_sq: &[[f32; 4]],
     ) {
+        debug_assert!(
+            self.replicates.is_none() || replicate.is_some(),
+            "replicates kept, but a slot of none"
+        );
         self.fold(first_pixel, sums, sums_sq);
         let scale = self.sum_scale;
-        if let Some(replicates) = &mut self.replicates {
-            let replicate = replicate_of(chunk_start);
+        if let (Some(replicates), Some(replicate)) = (&mut self.replicates, replicate) {
             for (i, s) in sums.iter().enumerate() {
                 if s[3] > 0.0 {
                     let sum = [s[0] as f64 * scale, s[1] as f64 * scale, s[2] as f64 * scale];
@@ -286,12 +289,12 @@ impl Accumulator {
     /// sum of (c_k + s_k)^2 since the two are independent; so the sample variance estimates
     /// var(c) + var(s). When some camera samples of the chunk were dropped (n < frames), S1
     /// and S2 are scaled by n / frames, the expected share of the kept samples. With replicates
-    /// kept, S1 joins the replicate of the chunk's first sample index `chunk_start`: frame k
-    /// pairs with sample k, and the caustic's sampler deals frames to replicates as the camera's.
+    /// kept, S1 joins `replicate`, the camera layer's: frame k pairs with sample k, and the
+    /// caustic's sampler deals frames to replicates as the camera's.
     pub fn fold_independent(
         &mut self,
         first_pixel: usize,
-        chunk_start: u64,
+        replicate: Option<usize>,
         camera: &[[f32; 4]],
         sum: &[[f64; 3]],
         sum_sq: &[[f64; 3]],
@@ -314,8 +317,8 @@ impl Accumulator {
                 self.sum_sq[p][c] +=
                     sum_sq[i][c] * share + 2.0 * f64::from(chunk[c]) * scale * sum[i][c] / frames;
             }
-            if let Some(replicates) = &mut self.replicates {
-                replicates.add_values(p, replicate_of(chunk_start), sum[i].map(|v| v * share));
+            if let (Some(replicates), Some(replicate)) = (&mut self.replicates, replicate) {
+                replicates.add_values(p, replicate, sum[i].map(|v| v * share));
             }
         }
     }

@@ -11,6 +11,7 @@ use illum_scene::Scene;
 
 use crate::PathTraceError;
 use crate::bindings::Binding;
+use crate::replicates::{REPLICATES, replicate_of, samples_in};
 
 /// Bytes of one slot of a batch buffer: a vec4 of f32 (the sum buffer and the sum-of-squares
 /// buffer each hold one per slot).
@@ -21,6 +22,55 @@ pub const SLOT_BYTES: u64 = 16;
 /// invocation's work: lavapipe silently ends an invocation's loops after 65535 iterations (in
 /// total), which a single invocation looping over thousands of samples would reach, losing them.
 pub const CHUNK_SAMPLES: u32 = 16;
+
+/// How a pass's samples are grouped into slots: per chunk of `chunk` samples, one layer of
+/// slots, or with `replicated` (the low-discrepancy sequence, `replicates.rs`) one per
+/// replicate, layer `k R + r` holding replicate r's samples of chunk k (pathtrace.wgsl's
+/// SLOT_LAYERS and write_slot).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Layers {
+    pub chunk: u32,
+    pub replicated: bool,
+}
+
+impl Layers {
+    /// Slot layers per chunk.
+    pub fn per_chunk(self) -> u32 {
+        if self.replicated { REPLICATES as u32 } else { 1 }
+    }
+
+    /// Slot layers of a pass of `spp` samples.
+    pub fn count(self, spp: u32) -> u32 {
+        spp.div_ceil(self.chunk.max(1)) * self.per_chunk()
+    }
+
+    /// The chunk that layer `layer` belongs to.
+    pub fn chunk_of(self, layer: u32) -> u32 {
+        layer / self.per_chunk()
+    }
+
+    /// The replicate whose samples layer `layer` holds (`None`: not replicated).
+    pub fn replicate(self, layer: u32) -> Option<usize> {
+        self.replicated.then(|| (layer % self.per_chunk()) as usize)
+    }
+
+    /// The layer holding sample `relative` of a pass whose first sample index is `pass_start`.
+    pub fn layer_of(self, pass_start: u32, relative: u32) -> u32 {
+        let replicate =
+            if self.replicated { replicate_of(u64::from(pass_start) + u64::from(relative)) } else { 0 };
+        relative / self.chunk.max(1) * self.per_chunk() + replicate as u32
+    }
+
+    /// The samples layer `layer` holds when its chunk takes the first `taken` of its sample
+    /// indices (pass starting at index `pass_start`).
+    pub fn samples(self, pass_start: u32, layer: u32, taken: u32) -> u32 {
+        let chunk_start = u64::from(pass_start) + u64::from(self.chunk_of(layer)) * u64::from(self.chunk);
+        match self.replicate(layer) {
+            None => taken,
+            Some(r) => samples_in(chunk_start, u64::from(taken), r) as u32,
+        }
+    }
+}
 
 /// The batch buffers (sum, sum of squares) and the bind group of the pipeline that uses them.
 pub(crate) struct BatchBuffers {
@@ -86,16 +136,18 @@ pub(crate) fn device_max_slots(limits: &wgpu::Limits) -> u64 {
     limits.max_storage_buffer_binding_size.min(limits.max_buffer_size) / SLOT_BYTES
 }
 
-/// One row of one chunk is the smallest band; it must fit in one batch buffer.
-pub(crate) fn check_row_fits(scene: &Scene, max_slots: u64) -> Result<(), PathTraceError> {
+/// One row of one chunk (its `per_chunk` slot layers) is the smallest band; it must fit in one
+/// batch buffer.
+pub(crate) fn check_row_fits(scene: &Scene, per_chunk: u32, max_slots: u64) -> Result<(), PathTraceError> {
     let width = u64::from(scene.camera.width);
-    if width > max_slots {
+    let slots = width * u64::from(per_chunk);
+    if slots > max_slots {
         return Err(PathTraceError::Unsupported {
             scene: scene.name.clone(),
             message: format!(
                 "camera.width = {width}: one row needs {} bytes per batch buffer, more than the {} \
                  bytes allowed (the device's max_storage_buffer_binding_size, or a lower cap)",
-                width * SLOT_BYTES,
+                slots * SLOT_BYTES,
                 max_slots * SLOT_BYTES
             ),
         });
@@ -123,19 +175,19 @@ pub(crate) fn decode_slots(bytes: &[u8]) -> Vec<[f32; 4]> {
         .collect()
 }
 
-/// Checks that every slot accounts for all of its chunk's samples (finite + dropped): `chunks`
-/// chunks of `band_pixels` slots each, slot i of chunk k expecting `expected(k, i)` samples.
+/// Checks that every slot accounts for all of its samples (finite + dropped): `layers` layers
+/// of `band_pixels` slots each, slot i of layer l expecting `expected(l, i)` samples.
 /// A shortfall means the driver ended an invocation early, and the band's statistics would
 /// silently be short. Returns the samples of the band.
 pub(crate) fn check_complete(
     sums: &[[f32; 4]],
     sums_sq: &[[f32; 4]],
-    chunks: u32,
+    layers: u32,
     band_pixels: usize,
     expected: impl Fn(u32, usize) -> u32,
 ) -> Result<u64, PathTraceError> {
     let mut total = 0;
-    for k in 0..chunks {
+    for k in 0..layers {
         let range = k as usize * band_pixels..(k as usize + 1) * band_pixels;
         for (i, (s, q)) in sums[range.clone()].iter().zip(&sums_sq[range]).enumerate() {
             let found = s[3] as u64 + q[3] as u64;
@@ -149,9 +201,16 @@ pub(crate) fn check_complete(
     Ok(total)
 }
 
-/// The samples slot i of chunk k holds in a pass of `spp` samples in chunks of `chunk`.
-pub(crate) fn uniform_chunk(spp: u32, chunk: u32) -> impl Fn(u32, usize) -> u32 {
-    move |k, _| chunk.min(spp - k * chunk)
+/// The samples slot i of layer l holds in a pass of `spp` samples starting at sample index
+/// `pass_start`, laid out as `layers`.
+pub(crate) fn uniform_chunk(layers: Layers, pass_start: u32, spp: u32) -> impl Fn(u32, usize) -> u32 {
+    move |l, _| layers.samples(pass_start, l, chunk_taken(layers, spp, l))
+}
+
+/// The samples of the pass that the chunk of layer `l` takes: a whole chunk, or the rest.
+pub(crate) fn chunk_taken(layers: Layers, spp: u32, l: u32) -> u32 {
+    let chunk = layers.chunk.max(1);
+    chunk.min(spp - layers.chunk_of(l) * chunk)
 }
 
 #[cfg(test)]
@@ -163,13 +222,50 @@ mod tests {
         // 2 pixels, 20 spp in chunks of 16: chunk 0 holds 16 samples, chunk 1 holds 4.
         let sums = [[0.0, 0.0, 0.0, 16.0], [0.0, 0.0, 0.0, 15.0], [0.0, 0.0, 0.0, 4.0], [0.0, 0.0, 0.0, 3.0]];
         let sums_sq = [[0.0; 4], [0.0, 0.0, 0.0, 1.0], [0.0; 4], [0.0, 0.0, 0.0, 1.0]];
-        let total =
-            check_complete(&sums, &sums_sq, 2, 2, uniform_chunk(20, 16)).expect("dropped samples count");
+        let layers = Layers { chunk: 16, replicated: false };
+        let total = check_complete(&sums, &sums_sq, 2, 2, uniform_chunk(layers, 0, 20))
+            .expect("dropped samples count");
         assert_eq!(total, 40);
         let mut short = sums_sq;
         short[3][3] = 0.0;
-        let error = check_complete(&sums, &short, 2, 2, uniform_chunk(20, 16)).expect_err("a lost sample");
+        let error =
+            check_complete(&sums, &short, 2, 2, uniform_chunk(layers, 0, 20)).expect_err("a lost sample");
         assert!(matches!(error, PathTraceError::IncompleteBatch { expected: 4, found: 3 }), "{error}");
+    }
+
+    /// The shader's layer count is the Rust one.
+    #[test]
+    fn slot_layers_match_the_shader() {
+        let source = include_str!("../shaders/pathtrace.wgsl");
+        assert!(source.contains("const SLOT_LAYERS: u32 = REPLICATES;"));
+        assert!(source.contains("const SLOT_LAYERS: u32 = 1u;"));
+        assert_eq!(Layers { chunk: 16, replicated: true }.per_chunk() as usize, REPLICATES);
+    }
+
+    /// Replicated layers: every sample of a pass is in the layer of its chunk and replicate, and
+    /// each layer's count is the number of its samples, for passes starting and ending inside
+    /// runs and chunks.
+    #[test]
+    fn every_sample_is_counted_in_its_chunks_replicate_layer() {
+        let layers = Layers { chunk: 16, replicated: true };
+        for pass_start in [0u32, 1, 6, 16, 29, 1 << 31] {
+            for spp in [1u32, 3, 16, 17, 40, 64] {
+                let mut counted = vec![0u32; layers.count(spp) as usize];
+                for relative in 0..spp {
+                    let l = layers.layer_of(pass_start, relative);
+                    assert_eq!(layers.chunk_of(l), relative / 16);
+                    let absolute = u64::from(pass_start) + u64::from(relative);
+                    assert_eq!(layers.replicate(l), Some(replicate_of(absolute)));
+                    counted[l as usize] += 1;
+                }
+                let expected = uniform_chunk(layers, pass_start, spp);
+                for (l, &n) in counted.iter().enumerate() {
+                    assert_eq!(expected(l as u32, 0), n, "start {pass_start}, {spp} spp, layer {l}");
+                }
+            }
+        }
+        let plain = Layers { chunk: 16, replicated: false };
+        assert_eq!((plain.count(40), plain.layer_of(5, 33), plain.replicate(2)), (3, 2, None));
     }
 
     #[test]

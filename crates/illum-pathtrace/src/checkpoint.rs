@@ -367,11 +367,7 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint, CheckpointError> {
     let aligned_prefix = match layers.next().transpose()?.flatten() {
         Some(prefix) => {
             let spp: u32 = whole_number(path, &metadata, "aligned_spp")?;
-            // A low-discrepancy render's chunks are its replicates' runs (replicates.rs).
-            let chunk = match metadata.get("sequence") {
-                Some("low-discrepancy") => crate::replicates::REPLICATE_RUN,
-                _ => crate::CHUNK_SAMPLES,
-            };
+            let chunk = crate::CHUNK_SAMPLES;
             if spp > spp_done || !(sample_start + spp).is_multiple_of(chunk) {
                 return Err(CheckpointError::InvalidField {
                     path: path.to_path_buf(),

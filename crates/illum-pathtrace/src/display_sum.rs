@@ -34,7 +34,7 @@ struct DisplayParams {
     width: u32,
     rows: u32,
     row_offset: u32,
-    chunks: u32,
+    layers: u32,
 }
 
 /// The display-sum pipeline (cached in the context: every tracer on a device uses the same one,
@@ -148,7 +148,8 @@ impl DisplaySum {
     }
 
     /// Records, into the band's encoder after its path-tracing pass, the pass that adds the
-    /// band's `batch_sum` slots (`chunks` chunks of `rows` rows from `row_offset`) into the sum.
+    /// band's `batch_sum` slots (`layers` slot layers of `rows` rows from `row_offset`, see
+    /// `batch::Layers`) into the sum.
     pub(crate) fn record(
         &mut self,
         gpu: &GpuContext,
@@ -156,9 +157,9 @@ impl DisplaySum {
         batch_sum: &wgpu::Buffer,
         rows: u32,
         row_offset: u32,
-        chunks: u32,
+        layers: u32,
     ) {
-        let params = DisplayParams { width: self.width, rows, row_offset, chunks };
+        let params = DisplayParams { width: self.width, rows, row_offset, layers };
         // Queue writes land before the next submission, which is this band's.
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         if self.bound.as_ref().is_none_or(|(bound, _)| bound != batch_sum) {

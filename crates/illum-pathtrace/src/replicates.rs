@@ -4,8 +4,8 @@
 //! low-discrepancy sequence: its samples are negatively correlated, and its error falls faster
 //! than 1/n (docs/accuracy.md measured s^2 / n at 4.5 times the true relMSE at 4096 spp). So
 //! the sampler (shaders/sampler.wgsl) deals a pixel's sample indices, in runs of
-//! [`REPLICATE_RUN`], to [`REPLICATES`] copies of the sequence, each with its own random shifts
-//! and shuffles. The R replicate means m_r are then independent and identically distributed,
+//! [`REPLICATE_RUN`], to [`REPLICATES`] copies of the sequence, each with its own random
+//! shuffles. The R replicate means m_r are then independent and identically distributed,
 //! each unbiased, and the pixel's mean is their average; its variance is estimated without
 //! assuming anything about the sequence by
 //!
@@ -18,14 +18,23 @@
 //! formula weighted, R / (R - 1) sum_r (n_r / N)^2 (m_r - m)^2, reduces to it when the n_r are
 //! equal. Fewer than two replicates with samples: unknown (infinite), as with one sample.
 //!
-//! The chunk of samples one GPU invocation sums must lie inside one run, so a low-discrepancy
-//! render uses chunks of [`REPLICATE_RUN`] samples; its folded chunk sums then add into the
-//! replicate of their first sample. The tracer therefore ends every planned pass of such a
-//! render on a multiple of the run (`tracer/passes.rs`), as chunk-aligned passes do. A pass
-//! that starts inside a run anyway (`add_samples_in_one_pass` with an spp that is not a multiple
-//! of it, then more) has chunks across two runs, each counted in the replicate of its first
-//! sample: that mixes replicates, whose means then spread more, and the estimate errs high.
-//! Measured with unaligned passes of any spp: est./true up to 2.4 at 4096 spp.
+//! The replicate is a function of the sample index alone, so the GPU keeps replicates apart
+//! inside any chunk: an invocation sums each replicate's samples of its chunk into a slot of its
+//! own (one slot layer per replicate, `batch::Layers`), and the f64 fold adds each slot to its
+//! replicate. Chunks, passes, resumed renders, `merge` and `--sample-range` parts may then start
+//! and end at any sample index: every sample reaches its own replicate's sums, whatever the
+//! batching (a chunk summed into the replicate of its first sample would mix replicates wherever
+//! it crossed a run, and then their means spread more and the estimate errs high: up to 2.4 times
+//! at 4096 spp, measured with that bookkeeping).
+//!
+//! The price of R replicates in error. One randomised sequence of N points has a relMSE falling
+//! as N^-alpha (alpha > 1 for the low-discrepancy sequence, 1 for independent samples). The mean
+//! of R independent replicates of N / R points each has relMSE (N / R)^-alpha / R, so its ratio
+//! to one sequence of N points is R^(alpha - 1), alpha taken between N / R and N: nothing for
+//! independent samples. On the 64 x 64 Cornell box (docs/accuracy.md, "The price"), one
+//! sequence's alpha is 1.33 from 16 to 64 spp, 1.19 from 64 to 256, 1.08 from 256 to 1024 and
+//! 1.06 from 1024 to 4096, so R = 4 predicts 1.57, 1.30, 1.12 and 1.09 times one sequence's
+//! relMSE at 64, 256, 1024 and 4096 spp; measured: 2.0, 1.35, 1.22 and 0.99.
 
 /// Independently randomised copies of the low-discrepancy sequence per pixel. R replicates of
 /// N / R points each have more error than one sequence of N points, since the sequence's
@@ -37,17 +46,24 @@
 /// estimate averages thousands of them).
 pub const REPLICATES: usize = 4;
 
-/// Consecutive sample indices that go to one replicate (the chunk size of a low-discrepancy
-/// render). 4: 16 spp reach every replicate. A chunk is one GPU invocation's samples, and
-/// shorter chunks cost throughput on lavapipe (more invocations, more slots read back and
-/// folded): at 256 x 256, 512 spp, low-discrepancy over independent samples/s measured about
-/// 0.4 with runs of 2, 0.6 with runs of 4 and 0.85 with runs of 16 (docs/accuracy-estimate.md), while
-/// runs of 16 would need 64 spp to reach every replicate.
+/// Consecutive sample indices that go to one replicate. 4: 16 spp reach every replicate, and
+/// any interleaving of the indices by parity (two halves of a render) still reaches all of
+/// them. The GPU's chunk does not depend on it: each replicate's samples of a chunk get a slot
+/// of their own.
 pub const REPLICATE_RUN: u32 = 4;
 
-/// The replicate that sample index `sample` of a pixel belongs to (as the shader's sampler_new).
+/// The replicate that sample index `sample` of a pixel belongs to (as the shader's replicate_of).
 pub fn replicate_of(sample: u64) -> usize {
     ((sample / u64::from(REPLICATE_RUN)) % REPLICATES as u64) as usize
+}
+
+/// How many of the sample indices `start..start + len` belong to `replicate`.
+pub fn samples_in(start: u64, len: u64, replicate: usize) -> u64 {
+    let (run, cycle) = (u64::from(REPLICATE_RUN), u64::from(REPLICATE_RUN) * REPLICATES as u64);
+    // Indices below n that belong to the replicate: whole cycles, then the part of its run
+    // inside the last partial cycle.
+    let below = |n: u64| n / cycle * run + (n % cycle).saturating_sub(replicate as u64 * run).min(run);
+    below(start + len) - below(start)
 }
 
 /// Per pixel and replicate: the sum of its finite samples (f64, rgb) and their count.
@@ -148,6 +164,20 @@ mod tests {
     fn samples_are_dealt_in_runs_over_every_replicate() {
         let dealt: Vec<usize> = (0..18).map(replicate_of).collect();
         assert_eq!(dealt, [0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3, 0, 0]);
+    }
+
+    /// The count of a range's indices in each replicate is the count of `replicate_of` over it,
+    /// for ranges starting and ending anywhere in a run or a cycle.
+    #[test]
+    fn samples_in_counts_each_replicates_indices_of_any_range() {
+        for start in [0u64, 1, 3, 5, 15, 16, 17, 61, 1 << 31, u64::from(u32::MAX) - 40] {
+            for len in [0u64, 1, 2, 3, 4, 7, 16, 17, 33, 40] {
+                for r in 0..REPLICATES {
+                    let direct = (start..start + len).filter(|&s| replicate_of(s) == r).count() as u64;
+                    assert_eq!(samples_in(start, len, r), direct, "{start}..+{len}, replicate {r}");
+                }
+            }
+        }
     }
 
     /// Equal counts: the textbook estimate sum (m_r - m)^2 / (R (R - 1)), by hand.

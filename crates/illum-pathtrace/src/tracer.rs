@@ -17,11 +17,10 @@
 use illum_gpu::{GpuContext, wgpu};
 use illum_scene::{Scene, Sequence};
 
-use crate::batch::{self, SLOT_BYTES};
+use crate::batch::{self, CHUNK_SAMPLES, Layers, SLOT_BYTES};
 use crate::display_sum::DisplaySum;
 use crate::gpu_scene::GpuScene;
 use crate::options::TracerOptions;
-use crate::replicates::REPLICATE_RUN;
 use crate::{Accumulator, PathTraceError, SampleAllocation, limits};
 
 mod accumulation;
@@ -116,7 +115,9 @@ impl PathTracer {
         // and one row of one chunk must fit (below).
         limits::check_texture_size(scene, &limits)?;
         let max_slots = batch::device_max_slots(&limits);
-        batch::check_row_fits(scene, max_slots)?;
+        let layers =
+            Layers { chunk: CHUNK_SAMPLES, replicated: options.sequence == Sequence::LowDiscrepancy };
+        batch::check_row_fits(scene, layers.per_chunk(), max_slots)?;
         // A low-discrepancy render also keeps its replicates, and writes them into its EXR.
         let replicate_bytes = if options.sequence == Sequence::LowDiscrepancy {
             2 * crate::replicates::Replicates::BYTES_PER_PIXEL
@@ -146,11 +147,10 @@ impl PathTracer {
         accumulator.set_radiance_exponent(gpu_scene.radiance_exponent);
         set_glint(&mut accumulator, scene);
         let pipeline = ScenePipeline::new(gpu, scene, &gpu_scene, options, allocation)?;
-        let mut bands = BandRunner::new(gpu, max_slots);
-        if options.sequence == Sequence::LowDiscrepancy {
-            // Its error comes from replicates, and a chunk must lie inside one replicate's run.
+        let bands = BandRunner::new(gpu, max_slots);
+        if layers.replicated {
+            // Its error comes from replicates, each summed in slots of its own (batch::Layers).
             accumulator.enable_replicates();
-            bands.chunk_samples = REPLICATE_RUN;
         }
         Ok(PathTracer { pipeline, bands, accumulation: Accumulation::new(accumulator) })
     }
@@ -352,13 +352,9 @@ impl PathTracer {
     /// Sets the samples per invocation (default [`crate::CHUNK_SAMPLES`]; values below 1 count as 1),
     /// from the next pass on. With 1 every sample reaches the f64 fold as its own f32 value, which
     /// makes the result the exact f64 fold of the samples (tests use it as the reference); larger
-    /// chunks round each chunk's f32 sum by up to (n - 1) x 2^-24 relative. With the
-    /// low-discrepancy sequence at most [`crate::replicates::REPLICATE_RUN`] (its default): a
-    /// chunk must lie inside one replicate's run of samples (see `replicates.rs`).
+    /// chunks round each chunk's f32 sum by up to (n - 1) x 2^-24 relative.
     pub fn set_chunk_samples(&mut self, samples: u32) {
-        let most =
-            if self.pipeline.options.sequence == Sequence::LowDiscrepancy { REPLICATE_RUN } else { u32::MAX };
-        self.bands.chunk_samples = samples.clamp(1, most);
+        self.bands.chunk_samples = samples.max(1);
     }
 
     /// Caps each batch buffer at `bytes` (at most the device's storage binding limit, which is the
@@ -367,7 +363,7 @@ impl PathTracer {
     pub fn limit_batch_bytes(&mut self, bytes: u64) -> Result<(), PathTraceError> {
         let limits = self.pipeline.gpu.device.limits();
         let slots = (bytes / SLOT_BYTES).min(batch::device_max_slots(&limits));
-        batch::check_row_fits(&self.pipeline.scene, slots)?;
+        batch::check_row_fits(&self.pipeline.scene, self.layers().per_chunk(), slots)?;
         self.bands.max_slots = slots;
         Ok(())
     }

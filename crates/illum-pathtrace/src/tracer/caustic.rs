@@ -3,8 +3,8 @@
 //!
 //! Frame k, N = width x height particles, pairs with sample index k of every pixel: pixel p's
 //! sample k is the camera path's estimate plus frame k's splat at p. Rather than adding the two
-//! per sample on the GPU, each pass traces its frames first, reads each frame back and keeps, per chunk of the pass (the same
-//! groups of sample indices as the camera's f32 chunk sums) and pixel, the f64 sum S1 and sum
+//! per sample on the GPU, each pass traces its frames first, reads each frame back and keeps, per slot layer of the pass
+//! (the same groups of sample indices as the camera's f32 slot sums, `batch::Layers`) and pixel, the f64 sum S1 and sum
 //! of squares S2 of the frames' values. Folding a camera chunk (sum C of n samples) then adds
 //!     sum += S1,   sum of squares += S2 + 2 C S1 / n.
 //! The last term replaces sum_k c_k s_k by its mean over the pairings of the chunk's camera and
@@ -41,6 +41,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use web_time::Instant;
 
 use crate::accumulator::Accumulator;
+use crate::batch::{self, Layers};
 
 use crate::PathTraceError;
 use crate::gpu_scene::GpuParams;
@@ -51,20 +52,20 @@ mod resources;
 mod schedule;
 
 pub use params::{CausticParams, bounding_sphere, fixed_point};
-use params::{PASS_BYTES, PASS_BYTES_PER_PIXEL_CHUNK, WORDS_PER_PIXEL};
+use params::{PASS_BYTES, PASS_BYTES_PER_PIXEL_LAYER, WORDS_PER_PIXEL};
 
-/// Which pass a caustic pass belongs to: its first absolute sample index, its spp, the samples
-/// per chunk of the camera's sums that its statistics are grouped by, and the render's first
+/// Which pass a caustic pass belongs to: its first absolute sample index, its spp, the slot
+/// layers of the camera's sums that its statistics are grouped by, and the render's first
 /// sample index (which the gather's radius counts from).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct PassKey {
     pub first_sample: u32,
     pub spp: u32,
-    pub chunk: u32,
+    pub layers: Layers,
     pub origin: u32,
 }
 
-/// One pass's caustic statistics: per chunk and pixel, S1 and S2 of its frames, complete once
+/// One pass's caustic statistics: per slot layer and pixel, S1 and S2 of its frames, complete once
 /// `frames_done` reaches the pass's spp.
 struct CausticPass {
     key: PassKey,
@@ -86,11 +87,11 @@ struct CausticPass {
 
 impl CausticPass {
     fn new(key: PassKey, pixels: usize) -> Self {
-        let chunks = key.spp.div_ceil(key.chunk) as usize;
+        let layers = key.layers.count(key.spp) as usize;
         CausticPass {
             key,
-            sum: vec![[0.0; 3]; chunks * pixels],
-            sum_sq: vec![[0.0; 3]; chunks * pixels],
+            sum: vec![[0.0; 3]; layers * pixels],
+            sum_sq: vec![[0.0; 3]; layers * pixels],
             dropped: 0,
             frames_done: 0,
             cursor: Cursor::FrameStart,
@@ -118,7 +119,7 @@ impl CausticPass {
         let words_per_frame = WORDS_PER_PIXEL as usize * pixels;
         for f in 0..count as usize {
             let relative = self.frames_done as usize + f;
-            let offset = (relative / self.key.chunk as usize) * pixels;
+            let offset = self.key.layers.layer_of(self.key.first_sample, relative as u32) as usize * pixels;
             let frame = &words[f * words_per_frame..(f + 1) * words_per_frame];
             for (p, w) in frame.chunks_exact(WORDS_PER_PIXEL as usize).enumerate() {
                 for c in 0..3 {
@@ -225,11 +226,12 @@ impl CausticTracer {
         self.base
     }
 
-    /// The most samples per pixel one pass may have so that its chunk statistics fit
+    /// The most samples per pixel one pass may have so that its layers' statistics fit
     /// [`PASS_BYTES`] (at least one chunk).
-    pub(crate) fn max_pass_spp(&self, chunk: u32) -> u32 {
-        let chunks = (PASS_BYTES / (PASS_BYTES_PER_PIXEL_CHUNK * self.pixels as u64)).max(1);
-        (chunks * u64::from(chunk)).min(u64::from(u32::MAX)) as u32
+    pub(crate) fn max_pass_spp(&self, layers: Layers) -> u32 {
+        let per_chunk = PASS_BYTES_PER_PIXEL_LAYER * u64::from(layers.per_chunk()) * self.pixels as u64;
+        let chunks = (PASS_BYTES / per_chunk).max(1);
+        (chunks * u64::from(layers.chunk)).min(u64::from(u32::MAX)) as u32
     }
 
     /// The share of pass `key`'s frames folded, counting the frame in pieces by the share of its
@@ -268,7 +270,7 @@ impl CausticTracer {
     }
 
     /// Traces the frames of pass `key` (absolute sample indices `key.first_sample..`, grouped
-    /// in chunks of `key.chunk`) and folds them, one submission per call sized to `target`
+    /// in the slot layers `key.layers`) and folds them, one submission per call sized to `target`
     /// seconds (`schedule.rs`), waiting for it. Returns true only when the pass's frames were all
     /// folded before this call (so a step is one submission of caustic work or one band, never
     /// both).
@@ -553,24 +555,24 @@ impl CausticTracer {
         Ok(result)
     }
 
-    /// Adds the held pass's chunk `k` for the band's pixels `first_pixel..` to the accumulator,
-    /// beside the camera's chunk sums `camera` just folded for them (see the module
+    /// Adds the held pass's layer `l` for the band's pixels `first_pixel..` to the accumulator,
+    /// beside the camera's slot sums `camera` of that layer just folded for them (see the module
     /// documentation for the cross term).
     pub(crate) fn fold(
         &self,
         accumulator: &mut Accumulator,
-        k: usize,
+        l: u32,
         first_pixel: usize,
-        chunk_start: u64,
         camera: &[[f32; 4]],
     ) {
         let pass = self.pass.as_ref().filter(|p| p.complete()).expect("prepare_pass before fold");
-        let (chunk, spp) = (pass.key.chunk, pass.key.spp);
-        let frames = (chunk * (k as u32 + 1)).min(spp) - chunk * k as u32;
-        let range = k * self.pixels + first_pixel..k * self.pixels + first_pixel + camera.len();
+        let PassKey { first_sample, spp, layers, .. } = pass.key;
+        let frames = layers.samples(first_sample, l, batch::chunk_taken(layers, spp, l));
+        let at = l as usize * self.pixels + first_pixel;
+        let range = at..at + camera.len();
         accumulator.fold_independent(
             first_pixel,
-            chunk_start,
+            layers.replicate(l),
             camera,
             &pass.sum[range.clone()],
             &pass.sum_sq[range],

@@ -122,9 +122,7 @@ impl PathTracer {
                     self.bands.planner.plan(camera.width, self.pipeline.active_height(start), remaining);
                 let mut plan =
                     self.fit(PassPlan { rows: self.pipeline.spread_rows(planned.rows, start), ..planned });
-                // Replicates (low-discrepancy) need every chunk inside one replicate's run, so
-                // their passes are always aligned (replicates.rs).
-                if self.bands.chunk_aligned || self.accumulation.accumulator.replicates().is_some() {
+                if self.bands.chunk_aligned {
                     let chunk = self.bands.chunk_samples;
                     plan = align_pass(plan, start, remaining, chunk);
                     if start.is_multiple_of(chunk.max(1)) {

@@ -17,7 +17,7 @@ use web_time::Instant;
 use super::StepReport;
 use super::pipeline::ScenePipeline;
 use crate::PathTraceError;
-use crate::batch::{BatchBuffers, CHUNK_SAMPLES};
+use crate::batch::{BatchBuffers, CHUNK_SAMPLES, Layers};
 use crate::planner::{BatchPlanner, DEFAULT_TARGET_SECONDS, PassPlan};
 
 pub(super) const TIMED_PASS: &str = "pathtrace";
@@ -116,9 +116,11 @@ pub(super) struct Band {
     pub(super) spp: u32,
     /// The pass's first sample index (absolute: the sample offset included).
     pub(super) sample_start: u32,
-    /// Samples per chunk when it was recorded (a later `set_chunk_samples` must not change it).
-    pub(super) chunk: u32,
+    /// Its slot layout when it was recorded (a later `set_chunk_samples` must not change it).
+    pub(super) layers: Layers,
+    /// Chunks (the dispatch's z dimension) and slot layers (chunks x layers per chunk).
     pub(super) chunks: u32,
+    pub(super) slot_layers: u32,
     pub(super) band_pixels: usize,
     /// Bytes of each of the two slot arrays (sums, sums of squares).
     pub(super) bytes: u64,

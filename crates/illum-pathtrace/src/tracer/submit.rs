@@ -27,7 +27,7 @@ use super::runner::{ActivePass, Band, Submitted, TIMED_PASS, Written};
 use super::runner::{Readback, Results};
 use super::{PathTracer, StepReport};
 use crate::PathTraceError;
-use crate::batch::{self, SLOT_BYTES};
+use crate::batch::{self, Layers, SLOT_BYTES};
 use crate::planner::PassPlan;
 
 const WORKGROUP: u32 = 8;
@@ -35,23 +35,32 @@ const WORKGROUP: u32 = 8;
 const READING: &str = "reading back a path-tracing batch";
 
 impl PathTracer {
+    /// The slot layout of the next pass: [`crate::batch::Layers`] of this tracer's chunk, one
+    /// layer per replicate with the low-discrepancy sequence.
+    pub(super) fn layers(&self) -> Layers {
+        let replicated = self.pipeline.options.sequence == illum_scene::Sequence::LowDiscrepancy;
+        Layers { chunk: self.bands.chunk_samples, replicated }
+    }
+
     /// Shrinks a pass plan to what the device can take: at most `max_chunks` chunks per dispatch
-    /// (the z dimension), and a band of at most `max_slots` slots (rows x width x chunks) per
-    /// batch buffer, so an image of any size is rendered band by band.
+    /// (the z dimension), and a band of at most `max_slots` slots (rows x width x slot layers)
+    /// per batch buffer, so an image of any size is rendered band by band.
     pub(super) fn fit(&self, plan: PassPlan) -> PassPlan {
         let width = u64::from(self.pipeline.scene.camera.width);
-        let chunk = u64::from(self.bands.chunk_samples);
+        let layers = self.layers();
+        let chunk = u64::from(layers.chunk);
+        let row_slots = width * u64::from(layers.per_chunk());
         let max_slots = self.bands.max_slots;
-        // check_row_fits guarantees max_slots >= width, so at least one chunk fits.
-        let max_chunks = u64::from(self.bands.max_chunks).min(max_slots / width).max(1);
+        // check_row_fits guarantees max_slots >= one row's slots, so at least one chunk fits.
+        let max_chunks = u64::from(self.bands.max_chunks).min(max_slots / row_slots).max(1);
         let spp = u64::from(plan.spp.max(1)).min(max_chunks * chunk);
         // The caustic's statistics of one pass must fit their host memory.
         let spp = match &self.pipeline.caustic {
-            Some(caustic) => spp.min(u64::from(caustic.max_pass_spp(self.bands.chunk_samples))),
+            Some(caustic) => spp.min(u64::from(caustic.max_pass_spp(layers))),
             None => spp,
         };
         let chunks = spp.div_ceil(chunk);
-        let max_rows = (max_slots / (width * chunks)).max(1);
+        let max_rows = (max_slots / (row_slots * chunks)).max(1);
         let rows = u64::from(plan.rows).clamp(1, max_rows);
         PassPlan { spp: spp as u32, rows: rows as u32 }
     }
@@ -61,7 +70,7 @@ impl PathTracer {
         PassKey {
             first_sample: self.bands.sample_offset + pass.sample_base,
             spp: pass.plan.spp,
-            chunk: self.bands.chunk_samples,
+            layers: self.layers(),
             origin: self.bands.sample_offset,
         }
     }
@@ -253,10 +262,11 @@ impl PathTracer {
         let (row_offset, end) =
             self.pipeline.active_rows(from, sample_start).unwrap_or((from.min(height - 1), height));
         let rows = pass.plan.rows.min(end - row_offset);
-        let chunk = self.bands.chunk_samples;
-        let chunks = spp.div_ceil(chunk);
+        let layers = self.layers();
+        let chunks = spp.div_ceil(layers.chunk);
+        let slot_layers = layers.count(spp);
         let band_pixels = rows as usize * width as usize;
-        let bytes = band_pixels as u64 * u64::from(chunks) * SLOT_BYTES;
+        let bytes = band_pixels as u64 * u64::from(slot_layers) * SLOT_BYTES;
         let scheduled = match &self.pipeline.allocation {
             None => band_pixels as u64 * u64::from(spp),
             Some((allocation, _)) => (row_offset..row_offset + rows)
@@ -270,8 +280,9 @@ impl PathTracer {
             rows,
             spp,
             sample_start,
-            chunk,
+            layers,
             chunks,
+            slot_layers,
             band_pixels,
             bytes,
             scheduled,
@@ -287,7 +298,7 @@ impl PathTracer {
         band: &Band,
         staging: Option<&wgpu::Buffer>,
     ) -> Result<Written, PathTraceError> {
-        let slots = band.band_pixels as u64 * u64::from(band.chunks);
+        let slots = band.band_pixels as u64 * u64::from(band.slot_layers);
         let bands = &mut self.bands;
         let batch = bands.buffers.batch_for(
             &self.pipeline,
@@ -303,7 +314,7 @@ impl PathTracer {
         params.rows = band.rows;
         params.sample_base = band.sample_start;
         params.sample_count = band.spp;
-        params.chunk_samples = band.chunk;
+        params.chunk_samples = band.layers.chunk;
         gpu.queue.write_buffer(&self.pipeline.params_buffer, 0, bytemuck::bytes_of(&params));
         // The caustic's frames of this pass were folded before its first band (`submit_band`,
         // `poll_band`): `finish_band` pairs them with the band's chunks.
@@ -311,7 +322,7 @@ impl PathTracer {
             let key = PassKey {
                 first_sample: band.sample_start,
                 spp: band.spp,
-                chunk: band.chunk,
+                layers: band.layers,
                 origin: bands.sample_offset,
             };
             debug_assert!(caustic.holds(key), "caustic pass {key:?} not ready");
@@ -337,7 +348,7 @@ impl PathTracer {
         // The display sum reads the slots on the GPU in the same submission (wgpu orders the two
         // passes); the copies below for the f64 fold are unchanged.
         if let Some(display) = &mut self.accumulation.display_sum {
-            display.record(gpu, &mut encoder, &batch.sum, band.rows, band.row_offset, band.chunks);
+            display.record(gpu, &mut encoder, &batch.sum, band.rows, band.row_offset, band.slot_layers);
         }
         match staging {
             None => {
@@ -362,19 +373,23 @@ impl PathTracer {
     /// Checks and folds a band's read-back bytes (its sums, sums of squares and timestamps), and
     /// moves the pass on.
     fn finish_band(&mut self, band: &Band, bytes: BandBytes) -> Result<StepReport, PathTraceError> {
-        let Band { row_offset, spp, sample_start, chunk, chunks, band_pixels, .. } = *band;
+        let Band { row_offset, spp, sample_start, layers, slot_layers, band_pixels, .. } = *band;
         let width = self.pipeline.scene.camera.width;
         let (sums, sums_sq) = (batch::slots(bytes.sums), batch::slots(bytes.sums_sq));
         let (sums, sums_sq) = (&sums[..], &sums_sq[..]);
-        let uniform = batch::uniform_chunk(spp, chunk);
+        let uniform = batch::uniform_chunk(layers, sample_start, spp);
         let checked = match &self.pipeline.allocation {
-            None => batch::check_complete(sums, sums_sq, chunks, band_pixels, uniform),
+            None => batch::check_complete(sums, sums_sq, slot_layers, band_pixels, uniform),
             // A block takes the part of each chunk below its count (the shader's ADAPTIVE code).
-            Some((allocation, _)) => batch::check_complete(sums, sums_sq, chunks, band_pixels, |k, i| {
-                let (x, y) = (i as u32 % width, row_offset + i as u32 / width);
-                let start = sample_start + k * chunk;
-                allocation.at(x, y).saturating_sub(start).min(uniform(k, i))
-            }),
+            Some((allocation, _)) => {
+                batch::check_complete(sums, sums_sq, slot_layers, band_pixels, |l, i| {
+                    let (x, y) = (i as u32 % width, row_offset + i as u32 / width);
+                    let start = sample_start + layers.chunk_of(l) * layers.chunk;
+                    let taken =
+                        allocation.at(x, y).saturating_sub(start).min(batch::chunk_taken(layers, spp, l));
+                    layers.samples(sample_start, l, taken)
+                })
+            }
         };
         let radiance_exponent = self.pipeline.radiance_exponent;
         let gpu = &self.pipeline.gpu;
@@ -388,13 +403,17 @@ impl PathTracer {
             }
         };
         let accumulator = &mut self.accumulation.accumulator;
-        for k in 0..chunks as usize {
-            let range = k * band_pixels..(k + 1) * band_pixels;
-            let first_pixel = row_offset as usize * width as usize;
-            let chunk_start = u64::from(sample_start) + k as u64 * u64::from(chunk);
-            accumulator.fold_chunk(first_pixel, chunk_start, &sums[range.clone()], &sums_sq[range.clone()]);
+        let first_pixel = row_offset as usize * width as usize;
+        for l in 0..slot_layers {
+            let range = l as usize * band_pixels..(l as usize + 1) * band_pixels;
+            accumulator.fold_slots(
+                first_pixel,
+                layers.replicate(l),
+                &sums[range.clone()],
+                &sums_sq[range.clone()],
+            );
             if let Some(caustic) = &self.pipeline.caustic {
-                caustic.fold(accumulator, k, first_pixel, chunk_start, &sums[range]);
+                caustic.fold(accumulator, l, first_pixel, &sums[range]);
             }
         }
         // The display pass added the camera's samples only: show the accumulator's image.

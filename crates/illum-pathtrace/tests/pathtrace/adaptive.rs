@@ -32,7 +32,15 @@ fn every_pixel_takes_its_blocks_samples() {
                 .expect("tracer");
         tracer.set_chunk_aligned_passes(true);
         if tiny_bands {
-            tracer.limit_batch_bytes(u64::from(width) * illum_pathtrace::SLOT_BYTES).expect("one row fits");
+            // One row of one chunk: its slot layers, one per replicate for the low-discrepancy
+            // sequence (src/batch.rs, `Layers`).
+            let layers = if sequence == Sequence::LowDiscrepancy {
+                illum_pathtrace::replicates::REPLICATES
+            } else {
+                1
+            };
+            let row = u64::from(width) * illum_pathtrace::SLOT_BYTES * layers as u64;
+            tracer.limit_batch_bytes(row).expect("one row fits");
         }
         tracer.set_sample_allocation(Some(allocation.clone())).expect("allocation fits");
         tracer.render_to_spp(allocation.max()).expect("render");

@@ -46,8 +46,8 @@ pub(super) const WORDS_PER_PIXEL: u64 = 6;
 pub(super) const SPLAT_BYTES: u64 = 64 << 20;
 /// Bytes per photon: three vec4 (caustic_buffers.wgsl).
 pub(super) const PHOTON_BYTES: u64 = 48;
-/// Host bytes per pixel and chunk of a pass: S1 and S2, three f64 each.
-pub(crate) const PASS_BYTES_PER_PIXEL_CHUNK: u64 = 48;
+/// Host bytes per pixel and slot layer of a pass: S1 and S2, three f64 each.
+pub(crate) const PASS_BYTES_PER_PIXEL_LAYER: u64 = 48;
 /// The most host memory one pass's caustic statistics may take.
 pub(crate) const PASS_BYTES: u64 = 256 << 20;
 
