@@ -105,7 +105,9 @@ impl CausticPass {
         self.frames_done >= self.key.spp
     }
 
-    /// Forgets the pieces of the frame in progress: it is traced again from its start.
+    /// Forgets the pieces of the frame in progress: it is traced again from its start (by the
+    /// blocking `prepare_pass`, which a browser does not have).
+    #[cfg(not(target_arch = "wasm32"))]
     fn restart_frame(&mut self) {
         self.cursor = Cursor::FrameStart;
         self.frame_seconds = 0.0;
