@@ -16,7 +16,7 @@
 use illum_image::{RgbImage32, load_exr, rel_mse};
 use illum_pathtrace::allocation::plan_adaptive;
 use illum_pathtrace::{PathTracer, Sequence, StopReason, StopRules, TracerOptions, render_progressive};
-use illum_scene::{Bounces, Overrides, Sampling};
+use illum_scene::{Bounces, Overrides, Sampling, Scene};
 
 use crate::common;
 
@@ -35,16 +35,7 @@ fn estimated_relative_error_tracks_the_true_error_within_a_factor_of_1_5() {
         .sum::<f64>()
         / (3.0 * reference.pixels.len() as f64);
 
-    let scene = common::scene(
-        "cornell",
-        Overrides {
-            width: Some(64),
-            height: Some(64),
-            bounces: Some(Bounces::Fixed(2)),
-            seed: Some(4242),
-            ..Default::default()
-        },
-    );
+    let scene = cornell_box(64, 4242);
     let mut tracer = PathTracer::new(common::gpu(), &scene).expect("builds");
     let mut log_points = Vec::new();
     for spp in [8, 32, 128, 512, 1024] {
@@ -150,16 +141,7 @@ fn target_error_stops_at_the_true_error_with_either_sequence() {
     let (reference, reference_noise) = reference();
     let mut stopped_at = Vec::new();
     for sequence in [Sequence::Independent, Sequence::LowDiscrepancy] {
-        let scene = common::scene(
-            "cornell",
-            Overrides {
-                width: Some(64),
-                height: Some(64),
-                bounces: Some(Bounces::Fixed(2)),
-                seed: Some(77),
-                ..Default::default()
-            },
-        );
+        let scene = cornell_box(64, 77);
         let mut tracer =
             PathTracer::with_options(common::gpu(), &scene, TracerOptions { sequence, ..Default::default() })
                 .expect("builds");
@@ -198,16 +180,7 @@ fn target_error_stops_at_the_true_error_with_either_sequence() {
 #[test]
 fn replicate_sums_are_exact_for_any_batching() {
     use illum_pathtrace::replicates::{REPLICATES, samples_in};
-    let scene = common::scene(
-        "cornell",
-        Overrides {
-            width: Some(8),
-            height: Some(8),
-            bounces: Some(Bounces::Fixed(2)),
-            seed: Some(5),
-            ..Default::default()
-        },
-    );
+    let scene = cornell_box(8, 5);
     let options = TracerOptions { sequence: Sequence::LowDiscrepancy, ..Default::default() };
     for offset in [0u32, 3] {
         let render = |chunk: u32, passes: &[u32]| {
@@ -250,16 +223,7 @@ fn the_low_discrepancy_estimate_is_honest_over_four_seeds() {
     // Per spp: (estimated, true) relMSE of each seed.
     let mut pairs = vec![Vec::new(); spps.len()];
     for seed in [11u32, 12, 13, 14] {
-        let scene = common::scene(
-            "cornell",
-            Overrides {
-                width: Some(64),
-                height: Some(64),
-                bounces: Some(Bounces::Fixed(2)),
-                seed: Some(seed),
-                ..Default::default()
-            },
-        );
+        let scene = cornell_box(64, seed);
         let options = TracerOptions { sequence: Sequence::LowDiscrepancy, ..Default::default() };
         let mut tracer = PathTracer::with_options(common::gpu(), &scene, options).expect("builds");
         for (k, &spp) in spps.iter().enumerate() {
@@ -360,4 +324,18 @@ fn a_whitted_part_is_honest_about_its_error_wherever_its_range_starts() {
         }
     }
     assert!(failures.is_empty(), "a part whose error estimate or image mean is not honest: {failures:?}");
+}
+
+/// The Cornell box at `size` x `size`, bounces 2, with `seed`: the scene of the estimates above.
+fn cornell_box(size: u32, seed: u32) -> Scene {
+    common::scene(
+        "cornell",
+        Overrides {
+            width: Some(size),
+            height: Some(size),
+            bounces: Some(Bounces::Fixed(2)),
+            seed: Some(seed),
+            ..Default::default()
+        },
+    )
 }
