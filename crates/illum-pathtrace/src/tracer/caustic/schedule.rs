@@ -213,8 +213,8 @@ mod tests {
         // 1 x 1 to 16384 x 16384 (and one beyond a u32 of pixels' reach is not an image).
         for invocations in [1u32, 63, 64, 65, 57_600, 921_600, 3_840 * 2_160, 16_384 * 16_384] {
             for gather in [false, true] {
-                // From cheap (1e-9 s per invocation: a whole 4K frame in 8 ms) to dear (1 ms each:
-                // one workgroup is the least a submission can carry).
+                // Invented costs per invocation, from cheap (a whole 4K frame fits one submission)
+                // to dear (a single workgroup, the least a submission carries, exceeds the target).
                 for per in [1e-9, 1e-7, 6.5e-7, 1e-5, 1e-3] {
                     let shape = FrameShape { invocations, gather, max_frames: 16 };
                     // The fold costs what the camera's own fold does, about 10 ns a pixel.
@@ -229,8 +229,8 @@ mod tests {
                             }
                         }
                     };
-                    // Three frames, or the first 20,000 submissions (a 16384 x 16384 frame at 1 ms
-                    // a workgroup is 4 million of them): the rule holds for each alike.
+                    // Three frames, or the first 20,000 submissions where the dearest costs make a
+                    // frame millions of them: the rule holds for each alike.
                     let plan = plan_pass(shape, Costs::default(), target, 3, 20_000, learn);
                     assert!(!plan.is_empty());
                     let mut expected = (Stage::Particles, 0u32);
