@@ -45,7 +45,7 @@ use crate::batch::{self, Layers};
 
 use crate::PathTraceError;
 use crate::gpu_scene::GpuParams;
-use schedule::{Costs, Cursor, FrameShape, Stage, Submission, WORKGROUP, next_submission};
+use schedule::{Costs, Cursor, FrameShape, Stage, Submission, Took, WORKGROUP, next_submission};
 
 mod params;
 mod resources;
@@ -144,6 +144,14 @@ struct InFlight {
     what: Flight,
     submission: Submission,
     launched: Instant,
+    /// Looks that found it not yet done.
+    looks: u32,
+}
+
+/// What the `seconds` from a submission to the look that saw it done say of its cost, after
+/// `looks` that saw it not done: a bound (see [`Took`]).
+fn seen_done(looks: u32, seconds: f64) -> Took {
+    if looks == 0 { Took::WithinOneLook(seconds) } else { Took::AtMost(seconds) }
 }
 
 enum Flight {
@@ -297,7 +305,7 @@ impl CausticTracer {
             Some(Launched::Piece(submission)) => {
                 gpu.wait_idle("tracing a piece of a caustic frame")?;
                 let seconds = started.elapsed().as_secs_f64();
-                self.record(&mut pass, submission, seconds, seconds);
+                self.record(&mut pass, submission, seconds, Took::Seconds(seconds));
             }
             Some(Launched::Frames { staging, bytes, count, submission }) => {
                 let mut fold_seconds = 0.0;
@@ -319,21 +327,21 @@ impl CausticTracer {
                 )?;
                 self.staging = Some(staging);
                 let seconds = started.elapsed().as_secs_f64();
-                self.record(&mut pass, submission, seconds, seconds - fold_seconds);
+                self.record(&mut pass, submission, seconds, Took::Seconds(seconds - fold_seconds));
             }
         }
         self.pass = Some(pass);
         Ok(ready)
     }
 
-    /// Learns from a submission that took `seconds` in all, `work_seconds` of them before its
-    /// fold (the piece's own cost).
-    fn record(&mut self, pass: &mut CausticPass, submission: Submission, seconds: f64, work_seconds: f64) {
+    /// Learns from a submission that took `seconds` in all as its caller saw it, `work` of
+    /// them before its fold (the piece's own cost).
+    fn record(&mut self, pass: &mut CausticPass, submission: Submission, seconds: f64, work: Took) {
         self.seconds_spent += seconds;
         match submission {
-            Submission::Frames { count } => self.costs.record_frames(count, seconds),
+            Submission::Frames { count } => self.costs.record_frames(count, work),
             Submission::Piece { stage, count, read, .. } => {
-                self.costs.record_piece(stage, count, work_seconds);
+                self.costs.record_piece(stage, count, work);
                 pass.frame_seconds += seconds;
                 if read {
                     self.costs.record_pieced_frame(pass.frame_seconds);
@@ -361,8 +369,11 @@ impl CausticTracer {
             match flight.what {
                 Flight::Read { read, bytes, count } => {
                     let Some(result) = read.poll(gpu) else {
-                        pass.in_flight =
-                            Some(InFlight { what: Flight::Read { read, bytes, count }, ..flight });
+                        pass.in_flight = Some(InFlight {
+                            what: Flight::Read { read, bytes, count },
+                            looks: flight.looks + 1,
+                            ..flight
+                        });
                         self.pass = Some(pass);
                         return Ok(false);
                     };
@@ -373,8 +384,12 @@ impl CausticTracer {
                         .then(|| self.timer.decode(&data[frames..]))
                         .flatten()
                         .map(|passes| passes.iter().map(|p| p.1).sum::<f64>() * 1e-3);
+                    let took = match gpu_seconds {
+                        Some(gpu) => Took::Seconds(gpu),
+                        None => seen_done(flight.looks, seconds),
+                    };
                     let seconds = gpu_seconds.unwrap_or(seconds);
-                    self.record(&mut pass, flight.submission, seconds, seconds);
+                    self.record(&mut pass, flight.submission, seconds, took);
                     self.staging = Some(read.into_buffer());
                 }
                 Flight::Piece(done) => {
@@ -383,11 +398,13 @@ impl CausticTracer {
                         return Err(illum_gpu::GpuError::DeviceLost { message: e.to_string() }.into());
                     }
                     if !done.load(Ordering::Acquire) {
-                        pass.in_flight = Some(InFlight { what: Flight::Piece(done), ..flight });
+                        pass.in_flight =
+                            Some(InFlight { what: Flight::Piece(done), looks: flight.looks + 1, ..flight });
                         self.pass = Some(pass);
                         return Ok(false);
                     }
-                    self.record(&mut pass, flight.submission, seconds, seconds);
+                    let took = seen_done(flight.looks, seconds);
+                    self.record(&mut pass, flight.submission, seconds, took);
                 }
             }
         }
@@ -403,13 +420,14 @@ impl CausticTracer {
                 },
                 submission,
                 launched: now,
+                looks: 0,
             }),
             Some(Launched::Piece(submission)) => {
                 pass.polled_frame = true;
                 let done = Arc::new(AtomicBool::new(false));
                 let flag = done.clone();
                 gpu.queue.on_submitted_work_done(move || flag.store(true, Ordering::Release));
-                Some(InFlight { what: Flight::Piece(done), submission, launched: now })
+                Some(InFlight { what: Flight::Piece(done), submission, launched: now, looks: 0 })
             }
             None => None,
         };
