@@ -13,6 +13,7 @@
 use illum_cli::auto::RendererChoice;
 use illum_cli::render::{RenderArgs, render};
 use illum_lab::auto::pilot::PilotOptions;
+use illum_lab::auto::plan::Goal;
 
 fn main() {
     illum_cli::main_with(run);
@@ -37,12 +38,25 @@ fn run_auto(mut args: RenderArgs) -> anyhow::Result<()> {
     let device_seconds = started.elapsed().as_secs_f64();
     let pilot = illum_lab::auto::pilot::measure(&gpu, &scene, device_seconds, &PilotOptions::default())?;
     drop(gpu);
-    let plan = illum_lab::auto::plan::plan(&pilot.candidates, goal)
+    let pilot_seconds = started.elapsed().as_secs_f64();
+    let left = illum_cli::auto::goal_left(goal, pilot_seconds).map_err(anyhow::Error::msg)?;
+    let plan = illum_lab::auto::plan::plan(&pilot.candidates, left)
         .map_err(|why| anyhow::anyhow!("{}: {why}", args.scene.display()))?;
-    print!("{}", illum_lab::auto::describe(&scene, &pilot, goal, &plan));
-    args.follow(&plan.choice, &scene);
-    let started = std::time::Instant::now();
+    if let (Goal::Seconds(budget), Goal::Seconds(rest)) = (goal, left) {
+        println!(
+            "auto: the pilot took {pilot_seconds:.1} s of the {budget} s budget; the render gets the {rest:.1} s left"
+        );
+    }
+    print!("{}", illum_lab::auto::describe(&scene, &pilot, left, &plan));
+    args.follow(&plan.choice, &scene, left);
+    let rendering = std::time::Instant::now();
     let noise = render(&args)?;
-    println!("{}", illum_lab::auto::reached(&plan.choice, noise, started.elapsed().as_secs_f64()));
+    println!("{}", illum_lab::auto::reached(&plan.choice, noise, rendering.elapsed().as_secs_f64()));
+    if let Goal::Seconds(budget) = goal {
+        println!(
+            "auto: the whole command took {:.1} s of its {budget} s budget (the device and the pilot {pilot_seconds:.1} s)",
+            started.elapsed().as_secs_f64()
+        );
+    }
     Ok(())
 }

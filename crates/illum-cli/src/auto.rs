@@ -66,6 +66,21 @@ pub fn check_auto_flags(
     }
 }
 
+/// The goal left for the render once the command has spent `spent` seconds (opening the device,
+/// the pilot): a time budget covers the whole command, so the render is planned for what is
+/// left of it, and stops there (see [`RenderArgs::follow`]). A target error is unchanged.
+pub fn goal_left(goal: Goal, spent: f64) -> Result<Goal, String> {
+    match goal {
+        Goal::Error(_) => Ok(goal),
+        Goal::Seconds(budget) if budget - spent > 0.0 => Ok(Goal::Seconds(budget - spent)),
+        Goal::Seconds(budget) => Err(format!(
+            "--time-budget {budget}: the pilot took {spent:.1} s of it, and nothing is left to render in \
+             (the budget covers the whole command, and the pilot measures this machine's speed on every run: \
+             give a budget above the pilot's time)"
+        )),
+    }
+}
+
 impl RenderArgs {
     /// `--renderer auto`'s goal, once its flags are checked ([`check_auto_flags`],
     /// [`illum_auto::plan::check_goal`]): before anything is measured.
@@ -93,10 +108,17 @@ impl RenderArgs {
     }
 
     /// Sets the flags that name the planned renderer and settings, as a user would type them,
-    /// in place of the goal (`scene`: the scene planned for).
-    pub fn follow(&mut self, choice: &Planned, scene: &Scene) {
+    /// in place of the goal (`scene`: the scene planned for). With a time budget (`goal`, what
+    /// is left of it, [`goal_left`]) a path-traced render also stops there if its planned spp
+    /// is not reached by then.
+    pub fn follow(&mut self, choice: &Planned, scene: &Scene, goal: Goal) {
         self.target_error = None;
-        self.time_budget = None;
+        self.time_budget = match (goal, &choice.candidate.setting) {
+            (Goal::Seconds(left), Setting::PathTrace { .. }) => {
+                Some(std::time::Duration::from_secs_f64(left))
+            }
+            _ => None,
+        };
         match &choice.candidate.setting {
             Setting::Raster { look, effects } => {
                 self.renderer = Some(RendererChoice::Kind(RendererKind::Raster));
@@ -183,6 +205,18 @@ mod tests {
         let error =
             RenderArgs::try_parse_from(["render", "--renderer", "automatic"]).unwrap_err().to_string();
         assert!(error.contains("\"automatic\" is not a renderer") && error.contains("\"auto\""), "{error}");
+    }
+
+    /// The budget covers the pilot: the render is planned for the rest, and a pilot that spent
+    /// it all is an error that says so; an error goal is the pilot's to keep.
+    #[test]
+    fn a_time_budget_covers_the_pilot_and_the_render_gets_the_rest() {
+        assert_eq!(goal_left(Goal::Seconds(10.0), 4.0), Ok(Goal::Seconds(6.0)));
+        assert_eq!(goal_left(Goal::Error(0.05), 40.0), Ok(Goal::Error(0.05)));
+        for spent in [10.0, 12.5] {
+            let error = goal_left(Goal::Seconds(10.0), spent).unwrap_err();
+            assert!(error.contains("--time-budget 10") && error.contains("nothing is left"), "{error}");
+        }
     }
 
     #[test]

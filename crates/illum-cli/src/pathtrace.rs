@@ -400,6 +400,9 @@ pub fn render_pathtrace(
         }
     }
     println!("{}", summary(&tracer, reason, seconds, status.samples_per_second()));
+    if let Some(over) = budget_overrun(reason, rules.time_budget, seconds) {
+        println!("{over}");
+    }
     let scope = progressive.error_scope();
     if *scope != ErrorScope::Image
         && let Some(error) = status.relative_error
@@ -418,6 +421,20 @@ pub fn render_pathtrace(
         std::process::exit(code);
     }
     Ok(Some(estimated_error))
+}
+
+/// What a render stopped by its time budget says when it ran well past it (by more than a
+/// submission's 0.15 s target and 5%): the budget is checked between submissions, and only
+/// once a first pass is complete.
+fn budget_overrun(reason: StopReason, budget: Option<Duration>, seconds: f64) -> Option<String> {
+    let budget = budget?.as_secs_f64();
+    let over = seconds - budget;
+    (reason == StopReason::TimeBudget && over > 0.15_f64.max(0.05 * budget)).then(|| {
+        format!(
+            "the time budget was {budget} s and the render took {seconds:.2} s: a render stops only once its first \
+             pass is complete, and then between submissions"
+        )
+    })
 }
 
 /// The line a finished render prints: the scene, size, spp, why it stopped, the settings, its
@@ -468,4 +485,24 @@ fn summary(tracer: &PathTracer, reason: StopReason, seconds: f64, samples_per_se
         samples_per_second * 1e-6,
         accumulator.dropped_samples(),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A render stopped by its budget says so when it ran past it by more than a submission and
+    /// 5%; a render stopped otherwise, or one without a budget, says nothing.
+    #[test]
+    fn a_render_past_its_time_budget_says_why() {
+        let budget = Some(Duration::from_secs(10));
+        let said = budget_overrun(StopReason::TimeBudget, budget, 12.0).expect("2 s past a 10 s budget");
+        assert!(said.contains("10 s") && said.contains("12.00 s") && said.contains("first pass"), "{said}");
+        assert_eq!(budget_overrun(StopReason::TimeBudget, budget, 10.3), None, "within 5%");
+        assert_eq!(budget_overrun(StopReason::SppReached, budget, 12.0), None);
+        assert_eq!(budget_overrun(StopReason::TimeBudget, None, 12.0), None);
+        let small = Some(Duration::from_millis(500));
+        assert_eq!(budget_overrun(StopReason::TimeBudget, small, 0.6), None, "within a submission");
+        assert!(budget_overrun(StopReason::TimeBudget, small, 0.7).is_some());
+    }
 }

@@ -37,7 +37,7 @@ pub fn describe(scene: &Scene, pilot: &Pilot, goal: Goal, plan: &Plan) -> String
             scene.name, scene.camera.width, scene.camera.height
         ),
         Goal::Seconds(s) => format!(
-            "auto: the most accurate render of {} at {}x{} predicted to finish within {s} s:\n",
+            "auto: the most accurate render of {} at {}x{} predicted to finish within {s:.1} s:\n",
             scene.name, scene.camera.width, scene.camera.height
         ),
     });
