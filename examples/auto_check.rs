@@ -120,9 +120,7 @@ fn run(args: Args) -> anyhow::Result<()> {
             &Overrides { width: Some(width), height: Some(height), ..Default::default() },
             "auto check",
         )?;
-        let mut truth_scene = scene.clone();
-        truth_scene.pathtrace.bounces = Bounces::Unbounded;
-        truth_scene.pathtrace.caustics = illum_lab::auto::pilot::has_caustic(&scene);
+        let truth_scene = illum_lab::auto::pilot::truth_scene(&scene, Bounces::Unbounded);
         let gpu = illum_cli::gpu()?;
         adapter = gpu.adapter_info.name.clone();
         let truth = match given_truth(&args.truth, &truth_scene)? {

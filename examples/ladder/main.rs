@@ -53,6 +53,7 @@ use illum::raster::{Options, RasterRenderer, RasterScene};
 use illum::scene::{Bounces, Effects, Look, MAX_WHITTED_DEPTH, MaterialKind, Scene};
 use illum::whitted::WhittedTracer;
 use illum_denoise::{DenoiseInput, Denoiser, DenoiserKind};
+use illum_lab::auto::pilot::{has_caustic, truth_scene};
 use illum_lab::plot::{self, Line, Style};
 use illum_lab::reference::{Reference, cached_reference, load_reference};
 use illum_lab::regions::{Comparison, Regions, compare, flip_heat_map};
@@ -176,9 +177,7 @@ fn run(args: Args) -> anyhow::Result<()> {
     } = match &args.truth {
         Some(path) => load_reference(path, &scene)?,
         None => {
-            let mut truth_scene = scene.clone();
-            truth_scene.pathtrace.bounces = args.truth_bounces;
-            truth_scene.pathtrace.caustics = has_caustic(&scene);
+            let truth_scene = truth_scene(&scene, args.truth_bounces);
             cached_reference(&gpu, &truth_scene, args.truth_spp, &args.out, "ladder truth")?
         }
     };
@@ -312,12 +311,6 @@ fn has_specular(scene: &Scene) -> bool {
         .materials
         .iter()
         .any(|m| matches!(m.kind, MaterialKind::Dielectric { .. } | MaterialKind::Mirror { .. }))
-}
-
-/// Whether the scene has a caustic for the light tracer: a directional light and a mirror or
-/// glass that can focus it.
-fn has_caustic(scene: &Scene) -> bool {
-    scene.directional_light.is_some() && has_specular(scene)
 }
 
 /// The scene's aspect with 320 pixels on the longer side, unless the flags say otherwise.

@@ -104,6 +104,16 @@ pub fn has_caustic(scene: &Scene) -> bool {
     illum_pathtrace::Estimators::of(&with).caustics()
 }
 
+/// The scene of the converged solution every measure of error is taken against: `scene` path
+/// traced with `bounces` (the rendering equation's solution is [`Bounces::Unbounded`]; the
+/// ladder lets a user choose), with the caustic's light tracer wherever it has anything to trace.
+pub fn truth_scene(scene: &Scene, bounces: Bounces) -> Scene {
+    let mut truth = scene.clone();
+    truth.pathtrace.bounces = bounces;
+    truth.pathtrace.caustics = has_caustic(scene);
+    truth
+}
+
 /// `scene` with `setting` applied (its renderer's section), at the scene's size.
 pub fn apply(scene: &Scene, setting: &Setting) -> Scene {
     let mut scene = scene.clone();

@@ -5,7 +5,7 @@
 
 use illum_gpu::testing::{gpu, workspace_path};
 use illum_image::rel_mse;
-use illum_lab::auto::pilot::{PilotOptions, apply, has_caustic, measure, render};
+use illum_lab::auto::pilot::{PilotOptions, apply, measure, render, truth_scene};
 use illum_lab::auto::plan::{Goal, plan};
 use illum_lab::reference::cached_reference;
 use illum_scene::{Bounces, Overrides, Scene};
@@ -27,9 +27,7 @@ fn predicted_errors_are_within_a_factor_1_5_of_the_measured_ones() {
     let pilot = measure(gpu(), &scene, 0.0, &options).unwrap();
     assert_eq!(pilot.size, (48, 27));
 
-    let mut truth_scene = scene.clone();
-    truth_scene.pathtrace.bounces = Bounces::Unbounded;
-    truth_scene.pathtrace.caustics = has_caustic(&scene);
+    let truth_scene = truth_scene(&scene, Bounces::Unbounded);
     let truth = cached_reference(gpu(), &truth_scene, 2048, &folder, "test truth").unwrap();
 
     let mut renderers = Vec::new();

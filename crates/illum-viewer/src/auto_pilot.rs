@@ -90,7 +90,7 @@ mod polled {
     use illum_auto::measure::{Measured, denoised, denoised_spps, measured};
     use illum_auto::plan::{Candidate, Setting};
     use illum_auto::regions::{Regions, compare_with_map};
-    use illum_auto::settings::{apply, has_caustic, pilot_size, settings_with_variants};
+    use illum_auto::settings::{apply, pilot_size, settings_with_variants, truth_scene};
     use illum_denoise::{AtrousDenoiser, AtrousSettings, DenoiseInput, PendingDenoise};
     use illum_gpu::GpuContext;
 
@@ -573,10 +573,8 @@ mod polled {
             let running = match &mut self.running {
                 Some(running) => running,
                 None => {
-                    let mut truth_scene = self.small.clone();
-                    truth_scene.pathtrace.bounces = Bounces::Unbounded;
-                    truth_scene.pathtrace.caustics = has_caustic(&self.small);
-                    self.running = Some(Running::start(gpu, &truth_scene)?);
+                    let truth = truth_scene(&self.small, Bounces::Unbounded);
+                    self.running = Some(Running::start(gpu, &truth)?);
                     return Ok(());
                 }
             };

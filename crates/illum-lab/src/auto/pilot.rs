@@ -38,7 +38,9 @@ use super::render::{path_tracer_throughput, spp_multiple, tracer_options};
 use crate::reference::{cached_reference, reference_settings};
 use crate::regions::{Regions, compare};
 use illum_auto::measure::{Measured, measured};
-pub use illum_auto::settings::{Variants, apply, has_caustic, pilot_size, settings, settings_with_variants};
+pub use illum_auto::settings::{
+    Variants, apply, has_caustic, pilot_size, settings, settings_with_variants, truth_scene,
+};
 
 /// How the pilot measures.
 #[derive(Clone, Debug)]
@@ -118,9 +120,7 @@ pub fn measure(
 
     // The truth: the converged solution (unbounded bounces, the caustic's light tracer where
     // there is one), cached by content.
-    let mut truth_scene = small.clone();
-    truth_scene.pathtrace.bounces = Bounces::Unbounded;
-    truth_scene.pathtrace.caustics = has_caustic(&small);
+    let truth_scene = truth_scene(&small, Bounces::Unbounded);
     let started = Instant::now();
     let truth = cached_reference(gpu, &truth_scene, options.truth_spp, &options.folder, "auto pilot truth")?;
     let truth_seconds =
