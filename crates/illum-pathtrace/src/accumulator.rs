@@ -4,12 +4,20 @@
 //! number of finite samples, and the number of dropped (NaN/Inf) ones. Folding those batch sums in
 //! f64 keeps 10^6 spp free of drift: f32 only ever sums one short batch.
 //!
-//! Over 450 lines with its tests: the statistics, their fold and their estimates are one type.
+//! This file holds the statistics and their fold; what they estimate (means, variances, the
+//! relative error) is `accumulator/estimates.rs`, the radiance scale the fold undoes
+//! `accumulator/radiance_scale.rs`, and the host memory a render needs
+//! `accumulator/host_memory.rs`.
 
-use illum_image::RgbImage32;
-// The epsilon of `illum_image::metrics::rel_mse` itself, so that the estimated and the measured
-// relMSE are the same quantity.
-use illum_image::metrics::REL_MSE_EPSILON;
+mod estimates;
+mod host_memory;
+mod radiance_scale;
+
+pub use host_memory::{
+    ALIGNED_COPY_BYTES_PER_PIXEL, RENDER_HOST_BYTES_PER_PIXEL, STATISTICS_BYTES_PER_PIXEL,
+    available_host_memory, check_host_memory,
+};
+pub use radiance_scale::{UNSCALED_RADIANCE_LIMIT, radiance_exponent};
 
 use crate::replicates::Replicates;
 
@@ -33,85 +41,6 @@ pub struct Accumulator {
     /// means and to nothing else. A point mass solved exactly has no variance: the statistics,
     /// the error estimate and the checkpoints' layers hold the samples alone.
     glint: Vec<(usize, [f64; 3])>,
-}
-
-/// Largest emitted radiance the GPU traces unscaled: 2^16. Above it the scene's emission is
-/// divided by a power of two 2^k on upload (so that the brightest light is below 2^17) and the
-/// fold multiplies the sums back by 2^k and the sums of squares by 2^(2k), in f64.
-///
-/// Why: a sample is at most about the brightest emission times a geometric factor of the
-/// next-event estimator (light area / distance^2), and the GPU squares it in f32 and sums 16 such
-/// squares. Unscaled, `emission = 1e30` would give squares of 1e60, past f32's 3.4e38: an
-/// infinite variance while the image is still finite. Scaled, a sample squares in range unless that
-/// geometric factor exceeds about 1e13, so every radiance the validator accepts (up to f32::MAX)
-/// keeps a finite error estimate. Multiplying by a power of two is exact in binary floating point
-/// (short of subnormal numbers), so the scaled render is the unscaled one, bit for bit, times 2^-k;
-/// and scenes whose lights are below 2^16 (every scene in scenes/) are not scaled at all.
-pub const UNSCALED_RADIANCE_LIMIT: f32 = 65536.0;
-
-/// The exponent k by which the GPU's radiance is scaled down (2^-k) for a scene whose brightest
-/// emission component is `max_emission` (0 for every emission up to [`UNSCALED_RADIANCE_LIMIT`]).
-pub fn radiance_exponent(max_emission: f32) -> i32 {
-    if max_emission.is_nan() || max_emission <= UNSCALED_RADIANCE_LIMIT {
-        return 0;
-    }
-    // max_emission in [2^e, 2^(e+1)), e >= 16; after scaling by 2^-(e - 16) it is below 2^17.
-    let e = ((max_emission.to_bits() >> 23) & 0xff) as i32 - 127;
-    e - 16
-}
-
-/// Host bytes per pixel of the f64 statistics: sum and sum of squares (3 x f64 each) and the
-/// sample count (u64).
-pub const STATISTICS_BYTES_PER_PIXEL: u64 = 56;
-const _: () = assert!(
-    STATISTICS_BYTES_PER_PIXEL as usize == 2 * std::mem::size_of::<[f64; 3]>() + std::mem::size_of::<u64>()
-);
-
-/// Host bytes per pixel a whole render needs at its peak, writing a PNG and a checkpoint EXR:
-/// the statistics and their EXR layer (2 x 56), the f32 mean image and its copy in the EXR
-/// encoder (2 x 12), an 8-bit PNG's pixels (3) and the driver's batch and staging buffers
-/// (about 20). Measured: 159 bytes per pixel at 4096 x 4096 (2.67 GB peak).
-pub const RENDER_HOST_BYTES_PER_PIXEL: u64 = 2 * STATISTICS_BYTES_PER_PIXEL + 2 * 12 + 3 + 20;
-
-/// Host bytes per pixel that a render ending inside a chunk needs on top: the copy of its
-/// statistics at the last chunk boundary and that copy's EXR layer (see `checkpoint.rs`).
-pub const ALIGNED_COPY_BYTES_PER_PIXEL: u64 = 2 * STATISTICS_BYTES_PER_PIXEL;
-
-/// Checks, before anything is allocated, that a `width x height` render fits in `available`
-/// bytes of host memory (`None`: unknown, not checked), with `extra_per_pixel` bytes per pixel
-/// on top of [`RENDER_HOST_BYTES_PER_PIXEL`] (a low-discrepancy render's replicates and their
-/// EXR layer: 2 x `Replicates::BYTES_PER_PIXEL`). The error says how much it would need.
-pub fn check_host_memory(
-    width: u32,
-    height: u32,
-    extra_per_pixel: u64,
-    available: Option<u64>,
-) -> Result<(), String> {
-    let per_pixel = RENDER_HOST_BYTES_PER_PIXEL + extra_per_pixel;
-    let needed = u64::from(width) * u64::from(height) * per_pixel;
-    match available {
-        Some(available) if needed > available => Err(format!(
-            "camera.width x camera.height = {width} x {height}: the render needs {:.1} GiB of host memory \
-             ({per_pixel} bytes per pixel: the f64 statistics, the output images and their encoders' copies), \
-             but only {:.1} GiB are available",
-            gib(needed),
-            gib(available)
-        )),
-        _ => Ok(()),
-    }
-}
-
-fn gib(bytes: u64) -> f64 {
-    bytes as f64 / (1u64 << 30) as f64
-}
-
-/// Host memory available to a new allocation without swapping (Linux: `MemAvailable` in
-/// /proc/meminfo); `None` where that is not known.
-pub fn available_host_memory() -> Option<u64> {
-    let meminfo = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = meminfo.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib * 1024)
 }
 
 impl Accumulator {
@@ -353,17 +282,6 @@ impl Accumulator {
         self.count[pixel]
     }
 
-    /// The pixel's estimate: the mean of its samples, plus the glint solved into it once it has
-    /// a sample (0 before).
-    pub fn pixel_mean(&self, pixel: usize) -> [f64; 3] {
-        let n = self.count[pixel];
-        let mean = self.sum[pixel].map(|s| s / n.max(1) as f64);
-        match self.glint.binary_search_by_key(&pixel, |g| g.0) {
-            Ok(i) if n > 0 => [0, 1, 2].map(|c| mean[c] + self.glint[i].1[c]),
-            _ => mean,
-        }
-    }
-
     /// Sets the glint added to the pixels' means: (pixel, radiance), at most once per pixel
     /// Refused for a pixel outside the image.
     pub fn set_glint(&mut self, glint: &[(usize, [f64; 3])]) -> Result<(), String> {
@@ -386,84 +304,6 @@ impl Accumulator {
     /// The glint added to the means: (pixel, radiance), sorted by pixel.
     pub fn glint(&self) -> &[(usize, [f64; 3])] {
         &self.glint
-    }
-
-    /// Variance of the pixel's mean, per channel: from the spread of the replicate means when
-    /// replicates are kept (low-discrepancy), else sample variance / n; infinite with < 2 samples
-    /// (or < 2 replicates).
-    pub fn pixel_variance_of_mean(&self, pixel: usize) -> [f64; 3] {
-        match &self.replicates {
-            Some(replicates) => replicates.variance_of_mean(pixel),
-            None => self.pixel_sample_variance_over_n(pixel),
-        }
-    }
-
-    /// The sample variance over n per channel, s^2 / n, whatever the sequence (the variance of
-    /// the mean for independent samples; for the low-discrepancy sequence an overestimate, used
-    /// where the per-sample spread is wanted: adaptive sampling's pilot). Infinite with < 2 samples.
-    pub fn pixel_sample_variance_over_n(&self, pixel: usize) -> [f64; 3] {
-        let n = self.count[pixel] as f64;
-        if n < 2.0 {
-            return [f64::INFINITY; 3];
-        }
-        let mut out = [0.0; 3];
-        for (c, value) in out.iter_mut().enumerate() {
-            let mean = self.sum[pixel][c] / n;
-            // Unbiased sample variance; clamp the rounding residue of a constant pixel at zero.
-            let variance = ((self.sum_sq[pixel][c] - n * mean * mean) / (n - 1.0)).max(0.0);
-            *value = variance / n;
-        }
-        out
-    }
-
-    pub fn mean_image(&self) -> RgbImage32 {
-        let mut image = RgbImage32::new(self.width, self.height);
-        for (p, px) in image.pixels.iter_mut().enumerate() {
-            // A mean beyond f32's range (a light near f32::MAX seen through noise) is stored as
-            // f32::MAX rather than infinity: EXR and PNG hold f32 at most.
-            *px = self.pixel_mean(p).map(|v| v.min(f32::MAX as f64) as f32);
-        }
-        image
-    }
-
-    /// Per-pixel variance of the mean, as an image (for Z-tests and the viewer's error view).
-    pub fn variance_image(&self) -> RgbImage32 {
-        let mut image = RgbImage32::new(self.width, self.height);
-        for (p, px) in image.pixels.iter_mut().enumerate() {
-            *px = self.pixel_variance_of_mean(p).map(|v| v as f32);
-        }
-        image
-    }
-
-    /// The relMSE of the current mean image against the (unknown) converged image, estimated from
-    /// the per-pixel variance alone: mean over pixels and channels of Var(mean) / (mean^2 + eps).
-    /// This is the expectation of `rel_mse(mean, truth)` when the estimator is unbiased.
-    pub fn estimated_rel_mse(&self) -> f64 {
-        let mut total = 0.0;
-        let mut terms = 0usize;
-        for p in 0..self.count.len() {
-            let mean = self.pixel_mean(p);
-            let var = self.pixel_variance_of_mean(p);
-            for c in 0..3 {
-                total += var[c] / (mean[c] * mean[c] + REL_MSE_EPSILON);
-                terms += 1;
-            }
-        }
-        if terms == 0 { f64::INFINITY } else { total / terms as f64 }
-    }
-
-    /// Samples per pixel from which [`Self::estimated_rel_mse`] is finite: 2 for independent
-    /// samples (a sample variance needs two), and for a low-discrepancy render two replicates'
-    /// runs (its variance comes from the spread of the replicates' means, and the first
-    /// `REPLICATE_RUN` samples all go to one replicate; a range starts on a chunk, which starts
-    /// a run of replicate 0).
-    pub fn spp_for_error_estimate(&self) -> u32 {
-        if self.replicates.is_some() { 2 * crate::replicates::REPLICATE_RUN } else { 2 }
-    }
-
-    /// Relative standard error of the image: the square root of [`Self::estimated_rel_mse`].
-    pub fn estimated_relative_error(&self) -> f64 {
-        self.estimated_rel_mse().sqrt()
     }
 
     /// Starts over (same size and radiance scale). Zeroes the statistics in place: fresh
@@ -529,42 +369,6 @@ mod tests {
     }
 
     #[test]
-    fn a_render_larger_than_memory_is_refused_with_what_it_needs() {
-        let err = check_host_memory(8192, 8192, 0, Some(2 << 30)).unwrap_err();
-        assert!(err.contains("8192 x 8192") && err.contains("9.9 GiB") && err.contains("2.0 GiB"), "{err}");
-        // With the replicates of a low-discrepancy render: 159 + 512 bytes per pixel.
-        let err = check_host_memory(8192, 8192, 512, Some(2 << 30)).unwrap_err();
-        assert!(err.contains("41.9 GiB") && err.contains("671 bytes per pixel"), "{err}");
-        assert!(check_host_memory(16384, 16384, 0, None).is_ok());
-        assert!(check_host_memory(512, 512, 0, Some(1 << 30)).is_ok());
-        if cfg!(target_os = "linux") {
-            assert!(available_host_memory().is_some_and(|b| b > 0));
-        }
-    }
-
-    #[test]
-    fn radiance_is_scaled_only_above_the_limit_and_by_a_power_of_two() {
-        assert_eq!(radiance_exponent(30.0), 0);
-        assert_eq!(radiance_exponent(UNSCALED_RADIANCE_LIMIT), 0);
-        assert_eq!(radiance_exponent(f32::NAN), 0);
-        for m in [65536.5f32, 1e20, 1e30, f32::MAX] {
-            let k = radiance_exponent(m);
-            let scaled = m as f64 * 2f64.powi(-k);
-            assert!((65536.0..131072.0).contains(&scaled), "{m}: k = {k}, scaled {scaled}");
-        }
-        // The fold undoes the scale exactly: a sample of f32::MAX, traced as f32::MAX / 2^k.
-        let k = radiance_exponent(f32::MAX);
-        let traced = f32::MAX * 2f32.powi(-k);
-        let mut acc = Accumulator::new(1, 1);
-        acc.set_radiance_exponent(k);
-        for _ in 0..2 {
-            acc.fold(0, &[[traced, 1.0, 1.0, 1.0]], &[[traced * traced, 1.0, 1.0, 0.0]]);
-        }
-        assert_eq!(acc.pixel_mean(0)[0], f32::MAX as f64);
-        assert!(acc.estimated_relative_error().is_finite());
-    }
-
-    #[test]
     fn state_round_trips_and_merges_add() {
         let mut a = Accumulator::new(2, 1);
         a.fold(
@@ -583,31 +387,5 @@ mod tests {
         assert_eq!(c.pixel_sum(0), [2.0, 4.0, 6.0]);
         assert_eq!(c.pixel_count(1), 4);
         assert!(Accumulator::from_state(3, 1, vec![], vec![], vec![], 0).unwrap_err().contains("3 x 1"));
-    }
-
-    #[test]
-    fn the_glint_adds_to_the_mean_of_sampled_pixels_and_to_nothing_else() {
-        let mut acc = Accumulator::new(3, 1);
-        acc.set_glint(&[(1, [5.0, 6.0, 7.0]), (1, [1.0, 1.0, 1.0])]).unwrap();
-        assert_eq!(acc.glint(), &[(1, [6.0, 7.0, 8.0])], "entries of one pixel add");
-        assert_eq!(acc.pixel_mean(1), [0.0; 3], "no sample yet: no glint");
-        let sums = [[2.0, 2.0, 2.0, 2.0]; 3];
-        let squares = [[2.0, 2.0, 2.0, 0.0]; 3];
-        acc.fold(0, &sums, &squares);
-        assert_eq!(acc.pixel_mean(0), [1.0; 3]);
-        assert_eq!(acc.pixel_mean(1), [7.0, 8.0, 9.0]);
-        assert_eq!(acc.pixel_variance_of_mean(1), acc.pixel_variance_of_mean(0), "no variance of its own");
-        assert_eq!(acc.pixel_sum(1), [2.0; 3], "the statistics hold the samples alone");
-        acc.reset();
-        acc.fold(0, &sums, &squares);
-        assert_eq!(acc.pixel_mean(1), [7.0, 8.0, 9.0], "kept across a reset");
-        assert!(acc.set_glint(&[(3, [1.0; 3])]).unwrap_err().contains("outside the 3 x 1 image"));
-    }
-
-    #[test]
-    fn single_sample_has_unknown_variance() {
-        let mut acc = Accumulator::new(1, 1);
-        acc.fold(0, &[[1.0, 1.0, 1.0, 1.0]], &[[1.0, 1.0, 1.0, 0.0]]);
-        assert!(acc.pixel_variance_of_mean(0)[0].is_infinite());
     }
 }

@@ -103,3 +103,14 @@ impl From<CheckpointError> for String {
         error.to_string()
     }
 }
+
+/// An error and its causes on one line ("reading x.exr as EXR failed: unexpected end of file").
+pub(super) fn with_causes(error: &dyn std::error::Error) -> String {
+    let mut text = error.to_string();
+    let mut source = error.source();
+    while let Some(cause) = source {
+        text += &format!(": {cause}");
+        source = cause.source();
+    }
+    text
+}

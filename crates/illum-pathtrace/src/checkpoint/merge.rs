@@ -4,7 +4,8 @@
 
 use std::path::{Path, PathBuf};
 
-use super::{Checkpoint, CheckpointError, CheckpointHeader, load_checkpoint, load_checkpoint_header, shown};
+use super::settings::shown;
+use super::{Checkpoint, CheckpointError, CheckpointHeader, load_checkpoint, load_checkpoint_header};
 
 /// The keys two partial renders must agree on to be merged. The scene is known by its content
 /// (`scene_hash`), not its name, as a resumed render's is.

@@ -7,9 +7,10 @@ use illum_gpu::timing::PassTimer;
 use illum_gpu::{GpuContext, wgpu};
 use illum_scene::{MaterialKind, Scene};
 
+use super::dispatch::{CAUSTIC_PASS, GATHER_PASS};
 use super::params::{PARTICLE_SEED_KEY, PHOTON_BYTES, SPLAT_BYTES, WORDS_PER_PIXEL};
 use super::schedule::Costs;
-use super::{CAUSTIC_PASS, CausticParams, CausticTracer, GATHER_PASS, Gather, bounding_sphere, fixed_point};
+use super::{CausticParams, CausticTracer, Gather, bounding_sphere, fixed_point};
 use crate::bindings::Binding;
 use crate::estimators::GATHER_RADIUS_FRACTION;
 use crate::gpu_scene::{GpuParams, GpuScene};

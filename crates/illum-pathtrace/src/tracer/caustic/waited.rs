@@ -1,0 +1,67 @@
+//! The waited form of a caustic pass, for a caller that can block (the native tools): each call
+//! submits the next work and waits for it, so that a submission's cost is measured whole.
+
+use illum_gpu::GpuContext;
+use web_time::Instant;
+
+use super::CausticTracer;
+use super::dispatch::Launched;
+use super::pass::PassKey;
+use super::schedule::Took;
+use crate::PathTraceError;
+
+impl CausticTracer {
+    /// Traces the frames of pass `key` (absolute sample indices `key.first_sample..`, grouped
+    /// in the slot layers `key.layers`) and folds them, one submission per call sized to `target`
+    /// seconds (`schedule.rs`), waiting for it. Returns true only when the pass's frames were all
+    /// folded before this call (so a step is one submission of caustic work or one band, never
+    /// both).
+    pub(crate) fn prepare_pass(
+        &mut self,
+        gpu: &GpuContext,
+        key: PassKey,
+        target: f64,
+    ) -> Result<bool, PathTraceError> {
+        let mut pass = self.take_pass(key);
+        // A polled submission left in flight is abandoned, and so is a frame begun by polling
+        // (its last piece may not be done): the frame is traced again from its start here.
+        if pass.in_flight.take().is_some() || pass.polled_frame {
+            pass.restart_frame();
+        }
+        let ready = pass.complete();
+        let (pixels, unit) = (self.pixels, self.unit);
+        let started = Instant::now();
+        match self.launch(gpu, &mut pass, target)? {
+            None => {}
+            Some(Launched::Piece(submission)) => {
+                gpu.wait_idle("tracing a piece of a caustic frame")?;
+                let seconds = started.elapsed().as_secs_f64();
+                self.record(&mut pass, submission, seconds, Took::Seconds(seconds));
+            }
+            Some(Launched::Frames { staging, bytes, count, submission }) => {
+                let mut fold_seconds = 0.0;
+                illum_gpu::readback::with_mapped(
+                    gpu,
+                    &staging,
+                    bytes.total,
+                    "reading back caustic frames",
+                    |data| {
+                        let fold = Instant::now();
+                        pass.fold_frames(
+                            bytemuck::cast_slice(&data[..bytes.frames as usize]),
+                            count,
+                            pixels,
+                            unit,
+                        );
+                        fold_seconds = fold.elapsed().as_secs_f64();
+                    },
+                )?;
+                self.staging = Some(staging);
+                let seconds = started.elapsed().as_secs_f64();
+                self.record(&mut pass, submission, seconds, Took::Seconds(seconds - fold_seconds));
+            }
+        }
+        self.pass = Some(pass);
+        Ok(ready)
+    }
+}
