@@ -193,7 +193,8 @@ def perf_tables(directory):
         ("bench-quick.txt", "bench-quick", "performance.md", False),
         ("bench-viewer.txt", "viewer-bench", "performance.md", False),
         ("bench-viewer-whitted.txt", "viewer-bench-whitted", "performance.md", False),
-        ("bench-glint.txt", "glint-bench", "performance.md", False),
+        ("bench-parts.txt", "caustic-parts", "performance-caustics.md", False),
+        ("bench-glint.txt", "glint-bench", "performance-caustics.md", False),
         ("raster-bench.txt", "raster-bench", "performance-raster.md", True),
     ]
     for name, block, page, preformatted in blocks:

@@ -111,6 +111,7 @@ echo "== The headline figures (README, between the headline markers)"
 "$bin/bench" --viewer --runs 3 scenes/whitted.toml | tee "$out/bench-viewer-whitted.txt"
 "$bin/raster_bench" --look enhanced | tee "$out/raster-bench.txt"
 for n in 10 50 200; do python3 scripts/many-spheres.py $n -o "$out/spheres-$n.toml"; done
+"$bin/bench" --runs 3 --parts scenes/whitted.toml | tee "$out/bench-parts.txt"
 "$bin/bench" --runs 3 --glint scenes/whitted.toml "$out"/spheres-{10,50,200}.toml | tee "$out/bench-glint.txt"
 if "$python" -c "import mitsuba" 2> /dev/null; then
     "$python" bench/vs_mitsuba.py --bounces 2 | tee "$out/vs-mitsuba.txt"

@@ -55,6 +55,6 @@ pub use shaders::{
     SURFACES_MODULE, shader_modules,
 };
 pub use tracer::{
-    CausticParams, GUIDE_SAMPLES_MAX, GUIDE_SAMPLES_MIN, Guides, PathTracer, PendingGuides, Readback,
-    StepReport, bounding_sphere, fixed_point, guide_samples,
+    CausticParams, CausticParts, GUIDE_SAMPLES_MAX, GUIDE_SAMPLES_MIN, Guides, PathTracer, PendingGuides,
+    Readback, StepReport, bounding_sphere, fixed_point, guide_samples,
 };

@@ -22,7 +22,7 @@ pub struct TracerOptions {
     /// pathtrace.wgsl's `main`), with the specialised traversal (the generic one always traces
     /// one path at a time, see `Specialisation::shader_defs`): the same image bit for bit, and a second,
     /// independent path gives the CPU core of a software driver work to overlap with the first
-    /// one's chains of dependent square roots and divisions (docs/performance.md, "Levers").
+    /// one's chains of dependent square roots and divisions (docs/performance-levers.md).
     /// The default natively; off in the browser, where Chrome's SwiftShader loses the device
     /// on the paired shader, so the page runs the one-path loop of the same shader.
     pub paired_paths: bool,

@@ -96,8 +96,7 @@ impl Specialisation {
             // The low-discrepancy sequence also draws light points from the bilinear fit of the
             // geometric term (sampling.wgsl, sample_light_bilinear): it lowers that sequence's
             // error by more than it adds time; independent numbers' error is mostly in the
-            // bounce directions, so for them it costs more than it buys (docs/performance.md,
-            // "Levers").
+            // bounce directions, so for them it costs more than it buys (docs/performance-levers.md).
             ("BILINEAR_LIGHT", low_discrepancy),
             // Pairs pay with the specialised traversal only: with the generic one's loop over
             // the object buffer they are slower than one path at a time (same section).

@@ -32,7 +32,7 @@ mod runner;
 mod submit;
 
 use accumulation::Accumulation;
-pub use caustic::{CausticParams, bounding_sphere, fixed_point};
+pub use caustic::{CausticParams, CausticParts, bounding_sphere, fixed_point};
 pub use guides::{GUIDE_SAMPLES_MAX, GUIDE_SAMPLES_MIN, Guides, PendingGuides, guide_samples};
 use pipeline::ScenePipeline;
 use runner::BandRunner;
@@ -263,6 +263,11 @@ impl PathTracer {
     /// bands': a caller that times a render by its steps adds this one's growth.
     pub fn caustic_seconds(&self) -> f64 {
         self.pipeline.caustic.as_ref().map_or(0.0, |c| c.seconds_spent())
+    }
+
+    /// Where the light tracer's time went so far, part by part (`None` without a light tracer).
+    pub fn caustic_parts(&self) -> Option<CausticParts> {
+        self.pipeline.caustic.as_ref().map(|c| c.parts())
     }
 
     /// GPU seconds of the compute passes since the last reset (0 without timestamp queries).

@@ -21,7 +21,7 @@ pub fn vec4(v: [f32; 4]) -> String {
 ///
 /// A switch over literals rather than a storage-buffer read: on a CPU Vulkan driver a read at a
 /// per-lane index is one scalar load per lane and component, while each case costs a few vector
-/// selects (docs/performance.md, "Levers").
+/// selects (docs/performance-levers.md).
 pub fn switch_cases(values: impl ExactSizeIterator<Item = String>) -> String {
     let count = values.len();
     let mut cases = String::new();

@@ -13,7 +13,7 @@
 //! - shadow rays test only the objects that can block a light (see [`can_block_light`]);
 //! - the object at a hit comes from literals (`object_at`), not from a storage buffer.
 //!
-//! The measured effect of each is in docs/performance.md ("Levers").
+//! The measured effect of each is in docs/performance-levers.md.
 
 use std::collections::BTreeSet;
 

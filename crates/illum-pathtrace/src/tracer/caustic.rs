@@ -89,6 +89,8 @@ pub(crate) struct CausticTracer {
     /// one (its GPU time where the device has timestamps): the light tracer's share of a
     /// render's time, which the bands' own reports do not hold ([`crate::PathTracer::caustic_seconds`]).
     seconds_spent: f64,
+    /// Where that time went ([`CausticParts`]).
+    parts: CausticParts,
     /// Times the light tracer's and the gather's passes, where the device has timestamps.
     timer: PassTimer,
     /// The most workgroups of a dispatch along x (a piece of more is laid out in rows).
@@ -100,10 +102,75 @@ pub(crate) struct CausticTracer {
     pass: Option<CausticPass>,
 }
 
+/// Where the light tracer's time went, summed over the frames folded so far, so that a
+/// benchmark can give each part its own row: its two stages over the frames whose stages were
+/// timed (traced whole on a device with timestamps: their GPU time; or in pieces, each waited
+/// for: the pieces' wall time, the GPU's work and the submissions' latency), and the host's fold
+/// of every frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CausticParts {
+    /// Frames folded.
+    pub frames: u64,
+    /// Frames whose stages were timed (the two stages' seconds are theirs).
+    pub timed_frames: u64,
+    /// Seconds of the particles' stage: tracing from the sun through the specular objects,
+    /// splatting to the eye, and storing the photons the gather reads.
+    pub particles: f64,
+    /// Seconds of the gather's stage (0 without a delta sun).
+    pub gather: f64,
+    /// Host seconds folding every frame's splat into the pass's f64 sums.
+    pub fold_host: f64,
+}
+
 impl CausticTracer {
     /// Seconds the light tracer's frames folded so far took (see `seconds_spent`).
     pub(crate) fn seconds_spent(&self) -> f64 {
         self.seconds_spent
+    }
+
+    /// Where the light tracer's time went so far.
+    pub(crate) fn parts(&self) -> CausticParts {
+        self.parts
+    }
+
+    /// Counts what a submission's frames cost: `count` frames (whole, or a frame's last piece)
+    /// folded in `fold_seconds`, with the GPU's `timestamps` (the bytes after the frames in the
+    /// staging copy) where whole frames were timed. A waited piece adds its `waited` seconds to
+    /// its stage, and its frame counts as timed when its last piece was waited for too.
+    fn record_parts(
+        &mut self,
+        submission: Submission,
+        count: u32,
+        timestamps: &[u8],
+        fold_seconds: f64,
+        waited: Option<f64>,
+    ) {
+        let parts = &mut self.parts;
+        parts.frames += u64::from(count);
+        parts.fold_host += fold_seconds;
+        match submission {
+            Submission::Frames { .. } => {
+                if let Some(passes) = self.timer.decode(timestamps) {
+                    parts.timed_frames += u64::from(count);
+                    for (name, ms) in passes {
+                        match name.as_str() {
+                            dispatch::CAUSTIC_PASS => parts.particles += ms * 1e-3,
+                            dispatch::GATHER_PASS => parts.gather += ms * 1e-3,
+                            _ => {}
+                        }
+                    }
+                }
+            }
+            Submission::Piece { stage, read, .. } => {
+                if let Some(seconds) = waited {
+                    match stage {
+                        Stage::Particles => parts.particles += seconds,
+                        Stage::Gather => parts.gather += seconds,
+                    }
+                    parts.timed_frames += u64::from(read);
+                }
+            }
+        }
     }
 
     /// The parameters the shader gets (for the layout test and the overflow tests).

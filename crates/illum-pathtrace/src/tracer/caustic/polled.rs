@@ -66,7 +66,15 @@ impl CausticTracer {
                     };
                     let data = result?;
                     let frames = bytes.frames as usize;
+                    let fold = Instant::now();
                     pass.fold_frames(bytemuck::cast_slice(&data[..frames]), count, self.pixels, self.unit);
+                    self.record_parts(
+                        flight.submission,
+                        count,
+                        &data[frames..],
+                        fold.elapsed().as_secs_f64(),
+                        None,
+                    );
                     let gpu_seconds = matches!(flight.submission, Submission::Frames { .. })
                         .then(|| self.timer.decode(&data[frames..]))
                         .flatten()

@@ -234,6 +234,7 @@ impl CausticTracer {
             max_frames_per_dispatch,
             costs: Costs::default(),
             seconds_spent: 0.0,
+            parts: Default::default(),
             timer,
             max_groups_x,
             pixels,

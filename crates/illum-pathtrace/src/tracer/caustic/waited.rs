@@ -36,10 +36,11 @@ impl CausticTracer {
             Some(Launched::Piece(submission)) => {
                 gpu.wait_idle("tracing a piece of a caustic frame")?;
                 let seconds = started.elapsed().as_secs_f64();
+                self.record_parts(submission, 0, &[], 0.0, Some(seconds));
                 self.record(&mut pass, submission, seconds, Took::Seconds(seconds));
             }
             Some(Launched::Frames { staging, bytes, count, submission }) => {
-                let mut fold_seconds = 0.0;
+                let (mut fold_seconds, mut timestamps) = (0.0, Vec::new());
                 illum_gpu::readback::with_mapped(
                     gpu,
                     &staging,
@@ -54,10 +55,12 @@ impl CausticTracer {
                             unit,
                         );
                         fold_seconds = fold.elapsed().as_secs_f64();
+                        timestamps = data[bytes.frames as usize..].to_vec();
                     },
                 )?;
                 self.staging = Some(staging);
                 let seconds = started.elapsed().as_secs_f64();
+                self.record_parts(submission, count, &timestamps, fold_seconds, Some(seconds - fold_seconds));
                 self.record(&mut pass, submission, seconds, Took::Seconds(seconds - fold_seconds));
             }
         }

@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! cargo run --release --example bench -- [--runs N] [--quick | --large [--compare-readback] | --viewer | --sequences
-//!     | --glint SCENE...]
+//!     | --glint SCENE... | --parts SCENE]
 //! ```
 //! For `scenes/cornell.toml` at each size and bounce count it renders a fixed number of samples
 //! per pixel `runs` times and prints the median of:
@@ -27,6 +27,9 @@
 //! statistics on exit), and `render`'s loop on the same scene at the viewer's resolution for the
 //! same wall time, run after it, side by side, `runs` times.
 //!
+//! `--parts` gives each part of a render with the caustic's estimators on its own row beside the
+//! camera paths alone (`parts.rs`).
+//!
 //! `--glint` times the host's solve of the sun's glint (`illum::pathtrace::glint::solve`, part of
 //! a render's set-up before its first sample) for each scene given, on all the host's threads:
 //! `scripts/many-spheres.py` writes scenes with many specular spheres for it.
@@ -43,6 +46,8 @@ use illum::raster::{Look, Motion, Options, bench_frames};
 use illum::scene::Sequence;
 use illum::scene::{Bounces, Scene};
 use illum_cli::SceneArgs;
+
+mod parts;
 
 #[derive(Parser, Debug)]
 #[command(about = "Measure path-tracer throughput (samples/s, rays/s, GPU time per submission; generic \
@@ -76,6 +81,10 @@ struct Args {
     /// Only the glint's solve on the host, for each of these scenes (see `scripts/many-spheres.py`).
     #[arg(long, num_args = 1.., conflicts_with_all = ["quick", "large", "viewer"])]
     glint: Vec<PathBuf>,
+    /// Only the parts of a render with the caustic's estimators on, each beside the camera paths
+    /// alone (the scene should have a caustic: scenes/whitted.toml).
+    #[arg(long, conflicts_with_all = ["quick", "large", "viewer", "sequences"])]
+    parts: bool,
 }
 
 struct Config {
@@ -103,6 +112,10 @@ fn run(args: Args) -> anyhow::Result<()> {
         return bench_glint(&args.glint, args.runs);
     }
     let gpu = illum_cli::gpu()?;
+    if args.parts {
+        let load = load_average().map_or(String::new(), |l| format!(", load average {l} at the start"));
+        return parts::bench_parts(&gpu, &Scene::load(&args.scene)?, args.runs, &load);
+    }
     if args.viewer {
         return bench_viewer(&gpu, &args);
     }
