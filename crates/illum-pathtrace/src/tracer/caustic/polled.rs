@@ -40,10 +40,10 @@ enum Flight {
 impl CausticTracer {
     /// The polled form of [`Self::prepare_pass`]: true once the frames of pass `key` are all
     /// folded. Each call folds the frames in flight if their mapping is done, or sees whether
-    /// the piece in flight is done, and then submits the next work; it never waits. Times are
-    /// taken from the submission to the call that sees it done (they count the frames a page
-    /// drew meanwhile, so submissions stay short), or from the GPU's timestamps for whole frames
-    /// where the device has them.
+    /// the piece in flight is done, and then submits the next work; it never waits. A
+    /// submission's cost is its GPU time where the device timed it (whole frames), else the time
+    /// from its submission to the call that sees it done, which counts the frames a page drew
+    /// meanwhile and the browser's delay in telling it: only a bound on the cost ([`Took`]).
     pub(crate) fn poll_pass(
         &mut self,
         gpu: &GpuContext,
