@@ -95,7 +95,7 @@ pub struct Candidate {
     /// relMSE against the truth that no number of samples removes (>= 0).
     pub bias_rel_mse: f64,
     /// How the path tracer's relMSE beyond its bias falls with the spp (the input of
-    /// [`noise_rel_mse`]); `None` for the deterministic renderers.
+    /// [`noise_rel_mse`](super::noise_rel_mse)); `None` for the deterministic renderers.
     pub noise: Option<NoiseCurve>,
     /// The path tracer's spp is a multiple of this (2 for a denoised render's two halves, the
     /// replicate run for the low-discrepancy sequence); 1 otherwise.

@@ -49,10 +49,10 @@ impl ExrMetadata {
             .collect()
     }
 
-    /// Rebuilds the metadata from the text attributes [`load_exr`] returns. `Ok(None)` when
-    /// the file carries none of illum's fixed fields (an EXR from another program); an error
-    /// when some are present but one is missing or does not parse. `path` is only used in
-    /// error messages. Attributes without the `illum.` prefix are ignored.
+    /// Rebuilds the metadata from the text attributes [`load_exr`](super::load_exr) returns.
+    /// `Ok(None)` when the file carries none of illum's fixed fields (an EXR from another
+    /// program); an error when some are present but one is missing or does not parse. `path` is
+    /// only used in error messages. Attributes without the `illum.` prefix are ignored.
     pub fn from_attributes(
         path: impl AsRef<Path>,
         attributes: &[(String, String)],

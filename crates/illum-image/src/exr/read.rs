@@ -174,8 +174,9 @@ struct ReadPixels {
 
 /// Reads the first layer with R, G and B channels of an EXR file (f16, f32 or u32 samples,
 /// converted to f32; other channels such as A are ignored), plus every text attribute of the
-/// file as (name, value), sorted by name. Use [`ExrMetadata::from_attributes`] to recover
-/// illum's settings.
+/// file as (name, value), sorted by name. Use
+/// [`ExrMetadata::from_attributes`](super::ExrMetadata::from_attributes) to recover illum's
+/// settings.
 pub fn load_exr(path: impl AsRef<Path>) -> Result<(RgbImage32, Vec<(String, String)>), ImageError> {
     let path = path.as_ref();
     let file = open_exr(path)?;
