@@ -1,43 +1,13 @@
-//! The `render` command's `--renderer` value: one of the renderers, or `auto` (the planner of
-//! `illum_auto::plan`, on the pilot's measurements, chooses the renderer and its settings), what
-//! `auto` refuses, and how the flags follow its choice.
-
-use std::fmt;
-use std::str::FromStr;
+//! `render --renderer auto` (the planner of `illum_auto::plan`, on the pilot's measurements,
+//! chooses the renderer and its settings): what `auto` refuses, and how the flags follow its
+//! choice. The `--renderer` value, [`RendererChoice`], is parsed beside the other flags
+//! (`render_args.rs`) and re-exported here.
 
 use illum_auto::plan::{Goal, Planned, Setting};
 use illum_scene::{RendererKind, Scene};
 
-use crate::render::RenderArgs;
-
-/// `--renderer pathtrace|raster|whitted|auto`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum RendererChoice {
-    Kind(RendererKind),
-    Auto,
-}
-
-impl FromStr for RendererChoice {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        if s == "auto" {
-            return Ok(RendererChoice::Auto);
-        }
-        s.parse::<RendererKind>().map(RendererChoice::Kind).map_err(|_| {
-            format!("{s:?} is not a renderer: must be \"pathtrace\", \"raster\", \"whitted\" or \"auto\"")
-        })
-    }
-}
-
-impl fmt::Display for RendererChoice {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            RendererChoice::Kind(kind) => kind.fmt(f),
-            RendererChoice::Auto => f.write_str("auto"),
-        }
-    }
-}
+use crate::render_args::RenderArgs;
+pub use crate::render_args::RendererChoice;
 
 /// What `--renderer auto` is asked for: one of `--target-error` and `--time-budget`, and none
 /// of the flags that choose what it chooses (`chosen`: the names of those given).
@@ -152,17 +122,6 @@ impl RenderArgs {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn auto_and_every_renderer_parse_and_anything_else_is_refused_by_name() {
-        assert_eq!("auto".parse(), Ok(RendererChoice::Auto));
-        for kind in RendererKind::ALL {
-            assert_eq!(kind.to_string().parse(), Ok(RendererChoice::Kind(kind)));
-            assert_eq!(RendererChoice::Kind(kind).to_string(), kind.to_string());
-        }
-        let error = "opengl".parse::<RendererChoice>().unwrap_err();
-        assert!(error.contains("\"opengl\"") && error.contains("\"auto\""), "{error}");
-    }
 
     /// `render --renderer auto` as typed: every bad goal and every flag that sets what auto
     /// chooses is refused by [`RenderArgs::auto_goal`] (which the example calls before anything

@@ -18,6 +18,7 @@ pub mod progress;
 pub mod raster;
 pub mod reference;
 pub mod render;
+mod render_args;
 mod resume;
 pub mod whitted;
 

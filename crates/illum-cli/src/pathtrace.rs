@@ -34,7 +34,8 @@ use illum_scene::Scene;
 
 use crate::interrupt::Interrupt;
 use crate::progress::RenderProgress;
-use crate::render::RenderArgs;
+use crate::render_args::RenderArgs;
+pub use crate::render_args::error_percentile_arg;
 use crate::{LongRender, OutputFormat, output_format};
 
 /// The default stop rules of a render given no stop-rule flag: a clean image in a few seconds
@@ -42,11 +43,6 @@ use crate::{LongRender, OutputFormat, output_format};
 const DEFAULT_TARGET_ERROR: f64 = 0.02;
 const DEFAULT_TIME_BUDGET: Duration = Duration::from_secs(5);
 const DEFAULT_CHECKPOINT: Duration = Duration::from_secs(60);
-
-/// Parses `--error-percentile` (see [`illum_pathtrace::error_map::parse_error_percentile`]).
-pub fn error_percentile_arg(text: &str) -> Result<f64, String> {
-    illum_pathtrace::error_map::parse_error_percentile("--error-percentile", text)
-}
 
 /// What `--target-error` is measured over: `--error-percentile`, `--region` (its pixels from
 /// the Whitted tracer's object-ID image of `scene`), or the whole image.

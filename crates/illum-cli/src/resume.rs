@@ -10,7 +10,7 @@ use illum_pathtrace::{PathTracer, Sequence, StopRules, TracerOptions};
 use illum_scene::Scene;
 
 use crate::SceneArgs;
-use crate::render::RenderArgs;
+use crate::render_args::RenderArgs;
 
 /// Fills the image-changing settings not given on the command line from a checkpoint's
 /// metadata, so that `--resume FILE` needs only the scene file and the new target.

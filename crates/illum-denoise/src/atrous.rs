@@ -15,27 +15,11 @@ use wgpu::util::DeviceExt;
 
 use crate::DenoiseError;
 use crate::input::DenoiseInput;
+use crate::spread::filter_variance;
+pub use crate::stops::{NO_NORMAL, NORMAL_POWER, TINY, unit_normals};
 
 /// One iteration of the filter (entry point `main`).
 pub const ATROUS_SHADER: ShaderFile = shader_file!("shaders/atrous.wgsl");
-
-/// The shader's constants (its `NORMAL_SQUARINGS` and `TINY`; tested to agree).
-pub const NORMAL_POWER: i32 = 128;
-pub const TINY: f64 = 1.0e-10;
-/// A mean normal shorter than this is "no normal" (the pixel's rays left the scene).
-pub const NO_NORMAL: f32 = 1.0e-3;
-
-/// The normals as the filter reads them: unit vectors with w = 1, or zero with w = 0 where a
-/// pixel has none (shorter than [`NO_NORMAL`]).
-pub fn unit_normals(normals: &[[f32; 3]]) -> Vec<[f32; 4]> {
-    normals
-        .iter()
-        .map(|n| {
-            let length = n.iter().map(|v| v * v).sum::<f32>().sqrt();
-            if length < NO_NORMAL { [0.0; 4] } else { [n[0] / length, n[1] / length, n[2] / length, 1.0] }
-        })
-        .collect()
-}
 
 /// The filter's settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -149,7 +133,7 @@ impl AtrousDenoiser {
         let vec4 = |rows: &mut dyn Iterator<Item = [f32; 4]>| -> Vec<u8> {
             rows.flat_map(|v| v.map(f32::to_le_bytes)).flatten().collect()
         };
-        let variance = crate::spread::filter_variance(input, settings.sigma_albedo);
+        let variance = filter_variance(input, settings.sigma_albedo);
         let colour = vec4(
             &mut input
                 .image
@@ -258,18 +242,5 @@ mod tests {
         );
         let pixel = shader::wgsl_struct(&module, "", "Pixel").expect("struct Pixel");
         assert_eq!(u64::from(pixel.size), PIXEL_BYTES, "size of the WGSL Pixel");
-    }
-
-    /// The WGSL constants are the ones the f64 copy (reference.rs) uses.
-    #[test]
-    fn the_shader_constants_match_the_f64_copy() {
-        let source = include_str!("../shaders/atrous.wgsl");
-        let constant = |name: &str| -> f64 {
-            let rest = source.split(&format!("const {name}: ")).nth(1).unwrap_or_else(|| panic!("{name}"));
-            let value = rest.split(" = ").nth(1).and_then(|r| r.split(';').next()).expect("a value");
-            value.trim_end_matches('u').parse().unwrap_or_else(|e| panic!("{name} = {value}: {e}"))
-        };
-        assert_eq!(2f64.powf(constant("NORMAL_SQUARINGS")), f64::from(NORMAL_POWER));
-        assert_eq!(constant("TINY") as f32, TINY as f32);
     }
 }

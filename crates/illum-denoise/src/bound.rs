@@ -1,8 +1,8 @@
 //! What any denoiser may do to a pixel: its denoised value stays, channel by channel, within
 //! [`BOUND_Z`] standard errors of the pixel's own noisy mean. Applied once to the output of
-//! every denoiser ([`crate::Denoiser::denoise`], and the viewer's polled à-trous runs), so that
-//! a denoiser cannot move a converged image beyond its noise (docs/denoising.md, "A converged
-//! image").
+//! every denoiser by [`DenoiseInput::finish`] (called by [`crate::Denoiser::denoise`] and by the
+//! viewer's polled à-trous runs), so that a denoiser cannot move a converged image beyond its
+//! noise (docs/denoising.md, "A converged image").
 //!
 //! Derivation of the width: the ideal denoiser returns each pixel's expected value mu. A
 //! pixel's mean x over n samples is, by the central limit theorem, about normal around mu with
@@ -35,6 +35,20 @@ pub fn bound(input: &DenoiseInput, denoised: &mut RgbImage32) {
             let value = f64::from(d[c]);
             if value.is_finite() {
                 d[c] = value.clamp(x - radius, x + radius) as f32;
+            }
+        }
+    }
+}
+
+impl DenoiseInput {
+    /// What every denoiser's output goes through (`Denoiser::denoise`, the viewer's polled
+    /// filter): the bound to the noisy image ([`bound`]), then the exact radiance added
+    /// back.
+    pub fn finish(&self, denoised: &mut RgbImage32) {
+        bound(self, denoised);
+        for &(p, g) in &self.exact {
+            for (value, glint) in denoised.pixels[p].iter_mut().zip(g) {
+                *value += glint;
             }
         }
     }

@@ -51,18 +51,6 @@ impl DenoiseInput {
         DenoiseInput { image, variance, albedo: guides.albedo.clone(), normal: guides.normal.clone(), exact }
     }
 
-    /// What every denoiser's output goes through (`Denoiser::denoise`, the viewer's polled
-    /// filter): the bound to the noisy image ([`crate::bound`]), then the exact radiance added
-    /// back.
-    pub fn finish(&self, denoised: &mut RgbImage32) {
-        crate::bound::bound(self, denoised);
-        for &(p, g) in &self.exact {
-            for (value, glint) in denoised.pixels[p].iter_mut().zip(g) {
-                *value += glint;
-            }
-        }
-    }
-
     pub fn width(&self) -> u32 {
         self.image.width
     }

@@ -24,6 +24,7 @@ pub mod input;
 pub mod oidn;
 pub mod reference;
 pub mod spread;
+mod stops;
 // Waits for the GPU: native only (a web page polls instead).
 #[cfg(not(target_arch = "wasm32"))]
 pub mod split;

@@ -3,8 +3,10 @@
 
 use illum_image::RgbImage32;
 
-use crate::atrous::{AtrousSettings, NORMAL_POWER, TINY, unit_normals};
+use crate::atrous::AtrousSettings;
 use crate::input::DenoiseInput;
+use crate::spread::filter_variance;
+use crate::stops::{TINY, normal_weight, unit_normals};
 
 /// One pixel of a pass: its colour and its channels' variances.
 type Pixel = ([f64; 3], [f64; 3]);
@@ -12,7 +14,7 @@ type Pixel = ([f64; 3], [f64; 3]);
 /// The filtered image and the variance of each pixel's channels after the last iteration.
 pub fn denoise(input: &DenoiseInput, settings: &AtrousSettings) -> (RgbImage32, Vec<[f64; 3]>) {
     let (width, height) = (input.width() as i64, input.height() as i64);
-    let variance = crate::spread::filter_variance(input, settings.sigma_albedo);
+    let variance = filter_variance(input, settings.sigma_albedo);
     let mut current: Vec<Pixel> =
         input.image.pixels.iter().zip(&variance).map(|(c, v)| (c.map(f64::from), v.map(f64::from))).collect();
     let albedo: Vec<[f64; 3]> = input.albedo.iter().map(|a| a.map(f64::from)).collect();
@@ -80,10 +82,4 @@ pub fn denoise(input: &DenoiseInput, settings: &AtrousSettings) -> (RgbImage32, 
 /// The B3 spline's taps at offsets -2..2.
 fn kernel(i: i64) -> f64 {
     [0.0625, 0.25, 0.375, 0.25, 0.0625][(i + 2) as usize]
-}
-
-/// The normal stop between two unit normals with w = 1 (or zero normals with w = 0).
-pub(crate) fn normal_weight(p: [f64; 4], q: [f64; 4]) -> f64 {
-    let cos = p[0] * q[0] + p[1] * q[1] + p[2] * q[2];
-    cos.max(0.0).powi(NORMAL_POWER) + (1.0 - p[3]) * (1.0 - q[3])
 }

@@ -14,8 +14,8 @@
 //! Known variances pass through unchanged; the bound ([`crate::bound`]) still reads only the
 //! pixel's own, so a 1-spp pixel stays unbounded.
 
-use crate::atrous::unit_normals;
 use crate::input::{DenoiseInput, UNKNOWN_VARIANCE};
+use crate::stops::{normal_weight, unit_normals};
 
 /// Half the side of the neighbourhood: 5 x 5 pixels.
 pub const SPREAD_RADIUS: i64 = 2;
@@ -43,7 +43,7 @@ pub fn filter_variance(input: &DenoiseInput, sigma_albedo: f32) -> Vec<[f32; 3]>
                     let q = (qy * width + qx) as usize;
                     let da: f64 =
                         (0..3).map(|k| f64::from(input.albedo[p][k] - input.albedo[q][k]).powi(2)).sum();
-                    let w = crate::reference::normal_weight(normal[p], normal[q]) * (-da * inv_sigma2).exp();
+                    let w = normal_weight(normal[p], normal[q]) * (-da * inv_sigma2).exp();
                     w_sum += w;
                     for k in 0..3 {
                         let v = f64::from(input.image.pixels[q][k]);

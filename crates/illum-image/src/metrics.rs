@@ -4,8 +4,6 @@
 //! Non-finite pixel values are not filtered: they make RMSE / relMSE / bias NaN or infinite,
 //! which is the honest answer (check [`RgbImage32::has_non_finite`] first if that matters);
 //! in the Z-test a non-finite mean fails its pixel.
-//!
-//! Over 450 lines with its tests: each metric beside the cases that pin it down.
 
 use crate::rgb_image::RgbImage32;
 

@@ -54,65 +54,11 @@ use glam::DVec3;
 use illum_scene::{Bounces, MaterialKind};
 
 use crate::gather::Photon;
-use crate::geometry::Surface;
-use crate::integrator::{Contact, Oracle, ROULETTE_AFTER, ROULETTE_MAX_SURVIVAL};
+use crate::integrator::{Contact, Oracle, ROULETTE_AFTER, ROULETTE_MAX_SURVIVAL, UNBOUNDED_LIMIT};
 use crate::optics::{reflect, scatter_dielectric};
+use crate::particle_source::particle_rng;
 use crate::rng::Rng;
 use crate::sampling::{local_to_world, uniform_cone};
-use crate::scene::Primitive;
-
-/// Key mixed into the particles' seed so that particle i of frame k never shares its random
-/// numbers with sample k of pixel i.
-pub(crate) const PARTICLE_SEED_KEY: u64 = 0xc0ff_ee00_ca05_71c5;
-/// A safety limit on specular scatterings for unbounded paths (survival 0.95^n beyond 3).
-const UNBOUNDED_LIMIT: u32 = 100_000;
-
-/// The bounding sphere (centre, radius) of a primitive.
-fn bounding_sphere(p: &Primitive) -> (DVec3, f64) {
-    match p.surface {
-        Surface::Ball(b) => (b.center, b.radius),
-        Surface::Parallelogram(q) => {
-            let centre = q.corner + 0.5 * (q.u + q.v);
-            (centre, 0.5 * (q.u + q.v).length().max((q.u - q.v).length()))
-        }
-        Surface::Box(b) => (b.rotation * (0.5 * (b.lo + b.hi)) + b.offset, 0.5 * (b.hi - b.lo).length()),
-    }
-}
-
-fn is_specular(material: MaterialKind) -> bool {
-    matches!(material, MaterialKind::Mirror { .. } | MaterialKind::Dielectric { .. })
-}
-
-/// Where particles start and what they carry: the specular objects' bounding spheres and the
-/// scene's bounding sphere (particles start outside it).
-#[derive(Clone, Debug)]
-pub(crate) struct Emitter {
-    discs: Vec<(DVec3, f64)>,
-    total_area: f64,
-    scene_centre: DVec3,
-    scene_radius: f64,
-    /// r_1 of the photon gather (`gather.rs`).
-    pub(crate) gather_radius: f64,
-}
-
-impl Emitter {
-    pub(crate) fn new(oracle: &Oracle) -> Option<Emitter> {
-        oracle.scene.sun?;
-        let discs: Vec<(DVec3, f64)> =
-            oracle.scene.surfaces.iter().filter(|p| is_specular(p.material)).map(bounding_sphere).collect();
-        if discs.is_empty() {
-            return None;
-        }
-        let total_area = discs.iter().map(|(_, r)| PI * r * r).sum();
-        let spheres: Vec<(DVec3, f64)> =
-            oracle.scene.surfaces.iter().chain(&oracle.scene.emitters).map(bounding_sphere).collect();
-        let scene_centre = spheres.iter().map(|(c, _)| *c).sum::<DVec3>() / spheres.len() as f64;
-        let scene_radius = spheres.iter().map(|(c, r)| (*c - scene_centre).length() + r).fold(0.0, f64::max);
-        let gather_radius =
-            crate::gather::RADIUS_FRACTION * discs.iter().map(|(_, r)| *r).fold(0.0, f64::max);
-        Some(Emitter { discs, total_area, scene_centre, scene_radius, gather_radius })
-    }
-}
 
 impl Oracle {
     /// Whether this oracle adds the caustic: `[pathtrace] caustics = true` on a scene with a
@@ -124,7 +70,7 @@ impl Oracle {
     /// One particle of a frame of `n` particles, traced to its first diffuse point after at
     /// least one specular scattering (its photon, `gather.rs`), or `None` when it has none.
     pub(crate) fn trace_particle(&self, n: u64, rng: &mut Rng) -> Option<Photon> {
-        let emitter = self.caustic.as_ref()?;
+        let source = self.caustic.as_ref()?;
         let sun = self.scene.sun?;
         // The direction the light travels, and the flux per unit area across the plane
         // perpendicular to it.
@@ -137,21 +83,21 @@ impl Oracle {
         };
         let d0 = -to_light;
         // A disc by area, a point uniform on it (radius R sqrt(u)).
-        let pick = rng.uniform() * emitter.total_area;
+        let pick = rng.uniform() * source.total_area;
         let mut k = 0;
         let mut acc = 0.0;
-        for (i, (_, r)) in emitter.discs.iter().enumerate() {
+        for (i, (_, r)) in source.discs.iter().enumerate() {
             acc += PI * r * r;
             k = i;
             if pick < acc {
                 break;
             }
         }
-        let (centre, radius) = emitter.discs[k];
+        let (centre, radius) = source.discs[k];
         let (s, phi) = (radius * rng.uniform().sqrt(), 2.0 * PI * rng.uniform());
         let x = centre + local_to_world(d0, DVec3::new(s * phi.cos(), s * phi.sin(), 0.0));
         // c(x): the discs whose sphere's projection covers the line through x.
-        let covering = emitter
+        let covering = source
             .discs
             .iter()
             .filter(|(c, r)| {
@@ -160,9 +106,9 @@ impl Oracle {
             })
             .count()
             .max(1);
-        let mut throughput = flux_density * (emitter.total_area / covering as f64 / n as f64);
+        let mut throughput = flux_density * (source.total_area / covering as f64 / n as f64);
         // Start outside the whole scene, on the light's side.
-        let mut o = x + d0 * ((emitter.scene_centre - x).dot(d0) - emitter.scene_radius - 1.0);
+        let mut o = x + d0 * ((source.scene_centre - x).dot(d0) - source.scene_radius - 1.0);
         let mut d = d0;
         let mut scatterings = 0u32;
         loop {
@@ -282,7 +228,7 @@ impl Oracle {
         }
         let mut photons = Vec::new();
         for particle in 0..n {
-            let mut rng = Rng::for_sample(seed ^ PARTICLE_SEED_KEY, particle, u64::from(frame));
+            let mut rng = particle_rng(seed, particle, frame);
             if let Some(photon) = self.trace_particle(n, &mut rng) {
                 if let Some((pixel, value)) =
                     self.connect(photon.point, photon.normal, photon.lift, photon.weight)

@@ -47,6 +47,7 @@ use illum_scene::{Bounces, MaterialKind};
 
 use crate::integrator::{Contact, Oracle};
 use crate::optics::{reflect, scatter_dielectric};
+use crate::particle_source::particle_rng;
 use crate::rng::Rng;
 
 /// r_1 as a fraction of the largest specular object's bounding radius.
@@ -155,8 +156,7 @@ impl Oracle {
         let n = u64::from(self.camera.width) * u64::from(self.camera.height);
         let photons = (0..n)
             .filter_map(|particle| {
-                let mut rng =
-                    Rng::for_sample(seed ^ crate::caustic::PARTICLE_SEED_KEY, particle, u64::from(frame));
+                let mut rng = particle_rng(seed, particle, frame);
                 self.trace_particle(n, &mut rng)
             })
             .collect();
@@ -167,8 +167,8 @@ impl Oracle {
     }
 
     fn photon_map(&self, photons: Vec<Photon>, frame: u32) -> Option<PhotonMap> {
-        let emitter = self.caustic.as_ref().filter(|_| self.gathers())?;
-        Some(PhotonMap::new(photons, radius(emitter.gather_radius, frame)))
+        let source = self.caustic.as_ref().filter(|_| self.gathers())?;
+        Some(PhotonMap::new(photons, radius(RADIUS_FRACTION * source.largest_radius, frame)))
     }
 
     fn gather_pixel(&self, map: &PhotonMap, x: u32, y: u32, seed: u64, frame: u32) -> DVec3 {

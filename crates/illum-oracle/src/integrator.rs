@@ -25,6 +25,7 @@ use illum_scene::{Bounces, MaterialKind, Sampling, Scene};
 use crate::camera::PinholeCamera;
 use crate::geometry::Surface;
 use crate::optics::{reflect, scatter_dielectric};
+use crate::particle_source::ParticleSource;
 use crate::rng::Rng;
 use crate::sampling::{cosine_hemisphere, local_to_world, uniform_cone, uniform_hemisphere};
 use crate::scene::{Primitive, TraceScene};
@@ -42,7 +43,7 @@ const SHADOW_SHORTEN: f64 = 1e-8;
 pub(crate) const ROULETTE_AFTER: u32 = 3;
 pub(crate) const ROULETTE_MAX_SURVIVAL: f64 = 0.95;
 /// A safety limit for unbounded paths; reaching it has probability below 0.95^100000.
-const UNBOUNDED_LIMIT: u32 = 100_000;
+pub(crate) const UNBOUNDED_LIMIT: u32 = 100_000;
 
 /// What a ray hit: the primitive, distance and geometric normal.
 #[derive(Clone, Copy, Debug)]
@@ -107,7 +108,7 @@ pub struct Oracle {
     pub bounces: Bounces,
     pub sampling: Sampling,
     /// The light tracer of the caustic (`caustic.rs`), when on and the scene can have one.
-    pub(crate) caustic: Option<crate::caustic::Emitter>,
+    pub(crate) caustic: Option<ParticleSource>,
     /// Whether the caustic's frames add the photon gather (`gather.rs`; with a delta sun only).
     pub(crate) gather: bool,
 }
@@ -132,7 +133,7 @@ impl Oracle {
     pub fn with_caustics(mut self, on: bool) -> Oracle {
         self.caustic = None;
         if on {
-            self.caustic = crate::caustic::Emitter::new(&self);
+            self.caustic = ParticleSource::new(&self.scene);
         }
         self
     }

@@ -52,6 +52,7 @@ pub mod glint;
 mod integrator;
 pub mod optics;
 mod parallel;
+mod particle_source;
 mod render;
 mod rng;
 mod sampling;

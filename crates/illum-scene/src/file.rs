@@ -5,8 +5,6 @@
 //! f64 / i64 so that range checks (`spp = 0`, `width = -1`, `vfov = 1e40`) happen in validation,
 //! where the error can name the field, rather than inside serde.
 //!
-//! Over 450 lines with its tests: the format's documentation beside the structs that mirror it.
-//!
 //! Format (lengths in scene units, angles in degrees, colours linear RGB). Every section but
 //! `[camera]` and `[[objects]]` is optional:
 //!

@@ -43,14 +43,18 @@ mod features;
 mod file;
 mod frame;
 mod lights;
+mod load;
 mod materials;
 mod paths;
 mod renderers;
 mod scene;
 mod settings;
 mod shapes;
+mod spelling;
 pub mod testing;
 mod validate;
+mod validate_materials;
+mod validate_objects;
 mod validate_sections;
 
 pub use camera::{Camera, CameraBasis, ClipPlanes};
@@ -67,4 +71,4 @@ pub use renderers::{
 };
 pub use scene::{Object, Overrides, Scene};
 pub use shapes::{BoxShape, Quad, Shape, Sphere};
-pub use validate::{fmt_f32, toml_key};
+pub use spelling::{fmt_f32, toml_key};

@@ -1,13 +1,10 @@
 //! The scene: one physical description that every renderer reads, plus the per-renderer
-//! sections. Loading, command-line overrides, device-limit checks and the list of emitters.
-
-use std::path::Path;
+//! sections, with command-line overrides and the list of emitters (loading a file is `load.rs`).
 
 use glam::{DVec3, Vec3};
 
 use crate::camera::{Camera, ClipPlanes};
 use crate::error::SceneError;
-use crate::file::RawScene;
 use crate::lights::{DirectionalLight, Environment};
 use crate::materials::Material;
 use crate::renderers::{
@@ -16,7 +13,6 @@ use crate::renderers::{
 };
 use crate::settings::bounces_allowed;
 use crate::shapes::{Quad, Shape};
-use crate::validate::scene_from_raw;
 
 /// A whole scene as loaded from TOML. Every value has passed validation (see `validate.rs`):
 /// vectors are finite, extents positive, the camera is not degenerate and material indices are
@@ -81,26 +77,6 @@ pub struct Overrides {
 }
 
 impl Scene {
-    /// Reads and validates a scene file. Errors name the file as `path` was given.
-    pub fn load(path: &Path) -> Result<Scene, SceneError> {
-        let label = path.display().to_string();
-        let text =
-            std::fs::read_to_string(path).map_err(|source| SceneError::Io { file: label.clone(), source })?;
-        Self::from_toml_str(&text, &label)
-    }
-
-    /// Parses and validates scene text. `file_label` names the source in errors, and its file
-    /// stem is the scene's name when the text has no `name`.
-    pub fn from_toml_str(text: &str, file_label: &str) -> Result<Scene, SceneError> {
-        let raw: RawScene = toml::from_str(text).map_err(|e| SceneError::from_toml(&e, text, file_label))?;
-        let default_name = Path::new(file_label)
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .filter(|s| !s.is_empty())
-            .unwrap_or_else(|| "scene".to_owned());
-        scene_from_raw(raw, file_label, &default_name)
-    }
-
     /// Replaces the file's settings with the given overrides, after checking them by the same
     /// rules as the file. `origin` labels the errors (e.g. "command line"), whose fields are the
     /// flag names (`--spp`, `--bounces`, `--width`, `--height`). On error nothing is changed.

@@ -1,5 +1,5 @@
 //! Validation of the lights and of the per-renderer sections, and the range checks they share
-//! with `validate.rs` (a positive number, a reflectance in [0, 1], ...). Same rules as there:
+//! with the other validation files (a positive number, a reflectance in [0, 1], ...). Same rules as there:
 //! every number is checked for finiteness in f32 before it is compared.
 
 use glam::Vec3;
@@ -15,7 +15,8 @@ use crate::renderers::{
     PathTraceSettings, RasterSettings, Sampling, Sequence, Shading, WhittedSettings,
 };
 use crate::settings::{LOOK_ALLOWED, UNBOUNDED, bounces_allowed};
-use crate::validate::{Check, fmt_num, fmt_vec};
+use crate::spelling::{fmt_num, fmt_vec};
+use crate::validate::Check;
 
 /// Largest angular radius of a sun disc, in degrees (exclusive): at 90 the disc is a hemisphere.
 const MAX_ANGULAR_RADIUS_DEG: f32 = 90.0;

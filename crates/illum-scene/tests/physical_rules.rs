@@ -6,8 +6,6 @@
 //! The refusals are data, `cases/physical_rules.toml`, checked by one test; the tests here check
 //! what a refusal cannot say: the values accepted up to the extremes, and what they load as.
 //! (`errors.rs` has the camera, shape and path-tracer rules.)
-//!
-//! Over 450 lines: one test per rule of the physical model, each beside the scene it edits.
 
 use glam::Vec3;
 use illum_scene::testing::{Edits, edit_once as edit_text, without};

@@ -202,7 +202,7 @@ pub fn measure(
             }
             Setting::PathTrace { .. } => {
                 let (setup, per_pixel_fixed, per_spp) =
-                    path_tracer_throughput(gpu, &small, setting, options)?;
+                    path_tracer_throughput(gpu, &small, setting, options.timing_spp)?;
                 (setup + per_pixel_fixed * pixel_ratio, per_spp * pixel_ratio)
             }
         };

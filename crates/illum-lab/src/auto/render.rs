@@ -4,6 +4,7 @@
 
 use std::time::Instant;
 
+use illum_auto::settings::apply;
 use illum_denoise::{Denoiser, SplitRender};
 use illum_gpu::GpuContext;
 use illum_image::RgbImage32;
@@ -12,7 +13,6 @@ use illum_raster::{Options, RasterRenderer, RasterScene};
 use illum_scene::{Scene, Sequence};
 use illum_whitted::WhittedTracer;
 
-use super::pilot::{PilotOptions, apply};
 use super::plan::Setting;
 
 /// The spp a path tracer's setting renders in multiples of: a denoised render's two halves
@@ -37,18 +37,17 @@ pub(super) fn tracer_options(setting: &Setting) -> TracerOptions {
 
 /// A path tracer's costs at the pilot's size: the set-up (pipelines, buffers), the seconds
 /// that scale with the pixels but not the spp (adaptive sampling's pilot, a denoised render's
-/// guides and filter runs) and the seconds per spp.
+/// guides and filter runs) and the seconds per spp, timed over `timing_spp` samples per pixel.
 pub(super) fn path_tracer_throughput(
     gpu: &GpuContext,
     small: &Scene,
     setting: &Setting,
-    options: &PilotOptions,
+    timing_spp: u32,
 ) -> anyhow::Result<(f64, f64, f64)> {
     let Setting::PathTrace { adaptive, denoise, .. } = setting else {
         anyhow::bail!("{setting} is not a path tracer's setting");
     };
     let variant = apply(small, setting);
-    let timing = options.timing_spp;
     let t = Instant::now();
     if let Some(kind) = denoise {
         let filter = Denoiser::new(gpu, *kind)?;
@@ -59,8 +58,8 @@ pub(super) fn path_tracer_throughput(
         split.b.reset();
         let setup = t.elapsed().as_secs_f64();
         let t = Instant::now();
-        split.advance(timing / 2, &cancel)?;
-        let per_spp = t.elapsed().as_secs_f64() / f64::from(timing / 2 * 2);
+        split.advance(timing_spp / 2, &cancel)?;
+        let per_spp = t.elapsed().as_secs_f64() / f64::from(timing_spp / 2 * 2);
         let t = Instant::now();
         split.denoise(&filter)?;
         return Ok((setup, t.elapsed().as_secs_f64(), per_spp));
@@ -81,14 +80,14 @@ pub(super) fn path_tracer_throughput(
     tracer.reset();
     let t = Instant::now();
     let (adaptive_pilot, until) = if *adaptive {
-        let allocation = illum_pathtrace::allocation::plan_adaptive(&mut tracer, timing)?;
+        let allocation = illum_pathtrace::allocation::plan_adaptive(&mut tracer, timing_spp)?;
         (t.elapsed().as_secs_f64(), allocation.max())
     } else {
-        (0.0, timing)
+        (0.0, timing_spp)
     };
     let t = Instant::now();
     tracer.render_to_spp(until)?;
-    Ok((setup, adaptive_pilot, t.elapsed().as_secs_f64() / f64::from(timing)))
+    Ok((setup, adaptive_pilot, t.elapsed().as_secs_f64() / f64::from(timing_spp)))
 }
 
 /// Renders `scene` (with `setting` applied, see [`apply`]) by the setting's renderer, the path
