@@ -9,7 +9,7 @@ use illum_scene::{Bounces, Feature, RendererKind, Scene, Shape};
 use illum_rtcore::{CameraRecord, Geometry, MaterialRecord, ObjectRecord, ordered_objects};
 
 use crate::PathTraceError;
-use crate::specialise::SceneCode;
+use crate::scene_code::SceneCode;
 
 /// What of the scene model the path tracer implements: all of it. Each feature is compiled
 /// into a scene's pipeline only when the scene uses it (see [`crate::specialise`]).

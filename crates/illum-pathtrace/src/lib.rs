@@ -30,6 +30,7 @@ pub mod planner;
 pub mod progressive;
 pub mod reference;
 pub mod replicates;
+mod scene_code;
 pub mod shaders;
 pub mod specialise;
 mod tracer;

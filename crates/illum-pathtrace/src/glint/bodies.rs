@@ -102,7 +102,8 @@ impl Bodies {
                 _ => Surface::Other,
             })
             .collect();
-        let (tree, order) = build_tree(&bodies, scale);
+        let boxes: Vec<(DVec3, DVec3)> = bodies.iter().map(|b| bounds(b, scale)).collect();
+        let (tree, order) = build_tree(&boxes);
         Self { bodies, surfaces, scale, tree, order }
     }
 
@@ -299,6 +300,31 @@ pub fn fresnel(cos_i: f64, eta: f64) -> (f64, Option<f64>) {
     let rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
     let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
     (0.5 * (rs * rs + rp * rp), Some(cos_t))
+}
+
+/// The box around a body, padded by 1e-9 of the scene's size so that rounding never puts a hit
+/// outside it.
+fn bounds(body: &Body, scale: f64) -> (DVec3, DVec3) {
+    let (lo, hi) = match *body {
+        Body::Sphere { center, radius } => (center - DVec3::splat(radius), center + DVec3::splat(radius)),
+        Body::Quad { corner, edge_u, edge_v, .. } => {
+            let corners = [corner, corner + edge_u, corner + edge_v, corner + edge_u + edge_v];
+            (corners.iter().fold(corner, |a, &c| a.min(c)), corners.iter().fold(corner, |a, &c| a.max(c)))
+        }
+        Body::Box { min, max, rotation, offset } => {
+            let corners = (0..8).map(|k| {
+                let local = DVec3::new(
+                    if k & 1 == 0 { min.x } else { max.x },
+                    if k & 2 == 0 { min.y } else { max.y },
+                    if k & 4 == 0 { min.z } else { max.z },
+                );
+                rotation * local + offset
+            });
+            corners.fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), c| (lo.min(c), hi.max(c)))
+        }
+    };
+    let pad = DVec3::splat(1e-9 * scale);
+    (lo - pad, hi + pad)
 }
 
 #[cfg(test)]

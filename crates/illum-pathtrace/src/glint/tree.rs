@@ -3,8 +3,6 @@
 
 use glam::DVec3;
 
-use super::bodies::Body;
-
 /// A node of the bodies' hierarchy: its box, and either two children (`count == 0`: `first` is
 /// the left child's index, the right one follows it) or the bodies `order[first..][..count]`.
 #[derive(Clone, Copy, Debug)]
@@ -18,37 +16,11 @@ pub(super) struct Node {
 /// Bodies per leaf of the hierarchy.
 const LEAF_BODIES: usize = 4;
 
-/// The box around a body, padded by 1e-9 of the scene's size so that rounding never puts a hit
-/// outside it.
-fn bounds(body: &Body, scale: f64) -> (DVec3, DVec3) {
-    let (lo, hi) = match *body {
-        Body::Sphere { center, radius } => (center - DVec3::splat(radius), center + DVec3::splat(radius)),
-        Body::Quad { corner, edge_u, edge_v, .. } => {
-            let corners = [corner, corner + edge_u, corner + edge_v, corner + edge_u + edge_v];
-            (corners.iter().fold(corner, |a, &c| a.min(c)), corners.iter().fold(corner, |a, &c| a.max(c)))
-        }
-        Body::Box { min, max, rotation, offset } => {
-            let corners = (0..8).map(|k| {
-                let local = DVec3::new(
-                    if k & 1 == 0 { min.x } else { max.x },
-                    if k & 2 == 0 { min.y } else { max.y },
-                    if k & 4 == 0 { min.z } else { max.z },
-                );
-                rotation * local + offset
-            });
-            corners.fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), c| (lo.min(c), hi.max(c)))
-        }
-    };
-    let pad = DVec3::splat(1e-9 * scale);
-    (lo - pad, hi + pad)
-}
-
-/// Builds the hierarchy by median splits on the widest axis of the boxes' centres, and orders
-/// the bodies to match it. Returns the nodes, the root first, and the scene indices of the
-/// bodies in the leaves' order.
-pub(super) fn build_tree(bodies: &[Body], scale: f64) -> (Vec<Node>, Vec<usize>) {
-    let boxes: Vec<(DVec3, DVec3)> = bodies.iter().map(|b| bounds(b, scale)).collect();
-    let mut order: Vec<usize> = (0..bodies.len()).collect();
+/// Builds the hierarchy over the bodies' `boxes` (lower and upper corners) by median splits on
+/// the widest axis of the boxes' centres, and orders the bodies to match it. Returns the nodes,
+/// the root first, and the scene indices of the bodies in the leaves' order.
+pub(super) fn build_tree(boxes: &[(DVec3, DVec3)]) -> (Vec<Node>, Vec<usize>) {
+    let mut order: Vec<usize> = (0..boxes.len()).collect();
     let mut nodes = vec![Node { lo: DVec3::ZERO, hi: DVec3::ZERO, first: 0, count: 0 }];
     // (node, range of `order`)
     let mut work = vec![(0usize, 0usize, order.len())];

@@ -6,7 +6,7 @@ use illum_scene::DirectionalLight;
 
 use super::tests::{compose_and_validate, path_tracer_scenes};
 use super::*;
-use crate::specialise::SceneCode;
+use crate::scene_code::SceneCode;
 
 /// A scene with one object of each material kind, two area lights, a sun and a sky: what
 /// [`scene_variants`] takes subsets of.

@@ -35,6 +35,7 @@
 //! `caustic/params.rs`, its scheduling `caustic/schedule.rs` (both pure, tested without a GPU).
 
 mod dispatch;
+mod flight;
 mod params;
 mod pass;
 mod polled;

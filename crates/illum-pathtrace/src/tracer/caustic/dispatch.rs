@@ -4,6 +4,7 @@
 
 use illum_gpu::{GpuContext, wgpu};
 
+use super::flight::DispatchBytes;
 use super::params::WORDS_PER_PIXEL;
 use super::pass::CausticPass;
 use super::schedule::{Cursor, FrameShape, Stage, Submission, WORKGROUP, next_submission};
@@ -16,13 +17,6 @@ pub(super) enum Launched {
     Piece(Submission),
     /// Frames to read back: whole ones, or a frame's last piece.
     Frames { staging: wgpu::Buffer, bytes: DispatchBytes, count: u32, submission: Submission },
-}
-
-/// What a dispatch's staging copy holds: its frames' bytes, then the timestamps (if timed).
-#[derive(Clone, Copy)]
-pub(super) struct DispatchBytes {
-    pub(super) frames: u64,
-    pub(super) total: u64,
 }
 
 /// The timer's names of the light tracer's and the photon gather's passes.

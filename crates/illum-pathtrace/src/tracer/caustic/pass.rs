@@ -2,8 +2,8 @@
 //! and sum of squares of the frames' values (see the parent module for how they join the
 //! camera's), and where the frame in progress stands.
 
+use super::flight::InFlight;
 use super::params::WORDS_PER_PIXEL;
-use super::polled::InFlight;
 use super::schedule::Cursor;
 use crate::batch::Layers;
 

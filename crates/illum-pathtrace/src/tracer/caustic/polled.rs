@@ -10,32 +10,11 @@ use illum_gpu::{GpuContext, wgpu};
 use web_time::Instant;
 
 use super::CausticTracer;
-use super::dispatch::{DispatchBytes, Launched};
+use super::dispatch::Launched;
+use super::flight::{Flight, InFlight, seen_done};
 use super::pass::PassKey;
 use super::schedule::{Submission, Took};
 use crate::PathTraceError;
-
-/// A polled submission: frames whose readback is under way, or a piece whose work is.
-pub(super) struct InFlight {
-    what: Flight,
-    submission: Submission,
-    launched: Instant,
-    /// Looks that found it not yet done.
-    looks: u32,
-}
-
-/// What the `seconds` from a submission to the look that saw it done say of its cost, after
-/// `looks` that saw it not done: a bound (see [`Took`]).
-fn seen_done(looks: u32, seconds: f64) -> Took {
-    if looks == 0 { Took::WithinOneLook(seconds) } else { Took::AtMost(seconds) }
-}
-
-enum Flight {
-    /// Frames to read back (whole ones, or a frame's last piece).
-    Read { read: PendingRead, bytes: DispatchBytes, count: u32 },
-    /// A piece of a frame, set done when the GPU has finished it.
-    Piece(Arc<AtomicBool>),
-}
 
 impl CausticTracer {
     /// The polled form of [`Self::prepare_pass`]: true once the frames of pass `key` are all
