@@ -8,7 +8,8 @@
 //! - [`readback`]: copy a GPU buffer back to the CPU.
 //! - [`timing`]: GPU pass timing with timestamp queries, where the adapter has them.
 //! - [`shader`]: WGSL composition (naga_oil) and validation.
-//! - [`testing`]: what every crate's GPU tests share (one device per test binary, paths).
+//! - `testing` (with the feature `testing`, which the workspace's tests enable): what every crate's GPU
+//!   tests share (one device per test binary, paths).
 
 pub mod buffers;
 mod context;
@@ -16,7 +17,7 @@ mod error;
 pub mod policy;
 pub mod readback;
 pub mod shader;
-#[cfg(not(target_arch = "wasm32"))]
+#[cfg(all(any(test, feature = "testing"), not(target_arch = "wasm32")))]
 pub mod testing;
 pub mod timing;
 

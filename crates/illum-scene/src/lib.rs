@@ -51,6 +51,7 @@ mod scene;
 mod settings;
 mod shapes;
 mod spelling;
+#[cfg(any(test, feature = "testing"))]
 pub mod testing;
 mod validate;
 mod validate_materials;
