@@ -26,31 +26,6 @@ pub fn check_texture_size(scene: &Scene, limits: &wgpu::Limits) -> Result<(), Sc
     Ok(())
 }
 
-/// [`check_texture_size`], and width x height x `bytes_per_pixel` (a buffer that holds the whole
-/// image at once) within one storage binding, `max_storage_buffer_binding_size`.
-pub fn check_resolution(
-    scene: &Scene,
-    limits: &wgpu::Limits,
-    bytes_per_pixel: u64,
-) -> Result<(), SceneError> {
-    check_texture_size(scene, limits)?;
-    let (w, h) = (scene.camera.width, scene.camera.height);
-    // u64 holds 2^32 * 2^32 pixels only without the factor; saturate rather than wrap.
-    let bytes = u64::from(w).saturating_mul(u64::from(h)).saturating_mul(bytes_per_pixel);
-    if bytes > limits.max_storage_buffer_binding_size {
-        return Err(SceneError::invalid(
-            &format!("scene {:?}", scene.name),
-            "camera.width x camera.height",
-            format!("{w} x {h} (x {bytes_per_pixel} bytes per pixel = {bytes} bytes)"),
-            format!(
-                "must fit in {} bytes, the device's max_storage_buffer_binding_size",
-                limits.max_storage_buffer_binding_size
-            ),
-        ));
-    }
-    Ok(())
-}
-
 #[cfg(test)]
 mod tests {
     use illum_scene::testing::check_invalid;
@@ -75,22 +50,21 @@ mod tests {
         s
     }
 
-    /// Why a `w` x `h` image of `bytes_per_pixel` is refused.
-    fn refused(w: u32, h: u32, bytes_per_pixel: u64) -> SceneError {
-        check_resolution(&with_size(w, h), &limits(), bytes_per_pixel).unwrap_err()
+    /// Why a `w` x `h` image is refused.
+    fn refused(w: u32, h: u32) -> SceneError {
+        check_texture_size(&with_size(w, h), &limits()).unwrap_err()
     }
 
     #[test]
     fn resolution_within_limits_passes() {
-        check_resolution(&with_size(8192, 1024), &limits(), 16).unwrap();
-        // Exactly at the buffer limit: 4096 x 2048 x 16 bytes = 128 MiB.
-        check_resolution(&with_size(4096, 2048), &limits(), 16).unwrap();
+        check_texture_size(&with_size(8192, 1024), &limits()).unwrap();
+        check_texture_size(&with_size(1, 8192), &limits()).unwrap();
     }
 
     #[test]
     fn resolution_beyond_the_texture_limit_names_it() {
         let label = "scene \"test\"";
-        let err = refused(8193, 16, 16);
+        let err = refused(8193, 16);
         check_invalid(
             &err,
             label,
@@ -98,23 +72,7 @@ mod tests {
             "8193",
             "must be at most 8192, the device's max_texture_dimension_2d",
         );
-        let err = refused(16, 10000, 16);
+        let err = refused(16, 10000);
         check_invalid(&err, label, "camera.height", "10000", "max_texture_dimension_2d");
-    }
-
-    #[test]
-    fn resolution_beyond_the_buffer_limit_names_it() {
-        let err = refused(4096, 2049, 16);
-        // 4096 * 2049 * 16 = 134283264 bytes > 134217728.
-        check_invalid(
-            &err,
-            "scene \"test\"",
-            "camera.width x camera.height",
-            "4096 x 2049 (x 16 bytes per pixel = 134283264 bytes)",
-            "must fit in 134217728 bytes, the device's max_storage_buffer_binding_size",
-        );
-        // An absurd per-pixel size saturates instead of wrapping around to a small number.
-        let err = refused(8192, 8192, u64::MAX);
-        assert!(err.to_string().contains("max_storage_buffer_binding_size"), "{err}");
     }
 }
