@@ -31,7 +31,7 @@ use illum_scene::RendererKind;
 
 use crate::auto_panel::AutoMode;
 use crate::frame_rate::FrameRate;
-use crate::pathtrace_panel::PathTraceMode;
+use crate::pathtrace_mode::PathTraceMode;
 use crate::raster_panel::RasterMode;
 use crate::scene_file::{DEFAULT_PATHTRACE_SCENE, DEFAULT_RASTER_SCENE};
 use crate::screenshot::ScreenshotJob;

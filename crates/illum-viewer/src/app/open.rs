@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use illum_scene::RendererKind;
 
 use super::ViewerApp;
-use crate::pathtrace_panel::PathTraceMode;
+use crate::pathtrace_mode::PathTraceMode;
 use crate::raster_panel::RasterMode;
 use crate::scene_file;
 use crate::whitted_panel::WhittedMode;

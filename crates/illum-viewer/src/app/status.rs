@@ -4,7 +4,7 @@
 use illum_scene::RendererKind;
 
 use super::ViewerApp;
-use crate::pathtrace_panel::PathTraceMode;
+use crate::pathtrace_mode::PathTraceMode;
 
 impl ViewerApp {
     /// What the window shows, as (name, value) pairs: the mode, the scene, the last open

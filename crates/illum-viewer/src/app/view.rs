@@ -5,7 +5,7 @@ use illum_gpu::GpuContext;
 use illum_scene::RendererKind;
 
 use super::ViewerApp;
-use crate::pathtrace_panel::PathTraceMode;
+use crate::pathtrace_mode::PathTraceMode;
 use crate::whitted_panel::WhittedMode;
 
 impl ViewerApp {
