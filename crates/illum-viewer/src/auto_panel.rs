@@ -16,7 +16,7 @@ use illum_scene::RendererKind;
 
 use crate::auto_pilot::ViewerPilot;
 use crate::auto_pilot::{PilotOptions, ViewSizes};
-use crate::pathtrace_panel::PathTraceMode;
+use crate::pathtrace_mode::PathTraceMode;
 use crate::raster_panel::RasterMode;
 use crate::whitted_panel::WhittedMode;
 

@@ -2,7 +2,9 @@
 //! device.
 //!
 //! - [`app`]: the application state, the mode switch and the scene field;
-//! - [`pathtrace_panel`] / [`raster_panel`]: each mode's settings, renderer and panel;
+//! - [`pathtrace_mode`] / [`pathtrace_panel`]: the path tracer's mode (settings, renderer,
+//!   statistics, saving) and its panel;
+//! - [`raster_panel`] / [`whitted_panel`]: each of the other modes' settings, renderer and panel;
 //! - [`auto_panel`] / [`auto_pilot`]: the Auto mode (the accuracy slider and the choice) and
 //!   its pilot, run across frames;
 //! - [`camera`]: orbit / pan / zoom with the mouse, shared by both modes;
@@ -39,6 +41,7 @@ pub mod error_view;
 pub mod frame_rate;
 pub mod gpu_setup;
 pub mod pacer;
+pub mod pathtrace_mode;
 pub mod pathtrace_panel;
 pub mod platform;
 pub mod raster_panel;

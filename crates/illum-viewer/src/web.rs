@@ -10,7 +10,7 @@ use wasm_bindgen::JsCast;
 use crate::app::{StartOptions, ViewerApp};
 use crate::browser::{STATUS_ID, document, js_text};
 use crate::cli::{StartMode, parse_start_mode};
-use crate::pathtrace_panel::{MAX_SCALE, MIN_SCALE};
+use crate::pathtrace_mode::{MAX_SCALE, MIN_SCALE};
 use crate::scene_file::DEFAULT_PATHTRACE_SCENE;
 
 /// The canvas the page gives the viewer.

@@ -7,8 +7,6 @@
 //!
 //! All harnesses share one device, as the real window has one (a device per harness would
 //! compile every pipeline again: the pipeline caches belong to each device's `GpuContext`).
-//!
-//! Over 450 lines: each test drives the same app through one user action, on one shared harness.
 
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;

@@ -16,8 +16,6 @@
 //! - Save EXR downloads a checkpoint of the Cornell box's 8 spp that the desktop's loader reads;
 //! - a bad scene file dropped on the page shows the desktop's error and keeps the scene.
 //!
-//! Over 450 lines: one browser run and the checks of what it saw, each beside its native render.
-//!
 //! Prerequisites (`.ci/run` installs them): `rustup target add wasm32-unknown-unknown`,
 //! `cargo install wasm-bindgen-cli --version <Cargo.lock's wasm-bindgen>`, chromium, node and
 //! `npm ci --prefix web/tests`. Without them the test fails under CI (`CI` set) naming the

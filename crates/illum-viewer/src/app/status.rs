@@ -1,0 +1,98 @@
+//! What the window reports about itself: the status the web page publishes for scripts and
+//! browser tests (`#illum-status`), and the summary line a `--screenshot` run prints.
+
+use illum_scene::RendererKind;
+
+use super::ViewerApp;
+use crate::pathtrace_mode::PathTraceMode;
+
+impl ViewerApp {
+    /// What the window shows, as (name, value) pairs: the mode, the scene, the last open
+    /// error, the adapter, and each mode's progress. The web page publishes them on the page
+    /// (`data-*` attributes of `#illum-status`) for scripts and browser tests.
+    pub fn status(&self) -> Vec<(&'static str, String)> {
+        // Every name every time (empty when it does not apply), so that a value never outlives
+        // what it describes.
+        let text = |value: Option<String>| value.unwrap_or_default();
+        let pathtrace = self.pathtrace();
+        let stats = pathtrace.map(PathTraceMode::stats);
+        let image = pathtrace.and_then(PathTraceMode::image_mean);
+        let seconds = pathtrace.and_then(PathTraceMode::submission_seconds);
+        let whitted_image = self.whitted().and_then(|w| w.image_mean);
+        let on_off = |on: bool| if on { "on" } else { "off" };
+        vec![
+            ("mode", self.mode.to_string()),
+            ("scene", text(self.current_scene_path())),
+            ("open-error", text(self.open_error.clone())),
+            ("mode-refusal", text(self.refusal_of(self.mode))),
+            ("window-fps", text(self.frame_rate.fps().map(|f| format!("{f:.1}")))),
+            (
+                "adapter",
+                text(
+                    self.gpu.as_ref().ok().map(|(gpu, _)| {
+                        format!("{} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend)
+                    }),
+                ),
+            ),
+            ("pathtrace-spp", text(stats.map(|s| s.spp.to_string()))),
+            ("pathtrace-samples-per-second", text(stats.map(|s| format!("{:.0}", s.samples_per_second)))),
+            ("pathtrace-stopped", text(pathtrace.and_then(|p| p.stop_reason()).map(|r| r.name().to_owned()))),
+            ("pathtrace-size", text(image.map(|(_, [w, h])| format!("{w}x{h}")))),
+            ("pathtrace-mean", text(image.map(|(m, _)| format!("{} {} {}", m[0], m[1], m[2])))),
+            ("pathtrace-submission-seconds", text(seconds.map(|(wall, _)| format!("{wall:.3}")))),
+            ("pathtrace-gpu-seconds", text(seconds.map(|(_, gpu)| format!("{gpu:.3}")))),
+            ("pathtrace-message", text(pathtrace.and_then(|p| p.message.clone()))),
+            (
+                "pathtrace-caustics",
+                text(pathtrace.and_then(PathTraceMode::caustics_running).map(|on| on_off(on).to_owned())),
+            ),
+            (
+                "pathtrace-denoise",
+                text(pathtrace.filter(|p| p.settings.denoise).map(|p| p.denoise.summary())),
+            ),
+            ("raster-message", text(self.raster().and_then(|r| r.message.clone()))),
+            ("view-rect", text(self.view_rect.map(|[x, y, w, h]| format!("{x} {y} {w} {h}")))),
+            ("whitted-frames", text(self.whitted().map(|w| w.frames.to_string()))),
+            ("whitted-size", text(whitted_image.map(|(_, [w, h])| format!("{w}x{h}")))),
+            ("whitted-mean", text(whitted_image.map(|(m, _)| format!("{} {} {}", m[0], m[1], m[2])))),
+            ("whitted-ms", text(self.whitted().and_then(|w| w.frame_ms).map(|ms| format!("{ms:.0}")))),
+            ("whitted-message", text(self.whitted().and_then(|w| w.message.clone()))),
+        ]
+    }
+
+    /// One line of the shown mode's statistics and the window's frame rate, as a
+    /// `--screenshot` run prints them on exit (the smoke test and `bench --viewer` read it).
+    pub fn summary(&self) -> String {
+        let mode = match self.mode {
+            RendererKind::PathTrace => self.pathtrace().map(PathTraceMode::summary),
+            RendererKind::Raster => self.raster().map(|r| {
+                let gpu = r
+                    .pass_times()
+                    .map_or("n/a".to_owned(), |t| format!("{:.2} ms", t.shadow_ms + t.cube_ms + t.main_ms));
+                format!("raster: GPU time per frame {gpu}")
+            }),
+            RendererKind::Whitted => self.whitted().map(|w| {
+                let ms = w.frame_ms.map_or("n/a".to_owned(), |ms| format!("{ms:.1} ms"));
+                format!("whitted: {} rendered, last frame {ms}", count(w.frames, "frame", "frames"))
+            }),
+        };
+        let fps = self.frame_rate.fps().map_or("n/a".to_owned(), |f| format!("{f:.1} fps"));
+        let auto = if self.auto_shown { format!("{}; ", self.auto.summary()) } else { String::new() };
+        format!("{auto}{}, window {fps}", mode.unwrap_or_else(|| format!("{}: no scene", self.mode)))
+    }
+}
+
+/// `n` and the noun in the number it takes ("1 frame", "2 frames").
+pub fn count(n: u64, one: &str, many: &str) -> String {
+    format!("{n} {}", if n == 1 { one } else { many })
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn counts_take_the_nouns_number() {
+        assert_eq!(super::count(1, "frame", "frames"), "1 frame");
+        assert_eq!(super::count(0, "frame", "frames"), "0 frames");
+        assert_eq!(super::count(30, "refresh", "refreshes"), "30 refreshes");
+    }
+}
