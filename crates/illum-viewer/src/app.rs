@@ -18,8 +18,6 @@ mod switch;
 mod top_bar;
 mod view;
 
-pub use status::count;
-
 use open::{load_pathtrace, load_raster, load_whitted};
 use top_bar::COMPACT_BELOW_POINTS;
 use view::margin_strips;

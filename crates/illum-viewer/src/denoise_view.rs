@@ -362,7 +362,7 @@ impl DenoiseView {
         format!(
             "denoise: {}, {}, last {:.0} ms from start to estimate, {:.2} s of the frames in the denoiser",
             self.summary(),
-            crate::app::count(self.refreshes, "refresh", "refreshes"),
+            crate::plural::count(self.refreshes, "refresh", "refreshes"),
             self.estimate.map_or(0.0, |e| 1e3 * e.seconds),
             self.seconds
         )

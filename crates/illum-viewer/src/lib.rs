@@ -18,6 +18,7 @@
 //! - [`pacer`]: how much of each frame the path tracer gets;
 //! - [`scene_file`]: opening scene files of either kind, with errors as text;
 //! - [`cli`] and [`screenshot`]: the command line, and `--screenshot FILE --frames N`;
+//! - [`plural`]: counts in words ("1 frame", "2 frames");
 //! - [`platform`]: what differs between the desktop and the browser (readback, scene files,
 //!   saving); `web` (wasm32 only): the viewer's start on a page, which builds the app; and
 //!   `browser` (wasm32 only): the page's services the app uses (downloads, the file picker,
@@ -44,6 +45,7 @@ pub mod pacer;
 pub mod pathtrace_mode;
 pub mod pathtrace_panel;
 pub mod platform;
+pub mod plural;
 pub mod raster_panel;
 pub mod scene_file;
 pub mod screenshot;

@@ -5,6 +5,7 @@ use illum_scene::RendererKind;
 
 use super::ViewerApp;
 use crate::pathtrace_mode::PathTraceMode;
+use crate::plural::count;
 
 impl ViewerApp {
     /// What the window shows, as (name, value) pairs: the mode, the scene, the last open
@@ -79,20 +80,5 @@ impl ViewerApp {
         let fps = self.frame_rate.fps().map_or("n/a".to_owned(), |f| format!("{f:.1} fps"));
         let auto = if self.auto_shown { format!("{}; ", self.auto.summary()) } else { String::new() };
         format!("{auto}{}, window {fps}", mode.unwrap_or_else(|| format!("{}: no scene", self.mode)))
-    }
-}
-
-/// `n` and the noun in the number it takes ("1 frame", "2 frames").
-pub fn count(n: u64, one: &str, many: &str) -> String {
-    format!("{n} {}", if n == 1 { one } else { many })
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn counts_take_the_nouns_number() {
-        assert_eq!(super::count(1, "frame", "frames"), "1 frame");
-        assert_eq!(super::count(0, "frame", "frames"), "0 frames");
-        assert_eq!(super::count(30, "refresh", "refreshes"), "30 refreshes");
     }
 }
