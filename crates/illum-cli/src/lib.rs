@@ -20,6 +20,7 @@ pub mod reference;
 pub mod render;
 mod render_args;
 mod resume;
+mod summary;
 pub mod whitted;
 
 use std::path::{Path, PathBuf};
