@@ -12,10 +12,11 @@
 use std::path::PathBuf;
 
 use clap::Parser;
-use illum::image::{Encoding, contact_sheet, save_png, save_rgba8_png, to_rgba8};
+use illum::image::{Encoding, save_png, save_rgba8_png, to_rgba8};
 use illum::pathtrace::PathTracer;
 use illum::scene::{Bounces, Overrides};
 use illum_cli::SceneArgs;
+use illum_lab::contact_sheet::contact_sheet;
 
 #[derive(Parser, Debug)]
 #[command(about = "Render the assignment's figures 2 and 3")]

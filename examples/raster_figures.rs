@@ -14,8 +14,9 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Parser;
 
-use illum::image::{Encoding, contact_sheet, save_png, save_rgba8_png, to_rgba8};
+use illum::image::{Encoding, save_png, save_rgba8_png, to_rgba8};
 use illum::raster::{Effects, Look, Options, RasterRenderer, RasterScene};
+use illum_lab::contact_sheet::contact_sheet;
 
 #[derive(Parser, Debug)]
 #[command(about = "Render the rasterizer's pictures: both looks, and a contact sheet of the \

@@ -47,13 +47,14 @@ use anyhow::{Context, bail};
 use clap::Parser;
 
 use illum::gpu::GpuContext;
-use illum::image::{Encoding, RgbImage32, contact_sheet, median, save_exr, save_rgba8_png, to_rgba8};
+use illum::image::{Encoding, RgbImage32, median, save_exr, save_rgba8_png, to_rgba8};
 use illum::pathtrace::PathTracer;
 use illum::raster::{Options, RasterRenderer, RasterScene};
 use illum::scene::{Bounces, Effects, Look, MAX_WHITTED_DEPTH, MaterialKind, Scene};
 use illum::whitted::WhittedTracer;
 use illum_denoise::{DenoiseInput, Denoiser, DenoiserKind};
 use illum_lab::auto::pilot::{has_caustic, truth_scene};
+use illum_lab::contact_sheet::contact_sheet;
 use illum_lab::plot::{self, Line, Style};
 use illum_lab::reference::{Reference, cached_reference, load_reference};
 use illum_lab::regions::{Comparison, Regions, compare, flip_heat_map};

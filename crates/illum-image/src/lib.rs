@@ -8,11 +8,9 @@
 //!   staying linear and carrying the render settings as text attributes;
 //! - [`metrics`]: RMSE, relative MSE, mean-luminance bias and the per-pixel Z-test used to
 //!   compare a render with a reference statistically;
-//! - [`mod@diff`] and [`mod@contact_sheet`]: pictures for humans, written when an image test fails or
-//!   when figures are assembled.
+//! - [`mod@diff`]: pictures for humans, written when an image test fails.
 
 pub mod atomic;
-pub mod contact_sheet;
 pub mod diff;
 pub mod exr;
 pub mod metrics;
@@ -23,7 +21,6 @@ pub mod tonemap;
 use std::path::PathBuf;
 
 pub use atomic::{check_output, write_atomically};
-pub use contact_sheet::contact_sheet;
 pub use diff::{DiffImages, save_diff_images};
 pub use exr::{
     ExrHeader, ExrMetadata, F32Layer, U32Layer, exr_bytes_with_layers, load_exr, load_exr_header,
