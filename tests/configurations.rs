@@ -7,8 +7,12 @@
 //!
 //! Each cell and renderer states its expectation in [`expected`]:
 //! - the Whitted ray tracer: every pixel finite, and the image the f64 copy of the algorithm's
-//!   (`illum_oracle::WhittedOracle`) by the criterion of crates/illum-whitted/tests/oracle.rs:
-//!   99% of the pixels within 1e-3 (relative to the larger of 1 and the oracle's value);
+//!   (`illum_oracle::WhittedOracle`) with 99% of the pixels within 1e-3 (relative to the larger
+//!   of 1 and the oracle's value). That is weaker than the shipped scenes' criterion
+//!   (`illum_oracle::whitted_agreement`: f32 rounding's tolerance, or an edge f32 can flip), which
+//!   these rows pass but one: with the spheres touching the floor one pixel of 14400 differs by
+//!   0.41 near a contact, where the floor and a sphere are closer than the spawn offset (about
+//!   1e-4 units) for about 0.015 units, so a ray spawned off one can start beyond the other;
 //! - the path tracer: no sample dropped as non-finite, and the image the f64 oracle's
 //!   (`illum_oracle::render`) by the criterion of
 //!   crates/illum-pathtrace/tests/pathtrace/oracle_agreement.rs: a pixel fails when a channel's

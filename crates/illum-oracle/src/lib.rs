@@ -58,6 +58,7 @@ mod rng;
 mod sampling;
 pub mod scene;
 pub mod whitted;
+pub mod whitted_agreement;
 
 pub use camera::PinholeCamera;
 pub use integrator::Oracle;
