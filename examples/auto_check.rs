@@ -125,7 +125,20 @@ fn run(args: Args) -> anyhow::Result<()> {
         adapter = gpu.adapter_info.name.clone();
         let truth = match given_truth(&args.truth, &truth_scene)? {
             Some(truth) => truth,
-            None => cached_reference(&gpu, &truth_scene, args.truth_spp, &args.out, "auto check truth")?,
+            None => {
+                let progress = illum_cli::progress::RenderProgress::new();
+                let on_step = &mut |t: &_, p: &_| progress.update(t, p);
+                let truth = cached_reference(
+                    &gpu,
+                    &truth_scene,
+                    args.truth_spp,
+                    &args.out,
+                    "auto check truth",
+                    on_step,
+                )?;
+                progress.finish();
+                truth
+            }
         };
         drop(gpu);
         // The cache's truths carry their estimated relMSE; a `render` EXR its estimated relative error.

@@ -36,7 +36,11 @@ fn run_auto(mut args: RenderArgs) -> anyhow::Result<()> {
     let started = std::time::Instant::now();
     let gpu = illum_cli::gpu()?;
     let device_seconds = started.elapsed().as_secs_f64();
-    let pilot = illum_lab::auto::pilot::measure(&gpu, &scene, device_seconds, &PilotOptions::default())?;
+    let progress = illum_cli::progress::RenderProgress::new();
+    let on_step = &mut |t: &_, p: &_| progress.update(t, p);
+    let pilot =
+        illum_lab::auto::pilot::measure(&gpu, &scene, device_seconds, &PilotOptions::default(), on_step)?;
+    progress.finish();
     drop(gpu);
     let pilot_seconds = started.elapsed().as_secs_f64();
     let left = illum_cli::auto::goal_left(goal, pilot_seconds).map_err(anyhow::Error::msg)?;

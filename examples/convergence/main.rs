@@ -201,13 +201,19 @@ fn run(mut args: Args) -> anyhow::Result<()> {
     let max_spp = taken.iter().map(|t| t.spp).max().unwrap_or(1).min(u64::from(u32::MAX)) as u32;
     let Reference { image: reference, .. } = match given_reference {
         Some(reference) => reference,
-        None => cached_reference(
-            &gpu,
-            &scene,
-            max_spp.saturating_mul(args.reference_factor),
-            &args.out,
-            "convergence reference",
-        )?,
+        None => {
+            let progress = illum_cli::progress::RenderProgress::new();
+            let reference = cached_reference(
+                &gpu,
+                &scene,
+                max_spp.saturating_mul(args.reference_factor),
+                &args.out,
+                "convergence reference",
+                &mut |t, p| progress.update(t, p),
+            )?;
+            progress.finish();
+            reference
+        }
     };
     println!("reference mean luminance {:.5}", reference.mean_luminance());
     let mut rows = Vec::new();

@@ -179,7 +179,17 @@ fn run(args: Args) -> anyhow::Result<()> {
         Some(path) => load_reference(path, &scene)?,
         None => {
             let truth_scene = truth_scene(&scene, args.truth_bounces);
-            cached_reference(&gpu, &truth_scene, args.truth_spp, &args.out, "ladder truth")?
+            let progress = illum_cli::progress::RenderProgress::new();
+            let truth = cached_reference(
+                &gpu,
+                &truth_scene,
+                args.truth_spp,
+                &args.out,
+                "ladder truth",
+                &mut |t, p| progress.update(t, p),
+            )?;
+            progress.finish();
+            truth
         }
     };
     println!("truth: {truth_spp} spp, its own estimated relMSE {truth_error:.2e}");

@@ -2,6 +2,7 @@
 //! size of a pilot's images: what the CLI's blocking pilot and the viewer's incremental one
 //! share.
 
+use illum_pathtrace::TracerOptions;
 use illum_raster::RasterScene;
 use illum_scene::{Bounces, DenoiserKind, Effects, Look, MaterialKind, Scene, Sequence};
 
@@ -133,6 +134,14 @@ pub fn apply(scene: &Scene, setting: &Setting) -> Scene {
         }
     }
     scene
+}
+
+/// The path tracer's options for `setting` (its sequence).
+pub fn tracer_options(setting: &Setting) -> TracerOptions {
+    match setting {
+        Setting::PathTrace { sequence, .. } => TracerOptions { sequence: *sequence, ..Default::default() },
+        _ => TracerOptions::default(),
+    }
 }
 
 /// The pilot's size: the scene's aspect, `longer_side` pixels on the longer side, never more

@@ -6,9 +6,9 @@ use std::path::{Path, PathBuf};
 
 use illum_gpu::GpuContext;
 use illum_image::{ExrMetadata, RgbImage32, load_exr, save_exr};
-use illum_pathtrace::PathTracer;
 use illum_pathtrace::reference::SizePolicy;
-use illum_scene::{Sampling, Scene};
+use illum_pathtrace::{PathTracer, Progressive};
+use illum_scene::Scene;
 
 /// A reference image and what is known of its own error.
 pub struct Reference {
@@ -42,14 +42,19 @@ pub fn load_reference(path: &Path, scene: &Scene) -> anyhow::Result<Reference> {
     })
 }
 
+/// What a long render shows of its progress after each step (the command line's bar or lines).
+pub type OnStep<'a> = &'a mut dyn FnMut(&PathTracer, &Progressive);
+
 /// The cached reference of `scene` at `spp` samples per pixel in `folder`, rendered (and
-/// written) if the cache has none made with exactly these settings. `label` names the tool.
+/// written) if the cache has none made with exactly these settings, telling `on_step` how far
+/// it is (a long render: minutes for the Whitted scene's caustic). `label` names the tool.
 pub fn cached_reference(
     gpu: &GpuContext,
     scene: &Scene,
     spp: u32,
     folder: &Path,
     label: &str,
+    on_step: OnStep,
 ) -> anyhow::Result<Reference> {
     let (reference_scene, key) = reference_settings(scene, spp);
     let path =
@@ -72,12 +77,9 @@ pub fn cached_reference(
     }
     println!("rendering the reference: {spp} spp (cached as {})", path.display());
     let mut tracer = PathTracer::new(gpu, &reference_scene)?;
-    // A long render (minutes for the Whitted scene's caustic): a progress bar on a terminal.
     let rules = illum_pathtrace::StopRules { spp: Some(spp), target_error: None, time_budget: None };
-    let progress = illum_cli::progress::RenderProgress::new();
     let never = std::sync::atomic::AtomicBool::new(false);
-    illum_pathtrace::render_progressive(&mut tracer, &rules, &never, |t, p| progress.update(t, p))?;
-    progress.finish();
+    illum_pathtrace::render_progressive(&mut tracer, &rules, &never, on_step)?;
     let image = tracer.accumulator().mean_image();
     let estimated_rel_mse = tracer.accumulator().estimated_rel_mse();
     let mut metadata = illum_pathtrace::metadata::exr_metadata(
@@ -92,16 +94,12 @@ pub fn cached_reference(
     Ok(Reference { image, path, spp: u64::from(spp), estimated_rel_mse, metadata })
 }
 
-/// The scene the reference is rendered with (cosine sampling, `spp`, a seed of its own), and
+/// The scene the reference is rendered with ([`illum_pathtrace::reference::reference_scene`]), and
 /// its cache key: everything that changes the reference image, written out explicitly: the
 /// scene's content hash ([`Scene::content_hash`], with the version of its canonical form), the
 /// resolution and every `[pathtrace]` setting.
 pub fn reference_settings(scene: &Scene, spp: u32) -> (Scene, String) {
-    let mut reference_scene = scene.clone();
-    reference_scene.pathtrace.sampling = Sampling::Cosine;
-    reference_scene.pathtrace.spp = spp;
-    // A seed the measured runs do not use, so reference and test noise are independent.
-    reference_scene.pathtrace.seed = scene.pathtrace.seed.wrapping_add(0x5eed);
+    let reference_scene = illum_pathtrace::reference::reference_scene(scene, spp);
     let (camera, settings) = (&reference_scene.camera, &reference_scene.pathtrace);
     let key = format!(
         "scene {} (canonical form {}), {}x{}, spp {}, bounces {}, seed {}, sampling {}, sequence {}, caustics {}, \
@@ -166,7 +164,7 @@ mod tests {
         }
         // The sampling of the measured rows does not change the reference (always cosine).
         let mut uniform = scene.clone();
-        uniform.pathtrace.sampling = Sampling::Uniform;
+        uniform.pathtrace.sampling = illum_scene::Sampling::Uniform;
         assert_eq!(reference_settings(&uniform, 1024).1, key);
         // Nor does what only another renderer reads.
         let mut raster = scene.clone();

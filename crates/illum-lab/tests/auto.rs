@@ -17,18 +17,19 @@ fn predicted_errors_are_within_a_factor_1_5_of_the_measured_ones() {
         .apply_overrides(&Overrides { width: Some(96), height: Some(54), ..Default::default() }, "test")
         .unwrap();
     let folder = std::env::temp_dir().join(format!("illum-auto-test-{}", std::process::id()));
-    let options = PilotOptions {
+    let pilot = illum_auto::pilot::PilotOptions {
         longer_side: 48,
         truth_spp: 2048,
         pilot_spp: 256,
         timing_spp: 16,
-        folder: folder.clone(),
+        ..illum_auto::pilot::PilotOptions::COMMAND_LINE
     };
-    let pilot = measure(gpu(), &scene, 0.0, &options).unwrap();
+    let options = PilotOptions { pilot, folder: folder.clone() };
+    let pilot = measure(gpu(), &scene, 0.0, &options, &mut |_, _| {}).unwrap();
     assert_eq!(pilot.size, (48, 27));
 
     let truth_scene = truth_scene(&scene, Bounces::Unbounded);
-    let truth = cached_reference(gpu(), &truth_scene, 2048, &folder, "test truth").unwrap();
+    let truth = cached_reference(gpu(), &truth_scene, 2048, &folder, "test truth", &mut |_, _| {}).unwrap();
 
     let mut renderers = Vec::new();
     for target in [0.3, 0.1, 0.03] {

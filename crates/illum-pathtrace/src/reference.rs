@@ -16,6 +16,18 @@ use illum_scene::Scene;
 
 use crate::metadata::scene_hash;
 
+/// The scene a converged reference of `scene` is rendered as, at `spp` samples per pixel:
+/// cosine sampling (the estimator with no sample-count-dependent choice), and a seed of its own
+/// (the scene's plus `0x5eed`), so that a reference's noise is independent of the renders it is
+/// compared with. The measuring tools' cached references and Auto's pilot truth both use it.
+pub fn reference_scene(scene: &Scene, spp: u32) -> Scene {
+    let mut reference = scene.clone();
+    reference.pathtrace.sampling = illum_scene::Sampling::Cosine;
+    reference.pathtrace.spp = spp;
+    reference.pathtrace.seed = scene.pathtrace.seed.wrapping_add(0x5eed);
+    reference
+}
+
 /// The metadata key that names a file's scene by content.
 pub const SCENE_HASH: &str = "scene_hash";
 

@@ -5,7 +5,8 @@
 //! with the path tracer's Denoise toggle on); the path tracer stops at the planned spp, so that the time and error it reaches can be set against the
 //! prediction (its panel's spp target can be raised or set to Unlimited to go on).
 //!
-//! The pilot ([`crate::auto_pilot`]) runs once per scene file and view size, when Auto is
+//! The pilot ([`illum_auto::pilot`], with the viewer's options and the window's frame pacing)
+//! runs once per scene file and view size, when Auto is
 //! first shown; **Measure again** runs it again (after the camera or the window changed).
 
 use std::path::{Path, PathBuf};
@@ -14,8 +15,9 @@ use illum_auto::plan::{Candidate, Goal, Plan, Planned, Setting, error_floor, pla
 use illum_pathtrace::StopRules;
 use illum_scene::RendererKind;
 
-use crate::auto_pilot::ViewerPilot;
-use crate::auto_pilot::{PilotOptions, ViewSizes};
+use illum_auto::pilot::{Pilot, PilotOptions, Progress, Sizes};
+
+use crate::pacer::FramePacer;
 use crate::pathtrace_mode::PathTraceMode;
 use crate::raster_panel::RasterMode;
 use crate::whitted_panel::WhittedMode;
@@ -32,7 +34,10 @@ pub struct AutoMode {
     pub target: f64,
     /// How the next pilot measures (tests make it smaller).
     pub pilot_options: PilotOptions,
-    pilot: Option<ViewerPilot>,
+    pilot: Option<Pilot>,
+    /// Paces the pilot's path tracing as the path-tracer mode's frames are, and measures the
+    /// rest of each frame.
+    pacer: FramePacer,
     /// The scene file the pilot measured.
     measured_path: Option<PathBuf>,
     /// Set by **Measure again**.
@@ -48,8 +53,9 @@ impl Default for AutoMode {
     fn default() -> Self {
         AutoMode {
             target: DEFAULT_TARGET,
-            pilot_options: PilotOptions::default(),
+            pilot_options: PilotOptions::VIEWER,
             pilot: None,
+            pacer: FramePacer::default(),
             measured_path: None,
             remeasure: false,
             plan: None,
@@ -67,7 +73,7 @@ impl AutoMode {
 
     /// The candidates the pilot measured, once it is done.
     pub fn candidates(&self) -> Option<&[Candidate]> {
-        self.pilot.as_ref().and_then(ViewerPilot::candidates)
+        self.pilot.as_ref().and_then(Pilot::candidates)
     }
 
     /// Whether the pilot is still measuring (the window keeps repainting, and shows its progress).
@@ -77,7 +83,10 @@ impl AutoMode {
 
     /// The pilot's progress (share done, what it measures now) while it measures.
     pub fn progress(&self) -> Option<(f32, String)> {
-        self.measuring().then(|| self.pilot.as_ref().expect("measuring").progress())
+        match self.pilot.as_ref()?.progress() {
+            Progress::Working { done, what } => Some((done, what)),
+            Progress::Done | Progress::Failed(_) => None,
+        }
     }
 
     /// Starts a pilot of `scene` (the file at `path`, its camera at the raster's size `sizes`)
@@ -89,7 +98,7 @@ impl AutoMode {
         gpu: &illum_gpu::GpuContext,
         path: &Path,
         scene: &illum_scene::Scene,
-        sizes: ViewSizes,
+        sizes: Sizes,
     ) -> Option<Planned> {
         if self.remeasure || self.measured_path.as_deref() != Some(path) {
             self.remeasure = false;
@@ -97,8 +106,11 @@ impl AutoMode {
             self.plan = None;
             self.planned_for = None;
             self.applied = None;
-            match ViewerPilot::new(scene, sizes, self.pilot_options) {
-                Ok(pilot) => self.pilot = Some(pilot),
+            match Pilot::new(scene, sizes, self.pilot_options) {
+                Ok(pilot) => {
+                    self.pilot = Some(pilot);
+                    self.pacer = FramePacer::default();
+                }
                 Err(e) => {
                     self.pilot = None;
                     self.plan = Some(Err(format!("the pilot could not start: {e}")));
@@ -107,8 +119,7 @@ impl AutoMode {
             }
         }
         let pilot = self.pilot.as_mut()?;
-        pilot.step(gpu);
-        if let Some(e) = pilot.error() {
+        if let Progress::Failed(e) = pilot.step(gpu, &mut self.pacer) {
             self.plan = Some(Err(format!("the pilot failed: {e}")));
             return None;
         }
@@ -293,7 +304,7 @@ pub fn apply_choice(
             RendererKind::Whitted
         }
         // The viewer's pilot measures independent samples, raw or denoised by à-trous
-        // (auto_pilot::SETTINGS), never the sequence or adaptive sampling.
+        // (illum_auto::pilot::PilotOptions::VIEWER), never the sequence or adaptive sampling.
         Setting::PathTrace { bounces, caustics, denoise, .. } => {
             if let Some(mode) = pathtrace {
                 mode.settings.bounces = *bounces;

@@ -5,8 +5,8 @@
 //! - [`pathtrace_mode`] / [`pathtrace_panel`]: the path tracer's mode (settings, renderer,
 //!   statistics, saving) and its panel;
 //! - [`raster_panel`] / [`whitted_panel`]: each of the other modes' settings, renderer and panel;
-//! - [`auto_panel`] / [`auto_pilot`]: the Auto mode (the accuracy slider and the choice) and
-//!   its pilot, run across frames;
+//! - [`auto_panel`]: the Auto mode (the accuracy slider and the choice), its pilot
+//!   (`illum_auto::pilot`) stepped once per frame;
 //! - [`camera`]: orbit / pan / zoom with the mouse, shared by both modes;
 //! - [`denoise_view`]: the path tracer's Denoise toggle (the denoised image and its estimated
 //!   error);
@@ -30,7 +30,6 @@
 
 pub mod app;
 pub mod auto_panel;
-pub mod auto_pilot;
 #[cfg(target_arch = "wasm32")]
 pub mod browser;
 pub mod camera;

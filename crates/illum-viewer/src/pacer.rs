@@ -84,6 +84,20 @@ fn share(other: Option<f64>, still: bool) -> f64 {
     }
 }
 
+/// The Auto pilot's path tracing is paced as the path-tracer mode's frames are; the view is
+/// still while it runs (it shows the progress).
+impl illum_auto::pilot::Pace for FramePacer {
+    fn slice_seconds(&mut self) -> f64 {
+        self.submission_seconds(false)
+    }
+    fn stepped(&mut self, started: Instant, seconds: f64) {
+        FramePacer::stepped(self, started, seconds);
+    }
+    fn wall_per_traced_second(&self) -> f64 {
+        FramePacer::wall_per_traced_second(self).unwrap_or(1.0)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

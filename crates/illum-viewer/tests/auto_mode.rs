@@ -10,10 +10,10 @@
 
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
+use illum_auto::pilot::PilotOptions;
 use illum_auto::plan::{Candidate, Goal, Plan, Planned, Setting, noise_rel_mse, plan};
 use illum_scene::{DenoiserKind, RendererKind};
 use illum_viewer::ViewerApp;
-use illum_viewer::auto_pilot::PilotOptions;
 
 mod common;
 use common::harness_sized;
@@ -25,8 +25,13 @@ fn harness(scene: &'static str) -> Harness<'static, ViewerApp> {
     let mut harness = harness_sized(scene, RendererKind::PathTrace, egui::vec2(900.0, 560.0));
     let app = harness.state_mut();
     app.pathtrace_mut().expect("path tracer loaded").settings.resolution_scale = 0.1;
-    app.auto_mut().pilot_options =
-        PilotOptions { longer_side: 32, truth_spp: 512, pilot_spp: 32, timing_spp: 2 };
+    app.auto_mut().pilot_options = PilotOptions {
+        longer_side: 32,
+        truth_spp: 512,
+        pilot_spp: 32,
+        timing_spp: 2,
+        ..PilotOptions::VIEWER
+    };
     harness
 }
 

@@ -87,7 +87,7 @@ impl ViewerApp {
     /// in the view. Returns whether the view should show the chosen mode's image.
     fn auto_frame(&mut self, ui: &mut egui::Ui, gpu: &GpuContext, view_pixels: [u32; 2]) -> bool {
         let Ok(pathtrace) = &self.pathtrace else { return true };
-        let sizes = crate::auto_pilot::ViewSizes {
+        let sizes = illum_auto::pilot::Sizes {
             raster: view_pixels.map(|v| v.max(1)),
             whitted: WhittedMode::render_size(view_pixels),
             pathtrace: pathtrace.render_size(view_pixels),
