@@ -120,7 +120,7 @@ fn run(args: Args) -> anyhow::Result<()> {
             &Overrides { width: Some(width), height: Some(height), ..Default::default() },
             "auto check",
         )?;
-        let truth_scene = illum_lab::auto::pilot::truth_scene(&scene, Bounces::Unbounded);
+        let truth_scene = illum_auto::settings::truth_scene(&scene, Bounces::Unbounded);
         let gpu = illum_cli::gpu()?;
         adapter = gpu.adapter_info.name.clone();
         let truth = match given_truth(&args.truth, &truth_scene)? {

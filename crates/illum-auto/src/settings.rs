@@ -1,6 +1,5 @@
 //! The settings Auto chooses among for a scene, how a setting is applied to the scene, and the
-//! size of a pilot's images: what the CLI's blocking pilot and the viewer's incremental one
-//! share.
+//! size of a pilot's images.
 
 use illum_pathtrace::TracerOptions;
 use illum_raster::RasterScene;

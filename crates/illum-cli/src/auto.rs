@@ -1,13 +1,57 @@
 //! `render --renderer auto` (the planner of `illum_auto::plan`, on the pilot's measurements,
-//! chooses the renderer and its settings): what `auto` refuses, and how the flags follow its
-//! choice. The `--renderer` value, [`RendererChoice`], is parsed beside the other flags
-//! (`render_args.rs`) and re-exported here.
+//! chooses the renderer and its settings): what `auto` refuses, the command itself ([`run`]:
+//! the [`pilot`] with its caches, the plan, the render and what it reached, [`text`]), and how
+//! the flags follow its choice. The `--renderer` value, [`RendererChoice`], is parsed beside the
+//! other flags (`render_args.rs`) and re-exported here.
+
+mod cache;
+pub mod pilot;
+pub mod text;
 
 use illum_auto::plan::{Goal, Planned, Setting};
 use illum_scene::{RendererKind, Scene};
 
 use crate::render_args::RenderArgs;
 pub use crate::render_args::RendererChoice;
+
+/// `render --renderer auto`: checks the flags, runs the pilot, prints the plan, then renders it
+/// as the flags naming its renderer and settings would, and compares what it reached with what
+/// was predicted.
+pub fn run(mut args: RenderArgs) -> anyhow::Result<()> {
+    let goal = args.auto_goal()?;
+    let scene = crate::load_scene(&args.scene, &args.settings)?;
+    crate::check_outputs(&args.outputs, &args.png_flags())?;
+    let started = std::time::Instant::now();
+    let gpu = crate::gpu()?;
+    let device_seconds = started.elapsed().as_secs_f64();
+    let progress = crate::progress::RenderProgress::new();
+    let on_step = &mut |t: &_, p: &_| progress.update(t, p);
+    let options = pilot::PilotOptions::default();
+    let pilot = pilot::measure(&gpu, &scene, device_seconds, &options, on_step)?;
+    progress.finish();
+    drop(gpu);
+    let pilot_seconds = started.elapsed().as_secs_f64();
+    let left = goal_left(goal, pilot_seconds).map_err(anyhow::Error::msg)?;
+    let plan = illum_auto::plan::plan(&pilot.candidates, left)
+        .map_err(|why| anyhow::anyhow!("{}: {why}", args.scene.display()))?;
+    if let (Goal::Seconds(budget), Goal::Seconds(rest)) = (goal, left) {
+        println!(
+            "auto: the pilot took {pilot_seconds:.1} s of the {budget} s budget; the render gets the {rest:.1} s left"
+        );
+    }
+    print!("{}", text::describe(&scene, &pilot, left, &plan));
+    args.follow(&plan.choice, &scene, left);
+    let rendering = std::time::Instant::now();
+    let noise = crate::render::render(&args)?;
+    println!("{}", text::reached(&plan.choice, noise, rendering.elapsed().as_secs_f64()));
+    if let Goal::Seconds(budget) = goal {
+        println!(
+            "auto: the whole command took {:.1} s of its {budget} s budget (the device and the pilot {pilot_seconds:.1} s)",
+            started.elapsed().as_secs_f64()
+        );
+    }
+    Ok(())
+}
 
 /// What `--renderer auto` is asked for: one of `--target-error` and `--time-budget`, and none
 /// of the flags that choose what it chooses (`chosen`: the names of those given).

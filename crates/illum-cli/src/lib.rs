@@ -8,7 +8,7 @@
 //! - [`progress`]: progress bars and log lines;
 //! - [`render`]: the `render` command's flags and the choice of renderer; [`pathtrace`],
 //!   [`raster`], [`whitted`]: each renderer's path of it, [`denoise`] the path tracer's with
-//!   `--denoise`, `resume` its `--resume`, [`auto`] the flags of `--renderer auto`.
+//!   `--denoise`, `resume` its `--resume`, [`auto`] `--renderer auto` (its flags, pilot and plan).
 
 pub mod auto;
 pub mod denoise;

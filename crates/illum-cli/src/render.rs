@@ -1,8 +1,7 @@
 //! The `render` command (`cargo run --example render`): its flags ([`RenderArgs`]) and
 //! [`render`], which picks the renderer and runs its path: [`crate::raster`],
-//! [`crate::whitted`] or [`crate::pathtrace`]. `--renderer auto` measures first (its pilot is a
-//! measuring tool, in illum-lab): the example checks its flags with [`RenderArgs::auto_goal`],
-//! and renders the plan with [`RenderArgs::follow`] and [`render`].
+//! [`crate::whitted`] or [`crate::pathtrace`]. `--renderer auto` measures first (`auto::run`),
+//! then renders its plan with [`render`].
 //!
 //! With no arguments it renders `scenes/cornell.toml` to `out/cornell.png` and `out/cornell.exr`.
 //! `--renderer pathtrace|raster|whitted|auto` picks the renderer; the default is the scene

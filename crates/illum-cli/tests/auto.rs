@@ -3,10 +3,12 @@
 //! is checked too), each choice rendered and compared with a path-traced truth at 96x54.
 //! The predicted relative error must be within a factor 1.5 of the measured one.
 
+use illum_auto::plan::{Goal, plan};
+use illum_auto::settings::{apply, truth_scene};
+use illum_cli::auto::pilot::{PilotOptions, measure};
 use illum_gpu::testing::{gpu, workspace_path};
 use illum_image::rel_mse;
-use illum_lab::auto::pilot::{PilotOptions, apply, measure, render, truth_scene};
-use illum_lab::auto::plan::{Goal, plan};
+use illum_lab::auto::render;
 use illum_lab::reference::cached_reference;
 use illum_scene::{Bounces, Overrides, Scene};
 
@@ -52,7 +54,7 @@ fn predicted_errors_are_within_a_factor_1_5_of_the_measured_ones() {
     // shadow alone is half as bright as the truth's).
     let choice = plan(&pilot.candidates, Goal::Error(0.03)).unwrap().choice;
     assert!(
-        matches!(choice.candidate.setting, illum_lab::auto::plan::Setting::PathTrace { caustics: true, .. }),
+        matches!(choice.candidate.setting, illum_auto::plan::Setting::PathTrace { caustics: true, .. }),
         "{choice:?}"
     );
     // 1% is beyond every deterministic setting: refused by them, met by the path tracer alone.

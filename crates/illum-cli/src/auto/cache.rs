@@ -4,9 +4,9 @@
 
 use std::path::Path;
 
-use super::plan::{NoiseCurve, Setting};
-use crate::report::{csv_text, write_text};
 use illum_auto::measure::Measured;
+use illum_auto::plan::{NoiseCurve, Setting};
+use illum_lab::report::{csv_text, write_text};
 
 /// The cached measurements, if `path` holds them for exactly `key`.
 pub(super) fn read_cache(path: &Path, key: &str, expected: usize) -> Option<Vec<Measured>> {

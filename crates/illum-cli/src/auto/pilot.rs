@@ -12,12 +12,8 @@ use illum_gpu::GpuContext;
 use illum_scene::Scene;
 
 use super::cache::{read_cache, write_cache};
-use super::plan::Candidate;
-pub use super::render::render;
-use crate::reference::{OnStep, cached_reference, reference_settings};
-pub use illum_auto::settings::{
-    apply, has_caustic, pilot_size, settings, settings_with_variants, truth_scene,
-};
+use illum_auto::plan::Candidate;
+use illum_lab::reference::{OnStep, cached_reference, reference_settings};
 
 /// How the command line's pilot measures, and where it caches.
 #[derive(Clone, Debug)]
