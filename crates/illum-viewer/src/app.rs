@@ -28,12 +28,14 @@ use illum_gpu::GpuContext;
 use illum_scene::RendererKind;
 
 use crate::auto_panel::AutoMode;
+use crate::difference_view::PathTracerTruth;
 use crate::frame_rate::FrameRate;
+use crate::mode::ViewMode;
 use crate::pathtrace_mode::PathTraceMode;
-use crate::raster_panel::RasterMode;
+use crate::raster_mode::RasterMode;
 use crate::scene_file::{DEFAULT_PATHTRACE_SCENE, DEFAULT_RASTER_SCENE};
 use crate::screenshot::ScreenshotJob;
-use crate::whitted_panel::WhittedMode;
+use crate::whitted_mode::WhittedMode;
 
 /// How the window starts.
 pub struct StartOptions {
@@ -195,18 +197,47 @@ impl ViewerApp {
         self.auto_shown = true;
     }
 
+    /// The mode of `kind`, or why its scene could not be loaded: the one place that tells the
+    /// modes apart.
+    fn mode_of(&mut self, kind: RendererKind) -> Result<&mut dyn ViewMode, &String> {
+        match kind {
+            RendererKind::Raster => self.raster.as_mut().map(|m| m as &mut dyn ViewMode).map_err(|e| &*e),
+            RendererKind::PathTrace => {
+                self.pathtrace.as_mut().map(|m| m as &mut dyn ViewMode).map_err(|e| &*e)
+            }
+            RendererKind::Whitted => self.whitted.as_mut().map(|m| m as &mut dyn ViewMode).map_err(|e| &*e),
+        }
+    }
+
+    /// [`Self::mode_of`] for a shared borrow.
+    fn mode_ref(&self, kind: RendererKind) -> Result<&dyn ViewMode, &String> {
+        match kind {
+            RendererKind::Raster => self.raster.as_ref().map(|m| m as &dyn ViewMode),
+            RendererKind::PathTrace => self.pathtrace.as_ref().map(|m| m as &dyn ViewMode),
+            RendererKind::Whitted => self.whitted.as_ref().map(|m| m as &dyn ViewMode),
+        }
+    }
+
+    /// The mode shown, with the path tracer's accumulation as the truth a deterministic mode's
+    /// Difference view may use (none for the path tracer itself).
+    fn shown(&mut self) -> (Option<&mut dyn ViewMode>, Option<PathTracerTruth<'_>>) {
+        fn truth(p: &Result<PathTraceMode, String>) -> Option<PathTracerTruth<'_>> {
+            p.as_ref().ok().and_then(PathTraceMode::truth)
+        }
+        match self.mode {
+            RendererKind::Raster => (self.raster.as_mut().ok().map(|m| m as _), truth(&self.pathtrace)),
+            RendererKind::Whitted => (self.whitted.as_mut().ok().map(|m| m as _), truth(&self.pathtrace)),
+            RendererKind::PathTrace => (self.pathtrace.as_mut().ok().map(|m| m as _), None),
+        }
+    }
+
     fn side_panel(&mut self, ui: &mut egui::Ui) {
         egui::ScrollArea::vertical().show(ui, |ui| {
             if self.auto_shown {
                 self.auto.panel(ui);
                 ui.separator();
             }
-            let result = match self.mode {
-                RendererKind::Raster => self.raster.as_mut().map(|m| m.panel(ui)),
-                RendererKind::PathTrace => self.pathtrace.as_mut().map(|m| m.panel(ui)),
-                RendererKind::Whitted => self.whitted.as_mut().map(|m| m.panel(ui)),
-            };
-            if let Err(error) = result {
+            if let Err(error) = self.mode_of(self.mode).map(|m| m.panel(ui)) {
                 ui.colored_label(ui.visuals().error_fg_color, error.as_str());
             }
             ui.separator();

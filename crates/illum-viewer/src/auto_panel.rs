@@ -19,8 +19,8 @@ use illum_auto::pilot::{Pilot, PilotOptions, Progress, Sizes};
 
 use crate::pacer::FramePacer;
 use crate::pathtrace_mode::PathTraceMode;
-use crate::raster_panel::RasterMode;
-use crate::whitted_panel::WhittedMode;
+use crate::raster_mode::RasterMode;
+use crate::whitted_mode::WhittedMode;
 
 /// The slider's range of target relative errors (log scale): 1e-5 is beyond what any renderer
 /// reaches in 30 days on the shipped scenes, so the slider can show a refusal.

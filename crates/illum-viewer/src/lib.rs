@@ -4,7 +4,9 @@
 //! - [`app`]: the application state, the mode switch and the scene field;
 //! - [`pathtrace_mode`] / [`pathtrace_panel`]: the path tracer's mode (settings, renderer,
 //!   statistics, saving) and its panel;
-//! - [`raster_panel`] / [`whitted_panel`]: each of the other modes' settings, renderer and panel;
+//! - [`raster_mode`] / [`raster_panel`], [`whitted_mode`] / [`whitted_panel`]: each of the
+//!   other modes' state (settings, renderer) and its panel;
+//! - [`mode`]: what the window asks of every mode ([`mode::ViewMode`]);
 //! - [`auto_panel`]: the Auto mode (the accuracy slider and the choice), its pilot
 //!   (`illum_auto::pilot`) stepped once per frame;
 //! - [`camera`]: orbit / pan / zoom with the mouse, shared by both modes;
@@ -40,16 +42,19 @@ pub mod display;
 pub mod error_view;
 pub mod frame_rate;
 pub mod gpu_setup;
+pub mod mode;
 pub mod pacer;
 pub mod pathtrace_mode;
 pub mod pathtrace_panel;
 pub mod platform;
 pub mod plural;
+pub mod raster_mode;
 pub mod raster_panel;
 pub mod scene_file;
 pub mod screenshot;
 #[cfg(target_arch = "wasm32")]
 pub mod web;
+pub mod whitted_mode;
 pub mod whitted_panel;
 
 pub use app::{StartOptions, ViewerApp};

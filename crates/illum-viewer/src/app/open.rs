@@ -7,9 +7,9 @@ use illum_scene::RendererKind;
 
 use super::ViewerApp;
 use crate::pathtrace_mode::PathTraceMode;
-use crate::raster_panel::RasterMode;
+use crate::raster_mode::RasterMode;
 use crate::scene_file;
-use crate::whitted_panel::WhittedMode;
+use crate::whitted_mode::WhittedMode;
 
 impl ViewerApp {
     /// Opens a scene file in every mode that can render it and returns the mode to show (the

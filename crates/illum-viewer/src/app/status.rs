@@ -1,11 +1,8 @@
 //! What the window reports about itself: the status the web page publishes for scripts and
 //! browser tests (`#illum-status`), and the summary line a `--screenshot` run prints.
 
-use illum_scene::RendererKind;
-
 use super::ViewerApp;
 use crate::pathtrace_mode::PathTraceMode;
-use crate::plural::count;
 
 impl ViewerApp {
     /// What the window shows, as (name, value) pairs: the mode, the scene, the last open
@@ -64,19 +61,7 @@ impl ViewerApp {
     /// One line of the shown mode's statistics and the window's frame rate, as a
     /// `--screenshot` run prints them on exit (the smoke test and `bench --viewer` read it).
     pub fn summary(&self) -> String {
-        let mode = match self.mode {
-            RendererKind::PathTrace => self.pathtrace().map(PathTraceMode::summary),
-            RendererKind::Raster => self.raster().map(|r| {
-                let gpu = r
-                    .pass_times()
-                    .map_or("n/a".to_owned(), |t| format!("{:.2} ms", t.shadow_ms + t.cube_ms + t.main_ms));
-                format!("raster: GPU time per frame {gpu}")
-            }),
-            RendererKind::Whitted => self.whitted().map(|w| {
-                let ms = w.frame_ms.map_or("n/a".to_owned(), |ms| format!("{ms:.1} ms"));
-                format!("whitted: {} rendered, last frame {ms}", count(w.frames, "frame", "frames"))
-            }),
-        };
+        let mode = self.mode_ref(self.mode).ok().map(|m| m.summary());
         let fps = self.frame_rate.fps().map_or("n/a".to_owned(), |f| format!("{f:.1} fps"));
         let auto = if self.auto_shown { format!("{}; ", self.auto.summary()) } else { String::new() };
         format!("{auto}{}, window {fps}", mode.unwrap_or_else(|| format!("{}: no scene", self.mode)))

@@ -14,22 +14,12 @@ impl ViewerApp {
 
     /// The scene file of `mode`, as it was given.
     pub(super) fn scene_path_of(&self, mode: RendererKind) -> Option<String> {
-        match mode {
-            RendererKind::Raster => self.raster.as_ref().ok().map(|m| m.scene_path().display().to_string()),
-            RendererKind::PathTrace => {
-                self.pathtrace.as_ref().ok().map(|m| m.scene_path().display().to_string())
-            }
-            RendererKind::Whitted => self.whitted.as_ref().ok().map(|m| m.scene_path().display().to_string()),
-        }
+        self.mode_ref(mode).ok().map(|m| m.scene_path().display().to_string())
     }
 
     /// The orbit camera of `mode`, when it has a scene.
     pub(super) fn camera_of(&mut self, mode: RendererKind) -> Option<&mut OrbitCamera> {
-        match mode {
-            RendererKind::Raster => self.raster.as_mut().ok().map(|m| &mut m.camera),
-            RendererKind::PathTrace => self.pathtrace.as_mut().ok().map(|m| &mut m.camera),
-            RendererKind::Whitted => self.whitted.as_mut().ok().map(|m| &mut m.camera),
-        }
+        self.mode_of(mode).ok().map(|m| m.camera())
     }
 
     /// Gives the mode now shown the camera of `from` if both show the same scene file (the

@@ -2,11 +2,9 @@
 //! which the mouse steers, and the margin around it.
 
 use illum_gpu::GpuContext;
-use illum_scene::RendererKind;
 
 use super::ViewerApp;
-use crate::pathtrace_mode::PathTraceMode;
-use crate::whitted_panel::WhittedMode;
+use crate::whitted_mode::WhittedMode;
 
 impl ViewerApp {
     /// The image of the shown mode, filling `ui`; `fill` where there is none yet.
@@ -33,22 +31,10 @@ impl ViewerApp {
             Ok(pair) => pair,
             Err(_) => return,
         };
-        let texture = match self.mode {
-            RendererKind::Raster => {
-                let truth = self.pathtrace.as_ref().ok().and_then(PathTraceMode::truth);
-                self.raster
-                    .as_mut()
-                    .ok()
-                    .and_then(|m| m.frame(gpu, ui.ctx(), render_state, view_pixels, truth))
-            }
-            RendererKind::PathTrace => self.pathtrace.as_mut().ok().and_then(|m| {
-                m.frame(gpu, ui.ctx(), render_state, view_pixels);
-                m.texture()
-            }),
-            RendererKind::Whitted => {
-                let truth = self.pathtrace.as_ref().ok().and_then(PathTraceMode::truth);
-                self.whitted.as_mut().ok().and_then(|m| m.frame(gpu, ui.ctx(), view_pixels, truth))
-            }
+        let (gpu, render_state) = (gpu.clone(), render_state.clone());
+        let texture = match self.shown() {
+            (Some(mode), truth) => mode.frame(&gpu, ui.ctx(), &render_state, view_pixels, truth),
+            (None, _) => None,
         };
         let sense = egui::Sense::click_and_drag();
         let response = match texture {
@@ -69,16 +55,8 @@ impl ViewerApp {
         {
             ui.ctx().request_repaint();
         }
-        // The raster redraws every frame (it is a real-time renderer and its frame rate is
-        // measured); the path tracer while it still has samples to take; Whitted on a change.
-        let busy = match self.mode {
-            RendererKind::Raster => self.raster.is_ok(),
-            RendererKind::PathTrace => self.pathtrace.as_ref().is_ok_and(PathTraceMode::is_rendering),
-            // Whitted redraws only when the view changes (handled above), and while its
-            // frame is being read back (in the browser).
-            RendererKind::Whitted => self.whitted.as_ref().is_ok_and(WhittedMode::is_busy),
-        };
-        if busy {
+        // Each mode says whether it has work under way; a camera change is handled above.
+        if self.mode_ref(self.mode).is_ok_and(|m| m.busy()) {
             ui.ctx().request_repaint();
         }
     }
