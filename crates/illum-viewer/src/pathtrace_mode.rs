@@ -34,6 +34,7 @@ use illum_scene::{Bounces, Sampling, Scene};
 use crate::camera::OrbitCamera;
 use crate::denoise_view::DenoiseView;
 use crate::display::Display;
+use crate::mode::ViewMode;
 use crate::pacer::FramePacer;
 
 /// Most paths a pass at the smallest spp may trace and still be one submission, a whole image
@@ -336,5 +337,41 @@ impl PathTraceMode {
     /// The display pass (tests read what it shows).
     pub fn display(&self) -> Option<&Display> {
         self.display.as_ref()
+    }
+}
+
+impl ViewMode for PathTraceMode {
+    fn scene_path(&self) -> &Path {
+        &self.scene_path
+    }
+
+    fn camera(&mut self) -> &mut OrbitCamera {
+        &mut self.camera
+    }
+
+    fn panel(&mut self, ui: &mut egui::Ui) {
+        self.controls(ui);
+    }
+
+    /// The path tracer is its own truth: `truth` is not used.
+    fn frame(
+        &mut self,
+        gpu: &illum_gpu::GpuContext,
+        ctx: &egui::Context,
+        render_state: &egui_wgpu::RenderState,
+        view_pixels: [u32; 2],
+        _: Option<crate::difference_view::PathTracerTruth<'_>>,
+    ) -> Option<egui::TextureId> {
+        self.step_frame(gpu, ctx, render_state, view_pixels);
+        self.texture()
+    }
+
+    /// Draws while it still has samples to take.
+    fn busy(&self) -> bool {
+        self.is_rendering()
+    }
+
+    fn summary(&self) -> String {
+        PathTraceMode::summary(self)
     }
 }

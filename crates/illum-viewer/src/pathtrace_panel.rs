@@ -13,7 +13,7 @@ pub const MAX_UI_BOUNCES: u32 = 64;
 
 impl PathTraceMode {
     /// The panel's controls.
-    pub fn panel(&mut self, ui: &mut egui::Ui) {
+    pub(crate) fn controls(&mut self, ui: &mut egui::Ui) {
         ui.heading("Path tracer");
         let caustics_apply = self.caustics_apply();
         let scene_spp = self.scene().pathtrace.spp;

@@ -22,6 +22,7 @@ use illum_scene::{Camera, Scene};
 use crate::camera::OrbitCamera;
 use crate::difference_view::{DifferenceView, PathTracerTruth};
 use crate::frame_rate::FrameRate;
+use crate::mode::ViewMode;
 
 /// The raster mode.
 pub struct RasterMode {
@@ -90,10 +91,6 @@ impl RasterMode {
         }
     }
 
-    pub fn scene_path(&self) -> &Path {
-        &self.scene_path
-    }
-
     /// Frames per second over the last frames drawn.
     pub fn fps(&self) -> Option<f64> {
         self.frame_rate.fps()
@@ -112,32 +109,6 @@ impl RasterMode {
     /// size).
     pub fn image(&self) -> Option<(&RgbImage32, &Scene)> {
         self.last.as_ref().map(|(image, scene)| (image, scene))
-    }
-
-    /// Draws one frame at `view_pixels` and returns the texture to show: with the Difference
-    /// view on, its difference from a truth (`path_tracer`: the path tracer's accumulation,
-    /// one of the truths it may use) once there is one.
-    pub fn frame(
-        &mut self,
-        gpu: &GpuContext,
-        ctx: &egui::Context,
-        render_state: &egui_wgpu::RenderState,
-        view_pixels: [u32; 2],
-        path_tracer: Option<PathTracerTruth<'_>>,
-    ) -> Option<egui::TextureId> {
-        let image = self.draw(gpu, render_state, view_pixels)?;
-        if !self.difference.on {
-            self.read = None;
-            self.pending = None;
-            return Some(image);
-        }
-        if let Err(e) = self.read_back(gpu) {
-            self.message = Some(e);
-        }
-        if let Some((last, scene)) = &self.last {
-            self.difference.update(ctx, last, self.reads, scene, 1.0, path_tracer);
-        }
-        Some(self.difference.texture().unwrap_or(image))
     }
 
     /// Polls the readback under way; starts one of the frame just drawn when its view has not
@@ -247,5 +218,57 @@ impl RasterMode {
             state.renderer.set_scene(scene).map_err(|e| e.to_string())?;
         }
         Ok(())
+    }
+}
+
+impl ViewMode for RasterMode {
+    fn scene_path(&self) -> &Path {
+        &self.scene_path
+    }
+
+    fn camera(&mut self) -> &mut OrbitCamera {
+        &mut self.camera
+    }
+
+    fn panel(&mut self, ui: &mut egui::Ui) {
+        self.controls(ui);
+    }
+
+    /// Draws one frame at `view_pixels` and returns the texture to show: with the Difference
+    /// view on, its difference from a truth (`path_tracer`: the path tracer's accumulation,
+    /// one of the truths it may use) once there is one.
+    fn frame(
+        &mut self,
+        gpu: &GpuContext,
+        ctx: &egui::Context,
+        render_state: &egui_wgpu::RenderState,
+        view_pixels: [u32; 2],
+        path_tracer: Option<PathTracerTruth<'_>>,
+    ) -> Option<egui::TextureId> {
+        let image = self.draw(gpu, render_state, view_pixels)?;
+        if !self.difference.on {
+            self.read = None;
+            self.pending = None;
+            return Some(image);
+        }
+        if let Err(e) = self.read_back(gpu) {
+            self.message = Some(e);
+        }
+        if let Some((last, scene)) = &self.last {
+            self.difference.update(ctx, last, self.reads, scene, 1.0, path_tracer);
+        }
+        Some(self.difference.texture().unwrap_or(image))
+    }
+
+    /// A real-time renderer: it redraws every frame, and its frame rate is measured.
+    fn busy(&self) -> bool {
+        true
+    }
+
+    fn summary(&self) -> String {
+        let gpu = self
+            .pass_times()
+            .map_or("n/a".to_owned(), |t| format!("{:.2} ms", t.shadow_ms + t.cube_ms + t.main_ms));
+        format!("raster: GPU time per frame {gpu}")
     }
 }

@@ -7,7 +7,7 @@ use crate::raster_mode::RasterMode;
 
 impl RasterMode {
     /// The panel's controls.
-    pub fn panel(&mut self, ui: &mut egui::Ui) {
+    pub(crate) fn controls(&mut self, ui: &mut egui::Ui) {
         ui.heading("Raster");
         ui.horizontal(|ui| {
             ui.label("Look");

@@ -15,6 +15,8 @@ use illum_whitted::{PendingImage, WhittedTracer};
 
 use crate::camera::OrbitCamera;
 use crate::difference_view::{DifferenceView, PathTracerTruth};
+use crate::mode::ViewMode;
+use crate::plural::count;
 
 /// What a frame depends on: when it is unchanged, the last image stands.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -74,31 +76,10 @@ impl WhittedMode {
             WhittedMode { texture: self.texture.take(), difference, ..WhittedMode::new(scene_path, scene) };
     }
 
-    pub fn scene_path(&self) -> &Path {
-        &self.scene_path
-    }
-
     /// The size the mode renders a view of `view_pixels` at: a quarter of its pixels (half each
     /// way), since Whitted at depth 8 costs more per pixel than the rasterizer.
     pub fn render_size(view_pixels: [u32; 2]) -> [u32; 2] {
         view_pixels.map(|v| (v / 2).max(1))
-    }
-
-    /// The image for a view of `view_pixels`, rendered again only when it changed; with the
-    /// Difference view on, its difference from a truth (`path_tracer`: the path tracer's
-    /// accumulation, one of the truths it may use).
-    pub fn frame(
-        &mut self,
-        gpu: &GpuContext,
-        ctx: &egui::Context,
-        view_pixels: [u32; 2],
-        path_tracer: Option<PathTracerTruth<'_>>,
-    ) -> Option<egui::TextureId> {
-        let image = self.render_frame(gpu, ctx, view_pixels);
-        if let Some((last, scene)) = &self.last {
-            self.difference.update(ctx, last, self.frames, scene, 0.5, path_tracer);
-        }
-        self.difference.texture().or(image)
     }
 
     /// The image for a view of `view_pixels`, rendered again only when it changed.
@@ -190,5 +171,47 @@ impl WhittedMode {
             Err(e) => self.message = Some(e.to_string()),
         }
         self.drawn = Some(key);
+    }
+}
+
+impl ViewMode for WhittedMode {
+    fn scene_path(&self) -> &Path {
+        &self.scene_path
+    }
+
+    fn camera(&mut self) -> &mut OrbitCamera {
+        &mut self.camera
+    }
+
+    fn panel(&mut self, ui: &mut egui::Ui) {
+        self.controls(ui);
+    }
+
+    /// The image for a view of `view_pixels`, rendered again only when it changed; with the
+    /// Difference view on, its difference from a truth (`path_tracer`: the path tracer's
+    /// accumulation, one of the truths it may use).
+    fn frame(
+        &mut self,
+        gpu: &GpuContext,
+        ctx: &egui::Context,
+        _: &egui_wgpu::RenderState,
+        view_pixels: [u32; 2],
+        path_tracer: Option<PathTracerTruth<'_>>,
+    ) -> Option<egui::TextureId> {
+        let image = self.render_frame(gpu, ctx, view_pixels);
+        if let Some((last, scene)) = &self.last {
+            self.difference.update(ctx, last, self.frames, scene, 0.5, path_tracer);
+        }
+        self.difference.texture().or(image)
+    }
+
+    /// Redraws only when the view changes, and while its frame is read back (in a web page).
+    fn busy(&self) -> bool {
+        self.is_busy()
+    }
+
+    fn summary(&self) -> String {
+        let ms = self.frame_ms.map_or("n/a".to_owned(), |ms| format!("{ms:.1} ms"));
+        format!("whitted: {} rendered, last frame {ms}", count(self.frames, "frame", "frames"))
     }
 }

@@ -7,7 +7,7 @@ use crate::whitted_mode::WhittedMode;
 
 impl WhittedMode {
     /// The panel's controls.
-    pub fn panel(&mut self, ui: &mut egui::Ui) {
+    pub(crate) fn controls(&mut self, ui: &mut egui::Ui) {
         ui.heading("Whitted ray tracer");
         ui.horizontal(|ui| {
             let label = ui.label("Depth");

@@ -12,7 +12,7 @@ use crate::display::Display;
 impl PathTraceMode {
     /// Brings the tracer in line with the settings, camera and `view_pixels` size, runs this
     /// frame's slice of work and refreshes the displayed texture.
-    pub fn frame(
+    pub(crate) fn step_frame(
         &mut self,
         gpu: &GpuContext,
         ctx: &egui::Context,
