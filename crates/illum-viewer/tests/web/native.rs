@@ -7,7 +7,7 @@ use illum_gpu::GpuContext;
 use illum_pathtrace::PathTracer;
 use illum_scene::Scene;
 
-use crate::matrix::{Cell, SPP};
+use crate::matrix::Cell;
 use crate::page::get;
 
 /// The largest relative difference of an image mean (per channel) between the page and the
@@ -29,12 +29,12 @@ pub(crate) fn sized_scene(root: &Path, path: &str, width: u32, height: u32) -> S
     scene
 }
 
-/// The image mean of a native path-traced render of `scene` with `seed`.
-pub(crate) fn native_pathtrace_mean(gpu: &GpuContext, scene: &Scene, seed: u32) -> [f64; 3] {
+/// The image mean of a native path-traced render of `scene` with `seed`, at `spp`.
+pub(crate) fn native_pathtrace_mean(gpu: &GpuContext, scene: &Scene, seed: u32, spp: u32) -> [f64; 3] {
     let mut scene = scene.clone();
     scene.pathtrace.seed = seed;
     let mut tracer = PathTracer::new(gpu, &scene).unwrap_or_else(|e| panic!("{e}"));
-    tracer.render_to_spp(SPP).unwrap_or_else(|e| panic!("{e}"));
+    tracer.render_to_spp(spp).unwrap_or_else(|e| panic!("{e}"));
     tracer.accumulator().mean_image().mean()
 }
 
@@ -64,7 +64,8 @@ pub(crate) fn check_pathtrace_cell(
     status: &HashMap<String, String>,
 ) -> f64 {
     let name = &cell.name;
-    assert_eq!(get(status, "pathtraceSpp"), SPP.to_string(), "{name}: {status:?}");
+    let spp = cell.spp;
+    assert_eq!(get(status, "pathtraceSpp"), spp.to_string(), "{name}: {status:?}");
     let expected = cell.caustics.map_or("off", |on| if on { "on" } else { "off" });
     assert_eq!(get(status, "pathtraceCaustics"), expected, "{name}: the light tracer: {status:?}");
     let (width, height) = size_of(get(status, "pathtraceSize"));
@@ -74,17 +75,17 @@ pub(crate) fn check_pathtrace_cell(
         scene.pathtrace.caustics = on;
     }
     let seed = scene.pathtrace.seed;
-    let native = native_pathtrace_mean(gpu, &scene, seed);
-    let other_seed = native_pathtrace_mean(gpu, &scene, seed + 1);
+    let native = native_pathtrace_mean(gpu, &scene, seed, spp);
+    let other_seed = native_pathtrace_mean(gpu, &scene, seed + 1, spp);
     let relative = relative_difference(web, native);
     println!(
-        "{name} ({width}x{height}, {SPP} spp): web {web:.6?}, native {native:.6?}: relative difference {relative:.2e} \
+        "{name} ({width}x{height}, {spp} spp): web {web:.6?}, native {native:.6?}: relative difference {relative:.2e} \
          (another seed: {:.2e})",
         relative_difference(other_seed, native)
     );
     assert!(
         relative < MEAN_TOLERANCE,
-        "{name}: web {web:?} vs native {native:?} ({width}x{height}, {SPP} spp)"
+        "{name}: web {web:?} vs native {native:?} ({width}x{height}, {spp} spp)"
     );
     relative
 }
