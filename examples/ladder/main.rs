@@ -217,7 +217,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         truth_error,
         truth_metadata,
     };
-    write_outputs(&args, &header, &truth, &regions, &rows)?;
+    write_outputs(&args.out, &header, &truth, &regions, &rows)?;
     Ok(())
 }
 

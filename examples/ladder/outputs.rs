@@ -1,6 +1,8 @@
 //! The ladder's outputs: the CSV, the Markdown tables, the plots, the contact sheet and the
 //! region map.
 
+use std::path::Path;
+
 use illum::image::{Encoding, RgbImage32, save_exr, save_rgba8_png, to_rgba8};
 use illum::scene::Scene;
 use illum_lab::contact_sheet::contact_sheet;
@@ -8,7 +10,6 @@ use illum_lab::plot::{self, Line, Style};
 use illum_lab::regions::{Comparison, Regions, flip_heat_map};
 use illum_lab::report::{csv_text, host_cpu, markdown_table, write_text};
 
-use crate::Args;
 use crate::rungs::{Rung, Series};
 
 pub(crate) struct Row {
@@ -35,13 +36,12 @@ fn ratio(x: f64) -> String {
 }
 
 pub(crate) fn write_outputs(
-    args: &Args,
+    out: &Path,
     header: &Header,
     truth: &RgbImage32,
     regions: &Regions,
     rows: &[Row],
 ) -> anyhow::Result<()> {
-    let out = &args.out;
     let sizes = regions.sizes();
     // CSV: one line per row and region ("all" for the whole image).
     let mut lines = Vec::new();
