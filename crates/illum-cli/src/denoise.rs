@@ -10,10 +10,9 @@
 //! An spp target is rounded up to an even number (both halves take the same samples).
 //!
 //! The time budget counts the sampling, and the filter's time comes on top (the summary says how
-//! much); past half the budget, the render also stops when what is left of it is less than a
-//! round's filter takes (another round would filter for longer than it samples). A denoised
-//! render then has about the samples a raw render of the same budget has, so its image is the
-//! nearer the truth, which a budget that also paid the filter could not promise (on
+//! much); a round that runs into the budget samples in shrinking steps and ends there. A
+//! denoised render then has about the samples a raw render of the same budget has, so its image
+//! is the nearer the truth, which a budget that also paid the filter could not promise (on
 //! lavapipe the filter of a 512 x 512 image takes longer than the default 5 s budget).
 
 use std::path::PathBuf;
@@ -77,7 +76,7 @@ pub fn render_denoised(request: &DenoiseRequest) -> anyhow::Result<Option<(StopR
     let reason = loop {
         let target = half_target.map_or(half, |t| half.min(t));
         let started = Instant::now();
-        if !split.advance(target, cancel)? {
+        if !advance(&mut split, target, rules.time_budget.map(|b| b.as_secs_f64() - sampling), cancel)? {
             break StopReason::Cancelled;
         }
         let tracing = started.elapsed().as_secs_f64();
@@ -103,15 +102,6 @@ pub fn render_denoised(request: &DenoiseRequest) -> anyhow::Result<Option<(StopR
         last = Some(denoised);
         if let Some(reason) = rules.check(&status) {
             break reason;
-        }
-        // Past half the budget, a round that would sample for less time than a round's filter
-        // takes is not worth it: what is left of the budget is spent.
-        let filtering = started.elapsed().as_secs_f64() - tracing;
-        if rules.time_budget.is_some_and(|budget| {
-            let left = budget.as_secs_f64() - sampling;
-            left < sampling && left < filtering
-        }) {
-            break StopReason::TimeBudget;
         }
         half = next_half(&rounds, rules, sampling);
     };
@@ -142,6 +132,34 @@ pub fn render_denoised(request: &DenoiseRequest) -> anyhow::Result<Option<(StopR
         println!("wrote {}", output.display());
     }
     Ok(Some((reason, result.estimate.relative_error())))
+}
+
+/// Advances both halves to `half` samples per pixel each; with `seconds` (what is left of the
+/// time budget), in steps that each take about half of what is left at the pace measured so far
+/// (one sample per half while nothing is measured or little is left), ending once the sampling
+/// has taken them: a round ends at the budget however the last round misjudged the cost per
+/// sample (the filter, the costly part, runs once per round). False when cancelled.
+fn advance(
+    split: &mut SplitRender,
+    half: u32,
+    seconds: Option<f64>,
+    cancel: &AtomicBool,
+) -> anyhow::Result<bool> {
+    let Some(seconds) = seconds else { return Ok(split.advance(half, cancel)?) };
+    let started = Instant::now();
+    let first = split.spp_done() / 2;
+    loop {
+        let (done, elapsed) = (split.spp_done() / 2, started.elapsed().as_secs_f64());
+        if done >= half || elapsed >= seconds {
+            return Ok(true);
+        }
+        let per_sample = (done > first).then(|| elapsed / f64::from(done - first));
+        let step = per_sample.map_or(1.0, |p| (0.5 * (seconds - elapsed) / p).floor().max(1.0));
+        let next = (f64::from(done) + step).min(f64::from(half)) as u32;
+        if !split.advance(next, cancel)? {
+            return Ok(false);
+        }
+    }
 }
 
 /// The PNG of the denoised image; the EXR of the denoised image with layers `noisy` (the raw
@@ -218,11 +236,10 @@ struct Round {
 ///   1, a denoised image's fall where the filter's bias shrinks with its noise), 1/2 before two
 ///   rounds are known, with a tenth to spare, so that one round usually lands on the target;
 ///   at most 8 times the last round's (a prediction from few samples can be far off);
-/// - for a time budget, the spp at which the sampling reaches the budget (5% over, so that the
-///   round ends past it rather than leave a sliver for another round and its filter), at the
-///   last round's cost per sample; when that comes before the error target's spp, or there is
-///   no error target, this is the next round, uncapped: its size is measured, not predicted;
-/// - else, or while the error is unknown, twice the last round's (within the budget).
+/// - for a time budget, when the sampling reaches it (at the last round's cost per sample)
+///   before the error target's spp, or there is no error target: the rest of the budget, in one
+///   round ([`advance`] ends it at the budget), so `u32::MAX`;
+/// - else, or while the error is unknown, twice the last round's.
 ///
 /// Always more than the last round's (a round of nothing would loop).
 fn next_half(rounds: &[Round], rules: &StopRules, sampling: f64) -> u32 {
@@ -243,15 +260,13 @@ fn next_half(rounds: &[Round], rules: &StopRules, sampling: f64) -> u32 {
     };
     let budgeted = rules.time_budget.and_then(|budget| {
         let per_sample = last.tracing / f64::from(last.half.saturating_sub(before).max(1));
-        (per_sample > 0.0)
-            .then(|| f64::from(last.half) + (1.05 * budget.as_secs_f64() - sampling) / per_sample)
+        (per_sample > 0.0).then(|| f64::from(last.half) + (budget.as_secs_f64() - sampling) / per_sample)
     });
     let half = match (predicted, budgeted) {
-        (Some(p), Some(b)) if b <= p => b,
+        (Some(p), Some(b)) if b <= p => f64::from(u32::MAX),
         (Some(p), _) => p.min(most),
-        (None, Some(b)) if rules.target_error.is_none() => b,
-        (None, Some(b)) => doubled.min(b),
-        (None, None) => doubled,
+        (None, Some(_)) if rules.target_error.is_none() => f64::from(u32::MAX),
+        _ => doubled,
     };
     (half.ceil().min(f64::from(u32::MAX)) as u32).max(last.half.saturating_add(1))
 }
@@ -288,29 +303,26 @@ mod tests {
         assert_eq!(next_half(&rose, &rules, 0.0), 18);
     }
 
-    /// The time budget counts the sampling: the next round samples to 5% past it at the last
-    /// round's cost per sample (the filter's time aside), in one round and uncapped when the
-    /// error target would come later; and it always advances by at least one sample.
+    /// With a time budget, the next round samples the rest of it ([`advance`] ends the round at
+    /// the budget) when the error target would come later or there is none; and a round always
+    /// advances by at least one sample.
     #[test]
-    fn a_round_samples_to_the_end_of_the_time_budget() {
+    fn a_round_samples_the_rest_of_the_time_budget() {
         let rules = StopRules { time_budget: Some(Duration::from_secs(10)), ..Default::default() };
-        // 0.1 s a sample per half, 5.8 s sampled: 10.5 - 5.8 = 4.7 s, 47 more samples.
-        assert_eq!(next_half(&[round(4, 0.1)], &rules, 5.8), 51);
-        // Far more than 8 times the last round: the cost is measured, not predicted.
-        assert_eq!(next_half(&[round(2, 0.1)], &rules, 0.2), 105);
-        // The cost per sample is the last round's own: 36 samples in 3.6 s after 4 in 0.4 s.
-        let rounds = [round(4, 0.1), Round { half: 40, error: Some(0.05), tracing: 3.6 }];
-        assert_eq!(next_half(&rounds, &rules, 4.0), 105);
-        assert_eq!(next_half(&[round(40, 0.1)], &rules, 10.6), 41);
-        // With an error target the budget decides when it comes first (the target predicted at
-        // 2 (0.1048 / 0.01)^2 1.1 = 242)...
-        let both = StopRules { target_error: Some(0.01), ..rules };
-        assert_eq!(next_half(&[round(2, 0.1048)], &both, 0.2), 105);
+        assert_eq!(next_half(&[round(4, 0.1)], &rules, 5.8), u32::MAX);
+        // With an error target, the budget's end at 0.1 s a sample per half (2 + 9.8 / 0.1 = 100)
+        // comes before the target's 2 (0.1048 / 0.01)^2 1.1 = 242...
+        let far = StopRules { target_error: Some(0.01), ..rules };
+        assert_eq!(next_half(&[round(2, 0.1048)], &far, 0.2), u32::MAX);
         // ... and the target when it comes first (2 (0.1048 / 0.09)^2 1.1 = 3.0), capped at 8
         // times the last round (0.02: 60, capped at 16).
         let near = StopRules { target_error: Some(0.09), ..rules };
         assert_eq!(next_half(&[round(2, 0.1048)], &near, 0.2), 3);
         let default = StopRules { target_error: Some(0.02), ..rules };
         assert_eq!(next_half(&[round(2, 0.1048)], &default, 0.2), 16);
+        // The cost per sample is the last round's own: 36 samples in 3.6 s after 4 in 0.4 s, so
+        // the budget's end (40 + 6 / 0.1 = 100) comes before the target's 40 (0.05 / 0.02)^2 1.1.
+        let rounds = [round(4, 0.1), Round { half: 40, error: Some(0.05), tracing: 3.6 }];
+        assert_eq!(next_half(&rounds, &default, 4.0), u32::MAX);
     }
 }
