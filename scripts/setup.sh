@@ -54,7 +54,7 @@ $SUDO apt-get install -y $packages
 
 if $browser; then
     # The web viewer's build: the wasm target and wasm-bindgen at exactly Cargo.lock's version
-    # (crates/illum-viewer/tests/web.rs fails under CI when any of this is missing).
+    # (crates/illum-viewer/tests/web/main.rs fails under CI when any of this is missing).
     rustup target add wasm32-unknown-unknown
     wasm_bindgen_version=$(awk '/^name = "wasm-bindgen"$/ { getline; gsub(/"/, "", $3); print $3 }' Cargo.lock)
     if [ "$(wasm-bindgen --version 2> /dev/null | awk '{ print $2 }')" != "$wasm_bindgen_version" ]; then

@@ -38,27 +38,24 @@
 //! flip-vs-time.png (log-log, one series per renderer), contact-sheet.png (each image beside
 //! its FLIP error map, labelled), regions.png.
 //!
-//! Over 450 lines: one study from its rows to its tables (shared parts are library modules).
+
+mod outputs;
+mod rungs;
 
 use std::path::PathBuf;
-use std::time::Instant;
 
 use anyhow::{Context, bail};
 use clap::Parser;
 
-use illum::gpu::GpuContext;
-use illum::image::{Encoding, RgbImage32, median, save_exr, save_rgba8_png, to_rgba8};
-use illum::pathtrace::PathTracer;
-use illum::raster::{Options, RasterRenderer, RasterScene};
-use illum::scene::{Bounces, Effects, Look, MAX_WHITTED_DEPTH, MaterialKind, Scene};
+use illum::scene::{Bounces, MAX_WHITTED_DEPTH, MaterialKind, Scene};
 use illum::whitted::WhittedTracer;
 use illum_auto::settings::{has_caustic, truth_scene};
-use illum_denoise::{DenoiseInput, Denoiser, DenoiserKind};
-use illum_lab::contact_sheet::contact_sheet;
-use illum_lab::plot::{self, Line, Style};
+use illum_denoise::{Denoiser, DenoiserKind};
 use illum_lab::reference::{Reference, cached_reference, load_reference};
-use illum_lab::regions::{Comparison, Regions, compare, flip_heat_map};
-use illum_lab::report::{csv_text, host_cpu, markdown_table, write_text};
+use illum_lab::regions::{Regions, compare};
+
+use outputs::{Header, Row, write_outputs};
+use rungs::{Series, denoised_rung, pathtrace_rung, print_rung, raster_rungs, whitted_rung};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -107,41 +104,6 @@ struct Args {
     /// Folder for the tables, plots, images and the cached truth.
     #[arg(long, default_value = "out/ladder")]
     out: PathBuf,
-}
-
-/// Which of the plots' series a rung belongs to.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Series {
-    Raster,
-    Whitted,
-    /// The path tracer at the scene's bounces, more samples per pixel each rung, without the
-    /// caustic estimator.
-    PathTraceSpp,
-    /// The same with the caustic estimator (light tracing, `[pathtrace] caustics`).
-    PathTraceCaustics,
-    /// The path tracer at a fixed spp, more bounces each rung.
-    PathTraceBounces,
-    /// The path tracer at the scene's bounces followed by the à-trous denoiser, more spp each rung.
-    PathTraceAtrous,
-    /// The same followed by Open Image Denoise (builds with the feature `oidn`).
-    PathTraceOidn,
-}
-
-/// One rung: an image made by one renderer with one setting, and how long it took.
-struct Rung {
-    renderer: &'static str,
-    series: Series,
-    settings: String,
-    /// Median wall time per frame, in milliseconds.
-    wall_ms: f64,
-    /// Median GPU time per frame (timestamp queries), where the renderer has them.
-    gpu_ms: Option<f64>,
-    image: RgbImage32,
-}
-
-struct Row {
-    rung: Rung,
-    errors: Comparison,
 }
 
 fn main() {
@@ -265,55 +227,8 @@ fn run(args: Args) -> anyhow::Result<()> {
         truth_error,
         truth_metadata,
     };
-    write_outputs(&args, &header, &truth, &regions, &rows)?;
+    write_outputs(&args.out, &header, &truth, &regions, &rows)?;
     Ok(())
-}
-
-/// The path tracer at `spp` (the scene's bounces and caustic estimator) followed by `filter`
-/// with its default settings and the bound of every denoised image: the time is the render's,
-/// the guide pass's and the filter's (median of `runs`, after a warm-up that compiles the
-/// pipelines).
-fn denoised_rung(
-    gpu: &GpuContext,
-    scene: &Scene,
-    spp: u32,
-    filter: &Denoiser,
-    runs: u32,
-) -> anyhow::Result<Rung> {
-    let mut scene = scene.clone();
-    scene.pathtrace.spp = spp;
-    let mut tracer = PathTracer::new(gpu, &scene)?;
-    let denoise = |tracer: &PathTracer| -> anyhow::Result<RgbImage32> {
-        let guides = tracer.guides(illum::pathtrace::guide_samples(tracer.spp_done()))?;
-        Ok(filter.denoise(&DenoiseInput::from_render(tracer.accumulator(), &guides))?)
-    };
-    tracer.render_to_spp(1)?; // warm-up: the pipelines and buffers
-    denoise(&tracer)?;
-    let mut ms = Vec::new();
-    let mut image = None;
-    for _ in 0..runs.max(1) {
-        tracer.reset();
-        let started = Instant::now();
-        tracer.render_to_spp(spp)?;
-        image = Some(denoise(&tracer)?);
-        ms.push(started.elapsed().as_secs_f64() * 1e3);
-    }
-    let (renderer, series, name) = match filter.kind() {
-        DenoiserKind::Atrous => ("pathtrace + à-trous", Series::PathTraceAtrous, "à-trous"),
-        DenoiserKind::Oidn => ("pathtrace + OIDN", Series::PathTraceOidn, "OIDN"),
-    };
-    Ok(Rung {
-        renderer,
-        series,
-        settings: format!(
-            "{spp} spp, bounces {}{}, {name}",
-            scene.pathtrace.bounces,
-            if scene.pathtrace.caustics { ", caustic estimator" } else { "" }
-        ),
-        wall_ms: median(&mut ms),
-        gpu_ms: None,
-        image: image.expect("at least one run"),
-    })
 }
 
 /// Whether the scene has a mirror or glass.
@@ -334,314 +249,4 @@ fn default_size(scene: &Scene, width: Option<u32>, height: Option<u32>) -> (u32,
     });
     let h = height.unwrap_or_else(|| (f64::from(w) * sh / sw).round().max(1.0) as u32);
     (w, h)
-}
-
-fn print_rung(r: &Rung) {
-    let gpu = r.gpu_ms.map_or(String::new(), |g| format!(" (GPU {g:.2} ms)"));
-    println!("{:9} {:34} {:10.2} ms{gpu}", r.renderer, r.settings, r.wall_ms);
-}
-
-/// The rasterizer's rows: both looks with every effect, then the enhanced look with each effect
-/// off in turn. A scene the rasterizer cannot draw (the Cornell box) has none; the reason is
-/// printed.
-fn raster_rungs(gpu: &GpuContext, scene: &Scene, frames: u32, rungs: &mut Vec<Rung>) -> anyhow::Result<()> {
-    let raster_scene = match RasterScene::from_scene(scene) {
-        Ok(s) => s,
-        Err(e) => {
-            println!("no rasterizer rows: {e}");
-            return Ok(());
-        }
-    };
-    let (w, h) = (scene.camera.width, scene.camera.height);
-    let mut settings = vec![
-        ("figure look".to_owned(), Options::all_on(Look::Figure)),
-        ("enhanced look".to_owned(), Options::all_on(Look::Enhanced)),
-    ];
-    for (name, off) in Effects::TOGGLES {
-        let mut options = Options::all_on(Look::Enhanced);
-        off(&mut options.effects);
-        settings.push((format!("enhanced, {name} off"), options));
-    }
-    let mut renderer = RasterRenderer::new(gpu, &raster_scene, w, h)?;
-    for (label, options) in settings {
-        let image = renderer.render(&options)?;
-        // The whole frame, every map made again: what the ray tracers pay too.
-        let motion = illum::raster::Motion::SceneChange;
-        let report = illum::raster::bench_frames(gpu, &raster_scene, w, h, &options, motion, 2, frames)?;
-        rungs.push(Rung {
-            renderer: "raster",
-            series: Series::Raster,
-            settings: label,
-            wall_ms: report.median_frame_ms(),
-            gpu_ms: report.median_pass_ms().map(|t| t.total_ms()),
-            image,
-        });
-        print_rung(rungs.last().expect("pushed"));
-    }
-    Ok(())
-}
-
-fn whitted_rung(gpu: &GpuContext, scene: &Scene, depth: u32, frames: u32) -> anyhow::Result<Rung> {
-    let mut scene = scene.clone();
-    scene.whitted.depth = depth;
-    let tracer = WhittedTracer::new(gpu, &scene)?;
-    let image = tracer.render()?; // also the warm-up
-    let mut ms = Vec::new();
-    for _ in 0..frames {
-        let started = Instant::now();
-        tracer.render()?;
-        ms.push(started.elapsed().as_secs_f64() * 1e3);
-    }
-    Ok(Rung {
-        renderer: "whitted",
-        series: Series::Whitted,
-        settings: format!("depth {depth}, {0}x{0} rays per pixel", scene.whitted.aa),
-        wall_ms: median(&mut ms),
-        gpu_ms: None,
-        image,
-    })
-}
-
-fn pathtrace_rung(
-    gpu: &GpuContext,
-    scene: &Scene,
-    (spp, bounces): (u32, Bounces),
-    series: Series,
-    runs: u32,
-) -> anyhow::Result<Rung> {
-    let mut scene = scene.clone();
-    scene.pathtrace.bounces = bounces;
-    scene.pathtrace.spp = spp;
-    let mut tracer = PathTracer::new(gpu, &scene)?;
-    tracer.render_to_spp(1)?; // warm-up: the pipeline and buffers
-    let mut ms = Vec::new();
-    for _ in 0..runs.max(1) {
-        tracer.reset();
-        let started = Instant::now();
-        tracer.render_to_spp(spp)?;
-        ms.push(started.elapsed().as_secs_f64() * 1e3);
-    }
-    Ok(Rung {
-        renderer: "pathtrace",
-        series,
-        settings: format!(
-            "{spp} spp, bounces {bounces}{}",
-            if scene.pathtrace.caustics { ", caustic estimator" } else { "" }
-        ),
-        wall_ms: median(&mut ms),
-        gpu_ms: None,
-        image: tracer.accumulator().mean_image(),
-    })
-}
-
-struct Header<'a> {
-    scene: &'a Scene,
-    adapter: &'a str,
-    truth_spp: u64,
-    truth_bounces: String,
-    truth_error: f64,
-    /// The truth's own metadata, written with its copy `truth.exr`.
-    truth_metadata: illum::image::ExrMetadata,
-}
-
-fn number(x: f64) -> String {
-    if x.is_nan() { "n/a".to_owned() } else { format!("{x:.3e}") }
-}
-
-fn ratio(x: f64) -> String {
-    if x.is_nan() { "n/a".to_owned() } else { format!("{x:.3}") }
-}
-
-fn write_outputs(
-    args: &Args,
-    header: &Header,
-    truth: &RgbImage32,
-    regions: &Regions,
-    rows: &[Row],
-) -> anyhow::Result<()> {
-    let out = &args.out;
-    let sizes = regions.sizes();
-    // CSV: one line per row and region ("all" for the whole image).
-    let mut lines = Vec::new();
-    for row in rows {
-        let r = &row.rung;
-        let all = std::iter::once(("all", &row.errors.overall));
-        let each = regions.names.iter().map(String::as_str).zip(&row.errors.regions);
-        for (region, e) in all.chain(each) {
-            lines.push(vec![
-                r.renderer.to_owned(),
-                r.settings.clone(),
-                format!("{:.4}", r.wall_ms),
-                r.gpu_ms.map_or(String::new(), |g| format!("{g:.4}")),
-                region.to_owned(),
-                e.pixels.to_string(),
-                format!("{:e}", e.rel_mse),
-                format!("{}", e.luminance_ratio),
-                format!("{}", e.flip),
-            ]);
-        }
-    }
-    let csv_header = [
-        "renderer",
-        "settings",
-        "wall_ms",
-        "gpu_ms",
-        "region",
-        "pixels",
-        "rel_mse",
-        "luminance_ratio",
-        "flip",
-    ];
-    write_text(&out.join("ladder.csv"), &csv_text(&csv_header, &lines)?)?;
-
-    // Markdown: the overall table, then one table per metric with a column per region.
-    let s = header.scene;
-    // The command that made the page, less where its files went.
-    let mut command = vec!["cargo run --release --example ladder --".to_owned()];
-    let mut given = std::env::args().skip(1);
-    while let Some(arg) = given.next() {
-        match arg.as_str() {
-            "--out" => _ = given.next(),
-            a if a.starts_with("--out=") => {}
-            _ => command.push(arg),
-        }
-    }
-    let mut md = format!(
-        "# The ladder: `{}`\n\n\
-         Every renderer and setting on one scene, timed, and compared with a converged path-traced \
-         truth, overall and per region. Made by `{}`.\n\n\
-         Scene `{}` at {}x{}, {} on {}. Truth: path traced, {} spp, bounces {}, its own estimated relMSE {}. \
-         Times are medians over frames; errors are against the truth (relMSE with epsilon 0.01; \
-         luminance ratio = mean luminance / the truth's; FLIP = mean LDR-FLIP, sRGB, exposure 0).\n\n",
-        s.name,
-        command.join(" "),
-        s.name,
-        s.camera.width,
-        s.camera.height,
-        header.adapter,
-        host_cpu(),
-        header.truth_spp,
-        header.truth_bounces,
-        number(header.truth_error)
-    );
-    let overall: Vec<Vec<String>> = rows
-        .iter()
-        .map(|row| {
-            let (r, e) = (&row.rung, &row.errors.overall);
-            vec![
-                r.renderer.to_owned(),
-                r.settings.clone(),
-                format!("{:.2}", r.wall_ms),
-                r.gpu_ms.map_or("-".to_owned(), |g| format!("{g:.2}")),
-                number(e.rel_mse),
-                ratio(e.luminance_ratio),
-                ratio(e.flip),
-            ]
-        })
-        .collect();
-    md.push_str(&markdown_table(
-        &["renderer", "settings", "wall ms", "GPU ms", "relMSE", "luminance ratio", "FLIP"],
-        &overall,
-    ));
-    let region_header: Vec<String> = std::iter::once("renderer, settings".to_owned())
-        .chain(regions.names.iter().zip(&sizes).map(|(n, px)| format!("{n} ({px} px)")))
-        .collect();
-    let region_header: Vec<&str> = region_header.iter().map(String::as_str).collect();
-    type Metric = (&'static str, fn(&illum_lab::regions::Errors) -> String);
-    let metrics: [Metric; 3] = [
-        ("relMSE per region", |e| number(e.rel_mse)),
-        ("Luminance ratio per region (1 = the truth's brightness)", |e| ratio(e.luminance_ratio)),
-        ("FLIP per region", |e| ratio(e.flip)),
-    ];
-    for (title, show) in metrics {
-        let table: Vec<Vec<String>> = rows
-            .iter()
-            .map(|row| {
-                std::iter::once(format!("{}, {}", row.rung.renderer, row.rung.settings))
-                    .chain(row.errors.regions.iter().map(show))
-                    .collect()
-            })
-            .collect();
-        md.push_str(&format!("\n{title}:\n\n"));
-        md.push_str(&markdown_table(&region_header, &table));
-    }
-    write_text(&out.join("ladder.md"), &md)?;
-
-    // Plots: error against time, one series per renderer.
-    for (file, title, label, value) in [
-        ("error-vs-time.png", "relMSE against time per frame", "relMSE", 0),
-        ("flip-vs-time.png", "FLIP against time per frame", "mean FLIP", 1),
-    ] {
-        let series = [
-            ("rasterizer", Series::Raster, Style::Markers),
-            ("Whitted ray tracer", Series::Whitted, Style::Markers),
-            ("path tracer, more spp", Series::PathTraceSpp, Style::Joined),
-            ("path tracer + caustic estimator, more spp", Series::PathTraceCaustics, Style::Joined),
-            ("path tracer, more bounces", Series::PathTraceBounces, Style::Joined),
-            ("path tracer + à-trous, more spp", Series::PathTraceAtrous, Style::Joined),
-            ("path tracer + OIDN, more spp", Series::PathTraceOidn, Style::Joined),
-        ];
-        let lines: Vec<Line> = series
-            .iter()
-            .map(|&(label, series, style)| Line {
-                label: label.to_owned(),
-                points: rows
-                    .iter()
-                    .filter(|r| r.rung.series == series)
-                    .map(|r| {
-                        let e = &r.errors.overall;
-                        (r.rung.wall_ms, if value == 0 { e.rel_mse } else { e.flip })
-                    })
-                    .collect(),
-                style,
-            })
-            .filter(|l| !l.points.is_empty())
-            .collect();
-        plot::log_log(&out.join(file), title, "wall time per frame (ms)", label, &lines)?;
-    }
-
-    // Images: the truth, the regions, then each row's image and FLIP map.
-    let (w, h) = (truth.width, truth.height);
-    let png = |i: &RgbImage32| to_rgba8(i, 0.0, Encoding::Srgb);
-    let region_map = region_colours(regions, w, h);
-    save_rgba8_png(out.join("regions.png"), &region_map)?;
-    // With the metadata of the render it is (renderer, scene, time, spp, settings).
-    save_exr(out.join("truth.exr"), truth, &header.truth_metadata)?;
-    let legend = regions.names.join("; ");
-    let mut panels = vec![
-        (format!("truth: path traced, {} spp", header.truth_spp), png(truth)),
-        (format!("regions: {legend}"), region_map),
-    ];
-    for row in rows {
-        let (r, e) = (&row.rung, &row.errors.overall);
-        panels.push((format!("{} {}: {:.2} ms", r.renderer, r.settings, r.wall_ms), png(&r.image)));
-        panels.push((
-            format!("FLIP {:.3}, relMSE {}, luminance x{:.3}", e.flip, number(e.rel_mse), e.luminance_ratio),
-            flip_heat_map(&row.errors.flip_map, w, h),
-        ));
-    }
-    save_rgba8_png(out.join("contact-sheet.png"), &contact_sheet(&panels, 4))?;
-    println!(
-        "wrote {}/ladder.csv, ladder.md, error-vs-time.png, flip-vs-time.png, contact-sheet.png",
-        out.display()
-    );
-    Ok(())
-}
-
-/// The regions drawn in distinct colours, in the order of their names.
-fn region_colours(regions: &Regions, w: u32, h: u32) -> image::RgbaImage {
-    const PALETTE: [[u8; 3]; 8] = [
-        [120, 170, 230],
-        [230, 200, 60],
-        [120, 60, 160],
-        [200, 80, 60],
-        [80, 180, 120],
-        [220, 220, 220],
-        [160, 100, 40],
-        [60, 60, 60],
-    ];
-    image::RgbaImage::from_fn(w, h, |x, y| {
-        let c = PALETTE[regions.of_pixel[(y * w + x) as usize] % PALETTE.len()];
-        image::Rgba([c[0], c[1], c[2], 255])
-    })
 }

@@ -5,13 +5,19 @@
 //! image is denoised and the stop rules are checked with the denoised image's estimated error,
 //! so `--target-error` stops at the error of what is written. Each round pays the filter three
 //! times, so rounds are few: each is sized to land on the rules ([`next_half`]): the spp that
-//! the error's fall over the last two rounds predicts for the target, and no more than the time
-//! budget leaves room for. An spp target alone is one round. An spp target is rounded up to an
-//! even number (both halves take the same samples).
+//! the error's fall over the last two rounds predicts for the target, or, when the time budget
+//! ends the render first, the rest of the budget in one round. An spp target alone is one round.
+//! An spp target is rounded up to an even number (both halves take the same samples).
+//!
+//! The time budget counts the sampling, and the filter's time comes on top (the summary says how
+//! much); a round that runs into the budget samples in shrinking steps and ends there. A
+//! denoised render then has about the samples a raw render of the same budget has, so its image
+//! is the nearer the truth, which a budget that also paid the filter could not promise (on
+//! lavapipe the filter of a 512 x 512 image takes longer than the default 5 s budget).
 
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use illum_denoise::Denoiser;
 pub use illum_denoise::DenoiserKind;
@@ -57,22 +63,31 @@ pub fn render_denoised(request: &DenoiseRequest) -> anyhow::Result<Option<(StopR
         Some(target) if rules.target_error.is_none() && rules.time_budget.is_none() => target,
         _ => 2u32,
     };
+    if let Some(budget) = rules.time_budget {
+        println!(
+            "the time budget ({} s) counts the sampling; each round's filter adds its own time",
+            budget.as_secs_f64()
+        );
+    }
     let mut last: Option<Denoised> = None;
     let mut rounds: Vec<Round> = Vec::new();
+    // Seconds spent sampling, over the rounds: what the time budget counts.
+    let mut sampling = 0.0;
     let reason = loop {
         let target = half_target.map_or(half, |t| half.min(t));
         let started = Instant::now();
-        if !split.advance(target, cancel)? {
+        if !advance(&mut split, target, rules.time_budget.map(|b| b.as_secs_f64() - sampling), cancel)? {
             break StopReason::Cancelled;
         }
         let tracing = started.elapsed().as_secs_f64();
+        sampling += tracing;
         let denoised = split.denoise(&filter)?;
         let error = denoised.estimate.relative_error();
         let status = Status {
             spp_done: split.spp_done(),
             samples: denoised.raw.total_samples(),
             run_samples: denoised.raw.total_samples(),
-            elapsed: clock.elapsed(),
+            elapsed: Duration::from_secs_f64(sampling),
             relative_error: denoised.estimate.rel_mse.is_finite().then_some(error),
             ..Status::default()
         };
@@ -83,17 +98,12 @@ pub fn render_denoised(request: &DenoiseRequest) -> anyhow::Result<Option<(StopR
             status.relative_error.map_or("unknown (below 2 spp per half)".to_owned(), |e| format!("{e:.4}")),
             denoised.raw.estimated_relative_error()
         );
-        rounds.push(Round {
-            half: target,
-            error: status.relative_error,
-            tracing,
-            denoising: started.elapsed().as_secs_f64() - tracing,
-        });
+        rounds.push(Round { half: target, error: status.relative_error, tracing });
         last = Some(denoised);
         if let Some(reason) = rules.check(&status) {
             break reason;
         }
-        half = next_half(&rounds, rules, clock.elapsed().as_secs_f64());
+        half = next_half(&rounds, rules, sampling);
     };
     let Some(result) = last else {
         eprintln!("error: stopped before the first round of the denoised render: nothing was written");
@@ -102,14 +112,17 @@ pub fn render_denoised(request: &DenoiseRequest) -> anyhow::Result<Option<(StopR
     let seconds = clock.elapsed().as_secs_f64();
     write(request, &split, &result, reason, seconds)?;
     println!(
-        "{}: {}x{}, {} spp in two halves, denoised ({}), {:.2} s (filter {:.3} s, guides {:.3} s), estimated \
-         relative error {:.4} denoised, {:.4} raw",
+        "{}: {}x{}, {} spp in two halves in {} round{}, denoised ({}), {:.2} s (sampling {:.2} s; the last \
+         round's filter {:.3} s, guides {:.3} s), estimated relative error {:.4} denoised, {:.4} raw",
         scene.name,
         scene.camera.width,
         scene.camera.height,
         split.spp_done(),
+        rounds.len(),
+        if rounds.len() == 1 { "" } else { "s" },
         denoiser,
         seconds,
+        sampling,
         result.filter_seconds,
         result.guide_seconds,
         result.estimate.relative_error(),
@@ -119,6 +132,34 @@ pub fn render_denoised(request: &DenoiseRequest) -> anyhow::Result<Option<(StopR
         println!("wrote {}", output.display());
     }
     Ok(Some((reason, result.estimate.relative_error())))
+}
+
+/// Advances both halves to `half` samples per pixel each; with `seconds` (what is left of the
+/// time budget), in steps that each take about half of what is left at the pace measured so far
+/// (one sample per half while nothing is measured or little is left), ending once the sampling
+/// has taken them: a round ends at the budget however the last round misjudged the cost per
+/// sample (the filter, the costly part, runs once per round). False when cancelled.
+fn advance(
+    split: &mut SplitRender,
+    half: u32,
+    seconds: Option<f64>,
+    cancel: &AtomicBool,
+) -> anyhow::Result<bool> {
+    let Some(seconds) = seconds else { return Ok(split.advance(half, cancel)?) };
+    let started = Instant::now();
+    let first = split.spp_done() / 2;
+    loop {
+        let (done, elapsed) = (split.spp_done() / 2, started.elapsed().as_secs_f64());
+        if done >= half || elapsed >= seconds {
+            return Ok(true);
+        }
+        let per_sample = (done > first).then(|| elapsed / f64::from(done - first));
+        let step = per_sample.map_or(1.0, |p| (0.5 * (seconds - elapsed) / p).floor().max(1.0));
+        let next = (f64::from(done) + step).min(f64::from(half)) as u32;
+        if !split.advance(next, cancel)? {
+            return Ok(false);
+        }
+    }
 }
 
 /// The PNG of the denoised image; the EXR of the denoised image with layers `noisy` (the raw
@@ -180,47 +221,54 @@ fn write(
 }
 
 /// One round of a denoised render: its samples per half after it, the denoised image's
-/// estimated error then (`None` while unknown), and its seconds tracing and denoising.
+/// estimated error then (`None` while unknown), and its seconds tracing.
 #[derive(Clone, Copy, Debug)]
 struct Round {
     half: u32,
     error: Option<f64>,
     tracing: f64,
-    denoising: f64,
 }
 
-/// The samples per half the next round aims at, after `rounds` (at least one), `elapsed`
-/// seconds into the render:
+/// The samples per half the next round aims at, after `rounds` (at least one), `sampling`
+/// seconds of sampling into the render:
 /// - for an error target, the spp at which the error reaches it: the error falls as
 ///   spp^-slope, the slope measured over the last two rounds (between 1/2, the raw image's, and
 ///   1, a denoised image's fall where the filter's bias shrinks with its noise), 1/2 before two
 ///   rounds are known, with a tenth to spare, so that one round usually lands on the target;
-/// - for a time budget, no more than fits in what is left of it once the round's filter is
-///   paid, at the last round's cost per sample;
-/// - else, or when nothing is known yet, twice the last round's.
+///   at most 8 times the last round's (a prediction from few samples can be far off);
+/// - for a time budget, when the sampling reaches it (at the last round's cost per sample)
+///   before the error target's spp, or there is no error target: the rest of the budget, in one
+///   round ([`advance`] ends it at the budget), so `u32::MAX`;
+/// - else, or while the error is unknown, twice the last round's.
 ///
-/// Always more than the last round's (a round of nothing would loop), and at most 8 times it
-/// (a prediction from few samples can be far off).
-fn next_half(rounds: &[Round], rules: &StopRules, elapsed: f64) -> u32 {
+/// Always more than the last round's (a round of nothing would loop).
+fn next_half(rounds: &[Round], rules: &StopRules, sampling: f64) -> u32 {
     let last = *rounds.last().expect("a round before the next");
-    let mut half = f64::from(last.half) * 2.0;
-    if let (Some(target), Some(error)) = (rules.target_error, last.error) {
-        let earlier = rounds.iter().rev().nth(1).and_then(|r| r.error.map(|e| (r.half, e)));
-        let slope = earlier
-            .filter(|&(h, e)| h < last.half && e > error && error > 0.0)
-            .map(|(h, e)| ((e / error).ln() / (f64::from(last.half) / f64::from(h)).ln()).clamp(0.5, 1.0))
-            .unwrap_or(0.5);
-        half = f64::from(last.half) * (error / target).powf(1.0 / slope) * 1.1;
-    }
-    if let Some(budget) = rules.time_budget {
-        let per_sample = last.tracing / f64::from(last.half.max(1));
-        let room = budget.as_secs_f64() - elapsed - last.denoising;
-        if per_sample > 0.0 {
-            half = half.min(f64::from(last.half) + room / per_sample);
+    let before = rounds.iter().rev().nth(1).map_or(0, |r| r.half);
+    let doubled = f64::from(last.half) * 2.0;
+    let most = f64::from(last.half.saturating_mul(8));
+    let predicted = match (rules.target_error, last.error) {
+        (Some(target), Some(error)) => {
+            let earlier = rounds.iter().rev().nth(1).and_then(|r| r.error.map(|e| (r.half, e)));
+            let slope = earlier
+                .filter(|&(h, e)| h < last.half && e > error && error > 0.0)
+                .map(|(h, e)| ((e / error).ln() / (f64::from(last.half) / f64::from(h)).ln()).clamp(0.5, 1.0))
+                .unwrap_or(0.5);
+            Some(f64::from(last.half) * (error / target).powf(1.0 / slope) * 1.1)
         }
-    }
-    let most = last.half.saturating_mul(8);
-    (half.ceil().min(f64::from(most)) as u32).max(last.half.saturating_add(1))
+        _ => None,
+    };
+    let budgeted = rules.time_budget.and_then(|budget| {
+        let per_sample = last.tracing / f64::from(last.half.saturating_sub(before).max(1));
+        (per_sample > 0.0).then(|| f64::from(last.half) + (budget.as_secs_f64() - sampling) / per_sample)
+    });
+    let half = match (predicted, budgeted) {
+        (Some(p), Some(b)) if b <= p => f64::from(u32::MAX),
+        (Some(p), _) => p.min(most),
+        (None, Some(_)) if rules.target_error.is_none() => f64::from(u32::MAX),
+        _ => doubled,
+    };
+    (half.ceil().min(f64::from(u32::MAX)) as u32).max(last.half.saturating_add(1))
 }
 
 #[cfg(test)]
@@ -229,7 +277,7 @@ mod tests {
     use std::time::Duration;
 
     fn round(half: u32, error: f64) -> Round {
-        Round { half, error: Some(error), tracing: f64::from(half) * 0.1, denoising: 1.0 }
+        Round { half, error: Some(error), tracing: f64::from(half) * 0.1 }
     }
 
     /// The error target: one round from the measured fall lands on it, where doubling took
@@ -255,16 +303,26 @@ mod tests {
         assert_eq!(next_half(&rose, &rules, 0.0), 18);
     }
 
-    /// The time budget: the next round fits in what is left once its filter is paid; and it
-    /// always advances by at least one sample.
+    /// With a time budget, the next round samples the rest of it ([`advance`] ends the round at
+    /// the budget) when the error target would come later or there is none; and a round always
+    /// advances by at least one sample.
     #[test]
-    fn a_round_fits_in_what_is_left_of_the_time_budget() {
+    fn a_round_samples_the_rest_of_the_time_budget() {
         let rules = StopRules { time_budget: Some(Duration::from_secs(10)), ..Default::default() };
-        // 0.1 s a sample per half, 1 s of filter, 5.8 s spent: room for 32 more samples.
-        assert_eq!(next_half(&[round(4, 0.1)], &rules, 5.8), 8);
-        assert_eq!(next_half(&[round(4, 0.1)], &rules, 3.0), 8);
-        assert_eq!(next_half(&[round(40, 0.1)], &rules, 5.0), 80);
-        assert_eq!(next_half(&[round(40, 0.1)], &rules, 7.0), 60);
-        assert_eq!(next_half(&[round(40, 0.1)], &rules, 9.9), 41);
+        assert_eq!(next_half(&[round(4, 0.1)], &rules, 5.8), u32::MAX);
+        // With an error target, the budget's end at 0.1 s a sample per half (2 + 9.8 / 0.1 = 100)
+        // comes before the target's 2 (0.1048 / 0.01)^2 1.1 = 242...
+        let far = StopRules { target_error: Some(0.01), ..rules };
+        assert_eq!(next_half(&[round(2, 0.1048)], &far, 0.2), u32::MAX);
+        // ... and the target when it comes first (2 (0.1048 / 0.09)^2 1.1 = 3.0), capped at 8
+        // times the last round (0.02: 60, capped at 16).
+        let near = StopRules { target_error: Some(0.09), ..rules };
+        assert_eq!(next_half(&[round(2, 0.1048)], &near, 0.2), 3);
+        let default = StopRules { target_error: Some(0.02), ..rules };
+        assert_eq!(next_half(&[round(2, 0.1048)], &default, 0.2), 16);
+        // The cost per sample is the last round's own: 36 samples in 3.6 s after 4 in 0.4 s, so
+        // the budget's end (40 + 6 / 0.1 = 100) comes before the target's 40 (0.05 / 0.02)^2 1.1.
+        let rounds = [round(4, 0.1), Round { half: 40, error: Some(0.05), tracing: 3.6 }];
+        assert_eq!(next_half(&rounds, &default, 4.0), u32::MAX);
     }
 }
