@@ -50,6 +50,7 @@ pub enum Surface {
     Box(OrientedBox),
     Parallelogram(Parallelogram),
     Ball(Ball),
+    Triangle(crate::triangle::Triangle),
 }
 
 impl Surface {
@@ -58,6 +59,7 @@ impl Surface {
             Surface::Box(b) => b.intersect(o, d, t_max),
             Surface::Parallelogram(p) => p.intersect(o, d, t_max),
             Surface::Ball(s) => s.intersect(o, d, t_max),
+            Surface::Triangle(t) => t.intersect(o, d, t_max),
         }
     }
 }

@@ -180,6 +180,9 @@ pub fn gpu_shape(shape: &Shape) -> GpuShape {
         }
         Shape::Quad(q) => GpuShape::Quad { corner: q.corner, edge_u: q.edge_u, edge_v: q.edge_v },
         Shape::Sphere(s) => GpuShape::Sphere { center: s.center, radius: s.radius },
+        Shape::Mesh(_) => {
+            unreachable!("a mesh is not one analytic shape; the ray tracers refuse meshes by name")
+        }
     }
 }
 

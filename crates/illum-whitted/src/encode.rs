@@ -11,7 +11,7 @@ use illum_rtcore::{CameraRecord, MaterialRecord};
 use illum_scene::{Feature, Scene, Shape};
 
 /// What of the scene model the Whitted ray tracer implements: everything but a sun of finite
-/// size (its shadow rays are hard).
+/// size (its shadow rays are hard) and meshes.
 pub fn implements(feature: Feature) -> bool {
     match feature {
         Feature::BoxShape
@@ -24,7 +24,7 @@ pub fn implements(feature: Feature) -> bool {
         | Feature::AreaLight
         | Feature::DeltaDirectionalLight
         | Feature::Environment => true,
-        Feature::SunDisc => false,
+        Feature::SunDisc | Feature::MeshShape | Feature::SmoothShading => false,
     }
 }
 
