@@ -16,10 +16,12 @@
 //! The measured effect of each is in docs/performance-levers.md.
 
 use std::collections::BTreeSet;
+use std::sync::Arc;
 
 use illum_gpu::shader::ShaderFile;
 use illum_scene::{Scene, Shape};
 
+use crate::bvh::{Bvh, MeshTriangle};
 use crate::literal::{lit, switch_cases, vec3, vec4};
 use crate::object::{GpuObject, GpuShape, ObjectRecord, ShapeKind, ordered_objects};
 
@@ -41,6 +43,9 @@ pub struct Geometry {
     /// Whether a shadow ray can leave in any direction: a directional light, or an emitter that
     /// is not a quad. Then every object may block a light.
     pub unbounded_lights: bool,
+    /// The BVH over the triangles of every mesh object, whose shaders bind it as group 1; `None`
+    /// for a scene without a mesh, whose traversal has no BVH code.
+    pub bvh: Option<Arc<Bvh>>,
 }
 
 impl Geometry {
@@ -60,7 +65,21 @@ impl Geometry {
                 _ => unbounded_lights = true,
             }
         }
+        let triangles: Vec<MeshTriangle> = scene
+            .objects
+            .iter()
+            .enumerate()
+            .filter_map(|(index, o)| match &o.shape {
+                Shape::Mesh(mesh) => Some(
+                    (0..mesh.triangles.len())
+                        .map(move |i| MeshTriangle::new(mesh.triangle(i), o.material as u32, index as u32)),
+                ),
+                _ => None,
+            })
+            .flatten()
+            .collect();
         Self {
+            bvh: (!triangles.is_empty()).then(|| Arc::new(Bvh::build(triangles))),
             scene: scene.name.clone(),
             names: ordered.iter().map(|(i, _)| scene.objects[*i].name.clone()).collect(),
             objects: ordered.into_iter().map(|(_, object)| object).collect(),
@@ -212,7 +231,13 @@ pub fn can_block_light(scene: &Geometry, index: usize) -> bool {
     let object = &scene.objects[index];
     // A directional light shines from everywhere on a hemisphere's worth of directions: the
     // half-space argument below covers only lights of bounded extent.
-    if object.shape.kind() != ShapeKind::Aabb || object.emitter || scene.unbounded_lights {
+    // Mesh triangles are surfaces the argument would have to clear too: with any, every object is
+    // kept.
+    if object.shape.kind() != ShapeKind::Aabb
+        || object.emitter
+        || scene.unbounded_lights
+        || scene.bvh.is_some()
+    {
         return true;
     }
     let o = Bounds::of(object);
@@ -307,11 +332,24 @@ fn surface_cases(kinds: &BTreeSet<ShapeKind>) -> String {
 
 /// Generates the `illum::rtcore::traversal` module for `scene`.
 pub fn generate(scene: &Geometry) -> Traversal {
-    let kinds: BTreeSet<ShapeKind> = scene.objects.iter().map(|o| o.shape.kind()).collect();
+    let mut kinds: BTreeSet<ShapeKind> = scene.objects.iter().map(|o| o.shape.kind()).collect();
     let mut closest = String::new();
     let mut occluded = String::new();
     let mut occluders = Vec::new();
+    // Triangles are numbered after the analytic objects.
+    let base = scene.objects.len();
+    let mesh_closest = |bvh: &Bvh| {
+        format!(
+            "    // The meshes' {} triangles under one BVH (bvh.wgsl), numbered from {base}.\n    best = bvh_closest(o, d, inv_d, own, best, {base}u);\n",
+            bvh.triangles.len()
+        )
+    };
     for (i, object) in scene.objects.iter().enumerate() {
+        if let Some(bvh) = &scene.bvh
+            && i == scene.first_emitter as usize
+        {
+            closest.push_str(&mesh_closest(bvh));
+        }
         let name = scene.names[i].replace(['\n', '\r'], " ");
         let hit = hit_expression(object, i);
         closest.push_str(&format!("    // {i}: {name}\n    t = {hit};\n"));
@@ -335,13 +373,36 @@ pub fn generate(scene: &Geometry) -> Traversal {
             }
         }
     }
+    let mut mesh_imports = String::new();
+    let object_cases = switch_cases(scene.object_records().iter().map(object_literal));
+    let mut object_body = format!("    switch index {{\n{object_cases}    }}\n");
+    if let Some(bvh) = &scene.bvh {
+        kinds.insert(ShapeKind::Triangle);
+        if scene.first_emitter as usize == scene.objects.len() {
+            closest.push_str(&mesh_closest(bvh));
+        }
+        occluded.push_str(&format!(
+            "    // The meshes' triangles\n    if (bvh_occluded(o, d, inv_d, t_max, own, {base}u)) {{\n        return true;\n    }}\n"
+        ));
+        object_body = if base == 0 {
+            "    return triangle_object(index, KIND_TRIANGLE);\n".to_owned()
+        } else {
+            format!(
+                "    if (index >= {base}u) {{\n        return triangle_object(index - {base}u, KIND_TRIANGLE);\n    }}\n{object_body}"
+            )
+        };
+        mesh_imports = format!(
+            "#import illum::rtcore::bvh::{{bvh_closest, bvh_occluded, triangle_object, surface_triangle}}\n\nconst {}: u32 = {}u;\n",
+            ShapeKind::Triangle.wgsl_constant(),
+            ShapeKind::Triangle.code()
+        );
+    }
     let normal_cases = surface_cases(&kinds);
     // Shading never needs an emitter's surface (a hit on a light only needs the side, from the
     // light's normal), so this reconstruction covers the non-emitters' kinds alone.
     let scattering: BTreeSet<ShapeKind> =
         scene.objects.iter().filter(|o| !o.emitter).map(|o| o.shape.kind()).collect();
     let scattering_cases = surface_cases(if scattering.is_empty() { &kinds } else { &scattering });
-    let object_cases = switch_cases(scene.object_records().iter().map(object_literal));
     let source = format!(
         "#define_import_path illum::rtcore::traversal
 
@@ -350,7 +411,7 @@ pub fn generate(scene: &Geometry) -> Traversal {
 
 #import illum::rtcore::codes::{{KIND_AABB, KIND_BOX, KIND_QUAD, KIND_SPHERE}}
 #import illum::rtcore::geometry::{{Hit, Object, FAR, NO_HIT, EMITTER_TIE, safe_inverse, hit_slabs, hit_box, hit_quad, hit_sphere, Surface, surface_aabb, surface_box, surface_quad, surface_sphere}}
-
+{mesh_imports}
 // The nearest object along the ray from o in the unit direction d. `own`: the index of the object
 // whose surface the ray leaves (NO_HIT for a camera or light ray); its root at o is never taken.
 fn closest_hit(o: vec3<f32>, d: vec3<f32>, own: u32) -> Hit {{
@@ -370,9 +431,7 @@ fn occluded(o: vec3<f32>, d: vec3<f32>, t_max: f32, own: u32) -> bool {{
 // The object at `index` (< the number of objects), as the storage buffer holds it, from
 // literals (a specialised pipeline binds no object buffer).
 fn object_at(index: u32) -> Object {{
-    switch index {{
-{object_cases}    }}
-}}
+{object_body}}}
 
 // Surfaces for the kinds of shape in this scene ({kind_list}).
 fn surface_at(obj: Object, p: vec3<f32>) -> Surface {{

@@ -83,13 +83,17 @@ fn every_scene_file_loads() {
             let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
             assert!(!scene.objects.is_empty());
             let name = path.file_name().unwrap().to_string_lossy().into_owned();
-            let expected =
-                if name == "whitted.toml" { RendererKind::Raster } else { RendererKind::PathTrace };
+            let expected = match name.as_str() {
+                "whitted.toml" => RendererKind::Raster,
+                // Only the Whitted ray tracer draws meshes on the GPU (docs/scene-format.md).
+                "cornell-mesh.toml" => RendererKind::Whitted,
+                _ => RendererKind::PathTrace,
+            };
             assert_eq!(scene.renderer, expected, "{name}");
             loaded.push(name);
         }
     }
-    for required in ["cornell.toml", "cornell-classic.toml", "whitted.toml"] {
+    for required in ["cornell.toml", "cornell-classic.toml", "whitted.toml", "cornell-mesh.toml"] {
         assert!(loaded.iter().any(|n| n == required), "{required} missing: {loaded:?}");
     }
 }
