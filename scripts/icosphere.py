@@ -90,8 +90,6 @@ def main():
     header = ("# Written by scripts/icosphere.py: scenes/cornell.toml with an icosphere mesh resting on the\n"
               "# short block (docs/scenes.md, \"Meshes\"). Edit the script, not this file.\n\n")
     cornell = cornell.replace('name = "cornell"', 'name = "cornell-mesh"', 1)
-    # The GPU path tracer does not draw meshes yet (docs/scene-format.md): the Whitted ray tracer does.
-    cornell = cornell.replace('renderer = "pathtrace"', 'renderer = "whitted"', 1)
     ball = ("\n# The icosphere of subdivision 3 (1280 flat triangles), radius 80, on the short block's top (y = 165).\n"
             "[[objects]]\n"
             "name = \"icosphere\"\n"

@@ -11,7 +11,8 @@ use illum_rtcore::{CameraRecord, Geometry, MaterialRecord, ObjectRecord, ordered
 use crate::PathTraceError;
 use crate::scene_code::SceneCode;
 
-/// What of the scene model the path tracer implements: all of it but meshes. Each feature is compiled
+/// What of the scene model the path tracer implements: all of it but the smooth shading of
+/// meshes. Each feature is compiled
 /// into a scene's pipeline only when the scene uses it (see [`crate::specialise`]).
 pub fn implements(feature: Feature) -> bool {
     match feature {
@@ -25,8 +26,9 @@ pub fn implements(feature: Feature) -> bool {
         | Feature::AreaLight
         | Feature::DeltaDirectionalLight
         | Feature::SunDisc
+        | Feature::MeshShape
         | Feature::Environment => true,
-        Feature::MeshShape | Feature::SmoothShading => false,
+        Feature::SmoothShading => false,
     }
 }
 

@@ -14,6 +14,8 @@ pub struct MeshBindGroup {
 impl MeshBindGroup {
     /// The bind group index the BVH's buffers take.
     pub const GROUP: u32 = 1;
+    /// The variables of group 1 in bvh.wgsl and their bindings.
+    pub const BINDINGS: [(&'static str, u32); 2] = [("bvh_nodes", 0), ("mesh_triangles", 1)];
 
     /// Uploads `bvh` and binds it to `pipeline`'s group 1 (which its shader must declare).
     pub fn new(device: &wgpu::Device, pipeline: &wgpu::ComputePipeline, bvh: &Bvh) -> Self {
@@ -27,7 +29,7 @@ impl MeshBindGroup {
             device,
             "bvh",
             &pipeline.get_bind_group_layout(Self::GROUP),
-            &[(0, &nodes), (1, &triangles)],
+            &[(Self::BINDINGS[0].1, &nodes), (Self::BINDINGS[1].1, &triangles)],
         );
         MeshBindGroup { bind_group }
     }

@@ -400,8 +400,10 @@ pub fn generate(scene: &Geometry) -> Traversal {
     let normal_cases = surface_cases(&kinds);
     // Shading never needs an emitter's surface (a hit on a light only needs the side, from the
     // light's normal), so this reconstruction covers the non-emitters' kinds alone.
+    // Mesh triangles never emit (validation refuses emitting meshes).
+    let triangles = scene.bvh.is_some().then_some(ShapeKind::Triangle);
     let scattering: BTreeSet<ShapeKind> =
-        scene.objects.iter().filter(|o| !o.emitter).map(|o| o.shape.kind()).collect();
+        scene.objects.iter().filter(|o| !o.emitter).map(|o| o.shape.kind()).chain(triangles).collect();
     let scattering_cases = surface_cases(if scattering.is_empty() { &kinds } else { &scattering });
     let source = format!(
         "#define_import_path illum::rtcore::traversal

@@ -85,8 +85,6 @@ fn every_scene_file_loads() {
             let name = path.file_name().unwrap().to_string_lossy().into_owned();
             let expected = match name.as_str() {
                 "whitted.toml" => RendererKind::Raster,
-                // Only the Whitted ray tracer draws meshes on the GPU (docs/scene-format.md).
-                "cornell-mesh.toml" => RendererKind::Whitted,
                 _ => RendererKind::PathTrace,
             };
             assert_eq!(scene.renderer, expected, "{name}");
