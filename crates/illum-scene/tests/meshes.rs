@@ -142,6 +142,14 @@ fn degenerate_triangles_are_dropped_and_counted() {
     let obj = format!("{OBJ}f 1 1 2\nv 4 4 4\nv 5 5 5\nv 6 6 6\nf 8 9 10\n");
     let s = scene("", &obj).unwrap();
     assert_eq!((mesh(&s).triangles.len(), mesh(&s).dropped_degenerate), (3, 2));
+    assert_eq!(
+        s.notes(),
+        [format!(
+            "{FILE}: objects[0] (\"ball\"): \"models/t.obj\": 2 of its triangles dropped: degenerate (repeated or \
+             collinear vertices, no area)"
+        )]
+    );
+    assert!(scene("", OBJ).unwrap().notes().is_empty());
 }
 
 #[test]
