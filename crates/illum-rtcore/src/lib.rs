@@ -20,6 +20,7 @@ pub mod camera;
 pub mod literal;
 pub mod material;
 pub mod mesh_buffers;
+pub mod mesh_traversal;
 pub mod object;
 pub mod shaders;
 pub mod spawn;

@@ -16,13 +16,13 @@
 //! The measured effect of each is in docs/performance-levers.md.
 
 use std::collections::BTreeSet;
-use std::sync::Arc;
 
 use illum_gpu::shader::ShaderFile;
 use illum_scene::{Scene, Shape};
 
 use crate::bvh::{Bvh, MeshTriangle};
 use crate::literal::{lit, switch_cases, vec3, vec4};
+use crate::mesh_traversal::{MeshForm, mesh_code};
 use crate::object::{GpuObject, GpuShape, ObjectRecord, ShapeKind, ordered_objects};
 
 /// What a traversal is generated from: the scene's objects in the order the shaders store them,
@@ -43,9 +43,9 @@ pub struct Geometry {
     /// Whether a shadow ray can leave in any direction: a directional light, or an emitter that
     /// is not a quad. Then every object may block a light.
     pub unbounded_lights: bool,
-    /// The BVH over the triangles of every mesh object, whose shaders bind it as group 1; `None`
-    /// for a scene without a mesh, whose traversal has no BVH code.
-    pub bvh: Option<Arc<Bvh>>,
+    /// The triangles of every mesh object, as literals or under a BVH (mesh_traversal.rs);
+    /// `None` for a scene without a mesh, whose traversal has no mesh code.
+    pub meshes: Option<MeshForm>,
 }
 
 impl Geometry {
@@ -79,13 +79,22 @@ impl Geometry {
             .flatten()
             .collect();
         Self {
-            bvh: (!triangles.is_empty()).then(|| Arc::new(Bvh::build(triangles))),
+            meshes: (!triangles.is_empty()).then(|| MeshForm::of(triangles)),
             scene: scene.name.clone(),
             names: ordered.iter().map(|(i, _)| scene.objects[*i].name.clone()).collect(),
             objects: ordered.into_iter().map(|(_, object)| object).collect(),
             first_emitter,
             light_corners,
             unbounded_lights,
+        }
+    }
+
+    /// The BVH the shaders bind as group 1, for a scene with more mesh triangles than the
+    /// traversal writes as literals.
+    pub fn bvh(&self) -> Option<&Bvh> {
+        match &self.meshes {
+            Some(MeshForm::Bvh(bvh)) => Some(bvh),
+            _ => None,
         }
     }
 
@@ -236,7 +245,7 @@ pub fn can_block_light(scene: &Geometry, index: usize) -> bool {
     if object.shape.kind() != ShapeKind::Aabb
         || object.emitter
         || scene.unbounded_lights
-        || scene.bvh.is_some()
+        || scene.meshes.is_some()
     {
         return true;
     }
@@ -338,17 +347,12 @@ pub fn generate(scene: &Geometry) -> Traversal {
     let mut occluders = Vec::new();
     // Triangles are numbered after the analytic objects.
     let base = scene.objects.len();
-    let mesh_closest = |bvh: &Bvh| {
-        format!(
-            "    // The meshes' {} triangles under one BVH (bvh.wgsl), numbered from {base}.\n    best = bvh_closest(o, d, inv_d, own, best, {base}u);\n",
-            bvh.triangles.len()
-        )
-    };
+    let mesh = scene.meshes.as_ref().map(|form| mesh_code(form, base));
     for (i, object) in scene.objects.iter().enumerate() {
-        if let Some(bvh) = &scene.bvh
+        if let Some(mesh) = &mesh
             && i == scene.first_emitter as usize
         {
-            closest.push_str(&mesh_closest(bvh));
+            closest.push_str(&mesh.closest);
         }
         let name = scene.names[i].replace(['\n', '\r'], " ");
         let hit = hit_expression(object, i);
@@ -374,34 +378,29 @@ pub fn generate(scene: &Geometry) -> Traversal {
         }
     }
     let mut mesh_imports = String::new();
-    let object_cases = switch_cases(scene.object_records().iter().map(object_literal));
-    let mut object_body = format!("    switch index {{\n{object_cases}    }}\n");
-    if let Some(bvh) = &scene.bvh {
+    let mut objects: Vec<String> = scene.object_records().iter().map(object_literal).collect();
+    let mut object_guard = String::new();
+    if let Some(mesh) = mesh {
         kinds.insert(ShapeKind::Triangle);
         if scene.first_emitter as usize == scene.objects.len() {
-            closest.push_str(&mesh_closest(bvh));
+            closest.push_str(&mesh.closest);
         }
-        occluded.push_str(&format!(
-            "    // The meshes' triangles\n    if (bvh_occluded(o, d, inv_d, t_max, own, {base}u)) {{\n        return true;\n    }}\n"
-        ));
-        object_body = if base == 0 {
-            "    return triangle_object(index, KIND_TRIANGLE);\n".to_owned()
-        } else {
-            format!(
-                "    if (index >= {base}u) {{\n        return triangle_object(index - {base}u, KIND_TRIANGLE);\n    }}\n{object_body}"
-            )
-        };
-        mesh_imports = format!(
-            "#import illum::rtcore::bvh::{{bvh_closest, bvh_occluded, triangle_object, surface_triangle}}\n\nconst {}: u32 = {}u;\n",
-            ShapeKind::Triangle.wgsl_constant(),
-            ShapeKind::Triangle.code()
-        );
+        occluded.push_str(&mesh.occluded);
+        objects.extend(mesh.object_literals);
+        object_guard = mesh.object_guard;
+        mesh_imports = mesh.imports;
     }
+    // A BVH's guard alone answers every index when there are no other objects.
+    let object_body = if objects.is_empty() {
+        object_guard
+    } else {
+        format!("{object_guard}    switch index {{\n{}    }}\n", switch_cases(objects.into_iter()))
+    };
     let normal_cases = surface_cases(&kinds);
     // Shading never needs an emitter's surface (a hit on a light only needs the side, from the
     // light's normal), so this reconstruction covers the non-emitters' kinds alone.
     // Mesh triangles never emit (validation refuses emitting meshes).
-    let triangles = scene.bvh.is_some().then_some(ShapeKind::Triangle);
+    let triangles = scene.meshes.is_some().then_some(ShapeKind::Triangle);
     let scattering: BTreeSet<ShapeKind> =
         scene.objects.iter().filter(|o| !o.emitter).map(|o| o.shape.kind()).chain(triangles).collect();
     let scattering_cases = surface_cases(if scattering.is_empty() { &kinds } else { &scattering });

@@ -120,7 +120,7 @@ impl WhittedTracer {
         let scene_index = {
             let (ordered, _) = illum_rtcore::ordered_objects(scene);
             let triangles =
-                geometry.bvh.iter().flat_map(|bvh| bvh.triangles.iter().map(|t| t.object as usize));
+                geometry.meshes.iter().flat_map(|m| m.triangles().iter().map(|t| t.object as usize));
             ordered.iter().map(|(i, _)| *i).chain(triangles).collect()
         };
 
@@ -136,7 +136,7 @@ impl WhittedTracer {
             &shader_defs(scene),
             "whitted ray tracer",
         )?;
-        if let Some(bvh) = &geometry.bvh {
+        if let Some(bvh) = geometry.bvh() {
             MeshBindGroup::check_size(scene, bvh, limit)?;
         }
         let (bind_group, image, params, mesh) =
@@ -159,7 +159,7 @@ impl WhittedTracer {
                     &pipeline.get_bind_group_layout(0),
                     &[(0, &params), (1, &lights), (2, &image)],
                 );
-                let mesh = geometry.bvh.as_ref().map(|bvh| MeshBindGroup::new(device, &pipeline, bvh));
+                let mesh = geometry.bvh().map(|bvh| MeshBindGroup::new(device, &pipeline, bvh));
                 (bind_group, image, params, mesh)
             })?;
         Ok(WhittedTracer {

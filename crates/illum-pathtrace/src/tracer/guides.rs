@@ -201,7 +201,7 @@ impl PathTracer {
         let bind_group = buffer_bind_group(device, "guide buffers", &layout, &bound);
         // A bind group of an automatic layout serves that pipeline only: the guides bind the BVH
         // anew.
-        let mesh = gpu_scene.geometry.bvh.as_ref().map(|bvh| MeshBindGroup::new(device, &compute, bvh));
+        let mesh = gpu_scene.geometry.bvh().map(|bvh| MeshBindGroup::new(device, &compute, bvh));
         let mut encoder = device.create_command_encoder(&Default::default());
         let workgroups = [width.div_ceil(8), height.div_ceil(8), 1];
         match &mesh {

@@ -58,7 +58,7 @@ impl ScenePipeline {
         options: TracerOptions,
         allocation: Option<SampleAllocation>,
     ) -> Result<Self, PathTraceError> {
-        if let Some(bvh) = &gpu_scene.geometry.bvh {
+        if let Some(bvh) = gpu_scene.geometry.bvh() {
             if options.traversal == Traversal::Generic {
                 return Err(PathTraceError::Unsupported {
                     scene: scene.name.clone(),
@@ -107,7 +107,7 @@ impl ScenePipeline {
             [&params_buffer, &objects_buffer, &materials_buffer],
             base_params,
         )?;
-        let mesh = gpu_scene.geometry.bvh.as_ref().map(|bvh| MeshBindGroup::new(device, &compute, bvh));
+        let mesh = gpu_scene.geometry.bvh().map(|bvh| MeshBindGroup::new(device, &compute, bvh));
         let mut pipeline = ScenePipeline {
             gpu: gpu.clone(),
             scene: scene.clone(),

@@ -1,6 +1,7 @@
 //! Meshes in the GPU path tracer (BVH, watertight triangles) against the f64 oracle's
 //! brute-force triangles, by oracle_agreement's per-pixel Z-test: the Cornell box with a flat
-//! white icosphere, and with a glass one, direct light and two bounces. And the caustic's
+//! white icosphere, and with a glass one, direct light and two bounces, under the BVH (80
+//! triangles) and as literals (20). And the caustic's
 //! estimators, which follow spheres only, are off for a scene with a mesh, with the reason.
 
 use illum_pathtrace::Estimators;
@@ -12,11 +13,16 @@ use crate::oracle_agreement::compare_scene_with;
 /// The Cornell box with an icosphere of 80 triangles (subdivision 1), radius 80, on the short
 /// block, of `material`, at 24 x 24 and 4096 spp.
 fn cornell_with_icosphere(material: &str, bounces: u32) -> Scene {
+    cornell_with_icosphere_of(material, bounces, 1)
+}
+
+/// As [`cornell_with_icosphere`], of subdivision `k`.
+fn cornell_with_icosphere_of(material: &str, bounces: u32, k: u32) -> Scene {
     let path = common::workspace_path("scenes/cornell.toml");
     let text = std::fs::read_to_string(&path).unwrap();
     let text = format!(
         "{text}\n[materials.glass]\ndielectric = {{ ior = 1.5 }}\n[[objects]]\nname = \"icosphere\"\nmaterial = \"{material}\"\n\
-         mesh = {{ file = \"models/icosphere-1.obj\", translate = [157.95, 245.0, 168.95], scale = 80.0 }}\n"
+         mesh = {{ file = \"models/icosphere-{k}.obj\", translate = [157.95, 245.0, 168.95], scale = 80.0 }}\n"
     );
     let mut scene =
         Scene::from_toml_str(&text, &path.display().to_string()).unwrap_or_else(|e| panic!("{e}"));
@@ -41,6 +47,14 @@ fn a_diffuse_mesh_agrees_with_the_oracle() {
             1024,
         );
     }
+}
+
+/// 20 triangles: literals in the generated traversal, not a BVH (mesh_traversal.rs).
+#[test]
+fn a_mesh_of_literal_triangles_agrees_with_the_oracle() {
+    let scene = cornell_with_icosphere_of("glass", 2, 0);
+    assert!(illum_rtcore::Geometry::new(&scene).bvh().is_none());
+    compare_scene_with("cornell + glass icosahedron (literals), bounces 2", &scene, 1024);
 }
 
 #[test]
