@@ -57,7 +57,6 @@ mod render;
 mod rng;
 mod sampling;
 pub mod scene;
-pub mod triangle;
 pub mod whitted;
 pub mod whitted_agreement;
 

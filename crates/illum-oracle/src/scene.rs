@@ -4,8 +4,7 @@
 use glam::DVec3;
 use illum_scene::{Feature, MaterialKind, Scene, SceneError, Shape};
 
-use crate::geometry::{Ball, OrientedBox, Parallelogram, Surface, dvec};
-use crate::triangle::mesh_surfaces;
+use crate::geometry::{Ball, OrientedBox, Parallelogram, Surface, dvec, mesh_surfaces};
 
 /// What the oracle implements: every feature of the scene model but the smooth shading of meshes,
 /// written independently of the GPU path tracer (it shares no code with the WGSL).

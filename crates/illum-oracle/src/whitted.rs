@@ -33,9 +33,8 @@ use glam::DVec3;
 use illum_scene::{Feature, MaterialKind, Scene, SceneError, Shape};
 
 use crate::camera::PinholeCamera;
-use crate::geometry::{Ball, OrientedBox, Parallelogram, Surface, dvec};
+use crate::geometry::{Ball, OrientedBox, Parallelogram, Surface, dvec, mesh_surfaces};
 use crate::optics::{checker_albedo, fresnel, reflect, refract};
-use crate::triangle::mesh_surfaces;
 
 /// One object: its surface and its material.
 #[derive(Clone, Copy, Debug)]

@@ -47,6 +47,7 @@ mod lights;
 mod load;
 mod materials;
 mod mesh;
+mod mesh_load;
 mod mesh_obj;
 mod paths;
 mod renderers;
@@ -69,6 +70,7 @@ pub use features::{Feature, FeatureSet};
 pub use lights::{DirectionalLight, Environment};
 pub use materials::{Checker, Material, MaterialKind};
 pub use mesh::{MeshPlacement, MeshRef, TriangleMesh};
+pub use mesh_load::ReadFile;
 pub use paths::resolve_scene_path;
 pub use renderers::{
     Bounces, DenoiserKind, DielectricShading, Effects, Look, MAX_BOUNCES, MAX_WHITTED_AA, MAX_WHITTED_DEPTH,
@@ -78,4 +80,3 @@ pub use renderers::{
 pub use scene::{Object, Overrides, Scene};
 pub use shapes::{BoxShape, Quad, Shape, Sphere};
 pub use spelling::{fmt_f32, toml_key};
-pub use validate_mesh::ReadFile;

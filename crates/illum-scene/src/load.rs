@@ -5,9 +5,9 @@ use std::path::Path;
 
 use crate::error::SceneError;
 use crate::file::RawScene;
+use crate::mesh_load::ReadFile;
 use crate::scene::Scene;
 use crate::validate::scene_from_raw;
-use crate::validate_mesh::ReadFile;
 
 impl Scene {
     /// Reads and validates a scene file and the mesh files it names (relative to its folder).

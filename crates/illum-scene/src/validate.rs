@@ -17,11 +17,11 @@ use crate::camera::{Camera, ClipPlanes, robust_normalize};
 use crate::error::SceneError;
 use crate::file::{Int, Num, RawCamera, RawScene, RawVec3};
 use crate::frame::frame_origin;
+use crate::mesh_load::{ReadFile, load_meshes};
 use crate::renderers::RendererKind;
 use crate::scene::Scene;
 use crate::settings::RENDERER_ALLOWED;
 use crate::spelling::{fmt_num, fmt_vec, fmt_vec32};
-use crate::validate_mesh::{ReadFile, load_meshes};
 
 const FINITE_ALLOWED: &str =
     "must be a finite number within f32 range (|x| <= 3.4e38); nan and inf are not allowed";

@@ -10,11 +10,12 @@ use crate::error::SceneError;
 use crate::file::{RawBox, RawMaterial, RawObject};
 use crate::frame::{box_local_bounds, box_local_to_world};
 use crate::materials::{Material, MaterialKind};
+use crate::mesh_load::LoadedMesh;
 use crate::scene::Object;
 use crate::shapes::{BoxShape, Quad, Shape, Sphere};
+use crate::spelling::object_label;
 use crate::spelling::{fmt_f32, fmt_num, fmt_vec, fmt_vec32, toml_key};
 use crate::validate::Check;
-use crate::validate_mesh::LoadedMesh;
 
 /// The relative size of |edge_u x edge_v| below which a quad counts as degenerate:
 /// |u x v| = |u| |v| sin(angle), so this is sin(angle) < 1e-12 between the edges.
@@ -24,14 +25,6 @@ const QUAD_DEGENERATE_SIN: f64 = 1e-12;
 /// edge loses its fraction (2^24 / 100000 ~ 168 steps per tile remain), so the board would break
 /// up.
 const MAX_TILES_PER_EDGE: f64 = 100_000.0;
-
-/// How errors name object `i`: `objects[3] ("tall block")`, or `objects[3]` without a name.
-pub(crate) fn object_label(i: usize, name: Option<&str>) -> String {
-    match name {
-        Some(name) => format!("objects[{i}] ({name:?})"),
-        None => format!("objects[{i}]"),
-    }
-}
 
 impl Check<'_> {
     pub(crate) fn object(
