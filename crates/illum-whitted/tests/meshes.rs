@@ -120,3 +120,30 @@ fn scenes_without_a_mesh_compose_the_same_shader_as_without_the_bvh_module() {
         assert_eq!(composed, compose(&without), "{name}");
     }
 }
+
+/// The object-ID image names a mesh's object for its triangles' pixels: every pixel labelled
+/// with an icosphere has its centre ray passing within the icosphere's radius of its centre
+/// (its vertices lie on that sphere), and each icosphere labels pixels.
+#[test]
+fn object_ids_name_the_mesh_a_triangle_belongs_to() {
+    let scene = whitted_with_meshes(160, 90);
+    let ids = WhittedTracer::new(gpu(), &scene).unwrap().object_ids().unwrap();
+    let camera = &scene.camera;
+    for (index, object) in scene.objects.iter().enumerate() {
+        let illum_scene::Shape::Mesh(mesh) = &object.shape else { continue };
+        let (centre, radius) = (mesh.placement.translate, mesh.placement.scale);
+        let mut labelled = 0;
+        for (p, hit) in ids.hit.iter().enumerate() {
+            if *hit != Some(index) {
+                continue;
+            }
+            labelled += 1;
+            let (x, y) = ((p as u32 % ids.width) as f32 + 0.5, (p as u32 / ids.width) as f32 + 0.5);
+            let d = camera.ray_direction(x, y);
+            let to_centre = centre - camera.eye;
+            let miss = (to_centre - to_centre.dot(d) * d).length();
+            assert!(miss <= radius * 1.001, "{}: pixel {p} passes {miss} from its centre", object.name);
+        }
+        assert!(labelled > 20, "{}: {labelled} pixels", object.name);
+    }
+}
