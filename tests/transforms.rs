@@ -259,6 +259,11 @@ fn in_world_f32(home: &Scene, offset: Vec3) -> Scene {
             Shape::Sphere(s) => s.center += offset,
             Shape::Quad(q) => q.corner += offset,
             Shape::Box(b) => b.translate += offset,
+            Shape::Mesh(m) => {
+                let m = std::sync::Arc::make_mut(m);
+                m.positions.iter_mut().for_each(|p| *p += offset);
+                m.placement.translate += offset;
+            }
         }
     }
     scene

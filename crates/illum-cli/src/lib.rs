@@ -84,6 +84,9 @@ impl SceneArgs {
 /// Loads a scene file and applies the command-line overrides.
 pub fn load_scene(path: &Path, args: &SceneArgs) -> anyhow::Result<Scene> {
     let mut scene = Scene::load(&resolve_scene_path(path))?;
+    for note in scene.notes() {
+        eprintln!("{note}");
+    }
     scene.apply_overrides(&args.overrides(), "command line")?;
     Ok(scene)
 }

@@ -107,7 +107,12 @@ fn prepare(args: &RenderArgs) -> anyhow::Result<Option<Prepared>> {
     if let Some(caustics) = caustics {
         scene.pathtrace.caustics = caustics;
     }
-    if args.caustics == Some(true) && !illum_pathtrace::Estimators::of(&scene).caustics() {
+    if let Some(why) = illum_pathtrace::Estimators::mesh_stops_caustics(&scene) {
+        if args.caustics == Some(true) {
+            bail!("{}: --caustics on: {why}", args.scene.display());
+        }
+        eprintln!("{}: {why}", args.scene.display());
+    } else if args.caustics == Some(true) && !illum_pathtrace::Estimators::of(&scene).caustics() {
         bail!(
             "{}: --caustics on: this scene has no caustic to light-trace (the light tracer follows a \
              directional light through mirror or glass objects, and the scene lacks one or the other)",

@@ -62,6 +62,9 @@ fn prepare(request: &WhittedRequest) -> anyhow::Result<(Scene, Vec<PathBuf>)> {
     let depth = in_range("--depth", request.args.depth, 0, MAX_WHITTED_DEPTH)?;
     let aa = in_range("--aa", request.args.aa, 1, MAX_WHITTED_AA)?;
     let mut scene = Scene::load(&crate::resolve_scene_path(request.scene))?;
+    for note in scene.notes() {
+        eprintln!("{note}");
+    }
     let sizes =
         Overrides { width: request.settings.width, height: request.settings.height, ..Default::default() };
     scene.apply_overrides(&sizes, "command line")?;

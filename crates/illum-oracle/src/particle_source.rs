@@ -29,6 +29,7 @@ fn bounding_sphere(p: &Primitive) -> (DVec3, f64) {
             (centre, 0.5 * (q.u + q.v).length().max((q.u - q.v).length()))
         }
         Surface::Box(b) => (b.rotation * (0.5 * (b.lo + b.hi)) + b.offset, 0.5 * (b.hi - b.lo).length()),
+        Surface::Triangle(t) => t.bounding_sphere(),
     }
 }
 

@@ -4,10 +4,10 @@
 use glam::DVec3;
 use illum_scene::{Feature, MaterialKind, Scene, SceneError, Shape};
 
-use crate::geometry::{Ball, OrientedBox, Parallelogram, Surface, dvec};
+use crate::geometry::{Ball, OrientedBox, Parallelogram, Surface, dvec, mesh_surfaces};
 
-/// What the oracle implements: every feature of the scene model, written independently of the
-/// GPU path tracer (it shares no code with the WGSL).
+/// What the oracle implements: every feature of the scene model but the smooth shading of meshes,
+/// written independently of the GPU path tracer (it shares no code with the WGSL).
 pub fn implements(feature: Feature) -> bool {
     match feature {
         Feature::BoxShape
@@ -20,7 +20,9 @@ pub fn implements(feature: Feature) -> bool {
         | Feature::AreaLight
         | Feature::DeltaDirectionalLight
         | Feature::SunDisc
+        | Feature::MeshShape
         | Feature::Environment => true,
+        Feature::SmoothShading => false,
     }
 }
 
@@ -106,6 +108,17 @@ impl TraceScene {
                 }
                 Shape::Sphere(s) => {
                     Surface::Ball(Ball { center: dvec(s.center), radius: f64::from(s.radius) })
+                }
+                Shape::Mesh(mesh) => {
+                    // Validation refuses emitting meshes: each triangle only scatters light.
+                    out.surfaces.extend(mesh_surfaces(mesh).map(|surface| Primitive {
+                        surface,
+                        material: material.kind,
+                        albedo: dvec(material.diffuse_albedo().unwrap_or_default()),
+                        emission: DVec3::ZERO,
+                        emitter: false,
+                    }));
+                    continue;
                 }
             };
             let primitive = Primitive {

@@ -33,7 +33,7 @@ use glam::DVec3;
 use illum_scene::{Feature, MaterialKind, Scene, SceneError, Shape};
 
 use crate::camera::PinholeCamera;
-use crate::geometry::{Ball, OrientedBox, Parallelogram, Surface, dvec};
+use crate::geometry::{Ball, OrientedBox, Parallelogram, Surface, dvec, mesh_surfaces};
 use crate::optics::{checker_albedo, fresnel, reflect, refract};
 
 /// One object: its surface and its material.
@@ -81,8 +81,8 @@ impl WhittedOracle {
     pub fn new(scene: &Scene) -> Result<WhittedOracle, SceneError> {
         // Every shape and material of the scene model, a delta directional light, area lights
         // (as point lights) and a constant environment; not a sun of finite size, since
-        // Whitted's shadow rays are hard.
-        scene.require("Whitted ray tracer", |f| !matches!(f, Feature::SunDisc))?;
+        // Whitted's shadow rays are hard, nor a mesh's smooth shading.
+        scene.require("Whitted ray tracer", |f| !matches!(f, Feature::SunDisc | Feature::SmoothShading))?;
         let mut items = Vec::with_capacity(scene.objects.len());
         let mut lights = Vec::new();
         for object in &scene.objects {
@@ -102,6 +102,10 @@ impl WhittedOracle {
                 }
                 Shape::Sphere(s) => {
                     Surface::Ball(Ball { center: dvec(s.center), radius: f64::from(s.radius) })
+                }
+                Shape::Mesh(mesh) => {
+                    items.extend(mesh_surfaces(mesh).map(|surface| Item { surface, material }));
+                    continue;
                 }
             };
             items.push(Item { surface, material });

@@ -70,13 +70,28 @@ impl Estimators {
             matches!(scene.material_of(o).kind, MaterialKind::Mirror { .. } | MaterialKind::Dielectric { .. })
         });
         let diffuse = scene.features().any(&[Feature::Lambertian, Feature::Checker]);
-        let light_tracer = scene.pathtrace.caustics && scene.directional_light.is_some() && specular;
+        let light_tracer = scene.pathtrace.caustics
+            && scene.directional_light.is_some()
+            && specular
+            && Self::mesh_stops_caustics(scene).is_none();
         let delta_sun = scene.directional_light.is_some_and(|l| l.is_delta());
         Estimators {
             light_tracer,
             photon_gather: light_tracer && delta_sun && diffuse,
             glint: light_tracer && delta_sun,
         }
+    }
+
+    /// Why the caustic's estimators are off although the scene asks for them: they follow light
+    /// through spheres (their particles aim at specular objects' bounding spheres, the glint is
+    /// solved on spheres and quads) and their passes bind no BVH, so a scene with a mesh renders
+    /// with camera paths alone, which miss the sun's caustic (docs/caustics.md).
+    pub fn mesh_stops_caustics(scene: &Scene) -> Option<&'static str> {
+        let mesh = scene.features().contains(Feature::MeshShape);
+        (scene.pathtrace.caustics && mesh).then_some(
+            "caustics off: the caustic's estimators do not follow light through meshes; camera paths \
+             alone miss the sun's caustic",
+        )
     }
 
     /// The caustic's light tracer (and the shaders' CAUSTIC code).

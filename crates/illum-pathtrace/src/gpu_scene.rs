@@ -11,7 +11,8 @@ use illum_rtcore::{CameraRecord, Geometry, MaterialRecord, ObjectRecord, ordered
 use crate::PathTraceError;
 use crate::scene_code::SceneCode;
 
-/// What of the scene model the path tracer implements: all of it. Each feature is compiled
+/// What of the scene model the path tracer implements: all of it but the smooth shading of
+/// meshes. Each feature is compiled
 /// into a scene's pipeline only when the scene uses it (see [`crate::specialise`]).
 pub fn implements(feature: Feature) -> bool {
     match feature {
@@ -25,7 +26,9 @@ pub fn implements(feature: Feature) -> bool {
         | Feature::AreaLight
         | Feature::DeltaDirectionalLight
         | Feature::SunDisc
+        | Feature::MeshShape
         | Feature::Environment => true,
+        Feature::SmoothShading => false,
     }
 }
 
@@ -121,7 +124,7 @@ impl GpuScene {
         let mut light_area = 0.0f32;
         for (index, object) in &objects {
             let material = &scene.materials[object.material as usize];
-            match (object.emitter, scene.objects[*index].shape) {
+            match (object.emitter, &scene.objects[*index].shape) {
                 (true, Shape::Quad(q)) => {
                     let area = q.area();
                     light_area += area;

@@ -28,7 +28,11 @@ pub fn implements(feature: Feature) -> bool {
         | Feature::Mirror
         | Feature::DeltaDirectionalLight
         | Feature::Environment => true,
-        Feature::BoxShape | Feature::AreaLight | Feature::SunDisc => false,
+        Feature::BoxShape
+        | Feature::MeshShape
+        | Feature::SmoothShading
+        | Feature::AreaLight
+        | Feature::SunDisc => false,
     }
 }
 
@@ -177,7 +181,7 @@ impl RasterScene {
         let (mut glass, mut metal) = (None, None);
         for (i, object) in scene.objects.iter().enumerate() {
             let material = scene.material_of(object);
-            match (object.shape, material.kind) {
+            match (&object.shape, material.kind) {
                 (Shape::Quad(quad), kind) => {
                     only_one(
                         floor.is_some(),
@@ -186,7 +190,7 @@ impl RasterScene {
                         "a second quad",
                         "the rasterizer draws one quad, the floor",
                     )?;
-                    floor = Some(checker_floor(file, &scene.object_label(i), quad, kind)?);
+                    floor = Some(checker_floor(file, &scene.object_label(i), *quad, kind)?);
                 }
                 (Shape::Sphere(sphere), MaterialKind::Dielectric { ior }) => {
                     let field = scene.object_label(i);

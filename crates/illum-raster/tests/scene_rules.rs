@@ -284,6 +284,13 @@ fn features_the_rasterizer_lacks_are_refused_by_name() {
 
     let sun = edit("angular_radius = 0.0", "angular_radius = 0.5");
     expect_unsupported(&sun, "[directional_light]", Feature::SunDisc);
+
+    let ball = repo_file("scenes/models/icosphere-0.obj");
+    let ball = format!(
+        "[[objects]]\nname = \"ball\"\nmaterial = \"grey\"\nmesh = {{ file = {:?}, translate = [-5.0, 1.0, 3.0] }}\n",
+        ball.display().to_string()
+    );
+    expect_unsupported(&with_object(&ball), "objects[3] (\"ball\")", Feature::MeshShape);
     assert!(Feature::SunDisc.to_string().contains("sun disc"));
 }
 

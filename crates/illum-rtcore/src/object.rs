@@ -21,10 +21,14 @@ pub enum ShapeKind {
     Box,
     Quad,
     Sphere,
+    /// A mesh's triangle, under the scene's BVH (bvh.rs): its constant is generated into the
+    /// traversal of a scene with a mesh only, so that other scenes' shaders stay as they were.
+    Triangle,
 }
 
 impl ShapeKind {
-    /// Every kind, in the order of their names.
+    /// Every analytic kind (all but [`ShapeKind::Triangle`]), in the order of their names: the
+    /// codes module's constants.
     pub const ALL: [ShapeKind; 4] = [ShapeKind::Aabb, ShapeKind::Box, ShapeKind::Quad, ShapeKind::Sphere];
 
     /// Its `KIND_*` value in the shaders (the `illum::rtcore::codes` module is generated from
@@ -35,6 +39,7 @@ impl ShapeKind {
             ShapeKind::Quad => 1,
             ShapeKind::Sphere => 2,
             ShapeKind::Aabb => 3,
+            ShapeKind::Triangle => 4,
         }
     }
 
@@ -45,6 +50,7 @@ impl ShapeKind {
             ShapeKind::Box => "box",
             ShapeKind::Quad => "quad",
             ShapeKind::Sphere => "sphere",
+            ShapeKind::Triangle => "triangle",
         }
     }
 
@@ -55,6 +61,7 @@ impl ShapeKind {
             ShapeKind::Box => "KIND_BOX",
             ShapeKind::Quad => "KIND_QUAD",
             ShapeKind::Sphere => "KIND_SPHERE",
+            ShapeKind::Triangle => "KIND_TRIANGLE",
         }
     }
 
@@ -65,6 +72,7 @@ impl ShapeKind {
             ShapeKind::Box => "surface_box",
             ShapeKind::Quad => "surface_quad",
             ShapeKind::Sphere => "surface_sphere",
+            ShapeKind::Triangle => "surface_triangle",
         }
     }
 }
@@ -180,19 +188,28 @@ pub fn gpu_shape(shape: &Shape) -> GpuShape {
         }
         Shape::Quad(q) => GpuShape::Quad { corner: q.corner, edge_u: q.edge_u, edge_v: q.edge_v },
         Shape::Sphere(s) => GpuShape::Sphere { center: s.center, radius: s.radius },
+        Shape::Mesh(_) => {
+            unreachable!("a mesh is not an analytic shape: ordered_objects leaves it to the BVH")
+        }
     }
 }
 
-/// The scene's objects as every compute ray tracer stores them: non-emitters first, then
-/// emitters (the shaders rely on this order to let a light win a tie with the surface it is set
-/// into), each with its index in `scene.objects`; and the index of the first emitter.
+/// The scene's analytic objects as every compute ray tracer stores them: non-emitters first,
+/// then emitters (the shaders rely on this order to let a light win a tie with the surface it is
+/// set into), each with its index in `scene.objects`; and the index of the first emitter. Mesh
+/// objects are not among them: their triangles are under the scene's BVH (bvh.rs).
 pub fn ordered_objects(scene: &Scene) -> (Vec<(usize, GpuObject)>, u32) {
     let object = |(i, o): (usize, &illum_scene::Object)| {
         let emitter = scene.materials[o.material].is_emitter();
         (i, GpuObject { shape: gpu_shape(&o.shape), material: o.material as u32, emitter })
     };
-    let (mut ordered, emitters): (Vec<_>, Vec<_>) =
-        scene.objects.iter().enumerate().map(object).partition(|(_, o)| !o.emitter);
+    let (mut ordered, emitters): (Vec<_>, Vec<_>) = scene
+        .objects
+        .iter()
+        .enumerate()
+        .filter(|(_, o)| !matches!(o.shape, Shape::Mesh(_)))
+        .map(object)
+        .partition(|(_, o)| !o.emitter);
     let first_emitter = ordered.len() as u32;
     ordered.extend(emitters);
     (ordered, first_emitter)

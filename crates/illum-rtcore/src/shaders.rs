@@ -16,10 +16,13 @@ pub const MATERIAL_MODULE: ShaderFile = shader_file!("shaders/material.wgsl");
 pub const OPTICS_MODULE: ShaderFile = shader_file!("shaders/optics.wgsl");
 /// The pinhole camera (`illum::rtcore::camera`).
 pub const CAMERA_MODULE: ShaderFile = shader_file!("shaders/camera.wgsl");
+/// The BVH over mesh triangles (`illum::rtcore::bvh`): imported only by the traversal of a
+/// scene with a mesh, so other scenes' shaders do not contain it.
+pub const BVH_MODULE: ShaderFile = shader_file!("shaders/bvh.wgsl");
 
 /// The files of [`core_modules`] (the generated codes module aside).
-pub const FILES: [ShaderFile; 5] =
-    [SPAWN_MODULE, GEOMETRY_MODULE, MATERIAL_MODULE, OPTICS_MODULE, CAMERA_MODULE];
+pub const FILES: [ShaderFile; 6] =
+    [SPAWN_MODULE, GEOMETRY_MODULE, MATERIAL_MODULE, OPTICS_MODULE, CAMERA_MODULE, BVH_MODULE];
 
 /// `illum::rtcore::codes`: the `KIND_*` and `MATERIAL_*` constants, generated from
 /// [`ShapeKind`] and [`MaterialCode`] so that no WGSL constant can disagree with the Rust code

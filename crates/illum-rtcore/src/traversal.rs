@@ -20,7 +20,9 @@ use std::collections::BTreeSet;
 use illum_gpu::shader::ShaderFile;
 use illum_scene::{Scene, Shape};
 
+use crate::bvh::{Bvh, MeshTriangle};
 use crate::literal::{lit, switch_cases, vec3, vec4};
+use crate::mesh_traversal::{MeshForm, mesh_code};
 use crate::object::{GpuObject, GpuShape, ObjectRecord, ShapeKind, ordered_objects};
 
 /// What a traversal is generated from: the scene's objects in the order the shaders store them,
@@ -41,6 +43,9 @@ pub struct Geometry {
     /// Whether a shadow ray can leave in any direction: a directional light, or an emitter that
     /// is not a quad. Then every object may block a light.
     pub unbounded_lights: bool,
+    /// The triangles of every mesh object, as literals or under a BVH (mesh_traversal.rs);
+    /// `None` for a scene without a mesh, whose traversal has no mesh code.
+    pub meshes: Option<MeshForm>,
 }
 
 impl Geometry {
@@ -60,13 +65,36 @@ impl Geometry {
                 _ => unbounded_lights = true,
             }
         }
+        let triangles: Vec<MeshTriangle> = scene
+            .objects
+            .iter()
+            .enumerate()
+            .filter_map(|(index, o)| match &o.shape {
+                Shape::Mesh(mesh) => Some(
+                    (0..mesh.triangles.len())
+                        .map(move |i| MeshTriangle::new(mesh.triangle(i), o.material as u32, index as u32)),
+                ),
+                _ => None,
+            })
+            .flatten()
+            .collect();
         Self {
+            meshes: (!triangles.is_empty()).then(|| MeshForm::of(triangles)),
             scene: scene.name.clone(),
             names: ordered.iter().map(|(i, _)| scene.objects[*i].name.clone()).collect(),
             objects: ordered.into_iter().map(|(_, object)| object).collect(),
             first_emitter,
             light_corners,
             unbounded_lights,
+        }
+    }
+
+    /// The BVH the shaders bind as group 1, for a scene with more mesh triangles than the
+    /// traversal writes as literals.
+    pub fn bvh(&self) -> Option<&Bvh> {
+        match &self.meshes {
+            Some(MeshForm::Bvh(bvh)) => Some(bvh),
+            _ => None,
         }
     }
 
@@ -212,7 +240,13 @@ pub fn can_block_light(scene: &Geometry, index: usize) -> bool {
     let object = &scene.objects[index];
     // A directional light shines from everywhere on a hemisphere's worth of directions: the
     // half-space argument below covers only lights of bounded extent.
-    if object.shape.kind() != ShapeKind::Aabb || object.emitter || scene.unbounded_lights {
+    // Mesh triangles are surfaces the argument would have to clear too: with any, every object is
+    // kept.
+    if object.shape.kind() != ShapeKind::Aabb
+        || object.emitter
+        || scene.unbounded_lights
+        || scene.meshes.is_some()
+    {
         return true;
     }
     let o = Bounds::of(object);
@@ -307,11 +341,19 @@ fn surface_cases(kinds: &BTreeSet<ShapeKind>) -> String {
 
 /// Generates the `illum::rtcore::traversal` module for `scene`.
 pub fn generate(scene: &Geometry) -> Traversal {
-    let kinds: BTreeSet<ShapeKind> = scene.objects.iter().map(|o| o.shape.kind()).collect();
+    let mut kinds: BTreeSet<ShapeKind> = scene.objects.iter().map(|o| o.shape.kind()).collect();
     let mut closest = String::new();
     let mut occluded = String::new();
     let mut occluders = Vec::new();
+    // Triangles are numbered after the analytic objects.
+    let base = scene.objects.len();
+    let mesh = scene.meshes.as_ref().map(|form| mesh_code(form, base));
     for (i, object) in scene.objects.iter().enumerate() {
+        if let Some(mesh) = &mesh
+            && i == scene.first_emitter as usize
+        {
+            closest.push_str(&mesh.closest);
+        }
         let name = scene.names[i].replace(['\n', '\r'], " ");
         let hit = hit_expression(object, i);
         closest.push_str(&format!("    // {i}: {name}\n    t = {hit};\n"));
@@ -335,13 +377,33 @@ pub fn generate(scene: &Geometry) -> Traversal {
             }
         }
     }
+    let mut mesh_imports = String::new();
+    let mut objects: Vec<String> = scene.object_records().iter().map(object_literal).collect();
+    let mut object_guard = String::new();
+    if let Some(mesh) = mesh {
+        kinds.insert(ShapeKind::Triangle);
+        if scene.first_emitter as usize == scene.objects.len() {
+            closest.push_str(&mesh.closest);
+        }
+        occluded.push_str(&mesh.occluded);
+        objects.extend(mesh.object_literals);
+        object_guard = mesh.object_guard;
+        mesh_imports = mesh.imports;
+    }
+    // A BVH's guard alone answers every index when there are no other objects.
+    let object_body = if objects.is_empty() {
+        object_guard
+    } else {
+        format!("{object_guard}    switch index {{\n{}    }}\n", switch_cases(objects.into_iter()))
+    };
     let normal_cases = surface_cases(&kinds);
     // Shading never needs an emitter's surface (a hit on a light only needs the side, from the
     // light's normal), so this reconstruction covers the non-emitters' kinds alone.
+    // Mesh triangles never emit (validation refuses emitting meshes).
+    let triangles = scene.meshes.is_some().then_some(ShapeKind::Triangle);
     let scattering: BTreeSet<ShapeKind> =
-        scene.objects.iter().filter(|o| !o.emitter).map(|o| o.shape.kind()).collect();
+        scene.objects.iter().filter(|o| !o.emitter).map(|o| o.shape.kind()).chain(triangles).collect();
     let scattering_cases = surface_cases(if scattering.is_empty() { &kinds } else { &scattering });
-    let object_cases = switch_cases(scene.object_records().iter().map(object_literal));
     let source = format!(
         "#define_import_path illum::rtcore::traversal
 
@@ -350,7 +412,7 @@ pub fn generate(scene: &Geometry) -> Traversal {
 
 #import illum::rtcore::codes::{{KIND_AABB, KIND_BOX, KIND_QUAD, KIND_SPHERE}}
 #import illum::rtcore::geometry::{{Hit, Object, FAR, NO_HIT, EMITTER_TIE, safe_inverse, hit_slabs, hit_box, hit_quad, hit_sphere, Surface, surface_aabb, surface_box, surface_quad, surface_sphere}}
-
+{mesh_imports}
 // The nearest object along the ray from o in the unit direction d. `own`: the index of the object
 // whose surface the ray leaves (NO_HIT for a camera or light ray); its root at o is never taken.
 fn closest_hit(o: vec3<f32>, d: vec3<f32>, own: u32) -> Hit {{
@@ -370,9 +432,7 @@ fn occluded(o: vec3<f32>, d: vec3<f32>, t_max: f32, own: u32) -> bool {{
 // The object at `index` (< the number of objects), as the storage buffer holds it, from
 // literals (a specialised pipeline binds no object buffer).
 fn object_at(index: u32) -> Object {{
-    switch index {{
-{object_cases}    }}
-}}
+{object_body}}}
 
 // Surfaces for the kinds of shape in this scene ({kind_list}).
 fn surface_at(obj: Object, p: vec3<f32>) -> Surface {{

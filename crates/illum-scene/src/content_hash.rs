@@ -22,13 +22,16 @@
 //!    `reflectance`; 4 emitter `radiance`;
 //! 4. the number of objects, then each object in file order: its material's index, its shape
 //!    code and fields: 0 box `min`, `max`, `rotate_y_deg`, `pivot`, `translate`; 1 quad
-//!    `corner`, `edge_u`, `edge_v`; 2 sphere `center`, `radius`;
+//!    `corner`, `edge_u`, `edge_v`; 2 sphere `center`, `radius`; 3 mesh: the u64 FNV-1a of
+//!    its file's bytes, then `translate`, `scale`, `rotate_deg`, and 1 for smooth shading or 0
+//!    for flat (so a changed mesh file makes another scene);
 //! 5. the directional light: 0, or 1 then `direction`, `irradiance`, `angular_radius_deg`;
 //! 6. the environment: 0, or 1 then `radiance`.
 //!
 //! The hash is 64-bit FNV-1a ([`fnv1a_64`]) of those bytes. A change to this list (a new field,
 //! another order) must raise [`CONTENT_VERSION`]; the pinned hash of `scenes/cornell.toml` in
-//! the tests below fails until it does.
+//! the tests below fails until it does. A new shape code (mesh, 3) extends the list without
+//! changing the bytes of any scene that could be written before it, so it keeps the version.
 
 use glam::Vec3;
 
@@ -133,6 +136,14 @@ impl Scene {
                     out.vec3(s.center);
                     out.f32(s.radius);
                 }
+                Shape::Mesh(m) => {
+                    out.u32(3);
+                    out.0.extend_from_slice(&m.file_hash.to_le_bytes());
+                    out.vec3(m.placement.translate);
+                    out.f32(m.placement.scale);
+                    out.vec3(m.placement.rotate_deg);
+                    out.u32(u32::from(m.smooth()));
+                }
             }
         }
         match &self.directional_light {
@@ -208,6 +219,12 @@ mod tests {
                 Shape::Sphere(s) => {
                     out.extend(vec3(&mut s.center));
                     out.push(&mut s.radius);
+                }
+                Shape::Mesh(m) => {
+                    let p = &mut std::sync::Arc::make_mut(m).placement;
+                    out.extend(vec3(&mut p.translate));
+                    out.push(&mut p.scale);
+                    out.extend(vec3(&mut p.rotate_deg));
                 }
             }
         }

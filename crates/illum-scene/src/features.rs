@@ -22,6 +22,10 @@ pub enum Feature {
     BoxShape,
     QuadShape,
     SphereShape,
+    /// A triangle mesh shaded with each triangle's geometric normal.
+    MeshShape,
+    /// A triangle mesh shaded with normals interpolated from its file's vertex normals.
+    SmoothShading,
     Lambertian,
     Checker,
     Dielectric,
@@ -37,10 +41,12 @@ pub enum Feature {
 
 impl Feature {
     /// Every feature of the scene model.
-    pub const ALL: [Feature; 11] = [
+    pub const ALL: [Feature; 13] = [
         Feature::BoxShape,
         Feature::QuadShape,
         Feature::SphereShape,
+        Feature::MeshShape,
+        Feature::SmoothShading,
         Feature::Lambertian,
         Feature::Checker,
         Feature::Dielectric,
@@ -98,6 +104,10 @@ impl fmt::Display for Feature {
             Feature::BoxShape => "a box",
             Feature::QuadShape => "a quad",
             Feature::SphereShape => "a sphere",
+            Feature::MeshShape => "a triangle mesh",
+            Feature::SmoothShading => {
+                "a triangle mesh with vertex normals (smooth shading; `flat = true` shades it flat)"
+            }
             Feature::Lambertian => "a Lambertian material",
             Feature::Checker => "a checkerboard material",
             Feature::Dielectric => "a dielectric (glass) material",
@@ -123,13 +133,19 @@ impl Scene {
         for (i, object) in self.objects.iter().enumerate() {
             let place = self.object_label(i);
             used.push((
-                match object.shape {
+                match &object.shape {
                     Shape::Box(_) => Feature::BoxShape,
                     Shape::Quad(_) => Feature::QuadShape,
                     Shape::Sphere(_) => Feature::SphereShape,
+                    Shape::Mesh(_) => Feature::MeshShape,
                 },
                 place.clone(),
             ));
+            if let Shape::Mesh(mesh) = &object.shape
+                && mesh.smooth()
+            {
+                used.push((Feature::SmoothShading, format!("{place}, file {:?}", mesh.file)));
+            }
             let material = self.material_of(object);
             let feature = match material.kind {
                 MaterialKind::Lambertian { .. } => Feature::Lambertian,

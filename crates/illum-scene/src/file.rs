@@ -40,6 +40,8 @@
 //!                                                        # optional rotate_y, pivot, translate
 //! quad = { corner = [..], edge_u = [..], edge_v = [..] } # front side: edge_u x edge_v
 //! sphere = { center = [..], radius = 1.0 }
+//! mesh = { file = "models/x.obj" }                      # OBJ, relative to this file; optional
+//!                                                        # translate, scale, rotate, flat
 //! [pathtrace]                      # the path tracer
 //! spp = 16                         # samples per pixel, >= 1
 //! bounces = 2                      # 0..=MAX_BOUNCES, or "unbounded" (Russian roulette)
@@ -288,6 +290,7 @@ pub(crate) struct RawObject {
     pub box_: Option<RawBox>,
     pub quad: Option<RawQuad>,
     pub sphere: Option<RawSphere>,
+    pub mesh: Option<RawMesh>,
 }
 
 /// A box by centre + half-extent or by min + max corners (validation checks it is one or the
@@ -320,6 +323,28 @@ pub(crate) struct RawQuad {
 pub(crate) struct RawSphere {
     pub center: RawVec3,
     pub radius: Num,
+}
+
+/// A triangle mesh read from a file (`validate_mesh.rs`), placed by `translate + scale R local`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawMesh {
+    /// Relative to the scene file's folder.
+    pub file: String,
+    #[serde(default)]
+    pub translate: RawVec3,
+    #[serde(default = "one")]
+    pub scale: Num,
+    /// Degrees about +X, then +Y, then +Z.
+    #[serde(default)]
+    pub rotate: RawVec3,
+    /// Shade with each triangle's own normal even when the file gives vertex normals.
+    #[serde(default)]
+    pub flat: bool,
+}
+
+fn one() -> Num {
+    Num(1.0)
 }
 
 /// A TOML number: float or integer (so `radius = 50` works as well as `radius = 50.0`). May be

@@ -30,14 +30,15 @@ use crate::file::{RawBox, RawObject, RawScene};
 
 /// The origin of the frame the scene's f32 positions are measured from, in the file's (world)
 /// coordinates: zero, or the eye (see the module's rule). Non-finite numbers are left to
-/// validation, which refuses them; they do not count toward the bounding box.
-pub(crate) fn frame_origin(raw: &RawScene) -> DVec3 {
+/// validation, which refuses them; they do not count toward the bounding box. `meshes`: the
+/// world bounds of the mesh objects, whose vertices only their files give.
+pub(crate) fn frame_origin(raw: &RawScene, meshes: &[(DVec3, DVec3)]) -> DVec3 {
     let eye = DVec3::from_array(raw.camera.eye.0);
     if !eye.is_finite() {
         return DVec3::ZERO;
     }
     let (mut lo, mut hi) = (eye, eye);
-    for (a, b) in raw.objects.iter().filter_map(object_bounds) {
+    for (a, b) in raw.objects.iter().filter_map(object_bounds).chain(meshes.iter().copied()) {
         if a.is_finite() && b.is_finite() {
             lo = lo.min(a);
             hi = hi.max(b);
@@ -51,6 +52,7 @@ pub(crate) fn frame_origin(raw: &RawScene) -> DVec3 {
 fn object_bounds(o: &RawObject) -> Option<(DVec3, DVec3)> {
     let v = |a: [f64; 3]| DVec3::from_array(a);
     match (&o.box_, &o.quad, &o.sphere) {
+        _ if o.mesh.is_some() => None,
         (Some(b), None, None) => {
             let corners = box_world_corners(b)?;
             Some(corners.iter().fold((corners[0], corners[0]), |(lo, hi), &c| (lo.min(c), hi.max(c))))
@@ -98,6 +100,10 @@ fn box_world_corners(b: &RawBox) -> Option<[DVec3; 8]> {
 mod tests {
     use super::*;
 
+    fn frame_origin_of(raw: &RawScene) -> DVec3 {
+        frame_origin(raw, &[])
+    }
+
     fn raw(text: &str) -> RawScene {
         toml::from_str(text).unwrap()
     }
@@ -116,14 +122,14 @@ mod tests {
         // The Whitted scene's numbers: the floor spans 30 units, the eye is 7.5 from the origin.
         let objects = "[[objects]]\nmaterial = \"m\"\nquad = { corner = [-23, 0, -7.5], edge_u = [0, 0, 15], \
                        edge_v = [30, 0, 0] }\n[[objects]]\nmaterial = \"m\"\nsphere = { center = [4.2, 2.6, -4.2], radius = 1 }\n";
-        assert_eq!(frame_origin(&scene([7.5, 2.3, -4.2], objects)), DVec3::ZERO);
+        assert_eq!(frame_origin_of(&scene([7.5, 2.3, -4.2], objects)), DVec3::ZERO);
     }
 
     #[test]
     fn a_scene_farther_than_its_size_from_the_origin_is_measured_from_the_eye() {
         let objects = "[[objects]]\nmaterial = \"m\"\nsphere = { center = [1e5, 2.6, -4.2], radius = 1 }\n";
         let eye = [100_003.5, 2.3, -4.2];
-        assert_eq!(frame_origin(&scene(eye, objects)), DVec3::from_array(eye));
+        assert_eq!(frame_origin_of(&scene(eye, objects)), DVec3::from_array(eye));
         // A rotated box's corners count: a block turned about a far pivot lies near it.
         let block = "[[objects]]\nmaterial = \"m\"\nbox = { min = [0, 0, 0], max = [1, 1, 1], rotate_y = 90, \
                      pivot = [50, 0, 0], translate = [0, 0, 0] }\n";
@@ -131,8 +137,8 @@ mod tests {
         // in [50, 51] x [49, 50]. An eye at z = 51.5 beside it spans 2.5 units with it, 51.5 from
         // the origin; an eye at x = 1 spans 50 units with it, and the origin is within that.
         let eye = [50.5, 0.5, 51.5];
-        assert_eq!(frame_origin(&scene(eye, block)), DVec3::from_array(eye));
-        let near = frame_origin(&scene([1.0, 0.5, 0.5], block));
+        assert_eq!(frame_origin_of(&scene(eye, block)), DVec3::from_array(eye));
+        let near = frame_origin_of(&scene([1.0, 0.5, 0.5], block));
         assert_eq!(near, DVec3::ZERO, "the eye within the box's 50-unit span of the origin");
     }
 }

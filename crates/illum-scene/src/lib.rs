@@ -11,6 +11,7 @@
 //! ([`Scene::origin`], `frame.rs`): the image does not depend on where the scene sits.
 //!
 //! The modules follow the scene's concepts: [`Camera`] (`camera.rs`), shapes (`shapes.rs`),
+//! triangle meshes (`mesh.rs`, read from OBJ files by `mesh_obj.rs`, checked by `validate_mesh.rs`),
 //! materials (`materials.rs`), lights (`lights.rs`; area lights are emitting quads), the
 //! per-renderer sections (`renderers.rs`), what a renderer must implement to render a scene
 //! (`features.rs`), and the scene's identity, a hash of its content over versioned canonical
@@ -45,6 +46,9 @@ mod frame;
 mod lights;
 mod load;
 mod materials;
+mod mesh;
+mod mesh_load;
+mod mesh_obj;
 mod paths;
 mod renderers;
 mod scene;
@@ -55,6 +59,7 @@ mod spelling;
 pub mod testing;
 mod validate;
 mod validate_materials;
+mod validate_mesh;
 mod validate_objects;
 mod validate_sections;
 
@@ -64,6 +69,8 @@ pub use error::{ParseValueError, SceneError};
 pub use features::{Feature, FeatureSet};
 pub use lights::{DirectionalLight, Environment};
 pub use materials::{Checker, Material, MaterialKind};
+pub use mesh::{MeshPlacement, MeshRef, TriangleMesh};
+pub use mesh_load::ReadFile;
 pub use paths::resolve_scene_path;
 pub use renderers::{
     Bounces, DenoiserKind, DielectricShading, Effects, Look, MAX_BOUNCES, MAX_WHITTED_AA, MAX_WHITTED_DEPTH,

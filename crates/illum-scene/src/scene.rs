@@ -129,6 +129,25 @@ impl Scene {
         if *name == format!("objects[{i}]") { name.clone() } else { format!("objects[{i}] ({name:?})") }
     }
 
+    /// What loading changed without refusing, one line each for a user to read: the degenerate
+    /// triangles dropped from each mesh, with their count.
+    pub fn notes(&self) -> Vec<String> {
+        self.objects
+            .iter()
+            .enumerate()
+            .filter_map(|(i, o)| match &o.shape {
+                Shape::Mesh(m) if m.dropped_degenerate > 0 => Some(format!(
+                    "{}: {}: {:?}: {} of its triangles dropped: degenerate (repeated or collinear vertices, no area)",
+                    self.source,
+                    self.object_label(i),
+                    m.file,
+                    m.dropped_degenerate
+                )),
+                _ => None,
+            })
+            .collect()
+    }
+
     /// The material of `object`.
     pub fn material_of(&self, object: &Object) -> &Material {
         &self.materials[object.material]

@@ -3,20 +3,25 @@
 
 use glam::{Mat3, Vec3};
 
-#[derive(Clone, Copy, Debug, PartialEq)]
+use crate::mesh::MeshRef;
+
+#[derive(Clone, Debug, PartialEq)]
 pub enum Shape {
     Box(BoxShape),
     Quad(Quad),
     Sphere(Sphere),
+    /// A triangle mesh read from a file (`mesh.rs`).
+    Mesh(MeshRef),
 }
 
 impl Shape {
-    /// The word a file uses for this shape (`box`, `quad`, `sphere`).
+    /// The word a file uses for this shape (`box`, `quad`, `sphere`, `mesh`).
     pub fn kind(&self) -> &'static str {
         match self {
             Shape::Box(_) => "box",
             Shape::Quad(_) => "quad",
             Shape::Sphere(_) => "sphere",
+            Shape::Mesh(_) => "mesh",
         }
     }
 }

@@ -44,6 +44,14 @@ pub fn toml_key(name: &str) -> String {
     if bare { name.to_owned() } else { format!("{name:?}") }
 }
 
+/// How errors name object `i`: `objects[3] ("tall block")`, or `objects[3]` without a name.
+pub(crate) fn object_label(i: usize, name: Option<&str>) -> String {
+    match name {
+        Some(name) => format!("objects[{i}] ({name:?})"),
+        None => format!("objects[{i}]"),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -4,6 +4,8 @@
 
 use serde::Deserialize;
 
+pub mod obj;
+
 use crate::error::SceneError;
 
 /// `text` with its one occurrence of `from` replaced by `to`; panics unless `from` occurs

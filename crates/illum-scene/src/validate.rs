@@ -17,6 +17,7 @@ use crate::camera::{Camera, ClipPlanes, robust_normalize};
 use crate::error::SceneError;
 use crate::file::{Int, Num, RawCamera, RawScene, RawVec3};
 use crate::frame::frame_origin;
+use crate::mesh_load::{ReadFile, load_meshes};
 use crate::renderers::RendererKind;
 use crate::scene::Scene;
 use crate::settings::RENDERER_ALLOWED;
@@ -30,8 +31,22 @@ const FINITE_ALLOWED: &str =
 const CAMERA_PARALLEL_SIN: f32 = 1e-6;
 
 /// Validates `raw` (read from `file`) into a scene named `raw.name` or else `default_name`.
-pub(crate) fn scene_from_raw(raw: RawScene, file: &str, default_name: &str) -> Result<Scene, SceneError> {
-    let origin = frame_origin(&raw);
+/// Mesh files are read by `read` (`validate_mesh.rs`) before anything else is checked, since
+/// their vertices count toward the frame's origin.
+pub(crate) fn scene_from_raw(
+    raw: RawScene,
+    file: &str,
+    default_name: &str,
+    read: &mut ReadFile<'_>,
+) -> Result<Scene, SceneError> {
+    let loaded = load_meshes(&raw, file, read)?;
+    let mesh_bounds: Vec<(DVec3, DVec3)> = raw
+        .objects
+        .iter()
+        .zip(&loaded)
+        .filter_map(|(o, l)| l.as_ref()?.world_bounds(o.mesh.as_ref()?))
+        .collect();
+    let origin = frame_origin(&raw, &mesh_bounds);
     let check = Check { file, origin };
     let renderer = match &raw.renderer {
         None => RendererKind::PathTrace,
@@ -46,14 +61,14 @@ pub(crate) fn scene_from_raw(raw: RawScene, file: &str, default_name: &str) -> R
         return Err(check.invalid(
             "objects",
             "[]",
-            "a scene needs at least one object (an [[objects]] table with a box, quad or sphere)",
+            "a scene needs at least one object (an [[objects]] table with a box, quad, sphere or mesh)",
         ));
     }
     let objects = raw
         .objects
         .iter()
         .enumerate()
-        .map(|(i, o)| check.object(i, o, &materials, &index_of, &raw.materials))
+        .map(|(i, o)| check.object(i, o, &materials, &index_of, &raw.materials, loaded[i].as_ref()))
         .collect::<Result<Vec<_>, _>>()?;
     Ok(Scene {
         name: raw.name.unwrap_or_else(|| default_name.to_owned()),

@@ -10,8 +10,10 @@ use crate::error::SceneError;
 use crate::file::{RawBox, RawMaterial, RawObject};
 use crate::frame::{box_local_bounds, box_local_to_world};
 use crate::materials::{Material, MaterialKind};
+use crate::mesh_load::LoadedMesh;
 use crate::scene::Object;
 use crate::shapes::{BoxShape, Quad, Shape, Sphere};
+use crate::spelling::object_label;
 use crate::spelling::{fmt_f32, fmt_num, fmt_vec, fmt_vec32, toml_key};
 use crate::validate::Check;
 
@@ -32,14 +34,16 @@ impl Check<'_> {
         materials: &[Material],
         index_of: &BTreeMap<String, usize>,
         raw_materials: &BTreeMap<String, RawMaterial>,
+        loaded: Option<&LoadedMesh>,
     ) -> Result<Object, SceneError> {
-        let label = match &raw.name {
-            Some(name) => format!("objects[{i}] ({name:?})"),
-            None => format!("objects[{i}]"),
-        };
-        let shape = match (&raw.box_, &raw.quad, &raw.sphere) {
-            (Some(b), None, None) => Shape::Box(self.box_shape(&format!("{label}.box"), b)?),
-            (None, Some(q), None) => {
+        let label = object_label(i, raw.name.as_deref());
+        let shape = match (&raw.box_, &raw.quad, &raw.sphere, &raw.mesh) {
+            (Some(b), None, None, None) => Shape::Box(self.box_shape(&format!("{label}.box"), b)?),
+            (None, None, None, Some(m)) => {
+                let loaded = loaded.expect("every mesh object's file is loaded before its validation");
+                Shape::Mesh(self.mesh(&label, m, loaded)?)
+            }
+            (None, Some(q), None, None) => {
                 let path = format!("{label}.quad");
                 let quad = Quad {
                     corner: self.position(&format!("{path}.corner"), q.corner)?,
@@ -49,7 +53,7 @@ impl Check<'_> {
                 self.quad_area(&path, q.edge_u.0, q.edge_v.0, &quad)?;
                 Shape::Quad(quad)
             }
-            (None, None, Some(s)) => {
+            (None, None, Some(s), None) => {
                 let path = format!("{label}.sphere");
                 let center = self.position(&format!("{path}.center"), s.center)?;
                 let radius_path = format!("{path}.radius");
@@ -59,18 +63,26 @@ impl Check<'_> {
                 }
                 Shape::Sphere(Sphere { center, radius })
             }
-            (b, q, s) => {
-                let given: Vec<&str> = [(b.is_some(), "box"), (q.is_some(), "quad")]
-                    .into_iter()
-                    .chain([(s.is_some(), "sphere")])
-                    .filter_map(|(present, key)| present.then_some(key))
-                    .collect();
+            (b, q, s, m) => {
+                let given: Vec<&str> = [
+                    (b.is_some(), "box"),
+                    (q.is_some(), "quad"),
+                    (s.is_some(), "sphere"),
+                    (m.is_some(), "mesh"),
+                ]
+                .into_iter()
+                .filter_map(|(present, key)| present.then_some(key))
+                .collect();
                 let value = if given.is_empty() {
                     "(no shape)".to_owned()
                 } else {
                     format!("(both {})", given.join(" and "))
                 };
-                return Err(self.invalid(label, value, "each object needs exactly one of box, quad, sphere"));
+                return Err(self.invalid(
+                    label,
+                    value,
+                    "each object needs exactly one of box, quad, sphere, mesh",
+                ));
             }
         };
 

@@ -30,14 +30,15 @@ fn offsets() -> Vec<DVec3> {
 }
 
 /// Every point that places the scene: the eye, the target, and each object's corners (a box's
-/// eight, a quad's four) or a sphere's centre, in the scene's own frame.
+/// eight, a quad's four, a mesh's vertices) or a sphere's centre, in the scene's own frame.
 fn points(scene: &Scene) -> Vec<Vec3> {
     let mut out = vec![scene.camera.eye, scene.camera.target];
     for object in &scene.objects {
-        match object.shape {
+        match &object.shape {
             Shape::Box(b) => out.extend(b.world_corners()),
             Shape::Quad(q) => out.extend([q.corner, q.corner + q.edge_u, q.corner + q.edge_v]),
             Shape::Sphere(s) => out.push(s.center),
+            Shape::Mesh(m) => out.extend(&m.positions),
         }
     }
     out
@@ -124,7 +125,7 @@ fn a_rotated_box_far_away_keeps_its_corners() {
     let offset = DVec3::new(-7e5, 3e5, 1e6);
     let far = load(&moved(&text("cornell.toml"), offset.to_array()));
     for (h, f) in home.objects.iter().zip(&far.objects) {
-        let (Shape::Box(h), Shape::Box(f)) = (h.shape, f.shape) else { continue };
+        let (Shape::Box(h), Shape::Box(f)) = (&h.shape, &f.shape) else { continue };
         for (a, b) in h.world_corners().iter().zip(f.world_corners()) {
             let expected = a.as_dvec3() + offset;
             let got = far.world_point(b);

@@ -32,8 +32,8 @@ fn material_name<'a>(scene: &'a Scene, object_name: &str) -> &'a str {
 }
 
 fn as_box(scene: &Scene, name: &str) -> BoxShape {
-    match object(scene, name).shape {
-        Shape::Box(b) => b,
+    match &object(scene, name).shape {
+        Shape::Box(b) => *b,
         other => panic!("{name} is not a box: {other:?}"),
     }
 }
@@ -83,13 +83,15 @@ fn every_scene_file_loads() {
             let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
             assert!(!scene.objects.is_empty());
             let name = path.file_name().unwrap().to_string_lossy().into_owned();
-            let expected =
-                if name == "whitted.toml" { RendererKind::Raster } else { RendererKind::PathTrace };
+            let expected = match name.as_str() {
+                "whitted.toml" => RendererKind::Raster,
+                _ => RendererKind::PathTrace,
+            };
             assert_eq!(scene.renderer, expected, "{name}");
             loaded.push(name);
         }
     }
-    for required in ["cornell.toml", "cornell-classic.toml", "whitted.toml"] {
+    for required in ["cornell.toml", "cornell-classic.toml", "whitted.toml", "cornell-mesh.toml"] {
         assert!(loaded.iter().any(|n| n == required), "{required} missing: {loaded:?}");
     }
 }
@@ -316,7 +318,7 @@ fn whitted_is_the_physical_scene_of_the_fake() {
     let checker = Checker { even: Vec3::new(0.8, 0.8, 0.0), odd: Vec3::new(0.8, 0.0, 0.0), tile: 1.0 };
     assert_eq!(s.materials[object(&s, "floor").material].kind, MaterialKind::Checker(checker));
 
-    let sphere = |name: &str| match object(&s, name).shape {
+    let sphere = |name: &str| match &object(&s, name).shape {
         Shape::Sphere(sphere) => (sphere.center, sphere.radius),
         other => panic!("{name} is not a sphere: {other:?}"),
     };

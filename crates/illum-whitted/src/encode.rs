@@ -11,7 +11,7 @@ use illum_rtcore::{CameraRecord, MaterialRecord};
 use illum_scene::{Feature, Scene, Shape};
 
 /// What of the scene model the Whitted ray tracer implements: everything but a sun of finite
-/// size (its shadow rays are hard).
+/// size (its shadow rays are hard) and the smooth shading of meshes.
 pub fn implements(feature: Feature) -> bool {
     match feature {
         Feature::BoxShape
@@ -23,8 +23,9 @@ pub fn implements(feature: Feature) -> bool {
         | Feature::Mirror
         | Feature::AreaLight
         | Feature::DeltaDirectionalLight
+        | Feature::MeshShape
         | Feature::Environment => true,
-        Feature::SunDisc => false,
+        Feature::SunDisc | Feature::SmoothShading => false,
     }
 }
 

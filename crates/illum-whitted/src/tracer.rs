@@ -8,7 +8,7 @@ use illum_gpu::buffers::{buffer_bind_group, dispatch};
 use illum_gpu::shader::{self, ShaderFile};
 use illum_gpu::{GpuContext, GpuError, readback, shader_file, wgpu};
 use illum_image::RgbImage32;
-use illum_rtcore::Geometry;
+use illum_rtcore::{Geometry, MeshBindGroup};
 use illum_scene::{RendererKind, Scene, SceneError};
 use wgpu::util::DeviceExt;
 
@@ -61,6 +61,8 @@ pub struct WhittedTracer {
     height: u32,
     pipeline: wgpu::ComputePipeline,
     bind_group: wgpu::BindGroup,
+    /// The BVH's buffers (group 1), for a scene with a mesh.
+    mesh: Option<MeshBindGroup>,
     params: wgpu::Buffer,
     radiance_params: WhittedParams,
     image: wgpu::Buffer,
@@ -117,7 +119,9 @@ impl WhittedTracer {
             encode::params(scene, geometry.first_emitter, lights.len() as u32, OUTPUT_RADIANCE);
         let scene_index = {
             let (ordered, _) = illum_rtcore::ordered_objects(scene);
-            ordered.iter().map(|(i, _)| *i).collect()
+            let triangles =
+                geometry.meshes.iter().flat_map(|m| m.triangles().iter().map(|t| t.object as usize));
+            ordered.iter().map(|(i, _)| *i).chain(triangles).collect()
         };
 
         let device = &gpu.device;
@@ -132,33 +136,39 @@ impl WhittedTracer {
             &shader_defs(scene),
             "whitted ray tracer",
         )?;
-        let (bind_group, image, params) = gpu.scoped("creating the Whitted ray tracer's buffers", || {
-            let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("whitted params"),
-                contents: bytemuck::bytes_of(&radiance_params),
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            });
-            let lights = storage("whitted lights", bytemuck::cast_slice(&lights_or_one));
-            let image = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("whitted image"),
-                size: bytes,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            });
-            let bind_group = buffer_bind_group(
-                device,
-                "whitted",
-                &pipeline.get_bind_group_layout(0),
-                &[(0, &params), (1, &lights), (2, &image)],
-            );
-            (bind_group, image, params)
-        })?;
+        if let Some(bvh) = geometry.bvh() {
+            MeshBindGroup::check_size(scene, bvh, limit)?;
+        }
+        let (bind_group, image, params, mesh) =
+            gpu.scoped("creating the Whitted ray tracer's buffers", || {
+                let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("whitted params"),
+                    contents: bytemuck::bytes_of(&radiance_params),
+                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                });
+                let lights = storage("whitted lights", bytemuck::cast_slice(&lights_or_one));
+                let image = device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("whitted image"),
+                    size: bytes,
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                    mapped_at_creation: false,
+                });
+                let bind_group = buffer_bind_group(
+                    device,
+                    "whitted",
+                    &pipeline.get_bind_group_layout(0),
+                    &[(0, &params), (1, &lights), (2, &image)],
+                );
+                let mesh = geometry.bvh().map(|bvh| MeshBindGroup::new(device, &pipeline, bvh));
+                (bind_group, image, params, mesh)
+            })?;
         Ok(WhittedTracer {
             gpu: gpu.clone(),
             width,
             height,
             pipeline,
             bind_group,
+            mesh,
             params,
             radiance_params,
             image,
@@ -227,7 +237,19 @@ impl WhittedTracer {
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("whitted") });
         let workgroups = [columns.div_ceil(WORKGROUP), rows.div_ceil(WORKGROUP), 1];
-        dispatch(&mut encoder, "whitted", &self.pipeline, &self.bind_group, workgroups);
+        match &self.mesh {
+            None => dispatch(&mut encoder, "whitted", &self.pipeline, &self.bind_group, workgroups),
+            Some(mesh) => {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("whitted"),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(&self.pipeline);
+                pass.set_bind_group(0, &self.bind_group, &[]);
+                mesh.set(&mut pass);
+                pass.dispatch_workgroups(workgroups[0], workgroups[1], workgroups[2]);
+            }
+        }
         self.gpu.queue.submit([encoder.finish()]);
     }
 }

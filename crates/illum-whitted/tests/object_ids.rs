@@ -28,7 +28,7 @@ fn margin(shape: &Shape, o: DVec3, d: DVec3) -> f64 {
             let (a, b) = (p.dot(u) / u.length(), p.dot(v) / v.length());
             [a, u.length() - a, b, v.length() - b].into_iter().map(f64::abs).fold(f64::MAX, f64::min)
         }
-        Shape::Box(_) => panic!("the Whitted scene has no boxes"),
+        Shape::Box(_) | Shape::Mesh(_) => panic!("the Whitted scene has no boxes or meshes"),
     }
 }
 

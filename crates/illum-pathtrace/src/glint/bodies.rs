@@ -73,7 +73,7 @@ impl Bodies {
         let bodies: Vec<Body> = scene
             .objects
             .iter()
-            .map(|o| match o.shape {
+            .map(|o| match &o.shape {
                 Shape::Sphere(s) => {
                     scale = scale.max(d3(s.center).abs().max_element() + f64::from(s.radius));
                     Body::Sphere { center: d3(s.center), radius: f64::from(s.radius) }
@@ -88,6 +88,9 @@ impl Bodies {
                     let offset = d3(b.pivot) + d3(b.translate) - rotation * d3(b.pivot);
                     scale = scale.max(offset.abs().max_element() + d3(b.max - b.min).length());
                     Body::Box { min: d3(b.min), max: d3(b.max), rotation, offset }
+                }
+                Shape::Mesh(_) => {
+                    unreachable!("the path tracer refuses meshes by name (gpu_scene.rs, implements)")
                 }
             })
             .collect();

@@ -12,6 +12,7 @@ use illum_gpu::buffers::{buffer_bind_group, dispatch};
 use illum_gpu::readback;
 use illum_gpu::readback::PendingRead;
 use illum_gpu::wgpu;
+use illum_rtcore::MeshBindGroup;
 use wgpu::util::DeviceExt;
 
 use super::PathTracer;
@@ -198,14 +199,24 @@ impl PathTracer {
         ]);
         let layout = compute.get_bind_group_layout(0);
         let bind_group = buffer_bind_group(device, "guide buffers", &layout, &bound);
+        // A bind group of an automatic layout serves that pipeline only: the guides bind the BVH
+        // anew.
+        let mesh = gpu_scene.geometry.bvh().map(|bvh| MeshBindGroup::new(device, &compute, bvh));
         let mut encoder = device.create_command_encoder(&Default::default());
-        dispatch(
-            &mut encoder,
-            "guide buffers",
-            &compute,
-            &bind_group,
-            [width.div_ceil(8), height.div_ceil(8), 1],
-        );
+        let workgroups = [width.div_ceil(8), height.div_ceil(8), 1];
+        match &mesh {
+            None => dispatch(&mut encoder, "guide buffers", &compute, &bind_group, workgroups),
+            Some(mesh) => {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("guide buffers"),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(&compute);
+                pass.set_bind_group(0, &bind_group, &[]);
+                mesh.set(&mut pass);
+                pass.dispatch_workgroups(workgroups[0], workgroups[1], workgroups[2]);
+            }
+        }
         gpu.queue.submit([encoder.finish()]);
         Ok(GuideOutput { width, height, samples, bytes, albedo, normal })
     }

@@ -3,6 +3,7 @@
 //! light tracer. What a band needs to be traced, and nothing of how bands are run or folded.
 
 use illum_gpu::{GpuContext, wgpu};
+use illum_rtcore::MeshBindGroup;
 use illum_scene::Scene;
 use wgpu::util::DeviceExt;
 
@@ -43,6 +44,8 @@ pub(super) struct ScenePipeline {
     pub(super) radiance_exponent: i32,
     /// The caustic's light tracer, when the scene asks for it and can have a caustic.
     pub(super) caustic: Option<CausticTracer>,
+    /// The BVH's buffers (group 1), for a scene with a mesh.
+    pub(super) mesh: Option<MeshBindGroup>,
 }
 
 impl ScenePipeline {
@@ -55,6 +58,17 @@ impl ScenePipeline {
         options: TracerOptions,
         allocation: Option<SampleAllocation>,
     ) -> Result<Self, PathTraceError> {
+        if let Some(bvh) = gpu_scene.geometry.bvh() {
+            if options.traversal == Traversal::Generic {
+                return Err(PathTraceError::Unsupported {
+                    scene: scene.name.clone(),
+                    message: "the generic traversal reads objects from a buffer and has no BVH: a scene \
+                              with a mesh needs the specialised traversal"
+                        .to_owned(),
+                });
+            }
+            MeshBindGroup::check_size(scene, bvh, gpu.device.limits().max_storage_buffer_binding_size)?;
+        }
         let base_params = gpu_scene::params(scene, gpu_scene);
         let (compute, traversal_source) =
             shaders::pathtrace_pipeline(gpu, scene, gpu_scene, options, allocation.is_some())?;
@@ -93,6 +107,7 @@ impl ScenePipeline {
             [&params_buffer, &objects_buffer, &materials_buffer],
             base_params,
         )?;
+        let mesh = gpu_scene.geometry.bvh().map(|bvh| MeshBindGroup::new(device, &compute, bvh));
         let mut pipeline = ScenePipeline {
             gpu: gpu.clone(),
             scene: scene.clone(),
@@ -107,6 +122,7 @@ impl ScenePipeline {
             allocation: None,
             radiance_exponent: gpu_scene.radiance_exponent,
             caustic,
+            mesh,
         };
         if let Some(allocation) = allocation {
             pipeline.check_allocation(&allocation)?;

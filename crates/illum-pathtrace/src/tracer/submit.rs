@@ -338,6 +338,9 @@ impl PathTracer {
             });
             compute.set_pipeline(&self.pipeline.compute);
             compute.set_bind_group(0, &batch.bind_group, &[]);
+            if let Some(mesh) = &self.pipeline.mesh {
+                mesh.set(&mut compute);
+            }
             let width = self.pipeline.scene.camera.width;
             compute.dispatch_workgroups(
                 width.div_ceil(WORKGROUP),

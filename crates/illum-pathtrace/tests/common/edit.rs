@@ -30,6 +30,12 @@ pub fn transformed(scene: &Scene, scale: f32, offset: Vec3) -> Scene {
                 s.center = point(s.center);
                 s.radius *= scale;
             }
+            Shape::Mesh(m) => {
+                let m = std::sync::Arc::make_mut(m);
+                m.positions.iter_mut().for_each(|p| *p = point(*p));
+                m.placement.translate = point(m.placement.translate);
+                m.placement.scale *= scale;
+            }
         }
     }
     out

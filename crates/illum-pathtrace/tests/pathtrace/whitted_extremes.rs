@@ -71,7 +71,7 @@ fn floor_point(scene: &Scene, px: f64, py: f64) -> Option<DVec3> {
                 let (a, b) = (p.dot(u) / u.length_squared(), p.dot(v) / v.length_squared());
                 on_floor = (0.0..=1.0).contains(&a) && (0.0..=1.0).contains(&b);
             }
-            Shape::Box(_) => unreachable!("the Whitted scene has no boxes"),
+            Shape::Box(_) | Shape::Mesh(_) => unreachable!("the Whitted scene has no boxes or meshes"),
         }
     }
     (d.y < 0.0 && on_floor).then_some(o + floor_t * d)

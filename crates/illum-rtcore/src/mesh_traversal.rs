@@ -1,0 +1,144 @@
+//! The part of the generated traversal (traversal.rs) that covers a scene's mesh triangles, in
+//! one of two forms:
+//! - a few triangles (at most [`LITERAL_TRIANGLES`]) as literals, one straight-line test each,
+//!   like the analytic objects: no buffer is read, no loop runs;
+//! - more under the BVH (bvh.rs, bvh.wgsl), read from bind group 1.
+//!
+//! Either way triangle i is object `base + i` (after the analytic objects) and is tested with
+//! the same watertight test (bvh.wgsl's `hit_triangle`).
+
+use crate::bvh::{Bvh, MeshTriangle};
+use crate::literal::{vec3, vec4};
+use crate::object::ShapeKind;
+
+/// Up to this many triangles a scene's meshes are literals; past it, a BVH. Measured on lavapipe
+/// (docs/performance.md, "Meshes"): the Cornell box with 20 triangles ran at 0.87 Msamples/s as
+/// literals against 0.66 under the BVH, with 80 at 0.30 against 0.54, with 320 at 0.04 against
+/// 0.54 (its shader then took a minute to compile); the crossover lies between 20 and 80.
+pub const LITERAL_TRIANGLES: usize = 32;
+
+/// The scene's triangles in the form the traversal uses.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MeshForm {
+    Literals(Vec<MeshTriangle>),
+    Bvh(std::sync::Arc<Bvh>),
+}
+
+impl MeshForm {
+    /// The form for `triangles` (at least one).
+    pub fn of(triangles: Vec<MeshTriangle>) -> MeshForm {
+        if triangles.len() <= LITERAL_TRIANGLES {
+            MeshForm::Literals(triangles)
+        } else {
+            MeshForm::Bvh(std::sync::Arc::new(Bvh::build(triangles)))
+        }
+    }
+
+    /// The triangles, in the order the traversal numbers them.
+    pub fn triangles(&self) -> &[MeshTriangle] {
+        match self {
+            MeshForm::Literals(triangles) => triangles,
+            MeshForm::Bvh(bvh) => &bvh.triangles,
+        }
+    }
+}
+
+/// The generated code for the triangles: what closest_hit runs before the emitters, what
+/// occluded runs last, the object records of literal triangles (after the analytic objects'),
+/// the guard object_at puts before its switch for a BVH's, and the module's imports.
+pub(crate) struct MeshCode {
+    pub closest: String,
+    pub occluded: String,
+    pub object_literals: Vec<String>,
+    pub object_guard: String,
+    pub imports: String,
+}
+
+fn triangle_object_literal(t: &MeshTriangle) -> String {
+    let v = |p: [f32; 3]| vec4([p[0], p[1], p[2], 0.0]);
+    format!(
+        "Object({}, {}u, 0u, 0u, {}, {}, {}, vec4<f32>(0.0))",
+        ShapeKind::Triangle.wgsl_constant(),
+        t.material,
+        v(t.a),
+        v(t.b),
+        v(t.c)
+    )
+}
+
+/// The code for `form`, its triangles numbered from `base`.
+pub(crate) fn mesh_code(form: &MeshForm, base: usize) -> MeshCode {
+    let constant =
+        format!("const {}: u32 = {}u;\n", ShapeKind::Triangle.wgsl_constant(), ShapeKind::Triangle.code());
+    match form {
+        MeshForm::Literals(triangles) => {
+            let mut closest = format!(
+                "    // The meshes' {} triangles, numbered from {base}, as literals (mesh_traversal.rs).\n    let ray = sheared_ray(o, d);\n",
+                triangles.len()
+            );
+            let mut occluded = "    // The meshes' triangles\n    let ray = sheared_ray(o, d);\n".to_owned();
+            for (i, t) in triangles.iter().enumerate() {
+                let index = base + i;
+                let corners = |p: [f32; 3]| vec3(glam::Vec3::from_array(p));
+                let (a, b, c) = (corners(t.a), corners(t.b), corners(t.c));
+                closest.push_str(&format!(
+                    "    t = hit_triangle(ray, {a}, {b}, {c}, best.t);\n    if (t < best.t && own != {index}u) {{\n        best = Hit(t, {index}u);\n    }}\n"
+                ));
+                occluded.push_str(&format!(
+                    "    if (own != {index}u && hit_triangle(ray, {a}, {b}, {c}, t_max) < t_max) {{\n        return true;\n    }}\n"
+                ));
+            }
+            MeshCode {
+                closest,
+                occluded,
+                object_literals: triangles.iter().map(triangle_object_literal).collect(),
+                object_guard: String::new(),
+                imports: format!(
+                    "#import illum::rtcore::bvh::{{sheared_ray, hit_triangle, surface_triangle}}\n\n{constant}"
+                ),
+            }
+        }
+        MeshForm::Bvh(bvh) => MeshCode {
+            closest: format!(
+                "    // The meshes' {} triangles under one BVH (bvh.wgsl), numbered from {base}.\n    best = bvh_closest(o, d, inv_d, own, best, {base}u);\n",
+                bvh.triangles.len()
+            ),
+            occluded: format!(
+                "    // The meshes' triangles\n    if (bvh_occluded(o, d, inv_d, t_max, own, {base}u)) {{\n        return true;\n    }}\n"
+            ),
+            object_literals: Vec::new(),
+            object_guard: if base == 0 {
+                "    return triangle_object(index, KIND_TRIANGLE);\n".to_owned()
+            } else {
+                format!(
+                    "    if (index >= {base}u) {{\n        return triangle_object(index - {base}u, KIND_TRIANGLE);\n    }}\n"
+                )
+            },
+            imports: format!(
+                "#import illum::rtcore::bvh::{{bvh_closest, bvh_occluded, triangle_object, surface_triangle}}\n\n{constant}"
+            ),
+        },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+
+    #[test]
+    fn a_few_triangles_are_literals_and_more_a_bvh() {
+        let triangles = |n: usize| {
+            (0..n)
+                .map(|i| MeshTriangle::new([Vec3::ZERO, Vec3::X, Vec3::Y + i as f32 * Vec3::Z], 0, 0))
+                .collect()
+        };
+        assert!(
+            matches!(MeshForm::of(triangles(LITERAL_TRIANGLES)), MeshForm::Literals(t) if t.len() == LITERAL_TRIANGLES)
+        );
+        let bvh = MeshForm::of(triangles(LITERAL_TRIANGLES + 1));
+        assert!(matches!(&bvh, MeshForm::Bvh(_)));
+        assert_eq!(bvh.triangles().len(), LITERAL_TRIANGLES + 1);
+    }
+}
