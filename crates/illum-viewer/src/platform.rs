@@ -5,8 +5,8 @@
 //!   browser maps buffers only between frames), so there the path tracer and the Whitted ray
 //!   tracer poll theirs ([`POLLED_READBACK`]).
 //! - **Scene files**: natively read from disk; in the browser the scenes of `scenes/` are built
-//!   into the page ([`BUILT_IN_SCENES`], with their mesh files, [`BUILT_IN_MESHES`]) and other
-//!   files come from the file picker or are dropped on the page ([`read_scene`]).
+//!   into the page ([`BUILT_IN_SCENES`]) and other files come from the file picker or are
+//!   dropped on the page ([`read_scene`]).
 //! - **Saving**: natively a file written atomically; in the browser a download
 //!   (`crate::browser::download`).
 
@@ -36,28 +36,7 @@ pub const BUILT_IN_SCENES: &[(&str, &str)] = &[
     ("scenes/cornell.toml", include_str!("../../../scenes/cornell.toml")),
     ("scenes/whitted.toml", include_str!("../../../scenes/whitted.toml")),
     ("scenes/cornell-classic.toml", include_str!("../../../scenes/cornell-classic.toml")),
-    ("scenes/cornell-mesh.toml", include_str!("../../../scenes/cornell-mesh.toml")),
 ];
-
-/// The mesh files the built-in scenes name, as they name them (relative to `scenes/`).
-pub const BUILT_IN_MESHES: &[(&str, &str)] =
-    &[("models/icosphere-3.obj", include_str!("../../../scenes/models/icosphere-3.obj"))];
-
-/// Scene text parsed, each mesh file it names from [`BUILT_IN_MESHES`] when it is one of them,
-/// else natively from disk relative to `label`'s folder; the browser has no other.
-pub fn parse_scene_text(text: &str, label: &str) -> Result<Scene, illum_scene::SceneError> {
-    let folder = Path::new(label).parent().unwrap_or(Path::new("")).to_path_buf();
-    Scene::from_toml_str_with(text, label, &mut |name: &str| {
-        if let Some((_, obj)) = BUILT_IN_MESHES.iter().find(|(mesh, _)| *mesh == name) {
-            return Ok(obj.as_bytes().to_vec());
-        }
-        if cfg!(target_arch = "wasm32") {
-            return Err(format!("cannot read {name}: the page holds only the built-in scenes' mesh files"));
-        }
-        let path = folder.join(name);
-        std::fs::read(&path).map_err(|e| format!("cannot read {}: {e}", path.display()))
-    })
-}
 
 /// The built-in text of a scene path (`scenes/x.toml`, or `./scenes/x.toml`), if it is one.
 pub fn built_in_scene(path: &Path) -> Option<&'static str> {
@@ -85,7 +64,7 @@ pub fn read_scene(path: &Path) -> Result<Scene, String> {
 pub fn read_scene(path: &Path) -> Result<Scene, String> {
     let label = path.display().to_string();
     match built_in_scene(path) {
-        Some(text) => parse_scene_text(text, &label).map_err(|e| e.to_string()),
+        Some(text) => Scene::from_toml_str(text, &label).map_err(|e| e.to_string()),
         None => Err(format!(
             "{label}: not one of the scenes built into this page ({}); open your own file with \"Open file...\" or drop it on the page",
             BUILT_IN_SCENES.iter().map(|(name, _)| *name).collect::<Vec<_>>().join(", ")
@@ -113,10 +92,7 @@ mod tests {
         assert_eq!(built_in, on_disk);
         for (name, text) in BUILT_IN_SCENES {
             assert_eq!(*text, std::fs::read_to_string(folder.join("..").join(name)).unwrap());
-            parse_scene_text(text, name).unwrap_or_else(|e| panic!("{e}"));
-        }
-        for (name, text) in BUILT_IN_MESHES {
-            assert_eq!(*text, std::fs::read_to_string(folder.join(name)).unwrap(), "{name}");
+            Scene::from_toml_str(text, name).unwrap_or_else(|e| panic!("{e}"));
         }
         assert!(built_in_scene(Path::new("./scenes/cornell.toml")).is_some());
         assert!(built_in_scene(Path::new("scenes/nope.toml")).is_none());

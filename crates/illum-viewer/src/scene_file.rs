@@ -50,7 +50,7 @@ pub fn load(path: &Path) -> Result<LoadedScene, String> {
 /// Loads scene text that did not come from a path the viewer can read (a file dropped on the
 /// window or picked in the browser). `label` names it in errors, as a path would.
 pub fn load_text(label: &str, text: &str) -> Result<LoadedScene, String> {
-    split(crate::platform::parse_scene_text(text, label).map_err(|e| e.to_string())?)
+    split(Scene::from_toml_str(text, label).map_err(|e| e.to_string())?)
 }
 
 /// The scene as each mode sees it.
