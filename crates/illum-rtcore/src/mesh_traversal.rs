@@ -11,10 +11,9 @@ use crate::bvh::{Bvh, MeshTriangle};
 use crate::literal::{vec3, vec4};
 use crate::object::ShapeKind;
 
-/// Up to this many triangles a scene's meshes are literals; past it, a BVH. Measured on lavapipe
-/// (docs/performance.md, "Meshes"): the Cornell box with 20 triangles ran at 0.87 Msamples/s as
-/// literals against 0.66 under the BVH, with 80 at 0.30 against 0.54, with 320 at 0.04 against
-/// 0.54 (its shader then took a minute to compile); the crossover lies between 20 and 80.
+/// Up to this many triangles a scene's meshes are literals; past it, a BVH: the crossover
+/// measured on lavapipe lies between 20 and 80 triangles (docs/performance.md, "Meshes", has
+/// the figures), and a literal list's shader compile grows with its length.
 pub const LITERAL_TRIANGLES: usize = 32;
 
 /// The scene's triangles in the form the traversal uses.
