@@ -222,18 +222,7 @@ fn measure(renderer: Renderer, scene: &Scene) -> Result<(String, bool), String> 
                 Err(passed) => (passed, false),
             };
             let ok = finite(&image) && comparison.passes() && powerful;
-            Ok((
-                format!(
-                    "finite {}, {} of {} pixels at edges beyond {:.1e}, unexplained {:?}, largest within it {:.2e}; {power}",
-                    finite(&image),
-                    comparison.edges,
-                    comparison.pixels,
-                    whitted_agreement::tolerance(depth),
-                    comparison.unexplained,
-                    comparison.worst_within
-                ),
-                ok,
-            ))
+            Ok((format!("finite {}, {}; {power}", finite(&image), comparison.summary(depth)), ok))
         }
         Renderer::PathTrace => path_traced(scene),
     }

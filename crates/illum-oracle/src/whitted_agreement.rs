@@ -75,6 +75,18 @@ impl Comparison {
     pub fn passes(&self) -> bool {
         self.unexplained.is_empty() && self.edges as f64 <= MAX_EDGE_FRACTION * self.pixels as f64
     }
+
+    /// What it found, in one line, for a comparison at `depth`.
+    pub fn summary(&self, depth: u32) -> String {
+        format!(
+            "{} of {} pixels at edges beyond {:.1e}, unexplained {:?}, largest difference within it {:.2e}",
+            self.edges,
+            self.pixels,
+            tolerance(depth),
+            self.unexplained,
+            self.worst_within
+        )
+    }
 }
 
 /// The largest difference of a channel between `a` and the oracle's `o`, relative to the

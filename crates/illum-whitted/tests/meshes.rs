@@ -6,7 +6,7 @@
 
 use illum_gpu::testing::gpu;
 use illum_oracle::WhittedOracle;
-use illum_oracle::whitted_agreement::{compare, tolerance};
+use illum_oracle::whitted_agreement::compare;
 use illum_scene::testing::obj::{box_obj, scene_with_files};
 use illum_scene::{Scene, resolve_scene_path};
 use illum_whitted::WhittedTracer;
@@ -48,13 +48,7 @@ fn check(name: &str, scene: &Scene) {
         illum_image::save_png(path, &image, 0.0, illum_image::Encoding::default()).unwrap();
     }
     let comparison = compare(&image, &reference, &oracle, depth);
-    println!(
-        "{name}, depth {depth}: {} of {} pixels at edges beyond {:.1e}; largest difference within it {:.2e}",
-        comparison.edges,
-        comparison.pixels,
-        tolerance(depth),
-        comparison.worst_within
-    );
+    println!("{name}, depth {depth}: {}", comparison.summary(depth));
     assert!(comparison.passes(), "{name}, depth {depth}: {comparison:?}");
 }
 

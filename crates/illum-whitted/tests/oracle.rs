@@ -9,7 +9,7 @@
 use illum_gpu::testing::gpu;
 use illum_image::RgbImage32;
 use illum_oracle::WhittedOracle;
-use illum_oracle::whitted_agreement::{compare, power, tolerance};
+use illum_oracle::whitted_agreement::{compare, power};
 use illum_scene::Scene;
 use illum_whitted::WhittedTracer;
 
@@ -26,13 +26,7 @@ fn check(name: &str, scene: &Scene) {
     let depth = scene.whitted.depth;
     let (image, oracle, reference) = render(scene);
     let comparison = compare(&image, &reference, &oracle, depth);
-    println!(
-        "{name}, depth {depth}: {} of {} pixels at edges beyond {:.1e}; largest difference within it {:.2e}",
-        comparison.edges,
-        comparison.pixels,
-        tolerance(depth),
-        comparison.worst_within
-    );
+    println!("{name}, depth {depth}: {}", comparison.summary(depth));
     assert!(comparison.passes(), "{name}, depth {depth}: {comparison:?}");
 
     match power(&image, &reference, &oracle, depth) {
