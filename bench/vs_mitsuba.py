@@ -2,7 +2,8 @@
 """illum's path tracer side by side with Mitsuba 3 on the same Cornell box.
 
 Builds the box of scenes/cornell.toml in Mitsuba 3 (boxes as `cube` shapes, Lambertian
-`diffuse` in `twosided`, the light a one-sided `rectangle` emitter, `path` integrator with
+`diffuse` in `twosided`, the light a one-sided `rectangle` emitter, a triangle mesh as an `obj`
+shape with Mitsuba's own loader and BVH (Embree in `llvm_ad_rgb`), `path` integrator with
 max_depth = bounces + 2 and rr_depth = max_depth, box pixel filter, float32 `hdrfilm`), renders
 it with Mitsuba's `llvm_ad_rgb` variant and with illum's `render` example at the same size, spp
 and bounces, and prints for each: the wall time of the whole process (start to written EXR),
@@ -14,7 +15,8 @@ the throughput, the relMSE against a converged reference and the efficiency
     cargo build --release --example render
     venv/bin/python bench/vs_mitsuba.py [--size 256] [--spp 1024] [--bounces 2]
         [--samplers independent,multijitter,orthogonal,ldsampler] [--reference-spp 32768]
-        [--reference-renderer mitsuba|illum]
+        [--reference-renderer mitsuba|illum] [--illum independent,low-discrepancy,adaptive]
+        [--scene scenes/cornell.toml]
 
 (`scripts/readme-figures.sh --mitsuba-venv` makes that venv itself, in out/mitsuba-venv, and
 runs this script at bounces 2 and 8.) Where libLLVM-19 is installed, the script points Dr.Jit
@@ -153,9 +155,36 @@ def mitsuba_scene(scene_path, size, spp, bounces, sampler):
             else:
                 shape["bsdf"] = materials[material]
             out[f"object{i}"] = shape
+        elif "mesh" in obj:
+            out[f"object{i}"] = mitsuba_mesh(scene_path, obj["mesh"], materials[material])
         else:
-            sys.exit(f"{scene_path}: objects[{i}]: only boxes and quads are translated")
+            sys.exit(f"{scene_path}: objects[{i}]: only boxes, quads and meshes are translated")
     return out
+
+
+def mitsuba_mesh(scene_path, mesh, bsdf):
+    """A `mesh` object as Mitsuba's `obj` shape: world = translate + scale R_z R_y R_x local, and
+    flat shading where illum shades flat (`flat = true`, or a file without vertex normals)."""
+    import mitsuba as mi
+
+    T = mi.ScalarTransform4f
+    path = os.path.join(os.path.dirname(os.path.abspath(scene_path)), mesh["file"])
+    if not path.endswith(".obj"):
+        sys.exit(f"{scene_path}: mesh file {mesh['file']}: only OBJ files are translated")
+    flat = mesh.get("flat", False)
+    if not flat:
+        with open(path) as f:
+            flat = not any(line.startswith("vn ") for line in f)
+    rx, ry, rz = mesh.get("rotate", [0.0, 0.0, 0.0])
+    to_world = (
+        T()
+        .translate(mesh.get("translate", [0.0, 0.0, 0.0]))
+        .rotate([0, 0, 1], rz)
+        .rotate([0, 1, 0], ry)
+        .rotate([1, 0, 0], rx)
+        .scale(mesh.get("scale", 1.0))
+    )
+    return {"type": "obj", "filename": path, "face_normals": flat, "to_world": to_world, "bsdf": bsdf}
 
 
 def run_mitsuba(args, sampler, path):
@@ -236,6 +265,8 @@ def main():
     parser.add_argument("--spp", type=int, default=1024)
     parser.add_argument("--bounces", type=int, default=2)
     parser.add_argument("--samplers", default="independent,multijitter,orthogonal,ldsampler")
+    parser.add_argument("--illum", default="independent,low-discrepancy,adaptive",
+                        help="illum's rows: independent, low-discrepancy, adaptive (the first is timed for throughput)")
     parser.add_argument("--reference-spp", type=int, default=32768)
     parser.add_argument("--reference-renderer", choices=["mitsuba", "illum"], default="mitsuba")
     parser.add_argument("--mitsuba-child", nargs=2, help=argparse.SUPPRESS)
@@ -254,7 +285,12 @@ def main():
 
     rows = []
     # Adaptive sampling (render --adaptive): the same mean spp, spread over the image by a pilot.
-    for sequence, extra in [("independent", ()), ("low-discrepancy", ()), ("low-discrepancy", ("--adaptive",))]:
+    variants = {"independent": ("independent", ()), "low-discrepancy": ("low-discrepancy", ()),
+                "adaptive": ("low-discrepancy", ("--adaptive",))}
+    for name in args.illum.split(","):
+        if name not in variants:
+            sys.exit(f"--illum {args.illum}: {name!r} is not one of {', '.join(variants)}")
+    for sequence, extra in (variants[name] for name in args.illum.split(",")):
         label = sequence + "".join(", " + e.lstrip("-") for e in extra)
         path = os.path.join(OUT, f"illum-{label.replace(', ', '-')}-{tag}.exr")
         seconds = run_illum(args, path, args.spp, sequence, extra=extra)
@@ -278,7 +314,7 @@ def main():
     best_mitsuba_eff = max(1 / (e * s) for n, s, e, _ in rows if n.startswith("Mitsuba"))
     illum_time = rows[0][1]
     illum_eff = max(1 / (e * s) for n, s, e, _ in rows if n.startswith("illum"))
-    print(f"\nthroughput illum / Mitsuba (fastest sampler): {best_mitsuba_time / illum_time:.2f}x")
+    print(f"\nthroughput {rows[0][0]} / Mitsuba (fastest sampler): {best_mitsuba_time / illum_time:.2f}x")
     print(f"efficiency illum / Mitsuba (best of each): {illum_eff / best_mitsuba_eff:.2f}x")
 
 

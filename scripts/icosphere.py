@@ -2,6 +2,9 @@
 """Writes the icosphere meshes and the Cornell box with a mesh in it (docs/scenes.md, "Meshes").
 
     scripts/icosphere.py            # writes scenes/models/icosphere-{0..4}.obj, scenes/cornell-mesh.toml
+    scripts/icosphere.py --subdivision 7 --out out/meshes
+                                    # writes out/meshes/icosphere-7.obj and cornell-mesh-7.toml:
+                                    # the same box with that subdivision's icosphere (benchmarks)
 
 An icosphere of subdivision k is the regular icosahedron (12 vertices, 20 faces) with every
 triangle split into four at its edges' midpoints k times, each new vertex pushed out onto the
@@ -13,8 +16,12 @@ Vertices are written with 9 significant digits, enough to read back the same f32
 cornell-mesh.toml is scenes/cornell.toml, read from the repository unchanged, with one object
 added: the icosphere of subdivision 3 (1280 triangles), radius 80, resting on the short block
 (its top face is at y = 165; the block's footprint centre is (157.95, 168.95), docs/scenes.md).
+With --subdivision k the box holds the icosphere of subdivision k instead (k = 5, 6, 7, 8 give
+20 480, 81 920, 327 680 and 1 310 720 triangles), written with its OBJ into --out, never into
+scenes/: a million triangles take 80 MB of text.
 """
 
+import argparse
 import math
 import pathlib
 
@@ -76,26 +83,51 @@ def obj_text(k, vertices, faces):
     return "\n".join(lines) + "\n"
 
 
-def main():
-    models = ROOT / "scenes" / "models"
-    models.mkdir(parents=True, exist_ok=True)
+def icosphere(k):
+    """The icosphere of subdivision k, checked: counts and outward winding."""
     vertices, faces = icosahedron()
-    for k in SUBDIVISIONS:
-        if k > 0:
-            vertices, faces = subdivide(vertices, faces)
-        assert outward(vertices, faces), f"subdivision {k} has a face wound inward"
-        assert len(faces) == 20 * 4 ** k and len(vertices) == 10 * 4 ** k + 2
-        (models / f"icosphere-{k}.obj").write_text(obj_text(k, vertices, faces))
+    for _ in range(k):
+        vertices, faces = subdivide(vertices, faces)
+    assert outward(vertices, faces), f"subdivision {k} has a face wound inward"
+    assert len(faces) == 20 * 4 ** k and len(vertices) == 10 * 4 ** k + 2
+    return vertices, faces
+
+
+def cornell_with(k, mesh_file, name):
+    """scenes/cornell.toml, renamed, with the icosphere of subdivision k (radius 80) on the short block."""
     cornell = (ROOT / "scenes" / "cornell.toml").read_text()
     header = ("# Written by scripts/icosphere.py: scenes/cornell.toml with an icosphere mesh resting on the\n"
               "# short block (docs/scenes.md, \"Meshes\"). Edit the script, not this file.\n\n")
-    cornell = cornell.replace('name = "cornell"', 'name = "cornell-mesh"', 1)
-    ball = ("\n# The icosphere of subdivision 3 (1280 flat triangles), radius 80, on the short block's top (y = 165).\n"
+    cornell = cornell.replace('name = "cornell"', f'name = "{name}"', 1)
+    ball = (f"\n# The icosphere of subdivision {k} ({20 * 4 ** k} flat triangles), radius 80, on the short block's top (y = 165).\n"
             "[[objects]]\n"
             "name = \"icosphere\"\n"
             "material = \"white\"\n"
-            f"mesh = {{ file = \"models/icosphere-{CORNELL_SUBDIVISION}.obj\", translate = [157.95, 245.0, 168.95], scale = 80.0 }}\n")
-    (ROOT / "scenes" / "cornell-mesh.toml").write_text(header + cornell + ball)
+            f"mesh = {{ file = \"{mesh_file}\", translate = [157.95, 245.0, 168.95], scale = 80.0 }}\n")
+    return header + cornell + ball
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--subdivision", type=int, help="write only this subdivision's box, into --out")
+    parser.add_argument("--out", type=pathlib.Path, help="the directory for --subdivision's files")
+    args = parser.parse_args()
+    if args.subdivision is not None:
+        if args.out is None or not 0 <= args.subdivision <= 9:
+            parser.error("--subdivision takes 0 to 9 and needs --out")
+        k = args.subdivision
+        args.out.mkdir(parents=True, exist_ok=True)
+        vertices, faces = icosphere(k)
+        (args.out / f"icosphere-{k}.obj").write_text(obj_text(k, vertices, faces))
+        (args.out / f"cornell-mesh-{k}.toml").write_text(cornell_with(k, f"icosphere-{k}.obj", f"cornell-mesh-{k}"))
+        return
+    models = ROOT / "scenes" / "models"
+    models.mkdir(parents=True, exist_ok=True)
+    for k in SUBDIVISIONS:
+        vertices, faces = icosphere(k)
+        (models / f"icosphere-{k}.obj").write_text(obj_text(k, vertices, faces))
+    scene = cornell_with(CORNELL_SUBDIVISION, f"models/icosphere-{CORNELL_SUBDIVISION}.obj", "cornell-mesh")
+    (ROOT / "scenes" / "cornell-mesh.toml").write_text(scene)
 
 
 if __name__ == "__main__":
