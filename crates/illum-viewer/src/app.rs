@@ -263,10 +263,11 @@ impl eframe::App for ViewerApp {
 
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         self.frame_rate.tick();
-        // A scene file dropped on the window opens like one named in the Scene field.
+        // A scene file dropped on the window (with its mesh files) opens like one named in
+        // the Scene field.
         let dropped = ui.ctx().input(|i| i.raw.dropped_files.clone());
-        for file in dropped {
-            self.open_dropped(ui.ctx(), file);
+        if !dropped.is_empty() {
+            self.open_dropped(ui.ctx(), dropped);
         }
         // The path tracer's wall clock runs only while its mode is shown.
         let showing_pathtrace =
@@ -312,9 +313,8 @@ impl eframe::App for ViewerApp {
         }
         #[cfg(target_arch = "wasm32")]
         {
-            let picked = self.picker.take();
-            if let Some((name, text)) = picked {
-                let result = text.and_then(|text| self.open_text(&name, &text));
+            if let Some(files) = self.picker.take() {
+                let result = self.open_files(&files);
                 self.opened(result);
             }
             crate::browser::publish_status(&self.status());

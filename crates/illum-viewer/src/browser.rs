@@ -8,6 +8,8 @@ use std::rc::Rc;
 use wasm_bindgen::JsCast;
 use wasm_bindgen::prelude::*;
 
+use crate::scene_file::GivenFile;
+
 /// The element the viewer reports its status to (the page's script reads it).
 pub(crate) const STATUS_ID: &str = "illum-status";
 
@@ -58,18 +60,16 @@ pub fn download(name: &str, bytes: &[u8], mime: &str) -> Result<(), String> {
     Ok(())
 }
 
-/// The browser's file picker for scene files. [`FilePicker::open`] shows it; the chosen
-/// file's name and text arrive later and are taken with [`FilePicker::take`].
+/// The browser's file picker for scene files and the mesh files they name, picked together.
+/// [`FilePicker::open`] shows it; the chosen files' names and bytes arrive later and are taken
+/// with [`FilePicker::take`].
 #[derive(Default)]
 pub struct FilePicker {
-    inbox: Rc<RefCell<Option<PickedFile>>>,
+    inbox: Rc<RefCell<Option<Vec<GivenFile>>>>,
 }
 
-/// A picked or dropped file: its name, and its text or why it could not be read.
-pub type PickedFile = (String, Result<String, String>);
-
 impl FilePicker {
-    /// Shows the picker; `ctx` is asked to repaint when the file has been read.
+    /// Shows the picker; `ctx` is asked to repaint when the files have been read.
     pub fn open(&mut self, ctx: &egui::Context) -> Result<(), String> {
         let failed = |e: JsValue| format!("the file picker could not open: {}", js_text(&e));
         let input = document()?
@@ -78,20 +78,25 @@ impl FilePicker {
             .dyn_into::<web_sys::HtmlInputElement>()
             .map_err(|_| "the file picker could not open: no input element".to_owned())?;
         input.set_type("file");
-        input.set_accept(".toml,text/plain");
+        input.set_multiple(true);
+        input.set_accept(".toml,.obj,text/plain");
         let inbox = self.inbox.clone();
         let ctx = ctx.clone();
         let chosen = input.clone();
         let on_change = Closure::once_into_js(move || {
-            let Some(file) = chosen.files().and_then(|files| files.get(0)) else { return };
+            let Some(list) = chosen.files() else { return };
+            let files: Vec<web_sys::File> = (0..list.length()).filter_map(|i| list.get(i)).collect();
             wasm_bindgen_futures::spawn_local(async move {
-                let name = file.name();
-                let text = wasm_bindgen_futures::JsFuture::from(file.text()).await;
-                let result = match text {
-                    Ok(value) => value.as_string().ok_or_else(|| format!("{name}: not a text file")),
-                    Err(e) => Err(format!("{name}: could not be read: {}", js_text(&e))),
-                };
-                *inbox.borrow_mut() = Some((name, result));
+                let mut given = Vec::with_capacity(files.len());
+                for file in files {
+                    let name = file.name();
+                    let bytes = wasm_bindgen_futures::JsFuture::from(file.array_buffer())
+                        .await
+                        .map(|buffer| js_sys::Uint8Array::new(&buffer).to_vec())
+                        .map_err(|e| format!("{name}: could not be read: {}", js_text(&e)));
+                    given.push((name, bytes));
+                }
+                *inbox.borrow_mut() = Some(given);
                 ctx.request_repaint();
             });
         });
@@ -100,27 +105,26 @@ impl FilePicker {
         Ok(())
     }
 
-    /// Reads a file dropped on the page into the same inbox as a picked one.
-    pub fn read_dropped(&mut self, ctx: &egui::Context, file: egui::DroppedFileHandle) {
+    /// Reads files dropped on the page together into the same inbox as picked ones.
+    pub fn read_dropped(&mut self, ctx: &egui::Context, files: Vec<egui::DroppedFileHandle>) {
         let inbox = self.inbox.clone();
         let ctx = ctx.clone();
         wasm_bindgen_futures::spawn_local(async move {
-            let name = file.path().display().to_string();
-            let name = if name.is_empty() { "dropped file".to_owned() } else { name };
-            let result =
-                file.bytes_async().await.map_err(|e| format!("{name}: could not be read: {e}")).and_then(
-                    |bytes| {
-                        String::from_utf8(bytes)
-                            .map_err(|e| format!("{name}: not a text (UTF-8) scene file: {e}"))
-                    },
-                );
-            *inbox.borrow_mut() = Some((name, result));
+            let mut given = Vec::with_capacity(files.len());
+            for file in files {
+                let name = file.path().display().to_string();
+                let name = if name.is_empty() { "dropped file".to_owned() } else { name };
+                let bytes = file.bytes_async().await.map_err(|e| format!("{name}: could not be read: {e}"));
+                given.push((name, bytes));
+            }
+            *inbox.borrow_mut() = Some(given);
             ctx.request_repaint();
         });
     }
 
-    /// The file chosen since the last call: its name and text, or why it could not be read.
-    pub fn take(&mut self) -> Option<PickedFile> {
+    /// The files chosen together since the last call: each one's name and bytes, or why it
+    /// could not be read.
+    pub fn take(&mut self) -> Option<Vec<GivenFile>> {
         self.inbox.borrow_mut().take()
     }
 }

@@ -53,6 +53,53 @@ pub fn load_text(label: &str, text: &str) -> Result<LoadedScene, String> {
     split(Scene::from_toml_str(text, label).map_err(|e| e.to_string())?)
 }
 
+/// A file picked or dropped in the browser, which gives its name (no folder) and its bytes, or
+/// why it could not be read.
+pub type GivenFile = (String, Result<Vec<u8>, String>);
+
+/// Loads a scene from files given together (picked or dropped in a browser page, which has no
+/// file system): the one scene file among them (`.toml`, or the only file given), with each
+/// mesh file it names read from the others by file name, since a page sees no folders. Returns
+/// the scene file's name and the scene.
+pub fn load_files(files: &[GivenFile]) -> Result<(String, LoadedScene), String> {
+    let names = || files.iter().map(|(name, _)| name.as_str()).collect::<Vec<_>>().join(", ");
+    let scenes: Vec<&GivenFile> = if files.len() == 1 {
+        files.iter().collect()
+    } else {
+        files.iter().filter(|(name, _)| name.to_ascii_lowercase().ends_with(".toml")).collect()
+    };
+    let (scene_name, bytes) = match scenes.as_slice() {
+        [one] => one,
+        [] => {
+            return Err(format!(
+                "none of the files given ({}) is a scene file (.toml): give the scene file together with the mesh files it names",
+                names()
+            ));
+        }
+        _ => {
+            return Err(format!(
+                "give one scene file (.toml) at a time, with its mesh files: {} were given",
+                names()
+            ));
+        }
+    };
+    let bytes = bytes.as_ref().map_err(Clone::clone)?;
+    let text = std::str::from_utf8(bytes)
+        .map_err(|e| format!("{scene_name}: not a text (UTF-8) scene file: {e}"))?;
+    let mut read = |mesh: &str| -> Result<Vec<u8>, String> {
+        let wanted =
+            Path::new(mesh).file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        match files.iter().find(|(name, _)| *name == wanted) {
+            Some((_, bytes)) => bytes.clone(),
+            None => Err(format!(
+                "cannot read {mesh}: a page reads only the files given with the scene; open {wanted} together with {scene_name}"
+            )),
+        }
+    };
+    let scene = Scene::from_toml_str_with(text, scene_name, &mut read).map_err(|e| e.to_string())?;
+    Ok((scene_name.clone(), split(scene)?))
+}
+
 /// The scene as each mode sees it.
 fn split(scene: Scene) -> Result<LoadedScene, String> {
     let pathtrace = scene
@@ -116,5 +163,40 @@ mod tests {
         assert_eq!(from_text, from_disk.replace(&path.display().to_string(), "dropped/bad.toml"));
         let cornell = include_str!("../../../scenes/cornell.toml");
         assert_eq!(load_text("cornell.toml", cornell).unwrap().mode(), RendererKind::PathTrace);
+    }
+
+    /// A page's files: the scene and the mesh files it names, matched by file name; what is
+    /// missing or ambiguous is named.
+    #[test]
+    fn files_given_together_load_their_meshes_by_name() {
+        let scene = include_str!("../../../scenes/cornell-mesh.toml");
+        let mesh = include_bytes!("../../../scenes/models/icosphere-3.obj").to_vec();
+        let given = |files: &[(&str, &[u8])]| -> Vec<GivenFile> {
+            files.iter().map(|(name, bytes)| ((*name).to_owned(), Ok(bytes.to_vec()))).collect()
+        };
+        let (name, loaded) =
+            load_files(&given(&[("icosphere-3.obj", &mesh), ("cornell-mesh.toml", scene.as_bytes())]))
+                .unwrap();
+        assert_eq!(name, "cornell-mesh.toml");
+        let from_disk = load(Path::new("../../scenes/cornell-mesh.toml")).unwrap();
+        assert_eq!(loaded.pathtrace.unwrap().content_hash(), from_disk.pathtrace.unwrap().content_hash());
+
+        let missing = load_files(&given(&[("cornell-mesh.toml", scene.as_bytes())])).unwrap_err();
+        assert!(
+            missing.contains("cornell-mesh.toml")
+                && missing.contains("cannot read models/icosphere-3.obj")
+                && missing.contains("open icosphere-3.obj together with cornell-mesh.toml"),
+            "{missing}"
+        );
+        let no_scene = load_files(&given(&[("a.obj", &mesh), ("b.obj", &mesh)])).unwrap_err();
+        assert!(no_scene.contains("a.obj, b.obj") && no_scene.contains("(.toml)"), "{no_scene}");
+        let two =
+            load_files(&given(&[("a.toml", scene.as_bytes()), ("b.toml", scene.as_bytes())])).unwrap_err();
+        assert!(two.contains("one scene file") && two.contains("a.toml, b.toml"), "{two}");
+        let unreadable = vec![("x.toml".to_owned(), Err("x.toml: could not be read: gone".to_owned()))];
+        assert_eq!(load_files(&unreadable).unwrap_err(), "x.toml: could not be read: gone");
+        // A single file is the scene whatever its name (a dropped file may have none).
+        let cornell = include_str!("../../../scenes/cornell.toml");
+        assert!(load_files(&given(&[("dropped file", cornell.as_bytes())])).is_ok());
     }
 }

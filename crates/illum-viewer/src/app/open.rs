@@ -1,4 +1,4 @@
-//! Opening scene files: from a path, from a file's text (dropped on the window or picked in the
+//! Opening scene files: from a path, from files' bytes (dropped on the window or picked in the
 //! browser), into every mode that can render them; and each mode's default scene.
 
 use std::path::{Path, PathBuf};
@@ -21,24 +21,31 @@ impl ViewerApp {
         Ok(self.install(path.to_path_buf(), loaded))
     }
 
-    /// As [`Self::open`], for the text of a file dropped on the window or picked in the
-    /// browser; `name` (its file name) names it in errors and in the UI.
-    pub fn open_text(&mut self, name: &str, text: &str) -> Result<RendererKind, String> {
-        let loaded = scene_file::load_text(name, text)?;
+    /// As [`Self::open`], for files picked or dropped together in the browser: the scene file
+    /// among them and the mesh files it names ([`scene_file::load_files`]); the scene file's
+    /// name names it in errors and in the UI.
+    pub fn open_files(&mut self, files: &[scene_file::GivenFile]) -> Result<RendererKind, String> {
+        let (name, loaded) = scene_file::load_files(files)?;
         Ok(self.install(PathBuf::from(name), loaded))
     }
 
-    /// Opens a scene file dropped on the window like the Open button (natively: its path; in
-    /// the browser its bytes arrive a few frames later, through the file picker's inbox).
-    pub(super) fn open_dropped(&mut self, ctx: &egui::Context, file: egui::DroppedFileHandle) {
+    /// Opens files dropped on the window together like the Open button (natively: the scene
+    /// file's path, whose mesh files are read beside it; in the browser their bytes arrive a
+    /// few frames later, through the file picker's inbox).
+    pub(super) fn open_dropped(&mut self, ctx: &egui::Context, files: Vec<egui::DroppedFileHandle>) {
         #[cfg(not(target_arch = "wasm32"))]
         {
             let _ = ctx;
-            let result = self.open(file.path());
-            self.opened(result);
+            // The scene file among them (a mesh file dropped with it is read from its folder).
+            let scene =
+                files.iter().find(|f| f.path().extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")));
+            if let Some(file) = scene.or(files.first()) {
+                let result = self.open(file.path());
+                self.opened(result);
+            }
         }
         #[cfg(target_arch = "wasm32")]
-        self.picker.read_dropped(ctx, file);
+        self.picker.read_dropped(ctx, files);
     }
 
     /// Shows the outcome of opening a scene from the UI: its mode and name, or the error.

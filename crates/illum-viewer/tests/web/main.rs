@@ -41,6 +41,22 @@ use page::{count, distinct_colours, get, screenshot, status};
 use prerequisites::{chromium, missing_prerequisites, workspace};
 use server::serve;
 
+/// The scene the page is given with "Open file...", with its mesh file: the Whitted scene shown
+/// by the Whitted ray tracer with a mirror icosahedron (20 triangles) added, written into `out`
+/// (`mesh.toml`, `models/icosphere-0.obj`) for browser.mjs, and checked to load from there.
+fn write_mesh_scene(root: &Path, out: &Path) {
+    let text = std::fs::read_to_string(root.join("scenes/whitted.toml")).expect("the Whitted scene");
+    assert!(text.contains("renderer = \"raster\""), "the Whitted scene's renderer line moved");
+    let text = text.replace("renderer = \"raster\"", "renderer = \"whitted\"")
+        + "\n[[objects]]\nname = \"ball\"\nmaterial = \"metal\"\n\
+           mesh = { file = \"models/icosphere-0.obj\", translate = [1.0, 1.0, -6.0], scale = 1.0 }\n";
+    std::fs::create_dir_all(out.join("models")).expect("the models folder");
+    std::fs::copy(root.join("scenes/models/icosphere-0.obj"), out.join("models/icosphere-0.obj"))
+        .expect("copying the mesh");
+    std::fs::write(out.join("mesh.toml"), text).expect("writing the mesh scene");
+    illum_scene::Scene::load(&out.join("mesh.toml")).unwrap_or_else(|e| panic!("{e}"));
+}
+
 #[test]
 fn the_web_viewer_works_in_headless_chromium() {
     let root = workspace();
@@ -70,6 +86,7 @@ fn the_web_viewer_works_in_headless_chromium() {
     let cells = matrix();
     let tsv: String = cells.iter().map(|c| format!("{}\t{}\t{}\n", c.name, c.query(), c.expect())).collect();
     std::fs::write(out.join("matrix.tsv"), tsv).expect("writing the matrix");
+    write_mesh_scene(&root, &out);
     let started = web_time::Instant::now();
     let run = Command::new("node")
         .arg(root.join("web/tests/browser.mjs"))
@@ -187,6 +204,24 @@ fn the_web_viewer_works_in_headless_chromium() {
         (get(&picked, "scene"), get(&picked, "mode"), get(&picked, "openError")),
         ("picked.toml", "raster", ""),
         "{picked:?}"
+    );
+    // A scene naming a mesh file, picked without it: refused, naming the file to pick with it;
+    // the scene before stays.
+    let alone = status(&out, "mesh-alone");
+    let error = get(&alone, "openError");
+    assert!(
+        error.contains("cannot read models/icosphere-0.obj")
+            && error.contains("open icosphere-0.obj together with mesh.toml"),
+        "{error}"
+    );
+    assert_eq!(get(&alone, "scene"), "picked.toml", "{alone:?}");
+    // Picked with its mesh file: it opens in its file's mode. Its frame is not awaited
+    // (browser.mjs: SwiftShader does not finish the pipeline).
+    let meshed = status(&out, "mesh-scene");
+    assert_eq!(
+        (get(&meshed, "scene"), get(&meshed, "mode"), get(&meshed, "openError")),
+        ("mesh.toml", "whitted", ""),
+        "{meshed:?}"
     );
 
     // The raster's figure look: the assignment's exact colours (docs/scenes.md).
