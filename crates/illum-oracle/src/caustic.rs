@@ -116,7 +116,7 @@ impl Oracle {
             if hit.primitive.emitter {
                 return None;
             }
-            let Contact { point: p, front, normal: nrm, lift } = hit.contact(o, d);
+            let Contact { point: p, front, normal: nrm, lift, .. } = hit.contact(o, d);
             match hit.primitive.material {
                 MaterialKind::Mirror { reflectance } => {
                     if !self.may_scatter(scatterings, &mut throughput, reflectance.as_dvec3(), rng) {
@@ -130,7 +130,7 @@ impl Oracle {
                         return None;
                     }
                     // Flux, not radiance: no eta^2 (see the module documentation).
-                    (o, d) = scatter_dielectric(d, nrm, p, front, ior, lift, rng);
+                    (o, d) = scatter_dielectric(d, nrm, nrm, p, front, ior, lift, rng);
                 }
                 MaterialKind::Lambertian { .. } | MaterialKind::Checker(_) => {
                     // A particle whose first hit is diffuse carries an L D path: not ours.

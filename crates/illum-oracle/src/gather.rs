@@ -192,7 +192,7 @@ impl Oracle {
             if hit.primitive.emitter {
                 return sum;
             }
-            let Contact { point, front, normal, lift } = hit.contact(o, d);
+            let Contact { point, front, normal, lift, .. } = hit.contact(o, d);
             match hit.primitive.material {
                 MaterialKind::Mirror { reflectance } => {
                     let reflectance = reflectance.as_dvec3();
@@ -209,7 +209,7 @@ impl Oracle {
                     if !self.may_continue(taken) || !self.roulette(taken, throughput, &mut throughput, rng) {
                         return sum;
                     }
-                    (o, d) = scatter_dielectric(d, normal, point, front, ior, lift, rng);
+                    (o, d) = scatter_dielectric(d, normal, normal, point, front, ior, lift, rng);
                 }
                 MaterialKind::Lambertian { .. } | MaterialKind::Checker(_) => {
                     if taken > 0 {

@@ -5,7 +5,9 @@
 //!
 //! Every routine returns the smallest root t in (0, t_max) of `o + t d` on the shape's surface,
 //! together with the surface's geometric unit normal there (outward for boxes and spheres, the
-//! front normal for parallelograms). Orientation toward the ray is the integrator's business.
+//! front normal for parallelograms and triangles) and its shading normal: the geometric one but
+//! on a smooth mesh's triangle (see [`Triangle::shading_normal`]). Orientation toward the ray is
+//! the integrator's business.
 //! A ray starting inside a box or a sphere hits its inner surface on the way out.
 
 use glam::{DMat3, DVec3, Vec3};
@@ -16,11 +18,20 @@ pub(crate) fn dvec(v: Vec3) -> DVec3 {
     v.as_dvec3()
 }
 
-/// A ray-surface intersection: distance along the ray (in units of |d|) and geometric normal.
+/// A ray-surface intersection: distance along the ray (in units of |d|), geometric normal and
+/// shading normal (unit, on the geometric normal's side of the surface).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SurfaceHit {
     pub t: f64,
     pub normal: DVec3,
+    pub shading: DVec3,
+}
+
+impl SurfaceHit {
+    /// A hit shaded with its geometric normal.
+    fn flat(t: f64, normal: DVec3) -> SurfaceHit {
+        SurfaceHit { t, normal, shading: normal }
+    }
 }
 
 /// An oriented box: the axis-aligned box [lo, hi] of its local frame, mapped to the world by
@@ -97,7 +108,7 @@ impl Parallelogram {
             return None;
         }
         let t = self.v.dot(qu) * inv_det;
-        (t > 0.0 && t < t_max).then_some(SurfaceHit { t, normal: self.normal })
+        (t > 0.0 && t < t_max).then_some(SurfaceHit::flat(t, self.normal))
     }
 
     /// The point with parameters (s, r) in [0, 1]^2; uniform (s, r) gives a uniform point.
@@ -130,7 +141,7 @@ impl Ball {
             return None;
         }
         let normal = (o + t * d - self.center) / self.radius;
-        Some(SurfaceHit { t, normal })
+        Some(SurfaceHit::flat(t, normal))
     }
 }
 
@@ -187,23 +198,43 @@ impl OrientedBox {
         }
         let mut local_normal = DVec3::ZERO;
         local_normal[axis] = outward_sign;
-        Some(SurfaceHit { t, normal: self.rotation * local_normal })
+        Some(SurfaceHit::flat(t, self.rotation * local_normal))
     }
 }
 
-/// The triangle {a + s e1 + r e2 : s, r >= 0, s + r <= 1}, front normal normalize(e1 x e2).
+/// The triangle {a + s e1 + r e2 : s, r >= 0, s + r <= 1}, front normal normalize(e1 x e2),
+/// with the unit vertex normals at a, b, c of a smooth mesh (`None`: flat).
 #[derive(Clone, Copy, Debug)]
 pub struct Triangle {
     pub a: DVec3,
     pub e1: DVec3,
     pub e2: DVec3,
     pub normal: DVec3,
+    pub vertex_normals: Option<[DVec3; 3]>,
 }
 
 impl Triangle {
+    /// A flat triangle.
     pub fn new(a: DVec3, b: DVec3, c: DVec3) -> Triangle {
         let (e1, e2) = (b - a, c - a);
-        Triangle { a, e1, e2, normal: e1.cross(e2).normalize() }
+        Triangle { a, e1, e2, normal: e1.cross(e2).normalize(), vertex_normals: None }
+    }
+
+    /// The shading normal at the point a + s e1 + r e2: the vertex normals weighted by the
+    /// point's barycentric coordinates (1 - s - r, s, r), normalised, and turned onto the front
+    /// normal's side when they point the other way (the winding decides sides; a file's normals
+    /// never do). The front normal itself on a flat triangle, or where the weighted sum is
+    /// shorter than 1e-6 (vertex normals that nearly cancel).
+    pub fn shading_normal(&self, s: f64, r: f64) -> DVec3 {
+        let Some([na, nb, nc]) = self.vertex_normals else { return self.normal };
+        let n = (1.0 - s - r) * na + s * nb + r * nc;
+        let length = n.length();
+        // Also a NaN length (a NaN normal cannot pass validation, but nothing is left to chance).
+        if length.is_nan() || length <= 1e-6 {
+            return self.normal;
+        }
+        let n = n / length;
+        if n.dot(self.normal) < 0.0 { -n } else { n }
     }
 
     /// Solves o + t d = a + s e1 + r e2 by Cramer's rule with scalar triple products (as for a
@@ -228,7 +259,11 @@ impl Triangle {
             return None;
         }
         let t = self.e2.dot(qu) * inv_det;
-        (t > 0.0 && t < t_max).then_some(SurfaceHit { t, normal: self.normal })
+        (t > 0.0 && t < t_max).then(|| SurfaceHit {
+            t,
+            normal: self.normal,
+            shading: self.shading_normal(s, r),
+        })
     }
 
     /// The centre and radius of a sphere around the triangle (about its centroid).
@@ -239,11 +274,13 @@ impl Triangle {
     }
 }
 
-/// The surfaces of a mesh: one per triangle, each shaded with its own normal.
+/// The surfaces of a mesh: one per triangle, with its vertex normals when the mesh is smooth.
 pub fn mesh_surfaces(mesh: &TriangleMesh) -> impl Iterator<Item = Surface> + '_ {
     (0..mesh.triangles.len()).map(|i| {
         let [a, b, c] = mesh.triangle(i).map(dvec);
-        Surface::Triangle(Triangle::new(a, b, c))
+        let vertex_normals =
+            mesh.normals.as_ref().map(|normals| mesh.triangles[i].map(|v| dvec(normals[v as usize])));
+        Surface::Triangle(Triangle { vertex_normals, ..Triangle::new(a, b, c) })
     })
 }
 

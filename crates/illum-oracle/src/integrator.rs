@@ -11,6 +11,14 @@
 //! counted by the light integral, a continuation ray that reaches an emitter (or nothing) ends
 //! the path with nothing added; only the camera ray itself may see an emitter directly.
 //!
+//! On a smooth mesh the shading normal n_s stands in for n in cos_x, in the light's cosine and
+//! as the axis of the hemisphere a direction is drawn from, while the geometric normal n_g keeps
+//! deciding sides: light arriving from behind the geometric surface counts nothing, so the
+//! integrand is rho/pi L(w) max(n_s.w, 0) [n_g.w > 0], and a direction drawn below the geometric
+//! surface ends the path. Specular scattering uses n_s where its directions stay on their sides
+//! ([`mirror_normal`], [`dielectric_normal`]). These are the GPU's rules (illum-rtcore's
+//! mesh_shading.wgsl), written here apart.
+//!
 //! Path length: `Bounces::Fixed(n)` allows n continuation rays (0 = direct light only).
 //! `Bounces::Unbounded` continues forever in principle; from the fourth continuation on, a
 //! path survives each step with probability q (the largest channel of throughput x albedo, at
@@ -24,7 +32,7 @@ use illum_scene::{Bounces, MaterialKind, Sampling, Scene};
 
 use crate::camera::PinholeCamera;
 use crate::geometry::Surface;
-use crate::optics::{reflect, scatter_dielectric};
+use crate::optics::{dielectric_normal, mirror_normal, reflect, scatter_dielectric};
 use crate::particle_source::ParticleSource;
 use crate::rng::Rng;
 use crate::sampling::{cosine_hemisphere, local_to_world, uniform_cone, uniform_hemisphere};
@@ -45,12 +53,13 @@ pub(crate) const ROULETTE_MAX_SURVIVAL: f64 = 0.95;
 /// A safety limit for unbounded paths; reaching it has probability below 0.95^100000.
 pub(crate) const UNBOUNDED_LIMIT: u32 = 100_000;
 
-/// What a ray hit: the primitive, distance and geometric normal.
+/// What a ray hit: the primitive, distance, geometric normal and shading normal.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Hit<'a> {
     pub(crate) primitive: &'a Primitive,
     pub(crate) t: f64,
     pub(crate) normal: DVec3,
+    pub(crate) shading: DVec3,
 }
 
 /// Where a ray meets the surface it hit, as both estimators (the camera's paths here and the
@@ -65,6 +74,8 @@ pub(crate) struct Contact {
     pub(crate) normal: DVec3,
     /// How far along `normal` a new ray starts (see [`SPAWN_OFFSET`]).
     pub(crate) lift: f64,
+    /// The shading normal, turned as `normal` is (on its side of the surface).
+    pub(crate) shading: DVec3,
 }
 
 impl Hit<'_> {
@@ -72,8 +83,9 @@ impl Hit<'_> {
     pub(crate) fn contact(&self, o: DVec3, d: DVec3) -> Contact {
         let point = o + self.t * d;
         let front = self.normal.dot(d) < 0.0;
-        let normal = if front { self.normal } else { -self.normal };
-        Contact { point, front, normal, lift: SPAWN_OFFSET * point.abs().max_element().max(1.0) }
+        let (normal, shading) =
+            if front { (self.normal, self.shading) } else { (-self.normal, -self.shading) };
+        Contact { point, front, normal, lift: SPAWN_OFFSET * point.abs().max_element().max(1.0), shading }
     }
 
     /// The diffuse albedo at `point` of this (Lambertian or checker) hit: a checker's tile
@@ -94,7 +106,7 @@ fn nearest_in(list: &[Primitive], o: DVec3, d: DVec3) -> Option<Hit<'_>> {
     for primitive in list {
         let limit = best.map_or(f64::INFINITY, |h| h.t);
         if let Some(h) = primitive.surface.intersect(o, d, limit) {
-            best = Some(Hit { primitive, t: h.t, normal: h.normal });
+            best = Some(Hit { primitive, t: h.t, normal: h.normal, shading: h.shading });
         }
     }
     best
@@ -170,8 +182,9 @@ impl Oracle {
     }
 
     /// One-sample estimate of the light arriving at x (already offset off the surface) with
-    /// facing normal n, weighted by cos_x: Le cos_x cos_y / r^2 A_total, or zero.
-    fn light_sample(&self, x: DVec3, n: DVec3, rng: &mut Rng) -> DVec3 {
+    /// facing normal n and shading normal n_s, weighted by cos_x = n_s.w: Le cos_x cos_y / r^2
+    /// A_total, or zero (also for light from behind n).
+    fn light_sample(&self, x: DVec3, n: DVec3, shading: DVec3, rng: &mut Rng) -> DVec3 {
         let lights = &self.scene.lights;
         if lights.is_empty() {
             return DVec3::ZERO;
@@ -185,9 +198,11 @@ impl Oracle {
         let dist_sq = to_light.length_squared();
         let dist = dist_sq.sqrt();
         let w = to_light / dist;
-        let cos_x = n.dot(w);
+        let cos_x = shading.dot(w);
         let cos_y = -light.shape.normal.dot(w);
-        if !(cos_x > 0.0 && cos_y > 0.0) || self.blocked(x, w, dist * (1.0 - SHADOW_SHORTEN)) {
+        if !(cos_x > 0.0 && cos_y > 0.0 && n.dot(w) > 0.0)
+            || self.blocked(x, w, dist * (1.0 - SHADOW_SHORTEN))
+        {
             return DVec3::ZERO;
         }
         light.emission * (cos_x * cos_y / dist_sq * self.scene.light_area)
@@ -202,22 +217,22 @@ impl Oracle {
     }
 
     /// One sample of the directional light's contribution to the integral of incoming radiance
-    /// x cos over the hemisphere at x (offset off the surface) with facing normal n: for a delta
-    /// light E cos V; for a disc, one direction uniform in its cone (pdf 1 / (2 pi (1 - cos_max)))
-    /// with L_sun cos V / pdf.
-    fn sun_sample(&self, x: DVec3, n: DVec3, rng: &mut Rng) -> DVec3 {
+    /// x cos over the hemisphere at x (offset off the surface) with facing normal n and shading
+    /// normal n_s (cos = n_s.w; nothing from behind n): for a delta light E cos V; for a disc,
+    /// one direction uniform in its cone (pdf 1 / (2 pi (1 - cos_max))) with L_sun cos V / pdf.
+    fn sun_sample(&self, x: DVec3, n: DVec3, shading: DVec3, rng: &mut Rng) -> DVec3 {
         let Some(sun) = self.scene.sun else { return DVec3::ZERO };
         if sun.is_delta() {
-            let cos = n.dot(sun.to_light);
-            if cos <= 0.0 || self.blocked(x, sun.to_light, f64::INFINITY) {
+            let cos = shading.dot(sun.to_light);
+            if cos <= 0.0 || n.dot(sun.to_light) <= 0.0 || self.blocked(x, sun.to_light, f64::INFINITY) {
                 return DVec3::ZERO;
             }
             return sun.irradiance * cos;
         }
         let (u1, u2) = (rng.uniform(), rng.uniform());
         let w = local_to_world(sun.to_light, uniform_cone(u1, u2, sun.cos_max)).normalize();
-        let cos = n.dot(w);
-        if cos <= 0.0 || self.blocked(x, w, f64::INFINITY) {
+        let cos = shading.dot(w);
+        if cos <= 0.0 || n.dot(w) <= 0.0 || self.blocked(x, w, f64::INFINITY) {
             return DVec3::ZERO;
         }
         sun.radiance() * (cos * 2.0 * PI * (1.0 - sun.cos_max))
@@ -282,7 +297,7 @@ impl Oracle {
                 }
                 break;
             }
-            let Contact { point: x, front, normal: n, lift } = hit.contact(o, d);
+            let Contact { point: x, front, normal: n, lift, shading } = hit.contact(o, d);
             match hit.primitive.material {
                 MaterialKind::Mirror { reflectance } => {
                     // A smooth mirror: one direction, weight = its reflectance.
@@ -293,7 +308,7 @@ impl Oracle {
                         break;
                     }
                     throughput *= reflectance;
-                    d = reflect(d, n);
+                    d = reflect(d, mirror_normal(d, n, shading));
                     o = x + n * lift;
                     direct_counts = true;
                 }
@@ -305,7 +320,9 @@ impl Oracle {
                     if !self.may_continue(taken) || !self.roulette(taken, throughput, &mut throughput, rng) {
                         break;
                     }
-                    (o, d) = scatter_dielectric(d, n, x, front, ior, lift, rng);
+                    let eta = if front { 1.0 / f64::from(ior) } else { f64::from(ior) };
+                    let optic = dielectric_normal(d, n, shading, eta);
+                    (o, d) = scatter_dielectric(d, n, optic, x, front, ior, lift, rng);
                     direct_counts = true;
                 }
                 MaterialKind::Lambertian { .. } | MaterialKind::Checker(_) => {
@@ -314,7 +331,8 @@ impl Oracle {
                     sum += throughput
                         * albedo
                         * FRAC_1_PI
-                        * (self.light_sample(x_off, n, rng) + self.sun_sample(x_off, n, rng));
+                        * (self.light_sample(x_off, n, shading, rng)
+                            + self.sun_sample(x_off, n, shading, rng));
                     if !self.may_continue(taken)
                         || !self.roulette(taken, throughput * albedo, &mut throughput, rng)
                     {
@@ -334,7 +352,11 @@ impl Oracle {
                             local
                         }
                     };
-                    d = local_to_world(n, local).normalize();
+                    d = local_to_world(shading, local).normalize();
+                    if d.dot(n) <= 0.0 {
+                        // Below the geometric surface: no light leaks through it.
+                        break;
+                    }
                     o = x_off;
                     direct_counts = false;
                     caustic_owned = taken == 0 && self.caustic.is_some();

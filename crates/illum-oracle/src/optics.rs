@@ -36,15 +36,37 @@ pub(crate) fn refract(d: DVec3, n: DVec3, eta: f64) -> Option<DVec3> {
     Some((eta * d + (eta * cos_i - cos_t) * n).normalize())
 }
 
+/// The normal a mirror reflects unit `d` about at a surface of geometric normal `n` and shading
+/// normal `shading` (a smooth mesh's; both facing d): the shading normal, unless d arrives from
+/// behind it or the reflection about it would go into the surface; then the geometric one. No
+/// reflection leaves a mirror on the side it arrived from.
+pub(crate) fn mirror_normal(d: DVec3, n: DVec3, shading: DVec3) -> DVec3 {
+    if d.dot(shading) < 0.0 && reflect(d, shading).dot(n) > 0.0 { shading } else { n }
+}
+
+/// The normal a dielectric's reflection and refraction of unit `d` use (eta = n_from / n_to;
+/// `n` and `shading` as for [`mirror_normal`]): the shading normal, unless d arrives from
+/// behind it, its reflection goes into the surface or its refraction stays out; then the
+/// geometric one.
+pub(crate) fn dielectric_normal(d: DVec3, n: DVec3, shading: DVec3, eta: f64) -> DVec3 {
+    let arrives = d.dot(shading) < 0.0;
+    let reflects_out = reflect(d, shading).dot(n) > 0.0;
+    let refracts_in = refract(d, shading, eta).is_none_or(|t| t.dot(n) < 0.0);
+    if arrives && reflects_out && refracts_in { shading } else { n }
+}
+
 /// One stochastic step through a smooth dielectric at point `p`, for the path tracer and the
 /// caustic's light tracer alike: `n` faces the incoming unit ray `d`, `front` says whether the
-/// ray arrives from outside (eta = 1 / ior) or inside (eta = ior). Reflect with probability F
-/// (the exact Fresnel reflectance; 1 under total internal reflection), else refract, so the
-/// weight is F / F = (1 - F) / (1 - F) = 1. The new origin is `lift` off the surface on the
-/// side the ray leaves to. Returns (origin, direction).
+/// ray arrives from outside (eta = 1 / ior) or inside (eta = ior). Reflect about `optic` (n, or
+/// the normal [`dielectric_normal`] chooses on a smooth mesh) with probability F (the exact
+/// Fresnel reflectance; 1 under total internal reflection), else refract through it, so the
+/// weight is F / F = (1 - F) / (1 - F) = 1. The new origin is `lift` off the surface along n
+/// on the side the ray leaves to. Returns (origin, direction).
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn scatter_dielectric(
     d: DVec3,
     n: DVec3,
+    optic: DVec3,
     p: DVec3,
     front: bool,
     ior: f32,
@@ -52,10 +74,10 @@ pub(crate) fn scatter_dielectric(
     rng: &mut crate::rng::Rng,
 ) -> (DVec3, DVec3) {
     let eta = if front { 1.0 / f64::from(ior) } else { f64::from(ior) };
-    let cos_i = -d.dot(n);
-    match refract(d, n, eta).filter(|t| rng.uniform() >= fresnel(cos_i, -t.dot(n), eta)) {
+    let cos_i = -d.dot(optic);
+    match refract(d, optic, eta).filter(|t| rng.uniform() >= fresnel(cos_i, -t.dot(optic), eta)) {
         Some(t) => (p - n * lift, t),
-        None => (p + n * lift, reflect(d, n)),
+        None => (p + n * lift, reflect(d, optic)),
     }
 }
 

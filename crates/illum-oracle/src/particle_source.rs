@@ -52,9 +52,16 @@ pub(crate) struct ParticleSource {
 }
 
 impl ParticleSource {
-    /// The particles' source in `scene`, or `None` without a sun or a mirror or dielectric.
+    /// The particles' source in `scene`, or `None` without a sun or a mirror or dielectric, or
+    /// with a smooth mesh: the particles follow geometric normals, and light carried through
+    /// shading normals needs the adjoint's correction (Veach 1996), which they do not make.
+    /// Without them the camera's paths estimate the caustic themselves.
     pub(crate) fn new(scene: &TraceScene) -> Option<ParticleSource> {
         scene.sun?;
+        let smooth = |p: &Primitive| matches!(p.surface, Surface::Triangle(t) if t.vertex_normals.is_some());
+        if scene.surfaces.iter().any(smooth) {
+            return None;
+        }
         let discs: Vec<(DVec3, f64)> =
             scene.surfaces.iter().filter(|p| is_specular(p.material)).map(bounding_sphere).collect();
         if discs.is_empty() {

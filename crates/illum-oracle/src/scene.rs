@@ -6,8 +6,8 @@ use illum_scene::{Feature, MaterialKind, Scene, SceneError, Shape};
 
 use crate::geometry::{Ball, OrientedBox, Parallelogram, Surface, dvec, mesh_surfaces};
 
-/// What the oracle implements: every feature of the scene model but the smooth shading of meshes,
-/// written independently of the GPU path tracer (it shares no code with the WGSL).
+/// What the oracle implements: every feature of the scene model, written independently of the
+/// GPU path tracer (it shares no code with the WGSL).
 pub fn implements(feature: Feature) -> bool {
     match feature {
         Feature::BoxShape
@@ -21,8 +21,8 @@ pub fn implements(feature: Feature) -> bool {
         | Feature::DeltaDirectionalLight
         | Feature::SunDisc
         | Feature::MeshShape
+        | Feature::SmoothShading
         | Feature::Environment => true,
-        Feature::SmoothShading => false,
     }
 }
 

@@ -23,6 +23,12 @@
 //! treated as a point light at its centre with the quad's power pattern: radiant intensity
 //! L x area x cos(theta_light) toward the point, so E_l = L x area x cos(theta_light) / (pi r^2).
 //!
+//! A smooth mesh is shaded with its shading normal n_s in place of n: in n.l, n.h and the
+//! specular directions (n_s where those stay on their sides: [`mirror_normal`],
+//! [`dielectric_normal`]), while the geometric normal decides sides, offsets new rays, and
+//! keeps a light behind the geometric surface from lighting it (the GPU's rules, illum-rtcore's
+//! mesh_shading.wgsl, written here apart).
+//!
 //! Recursion: reflected and refracted rays are followed `depth` times; past that they contribute
 //! nothing (black). Anti-aliasing: an n x n grid of rays through each pixel at the cell centres
 //! ((i + 0.5) / n), averaged: deterministic.
@@ -33,8 +39,9 @@ use glam::DVec3;
 use illum_scene::{Feature, MaterialKind, Scene, SceneError, Shape};
 
 use crate::camera::PinholeCamera;
+use crate::geometry::SurfaceHit;
 use crate::geometry::{Ball, OrientedBox, Parallelogram, Surface, dvec, mesh_surfaces};
-use crate::optics::{checker_albedo, fresnel, reflect, refract};
+use crate::optics::{checker_albedo, dielectric_normal, fresnel, mirror_normal, reflect, refract};
 
 /// One object: its surface and its material.
 #[derive(Clone, Copy, Debug)]
@@ -81,8 +88,8 @@ impl WhittedOracle {
     pub fn new(scene: &Scene) -> Result<WhittedOracle, SceneError> {
         // Every shape and material of the scene model, a delta directional light, area lights
         // (as point lights) and a constant environment; not a sun of finite size, since
-        // Whitted's shadow rays are hard, nor a mesh's smooth shading.
-        scene.require("Whitted ray tracer", |f| !matches!(f, Feature::SunDisc | Feature::SmoothShading))?;
+        // Whitted's shadow rays are hard.
+        scene.require("Whitted ray tracer", |f| !matches!(f, Feature::SunDisc))?;
         let mut items = Vec::with_capacity(scene.objects.len());
         let mut lights = Vec::new();
         for object in &scene.objects {
@@ -166,28 +173,28 @@ impl WhittedOracle {
         })
     }
 
-    /// The closest hit of o + t d, t > 0: (t, geometric normal, item index). An emitter wins a
-    /// tie with a coplanar surface (the Cornell light set into its ceiling), whatever their
-    /// order: it counts as closer unless the other surface is nearer by more than roundoff.
-    fn closest(&self, o: DVec3, d: DVec3) -> Option<(f64, DVec3, usize)> {
+    /// The closest hit of o + t d, t > 0, and its item's index. An emitter wins a tie with a
+    /// coplanar surface (the Cornell light set into its ceiling), whatever their order: it
+    /// counts as closer unless the other surface is nearer by more than roundoff.
+    fn closest(&self, o: DVec3, d: DVec3) -> Option<(SurfaceHit, usize)> {
         const TIE: f64 = 1e-9;
-        let mut best: Option<(f64, DVec3, usize, bool)> = None;
+        let mut best: Option<(SurfaceHit, usize, bool)> = None;
         for (i, item) in self.items.iter().enumerate() {
             let Some(hit) = item.surface.intersect(o, d, f64::INFINITY) else { continue };
             let emitter = matches!(item.material, MaterialKind::Emitter { .. });
             let wins = match best {
                 None => true,
-                Some((t, _, _, best_is_emitter)) => match (emitter, best_is_emitter) {
-                    (true, false) => hit.t <= t * (1.0 + TIE),
-                    (false, true) => hit.t < t * (1.0 - TIE),
-                    _ => hit.t < t,
+                Some((best_hit, _, best_is_emitter)) => match (emitter, best_is_emitter) {
+                    (true, false) => hit.t <= best_hit.t * (1.0 + TIE),
+                    (false, true) => hit.t < best_hit.t * (1.0 - TIE),
+                    _ => hit.t < best_hit.t,
                 },
             };
             if wins {
-                best = Some((hit.t, hit.normal, i, emitter));
+                best = Some((hit, i, emitter));
             }
         }
-        best.map(|(t, n, i, _)| (t, n, i))
+        best.map(|(hit, i, _)| (hit, i))
     }
 
     /// Whether any non-emitting object lies on o + t d for 0 < t < t_max.
@@ -222,30 +229,32 @@ impl WhittedOracle {
 
     /// Radiance arriving at o along unit d, with `depth` reflections or refractions left.
     fn trace(&self, o: DVec3, d: DVec3, depth: u32) -> DVec3 {
-        let Some((t, geometric_normal, index)) = self.closest(o, d) else { return self.background };
+        let Some((hit, index)) = self.closest(o, d) else { return self.background };
         let item = &self.items[index];
-        let p = o + t * d;
-        let front = geometric_normal.dot(d) < 0.0;
-        // The normal against the ray.
-        let n = if front { geometric_normal } else { -geometric_normal };
+        let p = o + hit.t * d;
+        let front = hit.normal.dot(d) < 0.0;
+        // The normals against the ray: geometric and shading.
+        let (n, ns) = if front { (hit.normal, hit.shading) } else { (-hit.normal, -hit.shading) };
         let v = -d;
+        // Lights in front of the geometric surface (none leaks through it).
+        let lights: Vec<(DVec3, DVec3, f64)> =
+            self.lights_at(p, n).into_iter().filter(|(l, _, _)| n.dot(*l) > 0.0).collect();
         let lambert = |c: DVec3| {
-            let direct: DVec3 =
-                self.lights_at(p, n).iter().map(|&(l, e, vis)| e * n.dot(l).max(0.0) * vis).sum();
+            let direct: DVec3 = lights.iter().map(|&(l, e, vis)| e * ns.dot(l).max(0.0) * vis).sum();
             c * (self.ambient + direct)
         };
         let highlights = |shininess: f64| -> DVec3 {
-            self.lights_at(p, n)
+            lights
                 .iter()
-                .filter(|(l, _, _)| n.dot(*l) > 0.0)
-                .map(|&(l, e, vis)| e * (n.dot((l + v).normalize()).max(0.0)).powf(shininess) * vis)
+                .filter(|(l, _, _)| ns.dot(*l) > 0.0)
+                .map(|&(l, e, vis)| e * (ns.dot((l + v).normalize()).max(0.0)).powf(shininess) * vis)
                 .sum()
         };
-        let reflected = |depth: u32| {
+        let reflected = |depth: u32, about: DVec3| {
             if depth == 0 {
                 return DVec3::ZERO;
             }
-            self.trace(offset(p, n), reflect(d, n), depth - 1)
+            self.trace(offset(p, n), reflect(d, about), depth - 1)
         };
         match item.material {
             MaterialKind::Emitter { radiance } => {
@@ -266,24 +275,25 @@ impl WhittedOracle {
                 let c = dvec(reflectance);
                 let w = self.mirror_weight;
                 (1.0 - w) * lambert(c)
-                    + w * c * reflected(depth)
+                    + w * c * reflected(depth, mirror_normal(d, n, ns))
                     + self.mirror_specular * highlights(self.mirror_shininess)
             }
             MaterialKind::Dielectric { ior } => {
                 // Entering through the front (outward normal against the ray) or leaving.
                 let eta = if front { 1.0 / f64::from(ior) } else { f64::from(ior) };
-                let cos_i = v.dot(n);
+                let optic = dielectric_normal(d, n, ns, eta);
+                let cos_i = v.dot(optic);
                 let spark = highlights(self.dielectric_shininess);
-                match refract(d, n, eta) {
-                    None => reflected(depth) + spark,
+                match refract(d, optic, eta) {
+                    None => reflected(depth, optic) + spark,
                     Some(refracted) => {
-                        let f = fresnel(cos_i, -refracted.dot(n), eta);
+                        let f = fresnel(cos_i, -refracted.dot(optic), eta);
                         let transmitted = if depth == 0 {
                             DVec3::ZERO
                         } else {
                             self.trace(offset(p, -n), refracted, depth - 1)
                         };
-                        f * reflected(depth) + (1.0 - f) * transmitted + spark
+                        f * reflected(depth, optic) + (1.0 - f) * transmitted + spark
                     }
                 }
             }

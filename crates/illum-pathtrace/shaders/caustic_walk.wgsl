@@ -105,6 +105,7 @@ fn scatter_specular(v: Vertex, d: vec3<f32>, sampler: ptr<function, Sampler>) ->
     if (v.m.kind == MATERIAL_MIRROR) {
         return Scattered(spawn_point(v.s.p, v.s.n, v.s.err), reflect(d, v.s.n));
     }
-    return scatter_dielectric(v.s, d, v.m.a.w, v.front, sampler);
+    // No mesh reaches the caustic's estimators (estimators.rs): the geometric normal is the optic one.
+    return scatter_dielectric(v.s, v.s.n, d, v.m.a.w, v.front, sampler);
 }
 #endif

@@ -15,8 +15,9 @@
 //
 // What a path that meets no diffuse surface records: an emitter it sees, albedo 1 and its
 // normal (OIDN: a light's albedo may be 1); a ray that leaves the scene, albedo and normal 0.
-// Normals are world-space unit vectors facing the incoming ray; their average over a pixel's
-// samples is shorter than 1 where the pixel straddles an edge, as OIDN expects.
+// Normals are world-space unit vectors facing the incoming ray (a smooth mesh's shading normal,
+// pathtrace.wgsl's ns); their average over a pixel's samples is shorter than 1 where the pixel
+// straddles an edge, as OIDN expects.
 
 #import illum::sampler::{sampler_new, sample_2d}
 #import illum::rtcore::spawn::spawn_point
@@ -33,6 +34,10 @@
 #endif
 #ifdef CHECKER
 #import illum::rtcore::optics::checker_albedo
+#endif
+#ifdef SMOOTH_SHADING
+#import illum::rtcore::traversal::KIND_TRIANGLE
+#import illum::rtcore::mesh_shading::{triangle_shading_normal, mirror_normal, dielectric_normal}
 #endif
 
 // Per pixel (row-major, the whole image): xyz = the mean albedo, w = the samples averaged.
@@ -66,19 +71,35 @@ fn first_diffuse(d_camera: vec3<f32>) -> Guide {
         if (obj.emitter != 0u) {
             return Guide(weight, s.n);
         }
+        var ns = s.n;
+#ifdef SMOOTH_SHADING
+        if (obj.kind == KIND_TRIANGLE) {
+            ns = triangle_shading_normal(obj, s.p, s.n);
+        }
+#endif
         let m = material_at(obj.material);
         // The path tracer takes no specular bounce beyond its last one: neither do the guides.
         let last = (params.bounces != UNBOUNDED && depth >= params.bounces) || depth >= UNBOUNDED_DEPTH_CAP;
 #ifdef SPECULAR
         if (!last && m.kind == MATERIAL_MIRROR) {
+#ifdef SMOOTH_SHADING
+            let optic = mirror_normal(d, s.n, ns);
+#else
+            let optic = s.n;
+#endif
             weight *= m.a.xyz;
-            d = reflect(d, s.n);
+            d = reflect(d, optic);
             o = spawn_point(s.p, s.n, s.err);
             depth += 1u;
             continue;
         }
         if (!last && m.kind == MATERIAL_DIELECTRIC) {
-            let branch = likelier_dielectric_branch(s, d, m.a.w, front);
+#ifdef SMOOTH_SHADING
+            let optic = dielectric_normal(d, s.n, ns, select(m.a.w, 1.0 / m.a.w, front));
+#else
+            let optic = s.n;
+#endif
+            let branch = likelier_dielectric_branch(s, optic, d, m.a.w, front);
             weight *= branch.probability;
             o = branch.scattered.o;
             d = branch.scattered.d;
@@ -87,7 +108,7 @@ fn first_diffuse(d_camera: vec3<f32>) -> Guide {
         }
         if (m.kind == MATERIAL_MIRROR || m.kind == MATERIAL_DIELECTRIC) {
             // Out of bounces on a specular surface: the path ends here, with nothing diffuse.
-            return Guide(vec3<f32>(0.0), s.n);
+            return Guide(vec3<f32>(0.0), ns);
         }
 #endif
         var albedo = m.a.xyz;
@@ -96,7 +117,7 @@ fn first_diffuse(d_camera: vec3<f32>) -> Guide {
             albedo = checker_albedo(obj, m, s.p);
         }
 #endif
-        return Guide(weight * albedo, s.n);
+        return Guide(weight * albedo, ns);
     }
     // Not reached (every iteration returns or continues); naga wants a function to end in one.
     return Guide(vec3<f32>(0.0), vec3<f32>(0.0));

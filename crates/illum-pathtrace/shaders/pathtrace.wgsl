@@ -11,6 +11,13 @@
 // drawn from the cosine or the uniform hemisphere pdf; a bounce ray that reaches a light adds
 // nothing, because that light was already counted by next-event estimation at the previous hit.
 // A camera ray that hits a light sees its emitted radiance.
+//
+// A smooth mesh (shader def SMOOTH_SHADING) is shaded with its interpolated normal ns: the
+// cosines of next-event estimation, the bounce's lobe and the specular directions use ns, while
+// the geometric normal s.n decides sides, spawns rays and stops light leaks (a light or a
+// bounce below the geometric surface counts nothing), by the rules stated in illum-rtcore's
+// mesh_shading.wgsl. Elsewhere ns is s.n. The integrand at a diffuse point is then
+// albedo / pi x L(w) x max(ns.w, 0) x [s.n.w > 0], which both estimators of it share.
 
 #import illum::constants::{PI, TWO_PI, INV_PI}
 #import illum::sampler::{Sampler, sampler_new, sample_1d, sample_2d, REPLICATES, REPLICATE_RUN, replicate_of}
@@ -36,6 +43,10 @@
 #ifdef CHECKER
 #import illum::rtcore::optics::checker_albedo
 #endif
+#ifdef SMOOTH_SHADING
+#import illum::rtcore::traversal::KIND_TRIANGLE
+#import illum::rtcore::mesh_shading::{triangle_shading_normal, mirror_normal, dielectric_normal}
+#endif
 
 // Adaptive sampling's blocks: 8 x 8 pixels, the workgroup (allocation.rs, BLOCK).
 const ADAPTIVE_BLOCK: u32 = 8u;
@@ -48,11 +59,12 @@ const ADAPTIVE_BLOCK: u32 = 8u;
 // whenever its gap to the light's plane exceeds the light's error band plus 2^-20 of the distance.
 const SHADOW_SHORTEN: f32 = 9.5367431640625e-7;
 
-// Next-event estimation at the surface point s (normal s.n facing the incoming ray): radiance
-// arriving from one point sampled on the lights, already divided by its pdf
-// (p(s, t) / A_total) and multiplied by cos(theta_x); the caller multiplies by albedo / pi. The
-// geometry uses the surface point itself; only visibility is tested from the spawned origin.
-fn direct_light(s: Surface, origin: vec3<f32>, own: u32, sampler: ptr<function, Sampler>) -> vec3<f32> {
+// Next-event estimation at the surface point s (normal s.n facing the incoming ray, shading
+// normal ns): radiance arriving from one point sampled on the lights, already divided by its pdf
+// (p(s, t) / A_total) and multiplied by cos(theta_x) = ns.wi; the caller multiplies by
+// albedo / pi. The geometry uses the surface point itself; only visibility is tested from the
+// spawned origin.
+fn direct_light(s: Surface, ns: vec3<f32>, origin: vec3<f32>, own: u32, sampler: ptr<function, Sampler>) -> vec3<f32> {
 #ifdef LIGHT_CHOICE
     let light = lights[choose_light(sample_1d(sampler) * params.light_area)];
 #else
@@ -62,7 +74,7 @@ fn direct_light(s: Surface, origin: vec3<f32>, own: u32, sampler: ptr<function, 
     let u = sample_2d(sampler);
 #ifdef BILINEAR_LIGHT
     // (s, t) on the light and 1 / pdf(s, t), the density following the geometric term.
-    let st = sample_light_bilinear(s.p, s.n, light.corner.xyz, light.edge_u.xyz, light.edge_v.xyz, light.normal.xyz, u.x, u.y);
+    let st = sample_light_bilinear(s.p, ns, light.corner.xyz, light.edge_u.xyz, light.edge_v.xyz, light.normal.xyz, u.x, u.y);
 #else
     // Uniform over the light's area.
     let st = vec3<f32>(u, 1.0);
@@ -71,12 +83,16 @@ fn direct_light(s: Surface, origin: vec3<f32>, own: u32, sampler: ptr<function, 
     let to_light = y - s.p;
     let dist2 = dot(to_light, to_light);
     let wi = to_light / sqrt(dist2);
-    let cos_x = dot(s.n, wi);
+    let cos_x = dot(ns, wi);
     let cos_y = -dot(light.normal.xyz, wi);
     // Only a point in front of the light, facing it, receives light. Written as a positive test
     // so that a NaN cosine (a point on the light itself: dist2 = 0) fails it as well, whatever a
     // compiler does with negated comparisons.
+#ifdef SMOOTH_SHADING
+    let lit = cos_x > 0.0 && cos_y > 0.0 && dot(s.n, wi) > 0.0;
+#else
     let lit = cos_x > 0.0 && cos_y > 0.0;
+#endif
     // The light's plane, and any surface lying in it such as the ceiling around the light, is
     // known only to within the light's error bound err_l; along a ray arriving at angle theta_y
     // that band is err_l / cos(theta_y) long, so the shadow ray stops that much short of y, and
@@ -95,7 +111,7 @@ fn direct_light(s: Surface, origin: vec3<f32>, own: u32, sampler: ptr<function, 
 // contribution to the integral of incoming radiance x cos(theta_x), divided by its pdf (see
 // surfaces.wgsl's sample_sun). A sun disc draws two numbers; a delta sun none. Every object
 // blocks it.
-fn sun_light(s: Surface, origin: vec3<f32>, own: u32, sampler: ptr<function, Sampler>) -> vec3<f32> {
+fn sun_light(s: Surface, ns: vec3<f32>, origin: vec3<f32>, own: u32, sampler: ptr<function, Sampler>) -> vec3<f32> {
 #ifdef SUN_DISC
     let u = sample_2d(sampler);
     let sun = sample_sun(u.x, u.y);
@@ -104,8 +120,13 @@ fn sun_light(s: Surface, origin: vec3<f32>, own: u32, sampler: ptr<function, Sam
 #endif
     let w = sun.w;
     let weight = sun.weight;
-    let cos_x = dot(s.n, w);
-    if (cos_x > 0.0 && !occluded(origin, w, FAR, own)) {
+    let cos_x = dot(ns, w);
+#ifdef SMOOTH_SHADING
+    let facing = cos_x > 0.0 && dot(s.n, w) > 0.0;
+#else
+    let facing = cos_x > 0.0;
+#endif
+    if (facing && !occluded(origin, w, FAR, own)) {
         return weight * cos_x;
     }
     return vec3<f32>(0.0);
@@ -210,6 +231,12 @@ fn path_step(path: ptr<function, Path>, sampler: ptr<function, Sampler>) {
     var s = scattering_surface_at(obj, o + hit.t * d);
     let front = dot(s.n, d) < 0.0;
     s.n = select(-s.n, s.n, front);
+    var ns = s.n;
+#ifdef SMOOTH_SHADING
+    if (obj.kind == KIND_TRIANGLE) {
+        ns = triangle_shading_normal(obj, s.p, s.n);
+    }
+#endif
     let last = (params.bounces != UNBOUNDED && depth >= params.bounces) || depth >= UNBOUNDED_DEPTH_CAP;
     let at_surface = was_alive && !missed && !emitter;
     var next = Path(o, d, throughput, radiance, depth + 1u, false, false, caustic_owned, hit.index);
@@ -220,11 +247,21 @@ fn path_step(path: ptr<function, Path>, sampler: ptr<function, Sampler>) {
     // Its only continuation is the bounce it may not take.
     if (at_surface && specular && !last) {
         if (kind == MATERIAL_MIRROR) {
+#ifdef SMOOTH_SHADING
+            let optic = mirror_normal(d, s.n, ns);
+#else
+            let optic = s.n;
+#endif
             next.throughput *= m.a.xyz;
-            next.d = reflect(d, s.n);
+            next.d = reflect(d, optic);
             next.o = spawn_point(s.p, s.n, s.err);
         } else {
-            let scattered = scatter_dielectric(s, d, m.a.w, front, sampler);
+#ifdef SMOOTH_SHADING
+            let optic = dielectric_normal(d, s.n, ns, select(m.a.w, 1.0 / m.a.w, front));
+#else
+            let optic = s.n;
+#endif
+            let scattered = scatter_dielectric(s, optic, d, m.a.w, front, sampler);
             next.o = scattered.o;
             next.d = scattered.d;
         }
@@ -234,20 +271,20 @@ fn path_step(path: ptr<function, Path>, sampler: ptr<function, Sampler>) {
         next.throughput = scattered_throughput;
     }
     if (at_surface && !specular) {
-        diffuse_vertex(obj.material, hit.index, s, depth, last, true, &next, sampler);
+        diffuse_vertex(obj.material, hit.index, s, ns, depth, last, true, &next, sampler);
     }
 #else
-    diffuse_vertex(obj.material, hit.index, s, depth, last, at_surface, &next, sampler);
+    diffuse_vertex(obj.material, hit.index, s, ns, depth, last, at_surface, &next, sampler);
 #endif
     *path = next;
 }
 
-// The diffuse part of path_step at surface s of object `index` (its material `material`), the
-// path's vertex number
+// The diffuse part of path_step at surface s (shading normal ns) of object `index` (its
+// material `material`), the path's vertex number
 // `depth`: next-event estimation, then, unless this is the last vertex, the bounce. `next` holds
 // the path as it arrived, with its depth already increased; this adds the vertex's light (if
 // `live`: without SPECULAR it is called for ended paths too) and sets the next ray and `alive`.
-fn diffuse_vertex(material: u32, index: u32, s: Surface, depth: u32, last: bool, live: bool, next: ptr<function, Path>, sampler: ptr<function, Sampler>) {
+fn diffuse_vertex(material: u32, index: u32, s: Surface, ns: vec3<f32>, depth: u32, last: bool, live: bool, next: ptr<function, Path>, sampler: ptr<function, Sampler>) {
 #ifdef CHECKER
     let checker = material_at(material);
     var albedo = checker.a.xyz;
@@ -260,7 +297,7 @@ fn diffuse_vertex(material: u32, index: u32, s: Surface, depth: u32, last: bool,
     // Every ray leaving this point (shadow and bounce) starts here, off the surface.
     let spawned = spawn_point(s.p, s.n, s.err);
     var throughput = (*next).throughput;
-    let light = throughput * albedo * INV_PI * direct(s, spawned, index, sampler);
+    let light = throughput * albedo * INV_PI * direct(s, ns, spawned, index, sampler);
     (*next).radiance += select(vec3<f32>(0.0), light, live);
     let u = sample_2d(sampler);
     // Lambertian f = albedo / pi. Cosine pdf cos/pi: f cos / pdf = albedo.
@@ -269,13 +306,18 @@ fn diffuse_vertex(material: u32, index: u32, s: Surface, depth: u32, last: bool,
     // (docs/performance.md, "What lavapipe does with a branch").
 #ifdef UNIFORM_SAMPLING
     let local = sample_uniform_hemisphere(u.x, u.y);
-    (*next).d = to_world(s.n, local);
+    (*next).d = to_world(ns, local);
     throughput *= albedo * (2.0 * local.z);
 #else
-    (*next).d = to_world(s.n, sample_cosine_hemisphere(u.x, u.y));
+    (*next).d = to_world(ns, sample_cosine_hemisphere(u.x, u.y));
     throughput *= albedo;
 #endif
+#ifdef SMOOTH_SHADING
+    // A bounce drawn around ns below the geometric surface would leak: the path ends.
+    let survives = roulette(depth, &throughput, sampler) && dot((*next).d, s.n) > 0.0;
+#else
     let survives = roulette(depth, &throughput, sampler);
+#endif
     (*next).throughput = throughput;
     (*next).o = spawned;
     (*next).direct_counts = false;
@@ -286,13 +328,13 @@ fn diffuse_vertex(material: u32, index: u32, s: Surface, depth: u32, last: bool,
 }
 
 // Next-event estimation at a diffuse point: the area lights and the directional light.
-fn direct(s: Surface, origin: vec3<f32>, own: u32, sampler: ptr<function, Sampler>) -> vec3<f32> {
+fn direct(s: Surface, ns: vec3<f32>, origin: vec3<f32>, own: u32, sampler: ptr<function, Sampler>) -> vec3<f32> {
     var l = vec3<f32>(0.0);
 #ifdef AREA_LIGHTS
-    l += direct_light(s, origin, own, sampler);
+    l += direct_light(s, ns, origin, own, sampler);
 #endif
 #ifdef SUN
-    l += sun_light(s, origin, own, sampler);
+    l += sun_light(s, ns, origin, own, sampler);
 #endif
     return l;
 }

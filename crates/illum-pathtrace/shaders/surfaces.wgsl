@@ -56,40 +56,42 @@ struct Scattered {
 }
 
 // The smooth dielectric of index `ior` (inside; 1 outside) met by direction d at s, whose
-// normal s.n faces d (`front`: d enters). Reflect or refract, chosen with the Fresnel
-// probability (one number from the sampler, none under total internal reflection, where
-// everything reflects). No weight: choosing by the reflectance makes it 1 for radiance from
+// normal s.n faces d (`front`: d enters). Reflect or refract about `optic` (s.n, or a smooth
+// mesh's shading normal where illum-rtcore's dielectric_normal keeps it), chosen with the
+// Fresnel probability (one number from the sampler, none under total internal reflection,
+// where everything reflects); the new ray starts on s.n's side it leaves to. No weight: choosing by the reflectance makes it 1 for radiance from
 // the camera and for flux from the light alike; radiance's eta^2 across the interface cancels
 // over the two crossings every path through a closed dielectric makes (docs/caustics.md).
-fn scatter_dielectric(s: Surface, d: vec3<f32>, ior: f32, front: bool, sampler: ptr<function, Sampler>) -> Scattered {
+fn scatter_dielectric(s: Surface, optic: vec3<f32>, d: vec3<f32>, ior: f32, front: bool, sampler: ptr<function, Sampler>) -> Scattered {
     let eta = select(ior, 1.0 / ior, front);
-    let cos_i = -dot(d, s.n);
+    let cos_i = -dot(d, optic);
     let k = transmitted_cos2(cos_i, eta);
     if (k >= 0.0) {
         let cos_t = sqrt(k);
         if (sample_1d(sampler) >= fresnel(cos_i, cos_t, eta)) {
-            return Scattered(spawn_point(s.p, -s.n, s.err), refracted(d, s.n, eta, cos_i, cos_t));
+            return Scattered(spawn_point(s.p, -s.n, s.err), refracted(d, optic, eta, cos_i, cos_t));
         }
     }
-    return Scattered(spawn_point(s.p, s.n, s.err), reflect(d, s.n));
+    return Scattered(spawn_point(s.p, s.n, s.err), reflect(d, optic));
 }
 
-// scatter_dielectric's likelier choice, taken without a random number, and its probability:
+// scatter_dielectric's likelier choice (`optic` as there), taken without a random number, and
+// its probability:
 // the refraction where the Fresnel reflectance is below 1/2, else the reflection (all of it
 // under total internal reflection). The denoiser's guides follow it (guides.wgsl).
-fn likelier_dielectric_branch(s: Surface, d: vec3<f32>, ior: f32, front: bool) -> LikelierBranch {
+fn likelier_dielectric_branch(s: Surface, optic: vec3<f32>, d: vec3<f32>, ior: f32, front: bool) -> LikelierBranch {
     let eta = select(ior, 1.0 / ior, front);
-    let cos_i = -dot(d, s.n);
+    let cos_i = -dot(d, optic);
     let k = transmitted_cos2(cos_i, eta);
     if (k >= 0.0) {
         let cos_t = sqrt(k);
         let r = fresnel(cos_i, cos_t, eta);
         if (r < 0.5) {
-            return LikelierBranch(Scattered(spawn_point(s.p, -s.n, s.err), refracted(d, s.n, eta, cos_i, cos_t)), 1.0 - r);
+            return LikelierBranch(Scattered(spawn_point(s.p, -s.n, s.err), refracted(d, optic, eta, cos_i, cos_t)), 1.0 - r);
         }
-        return LikelierBranch(Scattered(spawn_point(s.p, s.n, s.err), reflect(d, s.n)), r);
+        return LikelierBranch(Scattered(spawn_point(s.p, s.n, s.err), reflect(d, optic)), r);
     }
-    return LikelierBranch(Scattered(spawn_point(s.p, s.n, s.err), reflect(d, s.n)), 1.0);
+    return LikelierBranch(Scattered(spawn_point(s.p, s.n, s.err), reflect(d, optic)), 1.0);
 }
 
 struct LikelierBranch {

@@ -11,8 +11,7 @@ use illum_rtcore::{CameraRecord, Geometry, MaterialRecord, ObjectRecord, ordered
 use crate::PathTraceError;
 use crate::scene_code::SceneCode;
 
-/// What of the scene model the path tracer implements: all of it but the smooth shading of
-/// meshes. Each feature is compiled
+/// What of the scene model the path tracer implements: all of it. Each feature is compiled
 /// into a scene's pipeline only when the scene uses it (see [`crate::specialise`]).
 pub fn implements(feature: Feature) -> bool {
     match feature {
@@ -27,8 +26,8 @@ pub fn implements(feature: Feature) -> bool {
         | Feature::DeltaDirectionalLight
         | Feature::SunDisc
         | Feature::MeshShape
+        | Feature::SmoothShading
         | Feature::Environment => true,
-        Feature::SmoothShading => false,
     }
 }
 

@@ -35,6 +35,8 @@ pub struct SceneCode {
     pub uniform_sampling: bool,
     /// `bounces = "unbounded"`: Russian roulette.
     pub unbounded_bounces: bool,
+    /// A mesh shaded with its vertex normals (illum-rtcore's mesh_shading.wgsl).
+    pub smooth_shading: bool,
 }
 
 impl SceneCode {
@@ -53,6 +55,7 @@ impl SceneCode {
             caustic_gather: Estimators::of(scene).photon_gather(),
             uniform_sampling: scene.pathtrace.sampling == Sampling::Uniform,
             unbounded_bounces: scene.pathtrace.bounces == Bounces::Unbounded,
+            smooth_shading: features.contains(Feature::SmoothShading),
         }
     }
 }

@@ -51,6 +51,9 @@ impl Specialisation {
             // the object buffer they are slower than one path at a time (same section).
             ("PAIRED_PATHS", options.paired_paths && options.traversal == Traversal::Specialised),
             ("ADAPTIVE", self.adaptive),
+            // A mesh's triangles exist in the specialised traversal only (the generic one
+            // refuses meshes, tracer/pipeline.rs).
+            ("SMOOTH_SHADING", code.smooth_shading && options.traversal == Traversal::Specialised),
         ];
         illum_gpu::shader::flag_defs(&flags)
     }

@@ -112,6 +112,22 @@ fn shade_floor(sw: Switches, p: vec3<f32>, n: vec3<f32>, tile_coord: vec2<f32>, 
     return albedo * (scene.ambient.rgb + scene.light_radiance.rgb * direct);
 }
 
+// A mesh's Lambertian surface at p, as the Whitted ray tracer's local model shades it:
+// albedo x (ambient + light x max(ns.L, 0) x visibility). `n` is the geometric normal of the
+// side being seen, `ns` the shading normal on that side: a light behind the geometric surface
+// lights nothing, whatever ns says (no light leaks through a mesh). The lookup point moves
+// `normal_offset` along n, as a sphere's does, so that a lit face never shadows itself (the mesh
+// is in the shadow map); a face turned away from the light needs no lookup.
+fn shade_mesh(sw: Switches, p: vec3<f32>, n: vec3<f32>, ns: vec3<f32>, albedo: vec3<f32>) -> vec3<f32> {
+    let l = scene.to_light.xyz;
+    let n_dot_l = select(0.0, max(dot(ns, l), 0.0), dot(n, l) > 0.0);
+    var visibility = 0.0;
+    if n_dot_l > 0.0 {
+        visibility = shadow_visibility(sw, p, n, scene.shadow_params.x);
+    }
+    return albedo * (scene.ambient.rgb + scene.light_radiance.rgb * n_dot_l * visibility);
+}
+
 // The checkerboard's colour at `tile_coord`, box-filtered over the pixel's `footprint`.
 fn floor_albedo(tile_coord: vec2<f32>, footprint: vec2<f32>) -> vec3<f32> {
     let odd = filtered_checker(tile_coord, footprint);

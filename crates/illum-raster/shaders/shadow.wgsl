@@ -1,4 +1,6 @@
-// Shadow pass: the spheres' depth as seen from the directional light, into a depth-only target.
+// Shadow pass: the casters' depth as seen from the directional light, into a depth-only target:
+// the spheres (vs_main, fs_main) and the triangle meshes (vs_mesh, rasterized depth, no fragment
+// stage).
 //
 // Each sphere is a square facing the light (parallel projection, so its half-side is the radius).
 // The fragment keeps texels inside the sphere's disc and writes the depth of the sphere's
@@ -24,6 +26,12 @@ fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance
     out.world = world;
     out.sphere = instance;
     return out;
+}
+
+// A mesh corner from the vertex buffer (src/mesh.rs; only its position is read).
+@vertex
+fn vs_mesh(@location(0) position: vec3<f32>) -> @builtin(position) vec4<f32> {
+    return view.view_proj * vec4<f32>(position, 1.0);
 }
 
 @fragment

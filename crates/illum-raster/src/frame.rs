@@ -1,15 +1,15 @@
 //! Recording one frame: the shadow pass, the cube-map captures and the main pass.
 //!
 //! Order matters because each pass reads what the previous ones wrote:
-//! 1. shadow: the spheres' depth from the light;
+//! 1. shadow: the spheres' and the meshes' depth from the light;
 //! 2. glass cube: six faces from the glass sphere's centre showing everything but the glass
-//!    (the floor with its shadows, the metal sphere Phong-lit, the sky), then the same six at
-//!    an eighth of the side, the prefiltered level for lookups with a wide footprint;
+//!    (the floor with its shadows, the meshes, the metal sphere Phong-lit, the sky), then the
+//!    same six at an eighth of the side, the prefiltered level for lookups with a wide footprint;
 //! 3. metal cube: six faces from the metal sphere's centre showing everything but the metal,
 //!    the glass refracting the glass cube just made;
-//! 4. main: the floor, then the spheres back to front, the glass reading the glass cube and
-//!    (enhanced) the metal reading the metal cube; with anti-aliasing each edge is blended over
-//!    what is behind it by its coverage, so what is behind must be drawn first.
+//! 4. main: the floor, the meshes, then the spheres back to front, the glass reading the glass
+//!    cube and (enhanced) the metal reading the metal cube; with anti-aliasing each sphere's edge
+//!    is blended over what is behind it by its coverage, so what is behind must be drawn first.
 //!
 //! A pass the frame's [`FramePlan`] leaves out is not recorded at all (plan.rs says when).
 //!
@@ -46,7 +46,13 @@ pub struct FrameResources<'a> {
     pub uniforms: &'a wgpu::BindGroup,
     pub view_stride: u64,
     pub shadow_pipeline: &'a wgpu::RenderPipeline,
+    pub mesh_shadow_pipeline: &'a wgpu::RenderPipeline,
     pub shadow_map: &'a wgpu::TextureView,
+    /// The meshes' vertex buffer and its vertex count (`None`: the scene has no mesh).
+    pub mesh: Option<(&'a wgpu::Buffer, u32)>,
+    /// The meshes in cube faces and in the main view (`None`: no mesh, or no such pass).
+    pub cube_mesh: Option<&'a wgpu::RenderPipeline>,
+    pub main_mesh: Option<&'a wgpu::RenderPipeline>,
     /// The floor in cube faces (`None`: the frame captures no cube map).
     pub cube_floor: Option<&'a wgpu::RenderPipeline>,
     /// The floor's shadow receiver (`None`: shadows off), for the cube faces and the main view.
@@ -202,9 +208,23 @@ impl FrameResources<'_> {
         pass.set_pipeline(self.shadow_pipeline);
         pass.set_bind_group(0, self.uniforms, &[self.view_offset(SHADOW_VIEW)]);
         pass.draw(QUAD, self.plan.shadow_casters());
+        if let Some((buffer, vertices)) = self.mesh {
+            pass.set_pipeline(self.mesh_shadow_pipeline);
+            pass.set_vertex_buffer(0, buffer.slice(..));
+            pass.draw(0..vertices, 0..1);
+        }
     }
 
-    /// One cube face: the other sphere, if any, and the floor.
+    /// Draws the meshes with `pipeline` (if there are meshes and a pipeline for them).
+    fn draw_meshes(&self, pass: &mut wgpu::RenderPass<'_>, pipeline: Option<&wgpu::RenderPipeline>) {
+        if let (Some((buffer, vertices)), Some(pipeline)) = (self.mesh, pipeline) {
+            pass.set_pipeline(pipeline);
+            pass.set_vertex_buffer(0, buffer.slice(..));
+            pass.draw(0..vertices, 0..1);
+        }
+    }
+
+    /// One cube face: the other sphere, if any, the meshes and the floor.
     fn cube_face(&self, encoder: &mut wgpu::CommandEncoder, name: &str, capture: &Capture, face: usize) {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(name),
@@ -229,7 +249,13 @@ impl FrameResources<'_> {
         // no early test itself). On lavapipe this order also avoids a fixed cost per pass that a
         // floor-first pass pays (docs/performance-raster.md, "Levers").
         // The floor's shadow receiver goes before the rest of the floor (floor.wgsl).
-        for pipeline in [capture.sphere, self.cube_floor_receiver, self.cube_floor].into_iter().flatten() {
+        // The meshes are opaque and hide floor too.
+        if let Some(sphere) = capture.sphere {
+            pass.set_pipeline(sphere);
+            pass.draw(QUAD, 0..1);
+        }
+        self.draw_meshes(&mut pass, self.cube_mesh);
+        for pipeline in [self.cube_floor_receiver, self.cube_floor].into_iter().flatten() {
             pass.set_pipeline(pipeline);
             pass.draw(QUAD, 0..1);
         }
@@ -284,6 +310,8 @@ impl FrameResources<'_> {
         }
         pass.set_pipeline(self.main_floor);
         pass.draw(if self.main_floor_interior.is_some() { OUTLINE_VERTICES } else { QUAD }, 0..1);
+        // The meshes are opaque: drawn before the spheres, whose edges blend over them.
+        self.draw_meshes(&mut pass, self.main_mesh);
         for pipeline in [back, front].into_iter().flatten() {
             pass.set_pipeline(pipeline);
             pass.draw(QUAD, 0..1);

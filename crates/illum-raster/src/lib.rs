@@ -10,7 +10,9 @@
 //! - only the passes the scene needs: no shadow map for a light that casts no shadows, no cube
 //!   map for a sphere the scene lacks or that mirrors nothing ([`plan`]);
 //! - the **main pass** at one sample per pixel: the procedural checkerboard floor, anti-aliased
-//!   by an exact filter over each pixel's footprint, then the spheres back to front as analytic
+//!   by an exact filter over each pixel's footprint, then the triangle meshes from a vertex
+//!   buffer ([`mesh`]; Lambertian, smooth or flat, casting and receiving shadows and seen in the
+//!   cube maps; their edges are not anti-aliased), then the spheres back to front as analytic
 //!   impostors that write their true depth, so silhouettes are round at any size. With
 //!   anti-aliasing on, the floor's outline and each silhouette are blended over what is behind by
 //!   the exact fraction of the pixel they cover (docs/performance-raster.md has the measured
@@ -39,6 +41,7 @@ mod bindings;
 mod error;
 pub mod frame;
 pub mod limits;
+pub mod mesh;
 pub mod metadata;
 mod options;
 mod pass_times;
@@ -62,5 +65,7 @@ pub use options::Options;
 pub use pass_times::{Frame, PassTimes};
 pub use plan::FramePlan;
 pub use renderer::{MIN_MOVING_CUBE_SIZE, PendingFrame, RasterRenderer, moving_cube_size};
-pub use scene::{CheckerFloor, GlassSphere, MetalSphere, RasterLight, RasterQuality, RasterScene};
+pub use scene::{
+    CheckerFloor, GlassSphere, MetalSphere, RasterLight, RasterMesh, RasterQuality, RasterScene,
+};
 pub use shaders::{MODULES, SHADERS};

@@ -14,8 +14,8 @@ const READBACK_ROW_ALIGNMENT: u64 = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT as u64;
 
 /// Checks that the output and the cube maps of `scene` fit the device: every texture side within
 /// `max_texture_dimension_2d`, and the readback buffer (4 bytes per pixel, rows padded to
-/// 256 bytes) within `max_buffer_size`. Errors are labelled `scene "NAME"`, since the
-/// resolution may come from the file or from the command line.
+/// 256 bytes) and the meshes' vertex buffer within `max_buffer_size`. Errors are labelled
+/// `scene "NAME"`, since the resolution may come from the file or from the command line.
 pub fn check_device_limits(scene: &RasterScene, limits: &wgpu::Limits) -> Result<(), SceneError> {
     let label = format!("scene {:?}", scene.name);
     let max = limits.max_texture_dimension_2d;
@@ -42,5 +42,5 @@ pub fn check_device_limits(scene: &RasterScene, limits: &wgpu::Limits) -> Result
             format!("must fit in {} bytes, the device's max_buffer_size", limits.max_buffer_size),
         ));
     }
-    Ok(())
+    crate::mesh::check_size(scene, limits.max_buffer_size)
 }

@@ -57,6 +57,7 @@ mod tests {
             metal_shadowed: true,
             metal_cube: true,
             shadow_rings: true,
+            meshes: false,
             reuse_views: false,
         };
         let named: Vec<(String, f64)> = plan.pass_names().into_iter().map(|n| (n, 0.5)).collect();

@@ -12,7 +12,8 @@ use std::collections::HashMap;
 use illum_gpu::buffers::pipeline_layout;
 use illum_gpu::{GpuContext, GpuError, shader, wgpu};
 
-use crate::shaders::{self, FLOOR_SHADER, SHADOW_SHADER, SPHERES_SHADER};
+use crate::mesh::MeshVertex;
+use crate::shaders::{self, FLOOR_SHADER, MESH_SHADER, SHADOW_SHADER, SPHERES_SHADER};
 use crate::targets::{CUBE_FORMAT, DEPTH_FORMAT, OUTPUT_FORMAT};
 use crate::uniforms::{SceneUniform, ViewUniform};
 use crate::variants::{PipelineKey, Surface, Target};
@@ -23,7 +24,10 @@ pub struct Pipelines {
     surface_layout: wgpu::PipelineLayout,
     floor_module: wgpu::ShaderModule,
     spheres_module: wgpu::ShaderModule,
+    mesh_module: wgpu::ShaderModule,
     pub shadow: wgpu::RenderPipeline,
+    /// The meshes' depth into the shadow map (shadow.wgsl's vs_mesh).
+    pub mesh_shadow: wgpu::RenderPipeline,
     /// Floor and sphere pipelines, made on first use.
     surfaces: HashMap<PipelineKey, wgpu::RenderPipeline>,
 }
@@ -96,8 +100,8 @@ fn blends(key: &PipelineKey) -> bool {
     key.target.antialiased() && matches!(key.surface, Surface::Glass | Surface::Metal)
 }
 
-/// Impostor squares and the floor rectangle are drawn from either side, and cube faces use
-/// mirrored frames (views.rs), so nothing is culled by winding.
+/// Impostor squares, the floor rectangle and meshes (open ones too) are drawn from either side,
+/// and cube faces use mirrored frames (views.rs), so nothing is culled by winding.
 fn primitive() -> wgpu::PrimitiveState {
     wgpu::PrimitiveState { cull_mode: None, ..Default::default() }
 }
@@ -122,7 +126,7 @@ fn surface_pipeline(
                 module,
                 entry_point: Some("vs_main"),
                 compilation_options: options.clone(),
-                buffers: &[],
+                buffers: if key.surface == Surface::Mesh { &[Some(MeshVertex::LAYOUT)] } else { &[] },
             },
             primitive: primitive(),
             depth_stencil: Some(if key.surface == Surface::FloorUmbra {
@@ -232,15 +236,36 @@ impl Pipelines {
                 cache: None,
             })
         })?;
+        let mesh_shadow = gpu.scoped("creating the mesh shadow pipeline", || {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("raster mesh shadow"),
+                layout: Some(&shadow_layout),
+                vertex: wgpu::VertexState {
+                    module: &shadow_module,
+                    entry_point: Some("vs_mesh"),
+                    compilation_options: Default::default(),
+                    buffers: &[Some(MeshVertex::LAYOUT)],
+                },
+                primitive: primitive(),
+                depth_stencil: Some(depth_state(wgpu::CompareFunction::Less)),
+                multisample: Default::default(),
+                fragment: None,
+                multiview_mask: None,
+                cache: None,
+            })
+        })?;
         let floor_module = module(gpu, &FLOOR_SHADER)?;
         let spheres_module = module(gpu, &SPHERES_SHADER)?;
+        let mesh_module = module(gpu, &MESH_SHADER)?;
         Ok(Pipelines {
             uniforms_layout,
             textures_layout,
             surface_layout,
             floor_module,
             spheres_module,
+            mesh_module,
             shadow,
+            mesh_shadow,
             surfaces: HashMap::new(),
         })
     }
@@ -255,6 +280,7 @@ impl Pipelines {
                 | Surface::FloorUmbra
                 | Surface::FloorInterior => &self.floor_module,
                 Surface::Glass | Surface::Metal => &self.spheres_module,
+                Surface::Mesh => &self.mesh_module,
             };
             let pipeline = surface_pipeline(gpu, &self.surface_layout, module, &key)?;
             self.surfaces.insert(key, pipeline);

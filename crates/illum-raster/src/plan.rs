@@ -2,8 +2,8 @@
 //!
 //! "Model only what a scene requires": a pass whose result nothing reads is not recorded, not
 //! drawn into and not timed.
-//! - The shadow map needs a light that casts shadows, shadows switched on, and a sphere to cast
-//!   one (the floor casts on nothing).
+//! - The shadow map needs a light that casts shadows, shadows switched on, and a sphere or a
+//!   mesh to cast one (the floor casts on nothing).
 //! - The glass sphere's cube maps (fine and coarse) exist for the glass alone: no glass, none.
 //! - The metal sphere's cube map is read only by its mirror: the enhanced look with reflection on
 //!   and a mirror fraction above zero.
@@ -60,6 +60,8 @@ pub struct Draws {
     pub receiver: bool,
     pub glass: bool,
     pub metal: bool,
+    /// The triangle meshes.
+    pub meshes: bool,
 }
 
 /// The passes of one frame and what each sphere's pipelines may rely on.
@@ -81,6 +83,8 @@ pub struct FramePlan {
     /// lookups) and umbra disc (dark, without them) instead of the receiver parallelogram
     /// (`ShadowFit::rings`, floor.wgsl).
     pub shadow_rings: bool,
+    /// The scene has triangle meshes: every pass draws them (the shadow pass their depth).
+    pub meshes: bool,
     /// The shadow map and cube maps of the previous frame are this frame's (same scene but for
     /// the camera, same options): their passes are not recorded.
     pub reuse_views: bool,
@@ -89,7 +93,7 @@ pub struct FramePlan {
 impl FramePlan {
     pub fn new(scene: &RasterScene, options: &Options, fit: &ShadowFit) -> Self {
         let glass = scene.glass.is_some();
-        let shadow_pass = options.effects.shadows && !scene.spheres().is_empty();
+        let shadow_pass = options.effects.shadows && !scene.casters().is_empty();
         let metal_cube = options.look == Look::Enhanced
             && options.effects.reflection
             && scene.metal.is_some_and(|metal| metal.mirror > 0.0);
@@ -101,6 +105,7 @@ impl FramePlan {
             metal_shadowed: shadow_pass && fit.metal_shadowed,
             metal_cube,
             shadow_rings: shadow_pass && fit.rings,
+            meshes: !scene.meshes.is_empty(),
             reuse_views: false,
         }
     }
@@ -124,19 +129,24 @@ impl FramePlan {
         passes
     }
 
-    /// What `pass` draws. The shadow pass draws the spheres' depth only (see
-    /// [`Self::shadow_casters`]); every other pass draws the floor, with its shadow receiver when
-    /// the shadow pass ran, and the spheres it can see: a cube map shows everything but the
-    /// sphere it is captured from.
+    /// What `pass` draws. The shadow pass draws the casters' depth only, the spheres (see
+    /// [`Self::shadow_casters`]) and the meshes; every other pass draws the floor, with its
+    /// shadow receiver when the shadow pass ran, the meshes, and the spheres it can see: a cube
+    /// map shows everything but the sphere it is captured from.
     pub fn draws(&self, pass: Pass) -> Draws {
         let receiver = self.shadow_pass;
+        let meshes = self.meshes;
         match pass {
-            Pass::Shadow => Draws { floor: false, receiver: false, glass: self.glass, metal: self.metal },
-            Pass::Capture(Cube::Glass | Cube::GlassCoarse) => {
-                Draws { floor: true, receiver, glass: false, metal: self.metal }
+            Pass::Shadow => {
+                Draws { floor: false, receiver: false, glass: self.glass, metal: self.metal, meshes }
             }
-            Pass::Capture(Cube::Metal) => Draws { floor: true, receiver, glass: self.glass, metal: false },
-            Pass::Main => Draws { floor: true, receiver, glass: self.glass, metal: self.metal },
+            Pass::Capture(Cube::Glass | Cube::GlassCoarse) => {
+                Draws { floor: true, receiver, glass: false, metal: self.metal, meshes }
+            }
+            Pass::Capture(Cube::Metal) => {
+                Draws { floor: true, receiver, glass: self.glass, metal: false, meshes }
+            }
+            Pass::Main => Draws { floor: true, receiver, glass: self.glass, metal: self.metal, meshes },
         }
     }
 

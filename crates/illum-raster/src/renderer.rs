@@ -14,6 +14,7 @@ use illum_gpu::timing::PassTimer;
 
 use crate::RasterError;
 use crate::bindings::{Samplers, TextureGroups, Uniforms};
+use crate::mesh::MeshBuffer;
 use crate::options::Options;
 use crate::pipelines::Pipelines;
 use crate::plan::FramePlan;
@@ -34,6 +35,8 @@ pub struct RasterRenderer {
     shadow_map: ShadowMap,
     cubes: CubeSet,
     texture_groups: TextureGroups,
+    /// The scene's meshes' vertices (`None`: no mesh).
+    mesh: Option<MeshBuffer>,
     main: Option<MainTargets>,
     /// Timestamp queries for exactly the passes of the last frame's plan (rebuilt when the plan
     /// changes, so that every query resolved was written).
@@ -105,6 +108,7 @@ impl RasterRenderer {
         let cubes_side = scene.quality.cube_size;
         let texture_groups =
             TextureGroups::new(gpu, &pipelines.textures_layout, &samplers, &shadow_map, &cubes)?;
+        let mesh = gpu.scoped("uploading the meshes' vertices", || MeshBuffer::new(&gpu.device, &scene))?;
         Ok(RasterRenderer {
             gpu: gpu.clone(),
             scene,
@@ -117,6 +121,7 @@ impl RasterRenderer {
             shadow_map,
             cubes,
             texture_groups,
+            mesh,
             main: None,
             timer: PassTimer::new(gpu, &[]),
             timer_plan: None,
@@ -205,6 +210,11 @@ impl RasterRenderer {
             &self.shadow_map,
             &self.cubes,
         )?;
+        if scene.meshes != self.scene.meshes {
+            self.mesh = self
+                .gpu
+                .scoped("uploading the meshes' vertices", || MeshBuffer::new(&self.gpu.device, &scene))?;
+        }
         self.shadow_fit = fit;
         self.scene = scene;
         Ok(())

@@ -3,8 +3,10 @@
 //!
 //! The rasterizer draws one kind of scene, the assignment's task 1: a checkerboard (or plain)
 //! floor quad, at most one glass (dielectric) sphere and at most one metal (mirror) sphere,
-//! lit by one delta directional light, with the environment's radiance as its background and
-//! `[shading] ambient` in place of the sky's light. Anything else is refused with an error that
+//! any number of Lambertian triangle meshes, lit by one delta directional light, with the
+//! environment's radiance as its background and `[shading] ambient` in place of the sky's
+//! light. Glass and mirrors are drawn through a cube map each, captured from a sphere's centre,
+//! so a mesh may not be glass or a mirror. Anything else is refused with an error that
 //! names what and where ([`Scene::require`] for the features, [`RasterScene::from_scene`] for
 //! the arrangement); nothing is silently left out.
 
@@ -12,8 +14,8 @@ use std::path::Path;
 
 use glam::{Vec2, Vec3};
 use illum_scene::{
-    ClipPlanes, Effects, Feature, Look, MaterialKind, RendererKind, Scene, SceneError, Shape, Sphere,
-    fmt_f32, toml_key,
+    ClipPlanes, Effects, Feature, Look, MaterialKind, MeshRef, RendererKind, Scene, SceneError, Shape,
+    Sphere, fmt_f32, toml_key,
 };
 
 /// Whether the rasterizer implements `feature`. A match rather than a list, so that a feature
@@ -27,12 +29,10 @@ pub fn implements(feature: Feature) -> bool {
         | Feature::Dielectric
         | Feature::Mirror
         | Feature::DeltaDirectionalLight
-        | Feature::Environment => true,
-        Feature::BoxShape
         | Feature::MeshShape
         | Feature::SmoothShading
-        | Feature::AreaLight
-        | Feature::SunDisc => false,
+        | Feature::Environment => true,
+        Feature::BoxShape | Feature::AreaLight | Feature::SunDisc => false,
     }
 }
 
@@ -57,6 +57,8 @@ pub struct RasterScene {
     pub glass: Option<GlassSphere>,
     /// The Phong-lit (and, in the enhanced look, mirroring) sphere, if the scene has one.
     pub metal: Option<MetalSphere>,
+    /// The Lambertian triangle meshes, in file order.
+    pub meshes: Vec<RasterMesh>,
     /// The look used when the caller does not choose one.
     pub look: Look,
     /// The effect toggles used when the caller does not choose them.
@@ -147,6 +149,23 @@ pub struct MetalSphere {
     pub mirror: f32,
 }
 
+/// A Lambertian triangle mesh, shaded as the Whitted ray tracer's local model shades it:
+/// albedo x (ambient + light x N.L x visibility), smoothly with its vertex normals unless flat.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RasterMesh {
+    pub mesh: MeshRef,
+    pub albedo: Vec3,
+}
+
+impl RasterMesh {
+    /// A sphere around every vertex (centre and radius): what the shadow map and the cube
+    /// maps' clip planes are fitted to.
+    pub fn bounding_sphere(&self) -> (Vec3, f32) {
+        let (lo, hi) = self.mesh.bounds();
+        (0.5 * (lo + hi), 0.5 * (hi - lo).length())
+    }
+}
+
 /// Quality settings that trade speed for fidelity.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RasterQuality {
@@ -179,6 +198,7 @@ impl RasterScene {
 
         let mut floor = None;
         let (mut glass, mut metal) = (None, None);
+        let mut meshes = Vec::new();
         for (i, object) in scene.objects.iter().enumerate() {
             let material = scene.material_of(object);
             match (&object.shape, material.kind) {
@@ -242,18 +262,25 @@ impl RasterScene {
                         },
                     ));
                 }
+                (Shape::Mesh(mesh), MaterialKind::Lambertian { albedo }) => {
+                    meshes.push(RasterMesh { mesh: mesh.clone(), albedo });
+                }
                 (shape, _) => {
                     return Err(SceneError::invalid(
                         file,
                         format!("{}.material", scene.object_label(i)),
                         format!("{:?}", material.name),
                         format!(
-                            "the rasterizer draws a {} only with a {} material",
+                            "the rasterizer draws a {} only with a {}",
                             shape.kind(),
-                            if matches!(shape, Shape::Sphere(_)) {
-                                "dielectric or mirror"
-                            } else {
-                                "Lambertian or checker"
+                            match shape {
+                                Shape::Sphere(_) => "dielectric or mirror material",
+                                // Glass and mirrors look up a cube map captured from a sphere's centre.
+                                Shape::Mesh(_) => {
+                                    "Lambertian material (glass and mirrors are spheres only, each drawn \
+                                     through a cube map)"
+                                }
+                                _ => "Lambertian or checker material",
                             }
                         ),
                     ));
@@ -278,6 +305,7 @@ impl RasterScene {
             floor,
             glass: glass.map(|(_, g)| g),
             metal: metal.map(|(_, m)| m),
+            meshes,
             look: scene.raster.look,
             effects: scene.raster.effects,
             quality: RasterQuality { pcf_radius: scene.raster.pcf_radius, cube_size: scene.raster.cube_size },
@@ -288,6 +316,14 @@ impl RasterScene {
     pub fn spheres(&self) -> Vec<(Vec3, f32)> {
         let glass = self.glass.map(|g| (g.center, g.radius));
         glass.into_iter().chain(self.metal.map(|m| (m.center, m.radius))).collect()
+    }
+
+    /// A sphere around each shadow caster: the spheres ([`Self::spheres`]), then each mesh's
+    /// bounding sphere.
+    pub fn casters(&self) -> Vec<(Vec3, f32)> {
+        let mut casters = self.spheres();
+        casters.extend(self.meshes.iter().map(RasterMesh::bounding_sphere));
+        casters
     }
 
     /// Replaces the output resolution, after checking it by the same rules as the file.

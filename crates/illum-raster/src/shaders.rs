@@ -1,4 +1,4 @@
-//! The rasterizer's WGSL: three composable modules and three entry files in `shaders/`.
+//! The rasterizer's WGSL: three composable modules and four entry files in `shaders/`.
 //!
 //! Every entry file is composed with [`MODULES`] (see [`compose`]), and imports nothing else;
 //! the naga validation test below walks [`SHADERS`] the same way.
@@ -27,9 +27,11 @@ pub const SHADOW_SHADER: ShaderFile = illum_gpu::shader_file!("shaders/shadow.wg
 pub const FLOOR_SHADER: ShaderFile = illum_gpu::shader_file!("shaders/floor.wgsl");
 /// The glass and metal spheres (`vs_main`, `fs_main`).
 pub const SPHERES_SHADER: ShaderFile = illum_gpu::shader_file!("shaders/spheres.wgsl");
+/// The triangle meshes (`vs_main`, `fs_main`).
+pub const MESH_SHADER: ShaderFile = illum_gpu::shader_file!("shaders/mesh.wgsl");
 
 /// The entry files, each composed with [`MODULES`].
-pub const SHADERS: &[ShaderFile] = &[SHADOW_SHADER, FLOOR_SHADER, SPHERES_SHADER];
+pub const SHADERS: &[ShaderFile] = &[SHADOW_SHADER, FLOOR_SHADER, SPHERES_SHADER, MESH_SHADER];
 
 /// Composes one of [`SHADERS`] into a naga module (validated by naga_oil's composer).
 pub fn compose(entry: &ShaderFile) -> Result<naga::Module, GpuError> {

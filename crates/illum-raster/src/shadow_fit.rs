@@ -1,7 +1,8 @@
 //! Where the shadow map looks: an orthographic view along the light, fitted to the casters.
 //!
-//! Only the spheres cast shadows, so the map covers just their footprint as seen from the light
-//! (plus a margin for the PCF kernel), which spends every texel where a shadow can be. Its depth
+//! Only the spheres and the meshes cast shadows, so the map covers just their footprint as seen
+//! from the light (plus a margin for the PCF kernel), a mesh's by its bounding sphere, which
+//! spends every texel where a shadow can be. Its depth
 //! range spans the casters and the receivers (floor and spheres); the shader clamps receivers
 //! outside it. The texel size follows from the scene's `pcf_radius`: the PCF kernel reaches
 //! [`PCF_REACH_TEXELS`] texels, so texel = pcf_radius / PCF_REACH_TEXELS makes the soft edge
@@ -40,14 +41,14 @@ pub struct ShadowFit {
     /// unbounded, and this is the whole floor rectangle instead.
     pub receiver: [Vec2; 3],
     /// Whether the glass (metal) sphere can receive any shadow, even a soft edge: only the
-    /// other sphere can cast one on it (a sphere never shadows its own lit half), so a scene
-    /// with one sphere has neither.
+    /// other sphere or a mesh can cast one on it (a sphere never shadows its own lit half), so a
+    /// scene with one sphere and no mesh has neither.
     pub glass_shadowed: bool,
     pub metal_shadowed: bool,
     /// Whether the floor's shadows may be drawn as rings and discs (floor.wgsl, PART 1 and 2):
     /// the light comes from above, every sphere lies wholly above the floor (so it is in front
-    /// of every floor point it covers in the map) and `receiver` is the map's own footprint (the
-    /// rings are placed through it).
+    /// of every floor point it covers in the map), no mesh casts a shadow of another shape, and
+    /// `receiver` is the map's own footprint (the rings are placed through it).
     pub rings: bool,
 }
 
@@ -74,15 +75,15 @@ fn perpendicular_frame(w: Vec3) -> (Vec3, Vec3) {
     (u, u.cross(w))
 }
 
-/// Fits the shadow map to `scene`'s spheres, at most `max_size` texels on a side (the device's
+/// Fits the shadow map to `scene`'s casters ([`RasterScene::casters`]), at most `max_size` texels on a side (the device's
 /// texture limit, capped at [`MAX_SHADOW_MAP`]). When the wanted resolution exceeds that, the
 /// texel grows and the soft edge with it.
 pub fn fit_shadow(scene: &RasterScene, max_size: u32) -> ShadowFit {
     let direction = scene.light.direction();
     let (u, v) = perpendicular_frame(direction);
-    // Without a sphere nothing casts a shadow and no shadow pass runs (plan.rs); the map is then
+    // Without a caster nothing casts a shadow and no shadow pass runs (plan.rs); the map is then
     // fitted around the floor's centre only so that every number stays finite.
-    let mut casters = scene.spheres();
+    let mut casters = scene.casters();
     if casters.is_empty() {
         casters.push((scene.floor.center, scene.quality.pcf_radius));
     }
@@ -146,6 +147,7 @@ pub fn fit_shadow(scene: &RasterScene, max_size: u32) -> ShadowFit {
     let receiver = receiver_on_floor(&view_proj, floor);
     let rings = receiver.is_some()
         && direction.y < 0.0
+        && scene.meshes.is_empty()
         && scene.spheres().iter().all(|&(c, r)| c.y - r > floor.height());
     let receiver = receiver.unwrap_or_else(|| {
         let (lo, hi) = (floor.min_corner(), floor.max_corner());
@@ -154,7 +156,18 @@ pub fn fit_shadow(scene: &RasterScene, max_size: u32) -> ShadowFit {
     // The soft edge reaches pcf_radius beyond the sharp one, and a sphere's lookup point moves a
     // kernel and a texel along its normal: twice the kernel plus two texels covers both.
     let margin = 2.0 * (PCF_REACH_TEXELS + 1.0) * texel;
-    let pair = scene.glass.zip(scene.metal).map(|(g, m)| ((g.center, g.radius), (m.center, m.radius)));
+    let glass = scene.glass.map(|g| (g.center, g.radius));
+    let metal = scene.metal.map(|m| (m.center, m.radius));
+    let meshes: Vec<(Vec3, f32)> = scene.meshes.iter().map(|m| m.bounding_sphere()).collect();
+    // Whether `receiver` can be shadowed by `other` (the other sphere) or by a mesh.
+    let shadowed = |receiver: Option<(Vec3, f32)>, other: Option<(Vec3, f32)>| {
+        receiver.is_some_and(|r| {
+            other
+                .into_iter()
+                .chain(meshes.iter().copied())
+                .any(|caster| can_shadow(caster, r, direction, margin))
+        })
+    };
     ShadowFit {
         view_proj,
         size,
@@ -162,8 +175,8 @@ pub fn fit_shadow(scene: &RasterScene, max_size: u32) -> ShadowFit {
         direction,
         depth_range,
         receiver,
-        glass_shadowed: pair.is_some_and(|(glass, metal)| can_shadow(metal, glass, direction, margin)),
-        metal_shadowed: pair.is_some_and(|(glass, metal)| can_shadow(glass, metal, direction, margin)),
+        glass_shadowed: shadowed(glass, metal),
+        metal_shadowed: shadowed(metal, glass),
         rings,
     }
 }

@@ -30,6 +30,8 @@ pub enum Surface {
     FloorInterior,
     Glass,
     Metal,
+    /// The triangle meshes (mesh.wgsl).
+    Mesh,
 }
 
 /// The kind of target: a cube-map face (half float) or the main view (8-bit), both one sample
@@ -98,6 +100,8 @@ impl PipelineKey {
                 fresnel: e.fresnel && e.reflection,
                 metal_env: false,
             },
+            // A mesh can be shadowed by any caster, itself included.
+            Surface::Mesh => Switches { shadows: plan.shadow_pass, pcf: e.pcf, ..Default::default() },
             Surface::Metal => {
                 let mirror = plan.metal_cube && matches!(target, Target::Main { .. });
                 Switches {
@@ -125,7 +129,7 @@ impl PipelineKey {
             Surface::FloorPenumbra => Some(1.0),
             Surface::FloorUmbra => Some(2.0),
             Surface::FloorInterior => Some(3.0),
-            Surface::Glass | Surface::Metal => None,
+            Surface::Glass | Surface::Metal | Surface::Mesh => None,
         };
         if let Some(part) = floor_part {
             return vec![
@@ -136,7 +140,7 @@ impl PipelineKey {
             ];
         }
         let mut constants = vec![("SHADOWS", flag(s.shadows)), ("PCF", flag(s.pcf))];
-        {
+        if self.surface != Surface::Mesh {
             let sphere = if self.surface == Surface::Glass { 0.0 } else { 1.0 };
             constants.extend([
                 ("SPHERE", sphere),
@@ -169,6 +173,7 @@ mod tests {
             metal_shadowed: shadow_pass && shadowed,
             metal_cube: options.look == Look::Enhanced && options.effects.reflection,
             shadow_rings: shadow_pass,
+            meshes: false,
             reuse_views: false,
         }
     }

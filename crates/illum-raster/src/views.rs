@@ -58,9 +58,10 @@ pub fn cube_face_view_proj(center: Vec3, face: usize, clip: ClipPlanes) -> Mat4 
 /// The clip planes of the cube maps captured at `center` (a sphere's centre). They are not the
 /// camera's: a far plane set just beyond the floor's end as the camera sees it would, from the
 /// sphere, cut the floor's far corners out of the environment the glass refracts and the metal
-/// mirrors. Far reaches the farthest floor corner and the far side of the other sphere (with
-/// 1% slack); near is the camera's, but at most half the distance to the nearest surface (the
-/// floor's plane or the other sphere), so nothing the capture should see is clipped.
+/// mirrors. Far reaches the farthest floor corner and the far side of the other sphere and of
+/// each mesh's bounding sphere (with 1% slack); near is the camera's, but at most half the
+/// distance to the nearest surface (the floor's plane, the other sphere or a mesh's bounding
+/// sphere), so nothing the capture should see is clipped.
 pub fn capture_clip(scene: &RasterScene, center: Vec3) -> ClipPlanes {
     let floor = &scene.floor;
     let (lo, hi) = (floor.min_corner(), floor.max_corner());
@@ -68,7 +69,7 @@ pub fn capture_clip(scene: &RasterScene, center: Vec3) -> ClipPlanes {
     let corners = [(lo.x, lo.y), (lo.x, hi.y), (hi.x, lo.y), (hi.x, hi.y)];
     let mut far = corners.iter().map(|&(x, z)| center.distance(Vec3::new(x, y, z))).fold(0.0f32, f32::max);
     let mut nearest = (center.y - y).abs();
-    for (c, r) in scene.spheres() {
+    for (c, r) in scene.casters() {
         let d = center.distance(c);
         if d > r {
             far = far.max(d + r);

@@ -20,7 +20,9 @@ struct MeshTriangle {
     b: vec3<f32>,
     object: u32,
     c: vec3<f32>,
-    padding: u32,
+    // Its index among the scene's triangles in scene order (bvh.rs): where its shading normals
+    // are (mesh_shading.wgsl).
+    order: u32,
 }
 
 @group(1) @binding(0) var<storage, read> bvh_nodes: array<BvhNode>;
@@ -183,11 +185,11 @@ fn bvh_occluded(o: vec3<f32>, d: vec3<f32>, inv_d: vec3<f32>, t_max: f32, own: u
 }
 
 // Triangle `i` as an object record of kind `kind` (the traversal's KIND_TRIANGLE): a, b, c hold
-// its corners.
+// its corners, `padding` its order (mesh_shading.wgsl reads it).
 fn triangle_object(i: u32, kind: u32) -> Object {
     let tri = mesh_triangles[i];
     let zero = vec4<f32>(0.0);
-    return Object(kind, tri.material, 0u, 0u, vec4<f32>(tri.a, 0.0), vec4<f32>(tri.b, 0.0), vec4<f32>(tri.c, 0.0), zero);
+    return Object(kind, tri.material, 0u, tri.order, vec4<f32>(tri.a, 0.0), vec4<f32>(tri.b, 0.0), vec4<f32>(tri.c, 0.0), zero);
 }
 
 // The surface of a triangle (a, b, c) at a hit point, rebuilt as a + beta (b - a) + gamma (c - a)

@@ -43,8 +43,11 @@ pub struct BvhNode {
 }
 
 /// One triangle as `struct MeshTriangle` in bvh.wgsl: its corners (front: counter-clockwise,
-/// normal (b - a) x (c - a)), the index of its material, and the index in the scene of the
-/// mesh object it belongs to (for object-ID images; the shaders do not read it).
+/// normal (b - a) x (c - a)), the index of its material, the index in the scene of the
+/// mesh object it belongs to (for object-ID images; the shaders do not read it), and `order`,
+/// its index among the scene's triangles before the BVH reorders them (set by
+/// [`MeshForm::of`](crate::mesh_traversal::MeshForm::of)): where its shading normals are
+/// (mesh_shading.rs).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
 pub struct MeshTriangle {
@@ -53,12 +56,12 @@ pub struct MeshTriangle {
     pub b: [f32; 3],
     pub object: u32,
     pub c: [f32; 3],
-    pub padding: u32,
+    pub order: u32,
 }
 
 impl MeshTriangle {
     pub fn new([a, b, c]: [Vec3; 3], material: u32, object: u32) -> Self {
-        MeshTriangle { a: a.to_array(), material, b: b.to_array(), object, c: c.to_array(), padding: 0 }
+        MeshTriangle { a: a.to_array(), material, b: b.to_array(), object, c: c.to_array(), order: 0 }
     }
 
     fn corners(&self) -> [Vec3; 3] {

@@ -4,6 +4,8 @@
 //! - [`object`]: the objects as the shaders store them (one record layout for every kind of
 //!   shape), in the order both use (emitters last);
 //! - [`bvh`]: the hierarchy over a scene's mesh triangles (only a scene with a mesh has one);
+//! - [`mesh_shading`]: the shading normals of smooth meshes (`shaders/mesh_shading.wgsl` holds
+//!   the rules they follow);
 //! - [`material`]: the one material record and its kind codes;
 //! - [`camera`]: the pinhole camera's record;
 //! - [`spawn`]: where a ray leaving a surface starts, with its error bound (the CPU mirror of
@@ -20,6 +22,7 @@ pub mod camera;
 pub mod literal;
 pub mod material;
 pub mod mesh_buffers;
+pub mod mesh_shading;
 pub mod mesh_traversal;
 pub mod object;
 pub mod shaders;
@@ -28,6 +31,6 @@ pub mod traversal;
 
 pub use camera::CameraRecord;
 pub use material::{MaterialCode, MaterialRecord, materials_module};
-pub use mesh_buffers::MeshBindGroup;
+pub use mesh_buffers::{MeshBindGroup, MeshBuffers};
 pub use object::{GpuObject, GpuShape, ObjectRecord, ShapeKind, gpu_shape, ordered_objects};
 pub use traversal::{Geometry, Traversal};

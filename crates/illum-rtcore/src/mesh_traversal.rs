@@ -24,8 +24,13 @@ pub enum MeshForm {
 }
 
 impl MeshForm {
-    /// The form for `triangles` (at least one).
-    pub fn of(triangles: Vec<MeshTriangle>) -> MeshForm {
+    /// The form for `triangles` (at least one), in scene order: object by object, each mesh's
+    /// triangles in its own order. Each triangle's `order` is set to its index in that order,
+    /// which the shading normals' buffer follows (mesh_shading.rs).
+    pub fn of(mut triangles: Vec<MeshTriangle>) -> MeshForm {
+        for (i, t) in triangles.iter_mut().enumerate() {
+            t.order = i as u32;
+        }
         if triangles.len() <= LITERAL_TRIANGLES {
             MeshForm::Literals(triangles)
         } else {
@@ -53,12 +58,15 @@ pub(crate) struct MeshCode {
     pub imports: String,
 }
 
+/// A triangle's object record: its corners in a, b, c and its order in `padding`, as bvh.wgsl's
+/// triangle_object makes it (mesh_shading.wgsl reads the order).
 fn triangle_object_literal(t: &MeshTriangle) -> String {
     let v = |p: [f32; 3]| vec4([p[0], p[1], p[2], 0.0]);
     format!(
-        "Object({}, {}u, 0u, 0u, {}, {}, {}, vec4<f32>(0.0))",
+        "Object({}, {}u, 0u, {}u, {}, {}, {}, vec4<f32>(0.0))",
         ShapeKind::Triangle.wgsl_constant(),
         t.material,
+        t.order,
         v(t.a),
         v(t.b),
         v(t.c)
@@ -139,5 +147,9 @@ mod tests {
         let bvh = MeshForm::of(triangles(LITERAL_TRIANGLES + 1));
         assert!(matches!(&bvh, MeshForm::Bvh(_)));
         assert_eq!(bvh.triangles().len(), LITERAL_TRIANGLES + 1);
+        // Each triangle keeps its index in the input as its order, wherever the BVH puts it.
+        for t in bvh.triangles() {
+            assert_eq!(t.c[2], t.order as f32);
+        }
     }
 }

@@ -19,10 +19,20 @@ pub const CAMERA_MODULE: ShaderFile = shader_file!("shaders/camera.wgsl");
 /// The BVH over mesh triangles (`illum::rtcore::bvh`): imported only by the traversal of a
 /// scene with a mesh, so other scenes' shaders do not contain it.
 pub const BVH_MODULE: ShaderFile = shader_file!("shaders/bvh.wgsl");
+/// The shading normals of smooth meshes (`illum::rtcore::mesh_shading`): imported only by the
+/// shaders of a scene with a smooth mesh (shader def SMOOTH_SHADING).
+pub const MESH_SHADING_MODULE: ShaderFile = shader_file!("shaders/mesh_shading.wgsl");
 
 /// The files of [`core_modules`] (the generated codes module aside).
-pub const FILES: [ShaderFile; 6] =
-    [SPAWN_MODULE, GEOMETRY_MODULE, MATERIAL_MODULE, OPTICS_MODULE, CAMERA_MODULE, BVH_MODULE];
+pub const FILES: [ShaderFile; 7] = [
+    SPAWN_MODULE,
+    GEOMETRY_MODULE,
+    MATERIAL_MODULE,
+    OPTICS_MODULE,
+    CAMERA_MODULE,
+    BVH_MODULE,
+    MESH_SHADING_MODULE,
+];
 
 /// `illum::rtcore::codes`: the `KIND_*` and `MATERIAL_*` constants, generated from
 /// [`ShapeKind`] and [`MaterialCode`] so that no WGSL constant can disagree with the Rust code

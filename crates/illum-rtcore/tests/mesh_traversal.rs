@@ -61,3 +61,82 @@ fn mesh_traversals_compose_and_validate() {
         compose(others, triangles);
     }
 }
+
+/// The shading normals' buffer follows the triangles' order (mesh_shading.rs): triangle g of the
+/// traversal, wherever the BVH put it, finds the normals of the scene's triangle g, a flat
+/// mesh's triangles zeros; and a scene without a smooth mesh has no buffer.
+#[test]
+fn shading_normals_follow_the_triangles_order() {
+    use illum_rtcore::mesh_shading::{FLOATS_PER_TRIANGLE, shading_normals};
+    use illum_scene::testing::obj::{icosphere_obj, scene_with_files};
+    let text = "[camera]\neye = [0.0, 0.0, -5.0]\ntarget = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]\nvfov = 45.0\nwidth = 8\nheight = 8\n\
+                [environment]\nradiance = [1.0, 1.0, 1.0]\n[materials.grey]\nalbedo = [0.5, 0.5, 0.5]\n\
+                [[objects]]\nmaterial = \"grey\"\nmesh = { file = \"flat.obj\", translate = [3.0, 0.0, 0.0] }\n\
+                [[objects]]\nmaterial = \"grey\"\nmesh = { file = \"smooth.obj\", translate = [-3.0, 0.0, 0.0] }\n";
+    let (flat, smooth) = (icosphere_obj(1, false), icosphere_obj(1, true));
+    let scene = scene_with_files(text, "t.toml", &[("flat.obj", &flat), ("smooth.obj", &smooth)]).unwrap();
+    let geometry = Geometry::new(&scene);
+    let form = geometry.meshes.as_ref().unwrap();
+    assert!(geometry.bvh().is_some());
+    let normals = shading_normals(&scene).expect("a smooth mesh");
+    assert_eq!(normals.len(), FLOATS_PER_TRIANGLE * 160);
+    for t in form.triangles() {
+        let g = t.order as usize;
+        let corners = [t.a, t.b, t.c].map(glam::Vec3::from_array);
+        let n: Vec<glam::Vec3> =
+            (0..3).map(|k| glam::Vec3::from_slice(&normals[9 * g + 3 * k..9 * g + 3 * k + 3])).collect();
+        if g < 80 {
+            assert!(n.iter().all(|n| *n == glam::Vec3::ZERO), "flat triangle {g}");
+            assert!(corners.iter().all(|c| c.x > 1.0), "triangle {g} is the flat mesh's");
+        } else {
+            // The smooth icosphere's normals point from its centre (-3, 0, 0) to its corners.
+            for (c, n) in corners.iter().zip(&n) {
+                let radial = (*c - glam::Vec3::new(-3.0, 0.0, 0.0)).normalize();
+                assert!(radial.dot(*n) > 0.9999, "triangle {g}: normal {n} at corner {c}");
+            }
+        }
+    }
+    let only_flat =
+        scene_with_files(&text.replace("smooth.obj", "flat.obj"), "t.toml", &[("flat.obj", &flat)]).unwrap();
+    assert!(shading_normals(&only_flat).is_none());
+}
+
+/// The shading normal's module composes and validates with the traversal of a smooth mesh, as
+/// literals and under a BVH.
+#[test]
+fn smooth_shading_composes_with_each_form() {
+    use illum_scene::testing::obj::{icosphere_obj, scene_with_files};
+    let entry = ShaderFile::generated(
+        "entry".to_owned(),
+        "#import illum::rtcore::traversal::{closest_hit, object_at, surface_at, KIND_TRIANGLE}
+#import illum::rtcore::mesh_shading::{triangle_shading_normal, mirror_normal, dielectric_normal}
+@group(0) @binding(0) var<storage, read_write> out: array<vec4<f32>>;
+@compute @workgroup_size(1)
+fn main() {
+    let d = vec3<f32>(0.0, 0.0, 1.0);
+    let hit = closest_hit(vec3<f32>(0.1, 0.2, -5.0), d, 0xffffffffu);
+    let obj = object_at(hit.index);
+    let s = surface_at(obj, d * hit.t);
+    var ns = s.n;
+    if (obj.kind == KIND_TRIANGLE) {
+        ns = triangle_shading_normal(obj, s.p, s.n);
+    }
+    out[0] = vec4<f32>(mirror_normal(d, s.n, ns) + dielectric_normal(d, s.n, ns, 1.5), 0.0);
+}
+"
+        .to_owned(),
+    );
+    for k in [0, 1] {
+        let text = "[camera]\neye = [0.0, 0.0, -5.0]\ntarget = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]\nvfov = 45.0\nwidth = 8\nheight = 8\n\
+                    [environment]\nradiance = [1.0, 1.0, 1.0]\n[materials.grey]\nalbedo = [0.5, 0.5, 0.5]\n\
+                    [[objects]]\nmaterial = \"grey\"\nmesh = { file = \"m.obj\" }\n";
+        let scene = scene_with_files(text, "t.toml", &[("m.obj", &icosphere_obj(k, true))]).unwrap();
+        let geometry = Geometry::new(&scene);
+        assert_eq!(geometry.bvh().is_some(), k > 0);
+        let mut modules = illum_rtcore::shaders::core_modules();
+        modules.push(generate(&geometry).module("t"));
+        let module =
+            shader::compose(&modules, &entry, &[]).unwrap_or_else(|e| panic!("subdivision {k}: {e}"));
+        shader::validate(&module, "entry").unwrap_or_else(|e| panic!("subdivision {k}: {e}"));
+    }
+}

@@ -49,6 +49,7 @@ mod materials;
 mod mesh;
 mod mesh_load;
 mod mesh_obj;
+mod mesh_ply;
 mod paths;
 mod renderers;
 mod scene;

@@ -1,24 +1,42 @@
 //! Reading the mesh files a scene names, before the scene is validated (their vertices count
 //! toward the frame's origin, `frame.rs`): the caller's reader gives the bytes (so that a web
-//! page can hand them over), `mesh_obj.rs` parses them. Placing and checking the triangles is
-//! `validate_mesh.rs`.
+//! page can hand them over), `mesh_ply.rs` parses a file named `*.ply` and `mesh_obj.rs` any
+//! other. Placing and checking the triangles is `validate_mesh.rs`.
 
 use glam::{DMat3, DVec3, Vec3};
 
 use crate::content_hash::fnv1a_64;
 use crate::error::SceneError;
 use crate::file::{RawMesh, RawScene};
-use crate::mesh_obj::{ObjMesh, read_obj};
+use crate::mesh_obj::read_obj;
+use crate::mesh_ply::read_ply;
 use crate::spelling::object_label;
 
 /// Reads a mesh file named in a scene (relative to the scene file): its bytes, or why not, as a
 /// sentence naming the file.
 pub type ReadFile<'a> = dyn FnMut(&str) -> Result<Vec<u8>, String> + 'a;
 
+/// A mesh as its file gives it, in the file's own coordinates: every index in range, every
+/// position and normal finite, at least one triangle.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct FileMesh {
+    pub positions: Vec<[f32; 3]>,
+    /// One normal per position, when the file gives every vertex one.
+    pub normals: Option<Vec<[f32; 3]>>,
+    pub triangles: Vec<[u32; 3]>,
+}
+
 /// A mesh file read and parsed, before it is placed.
 pub(crate) struct LoadedMesh {
-    pub(crate) obj: ObjMesh,
+    pub(crate) file: FileMesh,
     pub(crate) file_hash: u64,
+}
+
+/// Parses a mesh file's bytes by its name: PLY for a name ending in `.ply` (any case), else
+/// Wavefront OBJ.
+pub(crate) fn read_mesh(bytes: &[u8], name: &str) -> Result<FileMesh, String> {
+    let ply = std::path::Path::new(name).extension().is_some_and(|e| e.eq_ignore_ascii_case("ply"));
+    if ply { read_ply(bytes, name) } else { read_obj(bytes, name) }
 }
 
 /// Reads and parses the file of every mesh object, in file order (`None` for other objects).
@@ -36,8 +54,8 @@ pub(crate) fn load_meshes(
         let field = format!("{}.mesh.file", object_label(i, object.name.as_deref()));
         let invalid = |why: String| SceneError::invalid(file, field.clone(), format!("{:?}", mesh.file), why);
         let bytes = read(&mesh.file).map_err(invalid)?;
-        let obj = read_obj(&bytes, &mesh.file).map_err(invalid)?;
-        out.push(Some(LoadedMesh { obj, file_hash: fnv1a_64(&bytes) }));
+        let file = read_mesh(&bytes, &mesh.file).map_err(invalid)?;
+        out.push(Some(LoadedMesh { file, file_hash: fnv1a_64(&bytes) }));
     }
     Ok(out)
 }
@@ -55,7 +73,7 @@ impl LoadedMesh {
         let r = rotation(raw.rotate.0);
         let t = DVec3::from_array(raw.translate.0);
         let placed =
-            self.obj.positions.iter().map(|p| t + raw.scale.0 * (r * Vec3::from_array(*p).as_dvec3()));
+            self.file.positions.iter().map(|p| t + raw.scale.0 * (r * Vec3::from_array(*p).as_dvec3()));
         let (lo, hi) =
             placed.fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)));
         (lo.is_finite() && hi.is_finite()).then_some((lo, hi))

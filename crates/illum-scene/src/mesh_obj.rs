@@ -8,14 +8,7 @@
 
 use std::io::Cursor;
 
-/// A mesh as its file gives it, in the file's own coordinates.
-#[derive(Clone, Debug, PartialEq)]
-pub(crate) struct ObjMesh {
-    pub positions: Vec<[f32; 3]>,
-    /// One normal per position, when the file gives every corner of every face one.
-    pub normals: Option<Vec<[f32; 3]>>,
-    pub triangles: Vec<[u32; 3]>,
-}
+use crate::mesh_load::FileMesh;
 
 fn options() -> tobj::LoadOptions {
     tobj::LoadOptions {
@@ -34,12 +27,12 @@ fn parse(bytes: &[u8]) -> Result<Vec<tobj::Model>, tobj::LoadError> {
 
 /// The file's triangles, or what is wrong with it as `FILE:LINE: problem` (`shown` names the
 /// file; the line is given wherever one line is at fault).
-pub(crate) fn read_obj(bytes: &[u8], shown: &str) -> Result<ObjMesh, String> {
+pub(crate) fn read_obj(bytes: &[u8], shown: &str) -> Result<FileMesh, String> {
     let models = parse(bytes).map_err(|e| match first_failing_line(bytes) {
         Some(line) => format!("{shown}:{line}: {e} (in `{}`)", quoted_line(bytes, line)),
         None => format!("{shown}: {e}"),
     })?;
-    let mut out = ObjMesh { positions: Vec::new(), normals: Some(Vec::new()), triangles: Vec::new() };
+    let mut out = FileMesh { positions: Vec::new(), normals: Some(Vec::new()), triangles: Vec::new() };
     for model in &models {
         let mesh = &model.mesh;
         let base = out.positions.len();
@@ -131,7 +124,7 @@ fn line_of_non_finite(bytes: &[u8], keyword: &str) -> Option<usize> {
 mod tests {
     use super::*;
 
-    fn read(text: &str) -> Result<ObjMesh, String> {
+    fn read(text: &str) -> Result<FileMesh, String> {
         read_obj(text.as_bytes(), "m.obj")
     }
 

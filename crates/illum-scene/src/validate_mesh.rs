@@ -38,8 +38,8 @@ impl Check<'_> {
         let file_field = format!("{path}.file");
         let shown_file = format!("{:?}", raw.file);
 
-        let mut positions = Vec::with_capacity(loaded.obj.positions.len());
-        for (i, p) in loaded.obj.positions.iter().enumerate() {
+        let mut positions = Vec::with_capacity(loaded.file.positions.len());
+        for (i, p) in loaded.file.positions.iter().enumerate() {
             let placed = (t + raw.scale.0 * (r * Vec3::from_array(*p).as_dvec3())).as_vec3();
             if !placed.is_finite() {
                 return Err(self.invalid(
@@ -57,7 +57,7 @@ impl Check<'_> {
             }
             positions.push(placed);
         }
-        let normals = match (&loaded.obj.normals, raw.flat) {
+        let normals = match (&loaded.file.normals, raw.flat) {
             (Some(normals), false) => Some(
                 normals
                     .iter()
@@ -82,8 +82,8 @@ impl Check<'_> {
             let [a, b, c] = t.map(|v| positions[v as usize]);
             robust_normalize((b - a).cross(c - a)).is_some()
         };
-        let triangles: Vec<[u32; 3]> = loaded.obj.triangles.iter().copied().filter(has_normal).collect();
-        let dropped_degenerate = loaded.obj.triangles.len() - triangles.len();
+        let triangles: Vec<[u32; 3]> = loaded.file.triangles.iter().copied().filter(has_normal).collect();
+        let dropped_degenerate = loaded.file.triangles.len() - triangles.len();
         if triangles.is_empty() {
             return Err(self.invalid(
                 file_field,

@@ -211,3 +211,50 @@ fn a_mesh_far_from_the_world_origin_is_measured_from_the_eye() {
         [Vec3::new(0.0, 0.0, 5.0), Vec3::new(0.0, 1.0, 5.0), Vec3::new(1.0, 0.0, 5.0)]
     );
 }
+
+/// OBJ text (vertices and triangles only) as an ASCII PLY file of the same vertices and faces.
+fn obj_as_ply(obj: &str) -> String {
+    let vertices: Vec<&str> = obj.lines().filter_map(|l| l.strip_prefix("v ")).collect();
+    let faces: Vec<Vec<usize>> = obj
+        .lines()
+        .filter_map(|l| l.strip_prefix("f "))
+        .map(|f| f.split_whitespace().map(|i| i.parse::<usize>().unwrap() - 1).collect())
+        .collect();
+    let mut text = format!(
+        "ply\nformat ascii 1.0\ncomment from OBJ\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\n\
+         element face {}\nproperty list uchar int vertex_indices\nend_header\n",
+        vertices.len(),
+        faces.len()
+    );
+    for v in &vertices {
+        text.push_str(&format!("{v}\n"));
+    }
+    for f in &faces {
+        let corners: Vec<String> = f.iter().map(usize::to_string).collect();
+        text.push_str(&format!("{} {}\n", f.len(), corners.join(" ")));
+    }
+    text
+}
+
+/// A file named `*.ply` is read as PLY: the same vertices and faces as an OBJ file give the same
+/// placed triangles; a PLY file's errors name the object, the file and the line.
+#[test]
+fn a_ply_file_gives_the_mesh_its_obj_twin_gives() {
+    let keys = ", translate = [0.5, 0.0, 1.0], scale = 2.0, rotate = [0.0, 30.0, 0.0]";
+    let from_obj = scene(keys, OBJ).unwrap();
+    let ply_scene = BASE.replace(" MESH", keys).replace("models/t.obj", "models/t.PLY");
+    let from_ply = load_with(&ply_scene, &[("models/t.PLY", &obj_as_ply(OBJ))]).unwrap();
+    let (a, b) = (mesh(&from_obj), mesh(&from_ply));
+    assert_eq!((&a.positions, &a.triangles), (&b.positions, &b.triangles));
+    assert_eq!(a.triangles.len(), 3);
+
+    let broken = obj_as_ply(OBJ).replace("\n3 0 1 2\n", "\n3 0 1 7\n");
+    let err = load_with(&ply_scene, &[("models/t.PLY", &broken)]).unwrap_err();
+    check_invalid(
+        &err,
+        FILE,
+        "objects[0] (\"ball\").mesh.file",
+        "\"models/t.PLY\"",
+        "models/t.PLY:18: a face refers to vertex 7 of a file with 7 vertices",
+    );
+}

@@ -15,6 +15,10 @@
 // tracer's are: one copy of intersection, optics and camera for both ray tracers. Shadow rays
 // test only the objects that can block a light; a Whitted point light lies inside the area
 // light it stands for, so the same occluders serve.
+//
+// A smooth mesh (shader def SMOOTH_SHADING) is shaded with its interpolated normal ns and
+// keeps its geometric normal n for sides, spawning and light leaks, by the rules stated in
+// illum-rtcore's mesh_shading.wgsl; elsewhere ns is n.
 
 #import illum::rtcore::spawn::spawn_point
 #import illum::rtcore::codes::{MATERIAL_CHECKER, MATERIAL_DIELECTRIC, MATERIAL_MIRROR, MATERIAL_EMITTER}
@@ -23,6 +27,10 @@
 #import illum::rtcore::optics::{checker_albedo, transmitted_cos2, refracted, fresnel}
 #import illum::rtcore::traversal::{closest_hit, occluded, surface_at, object_at}
 #import illum::rtcore::materials::material_at
+#ifdef SMOOTH_SHADING
+#import illum::rtcore::traversal::KIND_TRIANGLE
+#import illum::rtcore::mesh_shading::{triangle_shading_normal, mirror_normal, dielectric_normal}
+#endif
 
 const MAX_STACK: u32 = #{WHITTED_STACK}u;
 
@@ -68,15 +76,16 @@ struct Ray {
     own: u32,
 }
 
-// Light from every light at p on object `own` (normal n toward the viewer, spawn error err), for a white
-// Lambertian surface (sum E_l max(n.l, 0) V_l) and for a Blinn-Phong highlight of `shininess`
-// seen along v (sum E_l max(n.h, 0)^shininess V_l where n.l > 0).
+// Light from every light at p on object `own` (geometric normal n toward the viewer, shading
+// normal ns, spawn error err), for a white Lambertian surface (sum E_l max(ns.l, 0) V_l) and for
+// a Blinn-Phong highlight of `shininess` seen along v (sum E_l max(ns.h, 0)^shininess V_l where
+// ns.l > 0). A light behind the geometric surface (n.l <= 0) lights nothing.
 struct Lit {
     diffuse: vec3<f32>,
     highlight: vec3<f32>,
 }
 
-fn light_at(p: vec3<f32>, n: vec3<f32>, err: f32, own: u32, v: vec3<f32>, shininess: f32) -> Lit {
+fn light_at(p: vec3<f32>, n: vec3<f32>, ns: vec3<f32>, err: f32, own: u32, v: vec3<f32>, shininess: f32) -> Lit {
     var lit = Lit(vec3<f32>(0.0), vec3<f32>(0.0));
     let origin = spawn_point(p, n, err);
     for (var li = 0u; li < params.counts.x; li++) {
@@ -103,12 +112,17 @@ fn light_at(p: vec3<f32>, n: vec3<f32>, err: f32, own: u32, v: vec3<f32>, shinin
             t_max = r * (1.0 - 1.0e-5);
 #endif
         }
-        let cos_n = dot(n, l);
-        if (cos_n <= 0.0 || all(e == vec3<f32>(0.0)) || occluded(origin, l, t_max, own)) {
+        let cos_n = dot(ns, l);
+#ifdef SMOOTH_SHADING
+        let behind = dot(n, l) <= 0.0;
+#else
+        let behind = false;
+#endif
+        if (cos_n <= 0.0 || behind || all(e == vec3<f32>(0.0)) || occluded(origin, l, t_max, own)) {
             continue;
         }
         lit.diffuse += e * cos_n;
-        lit.highlight += e * pow(max(dot(n, normalize(l + v)), 0.0), shininess);
+        lit.highlight += e * pow(max(dot(ns, normalize(l + v)), 0.0), shininess);
     }
     return lit;
 }
@@ -131,6 +145,12 @@ fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
         let s = surface_at(obj, ray.o + hit.t * ray.d);
         let front = dot(s.n, ray.d) < 0.0;
         let n = select(-s.n, s.n, front);
+        var ns = n;
+#ifdef SMOOTH_SHADING
+        if (obj.kind == KIND_TRIANGLE) {
+            ns = triangle_shading_normal(obj, s.p, n);
+        }
+#endif
         let v = -ray.d;
         // Only the kinds of material the scene has are compiled (shader defs EMITTERS, MIRRORS,
         // DIELECTRICS, CHECKER): Lambertian and checker surfaces take the default case.
@@ -144,11 +164,16 @@ fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
             case MATERIAL_MIRROR: {
                 let c = m.a.rgb;
                 let w = params.shading.x;
-                let lit = light_at(s.p, n, s.err, hit.index, v, params.mirror_specular.w);
+                let lit = light_at(s.p, n, ns, s.err, hit.index, v, params.mirror_specular.w);
                 colour += ray.weight
                     * ((1.0 - w) * c * (params.ambient.rgb + lit.diffuse) + params.mirror_specular.rgb * lit.highlight);
+#ifdef SMOOTH_SHADING
+                let nr = mirror_normal(ray.d, n, ns);
+#else
+                let nr = n;
+#endif
                 if (ray.depth > 0u && top < MAX_STACK) {
-                    stack[top] = Ray(spawn_point(s.p, n, s.err), reflect(ray.d, n), ray.weight * w * c, ray.depth - 1u, hit.index);
+                    stack[top] = Ray(spawn_point(s.p, n, s.err), reflect(ray.d, nr), ray.weight * w * c, ray.depth - 1u, hit.index);
                     top += 1u;
                 }
             }
@@ -158,12 +183,17 @@ fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
                 // Entering through the front or leaving.
                 let ior = m.a.w;
                 let eta = select(ior, 1.0 / ior, front);
-                let lit = light_at(s.p, n, s.err, hit.index, v, params.shading.y);
+                let lit = light_at(s.p, n, ns, s.err, hit.index, v, params.shading.y);
                 colour += ray.weight * lit.highlight;
+#ifdef SMOOTH_SHADING
+                let nd = dielectric_normal(ray.d, n, ns, eta);
+#else
+                let nd = n;
+#endif
                 if (ray.depth > 0u) {
-                    let cos_i = dot(v, n);
+                    let cos_i = dot(v, nd);
                     let k = transmitted_cos2(cos_i, eta);
-                    let reflected = reflect(ray.d, n);
+                    let reflected = reflect(ray.d, nd);
                     if (k < 0.0) {
                         if (top < MAX_STACK) {
                             stack[top] = Ray(spawn_point(s.p, n, s.err), reflected, ray.weight, ray.depth - 1u, hit.index);
@@ -171,7 +201,7 @@ fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
                         }
                     } else {
                         let cos_t = sqrt(k);
-                        let transmitted = refracted(ray.d, n, eta, cos_i, cos_t);
+                        let transmitted = refracted(ray.d, nd, eta, cos_i, cos_t);
                         let f = fresnel(cos_i, cos_t, eta);
                         if (top + 1u < MAX_STACK) {
                             stack[top] = Ray(spawn_point(s.p, n, s.err), reflected, ray.weight * f, ray.depth - 1u, hit.index);
@@ -190,7 +220,7 @@ fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
                     c = checker_albedo(obj, m, s.p);
                 }
 #endif
-                let lit = light_at(s.p, n, s.err, hit.index, v, 1.0);
+                let lit = light_at(s.p, n, ns, s.err, hit.index, v, 1.0);
                 colour += ray.weight * c * (params.ambient.rgb + lit.diffuse);
             }
         }
@@ -226,7 +256,9 @@ fn object_ids(eye: vec3<f32>, d: vec3<f32>) -> vec2<u32> {
         return vec2<u32>(hit.index, SHADOW_FACING_AWAY);
     }
     let blocker = closest_hit(spawn_point(s.p, n, s.err), l, hit.index);
-    let blocks = blocker.index < params.sizes.z && blocker.t < t_max;
+    // Every object but an emitter blocks: the analytic ones before the first emitter and the
+    // mesh triangles, numbered after every analytic object (illum-rtcore's traversal).
+    let blocks = blocker.index != NO_HIT && blocker.t < t_max && object_at(blocker.index).emitter == 0u;
     return vec2<u32>(hit.index, select(SHADOW_LIT, blocker.index, blocks));
 }
 

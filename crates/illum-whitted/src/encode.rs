@@ -11,7 +11,7 @@ use illum_rtcore::{CameraRecord, MaterialRecord};
 use illum_scene::{Feature, Scene, Shape};
 
 /// What of the scene model the Whitted ray tracer implements: everything but a sun of finite
-/// size (its shadow rays are hard) and the smooth shading of meshes.
+/// size (its shadow rays are hard).
 pub fn implements(feature: Feature) -> bool {
     match feature {
         Feature::BoxShape
@@ -24,8 +24,9 @@ pub fn implements(feature: Feature) -> bool {
         | Feature::AreaLight
         | Feature::DeltaDirectionalLight
         | Feature::MeshShape
+        | Feature::SmoothShading
         | Feature::Environment => true,
-        Feature::SunDisc | Feature::SmoothShading => false,
+        Feature::SunDisc => false,
     }
 }
 
@@ -44,6 +45,8 @@ pub struct Specialisation {
     pub directional_light: bool,
     /// A point light at the centre of an emitting quad.
     pub point_lights: bool,
+    /// A mesh shaded with its vertex normals (illum-rtcore's mesh_shading.wgsl).
+    pub smooth_shading: bool,
 }
 
 impl Specialisation {
@@ -57,6 +60,7 @@ impl Specialisation {
             emitters: features.contains(Feature::AreaLight),
             directional_light: scene.directional_light.is_some(),
             point_lights: lights(scene).iter().any(|l| l.kind == LIGHT_POINT),
+            smooth_shading: features.contains(Feature::SmoothShading),
         }
     }
 
@@ -69,6 +73,7 @@ impl Specialisation {
             ("EMITTERS", self.emitters),
             ("DIRECTIONAL_LIGHT", self.directional_light),
             ("POINT_LIGHTS", self.point_lights),
+            ("SMOOTH_SHADING", self.smooth_shading),
         ];
         let mut defs = vec![("WHITTED_STACK", Def::UInt(self.stack))];
         defs.extend(illum_gpu::shader::flag_defs(&flags));

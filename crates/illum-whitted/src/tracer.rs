@@ -8,7 +8,7 @@ use illum_gpu::buffers::{buffer_bind_group, dispatch};
 use illum_gpu::shader::{self, ShaderFile};
 use illum_gpu::{GpuContext, GpuError, readback, shader_file, wgpu};
 use illum_image::RgbImage32;
-use illum_rtcore::{Geometry, MeshBindGroup};
+use illum_rtcore::{Geometry, MeshBindGroup, MeshBuffers};
 use illum_scene::{RendererKind, Scene, SceneError};
 use wgpu::util::DeviceExt;
 
@@ -61,7 +61,7 @@ pub struct WhittedTracer {
     height: u32,
     pipeline: wgpu::ComputePipeline,
     bind_group: wgpu::BindGroup,
-    /// The BVH's buffers (group 1), for a scene with a mesh.
+    /// The mesh's buffers (group 1), for a scene with a BVH or a smooth mesh.
     mesh: Option<MeshBindGroup>,
     params: wgpu::Buffer,
     radiance_params: WhittedParams,
@@ -136,9 +136,8 @@ impl WhittedTracer {
             &shader_defs(scene),
             "whitted ray tracer",
         )?;
-        if let Some(bvh) = geometry.bvh() {
-            MeshBindGroup::check_size(scene, bvh, limit)?;
-        }
+        let mesh_buffers = MeshBuffers::of(scene, &geometry);
+        mesh_buffers.check_size(scene, limit)?;
         let (bind_group, image, params, mesh) =
             gpu.scoped("creating the Whitted ray tracer's buffers", || {
                 let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -159,7 +158,7 @@ impl WhittedTracer {
                     &pipeline.get_bind_group_layout(0),
                     &[(0, &params), (1, &lights), (2, &image)],
                 );
-                let mesh = geometry.bvh().map(|bvh| MeshBindGroup::new(device, &pipeline, bvh));
+                let mesh = MeshBindGroup::new(device, &pipeline, &mesh_buffers);
                 (bind_group, image, params, mesh)
             })?;
         Ok(WhittedTracer {
@@ -415,10 +414,39 @@ mod tests {
                 emitters: bit(3),
                 directional_light: bit(4),
                 point_lights: bit(5),
+                // Needs a mesh's traversal: the_shader_validates_for_smooth_meshes.
+                smooth_shading: false,
             };
             let composed = shader::compose(&modules, &WHITTED_SHADER, &specialisation.shader_defs())
                 .unwrap_or_else(|e| panic!("{specialisation:?}: {e}"));
             shader::validate(&composed, "whitted.wgsl").unwrap_or_else(|e| panic!("{specialisation:?}: {e}"));
+        }
+    }
+
+    /// With smooth meshes (shader def SMOOTH_SHADING) the shader composes and validates, the
+    /// triangles as literals and under a BVH, with every material that reads the shading normal
+    /// (the Whitted scene's spheres are glass and a mirror).
+    #[test]
+    fn the_shader_validates_for_smooth_meshes() {
+        use illum_scene::testing::obj::{icosphere_obj, scene_with_files};
+        for k in [0, 1] {
+            let obj = icosphere_obj(k, true);
+            let mut text =
+                std::fs::read_to_string(illum_scene::resolve_scene_path("scenes/whitted.toml".as_ref()))
+                    .unwrap();
+            // 20 triangles are literals in the traversal, 80 under a BVH (mesh_traversal.rs).
+            text.push_str("\n[[objects]]\nmaterial = \"glass\"\nmesh = { file = \"ball.obj\" }\n");
+            let scene = scene_with_files(&text, "whitted.toml", &[("ball.obj", &obj)])
+                .unwrap_or_else(|e| panic!("{e}"));
+            let specialisation = encode::Specialisation::new(&scene);
+            assert!(specialisation.smooth_shading && specialisation.mirrors && specialisation.dielectrics);
+            let composed = shader::compose(
+                &shader_modules(&scene, &Geometry::new(&scene)),
+                &WHITTED_SHADER,
+                &specialisation.shader_defs(),
+            )
+            .unwrap_or_else(|e| panic!("subdivision {k}: {e}"));
+            shader::validate(&composed, "whitted.wgsl").unwrap_or_else(|e| panic!("subdivision {k}: {e}"));
         }
     }
 

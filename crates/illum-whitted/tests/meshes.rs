@@ -1,19 +1,21 @@
 //! Meshes in the GPU Whitted ray tracer (BVH traversal, watertight triangle test) against the
 //! f64 copy of the algorithm with its brute-force triangles (`illum_oracle::whitted`), pixel by
 //! pixel by `illum_oracle::whitted_agreement`'s criterion: the Whitted scene with a diffuse, a
-//! glass and a mirror icosphere added, at depths 0, 2 and 8; and a camera inside a closed black
-//! mesh under a bright sky sees nothing.
+//! glass and a mirror icosphere added, at depths 0, 2 and 8, flat and smoothly shaded; a camera
+//! inside a closed black mesh under a bright sky sees nothing; and no light leaks through a
+//! smooth mesh whose shading normals face a light behind it.
 
 use illum_gpu::testing::gpu;
 use illum_oracle::WhittedOracle;
 use illum_oracle::whitted_agreement::compare;
-use illum_scene::testing::obj::{box_obj, scene_with_files};
+use illum_scene::testing::obj::{box_obj, icosphere_obj, scene_with_files, tilted_square};
 use illum_scene::{Scene, resolve_scene_path};
 use illum_whitted::WhittedTracer;
 
-/// The Whitted scene with three icospheres on its floor: flat white (subdivision 1), glass and
-/// mirror (subdivision 2).
-fn whitted_with_meshes(width: u32, height: u32) -> Scene {
+/// The Whitted scene with three icospheres on its floor: white (subdivision 1), glass and mirror
+/// (subdivision 2), flat (the shipped files have no normals) or `smooth` (with their vertex
+/// normals).
+fn whitted_with_meshes(width: u32, height: u32, smooth: bool) -> Scene {
     let path = resolve_scene_path("scenes/whitted.toml".as_ref());
     let text = std::fs::read_to_string(&path).unwrap();
     let meshes = [
@@ -31,8 +33,17 @@ fn whitted_with_meshes(width: u32, height: u32) -> Scene {
         })
         .collect();
     let text = format!("{text}\n[materials.white]\nalbedo = [0.8, 0.8, 0.8]\n{added}");
-    let mut scene =
-        Scene::from_toml_str(&text, &path.display().to_string()).unwrap_or_else(|e| panic!("{e}"));
+    let file = path.display().to_string();
+    let mut scene = if smooth {
+        let files = [1, 2].map(|k| (format!("models/icosphere-{k}.obj"), icosphere_obj(k, true)));
+        let files: Vec<(&str, &str)> =
+            files.iter().map(|(name, text)| (name.as_str(), text.as_str())).collect();
+        scene_with_files(&text, &file, &files)
+    } else {
+        Scene::from_toml_str(&text, &file)
+    }
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(scene.features().contains(illum_scene::Feature::SmoothShading), smooth);
     scene.camera.width = width;
     scene.camera.height = height;
     scene
@@ -55,9 +66,41 @@ fn check(name: &str, scene: &Scene) {
 #[test]
 fn diffuse_glass_and_mirror_meshes_match_the_f64_copy() {
     for depth in [0, 2, 8] {
-        let mut scene = whitted_with_meshes(160, 90);
+        let mut scene = whitted_with_meshes(160, 90, false);
         scene.whitted.depth = depth;
         check("whitted-meshes", &scene);
+    }
+}
+
+#[test]
+fn smooth_diffuse_glass_and_mirror_meshes_match_the_f64_copy() {
+    for depth in [0, 2, 8] {
+        let mut scene = whitted_with_meshes(160, 90, true);
+        scene.whitted.depth = depth;
+        check("whitted-smooth-meshes", &scene);
+    }
+}
+
+/// No light leaks: lit from behind, the square is black, though its shading normals face the
+/// sun; lit from the front, its middle is lit (the test's control), as the f64 copy says.
+#[test]
+fn no_light_leaks_through_a_smooth_mesh() {
+    for behind in [true, false] {
+        let scene = tilted_square(behind);
+        let image = WhittedTracer::new(gpu(), &scene).unwrap_or_else(|e| panic!("{e}")).render().unwrap();
+        let centre = image.pixels[16 * 32 + 16];
+        let expected = WhittedOracle::new(&scene).unwrap().pixel(16, 16);
+        println!("lit from behind: {behind}: centre {centre:?}, f64 copy {expected:?}");
+        if behind {
+            assert!(image.pixels.iter().all(|p| *p == [0.0; 3]), "light leaked: centre {centre:?}");
+            assert_eq!(expected, [0.0; 3]);
+        } else {
+            assert!(centre[0] > 0.1, "the control is not lit: {centre:?}");
+            assert!(
+                (f64::from(centre[0]) - expected[0]).abs() < 1e-4 * expected[0],
+                "{centre:?} vs {expected:?}"
+            );
+        }
     }
 }
 
@@ -120,7 +163,7 @@ fn scenes_without_a_mesh_compose_the_same_shader_as_without_the_bvh_module() {
 /// (its vertices lie on that sphere), and each icosphere labels pixels.
 #[test]
 fn object_ids_name_the_mesh_a_triangle_belongs_to() {
-    let scene = whitted_with_meshes(160, 90);
+    let scene = whitted_with_meshes(160, 90, false);
     let ids = WhittedTracer::new(gpu(), &scene).unwrap().object_ids().unwrap();
     let camera = &scene.camera;
     for (index, object) in scene.objects.iter().enumerate() {

@@ -131,6 +131,8 @@ fn every_combination_of_the_scene_code_validates() {
             caustic_gather,
             uniform_sampling,
             unbounded_bounces,
+            // Compiled with the specialised traversal only: smooth_meshes_compose_and_validate.
+            smooth_shading: _,
         } = *c;
         [
             area_lights,
@@ -172,4 +174,34 @@ fn every_combination_of_the_scene_code_validates() {
     }
     println!("{} scene variants, {} scene codes, {composed} compositions", variants.len(), codes.len());
     assert!(composed > 600, "{composed} compositions");
+}
+
+/// With a smooth mesh (shader def SMOOTH_SHADING, compiled with the specialised traversal only)
+/// the integrator and the guide buffers compose and validate, the mesh's triangles as literals
+/// (20) and under a BVH (80), beside every material, under both hemisphere samplings and both
+/// sequences (the low-discrepancy one samples lights by the bilinear fit, which reads the normal).
+#[test]
+fn smooth_meshes_compose_and_validate() {
+    use illum_scene::testing::obj::{icosphere_obj, scene_with_files};
+    use illum_scene::{Sampling, Sequence};
+    for k in [0, 1] {
+        let text = format!(
+            "{EVERY_KIND}\n    [[objects]]\n    name = \"ball\"\n    material = \"grey\"\n    \
+             mesh = {{ file = \"ball.obj\", translate = [1.5, 1.0, 1.0], scale = 0.5 }}\n"
+        );
+        let mut scene = scene_with_files(&text, "every-kind.toml", &[("ball.obj", &icosphere_obj(k, true))])
+            .unwrap_or_else(|e| panic!("{e}"));
+        for (uniform, sequence) in [(false, Sequence::Independent), (true, Sequence::LowDiscrepancy)] {
+            scene.pathtrace.sampling = if uniform { Sampling::Uniform } else { Sampling::Cosine };
+            let gpu_scene = GpuScene::new(&scene).unwrap_or_else(|e| panic!("{e}"));
+            assert!(gpu_scene.code.smooth_shading && gpu_scene.code.specular);
+            assert_eq!(gpu_scene.geometry.bvh().is_some(), k > 0);
+            let options = TracerOptions { traversal: Traversal::Specialised, sequence, paired_paths: true };
+            let defs = Specialisation { scene: gpu_scene.code, options, adaptive: false }.shader_defs();
+            assert!(defs.iter().any(|(name, _)| *name == "SMOOTH_SHADING"));
+            let modules = shader_modules(&scene, &gpu_scene, Traversal::Specialised);
+            compose_and_validate(&modules, &PATHTRACE_SHADER, &defs);
+            compose_and_validate(&modules, &GUIDES_SHADER, &defs);
+        }
+    }
 }

@@ -12,7 +12,7 @@ use illum_gpu::buffers::{buffer_bind_group, dispatch};
 use illum_gpu::readback;
 use illum_gpu::readback::PendingRead;
 use illum_gpu::wgpu;
-use illum_rtcore::MeshBindGroup;
+use illum_rtcore::{MeshBindGroup, MeshBuffers};
 use wgpu::util::DeviceExt;
 
 use super::PathTracer;
@@ -201,7 +201,7 @@ impl PathTracer {
         let bind_group = buffer_bind_group(device, "guide buffers", &layout, &bound);
         // A bind group of an automatic layout serves that pipeline only: the guides bind the BVH
         // anew.
-        let mesh = gpu_scene.geometry.bvh().map(|bvh| MeshBindGroup::new(device, &compute, bvh));
+        let mesh = MeshBindGroup::new(device, &compute, &MeshBuffers::of(scene, &gpu_scene.geometry));
         let mut encoder = device.create_command_encoder(&Default::default());
         let workgroups = [width.div_ceil(8), height.div_ceil(8), 1];
         match &mesh {

@@ -3,7 +3,7 @@
 //! light tracer. What a band needs to be traced, and nothing of how bands are run or folded.
 
 use illum_gpu::{GpuContext, wgpu};
-use illum_rtcore::MeshBindGroup;
+use illum_rtcore::{MeshBindGroup, MeshBuffers};
 use illum_scene::Scene;
 use wgpu::util::DeviceExt;
 
@@ -44,7 +44,7 @@ pub(super) struct ScenePipeline {
     pub(super) radiance_exponent: i32,
     /// The caustic's light tracer, when the scene asks for it and can have a caustic.
     pub(super) caustic: Option<CausticTracer>,
-    /// The BVH's buffers (group 1), for a scene with a mesh.
+    /// The mesh's buffers (group 1), for a scene with a BVH or a smooth mesh.
     pub(super) mesh: Option<MeshBindGroup>,
 }
 
@@ -58,16 +58,17 @@ impl ScenePipeline {
         options: TracerOptions,
         allocation: Option<SampleAllocation>,
     ) -> Result<Self, PathTraceError> {
-        if let Some(bvh) = gpu_scene.geometry.bvh() {
+        let mesh_buffers = MeshBuffers::of(scene, &gpu_scene.geometry);
+        if gpu_scene.geometry.meshes.is_some() {
             if options.traversal == Traversal::Generic {
                 return Err(PathTraceError::Unsupported {
                     scene: scene.name.clone(),
-                    message: "the generic traversal reads objects from a buffer and has no BVH: a scene \
-                              with a mesh needs the specialised traversal"
+                    message: "the generic traversal reads objects from a buffer and has no triangles: a \
+                              scene with a mesh needs the specialised traversal"
                         .to_owned(),
                 });
             }
-            MeshBindGroup::check_size(scene, bvh, gpu.device.limits().max_storage_buffer_binding_size)?;
+            mesh_buffers.check_size(scene, gpu.device.limits().max_storage_buffer_binding_size)?;
         }
         let base_params = gpu_scene::params(scene, gpu_scene);
         let (compute, traversal_source) =
@@ -107,7 +108,7 @@ impl ScenePipeline {
             [&params_buffer, &objects_buffer, &materials_buffer],
             base_params,
         )?;
-        let mesh = gpu_scene.geometry.bvh().map(|bvh| MeshBindGroup::new(device, &compute, bvh));
+        let mesh = MeshBindGroup::new(device, &compute, &mesh_buffers);
         let mut pipeline = ScenePipeline {
             gpu: gpu.clone(),
             scene: scene.clone(),

@@ -1,8 +1,9 @@
 //! Meshes in the GPU path tracer (BVH, watertight triangles) against the f64 oracle's
 //! brute-force triangles, by oracle_agreement's per-pixel Z-test: the Cornell box with a flat
 //! white icosphere, and with a glass one, direct light and two bounces, under the BVH (80
-//! triangles) and as literals (20). And the caustic's
-//! estimators, which follow spheres only, are off for a scene with a mesh, with the reason.
+//! triangles) and as literals (20), flat and smoothly shaded; no light leaks through a smooth
+//! mesh. And the caustic's estimators, which follow spheres only, are off for a scene with a
+//! mesh, with the reason.
 
 use illum_pathtrace::Estimators;
 use illum_scene::{Bounces, Overrides, Scene};
@@ -13,19 +14,23 @@ use crate::oracle_agreement::compare_scene_with;
 /// The Cornell box with an icosphere of 80 triangles (subdivision 1), radius 80, on the short
 /// block, of `material`, at 24 x 24 and 4096 spp.
 fn cornell_with_icosphere(material: &str, bounces: u32) -> Scene {
-    cornell_with_icosphere_of(material, bounces, 1)
+    cornell_with_icosphere_of(material, bounces, 1, false)
 }
 
-/// As [`cornell_with_icosphere`], of subdivision `k`.
-fn cornell_with_icosphere_of(material: &str, bounces: u32, k: u32) -> Scene {
+/// As [`cornell_with_icosphere`], of subdivision `k`, shaded with its vertex normals when
+/// `smooth`.
+fn cornell_with_icosphere_of(material: &str, bounces: u32, k: u32, smooth: bool) -> Scene {
     let path = common::workspace_path("scenes/cornell.toml");
     let text = std::fs::read_to_string(&path).unwrap();
     let text = format!(
         "{text}\n[materials.glass]\ndielectric = {{ ior = 1.5 }}\n[[objects]]\nname = \"icosphere\"\nmaterial = \"{material}\"\n\
          mesh = {{ file = \"models/icosphere-{k}.obj\", translate = [157.95, 245.0, 168.95], scale = 80.0 }}\n"
     );
+    let file = format!("models/icosphere-{k}.obj");
+    let obj = illum_scene::testing::obj::icosphere_obj(k, smooth);
     let mut scene =
-        Scene::from_toml_str(&text, &path.display().to_string()).unwrap_or_else(|e| panic!("{e}"));
+        illum_scene::testing::obj::scene_with_files(&text, &path.display().to_string(), &[(&file, &obj)])
+            .unwrap_or_else(|e| panic!("{e}"));
     let overrides = Overrides {
         width: Some(24),
         height: Some(24),
@@ -52,7 +57,7 @@ fn a_diffuse_mesh_agrees_with_the_oracle() {
 /// 20 triangles: literals in the generated traversal, not a BVH (mesh_traversal.rs).
 #[test]
 fn a_mesh_of_literal_triangles_agrees_with_the_oracle() {
-    let scene = cornell_with_icosphere_of("glass", 2, 0);
+    let scene = cornell_with_icosphere_of("glass", 2, 0, false);
     assert!(illum_rtcore::Geometry::new(&scene).bvh().is_none());
     compare_scene_with("cornell + glass icosahedron (literals), bounces 2", &scene, 1024);
 }
@@ -60,6 +65,35 @@ fn a_mesh_of_literal_triangles_agrees_with_the_oracle() {
 #[test]
 fn a_glass_mesh_agrees_with_the_oracle() {
     compare_scene_with("cornell + glass icosphere, bounces 2", &cornell_with_icosphere("glass", 2), 1024);
+}
+
+/// A smooth white icosphere under the BVH (next-event estimation and bounces about the shading
+/// normal) and a smooth glass icosahedron as literals (refraction about it).
+#[test]
+fn smooth_meshes_agree_with_the_oracle() {
+    for (material, k) in [("white", 1), ("glass", 0)] {
+        let scene = cornell_with_icosphere_of(material, 2, k, true);
+        assert_eq!(illum_rtcore::Geometry::new(&scene).bvh().is_some(), k > 0);
+        compare_scene_with(&format!("cornell + smooth {material} icosphere-{k}, bounces 2"), &scene, 1024);
+    }
+}
+
+/// Lit from behind, a square whose shading normals face the sun is black; lit from the front
+/// (the control) it is not.
+#[test]
+fn no_light_leaks_through_a_smooth_mesh() {
+    for behind in [true, false] {
+        let scene = illum_scene::testing::obj::tilted_square(behind);
+        let tracer = common::render(&scene);
+        let image = tracer.accumulator().mean_image();
+        let centre = image.pixels[16 * 32 + 16];
+        println!("lit from behind: {behind}: centre {centre:?}");
+        if behind {
+            assert!(image.pixels.iter().all(|p| *p == [0.0; 3]), "light leaked: centre {centre:?}");
+        } else {
+            assert!(centre[0] > 0.1, "the control is not lit: {centre:?}");
+        }
+    }
 }
 
 #[test]

@@ -32,6 +32,8 @@ struct Keys {
     main_umbra: PipelineKey,
     main_glass: PipelineKey,
     main_metal: PipelineKey,
+    cube_mesh: PipelineKey,
+    main_mesh: PipelineKey,
 }
 
 impl RasterRenderer {
@@ -79,6 +81,8 @@ impl RasterRenderer {
             main_umbra: key(Surface::FloorUmbra, main),
             main_glass: key(Surface::Glass, main),
             main_metal: key(Surface::Metal, main),
+            cube_mesh: key(Surface::Mesh, Target::Cube),
+            main_mesh: key(Surface::Mesh, main),
         };
         // The pipelines the plan's passes draw with.
         let mut needed = std::collections::HashSet::new();
@@ -90,10 +94,14 @@ impl RasterRenderer {
             let interior = pass == Pass::Main && draws.floor && main.antialiased();
             let pass_keys = match pass {
                 Pass::Shadow => continue,
-                Pass::Capture(_) => [keys.cube_floor, keys.cube_receiver, keys.cube_glass, keys.cube_metal],
-                Pass::Main => [keys.main_floor, keys.main_receiver, keys.main_glass, keys.main_metal],
+                Pass::Capture(_) => {
+                    [keys.cube_floor, keys.cube_receiver, keys.cube_glass, keys.cube_metal, keys.cube_mesh]
+                }
+                Pass::Main => {
+                    [keys.main_floor, keys.main_receiver, keys.main_glass, keys.main_metal, keys.main_mesh]
+                }
             };
-            let drawn = [draws.floor, draws.receiver && !rings, draws.glass, draws.metal];
+            let drawn = [draws.floor, draws.receiver && !rings, draws.glass, draws.metal, draws.meshes];
             let main_only = [
                 (keys.main_penumbra, draws.receiver && rings),
                 (keys.main_umbra, draws.receiver && rings),
@@ -120,7 +128,11 @@ impl RasterRenderer {
             uniforms: &self.uniforms.group,
             view_stride: self.uniforms.view_stride,
             shadow_pipeline: &self.pipelines.shadow,
+            mesh_shadow_pipeline: &self.pipelines.mesh_shadow,
             shadow_map: &self.shadow_map.view,
+            mesh: self.mesh.as_ref().map(|m| (&m.buffer, m.vertices)),
+            cube_mesh: get(keys.cube_mesh),
+            main_mesh: get(keys.main_mesh),
             cube_floor: get(keys.cube_floor),
             cube_floor_receiver: get(keys.cube_receiver),
             main_floor_receiver: get(keys.main_receiver),

@@ -29,6 +29,58 @@ pub fn box_obj(corners: [Vec3; 8]) -> String {
     text
 }
 
+/// `obj` (OBJ text whose faces name vertices only, `f a b c`) with one normal per vertex,
+/// `normal(position)`, each face's corners naming their vertex's normal (`f a//a b//b c//c`).
+pub fn with_vertex_normals(obj: &str, normal: impl Fn(Vec3) -> Vec3) -> String {
+    let mut vertices = String::new();
+    let mut normals = String::new();
+    let mut faces = String::new();
+    for line in obj.lines() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => {
+                let p: Vec<f32> = words.map(|w| w.parse().expect("a number")).collect();
+                let n = normal(Vec3::new(p[0], p[1], p[2]));
+                vertices.push_str(line);
+                vertices.push('\n');
+                normals.push_str(&format!("vn {:?} {:?} {:?}\n", n.x, n.y, n.z));
+            }
+            Some("f") => {
+                let corners: Vec<String> = words.map(|i| format!("{i}//{i}")).collect();
+                faces.push_str(&format!("f {}\n", corners.join(" ")));
+            }
+            _ => {}
+        }
+    }
+    format!("{vertices}{normals}{faces}")
+}
+
+/// The shipped icosphere of subdivision `k` (scenes/models/icosphere-K.obj, on the unit sphere,
+/// wound counter-clockwise from outside), with its outward unit normals when `smooth`.
+pub fn icosphere_obj(k: u32, smooth: bool) -> String {
+    let path = crate::resolve_scene_path(std::path::Path::new(&format!("scenes/models/icosphere-{k}.obj")));
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    if smooth { with_vertex_normals(&text, Vec3::normalize) } else { text }
+}
+
+/// A two-triangle square facing the camera, its vertex normals tilted 70 degrees toward +x,
+/// lit only by a sun from behind the square (`behind`) or in front of it, up and to the +x
+/// side: the shading normals face the sun either way.
+pub fn tilted_square(behind: bool) -> Scene {
+    let n = Vec3::new(70f32.to_radians().sin(), 0.0, 70f32.to_radians().cos());
+    let obj = format!(
+        "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvn {} {} {}\nf 1//1 2//1 3//1\nf 1//1 3//1 4//1\n",
+        n.x, n.y, n.z
+    );
+    let z = if behind { 1.0 } else { -0.2 };
+    let text = format!(
+        "[camera]\neye = [0.0, 0.0, 4.0]\ntarget = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]\nvfov = 30.0\nwidth = 32\nheight = 32\n\
+         [directional_light]\ndirection = [-1.0, -0.3, {z:?}]\nirradiance = [3.0, 3.0, 3.0]\n\
+         [materials.white]\nalbedo = [0.8, 0.8, 0.8]\n[[objects]]\nmaterial = \"white\"\nmesh = {{ file = \"square.obj\" }}\n"
+    );
+    scene_with_files(&text, "square.toml", &[("square.obj", &obj)]).unwrap_or_else(|e| panic!("{e}"))
+}
+
 /// Loads scene `text` (labelled `file`) with its mesh files from `files` (name as the scene
 /// gives it, then the file's text).
 pub fn scene_with_files(text: &str, file: &str, files: &[(&str, &str)]) -> Result<Scene, SceneError> {
@@ -44,6 +96,18 @@ pub fn scene_with_files(text: &str, file: &str, files: &[(&str, &str)]) -> Resul
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn vertex_normals_are_added_to_every_corner() {
+        let text = with_vertex_normals("v 0 0 0\nv 2 0 0\nv 0 2 0\nf 1 2 3\n", |p| p + Vec3::Z);
+        assert_eq!(
+            text,
+            "v 0 0 0\nv 2 0 0\nv 0 2 0\nvn 0.0 0.0 1.0\nvn 2.0 0.0 1.0\nvn 0.0 2.0 1.0\nf 1//1 2//2 3//3\n"
+        );
+        let smooth = icosphere_obj(1, true);
+        assert_eq!(smooth.lines().filter(|l| l.starts_with("vn ")).count(), 42);
+        assert_eq!(smooth.lines().filter(|l| l.starts_with("f ")).count(), 80);
+    }
 
     #[test]
     fn a_box_is_closed_and_faces_out() {
