@@ -79,7 +79,7 @@ impl FilePicker {
             .map_err(|_| "the file picker could not open: no input element".to_owned())?;
         input.set_type("file");
         input.set_multiple(true);
-        input.set_accept(".toml,.obj,text/plain");
+        input.set_accept(".toml,.obj,.ply,text/plain");
         let inbox = self.inbox.clone();
         let ctx = ctx.clone();
         let chosen = input.clone();
