@@ -196,6 +196,7 @@ def perf_tables(directory):
         ("bench-parts.txt", "caustic-parts", "performance-caustics.md", False),
         ("bench-glint.txt", "glint-bench", "performance-caustics.md", False),
         ("raster-bench.txt", "raster-bench", "performance-raster.md", True),
+        ("vs-mitsuba-meshes.txt", "mitsuba-meshes", "performance.md", False),
     ]
     for name, block, page, preformatted in blocks:
         text = read(directory, name).strip()

@@ -116,6 +116,7 @@ for n in 10 50 200; do python3 scripts/many-spheres.py $n -o "$out/spheres-$n.to
 if "$python" -c "import mitsuba" 2> /dev/null; then
     "$python" bench/vs_mitsuba.py --bounces 2 | tee "$out/vs-mitsuba.txt"
     "$python" bench/vs_mitsuba.py --bounces 8 | tee "$out/vs-mitsuba-b8.txt"
+    scripts/mitsuba-meshes.sh "$python" "$out" | tee "$out/vs-mitsuba-meshes.txt"
 else
     echo "Mitsuba 3 is not installed here: the comparison is not re-measured (see bench/vs_mitsuba.py)" \
         | tee "$out/vs-mitsuba.txt"
