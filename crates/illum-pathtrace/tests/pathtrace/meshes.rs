@@ -53,7 +53,7 @@ fn a_diffuse_mesh_agrees_with_the_oracle() {
 #[test]
 fn a_mesh_of_literal_triangles_agrees_with_the_oracle() {
     let scene = cornell_with_icosphere_of("glass", 2, 0);
-    assert!(illum_rtcore::Geometry::new(&scene).bvh().is_none());
+    assert!(illum_rtcore::Geometry::new(&scene).mesh_bvh().is_none());
     compare_scene_with("cornell + glass icosahedron (literals), bounces 2", &scene, 1024);
 }
 
