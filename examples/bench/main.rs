@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! cargo run --release --example bench -- [--runs N] [--quick | --large [--compare-readback] | --viewer | --sequences
-//!     | --glint SCENE... | --parts SCENE]
+//!     | --glint SCENE... | --parts SCENE | --first-image SCENE...]
 //! ```
 //! For `scenes/cornell.toml` at each size and bounce count it renders a fixed number of samples
 //! per pixel `runs` times and prints the median of:
@@ -30,6 +30,9 @@
 //! `--parts` gives each part of a render with the caustic's estimators on its own row beside the
 //! camera paths alone (`parts.rs`).
 //!
+//! `--first-image` times the first image of each scene given, the whole `render` process with
+//! Mesa's shader cache cold and warm, beside the path tracer's throughput (`first_image.rs`).
+//!
 //! `--glint` times the host's solve of the sun's glint (`illum::pathtrace::glint::solve`, part of
 //! a render's set-up before its first sample) for each scene given, on all the host's threads:
 //! `scripts/many-spheres.py` writes scenes with many specular spheres for it.
@@ -47,6 +50,7 @@ use illum::scene::Sequence;
 use illum::scene::{Bounces, Scene};
 use illum_cli::SceneArgs;
 
+mod first_image;
 mod parts;
 
 #[derive(Parser, Debug)]
@@ -81,6 +85,10 @@ struct Args {
     /// Only the glint's solve on the host, for each of these scenes (see `scripts/many-spheres.py`).
     #[arg(long, num_args = 1.., conflicts_with_all = ["quick", "large", "viewer"])]
     glint: Vec<PathBuf>,
+    /// Only the time to the first image of each of these scenes, cold and warm (see
+    /// `scripts/many-spheres.py`; needs `cargo build --release --example render`).
+    #[arg(long, num_args = 1.., conflicts_with_all = ["quick", "large", "viewer", "sequences", "parts"])]
+    first_image: Vec<PathBuf>,
     /// Only the parts of a render with the caustic's estimators on, each beside the camera paths
     /// alone (the scene should have a caustic: scenes/whitted.toml).
     #[arg(long, conflicts_with_all = ["quick", "large", "viewer", "sequences"])]
@@ -112,6 +120,10 @@ fn run(args: Args) -> anyhow::Result<()> {
         return bench_glint(&args.glint, args.runs);
     }
     let gpu = illum_cli::gpu()?;
+    if !args.first_image.is_empty() {
+        let load = load_average().map_or(String::new(), |l| format!(", load average {l} at the start"));
+        return first_image::bench_first_image(&gpu, &args.first_image, args.runs, &load);
+    }
     if args.parts {
         let load = load_average().map_or(String::new(), |l| format!(", load average {l} at the start"));
         return parts::bench_parts(&gpu, &Scene::load(&args.scene)?, args.runs, &load);

@@ -84,8 +84,8 @@ impl Estimators {
 
     /// Why the caustic's estimators are off although the scene asks for them: they follow light
     /// through spheres (their particles aim at specular objects' bounding spheres, the glint is
-    /// solved on spheres and quads) and their passes bind no BVH, so a scene with a mesh renders
-    /// with camera paths alone, which miss the sun's caustic (docs/caustics.md).
+    /// solved on spheres and quads), so a scene with a mesh renders with camera paths alone,
+    /// which miss the sun's caustic (docs/caustics.md).
     pub fn mesh_stops_caustics(scene: &Scene) -> Option<&'static str> {
         let mesh = scene.features().contains(Feature::MeshShape);
         (scene.pathtrace.caustics && mesh).then_some(

@@ -166,7 +166,7 @@ mod tests {
 
     /// The composed pipeline's bindings are all in group 0, no two share a number, and each
     /// variable has the number the table gives it (bindings.rs), which the host binds it at; but
-    /// a scene with a mesh's BVH buffers, in group 1 at illum-rtcore's numbers.
+    /// a scene's hierarchies' buffers, in group 1 at illum-rtcore's numbers.
     fn check_bindings(module: &naga::Module, what: &str) {
         use crate::bindings::Binding;
         let mut seen = std::collections::HashMap::new();
@@ -175,8 +175,8 @@ mod tests {
             // naga_oil names an imported module's items NAME + "X_naga_oil_mod_X" + its path.
             let full = variable.name.as_deref().unwrap_or_default();
             let name = full.split("X_naga_oil_mod_X").next().unwrap_or_default();
-            if binding.group == illum_rtcore::MeshBindGroup::GROUP {
-                let bvh = illum_rtcore::MeshBindGroup::BINDINGS;
+            if binding.group == illum_rtcore::BvhBindGroup::GROUP {
+                let bvh = illum_rtcore::BvhBindGroup::BINDINGS;
                 assert!(bvh.contains(&(name, binding.binding)), "{what}: {name} at {binding:?}");
                 continue;
             }

@@ -3,9 +3,12 @@
 #import illum::rtcore::geometry::{Hit, Object, Surface, FAR}
 #import illum::rtcore::spawn::{spawn_error, max_abs}
 
-// The mesh triangles of a scene under one bounding volume hierarchy (built and flattened by
-// illum-rtcore's bvh.rs, which states the layout and why). Imported only by the traversal of a
-// scene with a mesh, which alone binds group 1.
+// The records of the bounding volume hierarchies (built and flattened by illum-rtcore's bvh.rs,
+// which states the layout and why) and the tests their walk makes; the walk itself is generated
+// into the traversal with the leaf tests of the primitives it holds (bvh_traversal.rs). Imported
+// only by the traversal of a scene with a mesh or with more spheres than the literal limit
+// (sphere_bvh.rs); only a scene with a hierarchy binds group 1, and only the buffers its
+// traversal reads: a mesh's nodes and triangles, the spheres' nodes and records.
 
 struct BvhNode {
     lo: vec3<f32>,
@@ -27,6 +30,22 @@ struct MeshTriangle {
 
 @group(1) @binding(0) var<storage, read> bvh_nodes: array<BvhNode>;
 @group(1) @binding(1) var<storage, read> mesh_triangles: array<MeshTriangle>;
+// A sphere under the spheres' hierarchy (sphere_bvh.rs): its (centre, radius) and material. The
+// hierarchy's nodes and these are read from uniform buffers (group 1, bindings 2 and 3), sized per
+// scene and so declared in the generated traversal (sphere_bvh.rs gives the reason).
+struct BvhSphere {
+    sphere: vec4<f32>,
+    material: u32,
+}
+
+// Reads for the generated walk (the buffers are this module's).
+fn mesh_node(i: u32) -> BvhNode {
+    return bvh_nodes[i];
+}
+
+fn mesh_triangle(i: u32) -> MeshTriangle {
+    return mesh_triangles[i];
+}
 
 // bvh.rs's MAX_DEPTH: at most one entry per level is pushed.
 const BVH_STACK: u32 = 32u;
@@ -111,77 +130,6 @@ fn enters_box(o: vec3<f32>, inv_d: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>, t_ma
     let t_enter = max(max(max(near.x, near.y), near.z), 0.0);
     let t_exit = min(min(far.x, far.y), far.z) * 1.0000004;
     return t_enter <= min(t_exit, t_max);
-}
-
-// The nearest triangle along the ray nearer than `best`, with its index plus `base` (the
-// traversal numbers triangles after the scene's analytic objects). `own`: the triangle the ray
-// leaves (its index plus `base`), never taken: a ray leaving a plane does not meet it again.
-fn bvh_closest(o: vec3<f32>, d: vec3<f32>, inv_d: vec3<f32>, own: u32, best_in: Hit, base: u32) -> Hit {
-    let ray = sheared_ray(o, d);
-    var best = best_in;
-    var stack: array<u32, BVH_STACK>;
-    var top = 0u;
-    var node = 0u;
-    loop {
-        let n = bvh_nodes[node];
-        if (enters_box(o, inv_d, n.lo, n.hi, best.t)) {
-            let count = n.b >> 2u;
-            if (count == 0u) {
-                let axis = n.b & 3u;
-                let second_first = d[axis] < 0.0;
-                stack[top] = select(n.a, node + 1u, second_first);
-                top += 1u;
-                node = select(node + 1u, n.a, second_first);
-                continue;
-            }
-            for (var i = n.a; i < n.a + count; i += 1u) {
-                let tri = mesh_triangles[i];
-                let t = hit_triangle(ray, tri.a, tri.b, tri.c, best.t);
-                if (t < best.t && i + base != own) {
-                    best = Hit(t, i + base);
-                }
-            }
-        }
-        if (top == 0u) {
-            break;
-        }
-        top -= 1u;
-        node = stack[top];
-    }
-    return best;
-}
-
-// Whether any triangle but `own` (as for bvh_closest) lies on the ray strictly between 0 and
-// t_max.
-fn bvh_occluded(o: vec3<f32>, d: vec3<f32>, inv_d: vec3<f32>, t_max: f32, own: u32, base: u32) -> bool {
-    let ray = sheared_ray(o, d);
-    var stack: array<u32, BVH_STACK>;
-    var top = 0u;
-    var node = 0u;
-    loop {
-        let n = bvh_nodes[node];
-        if (enters_box(o, inv_d, n.lo, n.hi, t_max)) {
-            let count = n.b >> 2u;
-            if (count == 0u) {
-                stack[top] = n.a;
-                top += 1u;
-                node += 1u;
-                continue;
-            }
-            for (var i = n.a; i < n.a + count; i += 1u) {
-                let tri = mesh_triangles[i];
-                if (i + base != own && hit_triangle(ray, tri.a, tri.b, tri.c, t_max) < t_max) {
-                    return true;
-                }
-            }
-        }
-        if (top == 0u) {
-            break;
-        }
-        top -= 1u;
-        node = stack[top];
-    }
-    return false;
 }
 
 // Triangle `i` as an object record of kind `kind` (the traversal's KIND_TRIANGLE): a, b, c hold

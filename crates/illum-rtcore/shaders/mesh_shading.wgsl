@@ -27,7 +27,7 @@
 // Per triangle, in scene order (the `padding` of its object record, set to its order by
 // mesh_traversal.rs and bvh.wgsl): nine floats, the unit normals at its corners a, b, c; zeros
 // for a triangle of a flat mesh.
-@group(1) @binding(2) var<storage, read> mesh_normals: array<f32>;
+@group(1) @binding(4) var<storage, read> mesh_normals: array<f32>;
 
 fn corner_normal(first: u32) -> vec3<f32> {
     return vec3<f32>(mesh_normals[first], mesh_normals[first + 1u], mesh_normals[first + 2u]);

@@ -1,12 +1,14 @@
-//! The bounding volume hierarchy over a scene's mesh triangles, built on the host and flattened
-//! into the two storage buffers `shaders/bvh.wgsl` traverses. Only a scene with a mesh has one;
-//! its spheres, quads and boxes stay literals in the generated traversal (traversal.rs).
+//! The bounding volume hierarchy, built on the host and flattened into the storage buffers the
+//! generated traversal walks (bvh_traversal.rs, `shaders/bvh.wgsl`). One builder ([`Hierarchy`])
+//! serves every primitive put under a BVH: a scene's mesh triangles past the literal limit
+//! (mesh_traversal.rs), and its spheres past theirs (sphere_bvh.rs). A scene with neither has
+//! none: its objects stay literals in the generated traversal (traversal.rs).
 //!
 //! Build: top-down, each node split where the surface area heuristic (SAH) is least among
-//! `BINS` equal bins of its triangles' centroids on each axis (binned SAH, Wald 2007): the cost
+//! `BINS` equal bins of its primitives' centroids on each axis (binned SAH, Wald 2007): the cost
 //! of a split is `TRAVERSAL_COST + (A_left N_left + A_right N_right) / A_node` in units of one
-//! ray-triangle test, and a node becomes a leaf when no split costs less than testing its N
-//! triangles, or when it has at most `MIN_SPLIT` triangles. Depth is capped at `MAX_DEPTH`, the
+//! ray-primitive test, and a node becomes a leaf when no split costs less than testing its N
+//! primitives, or when it has at most `MIN_SPLIT` primitives. Depth is capped at `MAX_DEPTH`, the
 //! size of the shader's stack.
 //!
 //! Layout, for a CPU Vulkan driver such as lavapipe: each lane of a SIMD group runs its own
@@ -23,15 +25,15 @@ use glam::Vec3;
 
 /// Centroid bins per axis.
 const BINS: usize = 16;
-/// The cost of visiting a node, relative to one ray-triangle test.
+/// The cost of visiting a node, relative to one ray-primitive test.
 const TRAVERSAL_COST: f32 = 1.0;
-/// Nodes with at most this many triangles are leaves.
+/// Nodes with at most this many primitives are leaves.
 const MIN_SPLIT: usize = 2;
 /// The deepest node; the shader's stack holds `MAX_DEPTH` entries (BVH_STACK in bvh.wgsl).
 pub const MAX_DEPTH: usize = 32;
 
 /// One node as `struct BvhNode` in bvh.wgsl: its bounds, and `a`, `b`: for a leaf, the first
-/// of its triangles and `count << 2` (count >= 1); for an inner node, the index of its second
+/// of its primitives and `count << 2` (count >= 1); for an inner node, the index of its second
 /// child (the first is the next node) and the split axis (0, 1, 2) in `b`, whose count is 0.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
@@ -109,8 +111,31 @@ impl Aabb {
     }
 }
 
+/// The hierarchy's shape over any primitives, from their bounds alone: the nodes, whose leaves
+/// index `order`, and `order`, the primitives' indices in leaf order. Every primitive kind the
+/// traversal puts under a BVH (mesh triangles, spheres) is built by this one builder.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Hierarchy {
+    pub nodes: Vec<BvhNode>,
+    pub order: Vec<usize>,
+}
+
+impl Hierarchy {
+    /// Builds the hierarchy over primitives with these bounds (`[lo, hi]` each, at least one).
+    pub fn build(bounds: impl IntoIterator<Item = [Vec3; 2]>) -> Hierarchy {
+        let bounds: Vec<Aabb> = bounds.into_iter().map(|[lo, hi]| Aabb { lo, hi }).collect();
+        assert!(!bounds.is_empty(), "a BVH needs at least one primitive");
+        let centroids = bounds.iter().map(|b| 0.5 * (b.lo + b.hi)).collect();
+        let count = bounds.len();
+        let mut builder = Builder { order: (0..count).collect(), bounds, centroids, nodes: Vec::new() };
+        builder.node(0, count, 0);
+        Hierarchy { nodes: builder.nodes, order: builder.order }
+    }
+}
+
 struct Builder {
-    triangles: Vec<MeshTriangle>,
+    /// The primitives' indices, partitioned in place as nodes are split.
+    order: Vec<usize>,
     bounds: Vec<Aabb>,
     centroids: Vec<Vec3>,
     nodes: Vec<BvhNode>,
@@ -120,18 +145,17 @@ impl Bvh {
     /// Builds the hierarchy over `triangles` (at least one).
     pub fn build(triangles: Vec<MeshTriangle>) -> Bvh {
         assert!(!triangles.is_empty(), "a BVH needs at least one triangle");
-        let bounds: Vec<Aabb> =
-            triangles.iter().map(|t| t.corners().into_iter().fold(Aabb::EMPTY, Aabb::grow)).collect();
-        let centroids = bounds.iter().map(|b| 0.5 * (b.lo + b.hi)).collect();
-        let mut builder = Builder { triangles, bounds, centroids, nodes: Vec::new() };
-        let count = builder.triangles.len();
-        builder.node(0, count, 0);
-        Bvh { nodes: builder.nodes, triangles: builder.triangles }
+        let hierarchy = Hierarchy::build(triangles.iter().map(|t| {
+            let b = t.corners().into_iter().fold(Aabb::EMPTY, Aabb::grow);
+            [b.lo, b.hi]
+        }));
+        let triangles = hierarchy.order.iter().map(|&i| triangles[i]).collect();
+        Bvh { nodes: hierarchy.nodes, triangles }
     }
 }
 
 impl Builder {
-    /// Builds the node of triangles `first..first + count` at `depth`; returns its index.
+    /// Builds the node of primitives `first..first + count` at `depth`; returns its index.
     fn node(&mut self, first: usize, count: usize, depth: usize) -> usize {
         let range = first..first + count;
         let bounds = self.bounds[range.clone()].iter().fold(Aabb::EMPTY, |a, &b| a.join(b));
@@ -155,7 +179,7 @@ impl Builder {
     }
 
     /// The cheapest binned split of `first..first + count`, if it costs less than a leaf: its
-    /// axis and the number of triangles on its left, which it has moved to the front.
+    /// axis and the number of primitives on its left, which it has moved to the front.
     fn best_split(&mut self, first: usize, count: usize, bounds: Aabb) -> Option<(usize, usize)> {
         let range = first..first + count;
         let centre_bounds = self.centroids[range.clone()].iter().fold(Aabb::EMPTY, |a, &c| a.grow(c));
@@ -202,11 +226,11 @@ impl Builder {
         if split_cost >= count as f32 {
             return None;
         }
-        // Partition: triangles whose centroid's bin is left of the boundary first.
+        // Partition: primitives whose centroid's bin is left of the boundary first.
         let mut left = first;
         for i in range {
             if bin_of(self.centroids[i], axis) < boundary {
-                self.triangles.swap(i, left);
+                self.order.swap(i, left);
                 self.bounds.swap(i, left);
                 self.centroids.swap(i, left);
                 left += 1;

@@ -3,7 +3,8 @@
 //!
 //! - [`object`]: the objects as the shaders store them (one record layout for every kind of
 //!   shape), in the order both use (emitters last);
-//! - [`bvh`]: the hierarchy over a scene's mesh triangles (only a scene with a mesh has one);
+//! - [`bvh`]: the hierarchy's builder, over a scene's mesh triangles or its spheres (only a
+//!   scene with a mesh, or with more spheres than [`sphere_bvh::LITERAL_SPHERES`], has one);
 //! - [`mesh_shading`]: the shading normals of smooth meshes (`shaders/mesh_shading.wgsl` holds
 //!   the rules they follow);
 //! - [`material`]: the one material record and its kind codes;
@@ -18,19 +19,21 @@
 //! Each renderer keeps its own lights, parameters, errors and entry shader.
 
 pub mod bvh;
+pub mod bvh_buffers;
+mod bvh_traversal;
 pub mod camera;
 pub mod literal;
 pub mod material;
-pub mod mesh_buffers;
 pub mod mesh_shading;
 pub mod mesh_traversal;
 pub mod object;
 pub mod shaders;
 pub mod spawn;
+pub mod sphere_bvh;
 pub mod traversal;
 
+pub use bvh_buffers::BvhBindGroup;
 pub use camera::CameraRecord;
 pub use material::{MaterialCode, MaterialRecord, materials_module};
-pub use mesh_buffers::{MeshBindGroup, MeshBuffers};
 pub use object::{GpuObject, GpuShape, ObjectRecord, ShapeKind, gpu_shape, ordered_objects};
 pub use traversal::{Geometry, Traversal};

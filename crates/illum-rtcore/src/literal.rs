@@ -16,20 +16,20 @@ pub fn vec4(v: [f32; 4]) -> String {
     format!("vec4<f32>({}, {}, {}, {})", lit(v[0]), lit(v[1]), lit(v[2]), lit(v[3]))
 }
 
-/// The cases of `switch index` returning value i for index i (the last as the default, which
-/// WGSL requires; callers pass only valid indices).
+/// The cases of `switch index` returning the k-th value for index `first + k` (the last as the
+/// default, which WGSL requires; callers pass only valid indices).
 ///
 /// A switch over literals rather than a storage-buffer read: on a CPU Vulkan driver a read at a
 /// per-lane index is one scalar load per lane and component, while each case costs a few vector
 /// selects (docs/performance-levers.md).
-pub fn switch_cases(values: impl ExactSizeIterator<Item = String>) -> String {
+pub fn switch_cases(first: usize, values: impl ExactSizeIterator<Item = String>) -> String {
     let count = values.len();
     let mut cases = String::new();
     for (i, value) in values.enumerate() {
         if i + 1 == count {
             cases.push_str(&format!("        default: {{ return {value}; }}\n"));
         } else {
-            cases.push_str(&format!("        case {i}u: {{ return {value}; }}\n"));
+            cases.push_str(&format!("        case {}u: {{ return {value}; }}\n", first + i));
         }
     }
     cases

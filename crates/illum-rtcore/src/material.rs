@@ -102,7 +102,7 @@ impl MaterialRecord {
 /// The `illum::rtcore::materials` module whose `material_at` returns `records` as literals, so
 /// that a specialised pipeline reads no material buffer (`scene` names it in comments).
 pub fn materials_module(scene: &str, records: &[MaterialRecord]) -> ShaderFile {
-    let cases = switch_cases(records.iter().map(MaterialRecord::literal));
+    let cases = switch_cases(0, records.iter().map(MaterialRecord::literal));
     let source = format!(
         "#define_import_path illum::rtcore::materials
 

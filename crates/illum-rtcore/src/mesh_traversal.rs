@@ -8,6 +8,7 @@
 //! the same watertight test (bvh.wgsl's `hit_triangle`).
 
 use crate::bvh::{Bvh, MeshTriangle};
+use crate::bvh_traversal::{self, Tree};
 use crate::literal::{vec3, vec4};
 use crate::object::ShapeKind;
 
@@ -49,13 +50,15 @@ impl MeshForm {
 
 /// The generated code for the triangles: what closest_hit runs before the emitters, what
 /// occluded runs last, the object records of literal triangles (after the analytic objects'),
-/// the guard object_at puts before its switch for a BVH's, and the module's imports.
+/// for a BVH's the expression of the record of object `index` (>= `base`), the names it imports
+/// from illum::rtcore::bvh, and its module-level definitions.
 pub(crate) struct MeshCode {
     pub closest: String,
     pub occluded: String,
     pub object_literals: Vec<String>,
-    pub object_guard: String,
-    pub imports: String,
+    pub object_range: Option<String>,
+    pub bvh_imports: Vec<&'static str>,
+    pub definitions: String,
 }
 
 /// A triangle's object record: its corners in a, b, c and its order in `padding`, as bvh.wgsl's
@@ -99,32 +102,34 @@ pub(crate) fn mesh_code(form: &MeshForm, base: usize) -> MeshCode {
                 closest,
                 occluded,
                 object_literals: triangles.iter().map(triangle_object_literal).collect(),
-                object_guard: String::new(),
-                imports: format!(
-                    "#import illum::rtcore::bvh::{{sheared_ray, hit_triangle, surface_triangle}}\n\n{constant}"
-                ),
+                object_range: None,
+                bvh_imports: vec!["sheared_ray", "hit_triangle", "surface_triangle"],
+                definitions: constant,
             }
         }
-        MeshForm::Bvh(bvh) => MeshCode {
-            closest: format!(
-                "    // The meshes' {} triangles under one BVH (bvh.wgsl), numbered from {base}.\n    best = bvh_closest(o, d, inv_d, own, best, {base}u);\n",
-                bvh.triangles.len()
-            ),
-            occluded: format!(
-                "    // The meshes' triangles\n    if (bvh_occluded(o, d, inv_d, t_max, own, {base}u)) {{\n        return true;\n    }}\n"
-            ),
-            object_literals: Vec::new(),
-            object_guard: if base == 0 {
-                "    return triangle_object(index, KIND_TRIANGLE);\n".to_owned()
-            } else {
-                format!(
-                    "    if (index >= {base}u) {{\n        return triangle_object(index - {base}u, KIND_TRIANGLE);\n    }}\n"
-                )
-            },
-            imports: format!(
-                "#import illum::rtcore::bvh::{{bvh_closest, bvh_occluded, triangle_object, surface_triangle}}\n\n{constant}"
-            ),
-        },
+        MeshForm::Bvh(bvh) => {
+            let tree = Tree::Triangles { base };
+            let prefix = tree.prefix();
+            let mut bvh_imports = tree.imports().to_vec();
+            bvh_imports.extend(["triangle_object", "surface_triangle"]);
+            MeshCode {
+                closest: format!(
+                    "    // The meshes' {} triangles under one BVH (bvh.rs), numbered from {base}.\n    best = {prefix}_closest(o, d, inv_d, own, best);\n",
+                    bvh.triangles.len()
+                ),
+                occluded: format!(
+                    "    // The meshes' triangles\n    if ({prefix}_occluded(o, d, inv_d, t_max, own)) {{\n        return true;\n    }}\n"
+                ),
+                object_literals: Vec::new(),
+                object_range: Some(if base == 0 {
+                    "triangle_object(index, KIND_TRIANGLE)".to_owned()
+                } else {
+                    format!("triangle_object(index - {base}u, KIND_TRIANGLE)")
+                }),
+                bvh_imports,
+                definitions: format!("{constant}\n{}", bvh_traversal::functions(tree)),
+            }
+        }
     }
 }
 

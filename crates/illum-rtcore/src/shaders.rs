@@ -16,8 +16,9 @@ pub const MATERIAL_MODULE: ShaderFile = shader_file!("shaders/material.wgsl");
 pub const OPTICS_MODULE: ShaderFile = shader_file!("shaders/optics.wgsl");
 /// The pinhole camera (`illum::rtcore::camera`).
 pub const CAMERA_MODULE: ShaderFile = shader_file!("shaders/camera.wgsl");
-/// The BVH over mesh triangles (`illum::rtcore::bvh`): imported only by the traversal of a
-/// scene with a mesh, so other scenes' shaders do not contain it.
+/// The BVH's records and tests (`illum::rtcore::bvh`): imported only by the traversal of a
+/// scene with a mesh or with spheres past the literal limit, so other scenes' shaders do not
+/// contain it.
 pub const BVH_MODULE: ShaderFile = shader_file!("shaders/bvh.wgsl");
 /// The shading normals of smooth meshes (`illum::rtcore::mesh_shading`): imported only by the
 /// shaders of a scene with a smooth mesh (shader def SMOOTH_SHADING).
@@ -78,6 +79,7 @@ mod tests {
         use illum_gpu::members;
         use illum_gpu::shader::wgsl_struct;
 
+        use crate::sphere_bvh::BvhSphere;
         use crate::{CameraRecord, MaterialRecord, ObjectRecord};
 
         let entry = ShaderFile::generated(
@@ -85,12 +87,14 @@ mod tests {
             "#import illum::rtcore::geometry::Object
 #import illum::rtcore::material::Material
 #import illum::rtcore::camera::Camera
+#import illum::rtcore::bvh::BvhSphere
 @group(0) @binding(0) var<storage, read> objects: array<Object>;
 @group(0) @binding(1) var<storage, read> materials: array<Material>;
 @group(0) @binding(2) var<uniform> camera: Camera;
+@group(0) @binding(3) var<uniform> spheres: array<BvhSphere, 2>;
 @compute @workgroup_size(1)
 fn main() {
-    let x = objects[0].a.x + materials[0].a.x + camera.eye.x;
+    let x = objects[0].a.x + materials[0].a.x + camera.eye.x + spheres[1].sphere.x;
 }
 "
             .to_owned(),
@@ -103,6 +107,8 @@ fn main() {
             size_of::<ObjectRecord>(),
             &members!(ObjectRecord: kind, material, emitter, padding, a, b, c, d),
         );
+        wgsl("illum::rtcore::bvh", "BvhSphere")
+            .assert_matches(size_of::<BvhSphere>(), &members!(BvhSphere: sphere, material));
         wgsl("illum::rtcore::material", "Material")
             .assert_matches(size_of::<MaterialRecord>(), &members!(MaterialRecord: kind, a, b));
         wgsl("illum::rtcore::camera", "Camera").assert_matches(

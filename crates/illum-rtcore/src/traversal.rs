@@ -13,17 +13,26 @@
 //! - shadow rays test only the objects that can block a light (see [`can_block_light`]);
 //! - the object at a hit comes from literals (`object_at`), not from a storage buffer.
 //!
+//! A literal list's compile time grows with its length, so past a measured crossover the many
+//! are read from storage buffers under a BVH instead: spheres past
+//! [`sphere_bvh::LITERAL_SPHERES`] (sphere_bvh.rs), mesh triangles past
+//! [`crate::mesh_traversal::LITERAL_TRIANGLES`] (mesh_traversal.rs); the other objects stay
+//! literals.
+//!
 //! The measured effect of each is in docs/performance-levers.md.
 
 use std::collections::BTreeSet;
+use std::sync::Arc;
 
 use illum_gpu::shader::ShaderFile;
 use illum_scene::{Scene, Shape};
 
 use crate::bvh::{Bvh, MeshTriangle};
+use crate::bvh_traversal::{self, Tree};
 use crate::literal::{lit, switch_cases, vec3, vec4};
 use crate::mesh_traversal::{MeshForm, mesh_code};
 use crate::object::{GpuObject, GpuShape, ObjectRecord, ShapeKind, ordered_objects};
+use crate::sphere_bvh::{self, SphereBvh};
 
 /// What a traversal is generated from: the scene's objects in the order the shaders store them,
 /// and what shadow rays can be aimed at.
@@ -31,10 +40,13 @@ use crate::object::{GpuObject, GpuShape, ObjectRecord, ShapeKind, ordered_object
 pub struct Geometry {
     /// The scene's name, for the generated module's comments.
     pub scene: String,
-    /// Non-emitters first, then emitters ([`ordered_objects`]).
+    /// Non-emitters first, then emitters ([`ordered_objects`]); with spheres under a BVH, those
+    /// first of all, in its leaf order ([`sphere_bvh::arrange`]).
     pub objects: Vec<GpuObject>,
     /// Each object's name, in the same order.
     pub names: Vec<String>,
+    /// Each object's index in the scene's objects, in the same order.
+    pub scene_index: Vec<usize>,
     /// The index of the first emitter in `objects`.
     pub first_emitter: u32,
     /// The corners of every emitting quad: every point a shadow ray toward an area light (or a
@@ -46,11 +58,15 @@ pub struct Geometry {
     /// The triangles of every mesh object, as literals or under a BVH (mesh_traversal.rs);
     /// `None` for a scene without a mesh, whose traversal has no mesh code.
     pub meshes: Option<MeshForm>,
+    /// The hierarchy over the spheres, objects 0 to n - 1, for a scene with more than
+    /// [`sphere_bvh::LITERAL_SPHERES`] of them; `None` when they are literals.
+    pub spheres: Option<Arc<SphereBvh>>,
 }
 
 impl Geometry {
     pub fn new(scene: &Scene) -> Self {
-        let (ordered, first_emitter) = ordered_objects(scene);
+        let (mut ordered, first_emitter) = ordered_objects(scene);
+        let spheres = sphere_bvh::arrange(&mut ordered);
         let mut light_corners = Vec::new();
         let mut unbounded_lights = scene.directional_light.is_some();
         for (index, object) in &ordered {
@@ -82,16 +98,18 @@ impl Geometry {
             meshes: (!triangles.is_empty()).then(|| MeshForm::of(triangles)),
             scene: scene.name.clone(),
             names: ordered.iter().map(|(i, _)| scene.objects[*i].name.clone()).collect(),
+            scene_index: ordered.iter().map(|(i, _)| *i).collect(),
             objects: ordered.into_iter().map(|(_, object)| object).collect(),
+            spheres,
             first_emitter,
             light_corners,
             unbounded_lights,
         }
     }
 
-    /// The BVH the shaders bind as group 1, for a scene with more mesh triangles than the
-    /// traversal writes as literals.
-    pub fn bvh(&self) -> Option<&Bvh> {
+    /// The BVH over the mesh triangles, for a scene with more of them than the traversal writes
+    /// as literals.
+    pub fn mesh_bvh(&self) -> Option<&Bvh> {
         match &self.meshes {
             Some(MeshForm::Bvh(bvh)) => Some(bvh),
             _ => None,
@@ -348,11 +366,41 @@ pub fn generate(scene: &Geometry) -> Traversal {
     // Triangles are numbered after the analytic objects.
     let base = scene.objects.len();
     let mesh = scene.meshes.as_ref().map(|form| mesh_code(form, base));
+    // Objects 0 to under_bvh - 1 are spheres under a hierarchy (sphere_bvh.rs), the rest literals.
+    let under_bvh = scene.spheres.as_ref().map_or(0, |bvh| bvh.records.len());
+    // The walks closest_hit runs after the literal non-emitters (whose nearest hit, often the
+    // floor's, bounds them) and before the emitters.
+    let mut walks = String::new();
+    let mut bvh_imports: Vec<&'static str> = Vec::new();
+    let mut definitions = String::new();
+    if under_bvh > 0 {
+        let tree = Tree::Spheres;
+        let prefix = tree.prefix();
+        walks.push_str(&format!(
+            "    // Objects 0 to {} (spheres) under one BVH (sphere_bvh.rs).\n    best = {prefix}_closest(o, d, inv_d, own, best);\n",
+            under_bvh - 1
+        ));
+        occluded.push_str(&format!(
+            "    // Objects 0 to {}\n    if ({prefix}_occluded(o, d, inv_d, t_max, own)) {{\n        return true;\n    }}\n",
+            under_bvh - 1
+        ));
+        occluders.extend(0..under_bvh);
+        bvh_imports.extend(tree.imports());
+        bvh_imports.push("BvhSphere");
+        if let Some(bvh) = &scene.spheres {
+            definitions.push_str(&sphere_bvh::declarations(bvh));
+        }
+        definitions.push_str(&bvh_traversal::functions(tree));
+    }
+    if let Some(mesh) = &mesh {
+        walks.push_str(&mesh.closest);
+    }
     for (i, object) in scene.objects.iter().enumerate() {
-        if let Some(mesh) = &mesh
-            && i == scene.first_emitter as usize
-        {
-            closest.push_str(&mesh.closest);
+        if i == scene.first_emitter as usize {
+            closest.push_str(&walks);
+        }
+        if i < under_bvh {
+            continue;
         }
         let name = scene.names[i].replace(['\n', '\r'], " ");
         let hit = hit_expression(object, i);
@@ -377,25 +425,49 @@ pub fn generate(scene: &Geometry) -> Traversal {
             }
         }
     }
-    let mut mesh_imports = String::new();
-    let mut objects: Vec<String> = scene.object_records().iter().map(object_literal).collect();
-    let mut object_guard = String::new();
+    if scene.first_emitter as usize == scene.objects.len() {
+        closest.push_str(&walks);
+    }
+    // object_at: the ranges read from buffers, each (condition, record), then the literals.
+    let mut ranges: Vec<(String, String)> = Vec::new();
+    if under_bvh > 0 {
+        ranges.push((format!("index < {under_bvh}u"), "sphere_object(index)".to_owned()));
+    }
+    let mut objects: Vec<String> = scene.object_records()[under_bvh..].iter().map(object_literal).collect();
     if let Some(mesh) = mesh {
         kinds.insert(ShapeKind::Triangle);
-        if scene.first_emitter as usize == scene.objects.len() {
-            closest.push_str(&mesh.closest);
-        }
         occluded.push_str(&mesh.occluded);
         objects.extend(mesh.object_literals);
-        object_guard = mesh.object_guard;
-        mesh_imports = mesh.imports;
+        if let Some(record) = mesh.object_range {
+            ranges.push((format!("index >= {base}u"), record));
+        }
+        for name in mesh.bvh_imports {
+            if !bvh_imports.contains(&name) {
+                bvh_imports.push(name);
+            }
+        }
+        definitions.insert_str(0, &mesh.definitions);
     }
-    // A BVH's guard alone answers every index when there are no other objects.
-    let object_body = if objects.is_empty() {
-        object_guard
+    let mesh_imports = if bvh_imports.is_empty() {
+        String::new()
     } else {
-        format!("{object_guard}    switch index {{\n{}    }}\n", switch_cases(objects.into_iter()))
+        format!("#import illum::rtcore::bvh::{{{}}}\n\n{definitions}", bvh_imports.join(", "))
     };
+    let mut object_body = String::new();
+    for (k, (condition, record)) in ranges.iter().enumerate() {
+        // Without literals the last range answers every index left.
+        if objects.is_empty() && k + 1 == ranges.len() {
+            object_body.push_str(&format!("    return {record};\n"));
+        } else {
+            object_body.push_str(&format!("    if ({condition}) {{\n        return {record};\n    }}\n"));
+        }
+    }
+    if !objects.is_empty() {
+        object_body.push_str(&format!(
+            "    switch index {{\n{}    }}\n",
+            switch_cases(under_bvh, objects.into_iter())
+        ));
+    }
     let normal_cases = surface_cases(&kinds);
     // Shading never needs an emitter's surface (a hit on a light only needs the side, from the
     // light's normal), so this reconstruction covers the non-emitters' kinds alone.

@@ -73,6 +73,52 @@ pub fn shipped_scene(name: &str, width: u32, height: u32) -> crate::Scene {
     scene
 }
 
+/// `scene` with `count` spheres of radius 0.3 added, resting on the plane y = 0 in rows of nine
+/// one unit apart (x from 5 toward -x, z from -6 to 2), clear of the scene's own spheres, their
+/// materials cycling through the scene's `glass` and `metal` (the Whitted scene's) and an added
+/// diffuse white: a scene of many objects, past the traversal's literal limit, for the
+/// renderers' agreement tests.
+pub fn with_small_spheres(mut scene: crate::Scene, count: usize) -> crate::Scene {
+    use crate::{Material, MaterialKind, Object, Shape, Sphere};
+    let material = |name: &str| {
+        scene.materials.iter().position(|m| m.name == name).unwrap_or_else(|| panic!("no material {name:?}"))
+    };
+    let materials = [material("glass"), material("metal"), scene.materials.len()];
+    scene.materials.push(Material {
+        name: "small white".to_owned(),
+        kind: MaterialKind::Lambertian { albedo: glam::Vec3::splat(0.8) },
+    });
+    let own: Vec<Sphere> = scene
+        .objects
+        .iter()
+        .filter_map(|o| match o.shape {
+            Shape::Sphere(s) => Some(s),
+            _ => None,
+        })
+        .collect();
+    let radius = 0.3;
+    let mut added = 0;
+    for cell in 0.. {
+        if added == count {
+            break;
+        }
+        let centre = glam::Vec3::new(5.0 - (cell / 9) as f32, radius, -6.0 + (cell % 9) as f32);
+        let clear = own.iter().all(|s| {
+            let d = glam::Vec2::new(s.center.x - centre.x, s.center.z - centre.z);
+            d.length() > s.radius + radius + 0.1
+        });
+        if clear {
+            scene.objects.push(Object {
+                name: format!("small sphere {added}"),
+                material: materials[added % materials.len()],
+                shape: Shape::Sphere(Sphere { center: centre, radius }),
+            });
+            added += 1;
+        }
+    }
+    scene
+}
+
 /// What an error test edits and how it loads the result: a valid scene text, the file label
 /// its errors name, and the loader (`Scene::from_toml_str`, or a renderer's view of a scene).
 /// The error tests of every crate share it, so that each checks a rule the same way.

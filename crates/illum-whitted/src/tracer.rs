@@ -8,7 +8,7 @@ use illum_gpu::buffers::{buffer_bind_group, dispatch};
 use illum_gpu::shader::{self, ShaderFile};
 use illum_gpu::{GpuContext, GpuError, readback, shader_file, wgpu};
 use illum_image::RgbImage32;
-use illum_rtcore::{Geometry, MeshBindGroup, MeshBuffers};
+use illum_rtcore::{BvhBindGroup, Geometry};
 use illum_scene::{RendererKind, Scene, SceneError};
 use wgpu::util::DeviceExt;
 
@@ -61,8 +61,9 @@ pub struct WhittedTracer {
     height: u32,
     pipeline: wgpu::ComputePipeline,
     bind_group: wgpu::BindGroup,
-    /// The mesh's buffers (group 1), for a scene with a BVH or a smooth mesh.
-    mesh: Option<MeshBindGroup>,
+    /// The hierarchies' and shading normals' buffers (group 1), for a scene with a mesh or many
+    /// spheres.
+    bvh: Option<BvhBindGroup>,
     params: wgpu::Buffer,
     radiance_params: WhittedParams,
     image: wgpu::Buffer,
@@ -118,10 +119,9 @@ impl WhittedTracer {
         let radiance_params =
             encode::params(scene, geometry.first_emitter, lights.len() as u32, OUTPUT_RADIANCE);
         let scene_index = {
-            let (ordered, _) = illum_rtcore::ordered_objects(scene);
             let triangles =
                 geometry.meshes.iter().flat_map(|m| m.triangles().iter().map(|t| t.object as usize));
-            ordered.iter().map(|(i, _)| *i).chain(triangles).collect()
+            geometry.scene_index.iter().copied().chain(triangles).collect()
         };
 
         let device = &gpu.device;
@@ -136,9 +136,13 @@ impl WhittedTracer {
             &shader_defs(scene),
             "whitted ray tracer",
         )?;
-        let mesh_buffers = MeshBuffers::of(scene, &geometry);
-        mesh_buffers.check_size(scene, limit)?;
-        let (bind_group, image, params, mesh) =
+        BvhBindGroup::check_size(
+            scene,
+            &geometry,
+            limit,
+            gpu.device.limits().max_uniform_buffer_binding_size,
+        )?;
+        let (bind_group, image, params, bvh) =
             gpu.scoped("creating the Whitted ray tracer's buffers", || {
                 let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some("whitted params"),
@@ -158,8 +162,8 @@ impl WhittedTracer {
                     &pipeline.get_bind_group_layout(0),
                     &[(0, &params), (1, &lights), (2, &image)],
                 );
-                let mesh = MeshBindGroup::new(device, &pipeline, &mesh_buffers);
-                (bind_group, image, params, mesh)
+                let bvh = BvhBindGroup::new(device, &pipeline, scene, &geometry);
+                (bind_group, image, params, bvh)
             })?;
         Ok(WhittedTracer {
             gpu: gpu.clone(),
@@ -167,7 +171,7 @@ impl WhittedTracer {
             height,
             pipeline,
             bind_group,
-            mesh,
+            bvh,
             params,
             radiance_params,
             image,
@@ -236,16 +240,16 @@ impl WhittedTracer {
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("whitted") });
         let workgroups = [columns.div_ceil(WORKGROUP), rows.div_ceil(WORKGROUP), 1];
-        match &self.mesh {
+        match &self.bvh {
             None => dispatch(&mut encoder, "whitted", &self.pipeline, &self.bind_group, workgroups),
-            Some(mesh) => {
+            Some(bvh) => {
                 let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("whitted"),
                     timestamp_writes: None,
                 });
                 pass.set_pipeline(&self.pipeline);
                 pass.set_bind_group(0, &self.bind_group, &[]);
-                mesh.set(&mut pass);
+                bvh.set(&mut pass);
                 pass.dispatch_workgroups(workgroups[0], workgroups[1], workgroups[2]);
             }
         }

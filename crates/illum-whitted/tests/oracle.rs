@@ -54,6 +54,22 @@ fn the_cornell_box_matches_the_f64_copy() {
     }
 }
 
+/// Spheres past the traversal's literal limit go under a BVH (illum-rtcore's sphere_bvh.rs);
+/// the f64 copy tests every object by brute force.
+#[test]
+fn many_spheres_under_the_bvh_match_the_f64_copy() {
+    let count = illum_rtcore::sphere_bvh::LITERAL_SPHERES + 24;
+    for depth in [1, 8] {
+        let mut scene = illum_scene::testing::with_small_spheres(
+            illum_scene::testing::shipped_scene("whitted.toml", 96, 54),
+            count,
+        );
+        assert!(illum_rtcore::Geometry::new(&scene).spheres.is_some());
+        scene.whitted.depth = depth;
+        check(&format!("whitted + {count} spheres (BVH)"), &scene);
+    }
+}
+
 #[test]
 fn a_sun_of_finite_size_is_refused_by_name() {
     let mut scene = illum_scene::testing::shipped_scene("whitted.toml", 8, 8);

@@ -60,6 +60,8 @@ use schedule::{Costs, Cursor, Stage, Submission, Took};
 struct Gather {
     pipeline: wgpu::ComputePipeline,
     bind_group: wgpu::BindGroup,
+    /// The hierarchies' buffers (group 1), for a scene with a mesh or many spheres.
+    bvh: Option<illum_rtcore::BvhBindGroup>,
     /// The grid's bucket heads, cleared before each dispatch.
     heads: wgpu::Buffer,
     heads_frame_bytes: u64,
@@ -67,6 +69,8 @@ struct Gather {
 
 pub(crate) struct CausticTracer {
     pipeline: wgpu::ComputePipeline,
+    /// The hierarchies' buffers (group 1), for a scene with a mesh or many spheres.
+    bvh: Option<illum_rtcore::BvhBindGroup>,
     /// The photon gather, with a delta sun.
     gather: Option<Gather>,
     params_buffer: wgpu::Buffer,

@@ -12,7 +12,6 @@ use illum_gpu::buffers::{buffer_bind_group, dispatch};
 use illum_gpu::readback;
 use illum_gpu::readback::PendingRead;
 use illum_gpu::wgpu;
-use illum_rtcore::{MeshBindGroup, MeshBuffers};
 use wgpu::util::DeviceExt;
 
 use super::PathTracer;
@@ -201,19 +200,19 @@ impl PathTracer {
         let bind_group = buffer_bind_group(device, "guide buffers", &layout, &bound);
         // A bind group of an automatic layout serves that pipeline only: the guides bind the BVH
         // anew.
-        let mesh = MeshBindGroup::new(device, &compute, &MeshBuffers::of(scene, &gpu_scene.geometry));
+        let bvh = super::pipeline::bvh_bind_group(device, &compute, scene, &gpu_scene, pipeline.options);
         let mut encoder = device.create_command_encoder(&Default::default());
         let workgroups = [width.div_ceil(8), height.div_ceil(8), 1];
-        match &mesh {
+        match &bvh {
             None => dispatch(&mut encoder, "guide buffers", &compute, &bind_group, workgroups),
-            Some(mesh) => {
+            Some(bvh) => {
                 let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("guide buffers"),
                     timestamp_writes: None,
                 });
                 pass.set_pipeline(&compute);
                 pass.set_bind_group(0, &bind_group, &[]);
-                mesh.set(&mut pass);
+                bvh.set(&mut pass);
                 pass.dispatch_workgroups(workgroups[0], workgroups[1], workgroups[2]);
             }
         }

@@ -3,7 +3,7 @@
 //! light tracer. What a band needs to be traced, and nothing of how bands are run or folded.
 
 use illum_gpu::{GpuContext, wgpu};
-use illum_rtcore::{MeshBindGroup, MeshBuffers};
+use illum_rtcore::BvhBindGroup;
 use illum_scene::Scene;
 use wgpu::util::DeviceExt;
 
@@ -44,8 +44,25 @@ pub(super) struct ScenePipeline {
     pub(super) radiance_exponent: i32,
     /// The caustic's light tracer, when the scene asks for it and can have a caustic.
     pub(super) caustic: Option<CausticTracer>,
-    /// The mesh's buffers (group 1), for a scene with a BVH or a smooth mesh.
-    pub(super) mesh: Option<MeshBindGroup>,
+    /// The hierarchies' and shading normals' buffers (group 1), for a scene with a mesh or many
+    /// spheres.
+    pub(super) bvh: Option<BvhBindGroup>,
+}
+
+/// The group 1 buffers bound to `pipeline`, which a pipeline has when its specialised traversal
+/// walks a hierarchy or its shading reads smooth meshes' normals; the generic traversal reads
+/// every analytic object from the objects buffer (and is refused a mesh) and binds no group 1.
+pub(crate) fn bvh_bind_group(
+    device: &wgpu::Device,
+    pipeline: &wgpu::ComputePipeline,
+    scene: &Scene,
+    gpu_scene: &GpuScene,
+    options: TracerOptions,
+) -> Option<BvhBindGroup> {
+    match options.traversal {
+        Traversal::Generic => None,
+        Traversal::Specialised => BvhBindGroup::new(device, pipeline, scene, &gpu_scene.geometry),
+    }
 }
 
 impl ScenePipeline {
@@ -58,18 +75,21 @@ impl ScenePipeline {
         options: TracerOptions,
         allocation: Option<SampleAllocation>,
     ) -> Result<Self, PathTraceError> {
-        let mesh_buffers = MeshBuffers::of(scene, &gpu_scene.geometry);
-        if gpu_scene.geometry.meshes.is_some() {
-            if options.traversal == Traversal::Generic {
-                return Err(PathTraceError::Unsupported {
-                    scene: scene.name.clone(),
-                    message: "the generic traversal reads objects from a buffer and has no triangles: a \
-                              scene with a mesh needs the specialised traversal"
-                        .to_owned(),
-                });
-            }
-            mesh_buffers.check_size(scene, gpu.device.limits().max_storage_buffer_binding_size)?;
+        if gpu_scene.geometry.meshes.is_some() && options.traversal == Traversal::Generic {
+            return Err(PathTraceError::Unsupported {
+                scene: scene.name.clone(),
+                message: "the generic traversal reads objects from a buffer and has no triangles: a \
+                          scene with a mesh needs the specialised traversal"
+                    .to_owned(),
+            });
         }
+        let limits = gpu.device.limits();
+        BvhBindGroup::check_size(
+            scene,
+            &gpu_scene.geometry,
+            limits.max_storage_buffer_binding_size,
+            limits.max_uniform_buffer_binding_size,
+        )?;
         let base_params = gpu_scene::params(scene, gpu_scene);
         let (compute, traversal_source) =
             shaders::pathtrace_pipeline(gpu, scene, gpu_scene, options, allocation.is_some())?;
@@ -108,7 +128,7 @@ impl ScenePipeline {
             [&params_buffer, &objects_buffer, &materials_buffer],
             base_params,
         )?;
-        let mesh = MeshBindGroup::new(device, &compute, &mesh_buffers);
+        let bvh = bvh_bind_group(device, &compute, scene, gpu_scene, options);
         let mut pipeline = ScenePipeline {
             gpu: gpu.clone(),
             scene: scene.clone(),
@@ -123,7 +143,7 @@ impl ScenePipeline {
             allocation: None,
             radiance_exponent: gpu_scene.radiance_exponent,
             caustic,
-            mesh,
+            bvh,
         };
         if let Some(allocation) = allocation {
             pipeline.check_allocation(&allocation)?;

@@ -338,8 +338,8 @@ impl PathTracer {
             });
             compute.set_pipeline(&self.pipeline.compute);
             compute.set_bind_group(0, &batch.bind_group, &[]);
-            if let Some(mesh) = &self.pipeline.mesh {
-                mesh.set(&mut compute);
+            if let Some(bvh) = &self.pipeline.bvh {
+                bvh.set(&mut compute);
             }
             let width = self.pipeline.scene.camera.width;
             compute.dispatch_workgroups(

@@ -58,7 +58,7 @@ fn a_diffuse_mesh_agrees_with_the_oracle() {
 #[test]
 fn a_mesh_of_literal_triangles_agrees_with_the_oracle() {
     let scene = cornell_with_icosphere_of("glass", 2, 0, false);
-    assert!(illum_rtcore::Geometry::new(&scene).bvh().is_none());
+    assert!(illum_rtcore::Geometry::new(&scene).mesh_bvh().is_none());
     compare_scene_with("cornell + glass icosahedron (literals), bounces 2", &scene, 1024);
 }
 
@@ -73,7 +73,7 @@ fn a_glass_mesh_agrees_with_the_oracle() {
 fn smooth_meshes_agree_with_the_oracle() {
     for (material, k) in [("white", 1), ("glass", 0)] {
         let scene = cornell_with_icosphere_of(material, 2, k, true);
-        assert_eq!(illum_rtcore::Geometry::new(&scene).bvh().is_some(), k > 0);
+        assert_eq!(illum_rtcore::Geometry::new(&scene).mesh_bvh().is_some(), k > 0);
         compare_scene_with(&format!("cornell + smooth {material} icosphere-{k}, bounces 2"), &scene, 1024);
     }
 }

@@ -252,3 +252,16 @@ fn a_sun_disc_agrees_with_the_oracle() {
     }
     compare_scene("whitted, sun of radius 5 degrees, bounces 1", &s);
 }
+
+/// Spheres past the traversal's literal limit go under a BVH (illum-rtcore's sphere_bvh.rs) in
+/// the camera paths and the caustic's passes alike; the oracle tests every object by brute force.
+#[test]
+fn many_spheres_under_the_bvh_agree_with_the_oracle() {
+    let count = illum_rtcore::sphere_bvh::LITERAL_SPHERES + 24;
+    let mut s = illum_scene::testing::with_small_spheres(scene("whitted", 2), count);
+    assert!(illum_rtcore::Geometry::new(&s).spheres.is_some());
+    // Fewer samples than the other comparisons (the oracle's brute force tests 43 objects per
+    // ray): the power checks below still hold.
+    s.pathtrace.spp = 1024;
+    compare_scene_with(&format!("whitted + {count} spheres (BVH), bounces 2"), &s, 256);
+}

@@ -138,6 +138,9 @@ impl CausticTracer {
             });
             compute.set_pipeline(&self.pipeline);
             compute.set_bind_group(0, &self.bind_group, &[]);
+            if let Some(bvh) = &self.bvh {
+                bvh.set(&mut compute);
+            }
             compute.dispatch_workgroups(gx, gy, frames);
         }
         // Its own pass: the gather reads what every particle of the frames stored.
@@ -148,6 +151,9 @@ impl CausticTracer {
             });
             compute.set_pipeline(&gather.pipeline);
             compute.set_bind_group(0, &gather.bind_group, &[]);
+            if let Some(bvh) = &gather.bvh {
+                bvh.set(&mut compute);
+            }
             compute.dispatch_workgroups(gx, gy, frames);
         }
         let result = staging.map(|staging| {

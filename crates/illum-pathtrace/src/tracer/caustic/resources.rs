@@ -15,6 +15,7 @@ use crate::bindings::Binding;
 use crate::estimators::GATHER_RADIUS_FRACTION;
 use crate::gpu_scene::{GpuParams, GpuScene};
 use crate::options::TracerOptions;
+use crate::tracer::pipeline::bvh_bind_group;
 use crate::{PathTraceError, shaders};
 
 impl CausticTracer {
@@ -216,11 +217,19 @@ impl CausticTracer {
                         entries: &gather_entries,
                     })
                 })?;
-                Some(Gather { pipeline, bind_group, heads: heads.clone(), heads_frame_bytes: 4 * buckets })
+                let bvh = bvh_bind_group(device, &pipeline, scene, gpu_scene, options);
+                Some(Gather {
+                    pipeline,
+                    bind_group,
+                    bvh,
+                    heads: heads.clone(),
+                    heads_frame_bytes: 4 * buckets,
+                })
             }
             None => None,
         };
         Ok(Some(CausticTracer {
+            bvh: bvh_bind_group(device, &pipeline, scene, gpu_scene, options),
             pipeline,
             gather,
             params_buffer,
