@@ -15,13 +15,18 @@ python="$1"
 out="$2"
 mkdir -p "$out/meshes"
 
+# The tables only (not the reference renders' progress); the machine's load beside them, since
+# a second job on the 2 cores slows both renderers' whole processes unevenly.
+tables() { grep -v '^rendering the reference'; }
+echo "Load average at the start: $(cut -d' ' -f1-3 /proc/loadavg)."
+echo
 echo "### The image: scenes/cornell-mesh.toml (1280 triangles)"
 "$python" bench/vs_mitsuba.py --scene scenes/cornell-mesh.toml --size 256 --spp 1024 --bounces 2 \
-    --reference-spp 4096 --samplers independent --illum independent
+    --reference-spp 4096 --samplers independent --illum independent | tables
 for k in 5 7 8; do
     python3 scripts/icosphere.py --subdivision "$k" --out "$out/meshes"
     echo
     echo "### $((20 * 4 ** k)) triangles (icosphere subdivision $k)"
     "$python" bench/vs_mitsuba.py --scene "$out/meshes/cornell-mesh-$k.toml" --size 256 --spp 64 --bounces 2 \
-        --reference-spp 1024 --samplers independent,multijitter --illum independent,low-discrepancy
+        --reference-spp 1024 --samplers independent,multijitter --illum independent,low-discrepancy | tables
 done
