@@ -1,6 +1,6 @@
 #define_import_path illum::rtcore::bvh
 
-#import illum::rtcore::geometry::{Hit, Object, Surface, FAR}
+#import illum::rtcore::geometry::{Hit, Object, Surface, FAR, triangle_barycentrics}
 #import illum::rtcore::spawn::{spawn_error, max_abs}
 
 // The records of the bounding volume hierarchies (built and flattened by illum-rtcore's bvh.rs,
@@ -149,9 +149,8 @@ fn surface_triangle(obj: Object, p: vec3<f32>) -> Surface {
     let edge_b = obj.b.xyz - corner;
     let edge_c = obj.c.xyz - corner;
     let n = cross(edge_b, edge_c);
-    let w = n / dot(n, n);
-    let h = p - corner;
-    let q = corner + dot(w, cross(h, edge_c)) * edge_b + dot(w, cross(edge_b, h)) * edge_c;
+    let barycentric = triangle_barycentrics(obj, p);
+    let q = corner + barycentric.x * edge_b + barycentric.y * edge_c;
     let magnitude = max_abs(corner) + max_abs(edge_b) + max_abs(edge_c);
     return Surface(q, normalize(n), spawn_error(magnitude));
 }

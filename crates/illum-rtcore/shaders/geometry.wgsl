@@ -36,6 +36,19 @@ struct Object {
     d: vec4<f32>,
 }
 
+// The barycentric coordinates (beta, gamma) of a point p in the plane of the triangle (a, b, c)
+// that `obj` holds, p = a + beta (b - a) + gamma (c - a): what both the hit's rebuilt point
+// (surface_triangle, bvh.wgsl) and a smooth mesh's shading normal (mesh_shading.wgsl) are made of.
+fn triangle_barycentrics(obj: Object, p: vec3<f32>) -> vec2<f32> {
+    let corner = obj.a.xyz;
+    let edge_b = obj.b.xyz - corner;
+    let edge_c = obj.c.xyz - corner;
+    let n = cross(edge_b, edge_c);
+    let w = n / dot(n, n);
+    let h = p - corner;
+    return vec2<f32>(dot(w, cross(h, edge_c)), dot(w, cross(edge_b, h)));
+}
+
 struct Hit {
     t: f32,
     index: u32,

@@ -21,7 +21,7 @@
 //   reflection in front of the surface, the refraction behind it); otherwise the geometric
 //   normal, so that no reflection goes into the surface and no refraction stays out of it.
 
-#import illum::rtcore::geometry::Object
+#import illum::rtcore::geometry::{Object, triangle_barycentrics}
 #import illum::rtcore::optics::{transmitted_cos2, refracted}
 
 // Per triangle, in scene order (the `padding` of its object record, set to its order by
@@ -41,15 +41,9 @@ fn triangle_shading_normal(obj: Object, p: vec3<f32>, n: vec3<f32>) -> vec3<f32>
     let na = corner_normal(first);
     let nb = corner_normal(first + 3u);
     let nc = corner_normal(first + 6u);
-    // p's barycentric coordinates, as surface_triangle (bvh.wgsl) computes them.
-    let corner = obj.a.xyz;
-    let edge_b = obj.b.xyz - corner;
-    let edge_c = obj.c.xyz - corner;
-    let m = cross(edge_b, edge_c);
-    let w = m / dot(m, m);
-    let h = p - corner;
-    let beta = dot(w, cross(h, edge_c));
-    let gamma = dot(w, cross(edge_b, h));
+    let barycentric = triangle_barycentrics(obj, p);
+    let beta = barycentric.x;
+    let gamma = barycentric.y;
     let ns = (1.0 - beta - gamma) * na + beta * nb + gamma * nc;
     let length2 = dot(ns, ns);
     // Unit corner normals interpolate to a length of at least 1e-3 unless they nearly oppose.
