@@ -1,4 +1,4 @@
-//! A scene without a mesh compiles no BVH code: the traversal generated for the shipped scenes
+//! A scene without a mesh or many spheres compiles no BVH code: the traversal generated for the shipped scenes
 //! is pinned, byte for byte (64-bit FNV-1a of its text), as it was before meshes existed.
 
 use illum_rtcore::Geometry;
