@@ -47,6 +47,7 @@ mod lights;
 mod load;
 mod materials;
 mod mesh;
+mod mesh_file;
 mod mesh_load;
 mod mesh_obj;
 mod mesh_ply;

@@ -8,6 +8,7 @@ use glam::{DMat3, DVec3, Vec3};
 use crate::content_hash::fnv1a_64;
 use crate::error::SceneError;
 use crate::file::{RawMesh, RawScene};
+use crate::mesh_file::FileMesh;
 use crate::mesh_obj::read_obj;
 use crate::mesh_ply::read_ply;
 use crate::spelling::object_label;
@@ -15,16 +16,6 @@ use crate::spelling::object_label;
 /// Reads a mesh file named in a scene (relative to the scene file): its bytes, or why not, as a
 /// sentence naming the file.
 pub type ReadFile<'a> = dyn FnMut(&str) -> Result<Vec<u8>, String> + 'a;
-
-/// A mesh as its file gives it, in the file's own coordinates: every index in range, every
-/// position and normal finite, at least one triangle.
-#[derive(Clone, Debug, PartialEq)]
-pub(crate) struct FileMesh {
-    pub positions: Vec<[f32; 3]>,
-    /// One normal per position, when the file gives every vertex one.
-    pub normals: Option<Vec<[f32; 3]>>,
-    pub triangles: Vec<[u32; 3]>,
-}
 
 /// A mesh file read and parsed, before it is placed.
 pub(crate) struct LoadedMesh {

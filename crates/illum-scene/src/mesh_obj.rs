@@ -8,7 +8,7 @@
 
 use std::io::Cursor;
 
-use crate::mesh_load::FileMesh;
+use crate::mesh_file::FileMesh;
 
 fn options() -> tobj::LoadOptions {
     tobj::LoadOptions {

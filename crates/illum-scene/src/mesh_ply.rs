@@ -16,7 +16,7 @@ use std::io::Cursor;
 use ply_rs_bw::parser::Parser;
 use ply_rs_bw::ply::{DefaultElement, Encoding, Ply, Property};
 
-use crate::mesh_load::FileMesh;
+use crate::mesh_file::FileMesh;
 
 /// Where element `index` of `element` is, for messages: `FILE:LINE` in ASCII, else
 /// `FILE, element NAME ENTRY` (0-based).
