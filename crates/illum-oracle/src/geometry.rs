@@ -91,30 +91,46 @@ impl Parallelogram {
     ///     s = q . (d x v) / det,   r = d . (q x u) / det,   t = v . (q x u) / det.
     /// det = 0 means d is parallel to the plane (no single crossing).
     pub fn intersect(&self, o: DVec3, d: DVec3, t_max: f64) -> Option<SurfaceHit> {
-        let dv = d.cross(self.v);
-        let det = self.u.dot(dv);
-        if det == 0.0 || !det.is_finite() {
-            return None;
-        }
-        let inv_det = 1.0 / det;
-        let q = o - self.corner;
-        let s = q.dot(dv) * inv_det;
-        if !(0.0..=1.0).contains(&s) {
-            return None;
-        }
-        let qu = q.cross(self.u);
-        let r = d.dot(qu) * inv_det;
-        if !(0.0..=1.0).contains(&r) {
-            return None;
-        }
-        let t = self.v.dot(qu) * inv_det;
-        (t > 0.0 && t < t_max).then_some(SurfaceHit::flat(t, self.normal))
+        let inside = |s: f64, r: f64| (0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&r);
+        let (t, _, _) = plane_crossing(o, d, self.corner, self.u, self.v, t_max, inside)?;
+        Some(SurfaceHit::flat(t, self.normal))
     }
 
     /// The point with parameters (s, r) in [0, 1]^2; uniform (s, r) gives a uniform point.
     pub fn point(&self, s: f64, r: f64) -> DVec3 {
         self.corner + s * self.u + r * self.v
     }
+}
+
+/// Where o + t d crosses corner + s e1 + r e2, for a parallelogram's and a triangle's test: Cramer's
+/// rule with scalar triple products, with q = o - corner and det = e1 . (d x e2),
+///     s = q . (d x e2) / det,   r = d . (q x e1) / det,   t = e2 . (q x e1) / det;
+/// `(t, s, r)` when (s, r) is `inside` the shape and 0 < t < t_max. det = 0 means d is parallel
+/// to the plane (no single crossing).
+fn plane_crossing(
+    o: DVec3,
+    d: DVec3,
+    corner: DVec3,
+    e1: DVec3,
+    e2: DVec3,
+    t_max: f64,
+    inside: impl Fn(f64, f64) -> bool,
+) -> Option<(f64, f64, f64)> {
+    let dv = d.cross(e2);
+    let det = e1.dot(dv);
+    if det == 0.0 || !det.is_finite() {
+        return None;
+    }
+    let inv_det = 1.0 / det;
+    let q = o - corner;
+    let s = q.dot(dv) * inv_det;
+    let qu = q.cross(e1);
+    let r = d.dot(qu) * inv_det;
+    if !inside(s, r) {
+        return None;
+    }
+    let t = e2.dot(qu) * inv_det;
+    (t > 0.0 && t < t_max).then_some((t, s, r))
 }
 
 impl Ball {
@@ -242,28 +258,9 @@ impl Triangle {
     /// (s = 0, r = 0 and s + r = 1 count as inside); in f64 a ray through a shared edge of two
     /// f32 triangles is found by at least one of them but for rounding of order 1e-16.
     pub fn intersect(&self, o: DVec3, d: DVec3, t_max: f64) -> Option<SurfaceHit> {
-        let dv = d.cross(self.e2);
-        let det = self.e1.dot(dv);
-        if det == 0.0 || !det.is_finite() {
-            return None;
-        }
-        let inv_det = 1.0 / det;
-        let q = o - self.a;
-        let s = q.dot(dv) * inv_det;
-        if !(0.0..=1.0).contains(&s) {
-            return None;
-        }
-        let qu = q.cross(self.e1);
-        let r = d.dot(qu) * inv_det;
-        if !(r >= 0.0 && s + r <= 1.0) {
-            return None;
-        }
-        let t = self.e2.dot(qu) * inv_det;
-        (t > 0.0 && t < t_max).then(|| SurfaceHit {
-            t,
-            normal: self.normal,
-            shading: self.shading_normal(s, r),
-        })
+        let inside = |s: f64, r: f64| (0.0..=1.0).contains(&s) && r >= 0.0 && s + r <= 1.0;
+        let (t, s, r) = plane_crossing(o, d, self.a, self.e1, self.e2, t_max, inside)?;
+        Some(SurfaceHit { t, normal: self.normal, shading: self.shading_normal(s, r) })
     }
 
     /// The centre and radius of a sphere around the triangle (about its centroid).
