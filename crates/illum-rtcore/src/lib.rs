@@ -27,6 +27,7 @@ pub mod material;
 pub mod mesh_shading;
 pub mod mesh_traversal;
 pub mod object;
+pub mod scene_geometry;
 pub mod shaders;
 pub mod spawn;
 pub mod sphere_bvh;
