@@ -114,6 +114,15 @@ impl Bodies {
         self.surfaces[object]
     }
 
+    /// The derivative of the outward normal per unit move of the hit point along the surface:
+    /// 1 / r on a sphere (n = (p - c) / r), 0 on a flat face.
+    pub fn curvature(&self, object: usize) -> f64 {
+        match self.bodies[object] {
+            Body::Sphere { radius, .. } => 1.0 / radius,
+            Body::Quad { .. } | Body::Box { .. } => 0.0,
+        }
+    }
+
     /// The spheres with a specular surface: (object, centre, radius).
     pub fn specular_spheres(&self) -> impl Iterator<Item = (usize, DVec3, f64)> + '_ {
         self.bodies.iter().enumerate().filter_map(|(i, b)| match (b, self.surfaces[i]) {
