@@ -238,20 +238,21 @@ impl Solver {
 
     /// The camera ray through s followed along `chain`: the direction its last ray leaves in,
     /// that direction's derivatives per film coordinate, and the chain's throughput; None where
-    /// the ray does not follow the chain (another object is nearer, an event is impossible, or
-    /// the last ray does not escape).
+    /// the ray does not follow the chain (an event is impossible, another object is nearer, or
+    /// the last ray does not escape) or leaves behind the sun's hemisphere.
     fn follow(&self, s: [f64; 2], chain: &[Step]) -> Option<(DVec3, [DVec3; 2], [f64; 3])> {
         let mut o = self.film.eye;
         let mut d_o = [DVec3::ZERO; 2];
         let (mut d, mut dd) = self.film.direction_and_derivatives(s);
         let mut own = None;
         let mut throughput = [1.0; 3];
+        // The segments (origin, direction, object left, length, object hit), checked for blockers
+        // once the chain's own geometry holds: Newton's trial points mostly leave a chain by
+        // missing its objects, which costs no walk of the hierarchy.
+        let mut segments = Vec::with_capacity(chain.len());
         for &(object, event) in chain {
-            // The chain's object, and nothing nearer on the way to it.
             let hit = self.bodies.hit(object, o, d, own)?;
-            if self.bodies.blocked(o, d, own, hit.t, Some(object)) {
-                return None;
-            }
+            segments.push((o, d, own, hit.t, object));
             // The hit point p = o + t d stays on the surface as s moves: n . dp = 0 gives dt, and
             // the normal turns by the curvature times dp.
             let dp = [0, 1].map(|c| {
@@ -268,17 +269,19 @@ impl Solver {
             dd = dd2;
             own = Some(object);
         }
-        (!self.bodies.blocked(o, d, own, f64::INFINITY, None)).then_some((d, dd, throughput))
+        if d.dot(self.w) <= SUN_HEMISPHERE {
+            return None;
+        }
+        let blocked =
+            segments.iter().any(|&(o, d, own, t, object)| self.bodies.blocked(o, d, own, t, Some(object)));
+        (!blocked && !self.bodies.blocked(o, d, own, f64::INFINITY, None)).then_some((d, dd, throughput))
     }
 
     /// The gnomonic coordinates g of the leaving direction about w, their Jacobian dg/ds and the
-    /// chain's throughput at s (None behind the sun's hemisphere).
+    /// chain's throughput at s (None where [`Self::follow`] has none).
     fn residual(&self, s: [f64; 2], chain: &[Step]) -> Option<Residual> {
         let (d, dd, throughput) = self.follow(s, chain)?;
         let z = d.dot(self.w);
-        if z <= 1e-6 {
-            return None;
-        }
         let g = [d.dot(self.t1) / z, d.dot(self.t2) / z];
         // g_r = d . t_r / z, z = d . w: dg_r = (dd . t_r - g_r dd . w) / z.
         let mut j = [[0.0; 2]; 2];
@@ -382,6 +385,9 @@ const NEWTON_ITERATIONS: usize = 60;
 /// [`NEWTON_ITERATIONS`] (60 x 2^-12 = 1.5%): it has met the edge of its chain's region. Further
 /// halvings would cost a residual each, most of the solve's time (docs/performance-caustics.md).
 const LINE_SEARCH_HALVINGS: usize = 12;
+/// The least cosine between a chain's leaving direction and the sun for the gnomonic
+/// coordinates (which divide by it) to be kept.
+const SUN_HEMISPHERE: f64 = 1e-6;
 /// A root's largest residual: the angle (radians) between its leaving direction and the sun.
 const ROOT_RESIDUAL: f64 = 1e-10;
 
