@@ -23,9 +23,10 @@
 //! through every branch of the specular tree, up to the render's bounce limit (a chain of k
 //! scatterings takes k continuation rays, counted when k <= bounces); the leaves that escape the
 //! scene name the chains. For each chain, Newton's method on the film coordinate, from the seeds
-//! whose leaving direction is nearest w, finds the roots, with the Jacobian by central
-//! differences extrapolated (Richardson) to fourth order. The empty chain is the sun seen
-//! directly.
+//! whose leaving direction is nearest w, finds the roots, with the Jacobian by forward
+//! derivatives carried along the chain with the ray (each hit point moving on its surface, the
+//! normal turning by its curvature, reflection and refraction differentiated). The empty chain
+//! is the sun seen directly.
 
 mod bodies;
 mod film;

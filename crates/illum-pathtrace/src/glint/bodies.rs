@@ -61,6 +61,11 @@ pub struct Bodies {
     tree: Vec<Node>,
     /// Scene indices of the bodies in the hierarchy's order: a leaf holds `order[first..][..count]`.
     order: Vec<usize>,
+    /// The bodies kept out of the hierarchy and tested by every ray: those whose box spans more
+    /// than a quarter of the scene's on some axis (a floor). In a leaf, such a body's box would
+    /// swell the leaf's and its ancestors' to the whole scene, and every ray near it would test
+    /// the leaf's other bodies too.
+    large: Vec<usize>,
 }
 
 fn d3(v: glam::Vec3) -> DVec3 {
@@ -106,12 +111,26 @@ impl Bodies {
             })
             .collect();
         let boxes: Vec<(DVec3, DVec3)> = bodies.iter().map(|b| bounds(b, scale)).collect();
-        let (tree, order) = build_tree(&boxes);
-        Self { bodies, surfaces, scale, tree, order }
+        let (lo, hi) = boxes
+            .iter()
+            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), b| (lo.min(b.0), hi.max(b.1)));
+        let (large, members): (Vec<usize>, Vec<usize>) =
+            (0..boxes.len()).partition(|&i| (boxes[i].1 - boxes[i].0).cmpgt(0.25 * (hi - lo)).any());
+        let (tree, order) = build_tree(&boxes, members);
+        Self { bodies, surfaces, scale, tree, order, large }
     }
 
     pub fn surface(&self, object: usize) -> Surface {
         self.surfaces[object]
+    }
+
+    /// The derivative of the outward normal per unit move of the hit point along the surface:
+    /// 1 / r on a sphere (n = (p - c) / r), 0 on a flat face.
+    pub fn curvature(&self, object: usize) -> f64 {
+        match self.bodies[object] {
+            Body::Sphere { radius, .. } => 1.0 / radius,
+            Body::Quad { .. } | Body::Box { .. } => 0.0,
+        }
     }
 
     /// The spheres with a specular surface: (object, centre, radius).
@@ -168,13 +187,18 @@ impl Bodies {
         found
     }
 
-    /// Walks the hierarchy along the ray o + t d through the nodes it meets before `far`:
-    /// `body(i, far)` is called with each body of an entered leaf, may lower `far`, and ends the
-    /// walk by returning true.
+    /// Walks the large bodies, then the hierarchy along the ray o + t d through the nodes it
+    /// meets before `far`: `body(i, far)` is called with each large body and each body of an
+    /// entered leaf, may lower `far`, and ends the walk by returning true.
     fn visit(&self, o: DVec3, d: DVec3, mut far: f64, mut body: impl FnMut(usize, &mut f64) -> bool) {
+        for &i in &self.large {
+            if body(i, &mut far) {
+                return;
+            }
+        }
         let inv = d.recip();
         let mut stack = [0usize; 64];
-        let mut depth = 1;
+        let mut depth = usize::from(!self.tree.is_empty());
         while depth > 0 {
             depth -= 1;
             let node = self.tree[stack[depth]];

@@ -32,9 +32,23 @@ impl Film {
 
     /// Unit direction of the camera ray through film point s (pixels).
     pub(super) fn direction(&self, s: [f64; 2]) -> DVec3 {
+        self.direction_and_derivatives(s).0
+    }
+
+    /// Unit direction d of the camera ray through film point s (pixels), and its derivatives
+    /// dd/ds_c: with v = forward + x right + y up (x, y linear in s) and d = v / |v|,
+    /// dd = (dv - d (d . dv)) / |v|.
+    pub(super) fn direction_and_derivatives(&self, s: [f64; 2]) -> (DVec3, [DVec3; 2]) {
         let x = (2.0 * s[0] / self.width - 1.0) * self.aspect * self.tan_half_fov;
         let y = (1.0 - 2.0 * s[1] / self.height) * self.tan_half_fov;
-        (self.forward + x * self.right + y * self.up).normalize()
+        let v = self.forward + x * self.right + y * self.up;
+        let length = v.length();
+        let d = v / length;
+        let dv = [
+            (2.0 * self.aspect * self.tan_half_fov / self.width) * self.right,
+            (-2.0 * self.tan_half_fov / self.height) * self.up,
+        ];
+        (d, dv.map(|dv| (dv - d * d.dot(dv)) / length))
     }
 
     /// Film point (pixels) of direction d from the eye; None behind the eye.

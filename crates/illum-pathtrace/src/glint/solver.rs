@@ -223,7 +223,11 @@ impl Solver {
         }
         let p = o + hit.t * d;
         for event in [Event::Reflect, Event::Refract] {
-            if let Some((d2, weight)) = scatter(self.bodies.surface(hit.object), d, hit.normal, event) {
+            // The tree needs no derivatives: zero ones cost a few multiplications.
+            let none = [DVec3::ZERO; 2];
+            if let Some((d2, _, weight)) =
+                scatter(self.bodies.surface(hit.object), d, none, hit.normal, none, event)
+            {
                 chain.push((hit.object, event));
                 let t = [0, 1, 2].map(|c| throughput[c] * weight[c]);
                 self.explore(index, seed, p, d2, Some(hit.object), t, chain, found);
@@ -232,82 +236,61 @@ impl Solver {
         }
     }
 
-    /// The direction the camera ray through s leaves in after `chain`, and the chain's
-    /// throughput; None where the ray does not follow the chain (another object is nearer, an
-    /// event is impossible, or the last ray does not escape).
-    fn follow(&self, s: [f64; 2], chain: &[Step]) -> Option<(DVec3, [f64; 3])> {
+    /// The camera ray through s followed along `chain`: the direction its last ray leaves in,
+    /// that direction's derivatives per film coordinate, and the chain's throughput; None where
+    /// the ray does not follow the chain (an event is impossible, another object is nearer, or
+    /// the last ray does not escape) or leaves behind the sun's hemisphere.
+    fn follow(&self, s: [f64; 2], chain: &[Step]) -> Option<(DVec3, [DVec3; 2], [f64; 3])> {
         let mut o = self.film.eye;
-        let mut d = self.film.direction(s);
+        let mut d_o = [DVec3::ZERO; 2];
+        let (mut d, mut dd) = self.film.direction_and_derivatives(s);
         let mut own = None;
         let mut throughput = [1.0; 3];
+        // The segments (origin, direction, object left, length, object hit), checked for blockers
+        // once the chain's own geometry holds: Newton's trial points mostly leave a chain by
+        // missing its objects, which costs no walk of the hierarchy.
+        let mut segments = Vec::with_capacity(chain.len());
         for &(object, event) in chain {
-            // The chain's object, and nothing nearer on the way to it.
             let hit = self.bodies.hit(object, o, d, own)?;
-            if self.bodies.blocked(o, d, own, hit.t, Some(object)) {
-                return None;
-            }
-            let (d2, weight) = scatter(self.bodies.surface(object), d, hit.normal, event)?;
+            segments.push((o, d, own, hit.t, object));
+            // The hit point p = o + t d stays on the surface as s moves: n . dp = 0 gives dt, and
+            // the normal turns by the curvature times dp.
+            let dp = [0, 1].map(|c| {
+                let along = d_o[c] + hit.t * dd[c];
+                along - d * (hit.normal.dot(along) / hit.normal.dot(d))
+            });
+            let curvature = self.bodies.curvature(object);
+            let dn = dp.map(|v| curvature * v);
+            let (d2, dd2, weight) = scatter(self.bodies.surface(object), d, dd, hit.normal, dn, event)?;
             throughput = [0, 1, 2].map(|c| throughput[c] * weight[c]);
             o += hit.t * d;
+            d_o = dp;
             d = d2;
+            dd = dd2;
             own = Some(object);
         }
-        (!self.bodies.blocked(o, d, own, f64::INFINITY, None)).then_some((d, throughput))
+        if d.dot(self.w) <= SUN_HEMISPHERE {
+            return None;
+        }
+        let blocked =
+            segments.iter().any(|&(o, d, own, t, object)| self.bodies.blocked(o, d, own, t, Some(object)));
+        (!blocked && !self.bodies.blocked(o, d, own, f64::INFINITY, None)).then_some((d, dd, throughput))
     }
 
-    /// Gnomonic coordinates of the leaving direction about w (None behind the sun's hemisphere).
-    fn residual(&self, s: [f64; 2], chain: &[Step]) -> Option<([f64; 2], [f64; 3])> {
-        let (d, throughput) = self.follow(s, chain)?;
+    /// The gnomonic coordinates g of the leaving direction about w, their Jacobian dg/ds and the
+    /// chain's throughput at s (None where [`Self::follow`] has none).
+    fn residual(&self, s: [f64; 2], chain: &[Step]) -> Option<Residual> {
+        let (d, dd, throughput) = self.follow(s, chain)?;
         let z = d.dot(self.w);
-        (z > 1e-6).then(|| ([d.dot(self.t1) / z, d.dot(self.t2) / z], throughput))
-    }
-
-    /// dg/ds at s by central differences of step h (error O(h^2), enough to steer Newton's
-    /// method), retrying with smaller steps where a difference leaves the chain.
-    fn newton_jacobian(&self, s: [f64; 2], chain: &[Step]) -> Option<[[f64; 2]; 2]> {
-        let mut h = JACOBIAN_STEP;
-        for _ in 0..6 {
-            if let Some(j) = self.central(s, chain, h) {
-                return Some(j);
-            }
-            h *= 0.1;
-        }
-        None
-    }
-
-    /// dg/ds at s, for the glint's value: central differences of step h and h/2, extrapolated
-    /// (error O(h^4)). Retries with smaller steps where a difference leaves the chain.
-    fn jacobian(&self, s: [f64; 2], chain: &[Step]) -> Option<[[f64; 2]; 2]> {
-        let mut h = JACOBIAN_STEP;
-        for _ in 0..6 {
-            if let (Some(a), Some(b)) = (self.central(s, chain, h), self.central(s, chain, 0.5 * h)) {
-                let mut j = [[0.0; 2]; 2];
-                for r in 0..2 {
-                    for c in 0..2 {
-                        j[r][c] = (4.0 * b[r][c] - a[r][c]) / 3.0;
-                    }
-                }
-                return Some(j);
-            }
-            h *= 0.1;
-        }
-        None
-    }
-
-    /// j[r][c] = d g_r / d s_c by central differences of step h.
-    fn central(&self, s: [f64; 2], chain: &[Step], h: f64) -> Option<[[f64; 2]; 2]> {
+        let g = [d.dot(self.t1) / z, d.dot(self.t2) / z];
+        // g_r = d . t_r / z, z = d . w: dg_r = (dd . t_r - g_r dd . w) / z.
         let mut j = [[0.0; 2]; 2];
-        for c in 0..2 {
-            let (mut plus, mut minus) = (s, s);
-            plus[c] += h;
-            minus[c] -= h;
-            let (gp, _) = self.residual(plus, chain)?;
-            let (gm, _) = self.residual(minus, chain)?;
-            for r in 0..2 {
-                j[r][c] = (gp[r] - gm[r]) / (2.0 * h);
+        for (r, t) in [self.t1, self.t2].into_iter().enumerate() {
+            for c in 0..2 {
+                j[r][c] = (dd[c].dot(t) - g[r] * dd[c].dot(self.w)) / z;
             }
         }
-        Some(j)
+        Some(Residual { g, j, throughput })
     }
 
     /// Newton's method on the film coordinate for `chain` from `seed`, with the step halved
@@ -315,9 +298,12 @@ impl Solver {
     /// onto the film.
     fn newton(&self, seed: [f64; 2], chain: &[Step]) -> Option<GlintPoint> {
         let mut s = seed;
-        let (mut g, _) = self.residual(s, chain)?;
+        let mut at = self.residual(s, chain)?;
         for _ in 0..NEWTON_ITERATIONS {
-            let j = self.newton_jacobian(s, chain)?;
+            if norm2(at.g) < 1e-15 {
+                break;
+            }
+            let (j, g) = (at.j, at.g);
             let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
             if det == 0.0 || !det.is_finite() {
                 return None;
@@ -325,49 +311,57 @@ impl Solver {
             let delta = [(-j[1][1] * g[0] + j[0][1] * g[1]) / det, (j[1][0] * g[0] - j[0][0] * g[1]) / det];
             let mut scale = 1.0;
             let mut moved = None;
-            for _ in 0..40 {
+            for _ in 0..LINE_SEARCH_HALVINGS {
                 let next = [s[0] + scale * delta[0], s[1] + scale * delta[1]];
-                if let Some((g2, _)) = self.residual(next, chain)
-                    && norm2(g2) < norm2(g)
+                if let Some(r) = self.residual(next, chain)
+                    && norm2(r.g) < norm2(g)
                 {
-                    moved = Some((next, g2));
+                    moved = Some((next, r));
+                    break;
+                }
+                // Steps below the rounding of s leave it where it is (or move it by rounding).
+                if scale * norm2(delta) < 1e-12 * (1.0 + norm2(s)) {
                     break;
                 }
                 scale *= 0.5;
             }
-            let Some((next, g2)) = moved else {
-                // No step lowers the residual: converged to rounding, or stuck off a root.
-                return (norm2(g) < ROOT_RESIDUAL).then(|| self.point(s, chain)).flatten();
-            };
-            let step = scale * norm2(delta);
+            // No step lowers the residual: converged to rounding, or stuck off a root.
+            let Some((next, r)) = moved else { break };
             s = next;
-            g = g2;
-            if step < 1e-12 * (1.0 + norm2(s)) || norm2(g) < 1e-15 {
-                return (norm2(g) < ROOT_RESIDUAL).then(|| self.point(s, chain)).flatten();
+            at = r;
+            if scale * norm2(delta) < 1e-12 * (1.0 + norm2(s)) {
+                break;
             }
         }
-        (norm2(g) < ROOT_RESIDUAL).then(|| self.point(s, chain)).flatten()
+        (norm2(at.g) < ROOT_RESIDUAL).then(|| self.point(s, &at, chain)).flatten()
     }
 
-    fn point(&self, s: [f64; 2], chain: &[Step]) -> Option<GlintPoint> {
+    fn point(&self, s: [f64; 2], at: &Residual, chain: &[Step]) -> Option<GlintPoint> {
         let pixel = self.film.pixel(s)?;
-        let (_, throughput) = self.residual(s, chain)?;
-        let j = self.jacobian(s, chain)?;
+        let j = at.j;
         let jacobian = (j[0][0] * j[1][1] - j[0][1] * j[1][0]).abs();
-        let value = [0, 1, 2].map(|c| self.irradiance[c] * throughput[c] / jacobian);
+        let value = [0, 1, 2].map(|c| self.irradiance[c] * at.throughput[c] / jacobian);
         let direction = self.film.direction(s);
         let camera_solid_angle = self.film.pixel_area() * direction.dot(self.film.forward).powi(3);
         value.iter().all(|v| v.is_finite()).then(|| GlintPoint {
             film: s,
             pixel,
             value,
-            throughput,
+            throughput: at.throughput,
             jacobian,
             direction: direction.to_array(),
             eye_irradiance: value.map(|v| v * camera_solid_angle),
             chain: chain.to_vec(),
         })
     }
+}
+
+/// A chain's state at a film point: the gnomonic coordinates g of its leaving direction about
+/// the sun (0 at a root), their Jacobian j[r][c] = d g_r / d s_c, and the chain's throughput.
+struct Residual {
+    g: [f64; 2],
+    j: [[f64; 2]; 2],
+    throughput: [f64; 3],
 }
 
 fn norm2(v: [f64; 2]) -> f64 {
@@ -386,30 +380,65 @@ const GRID_SEEDS: usize = 96;
 /// Newton starts per chain, from its seeds nearest the sun.
 const NEWTON_STARTS: usize = 6;
 const NEWTON_ITERATIONS: usize = 60;
-/// Film step (pixels) of the Jacobian's differences.
-const JACOBIAN_STEP: f64 = 1e-3;
+/// Halvings of a Newton step before the start counts as stuck. A step cut to 2^-12 of Newton's
+/// lowers the residual by about that fraction, so a start that needs it cannot converge within
+/// [`NEWTON_ITERATIONS`] (60 x 2^-12 = 1.5%): it has met the edge of its chain's region. Further
+/// halvings would cost a residual each, most of the solve's time (docs/performance-caustics.md).
+const LINE_SEARCH_HALVINGS: usize = 12;
+/// The least cosine between a chain's leaving direction and the sun for the gnomonic
+/// coordinates (which divide by it) to be kept.
+const SUN_HEMISPHERE: f64 = 1e-6;
 /// A root's largest residual: the angle (radians) between its leaving direction and the sun.
 const ROOT_RESIDUAL: f64 = 1e-10;
 
-/// The direction a ray along d leaves a surface of outward normal n in by `event`, and the
-/// weight per channel; None where the surface cannot do it (a diffuse surface, a mirror's
-/// refraction, total internal reflection's refraction).
-fn scatter(surface: Surface, d: DVec3, n: DVec3, event: Event) -> Option<(DVec3, [f64; 3])> {
-    let reflect = |n: DVec3| d - 2.0 * d.dot(n) * n;
+/// The direction a ray along d leaves a surface of outward normal n in by `event`, its
+/// derivatives per film coordinate (from dd and dn, those of d and n), and the weight per
+/// channel; None where the surface cannot do it (a diffuse surface, a mirror's refraction,
+/// total internal reflection's refraction).
+fn scatter(
+    surface: Surface,
+    d: DVec3,
+    dd: [DVec3; 2],
+    n: DVec3,
+    dn: [DVec3; 2],
+    event: Event,
+) -> Option<(DVec3, [DVec3; 2], [f64; 3])> {
+    // r = d - 2 (d . n) n, differentiated in d and n.
+    let reflect = |n: DVec3, dn: [DVec3; 2]| {
+        let dot = d.dot(n);
+        let dr = [0, 1].map(|c| dd[c] - 2.0 * ((dd[c].dot(n) + d.dot(dn[c])) * n + dot * dn[c]));
+        (d - 2.0 * dot * n, dr)
+    };
     match (surface, event) {
-        (Surface::Mirror { reflectance }, Event::Reflect) => Some((reflect(n), reflectance)),
+        (Surface::Mirror { reflectance }, Event::Reflect) => {
+            let (r, dr) = reflect(n, dn);
+            Some((r, dr, reflectance))
+        }
         (Surface::Dielectric { ior }, _) => {
             let front = d.dot(n) < 0.0;
-            let n = if front { n } else { -n };
+            let (n, dn) = if front { (n, dn) } else { (-n, dn.map(|v| -v)) };
             let eta = if front { 1.0 / ior } else { ior };
             let cos_i = -d.dot(n);
             let (f, cos_t) = fresnel(cos_i, eta);
             match event {
-                Event::Reflect => Some((reflect(n), [f; 3])),
+                Event::Reflect => {
+                    let (r, dr) = reflect(n, dn);
+                    Some((r, dr, [f; 3]))
+                }
                 Event::Refract => {
                     let cos_t = cos_t?;
-                    let t = (eta * d + (eta * cos_i - cos_t) * n).normalize();
-                    Some((t, [1.0 - f; 3]))
+                    // u = eta d + (eta cos_i - cos_t) n, cos_t^2 = 1 - eta^2 (1 - cos_i^2), t = u / |u|.
+                    let k = eta * cos_i - cos_t;
+                    let u = eta * d + k * n;
+                    let length = u.length();
+                    let t = u / length;
+                    let dt = [0, 1].map(|c| {
+                        let dcos_i = -(dd[c].dot(n) + d.dot(dn[c]));
+                        let dcos_t = eta * eta * cos_i * dcos_i / cos_t;
+                        let du = eta * dd[c] + (eta * dcos_i - dcos_t) * n + k * dn[c];
+                        (du - t * t.dot(du)) / length
+                    });
+                    Some((t, dt, [1.0 - f; 3]))
                 }
             }
         }
@@ -421,10 +450,8 @@ fn scatter(surface: Surface, d: DVec3, n: DVec3, event: Event) -> Option<(DVec3,
 mod tests {
     use super::*;
 
-    #[test]
-    fn the_glints_do_not_depend_on_how_many_threads_share_the_solve() {
-        // The Whitted scene with a row of small glass and mirror balls before it: hundreds of
-        // chains, whose starts come from shares of the seeds cut where the thread count says.
+    /// The Whitted scene with a row of small glass and mirror balls before it, at 320 x 180.
+    pub(super) fn whitted_row() -> Scene {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/whitted.toml");
         let mut text = std::fs::read_to_string(&path).expect("scenes/whitted.toml");
         for k in 0..6 {
@@ -437,7 +464,14 @@ mod tests {
         let mut scene = Scene::from_toml_str(&text, "whitted-row.toml").unwrap_or_else(|e| panic!("{e}"));
         scene.camera.width = 320;
         scene.camera.height = 180;
-        let mut solver = Solver::new(&scene);
+        scene
+    }
+
+    #[test]
+    fn the_glints_do_not_depend_on_how_many_threads_share_the_solve() {
+        // Hundreds of chains, whose starts come from shares of the seeds cut where the thread
+        // count says.
+        let mut solver = Solver::new(&whitted_row());
         solver.threads = 1;
         let one = solver.solve();
         assert!(one.len() > 40, "{} glints", one.len());
@@ -445,5 +479,72 @@ mod tests {
             solver.threads = threads;
             assert_eq!(solver.solve(), one, "{threads} threads against 1");
         }
+    }
+}
+
+#[cfg(test)]
+mod jacobian_tests {
+    use super::*;
+
+    /// dg/ds by central differences of step h and h / 2, extrapolated (Richardson, error O(h^4)).
+    fn differences(solver: &Solver, s: [f64; 2], chain: &[Step], h: f64) -> Option<[[f64; 2]; 2]> {
+        let central = |h: f64| -> Option<[[f64; 2]; 2]> {
+            let mut j = [[0.0; 2]; 2];
+            for c in 0..2 {
+                let (mut plus, mut minus) = (s, s);
+                plus[c] += h;
+                minus[c] -= h;
+                let (gp, gm) = (solver.residual(plus, chain)?.g, solver.residual(minus, chain)?.g);
+                for r in 0..2 {
+                    j[r][c] = (gp[r] - gm[r]) / (2.0 * h);
+                }
+            }
+            Some(j)
+        };
+        let (a, b) = (central(h)?, central(0.5 * h)?);
+        Some([0, 1].map(|r| [0, 1].map(|c| (4.0 * b[r][c] - a[r][c]) / 3.0)))
+    }
+
+    #[test]
+    fn the_forward_jacobian_matches_differences_along_every_kind_of_chain() {
+        let solver = Solver::new(&super::tests::whitted_row());
+        let points = solver.solve();
+        let (mut checked, mut refractions, mut long) = (0, 0, 0);
+        for p in &points {
+            // At the root and off it, where Newton's method steers.
+            for offset in [[0.0, 0.0], [0.37, -0.21], [-1.3, 0.8]] {
+                let s = [p.film[0] + offset[0], p.film[1] + offset[1]];
+                let Some(at) = solver.residual(s, &p.chain) else { continue };
+                // Differences err by truncation (large steps near a caustic) or by the residual's
+                // rounding (small steps along long chains): the forward Jacobian must match them
+                // at one of the steps, to 1e-4 of its largest entry.
+                let errors: Vec<f64> = [1e-2, 1e-3, 1e-4, 1e-5]
+                    .into_iter()
+                    .filter_map(|h| differences(&solver, s, &p.chain, h))
+                    .map(|want| {
+                        let size = want.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+                        (0..4).map(|k| (at.j[k / 2][k % 2] - want[k / 2][k % 2]).abs()).fold(0.0, f64::max)
+                            / size
+                    })
+                    .collect();
+                if errors.is_empty() {
+                    continue;
+                }
+                let best = errors.iter().copied().fold(f64::INFINITY, f64::min);
+                assert!(
+                    best < 1e-4,
+                    "chain {:?} at {s:?}: forward {:?}, relative errors {errors:?}",
+                    p.chain,
+                    at.j
+                );
+                checked += 1;
+                refractions += usize::from(p.chain.iter().any(|&(_, e)| e == Event::Refract));
+                long += usize::from(p.chain.len() >= 3);
+            }
+        }
+        assert!(
+            checked > 100 && refractions > 20 && long > 20,
+            "{checked} checked, {refractions} refracting, {long} long"
+        );
     }
 }

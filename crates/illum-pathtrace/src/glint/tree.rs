@@ -16,11 +16,15 @@ pub(super) struct Node {
 /// Bodies per leaf of the hierarchy.
 const LEAF_BODIES: usize = 4;
 
-/// Builds the hierarchy over the bodies' `boxes` (lower and upper corners) by median splits on
-/// the widest axis of the boxes' centres, and orders the bodies to match it. Returns the nodes,
-/// the root first, and the scene indices of the bodies in the leaves' order.
-pub(super) fn build_tree(boxes: &[(DVec3, DVec3)]) -> (Vec<Node>, Vec<usize>) {
-    let mut order: Vec<usize> = (0..boxes.len()).collect();
+/// Builds the hierarchy over the bodies `members` (indices into `boxes`, their lower and upper
+/// corners) by median splits on the widest axis of the boxes' centres, and orders the bodies to
+/// match it. Returns the nodes, the root first (none for no members), and the indices of the
+/// bodies in the leaves' order.
+pub(super) fn build_tree(boxes: &[(DVec3, DVec3)], members: Vec<usize>) -> (Vec<Node>, Vec<usize>) {
+    let mut order = members;
+    if order.is_empty() {
+        return (Vec::new(), order);
+    }
     let mut nodes = vec![Node { lo: DVec3::ZERO, hi: DVec3::ZERO, first: 0, count: 0 }];
     // (node, range of `order`)
     let mut work = vec![(0usize, 0usize, order.len())];
