@@ -1,10 +1,12 @@
-//! The command line: `illum-viewer [SCENE] [--mode raster|pathtrace|whitted|auto] [--screenshot FILE --frames N]`.
+//! The desktop's command line (the page reads its mode from the URL, `start_mode`): `illum-viewer [SCENE] [--mode raster|pathtrace|whitted|auto] [--screenshot FILE --frames N]`.
 
 use std::path::PathBuf;
 
 use clap::Parser;
 
 use illum_scene::RendererKind;
+
+use crate::start_mode::{StartMode, parse_start_mode};
 
 #[derive(Parser, Debug, Clone)]
 #[command(
@@ -44,37 +46,6 @@ pub struct Args {
     /// Initial window height in points.
     #[arg(long, default_value_t = 600.0)]
     pub height: f32,
-}
-
-/// A mode is named like the renderer it shows: `raster`, `pathtrace` or `whitted` (the page's
-/// `?mode=` too).
-pub fn parse_mode(text: &str) -> Result<RendererKind, String> {
-    text.parse::<RendererKind>().map_err(|e| format!("unknown mode {text:?}: {}", e.allowed))
-}
-
-/// The command line's first mode: one of the renderers, or Auto.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum StartMode {
-    Renderer(RendererKind),
-    Auto,
-}
-
-impl StartMode {
-    /// The renderer shown first (Auto starts from the scene's and then shows its choice's).
-    pub fn renderer(self) -> Option<RendererKind> {
-        match self {
-            StartMode::Renderer(kind) => Some(kind),
-            StartMode::Auto => None,
-        }
-    }
-}
-
-/// `auto`, or a renderer as [`parse_mode`] reads it.
-pub fn parse_start_mode(text: &str) -> Result<StartMode, String> {
-    if text == "auto" {
-        return Ok(StartMode::Auto);
-    }
-    parse_mode(text).map(StartMode::Renderer).map_err(|e| format!("{e}, or auto"))
 }
 
 /// Why no window can open, before trying: on Linux, none of the variables through which a

@@ -19,7 +19,8 @@
 //! - [`frame_rate`]: frames per second over recent frames;
 //! - [`pacer`]: how much of each frame the path tracer gets;
 //! - [`scene_file`]: opening scene files of either kind, with errors as text;
-//! - [`cli`] and [`screenshot`]: the command line, and `--screenshot FILE --frames N`;
+//! - [`cli`] and [`screenshot`]: the desktop's command line, and `--screenshot FILE --frames N`;
+//!   [`start_mode`]: the first mode as `--mode` and the page's `?mode=` name it;
 //! - [`plural`]: counts in words ("1 frame", "2 frames");
 //! - [`platform`]: what differs between the desktop and the browser (readback, scene files,
 //!   saving); `web` (wasm32 only): the viewer's start on a page, which builds the app; and
@@ -35,6 +36,7 @@ pub mod auto_panel;
 #[cfg(target_arch = "wasm32")]
 pub mod browser;
 pub mod camera;
+#[cfg(not(target_arch = "wasm32"))]
 pub mod cli;
 pub mod denoise_view;
 pub mod difference_view;
@@ -52,6 +54,7 @@ pub mod raster_mode;
 pub mod raster_panel;
 pub mod scene_file;
 pub mod screenshot;
+pub mod start_mode;
 #[cfg(target_arch = "wasm32")]
 pub mod web;
 pub mod whitted_mode;

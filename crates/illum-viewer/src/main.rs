@@ -45,11 +45,11 @@ mod native {
             args.screenshot.clone().map(|path| ScreenshotJob::new(path, args.frames, outcome.clone()));
         let start = StartOptions {
             scene: args.scene.clone(),
-            mode: args.mode.and_then(illum_viewer::cli::StartMode::renderer),
+            mode: args.mode.and_then(illum_viewer::start_mode::StartMode::renderer),
             screenshot,
             clear_is_backdrop: true,
         };
-        let auto = args.mode == Some(illum_viewer::cli::StartMode::Auto);
+        let auto = args.mode == Some(illum_viewer::start_mode::StartMode::Auto);
 
         let mut native = eframe::NativeOptions {
             viewport: egui::ViewportBuilder::default()

@@ -9,9 +9,9 @@ use wasm_bindgen::JsCast;
 
 use crate::app::{StartOptions, ViewerApp};
 use crate::browser::{STATUS_ID, document, js_text};
-use crate::cli::{StartMode, parse_start_mode};
 use crate::pathtrace_mode::{MAX_SCALE, MIN_SCALE};
 use crate::scene_file::DEFAULT_PATHTRACE_SCENE;
+use crate::start_mode::{StartMode, parse_start_mode};
 
 /// The canvas the page gives the viewer.
 const CANVAS_ID: &str = "illum-canvas";
