@@ -2,7 +2,8 @@
 # Builds the web viewer into web/dist/ (index.html, illum_viewer.js, illum_viewer_bg.wasm), and
 # records in web/dist/inputs.sha256 the fingerprint of what it was built from.
 # With --if-stale, builds only when web/dist's fingerprint differs from the sources' (the browser
-# test, crates/illum-viewer/tests/web/main.rs, calls it so; .ci/run builds the page before it).
+# test, crates/illum-viewer/tests/web/main.rs, calls it so; .ci/run builds the page beside the
+# tests, and the test waits for that build).
 # With --serve, then serves it on http://127.0.0.1:8000/ (PORT=... to change).
 #
 # Needs: rustup target add wasm32-unknown-unknown
@@ -44,6 +45,11 @@ fingerprint() {
 }
 
 mode="${1:-}"
+# One build at a time: a second caller (the browser test while .ci/run builds the page beside
+# the tests) waits here, then finds the page up to date.
+mkdir -p web
+exec 9>web/.build-lock
+flock 9
 inputs=$(fingerprint)
 if [ "$mode" = "--if-stale" ] && [ "$(cat "$dist/inputs.sha256" 2>/dev/null)" = "$inputs" ]; then
     echo "$dist is up to date (built from the same inputs, $inputs)"
@@ -61,6 +67,7 @@ echo "$inputs" >"$dist/inputs.sha256"
 echo "built $dist: $(du -sh "$dist" | cut -f1)"
 
 if [ "$mode" = "--serve" ]; then
+    exec 9>&-
     port="${PORT:-8000}"
     echo "serving on http://127.0.0.1:$port/ (Ctrl-C stops)"
     exec python3 -m http.server "$port" --bind 127.0.0.1 --directory "$dist"
