@@ -1,7 +1,7 @@
 //! The web viewer in a real browser: builds it, or uses the page already built from the same
-//! sources (`scripts/build-web.sh --if-stale`; `.ci/run` builds it first), serves `web/dist/` on
-//! 127.0.0.1, drives headless Chromium on WebGPU (SwiftShader) with `web/tests/browser.mjs`
-//! (Playwright), and checks what the page showed and reported:
+//! sources (`scripts/build-web.sh --if-stale`; `.ci/run` builds it beside the tests, and this
+//! waits for that build), serves `web/dist/` on 127.0.0.1, drives headless Chromium on WebGPU
+//! (SwiftShader) with `web/tests/browser.mjs` (Playwright), and checks what the page showed and reported:
 //!
 //! - a browser without WebGPU (no adapter, or no API at all) gets the page that says so and how
 //!   to enable it;
