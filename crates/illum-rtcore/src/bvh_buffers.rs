@@ -93,9 +93,10 @@ impl BvhBindGroup {
         contents(scene, geometry).iter().map(|(_, _, _, bytes)| bytes.len() as u64).sum()
     }
 
-    /// Refuses hierarchies one of whose buffers exceeds the device's limit for its binding
-    /// (`storage`: max_storage_buffer_binding_size, `uniform`: max_uniform_buffer_binding_size),
-    /// with the bytes it needs.
+    /// Refuses a scene whose group 1 the device cannot hold: a buffer beyond the device's
+    /// limit for its binding (`storage`: max_storage_buffer_binding_size, `uniform`:
+    /// max_uniform_buffer_binding_size), with the bytes it needs and, for a mesh's buffers, the
+    /// mesh files.
     pub fn check_size(
         scene: &Scene,
         geometry: &Geometry,
@@ -111,27 +112,28 @@ impl BvhBindGroup {
             if needed <= limit {
                 continue;
             }
-            let (field, value) = match (geometry.mesh_bvh(), &geometry.spheres) {
-                (_, Some(spheres)) if label.contains("sphere") => (
+            let meshes = || {
+                scene
+                    .objects
+                    .iter()
+                    .filter_map(|o| match &o.shape {
+                        Shape::Mesh(m) => Some(m),
+                        _ => None,
+                    })
+                    .collect::<Vec<_>>()
+            };
+            let mesh_value = || {
+                let meshes = meshes();
+                let triangles: usize = meshes.iter().map(|m| m.triangles.len()).sum();
+                let files: Vec<String> = meshes.iter().map(|m| format!("{:?}", m.file)).collect();
+                format!("{triangles} triangles of {} ({needed} bytes of {label})", files.join(", "))
+            };
+            let (field, value) = match &geometry.spheres {
+                Some(spheres) if label.contains("sphere") => (
                     "objects (spheres)",
                     format!("{} spheres ({needed} bytes of {label})", spheres.records.len()),
                 ),
-                (Some(bvh), _) if !label.contains("normals") => (
-                    "objects (meshes)",
-                    format!("{} triangles ({needed} bytes of {label})", bvh.triangles.len()),
-                ),
-                _ if label.contains("normals") => {
-                    let triangles: usize = scene
-                        .objects
-                        .iter()
-                        .map(|o| match &o.shape {
-                            Shape::Mesh(m) => m.triangles.len(),
-                            _ => 0,
-                        })
-                        .sum();
-                    ("objects (meshes)", format!("{triangles} triangles ({needed} bytes of {label})"))
-                }
-                _ => ("objects", format!("{needed} bytes of {label}")),
+                _ => ("objects (meshes)", mesh_value()),
             };
             return Err(SceneError::invalid(
                 &scene.source,
@@ -143,8 +145,118 @@ impl BvhBindGroup {
         Ok(())
     }
 
+    /// The bind group, for a pass its owner records (tests' compute runs).
+    pub fn bind_group(&self) -> &wgpu::BindGroup {
+        &self.bind_group
+    }
+
     /// Binds the buffers in `pass`.
     pub fn set(&self, pass: &mut wgpu::ComputePass<'_>) {
         pass.set_bind_group(Self::GROUP, &self.bind_group, &[]);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::mem::size_of;
+
+    use illum_scene::testing::obj::{icosphere_obj, scene_with_files};
+
+    use super::*;
+    use crate::bvh::{BvhNode, MeshTriangle};
+    use crate::sphere_bvh::BvhSphere;
+
+    const HEADER: &str = "[camera]\neye = [0.0, 0.0, -5.0]\ntarget = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]\n\
+                          vfov = 45.0\nwidth = 8\nheight = 8\n[environment]\nradiance = [1.0, 1.0, 1.0]\n\
+                          [materials.grey]\nalbedo = [0.5, 0.5, 0.5]\n";
+
+    /// A scene "big.toml" of one icosphere of subdivision `k` read from "models/ball.obj".
+    fn icosphere_scene(k: u32, smooth: bool) -> Scene {
+        let text =
+            format!("{HEADER}[[objects]]\nmaterial = \"grey\"\nmesh = {{ file = \"models/ball.obj\" }}\n");
+        scene_with_files(&text, "big.toml", &[("models/ball.obj", &icosphere_obj(k, smooth))])
+            .unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// A scene "many.toml" of `n` small grey spheres.
+    fn spheres_scene(n: usize) -> Scene {
+        let sphere = |i: usize| {
+            format!(
+                "[[objects]]\nmaterial = \"grey\"\nsphere = {{ center = [{}.0, {}.0, 9.0], radius = 0.25 }}\n",
+                i % 64,
+                i / 64
+            )
+        };
+        let mut text = HEADER.to_owned();
+        text.extend((0..n).map(sphere));
+        Scene::from_toml_str(&text, "many.toml").unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// `scene`'s buffers bound as `kind`, the largest of which needs `needed` bytes, pass a limit
+    /// of `needed` and are refused at a byte less, by a message that names each of `names`, the
+    /// bytes needed, the limit and the binding's limit.
+    fn check_just_fits(scene: &Scene, kind: Kind, needed: u64, names: &[&str]) {
+        let geometry = Geometry::new(scene);
+        let limits = |limit: u64| match kind {
+            Kind::Storage => (limit, u64::MAX),
+            Kind::Uniform => (u64::MAX, limit),
+        };
+        let (storage, uniform) = limits(needed);
+        BvhBindGroup::check_size(scene, &geometry, storage, uniform)
+            .unwrap_or_else(|e| panic!("{needed} bytes fit a limit of {needed}: {e}"));
+        let (storage, uniform) = limits(needed - 1);
+        let message = BvhBindGroup::check_size(scene, &geometry, storage, uniform)
+            .expect_err("a byte over the limit")
+            .to_string();
+        let binding = match kind {
+            Kind::Storage => "max_storage_buffer_binding_size",
+            Kind::Uniform => "max_uniform_buffer_binding_size",
+        };
+        let needed_text = format!("{needed} bytes");
+        let limit_text = format!("{} bytes", needed - 1);
+        for part in names.iter().copied().chain([needed_text.as_str(), limit_text.as_str(), binding]) {
+            assert!(message.contains(part), "{part:?} is not in {message:?}");
+        }
+    }
+
+    /// A mesh under a BVH (320 triangles): its largest storage buffer, counted from the
+    /// hierarchy's own lengths and the records' sizes, fits a limit of its size and not a byte
+    /// less; the message names the scene, the mesh file and the triangles.
+    #[test]
+    fn a_mesh_just_over_the_storage_binding_is_refused_by_file_and_bytes() {
+        let scene = icosphere_scene(2, false);
+        let geometry = Geometry::new(&scene);
+        let bvh = geometry.mesh_bvh().expect("320 triangles are under a BVH");
+        assert_eq!(bvh.triangles.len(), 320);
+        let nodes = (bvh.nodes.len() * size_of::<BvhNode>()) as u64;
+        let triangles = (320 * size_of::<MeshTriangle>()) as u64;
+        assert_ne!(nodes, triangles, "one buffer is the largest");
+        check_just_fits(
+            &scene,
+            Kind::Storage,
+            nodes.max(triangles),
+            &["big.toml", "\"models/ball.obj\"", "320 triangles"],
+        );
+    }
+
+    /// A mesh of literal triangles (20) binds no buffer, so no storage limit refuses it.
+    #[test]
+    fn literal_triangles_bind_no_buffer() {
+        let scene = icosphere_scene(0, false);
+        let geometry = Geometry::new(&scene);
+        assert!(geometry.mesh_bvh().is_none());
+        BvhBindGroup::check_size(&scene, &geometry, 0, 0).expect("nothing to bind");
+    }
+
+    /// The spheres' hierarchy is held to the uniform binding: its spheres' buffer (32 bytes a
+    /// sphere) is the larger at 100 spheres.
+    #[test]
+    fn spheres_just_over_the_uniform_binding_are_refused_by_count_and_bytes() {
+        let scene = spheres_scene(100);
+        let geometry = Geometry::new(&scene);
+        let bvh = geometry.spheres.as_ref().expect("100 spheres are under a BVH");
+        let spheres = (100 * size_of::<BvhSphere>()) as u64;
+        let nodes = (bvh.nodes.len() * size_of::<BvhNode>()) as u64;
+        check_just_fits(&scene, Kind::Uniform, spheres.max(nodes), &["many.toml", "100 spheres"]);
     }
 }
