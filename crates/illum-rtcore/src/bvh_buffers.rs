@@ -6,6 +6,7 @@ use illum_gpu::wgpu;
 use illum_scene::{Scene, SceneError, Shape};
 use wgpu::util::DeviceExt;
 
+use crate::sphere_bvh;
 use crate::traversal::Geometry;
 
 /// Group 1: a mesh's nodes (binding 0) and triangles (1) in storage buffers (bvh.wgsl); the
@@ -93,16 +94,18 @@ impl BvhBindGroup {
         contents(scene, geometry).iter().map(|(_, _, _, bytes)| bytes.len() as u64).sum()
     }
 
-    /// Refuses a scene whose group 1 the device cannot hold: a buffer beyond the device's
+    /// Refuses a scene whose group 1 the device cannot hold: more non-emitting spheres than the
+    /// spheres' hierarchy takes ([`sphere_bvh::check_count`]), or a buffer beyond the device's
     /// limit for its binding (`storage`: max_storage_buffer_binding_size, `uniform`:
     /// max_uniform_buffer_binding_size), with the bytes it needs and, for a mesh's buffers, the
-    /// mesh files.
+    /// mesh files. Every GPU ray tracer calls it before compiling the scene's traversal.
     pub fn check_size(
         scene: &Scene,
         geometry: &Geometry,
         storage: u64,
         uniform: u64,
     ) -> Result<(), SceneError> {
+        sphere_bvh::check_count(scene, &geometry.objects)?;
         for (_, label, kind, bytes) in contents(scene, geometry) {
             let (limit, name) = match kind {
                 Kind::Storage => (storage, "max_storage_buffer_binding_size"),
@@ -164,7 +167,7 @@ mod tests {
 
     use super::*;
     use crate::bvh::{BvhNode, MeshTriangle};
-    use crate::sphere_bvh::BvhSphere;
+    use crate::sphere_bvh::{BvhSphere, MAX_BVH_SPHERES};
 
     const HEADER: &str = "[camera]\neye = [0.0, 0.0, -5.0]\ntarget = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]\n\
                           vfov = 45.0\nwidth = 8\nheight = 8\n[environment]\nradiance = [1.0, 1.0, 1.0]\n\
@@ -258,5 +261,23 @@ mod tests {
         let spheres = (100 * size_of::<BvhSphere>()) as u64;
         let nodes = (bvh.nodes.len() * size_of::<BvhNode>()) as u64;
         check_just_fits(&scene, Kind::Uniform, spheres.max(nodes), &["many.toml", "100 spheres"]);
+    }
+
+    /// MAX_BVH_SPHERES spheres are taken within WebGPU's default uniform binding (64 KiB); one
+    /// more is refused by count and limit, whatever the device's limits.
+    #[test]
+    fn more_spheres_than_the_hierarchy_holds_are_refused_by_count() {
+        let most = spheres_scene(MAX_BVH_SPHERES);
+        BvhBindGroup::check_size(&most, &Geometry::new(&most), u64::MAX, 64 << 10)
+            .unwrap_or_else(|e| panic!("{MAX_BVH_SPHERES} spheres fit WebGPU's default 64 KiB: {e}"));
+        let over = spheres_scene(MAX_BVH_SPHERES + 1);
+        let message = BvhBindGroup::check_size(&over, &Geometry::new(&over), u64::MAX, u64::MAX)
+            .expect_err("one sphere too many")
+            .to_string();
+        let count = format!("{} non-emitting spheres", MAX_BVH_SPHERES + 1);
+        let limit = format!("at most {MAX_BVH_SPHERES}");
+        for part in ["many.toml", count.as_str(), limit.as_str(), "remove spheres"] {
+            assert!(message.contains(part), "{part:?} is not in {message:?}");
+        }
     }
 }

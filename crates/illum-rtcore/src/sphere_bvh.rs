@@ -19,6 +19,7 @@
 use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
+use illum_scene::{Scene, SceneError};
 
 use crate::bvh::{BvhNode, Hierarchy};
 use crate::object::{GpuObject, GpuShape, ObjectRecord};
@@ -30,7 +31,8 @@ use crate::object::{GpuObject, GpuShape, ObjectRecord};
 pub const LITERAL_SPHERES: usize = 16;
 
 /// The most spheres the hierarchy holds: its nodes (at most 2n - 1 of 32 bytes) and its spheres
-/// (32 bytes each) each fit a 64 KiB uniform binding. A scene with more keeps them literals.
+/// (32 bytes each) each fit a 64 KiB uniform binding. A scene with more is refused
+/// ([`check_count`]): as literals its traversal would take minutes to compile.
 pub const MAX_BVH_SPHERES: usize = 1024;
 
 /// The spheres' hierarchy: its nodes (the root first) and the records of the spheres, objects
@@ -92,14 +94,34 @@ fn is_bvh_sphere(object: &GpuObject) -> bool {
     !object.emitter && matches!(object.shape, GpuShape::Sphere { .. })
 }
 
-/// Whether the objects (in the scene's order) put their spheres under a BVH.
-pub fn spheres_under_bvh<'a>(objects: impl IntoIterator<Item = &'a GpuObject>) -> bool {
-    (LITERAL_SPHERES + 1..=MAX_BVH_SPHERES)
-        .contains(&objects.into_iter().filter(|o| is_bvh_sphere(o)).count())
+fn bvh_sphere_count<'a>(objects: impl IntoIterator<Item = &'a GpuObject>) -> usize {
+    objects.into_iter().filter(|o| is_bvh_sphere(o)).count()
 }
 
-/// With more non-emitting spheres than [`LITERAL_SPHERES`] (and at most [`MAX_BVH_SPHERES`])
-/// among `ordered` (the scene's order:
+/// Whether the objects (in the scene's order) put their spheres under a BVH.
+pub fn spheres_under_bvh<'a>(objects: impl IntoIterator<Item = &'a GpuObject>) -> bool {
+    bvh_sphere_count(objects) > LITERAL_SPHERES
+}
+
+/// Refuses more non-emitting spheres among `objects` (`scene`'s, in any order) than
+/// [`MAX_BVH_SPHERES`], by count, limit and remedy.
+pub fn check_count(scene: &Scene, objects: &[GpuObject]) -> Result<(), SceneError> {
+    let count = bvh_sphere_count(objects);
+    if count <= MAX_BVH_SPHERES {
+        return Ok(());
+    }
+    Err(SceneError::invalid(
+        &scene.source,
+        "objects (spheres)",
+        format!("{count} non-emitting spheres"),
+        format!(
+            "the GPU ray tracers hold at most {MAX_BVH_SPHERES} (the most whose hierarchy fits a 64 KiB \
+             uniform binding); remove spheres, or model some of them as one triangle mesh"
+        ),
+    ))
+}
+
+/// With more non-emitting spheres than [`LITERAL_SPHERES`] among `ordered` (the scene's order:
 /// non-emitters, then emitters, each with its index in the scene), moves them to the front in
 /// the leaf order of a hierarchy built over them, and returns the hierarchy. The rest keep
 /// their order, so emitters stay last.
@@ -144,23 +166,28 @@ mod tests {
         }
     }
 
+    /// A few spheres stay literals in place; more move first, in leaf order, past the most the
+    /// GPU ray tracers take too (check_count refuses those by name, so none fall back to a
+    /// literal list that would take minutes to compile).
     #[test]
-    fn a_few_or_too_many_spheres_stay_in_place_and_more_move_first_in_leaf_order() {
+    fn a_few_spheres_stay_in_place_and_more_move_first_in_leaf_order() {
         let objects = |n: usize| {
             let mut o: Vec<(usize, GpuObject)> = vec![(0, quad())];
             o.extend((0..n).map(|i| (i + 1, sphere(((i * 7) % n) as f32, false))));
             o.push((n + 1, sphere(0.0, true)));
             o
         };
-        for count in [LITERAL_SPHERES, MAX_BVH_SPHERES + 1] {
-            let mut few = objects(count);
-            let before = few.clone();
-            assert!(arrange(&mut few).is_none(), "{count}");
-            assert_eq!(few, before);
-        }
+        let mut few = objects(LITERAL_SPHERES);
+        let before = few.clone();
+        assert!(arrange(&mut few).is_none());
+        assert_eq!(few, before);
 
-        let n = LITERAL_SPHERES + 1;
-        let mut many = objects(n);
+        for n in [LITERAL_SPHERES + 1, MAX_BVH_SPHERES + 1] {
+            check_arranged(n, objects(n));
+        }
+    }
+
+    fn check_arranged(n: usize, mut many: Vec<(usize, GpuObject)>) {
         let bvh = arrange(&mut many).expect("a BVH past the limit");
         // The spheres first (each once), then the quad, then the emitter: the same objects.
         let mut indices: Vec<usize> = many[..n].iter().map(|(i, _)| *i).collect();

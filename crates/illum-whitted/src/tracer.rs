@@ -129,18 +129,19 @@ impl WhittedTracer {
         let storage =
             |label: &str, contents: &[u8]| illum_gpu::buffers::storage_buffer(device, label, contents);
         let lights_or_one = if lights.is_empty() { vec![WhittedLight::default()] } else { lights };
+        // Checked before compiling: a scene past the limits would fail there, or take minutes.
+        BvhBindGroup::check_size(
+            scene,
+            &geometry,
+            limit,
+            gpu.device.limits().max_uniform_buffer_binding_size,
+        )?;
         let pipeline = shader::compute_pipeline(
             gpu,
             &shader_modules(scene, &geometry),
             &WHITTED_SHADER,
             &shader_defs(scene),
             "whitted ray tracer",
-        )?;
-        BvhBindGroup::check_size(
-            scene,
-            &geometry,
-            limit,
-            gpu.device.limits().max_uniform_buffer_binding_size,
         )?;
         let (bind_group, image, params, bvh) =
             gpu.scoped("creating the Whitted ray tracer's buffers", || {

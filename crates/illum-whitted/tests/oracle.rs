@@ -70,6 +70,22 @@ fn many_spheres_under_the_bvh_match_the_f64_copy() {
     }
 }
 
+/// Past the most spheres the hierarchy holds the tracer refuses the scene by count and limit
+/// (illum-rtcore's sphere_bvh::check_count), before compiling anything: as literals the
+/// traversal would take minutes to compile.
+#[test]
+fn more_spheres_than_the_bvh_holds_are_refused_by_count() {
+    use illum_rtcore::sphere_bvh::MAX_BVH_SPHERES;
+    let scene = illum_scene::testing::with_small_spheres(
+        illum_scene::testing::shipped_scene("whitted.toml", 8, 8),
+        MAX_BVH_SPHERES + 1,
+    );
+    let err = WhittedTracer::new(gpu(), &scene).err().expect("refused").to_string();
+    // The Whitted scene's own two spheres make MAX_BVH_SPHERES + 3.
+    let count = format!("{} non-emitting spheres", MAX_BVH_SPHERES + 3);
+    assert!(err.contains(&count) && err.contains(&format!("at most {MAX_BVH_SPHERES}")), "{err}");
+}
+
 #[test]
 fn a_sun_of_finite_size_is_refused_by_name() {
     let mut scene = illum_scene::testing::shipped_scene("whitted.toml", 8, 8);

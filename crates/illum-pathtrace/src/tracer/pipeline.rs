@@ -83,13 +83,17 @@ impl ScenePipeline {
                     .to_owned(),
             });
         }
-        let limits = gpu.device.limits();
-        BvhBindGroup::check_size(
-            scene,
-            &gpu_scene.geometry,
-            limits.max_storage_buffer_binding_size,
-            limits.max_uniform_buffer_binding_size,
-        )?;
+        // Group 1 is the specialised traversal's only: the generic one reads every object from
+        // a buffer.
+        if options.traversal == Traversal::Specialised {
+            let limits = gpu.device.limits();
+            BvhBindGroup::check_size(
+                scene,
+                &gpu_scene.geometry,
+                limits.max_storage_buffer_binding_size,
+                limits.max_uniform_buffer_binding_size,
+            )?;
+        }
         let base_params = gpu_scene::params(scene, gpu_scene);
         let (compute, traversal_source) =
             shaders::pathtrace_pipeline(gpu, scene, gpu_scene, options, allocation.is_some())?;

@@ -253,6 +253,18 @@ fn a_sun_disc_agrees_with_the_oracle() {
     compare_scene("whitted, sun of radius 5 degrees, bounces 1", &s);
 }
 
+/// Past the most spheres the hierarchy holds the tracer refuses the scene by count and limit
+/// (illum-rtcore's sphere_bvh::check_count), before compiling the traversal.
+#[test]
+fn more_spheres_than_the_bvh_holds_are_refused_by_count() {
+    use illum_rtcore::sphere_bvh::MAX_BVH_SPHERES;
+    let s = illum_scene::testing::with_small_spheres(scene("whitted", 1), MAX_BVH_SPHERES + 1);
+    let err = illum_pathtrace::PathTracer::new(common::gpu(), &s).err().expect("refused").to_string();
+    // The Whitted scene's own two spheres make MAX_BVH_SPHERES + 3.
+    let count = format!("{} non-emitting spheres", MAX_BVH_SPHERES + 3);
+    assert!(err.contains(&count) && err.contains(&format!("at most {MAX_BVH_SPHERES}")), "{err}");
+}
+
 /// Spheres past the traversal's literal limit go under a BVH (illum-rtcore's sphere_bvh.rs) in
 /// the camera paths and the caustic's passes alike; the oracle tests every object by brute force.
 #[test]
