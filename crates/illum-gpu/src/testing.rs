@@ -10,7 +10,7 @@ use std::sync::OnceLock;
 use wgpu::util::DeviceExt;
 
 use crate::GpuContext;
-use crate::buffers::{buffer_bind_group, dispatch};
+use crate::buffers::buffer_bind_group;
 use crate::readback::read_buffer;
 use crate::shader::{self, ShaderFile};
 
@@ -48,6 +48,21 @@ pub fn run_compute(
     output_bytes: u64,
     workgroups: (u32, u32, u32),
 ) -> Vec<u8> {
+    run_compute_with(label, modules, source, inputs, output_bytes, workgroups, |_| Vec::new())
+}
+
+/// As [`run_compute`], the buffers above at group 0, with the further bind groups `groups` makes
+/// for the compiled pipeline (whose layouts the shader's use of them decides), each with its
+/// group index.
+pub fn run_compute_with(
+    label: &str,
+    modules: &[ShaderFile],
+    source: String,
+    inputs: &[&[u8]],
+    output_bytes: u64,
+    workgroups: (u32, u32, u32),
+    groups: impl FnOnce(&wgpu::ComputePipeline) -> Vec<(u32, wgpu::BindGroup)>,
+) -> Vec<u8> {
     let gpu = gpu();
     let entry = ShaderFile::generated(label.into(), source);
     let pipeline = shader::compute_pipeline(gpu, modules, &entry, &[], label)
@@ -71,8 +86,18 @@ pub fn run_compute(
     let bindings: Vec<(u32, &wgpu::Buffer)> =
         buffers.iter().enumerate().map(|(i, b)| (i as u32, b)).collect();
     let bind_group = buffer_bind_group(&gpu.device, label, &pipeline.get_bind_group_layout(0), &bindings);
+    let more = groups(&pipeline);
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    dispatch(&mut encoder, label, &pipeline, &bind_group, [workgroups.0, workgroups.1, workgroups.2]);
+    {
+        let mut pass = encoder
+            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes: None });
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        for (index, group) in &more {
+            pass.set_bind_group(*index, group, &[]);
+        }
+        pass.dispatch_workgroups(workgroups.0, workgroups.1, workgroups.2);
+    }
     gpu.queue.submit([encoder.finish()]);
     let output = buffers.last().expect("the output buffer");
     read_buffer(gpu, output, 0, output_bytes, label).expect("readback")

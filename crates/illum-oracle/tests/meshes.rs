@@ -202,3 +202,33 @@ fn inside_a_closed_black_mesh_under_a_bright_sky_nothing_is_seen() {
         assert_eq!(whitted.pixel(i % 48, i / 48), [0.0; 3], "pixel {i}");
     }
 }
+
+/// The f64 oracle's triangles meet every ray the GPU traversal's watertightness test aims at a
+/// shared edge or vertex of a closed cube and icosphere
+/// ([`closed_meshes`](illum_scene::testing::obj::closed_meshes); illum-rtcore's
+/// tests/mesh_traversal.rs casts the same rays on the GPU), where aimed.
+#[test]
+fn rays_at_shared_edges_and_vertices_meet_the_oracle_s_triangles() {
+    use illum_oracle::geometry::mesh_surfaces;
+    for (n, k) in [(1, 0), (2, 1)] {
+        let (scene, rays) = illum_scene::testing::obj::closed_meshes(n, k);
+        let surfaces: Vec<_> = scene
+            .objects
+            .iter()
+            .flat_map(|o| match &o.shape {
+                Shape::Mesh(mesh) => mesh_surfaces(mesh).collect(),
+                _ => Vec::new(),
+            })
+            .collect();
+        for ray in &rays {
+            let (o, d) = (ray.origin.as_dvec3(), ray.direction.as_dvec3());
+            let t = surfaces
+                .iter()
+                .filter_map(|s| s.intersect(o, d, f64::INFINITY))
+                .map(|hit| hit.t)
+                .fold(f64::INFINITY, f64::min);
+            assert!((t - f64::from(ray.t)).abs() <= 1e-3, "{} triangles: {ray:?} met at {t}", surfaces.len());
+        }
+        println!("{} triangles: {} rays", surfaces.len(), rays.len());
+    }
+}
