@@ -66,17 +66,19 @@ pub fn vertex_bytes(scene: &RasterScene) -> u64 {
     3 * triangles as u64 * std::mem::size_of::<MeshVertex>() as u64
 }
 
-/// Refuses meshes whose vertex buffer exceeds `max_buffer_size`, with the bytes it needs.
+/// Refuses meshes whose vertex buffer exceeds `max_buffer_size`, with their files and the bytes
+/// it needs.
 pub fn check_size(scene: &RasterScene, max_buffer_size: u64) -> Result<(), SceneError> {
     let bytes = vertex_bytes(scene);
     if bytes <= max_buffer_size {
         return Ok(());
     }
     let triangles: usize = scene.meshes.iter().map(|m| m.mesh.triangles.len()).sum();
+    let files: Vec<String> = scene.meshes.iter().map(|m| format!("{:?}", m.mesh.file)).collect();
     Err(SceneError::invalid(
         &format!("scene {:?}", scene.name),
         "objects (meshes)",
-        format!("{triangles} triangles ({bytes} bytes of vertices)"),
+        format!("{triangles} triangles of {} ({bytes} bytes of vertices)", files.join(", ")),
         format!("must fit in {max_buffer_size} bytes, the device's max_buffer_size"),
     ))
 }

@@ -373,6 +373,29 @@ fn device_limits(max_texture_dimension_2d: u32, max_buffer_size: u64) -> wgpu::L
     wgpu::Limits { max_texture_dimension_2d, max_buffer_size, ..wgpu::Limits::default() }
 }
 
+/// The meshes' vertex buffer (three 48-byte corners a triangle, mesh.rs) fits a max_buffer_size
+/// of its size and not a byte less, refused by a message that names the mesh file, the bytes it
+/// needs and the limit. At 1 x 1 the readback needs 256 bytes, so the vertices decide.
+#[test]
+fn the_meshes_vertex_buffer_is_held_to_max_buffer_size() {
+    let ball = repo_file("scenes/models/icosphere-0.obj").display().to_string();
+    let mesh = format!(
+        "[[objects]]\nname = \"ball\"\nmaterial = \"grey\"\nmesh = {{ file = {ball:?}, translate = [-5.0, 1.0, 3.0] }}\n"
+    );
+    let mut s = parse(&with_object(&mesh)).unwrap_or_else(|e| panic!("{e}"));
+    (s.camera.width, s.camera.height) = (1, 1);
+    let bytes = (20 * 3 * std::mem::size_of::<illum_raster::mesh::MeshVertex>()) as u64;
+    check_device_limits(&s, &device_limits(16384, bytes)).unwrap_or_else(|e| panic!("{bytes} bytes: {e}"));
+    let err = check_device_limits(&s, &device_limits(16384, bytes - 1)).unwrap_err();
+    check_invalid(
+        &err,
+        "scene \"w\"",
+        "objects (meshes)",
+        &format!("20 triangles of {ball:?} ({bytes} bytes of vertices)"),
+        &format!("must fit in {} bytes, the device's max_buffer_size", bytes - 1),
+    );
+}
+
 #[test]
 fn device_limits_name_the_limit() {
     let limits = device_limits(16384, 1 << 28);
