@@ -23,9 +23,6 @@
 //!
 //! The rotation row (`check_rotated`) turns each scene as a whole about an axis; its criterion
 //! for the path tracer is statistical, since a turn changes the sampled directions.
-//!
-//! Over 450 lines: the three transforms of the whole scene share one scene loader, one renderer
-//! switch and one criterion, so they sit in one file.
 
 use std::sync::OnceLock;
 

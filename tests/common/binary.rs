@@ -1,6 +1,6 @@
 //! Running the `render` example's executable as a user does, and reading what it wrote. For the
 //! test binaries that run it and the other examples (`tests/render_cli/`, `tests/denoise_cli.rs`, `tests/jobs.rs`,
-//! `tests/slurm.rs`).
+//! `tests/slurm/main.rs`).
 #![allow(dead_code)] // each test binary uses a different subset
 
 use std::path::{Path, PathBuf};
