@@ -83,7 +83,7 @@ else
 fi
 
 echo
-echo "== The ladder (docs/ladder-whitted.md, docs/ladder-cornell.md, the README's ladder table)"
+echo "== The ladder (docs/ladder-whitted.md, docs/ladder-cornell.md, docs/ladder-tessellation.md, the README's ladder table)"
 "$bin/ladder" --out "$out/ladder"
 cp "$out/ladder/ladder.md" docs/ladder-whitted.md
 cp "$out/ladder/error-vs-time.png" docs/images/ladder-error-vs-time.png
@@ -93,6 +93,14 @@ cp "$out/ladder/contact-sheet.png" docs/images/ladder-contact-sheet.png
     --bounce-list 0,1,2,4,8 --bounce-spp 512 --out "$out/ladder-cornell"
 cp "$out/ladder-cornell/ladder.md" docs/ladder-cornell.md
 cp "$out/ladder-cornell/contact-sheet.png" docs/images/ladder-cornell-contact-sheet.png
+# docs/ladder-tessellation.md: the box's sphere against icospheres in its place (the truth at the
+# rows' own bounces, so that a row's error is its noise and its geometry's).
+"$bin/ladder" scenes/cornell-sphere.toml --width 256 --height 256 --truth-spp 8192 --truth-bounces 2 \
+    --spp-list 16 --depths 1 --bounce-spp 0 --denoise-spp-list --tessellate 1,2,3,4 --tessellate-flat 1,3 \
+    --tessellate-spp 256 --frames 2 --out "$out/ladder-tessellation"
+sed 's|](tessellation-sheet.png)|](images/ladder-tessellation-sheet.png)|' "$out/ladder-tessellation/ladder.md" \
+    > docs/ladder-tessellation.md
+cp "$out/ladder-tessellation/tessellation-sheet.png" docs/images/ladder-tessellation-sheet.png
 # docs/auto-check.md: render --renderer auto against the truth, predicted against measured.
 "$bin/auto_check" --out "$out/auto-check"
 cp "$out/auto-check/auto-check.md" docs/auto-check.md

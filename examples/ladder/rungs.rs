@@ -26,6 +26,9 @@ pub(crate) enum Series {
     PathTraceAtrous,
     /// The same followed by Open Image Denoise (builds with the feature `oidn`).
     PathTraceOidn,
+    /// The path tracer with the scene's spheres, then icospheres in their place
+    /// (`tessellation.rs`).
+    Tessellation,
 }
 
 /// One rung: an image made by one renderer with one setting, and how long it took.
