@@ -42,7 +42,9 @@
 //! Outputs in DIR: ladder.csv (one line per row and region: renderer, settings, times, pixels,
 //! relMSE, luminance ratio, FLIP), ladder.md (the tables), error-vs-time.png and
 //! flip-vs-time.png (log-log, one series per renderer), contact-sheet.png (each image beside
-//! its FLIP error map, labelled), regions.png.
+//! its FLIP error map, labelled), regions.png; with `--tessellate`, tessellation-sheet.png (each
+//! tessellation row around the sphere, enlarged, beside FLIP's map of its difference from the
+//! analytic sphere's image).
 //!
 
 mod outputs;
@@ -151,7 +153,7 @@ fn run(args: Args) -> anyhow::Result<()> {
     }
     let tessellating = !args.tessellate.is_empty() || !args.tessellate_flat.is_empty();
     let geometries = if tessellating {
-        tessellation::geometries(&args.tessellate, &args.tessellate_flat)?
+        tessellation::geometries(&scene, &args.tessellate, &args.tessellate_flat)?
     } else {
         Vec::new()
     };

@@ -1,5 +1,5 @@
 //! The tessellation rows (`--tessellate`, `--tessellate-flat`): the scene's spheres replaced by
-//! icospheres, path traced at one spp, against the truth of the analytic scene, so that what
+//! icospheres, path traced at one sample count, against the truth of the analytic scene, so that what
 //! the rows measure beyond the analytic sphere's own row is what the tessellation costs.
 //!
 //! Convention: the icosphere of subdivision k is `scenes/models/icosphere-K.obj` (written by
@@ -68,8 +68,11 @@ fn triangles(k: u32) -> u32 {
     20 * 4u32.pow(k)
 }
 
-/// The geometries of the rows, the analytic sphere first.
-pub(crate) fn geometries(smooth: &[u32], flat: &[u32]) -> anyhow::Result<Vec<Geometry>> {
+/// The geometries of the rows, the analytic sphere first; refused for a scene without a sphere.
+pub(crate) fn geometries(scene: &Scene, smooth: &[u32], flat: &[u32]) -> anyhow::Result<Vec<Geometry>> {
+    if !scene.objects.iter().any(|o| matches!(o.shape, Shape::Sphere(_))) {
+        bail!("--tessellate: scene {} has no sphere to tessellate", scene.name);
+    }
     if let Some(k) = smooth.iter().chain(flat).find(|k| !SUBDIVISIONS.contains(k)) {
         bail!("--tessellate {k}: scenes/models holds the icospheres of subdivision 0 to 4");
     }
@@ -113,9 +116,6 @@ pub(crate) fn tessellation_rungs(
     spp: u32,
     runs: u32,
 ) -> anyhow::Result<Vec<(Geometry, Rung)>> {
-    if !scene.objects.iter().any(|o| matches!(o.shape, Shape::Sphere(_))) {
-        bail!("--tessellate: scene {} has no sphere to tessellate", scene.name);
-    }
     let mut rows = Vec::new();
     for &geometry in geometries {
         let variant = tessellated(scene, geometry)?;
