@@ -2,7 +2,7 @@
 # Regenerates every picture the README shows and re-measures every number it quotes, from the
 # code as it is now, and writes the numbers into the generated blocks of the README (`headline`,
 # `ladder-summary`) and of docs/performance*.md (`bench-quick`, `viewer-bench`,
-# `viewer-bench-whitted`, `glint-bench`, `raster-bench`),
+# `viewer-bench-whitted`, `glint-bench`, `raster-bench`, `largest-mesh`),
 # each with the date and the CPU:
 #
 #     scripts/readme-figures.sh              pictures, the ladder, then the headline figures
@@ -123,6 +123,8 @@ for n in 10 50 200; do python3 scripts/many-spheres.py $n -o "$out/spheres-$n.to
 "$bin/bench" --runs 3 --glint scenes/whitted.toml "$out"/spheres-{10,50,200}.toml | tee "$out/bench-glint.txt"
 # docs/performance.md, "Many spheres": the time to the first image, cold and warm.
 "$bin/bench" --runs 3 --first-image scenes/whitted.toml "$out"/spheres-{50,200}.toml | tee "$out/bench-first-image.txt"
+# docs/performance.md, "Meshes": the largest mesh the device holds.
+"$bin/bench" --largest-mesh | tee "$out/bench-largest-mesh.txt"
 if "$python" -c "import mitsuba" 2> /dev/null; then
     "$python" bench/vs_mitsuba.py --bounces 2 | tee "$out/vs-mitsuba.txt"
     "$python" bench/vs_mitsuba.py --bounces 8 | tee "$out/vs-mitsuba-b8.txt"
