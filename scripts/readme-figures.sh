@@ -97,7 +97,7 @@ cp "$out/ladder-cornell/contact-sheet.png" docs/images/ladder-cornell-contact-sh
 # rows' own bounces, so that a row's error is its noise and its geometry's).
 "$bin/ladder" scenes/cornell-sphere.toml --width 256 --height 256 --truth-spp 8192 --truth-bounces 2 \
     --spp-list 16 --depths 1 --bounce-spp 0 --denoise-spp-list --tessellate 1,2,3,4 --tessellate-flat 1,3 \
-    --tessellate-spp 256 --frames 2 --out "$out/ladder-tessellation"
+    --tessellate-spp 256 --frames 3 --out "$out/ladder-tessellation"
 sed 's|](tessellation-sheet.png)|](images/ladder-tessellation-sheet.png)|' "$out/ladder-tessellation/ladder.md" \
     > docs/ladder-tessellation.md
 cp "$out/ladder-tessellation/tessellation-sheet.png" docs/images/ladder-tessellation-sheet.png

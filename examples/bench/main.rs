@@ -53,6 +53,7 @@ use illum::raster::{Look, Motion, Options, bench_frames};
 use illum::scene::Sequence;
 use illum::scene::{Bounces, Scene};
 use illum_cli::SceneArgs;
+use illum_lab::report::load_average;
 
 mod first_image;
 mod largest_mesh;
@@ -474,11 +475,4 @@ fn bench_glint(scenes: &[PathBuf], runs: u32) -> anyhow::Result<()> {
         );
     }
     Ok(())
-}
-
-/// The host's one-minute load average, where the system tells it (Linux): other work on the host
-/// slows every figure here, and a table quoted without it cannot be judged.
-fn load_average() -> Option<String> {
-    let text = std::fs::read_to_string("/proc/loadavg").ok()?;
-    text.split(' ').next().map(str::to_owned)
 }

@@ -244,10 +244,10 @@ fn run(args: Args) -> anyhow::Result<()> {
         }
     }
     let tessellate_spp = args.tessellate_spp.unwrap_or(args.spp_list.iter().copied().max().unwrap_or(1));
-    let tessellated = if tessellating {
+    let (tessellated, timing) = if tessellating {
         tessellation::tessellation_rungs(&gpu, &scene, &geometries, tessellate_spp, args.frames.min(3))?
     } else {
-        Vec::new()
+        (Vec::new(), String::new())
     };
     let first_tessellated = rungs.len();
     let row_geometries: Vec<_> = tessellated.iter().map(|(g, _)| *g).collect();
@@ -265,7 +265,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         .map(|(&g, row)| (g, &row.rung, &row.errors))
         .collect();
     let tessellation_rows = tessellation::compared(&tessellation_rows, &regions);
-    let tessellation_md = tessellation::section(&tessellation_rows, &regions);
+    let tessellation_md = tessellation::section(&tessellation_rows, &regions, &timing);
     if let Some(crop) = tessellation::sphere_crop(&scene, &ids).filter(|_| !tessellation_rows.is_empty()) {
         let sheet = tessellation::sheet(&tessellation_rows, crop);
         illum::image::save_rgba8_png(args.out.join(tessellation::SHEET), &sheet)?;

@@ -25,10 +25,10 @@ use illum::gpu::GpuContext;
 use illum::scene::{MaterialKind, Scene, Shape, Sphere};
 use illum::whitted::ObjectIds;
 use illum_lab::regions::{Comparison, Regions, compare};
-use illum_lab::report::markdown_table;
+use illum_lab::report::{load_average, markdown_table};
 use illum_scene::testing::obj::{icosphere_obj, scene_with_files};
 
-use crate::rungs::{Rung, Series, pathtrace_rung, print_rung};
+use crate::rungs::{PathTraceRow, Rung, Series, print_rung};
 
 /// The subdivisions scenes/models holds (scripts/icosphere.py).
 pub(crate) const SUBDIVISIONS: std::ops::RangeInclusive<u32> = 0..=4;
@@ -108,24 +108,39 @@ pub(crate) fn tessellated(scene: &Scene, geometry: Geometry) -> anyhow::Result<S
     Ok(out)
 }
 
-/// The rows: each geometry path traced at `spp` with the scene's bounces.
+/// The rows: each geometry path traced at `spp` with the scene's bounces, and the host's load
+/// average before and after them (", load average A before them, B after"). The runs are
+/// interleaved (every geometry once, then again), so that a change in the machine's load
+/// weighs on every row alike and the times' ratios hold.
 pub(crate) fn tessellation_rungs(
     gpu: &GpuContext,
     scene: &Scene,
     geometries: &[Geometry],
     spp: u32,
     runs: u32,
-) -> anyhow::Result<Vec<(Geometry, Rung)>> {
+) -> anyhow::Result<(Vec<(Geometry, Rung)>, String)> {
+    let setting = (spp, scene.pathtrace.bounces);
+    let load = load_average().map_or(String::new(), |l| format!(", load average {l} before them"));
     let mut rows = Vec::new();
     for &geometry in geometries {
-        let variant = tessellated(scene, geometry)?;
-        let setting = (spp, scene.pathtrace.bounces);
-        let mut rung = pathtrace_rung(gpu, &variant, setting, Series::Tessellation, runs)?;
-        rung.settings = format!("{}, {}", geometry.label(), rung.settings);
-        print_rung(&rung);
-        rows.push((geometry, rung));
+        rows.push((geometry, PathTraceRow::new(gpu, &tessellated(scene, geometry)?, setting)?));
     }
-    Ok(rows)
+    for _ in 0..runs.max(1) {
+        for (_, row) in &mut rows {
+            row.run()?;
+        }
+    }
+    let load = format!("{load}{}", load_average().map_or(String::new(), |l| format!(", {l} after")));
+    let rungs = rows
+        .into_iter()
+        .map(|(geometry, row)| {
+            let mut rung = row.rung(Series::Tessellation);
+            rung.settings = format!("{}, {}", geometry.label(), rung.settings);
+            print_rung(&rung);
+            (geometry, rung)
+        })
+        .collect();
+    Ok((rungs, load))
 }
 
 /// Which band of a sphere a pixel's centre ray meets it in.
@@ -314,7 +329,7 @@ pub(crate) fn compared<'a>(
 /// analytic row's image, which had the same samples (the same seed: pixels whose paths never
 /// meet the sphere come out the same, so what differs is the geometry's doing), and the
 /// regions that hold most of that difference.
-pub(crate) fn section(rows: &[TessellationRow], regions: &Regions) -> String {
+pub(crate) fn section(rows: &[TessellationRow], regions: &Regions, timing: &str) -> String {
     let Some(analytic) = rows.iter().find(|r| r.geometry == Geometry::Analytic) else {
         return String::new();
     };
@@ -380,7 +395,7 @@ pub(crate) fn section(rows: &[TessellationRow], regions: &Regions) -> String {
     let mut md = format!(
         "\n## Tessellation: what replacing the sphere by an icosphere costs\n\n\
          Each row path traces the scene at {} with its spheres replaced (the first row keeps them), \
-         with the same seed. The icosphere of subdivision k (scenes/models/icosphere-k.obj) is \
+         with the same seed; its time is the median of its runs, the rows' runs taken in turn{timing}. The icosphere of subdivision k (scenes/models/icosphere-k.obj) is \
          inscribed: its vertices lie on the sphere, its faces inside it. Smooth rows shade with \
          the sphere's normal at each vertex, interpolated; flat rows with each face's normal. \
          Against the truth (of the analytic scene) each row's error is its noise plus what the \
