@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Writes the icosphere meshes and the Cornell box with a mesh in it (docs/scenes.md, "Meshes").
 
-    scripts/icosphere.py            # writes scenes/models/icosphere-{0..4}.obj, scenes/cornell-mesh.toml
+    scripts/icosphere.py            # writes scenes/models/icosphere-{0..4}.obj, scenes/cornell-mesh.toml,
+                                    # scenes/cornell-sphere.toml
     scripts/icosphere.py --subdivision 7 --out out/meshes
                                     # writes out/meshes/icosphere-7.obj and cornell-mesh-7.toml:
                                     # the same box with that subdivision's icosphere (benchmarks)
@@ -16,6 +17,9 @@ Vertices are written with 9 significant digits, enough to read back the same f32
 cornell-mesh.toml is scenes/cornell.toml, read from the repository unchanged, with one object
 added: the icosphere of subdivision 3 (1280 triangles), radius 80, resting on the short block
 (its top face is at y = 165; the block's footprint centre is (157.95, 168.95), docs/scenes.md).
+cornell-sphere.toml is the same box with an analytic sphere of the same centre and radius in
+the icosphere's place: the scene the ladder's tessellation rows start from (examples/ladder,
+--tessellate), whose icospheres have their vertices on this sphere.
 With --subdivision k the box holds the icosphere of subdivision k instead (k = 5, 6, 7, 8 give
 20 480, 81 920, 327 680 and 1 310 720 triangles), written with its OBJ into --out, never into
 scenes/: a million triangles take 80 MB of text.
@@ -93,18 +97,38 @@ def icosphere(k):
     return vertices, faces
 
 
+# Where the ball rests: centred over the short block's footprint, on its top face (y = 165).
+BALL_CENTRE = "[157.95, 245.0, 168.95]"
+BALL_RADIUS = "80.0"
+
+
+def cornell_renamed(name, what):
+    """scenes/cornell.toml, renamed, under a header saying it was written here with `what` added."""
+    cornell = (ROOT / "scenes" / "cornell.toml").read_text()
+    header = (f"# Written by scripts/icosphere.py: scenes/cornell.toml with {what} resting on the\n"
+              "# short block (docs/scenes.md, \"Meshes\"). Edit the script, not this file.\n\n")
+    return header + cornell.replace('name = "cornell"', f'name = "{name}"', 1)
+
+
 def cornell_with(k, mesh_file, name):
     """scenes/cornell.toml, renamed, with the icosphere of subdivision k (radius 80) on the short block."""
-    cornell = (ROOT / "scenes" / "cornell.toml").read_text()
-    header = ("# Written by scripts/icosphere.py: scenes/cornell.toml with an icosphere mesh resting on the\n"
-              "# short block (docs/scenes.md, \"Meshes\"). Edit the script, not this file.\n\n")
-    cornell = cornell.replace('name = "cornell"', f'name = "{name}"', 1)
     ball = (f"\n# The icosphere of subdivision {k} ({20 * 4 ** k} flat triangles), radius 80, on the short block's top (y = 165).\n"
             "[[objects]]\n"
             "name = \"icosphere\"\n"
             "material = \"white\"\n"
-            f"mesh = {{ file = \"{mesh_file}\", translate = [157.95, 245.0, 168.95], scale = 80.0 }}\n")
-    return header + cornell + ball
+            f"mesh = {{ file = \"{mesh_file}\", translate = {BALL_CENTRE}, scale = {BALL_RADIUS} }}\n")
+    return cornell_renamed(name, "an icosphere mesh") + ball
+
+
+def cornell_with_sphere():
+    """scenes/cornell.toml, renamed, with an analytic sphere where cornell_with puts the icosphere."""
+    ball = ("\n# An analytic sphere of radius 80 on the short block's top (y = 165), where cornell-mesh.toml\n"
+            "# has its icosphere: the ladder's tessellation rows put icospheres in its place.\n"
+            "[[objects]]\n"
+            "name = \"sphere\"\n"
+            "material = \"white\"\n"
+            f"sphere = {{ center = {BALL_CENTRE}, radius = {BALL_RADIUS} }}\n")
+    return cornell_renamed("cornell-sphere", "an analytic sphere") + ball
 
 
 def main():
@@ -128,6 +152,7 @@ def main():
         (models / f"icosphere-{k}.obj").write_text(obj_text(k, vertices, faces))
     scene = cornell_with(CORNELL_SUBDIVISION, f"models/icosphere-{CORNELL_SUBDIVISION}.obj", "cornell-mesh")
     (ROOT / "scenes" / "cornell-mesh.toml").write_text(scene)
+    (ROOT / "scenes" / "cornell-sphere.toml").write_text(cornell_with_sphere())
 
 
 if __name__ == "__main__":

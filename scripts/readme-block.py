@@ -197,6 +197,7 @@ def perf_tables(directory):
         ("bench-glint.txt", "glint-bench", "performance-caustics.md", False),
         ("raster-bench.txt", "raster-bench", "performance-raster.md", True),
         ("vs-mitsuba-meshes.txt", "mitsuba-meshes", "performance.md", False),
+        ("bench-largest-mesh.txt", "largest-mesh", "performance.md", True),
     ]
     for name, block, page, preformatted in blocks:
         text = read(directory, name).strip()

@@ -2,7 +2,7 @@
 # Regenerates every picture the README shows and re-measures every number it quotes, from the
 # code as it is now, and writes the numbers into the generated blocks of the README (`headline`,
 # `ladder-summary`) and of docs/performance*.md (`bench-quick`, `viewer-bench`,
-# `viewer-bench-whitted`, `glint-bench`, `raster-bench`),
+# `viewer-bench-whitted`, `glint-bench`, `raster-bench`, `largest-mesh`),
 # each with the date and the CPU:
 #
 #     scripts/readme-figures.sh              pictures, the ladder, then the headline figures
@@ -83,7 +83,7 @@ else
 fi
 
 echo
-echo "== The ladder (docs/ladder-whitted.md, docs/ladder-cornell.md, the README's ladder table)"
+echo "== The ladder (docs/ladder-whitted.md, docs/ladder-cornell.md, docs/ladder-tessellation.md, the README's ladder table)"
 "$bin/ladder" --out "$out/ladder"
 cp "$out/ladder/ladder.md" docs/ladder-whitted.md
 cp "$out/ladder/error-vs-time.png" docs/images/ladder-error-vs-time.png
@@ -93,6 +93,14 @@ cp "$out/ladder/contact-sheet.png" docs/images/ladder-contact-sheet.png
     --bounce-list 0,1,2,4,8 --bounce-spp 512 --out "$out/ladder-cornell"
 cp "$out/ladder-cornell/ladder.md" docs/ladder-cornell.md
 cp "$out/ladder-cornell/contact-sheet.png" docs/images/ladder-cornell-contact-sheet.png
+# docs/ladder-tessellation.md: the box's sphere against icospheres in its place (the truth at the
+# rows' own bounces, so that a row's error is its noise and its geometry's).
+"$bin/ladder" scenes/cornell-sphere.toml --width 256 --height 256 --truth-spp 8192 --truth-bounces 2 \
+    --spp-list 16 --depths 1 --bounce-spp 0 --denoise-spp-list --tessellate 1,2,3,4 --tessellate-flat 1,3 \
+    --tessellate-spp 256 --frames 3 --out "$out/ladder-tessellation"
+sed 's|](tessellation-sheet.png)|](images/ladder-tessellation-sheet.png)|' "$out/ladder-tessellation/ladder.md" \
+    > docs/ladder-tessellation.md
+cp "$out/ladder-tessellation/tessellation-sheet.png" docs/images/ladder-tessellation-sheet.png
 # docs/auto-check.md: render --renderer auto against the truth, predicted against measured.
 "$bin/auto_check" --out "$out/auto-check"
 cp "$out/auto-check/auto-check.md" docs/auto-check.md
@@ -115,6 +123,8 @@ for n in 10 50 200; do python3 scripts/many-spheres.py $n -o "$out/spheres-$n.to
 "$bin/bench" --runs 3 --glint scenes/whitted.toml "$out"/spheres-{10,50,200}.toml | tee "$out/bench-glint.txt"
 # docs/performance.md, "Many spheres": the time to the first image, cold and warm.
 "$bin/bench" --runs 3 --first-image scenes/whitted.toml "$out"/spheres-{50,200}.toml | tee "$out/bench-first-image.txt"
+# docs/performance.md, "Meshes": the largest mesh the device holds.
+"$bin/bench" --largest-mesh | tee "$out/bench-largest-mesh.txt"
 if "$python" -c "import mitsuba" 2> /dev/null; then
     "$python" bench/vs_mitsuba.py --bounces 2 | tee "$out/vs-mitsuba.txt"
     "$python" bench/vs_mitsuba.py --bounces 8 | tee "$out/vs-mitsuba-b8.txt"

@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! cargo run --release --example bench -- [--runs N] [--quick | --large [--compare-readback] | --viewer | --sequences
-//!     | --glint SCENE... | --parts SCENE | --first-image SCENE...]
+//!     | --glint SCENE... | --parts SCENE | --first-image SCENE... | --largest-mesh [SCENE]]
 //! ```
 //! For `scenes/cornell.toml` at each size and bounce count it renders a fixed number of samples
 //! per pixel `runs` times and prints the median of:
@@ -37,6 +37,10 @@
 //! a render's set-up before its first sample) for each scene given, on all the host's threads:
 //! `scripts/many-spheres.py` writes scenes with many specular spheres for it.
 //!
+//! `--largest-mesh` grows a grid mesh on the scene's floor until the device's limit on one
+//! storage binding refuses it, and prints the largest accepted size's triangles, bytes on the
+//! device per triangle, hierarchy build time and one frame's throughput (`largest_mesh.rs`).
+//!
 //! Timings are never asserted in tests; the figures go to docs/performance.md.
 
 use std::path::PathBuf;
@@ -49,8 +53,10 @@ use illum::raster::{Look, Motion, Options, bench_frames};
 use illum::scene::Sequence;
 use illum::scene::{Bounces, Scene};
 use illum_cli::SceneArgs;
+use illum_lab::report::load_average;
 
 mod first_image;
+mod largest_mesh;
 mod parts;
 
 #[derive(Parser, Debug)]
@@ -93,6 +99,10 @@ struct Args {
     /// alone (the scene should have a caustic: scenes/whitted.toml).
     #[arg(long, conflicts_with_all = ["quick", "large", "viewer", "sequences"])]
     parts: bool,
+    /// Only the largest mesh the device holds: a grid on the scene's floor, grown until the
+    /// device's storage-binding limit refuses it.
+    #[arg(long, conflicts_with_all = ["quick", "large", "viewer", "sequences", "parts", "glint", "first_image"])]
+    largest_mesh: bool,
 }
 
 struct Config {
@@ -123,6 +133,10 @@ fn run(args: Args) -> anyhow::Result<()> {
     if !args.first_image.is_empty() {
         let load = load_average().map_or(String::new(), |l| format!(", load average {l} at the start"));
         return first_image::bench_first_image(&gpu, &args.first_image, args.runs, &load);
+    }
+    if args.largest_mesh {
+        let load = load_average().map_or(String::new(), |l| format!(", load average {l} at the start"));
+        return largest_mesh::bench_largest_mesh(&gpu, &Scene::load(&args.scene)?, &load);
     }
     if args.parts {
         let load = load_average().map_or(String::new(), |l| format!(", load average {l} at the start"));
@@ -461,11 +475,4 @@ fn bench_glint(scenes: &[PathBuf], runs: u32) -> anyhow::Result<()> {
         );
     }
     Ok(())
-}
-
-/// The host's one-minute load average, where the system tells it (Linux): other work on the host
-/// slows every figure here, and a table quoted without it cannot be judged.
-fn load_average() -> Option<String> {
-    let text = std::fs::read_to_string("/proc/loadavg").ok()?;
-    text.split(' ').next().map(str::to_owned)
 }

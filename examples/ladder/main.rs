@@ -5,7 +5,7 @@
 //! cargo run --release --example ladder -- [SCENE] [--width W --height H] [--truth-spp N]
 //!     [--truth-bounces B] [--truth FILE.exr] [--spp-list 1,4,16,64,256,1024] [--depths 1,2,8]
 //!     [--bounce-list 0,1,2,4] [--bounce-spp 1024] [--denoise-spp-list 1,4,16,64,256] [--frames 5]
-//!     [--out DIR]
+//!     [--tessellate 1,2,3,4] [--tessellate-flat 1,3] [--tessellate-spp N] [--out DIR]
 //! ```
 //! Rows:
 //! - the rasterizer (if it can draw the scene): the `figure` look, the `enhanced` look, and the
@@ -18,7 +18,13 @@
 //!   the classic "Whitted against path tracing, bounce by bounce");
 //! - the path tracer at each spp of `--denoise-spp-list` followed by the à-trous denoiser, and
 //!   by Open Image Denoise in builds with `--features illum-denoise/oidn` (illum-denoise, with
-//!   its bound on every denoised pixel; the guide pass and the filter are part of its time).
+//!   its bound on every denoised pixel; the guide pass and the filter are part of its time);
+//! - with `--tessellate` (a scene with a sphere, e.g. scenes/cornell-sphere.toml): the path
+//!   tracer at `--tessellate-spp` with the scene's spheres, then with icospheres of each
+//!   subdivision of `--tessellate` (shaded smoothly) and `--tessellate-flat` (flat) in their
+//!   place, against the analytic scene's truth; the sphere's pixels get regions of their own
+//!   (rim, shadow terminator, lit and dark side), and ladder.md a section on what the
+//!   tessellation costs (`tessellation.rs`).
 //!
 //! Each row's time is the median of `--frames` frames: the rasterizer's wall time per frame as
 //! a viewer pays it (no readback) and its GPU time from timestamp queries; the Whitted ray
@@ -36,11 +42,14 @@
 //! Outputs in DIR: ladder.csv (one line per row and region: renderer, settings, times, pixels,
 //! relMSE, luminance ratio, FLIP), ladder.md (the tables), error-vs-time.png and
 //! flip-vs-time.png (log-log, one series per renderer), contact-sheet.png (each image beside
-//! its FLIP error map, labelled), regions.png.
+//! its FLIP error map, labelled), regions.png; with `--tessellate`, tessellation-sheet.png (each
+//! tessellation row around the sphere, enlarged, beside FLIP's map of its difference from the
+//! analytic sphere's image).
 //!
 
 mod outputs;
 mod rungs;
+mod tessellation;
 
 use std::path::PathBuf;
 
@@ -101,6 +110,16 @@ struct Args {
     /// Frames timed per row (the median is reported).
     #[arg(long, default_value_t = 5)]
     frames: u32,
+    /// Tessellation rows: the scene's spheres replaced by the icosphere of each of these
+    /// subdivisions (0 to 4), shaded smoothly (comma-separated; none by default).
+    #[arg(long, value_delimiter = ',')]
+    tessellate: Vec<u32>,
+    /// Tessellation rows shaded flat, by subdivision (comma-separated; none by default).
+    #[arg(long, value_delimiter = ',')]
+    tessellate_flat: Vec<u32>,
+    /// Samples per pixel of the tessellation rows (default: the largest of --spp-list).
+    #[arg(long)]
+    tessellate_spp: Option<u32>,
     /// Folder for the tables, plots, images and the cached truth.
     #[arg(long, default_value = "out/ladder")]
     out: PathBuf,
@@ -114,8 +133,14 @@ fn run(args: Args) -> anyhow::Result<()> {
     if args.frames == 0 {
         bail!("--frames 0: at least one frame must be timed");
     }
-    if args.truth_spp == 0 || args.spp_list.contains(&0) || args.denoise_spp_list.contains(&0) {
-        bail!("samples per pixel must be at least 1 (--truth-spp, --spp-list, --denoise-spp-list)");
+    if args.truth_spp == 0
+        || args.spp_list.contains(&0)
+        || args.denoise_spp_list.contains(&0)
+        || args.tessellate_spp == Some(0)
+    {
+        bail!(
+            "samples per pixel must be at least 1 (--truth-spp, --spp-list, --denoise-spp-list, --tessellate-spp)"
+        );
     }
     let mut scene = Scene::load(&illum_cli::resolve_scene_path(&args.scene))?;
     let (w, h) = default_size(&scene, args.width, args.height);
@@ -126,6 +151,12 @@ fn run(args: Args) -> anyhow::Result<()> {
     if let Some(depth) = args.depths.iter().find(|&&d| d > MAX_WHITTED_DEPTH) {
         bail!("--depths {depth}: a Whitted depth must be 0 to {MAX_WHITTED_DEPTH}");
     }
+    let tessellating = !args.tessellate.is_empty() || !args.tessellate_flat.is_empty();
+    let geometries = if tessellating {
+        tessellation::geometries(&scene, &args.tessellate, &args.tessellate_flat)?
+    } else {
+        Vec::new()
+    };
     illum::image::check_output(args.out.join("ladder.csv"))?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     let gpu = illum_cli::gpu()?;
@@ -162,7 +193,10 @@ fn run(args: Args) -> anyhow::Result<()> {
              that row's error includes a sixteenth or more of the truth's own"
         );
     }
-    let regions = Regions::from_ids(&scene, &WhittedTracer::new(&gpu, &scene)?.object_ids()?);
+    let ids = WhittedTracer::new(&gpu, &scene)?.object_ids()?;
+    let regions = Regions::from_ids(&scene, &ids);
+    let regions =
+        if tessellating { tessellation::with_sphere_bands(&scene, &regions, &ids) } else { regions };
 
     let mut rungs = Vec::new();
     raster_rungs(&gpu, &scene, args.frames, &mut rungs)?;
@@ -209,6 +243,15 @@ fn run(args: Args) -> anyhow::Result<()> {
             print_rung(rungs.last().expect("pushed"));
         }
     }
+    let tessellate_spp = args.tessellate_spp.unwrap_or(args.spp_list.iter().copied().max().unwrap_or(1));
+    let (tessellated, timing) = if tessellating {
+        tessellation::tessellation_rungs(&gpu, &scene, &geometries, tessellate_spp, args.frames.min(3))?
+    } else {
+        (Vec::new(), String::new())
+    };
+    let first_tessellated = rungs.len();
+    let row_geometries: Vec<_> = tessellated.iter().map(|(g, _)| *g).collect();
+    rungs.extend(tessellated.into_iter().map(|(_, rung)| rung));
     let rows: Vec<Row> = rungs
         .into_iter()
         .map(|rung| {
@@ -216,6 +259,18 @@ fn run(args: Args) -> anyhow::Result<()> {
             Row { rung, errors }
         })
         .collect();
+    let tessellation_rows: Vec<_> = row_geometries
+        .iter()
+        .zip(&rows[first_tessellated..])
+        .map(|(&g, row)| (g, &row.rung, &row.errors))
+        .collect();
+    let tessellation_rows = tessellation::compared(&tessellation_rows, &regions);
+    let tessellation_md = tessellation::section(&tessellation_rows, &regions, &timing);
+    if let Some(crop) = tessellation::sphere_crop(&scene, &ids).filter(|_| !tessellation_rows.is_empty()) {
+        let sheet = tessellation::sheet(&tessellation_rows, crop);
+        illum::image::save_rgba8_png(args.out.join(tessellation::SHEET), &sheet)?;
+        println!("wrote {}/{}", args.out.display(), tessellation::SHEET);
+    }
 
     let truth_bounces =
         if args.truth.is_some() { "as in the given file".to_owned() } else { args.truth_bounces.to_string() };
@@ -227,7 +282,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         truth_error,
         truth_metadata,
     };
-    write_outputs(&args.out, &header, &truth, &regions, &rows)?;
+    write_outputs(&args.out, &header, &truth, &regions, &rows, &tessellation_md)?;
     Ok(())
 }
 

@@ -41,6 +41,7 @@ pub(crate) fn write_outputs(
     truth: &RgbImage32,
     regions: &Regions,
     rows: &[Row],
+    tessellation: &str,
 ) -> anyhow::Result<()> {
     let sizes = regions.sizes();
     // CSV: one line per row and region ("all" for the whole image).
@@ -125,6 +126,7 @@ pub(crate) fn write_outputs(
         &["renderer", "settings", "wall ms", "GPU ms", "relMSE", "luminance ratio", "FLIP"],
         &overall,
     ));
+    md.push_str(tessellation);
     let region_header: Vec<String> = std::iter::once("renderer, settings".to_owned())
         .chain(regions.names.iter().zip(&sizes).map(|(n, px)| format!("{n} ({px} px)")))
         .collect();
@@ -162,6 +164,7 @@ pub(crate) fn write_outputs(
             ("path tracer, more bounces", Series::PathTraceBounces, Style::Joined),
             ("path tracer + à-trous, more spp", Series::PathTraceAtrous, Style::Joined),
             ("path tracer + OIDN, more spp", Series::PathTraceOidn, Style::Joined),
+            ("path tracer, the sphere and icospheres", Series::Tessellation, Style::Markers),
         ];
         let lines: Vec<Line> = series
             .iter()

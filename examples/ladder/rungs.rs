@@ -26,6 +26,9 @@ pub(crate) enum Series {
     PathTraceAtrous,
     /// The same followed by Open Image Denoise (builds with the feature `oidn`).
     PathTraceOidn,
+    /// The path tracer with the scene's spheres, then icospheres in their place
+    /// (`tessellation.rs`).
+    Tessellation,
 }
 
 /// One rung: an image made by one renderer with one setting, and how long it took.
@@ -158,34 +161,65 @@ pub(crate) fn whitted_rung(gpu: &GpuContext, scene: &Scene, depth: u32, frames: 
     })
 }
 
+/// The path tracer set up for one row: `scene` at `spp` and `bounces`, warmed up (the pipeline
+/// compiled, the buffers made), each timed run rendering those samples from nothing.
+pub(crate) struct PathTraceRow {
+    tracer: PathTracer,
+    spp: u32,
+    settings: String,
+    ms: Vec<f64>,
+}
+
+impl PathTraceRow {
+    pub(crate) fn new(
+        gpu: &GpuContext,
+        scene: &Scene,
+        (spp, bounces): (u32, Bounces),
+    ) -> anyhow::Result<Self> {
+        let mut scene = scene.clone();
+        scene.pathtrace.bounces = bounces;
+        scene.pathtrace.spp = spp;
+        let mut tracer = PathTracer::new(gpu, &scene)?;
+        tracer.render_to_spp(1)?; // warm-up: the pipeline and buffers
+        let settings = format!(
+            "{spp} spp, bounces {bounces}{}",
+            if scene.pathtrace.caustics { ", caustic estimator" } else { "" }
+        );
+        Ok(PathTraceRow { tracer, spp, settings, ms: Vec::new() })
+    }
+
+    /// One timed run.
+    pub(crate) fn run(&mut self) -> anyhow::Result<()> {
+        self.tracer.reset();
+        let started = Instant::now();
+        self.tracer.render_to_spp(self.spp)?;
+        self.ms.push(started.elapsed().as_secs_f64() * 1e3);
+        Ok(())
+    }
+
+    /// The rung: the median of the runs' times, the last run's image.
+    pub(crate) fn rung(mut self, series: Series) -> Rung {
+        Rung {
+            renderer: "pathtrace",
+            series,
+            settings: self.settings,
+            wall_ms: median(&mut self.ms),
+            gpu_ms: None,
+            image: self.tracer.accumulator().mean_image(),
+        }
+    }
+}
+
 pub(crate) fn pathtrace_rung(
     gpu: &GpuContext,
     scene: &Scene,
-    (spp, bounces): (u32, Bounces),
+    setting: (u32, Bounces),
     series: Series,
     runs: u32,
 ) -> anyhow::Result<Rung> {
-    let mut scene = scene.clone();
-    scene.pathtrace.bounces = bounces;
-    scene.pathtrace.spp = spp;
-    let mut tracer = PathTracer::new(gpu, &scene)?;
-    tracer.render_to_spp(1)?; // warm-up: the pipeline and buffers
-    let mut ms = Vec::new();
+    let mut row = PathTraceRow::new(gpu, scene, setting)?;
     for _ in 0..runs.max(1) {
-        tracer.reset();
-        let started = Instant::now();
-        tracer.render_to_spp(spp)?;
-        ms.push(started.elapsed().as_secs_f64() * 1e3);
+        row.run()?;
     }
-    Ok(Rung {
-        renderer: "pathtrace",
-        series,
-        settings: format!(
-            "{spp} spp, bounces {bounces}{}",
-            if scene.pathtrace.caustics { ", caustic estimator" } else { "" }
-        ),
-        wall_ms: median(&mut ms),
-        gpu_ms: None,
-        image: tracer.accumulator().mean_image(),
-    })
+    Ok(row.rung(series))
 }

@@ -50,6 +50,13 @@ pub fn host_cpu() -> String {
     model.map_or("unknown CPU".to_owned(), |m| format!("{m}, {count} vCPUs"))
 }
 
+/// The host's one-minute load average, where the system tells it (Linux): other work on the host
+/// slows every timed figure, and a table quoted without it cannot be judged.
+pub fn load_average() -> Option<String> {
+    let text = std::fs::read_to_string("/proc/loadavg").ok()?;
+    text.split(' ').next().map(str::to_owned)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
