@@ -1,10 +1,15 @@
 #!/usr/bin/env python3
-"""Writes the Whitted scene with N small spheres added on its floor: a scene with many specular
-objects, for measuring what each renderer's cost does as objects are added (docs/performance-caustics.md,
-"Many specular objects").
+"""Writes the Whitted scene with N small spheres (or quads, or boxes) added on its floor: a scene
+with many specular objects, for measuring what each renderer's cost does as objects are added
+(docs/performance-caustics.md, "Many specular objects"; docs/performance.md, "Many spheres").
 
     scripts/many-spheres.py 200 > out/spheres-200.toml
     scripts/many-spheres.py 50 -o out/spheres-50.toml
+    scripts/many-spheres.py 200 --shape quad -o out/quads-200.toml
+
+With `--shape quad` each sphere's place holds a square of its diameter standing on its lower edge,
+tilted back by 30 degrees and turned about +Y; with `--shape box` a cube of its diameter resting
+on the floor, turned about +Y.
 
 The spheres cycle through glass, mirror and a diffuse white, in that order, on a jittered grid
 over the lit part of the floor (x in [-10, 6], z in [-7, 7]) that keeps clear of the scene's two
@@ -57,20 +62,42 @@ def spheres(count, seed=1):
     return placed
 
 
-def scene(count):
+def vec(v):
+    return "[" + ", ".join(f"{c:.4f}" for c in v) + "]"
+
+
+def shape_line(shape, x, radius, z, turn):
+    """The TOML of one small object in the place of the sphere (x, radius, z)."""
+    if shape == "sphere":
+        return f"sphere = {{ center = {vec((x, radius, z))}, radius = {radius:.4f} }}"
+    side = 2.0 * radius
+    if shape == "box":
+        return (f"box = {{ min = {vec((-radius, 0.0, -radius))}, max = {vec((radius, side, radius))}, "
+                f"rotate_y = {math.degrees(turn):.2f}, translate = {vec((x, 0.0, z))} }}")
+    # A square on its lower edge (along the turned x axis), its other edge tilted back 30 degrees.
+    c, s = math.cos(turn), math.sin(turn)
+    edge_u = (side * c, 0.0, -side * s)
+    tilt = math.radians(30.0)
+    back = (side * math.sin(tilt) * s, side * math.cos(tilt), side * math.sin(tilt) * c)
+    corner = (x - edge_u[0] / 2, 0.001, z - edge_u[2] / 2)
+    return f"quad = {{ corner = {vec(corner)}, edge_u = {vec(edge_u)}, edge_v = {vec(back)} }}"
+
+
+def scene(count, shape="sphere"):
     base = BASE.read_text()
-    # The base scene's name and materials, plus the diffuse white the spheres use.
-    base = base.replace('name = "whitted"', f'name = "whitted-{count}-spheres"', 1)
+    # The base scene's name and materials, plus the diffuse white the objects use.
+    base = base.replace('name = "whitted"', f'name = "whitted-{count}-{shape}s"', 1)
     out = [base.rstrip("\n"), "", "# Added by scripts/many-spheres.py.", "[materials.white]",
            "albedo = [0.8, 0.8, 0.8]", ""]
     placed = spheres(count)
+    turns = random.Random(2)
     for k, (x, radius, z) in enumerate(placed):
         material = MATERIALS[k % len(MATERIALS)]
         out += [
             "[[objects]]",
-            f'name = "small sphere {k}"',
+            f'name = "small {shape} {k}"',
             f'material = "{material}"',
-            f"sphere = {{ center = [{x:.4f}, {radius:.4f}, {z:.4f}], radius = {radius:.4f} }}",
+            shape_line(shape, x, radius, z, turns.uniform(0.0, math.pi)),
             "",
         ]
     return "\n".join(out), len(placed)
@@ -79,13 +106,15 @@ def scene(count):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("count", type=int, help=f"spheres to add, 1 to {MAX_COUNT}")
+    parser.add_argument("--shape", choices=["sphere", "quad", "box"], default="sphere",
+                        help="the shape added (default sphere)")
     parser.add_argument("-o", "--output", help="file to write (atomically); standard output if absent")
     args = parser.parse_args()
     if not 1 <= args.count <= MAX_COUNT:
         parser.error(f"count {args.count}: must be 1 to {MAX_COUNT}")
-    text, placed = scene(args.count)
+    text, placed = scene(args.count, args.shape)
     if placed < args.count:
-        print(f"many-spheres.py: placed {placed} of {args.count} spheres (the rest met the scene's own)",
+        print(f"many-spheres.py: placed {placed} of {args.count} {args.shape}s (the rest met the scene's own)",
               file=sys.stderr)
     if args.output is None:
         sys.stdout.write(text)

@@ -6,9 +6,10 @@
 // The records of the bounding volume hierarchies (built and flattened by illum-rtcore's bvh.rs,
 // which states the layout and why) and the tests their walk makes; the walk itself is generated
 // into the traversal with the leaf tests of the primitives it holds (bvh_traversal.rs). Imported
-// only by the traversal of a scene with a mesh or with more spheres than the literal limit
-// (sphere_bvh.rs); only a scene with a hierarchy binds group 1, and only the buffers its
-// traversal reads: a mesh's nodes and triangles, the spheres' nodes and records.
+// only by the traversal of a scene with a mesh or with more small analytic objects than the
+// literal limit (analytic_bvh.rs); only a scene with a hierarchy binds group 1, and only the
+// buffers its traversal reads: a mesh's nodes and triangles, the analytic objects' nodes and
+// records.
 
 struct BvhNode {
     lo: vec3<f32>,
@@ -30,12 +31,16 @@ struct MeshTriangle {
 
 @group(1) @binding(0) var<storage, read> bvh_nodes: array<BvhNode>;
 @group(1) @binding(1) var<storage, read> mesh_triangles: array<MeshTriangle>;
-// A sphere under the spheres' hierarchy (sphere_bvh.rs): its (centre, radius) and material. The
-// hierarchy's nodes and these are read from uniform buffers (group 1, bindings 2 and 3), sized per
-// scene and so declared in the generated traversal (sphere_bvh.rs gives the reason).
-struct BvhSphere {
-    sphere: vec4<f32>,
-    material: u32,
+// An object under the analytic objects' hierarchy (analytic_bvh.rs): its Object record's a, b, c
+// and d.xyz (geometry.wgsl), and `tag`, its kind in the low 4 bits and its material above them.
+// The hierarchy's nodes and these are read from uniform buffers (group 1, bindings 2 and 3),
+// sized per scene and so declared in the generated traversal (analytic_bvh.rs gives the reason).
+struct BvhObject {
+    a: vec4<f32>,
+    b: vec4<f32>,
+    c: vec4<f32>,
+    d: vec3<f32>,
+    tag: u32,
 }
 
 // Reads for the generated walk (the buffers are this module's).

@@ -1,7 +1,7 @@
 //! The bounding volume hierarchy, built on the host and flattened into the storage buffers the
 //! generated traversal walks (bvh_traversal.rs, `shaders/bvh.wgsl`). One builder ([`Hierarchy`])
 //! serves every primitive put under a BVH: a scene's mesh triangles past the literal limit
-//! (mesh_traversal.rs), and its spheres past theirs (sphere_bvh.rs). A scene with neither has
+//! (mesh_traversal.rs), and its small analytic objects past theirs (analytic_bvh.rs). A scene with neither has
 //! none: its objects stay literals in the generated traversal (traversal.rs).
 //!
 //! Build: top-down, each node split where the surface area heuristic (SAH) is least among
@@ -113,7 +113,7 @@ impl Aabb {
 
 /// The hierarchy's shape over any primitives, from their bounds alone: the nodes, whose leaves
 /// index `order`, and `order`, the primitives' indices in leaf order. Every primitive kind the
-/// traversal puts under a BVH (mesh triangles, spheres) is built by this one builder.
+/// traversal puts under a BVH (mesh triangles, analytic objects) is built by this one builder.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Hierarchy {
     pub nodes: Vec<BvhNode>,

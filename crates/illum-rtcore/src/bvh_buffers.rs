@@ -6,11 +6,11 @@ use illum_gpu::wgpu;
 use illum_scene::{Scene, SceneError, Shape};
 use wgpu::util::DeviceExt;
 
-use crate::sphere_bvh;
+use crate::analytic_bvh;
 use crate::traversal::Geometry;
 
 /// Group 1: a mesh's nodes (binding 0) and triangles (1) in storage buffers (bvh.wgsl); the
-/// spheres' nodes (2) and spheres (3) in uniform buffers (sphere_bvh.rs says why); the smooth
+/// analytic objects' nodes (2) and records (3) in uniform buffers (analytic_bvh.rs says why); the smooth
 /// meshes' shading normals (4) in a storage buffer (mesh_shading.wgsl). Each buffer is bound
 /// only when the scene has it, as the shader reads only those (and a pipeline's automatic layout
 /// holds only what it reads).
@@ -33,9 +33,14 @@ fn contents(scene: &Scene, geometry: &Geometry) -> Vec<(u32, &'static str, Kind,
         out.push((0, "bvh nodes", Kind::Storage, bytemuck::cast_slice(&bvh.nodes).to_vec()));
         out.push((1, "mesh triangles", Kind::Storage, bytemuck::cast_slice(&bvh.triangles).to_vec()));
     }
-    if let Some(spheres) = &geometry.spheres {
-        out.push((2, "sphere bvh nodes", Kind::Uniform, bytemuck::cast_slice(&spheres.nodes).to_vec()));
-        out.push((3, "bvh spheres", Kind::Uniform, bytemuck::cast_slice(&spheres.spheres()).to_vec()));
+    if let Some(analytic) = &geometry.analytic {
+        out.push((2, "analytic bvh nodes", Kind::Uniform, bytemuck::cast_slice(&analytic.nodes).to_vec()));
+        out.push((
+            3,
+            "analytic bvh records",
+            Kind::Uniform,
+            bytemuck::cast_slice(&analytic.records()).to_vec(),
+        ));
     }
     if let Some(normals) = crate::mesh_shading::shading_normals(scene) {
         out.push((4, "mesh shading normals", Kind::Storage, bytemuck::cast_slice(&normals).to_vec()));
@@ -46,10 +51,15 @@ fn contents(scene: &Scene, geometry: &Geometry) -> Vec<(u32, &'static str, Kind,
 impl BvhBindGroup {
     /// The bind group index the hierarchies' buffers take.
     pub const GROUP: u32 = 1;
-    /// The variables of group 1 (bvh.wgsl's, the spheres' uniform buffers that the generated
+    /// The variables of group 1 (bvh.wgsl's, the analytic objects' uniform buffers that the generated
     /// traversal declares with the scene's sizes, and mesh_shading.wgsl's) and their bindings.
-    pub const BINDINGS: [(&'static str, u32); 5] =
-        [("bvh_nodes", 0), ("mesh_triangles", 1), ("sphere_nodes", 2), ("spheres", 3), ("mesh_normals", 4)];
+    pub const BINDINGS: [(&'static str, u32); 5] = [
+        ("bvh_nodes", 0),
+        ("mesh_triangles", 1),
+        ("analytic_nodes", 2),
+        ("analytic_records", 3),
+        ("mesh_normals", 4),
+    ];
 
     /// Uploads `scene`'s hierarchies (from `geometry`) and shading normals and binds them to
     /// `pipeline`'s group 1 (which its shader, specialised for this scene, declares); `None`
@@ -94,8 +104,8 @@ impl BvhBindGroup {
         contents(scene, geometry).iter().map(|(_, _, _, bytes)| bytes.len() as u64).sum()
     }
 
-    /// Refuses a scene whose group 1 the device cannot hold: more non-emitting spheres than the
-    /// spheres' hierarchy takes ([`sphere_bvh::check_count`]), or a buffer beyond the device's
+    /// Refuses a scene whose group 1 the device cannot hold: more objects than the analytic
+    /// objects' hierarchy takes ([`analytic_bvh::check_count`]), or a buffer beyond the device's
     /// limit for its binding (`storage`: max_storage_buffer_binding_size, `uniform`:
     /// max_uniform_buffer_binding_size), with the bytes it needs and, for a mesh's buffers, the
     /// mesh files. Every GPU ray tracer calls it before compiling the scene's traversal.
@@ -105,7 +115,7 @@ impl BvhBindGroup {
         storage: u64,
         uniform: u64,
     ) -> Result<(), SceneError> {
-        sphere_bvh::check_count(scene, &geometry.objects)?;
+        analytic_bvh::check_count(scene, &geometry.objects)?;
         for (_, label, kind, bytes) in contents(scene, geometry) {
             let (limit, name) = match kind {
                 Kind::Storage => (storage, "max_storage_buffer_binding_size"),
@@ -131,10 +141,10 @@ impl BvhBindGroup {
                 let files: Vec<String> = meshes.iter().map(|m| format!("{:?}", m.file)).collect();
                 format!("{triangles} triangles of {} ({needed} bytes of {label})", files.join(", "))
             };
-            let (field, value) = match &geometry.spheres {
-                Some(spheres) if label.contains("sphere") => (
-                    "objects (spheres)",
-                    format!("{} spheres ({needed} bytes of {label})", spheres.records.len()),
+            let (field, value) = match &geometry.analytic {
+                Some(analytic) if label.contains("analytic") => (
+                    "objects",
+                    format!("{} objects under a BVH ({needed} bytes of {label})", analytic.objects.len()),
                 ),
                 _ => ("objects (meshes)", mesh_value()),
             };
@@ -166,8 +176,8 @@ mod tests {
     use illum_scene::testing::obj::{icosphere_obj, scene_with_files};
 
     use super::*;
+    use crate::analytic_bvh::{BvhObject, MAX_BVH_OBJECTS};
     use crate::bvh::{BvhNode, MeshTriangle};
-    use crate::sphere_bvh::{BvhSphere, MAX_BVH_SPHERES};
 
     const HEADER: &str = "[camera]\neye = [0.0, 0.0, -5.0]\ntarget = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]\n\
                           vfov = 45.0\nwidth = 8\nheight = 8\n[environment]\nradiance = [1.0, 1.0, 1.0]\n\
@@ -181,17 +191,22 @@ mod tests {
             .unwrap_or_else(|e| panic!("{e}"))
     }
 
-    /// A scene "many.toml" of `n` small grey spheres.
-    fn spheres_scene(n: usize) -> Scene {
-        let sphere = |i: usize| {
-            format!(
-                "[[objects]]\nmaterial = \"grey\"\nsphere = {{ center = [{}.0, {}.0, 9.0], radius = 0.25 }}\n",
-                i % 64,
-                i / 64
-            )
+    /// A scene "many.toml" of `n` small grey objects in rows of 64, every other one a sphere
+    /// and a quad.
+    fn small_objects_scene(n: usize) -> Scene {
+        let object = |i: usize| {
+            let (x, y) = (i % 64, i / 64);
+            let shape = if i.is_multiple_of(2) {
+                format!("sphere = {{ center = [{x}.0, {y}.0, 9.0], radius = 0.25 }}")
+            } else {
+                format!(
+                    "quad = {{ corner = [{x}.0, {y}.0, 9.0], edge_u = [0.5, 0.0, 0.0], edge_v = [0.0, 0.5, 0.1] }}"
+                )
+            };
+            format!("[[objects]]\nmaterial = \"grey\"\n{shape}\n")
         };
         let mut text = HEADER.to_owned();
-        text.extend((0..n).map(sphere));
+        text.extend((0..n).map(object));
         Scene::from_toml_str(&text, "many.toml").unwrap_or_else(|e| panic!("{e}"))
     }
 
@@ -251,32 +266,32 @@ mod tests {
         BvhBindGroup::check_size(&scene, &geometry, 0, 0).expect("nothing to bind");
     }
 
-    /// The spheres' hierarchy is held to the uniform binding: its spheres' buffer (32 bytes a
-    /// sphere) is the larger at 100 spheres.
+    /// The analytic objects' hierarchy is held to the uniform binding: its records' buffer (64
+    /// bytes an object) is the larger at 100 objects.
     #[test]
-    fn spheres_just_over_the_uniform_binding_are_refused_by_count_and_bytes() {
-        let scene = spheres_scene(100);
+    fn objects_just_over_the_uniform_binding_are_refused_by_count_and_bytes() {
+        let scene = small_objects_scene(100);
         let geometry = Geometry::new(&scene);
-        let bvh = geometry.spheres.as_ref().expect("100 spheres are under a BVH");
-        let spheres = (100 * size_of::<BvhSphere>()) as u64;
+        let bvh = geometry.analytic.as_ref().expect("100 objects are under a BVH");
+        let records = (100 * size_of::<BvhObject>()) as u64;
         let nodes = (bvh.nodes.len() * size_of::<BvhNode>()) as u64;
-        check_just_fits(&scene, Kind::Uniform, spheres.max(nodes), &["many.toml", "100 spheres"]);
+        check_just_fits(&scene, Kind::Uniform, records.max(nodes), &["many.toml", "100 objects"]);
     }
 
-    /// MAX_BVH_SPHERES spheres are taken within WebGPU's default uniform binding (64 KiB); one
+    /// MAX_BVH_OBJECTS objects are taken within WebGPU's default uniform binding (64 KiB); one
     /// more is refused by count and limit, whatever the device's limits.
     #[test]
-    fn more_spheres_than_the_hierarchy_holds_are_refused_by_count() {
-        let most = spheres_scene(MAX_BVH_SPHERES);
+    fn more_objects_than_the_hierarchy_holds_are_refused_by_count() {
+        let most = small_objects_scene(MAX_BVH_OBJECTS);
         BvhBindGroup::check_size(&most, &Geometry::new(&most), u64::MAX, 64 << 10)
-            .unwrap_or_else(|e| panic!("{MAX_BVH_SPHERES} spheres fit WebGPU's default 64 KiB: {e}"));
-        let over = spheres_scene(MAX_BVH_SPHERES + 1);
+            .unwrap_or_else(|e| panic!("{MAX_BVH_OBJECTS} objects fit WebGPU's default 64 KiB: {e}"));
+        let over = small_objects_scene(MAX_BVH_OBJECTS + 1);
         let message = BvhBindGroup::check_size(&over, &Geometry::new(&over), u64::MAX, u64::MAX)
-            .expect_err("one sphere too many")
+            .expect_err("one object too many")
             .to_string();
-        let count = format!("{} non-emitting spheres", MAX_BVH_SPHERES + 1);
-        let limit = format!("at most {MAX_BVH_SPHERES}");
-        for part in ["many.toml", count.as_str(), limit.as_str(), "remove spheres"] {
+        let count = format!("{} non-emitting spheres, quads and boxes", MAX_BVH_OBJECTS + 1);
+        let limit = format!("at most {MAX_BVH_OBJECTS}");
+        for part in ["many.toml", count.as_str(), limit.as_str(), "remove some"] {
             assert!(message.contains(part), "{part:?} is not in {message:?}");
         }
     }

@@ -1,56 +1,105 @@
 //! The walk of a bounding volume hierarchy (bvh.rs), generated into the traversal module with
 //! the leaf test of the primitives its tree holds: one walk, written once here, for the tree
-//! over a mesh's triangles and the tree over the spheres (sphere_bvh.rs), so that a scene's
-//! shader holds only the primitive tests it needs.
+//! over a mesh's triangles and the tree over the analytic objects (analytic_bvh.rs), so that a
+//! scene's shader holds only the primitive tests it needs: the analytic tree's leaf test
+//! dispatches on the kinds it holds, and only on those.
 //!
 //! The walk visits one node per step, the near child first by the ray's sign on the node's
 //! split axis, with a stack of at most `BVH_STACK` entries (bvh.rs, `MAX_DEPTH`).
 
+use std::collections::BTreeSet;
+
+use crate::object::ShapeKind;
+
 /// A tree of the scene's hierarchy: which buffers it reads and what its leaves hold.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub(crate) enum Tree {
     /// Mesh triangles; triangle i is object `base + i` (after the analytic objects).
     Triangles { base: usize },
-    /// Spheres; sphere i is object i of the scene's order (sphere_bvh.rs puts them first).
-    Spheres,
+    /// Analytic objects of these kinds; object i of the tree is object i of the scene's order
+    /// (analytic_bvh.rs puts them first).
+    Analytic { kinds: BTreeSet<ShapeKind> },
+}
+
+/// The hit distance of the analytic tree's record `r` (bvh.wgsl's BvhObject, object `i`) of
+/// `kind`: the literal's test (traversal.rs) with the record's numbers.
+fn record_hit(kind: ShapeKind) -> &'static str {
+    match kind {
+        ShapeKind::Aabb => "hit_slabs(o, inv_d, r.a.xyz, r.b.xyz)",
+        ShapeKind::Box => "hit_box(o, d, r.a.xyz, r.b.xyz, r.a.w, r.b.w, r.c.xyz)",
+        ShapeKind::Quad => "hit_quad(o, d, r.a.xyz, r.b.xyz, r.c.xyz, r.d)",
+        // hit_sphere never takes the own sphere's root at the ray's origin (geometry.wgsl).
+        ShapeKind::Sphere => "hit_sphere(o, d, r.a.xyz, r.a.w, own == i)",
+        ShapeKind::Triangle => unreachable!("triangles are the mesh tree's"),
+    }
+}
+
+/// `let t` = the hit distance of record `r`, dispatched on its kind among `kinds` (the last
+/// one is the switch's default). An axis-aligned box's record is also a box rotated by zero,
+/// whose test in its frame is exact (x * 1 - z * 0 = x), so where both kinds occur hit_box
+/// serves both, as surface_box does (traversal.rs, surface_cases).
+fn analytic_hit(kinds: &BTreeSet<ShapeKind>) -> String {
+    let tests: Vec<ShapeKind> = kinds
+        .iter()
+        .copied()
+        .filter(|&k| !(k == ShapeKind::Aabb && kinds.contains(&ShapeKind::Box)))
+        .collect();
+    let mut out = "                let r = analytic_record(i);\n".to_owned();
+    if let [kind] = tests[..] {
+        out.push_str(&format!("                let t = {};\n", record_hit(kind)));
+        return out;
+    }
+    out.push_str("                var t: f32;\n                switch r.tag & 15u {\n");
+    for (k, &kind) in tests.iter().enumerate() {
+        let selector = if k + 1 == tests.len() {
+            "default".to_owned()
+        } else if kind == ShapeKind::Box && kinds.contains(&ShapeKind::Aabb) {
+            "case KIND_AABB, KIND_BOX".to_owned()
+        } else {
+            format!("case {}", kind.wgsl_constant())
+        };
+        out.push_str(&format!("                    {selector}: {{ t = {}; }}\n", record_hit(kind)));
+    }
+    out.push_str("                }\n");
+    out
 }
 
 impl Tree {
     /// The generated functions' prefix: `{prefix}_closest` and `{prefix}_occluded`.
-    pub(crate) fn prefix(self) -> &'static str {
+    pub(crate) fn prefix(&self) -> &'static str {
         match self {
             Tree::Triangles { .. } => "mesh_bvh",
-            Tree::Spheres => "sphere_bvh",
+            Tree::Analytic { .. } => "analytic_bvh",
         }
     }
 
-    /// The bvh.wgsl functions the generated walk calls.
-    pub(crate) fn imports(self) -> &'static [&'static str] {
+    /// The bvh.wgsl functions and structs the generated walk calls.
+    pub(crate) fn imports(&self) -> &'static [&'static str] {
         match self {
             Tree::Triangles { .. } => {
                 &["BVH_STACK", "enters_box", "mesh_node", "mesh_triangle", "sheared_ray", "hit_triangle"]
             }
-            Tree::Spheres => &["BVH_STACK", "enters_box", "BvhNode"],
+            Tree::Analytic { .. } => &["BVH_STACK", "enters_box", "BvhNode", "BvhObject"],
         }
     }
 
-    fn node_read(self) -> &'static str {
+    fn node_read(&self) -> &'static str {
         match self {
             Tree::Triangles { .. } => "mesh_node",
-            Tree::Spheres => "sphere_node",
+            Tree::Analytic { .. } => "analytic_node",
         }
     }
 
     /// Set-up before the walk (the sheared ray of the watertight triangle test).
-    fn setup(self) -> &'static str {
+    fn setup(&self) -> &'static str {
         match self {
             Tree::Triangles { .. } => "    let ray = sheared_ray(o, d);\n",
-            Tree::Spheres => "",
+            Tree::Analytic { .. } => "",
         }
     }
 
     /// The test of primitive `i` in a leaf of closest_hit's walk, which lowers `best`.
-    fn closest_leaf(self) -> String {
+    fn closest_leaf(&self) -> String {
         match self {
             Tree::Triangles { base } => format!(
                 "                let tri = mesh_triangle(i);
@@ -60,19 +109,18 @@ impl Tree {
                 }}
 "
             ),
-            // hit_sphere never takes the own sphere's root at the ray's origin (geometry.wgsl).
-            Tree::Spheres => "                let s = sphere_at(i);
-                let t = hit_sphere(o, d, s.xyz, s.w, own == i);
-                if (t < best.t) {
+            Tree::Analytic { kinds } => format!(
+                "{}                if (t < best.t) {{
                     best = Hit(t, i);
-                }
-"
-            .to_owned(),
+                }}
+",
+                analytic_hit(kinds)
+            ),
         }
     }
 
     /// The test of primitive `i` in a leaf of occluded's walk.
-    fn occluded_leaf(self) -> String {
+    fn occluded_leaf(&self) -> String {
         match self {
             Tree::Triangles { base } => format!(
                 "                let tri = mesh_triangle(i);
@@ -81,12 +129,13 @@ impl Tree {
                 }}
 "
             ),
-            Tree::Spheres => "                let s = sphere_at(i);
-                if (hit_sphere(o, d, s.xyz, s.w, own == i) < t_max) {
+            Tree::Analytic { kinds } => format!(
+                "{}                if (t < t_max) {{
                     return true;
-                }
-"
-            .to_owned(),
+                }}
+",
+                analytic_hit(kinds)
+            ),
         }
     }
 }
@@ -94,7 +143,7 @@ impl Tree {
 /// The walk's loop: `bound` is the distance a node must be entered before (`best.t` or
 /// `t_max`), `ordered` whether inner nodes push the far child (closest_hit) or either (occluded,
 /// which stops at the first hit), `leaf` the test of primitive `i`.
-fn walk(tree: Tree, bound: &str, ordered: bool, leaf: &str) -> String {
+fn walk(tree: &Tree, bound: &str, ordered: bool, leaf: &str) -> String {
     let node = tree.node_read();
     let descend = if ordered {
         "                let axis = n.b & 3u;
@@ -136,7 +185,7 @@ fn walk(tree: Tree, bound: &str, ordered: bool, leaf: &str) -> String {
 /// `{prefix}_closest(o, d, inv_d, own, best)`: the nearest primitive of `tree` nearer than
 /// `best`, and `{prefix}_occluded(o, d, inv_d, t_max, own)`: whether one lies strictly between 0
 /// and t_max. `own` is the object the ray leaves, as for closest_hit.
-pub(crate) fn functions(tree: Tree) -> String {
+pub(crate) fn functions(tree: &Tree) -> String {
     let prefix = tree.prefix();
     let setup = tree.setup();
     format!(

@@ -3,8 +3,9 @@
 //!
 //! - [`object`]: the objects as the shaders store them (one record layout for every kind of
 //!   shape), in the order both use (emitters last);
-//! - [`bvh`]: the hierarchy's builder, over a scene's mesh triangles or its spheres (only a
-//!   scene with a mesh, or with more spheres than [`sphere_bvh::LITERAL_SPHERES`], has one);
+//! - [`bvh`]: the hierarchy's builder, over a scene's mesh triangles or its small analytic
+//!   objects (only a scene with a mesh, or with more of those than
+//!   [`analytic_bvh::LITERAL_OBJECTS`], has one);
 //! - [`mesh_shading`]: the shading normals of smooth meshes (`shaders/mesh_shading.wgsl` holds
 //!   the rules they follow);
 //! - [`material`]: the one material record and its kind codes;
@@ -18,6 +19,7 @@
 //!
 //! Each renderer keeps its own lights, parameters, errors and entry shader.
 
+pub mod analytic_bvh;
 pub mod bvh;
 pub mod bvh_buffers;
 mod bvh_traversal;
@@ -30,7 +32,6 @@ pub mod object;
 pub mod scene_geometry;
 pub mod shaders;
 pub mod spawn;
-pub mod sphere_bvh;
 pub mod traversal;
 
 pub use bvh_buffers::BvhBindGroup;

@@ -127,7 +127,7 @@ pub(crate) fn mesh_code(form: &MeshForm, base: usize) -> MeshCode {
                     format!("triangle_object(index - {base}u, KIND_TRIANGLE)")
                 }),
                 bvh_imports,
-                definitions: format!("{constant}\n{}", bvh_traversal::functions(tree)),
+                definitions: format!("{constant}\n{}", bvh_traversal::functions(&tree)),
             }
         }
     }

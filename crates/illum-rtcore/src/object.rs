@@ -115,6 +115,28 @@ impl GpuShape {
             GpuShape::Sphere { .. } => ShapeKind::Sphere,
         }
     }
+
+    /// Its axis-aligned bounds `[lo, hi]` (lo <= hi; flat for a quad on an axis plane).
+    pub fn bounds(&self) -> [Vec3; 2] {
+        let points: Vec<Vec3> = match *self {
+            GpuShape::Aabb { min, max } => vec![min, max],
+            GpuShape::Box { local_min, local_max, cos: c, sin: s, offset } => (0..8)
+                .map(|i| {
+                    let l = Vec3::select(
+                        glam::BVec3::new(i & 1 == 0, i & 2 == 0, i & 4 == 0),
+                        local_min,
+                        local_max,
+                    );
+                    Vec3::new(c * l.x + s * l.z + offset.x, l.y + offset.y, -s * l.x + c * l.z + offset.z)
+                })
+                .collect(),
+            GpuShape::Quad { corner, edge_u, edge_v } => {
+                vec![corner, corner + edge_u, corner + edge_v, corner + edge_u + edge_v]
+            }
+            GpuShape::Sphere { center, radius } => vec![center - radius, center + radius],
+        };
+        points.into_iter().fold([Vec3::INFINITY, Vec3::NEG_INFINITY], |[lo, hi], p| [lo.min(p), hi.max(p)])
+    }
 }
 
 /// One object of the uploaded scene: its shape, its material (an index into the scene's

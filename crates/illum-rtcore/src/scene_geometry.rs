@@ -1,15 +1,15 @@
 //! The scene's objects as both ray tracers' traversals see them ([`Geometry`]): in the order the
-//! shaders store them, with what shadow rays can be aimed at, and the meshes' and spheres' forms
+//! shaders store them, with what shadow rays can be aimed at, and the meshes' and analytic objects' forms
 //! (literals or a BVH). `traversal.rs` generates the WGSL from it.
 
 use std::sync::Arc;
 
 use illum_scene::{Scene, Shape};
 
+use crate::analytic_bvh::{self, AnalyticBvh};
 use crate::bvh::{Bvh, MeshTriangle};
 use crate::mesh_traversal::MeshForm;
 use crate::object::{GpuObject, ObjectRecord, ordered_objects};
-use crate::sphere_bvh::{self, SphereBvh};
 
 /// What a traversal is generated from: the scene's objects in the order the shaders store them,
 /// and what shadow rays can be aimed at.
@@ -17,8 +17,8 @@ use crate::sphere_bvh::{self, SphereBvh};
 pub struct Geometry {
     /// The scene's name, for the generated module's comments.
     pub scene: String,
-    /// Non-emitters first, then emitters ([`ordered_objects`]); with spheres under a BVH, those
-    /// first of all, in its leaf order ([`sphere_bvh::arrange`]).
+    /// Non-emitters first, then emitters ([`ordered_objects`]); with objects under a BVH, those
+    /// first of all, in its leaf order ([`analytic_bvh::arrange`]).
     pub objects: Vec<GpuObject>,
     /// Each object's name, in the same order.
     pub names: Vec<String>,
@@ -35,15 +35,15 @@ pub struct Geometry {
     /// The triangles of every mesh object, as literals or under a BVH (mesh_traversal.rs);
     /// `None` for a scene without a mesh, whose traversal has no mesh code.
     pub meshes: Option<MeshForm>,
-    /// The hierarchy over the spheres, objects 0 to n - 1, for a scene with more than
-    /// [`sphere_bvh::LITERAL_SPHERES`] of them; `None` when they are literals.
-    pub spheres: Option<Arc<SphereBvh>>,
+    /// The hierarchy over the analytic objects 0 to n - 1, for a scene with more than
+    /// [`analytic_bvh::LITERAL_OBJECTS`] that may go under one; `None` when all are literals.
+    pub analytic: Option<Arc<AnalyticBvh>>,
 }
 
 impl Geometry {
     pub fn new(scene: &Scene) -> Self {
         let (mut ordered, first_emitter) = ordered_objects(scene);
-        let spheres = sphere_bvh::arrange(&mut ordered);
+        let analytic = analytic_bvh::arrange(&mut ordered);
         let mut light_corners = Vec::new();
         let mut unbounded_lights = scene.directional_light.is_some();
         for (index, object) in &ordered {
@@ -77,7 +77,7 @@ impl Geometry {
             names: ordered.iter().map(|(i, _)| scene.objects[*i].name.clone()).collect(),
             scene_index: ordered.iter().map(|(i, _)| *i).collect(),
             objects: ordered.into_iter().map(|(_, object)| object).collect(),
-            spheres,
+            analytic,
             first_emitter,
             light_corners,
             unbounded_lights,

@@ -79,7 +79,7 @@ mod tests {
         use illum_gpu::members;
         use illum_gpu::shader::wgsl_struct;
 
-        use crate::sphere_bvh::BvhSphere;
+        use crate::analytic_bvh::BvhObject;
         use crate::{CameraRecord, MaterialRecord, ObjectRecord};
 
         let entry = ShaderFile::generated(
@@ -87,14 +87,14 @@ mod tests {
             "#import illum::rtcore::geometry::Object
 #import illum::rtcore::material::Material
 #import illum::rtcore::camera::Camera
-#import illum::rtcore::bvh::BvhSphere
+#import illum::rtcore::bvh::BvhObject
 @group(0) @binding(0) var<storage, read> objects: array<Object>;
 @group(0) @binding(1) var<storage, read> materials: array<Material>;
 @group(0) @binding(2) var<uniform> camera: Camera;
-@group(0) @binding(3) var<uniform> spheres: array<BvhSphere, 2>;
+@group(0) @binding(3) var<uniform> records: array<BvhObject, 2>;
 @compute @workgroup_size(1)
 fn main() {
-    let x = objects[0].a.x + materials[0].a.x + camera.eye.x + spheres[1].sphere.x;
+    let x = objects[0].a.x + materials[0].a.x + camera.eye.x + records[1].d.x;
 }
 "
             .to_owned(),
@@ -107,8 +107,8 @@ fn main() {
             size_of::<ObjectRecord>(),
             &members!(ObjectRecord: kind, material, emitter, padding, a, b, c, d),
         );
-        wgsl("illum::rtcore::bvh", "BvhSphere")
-            .assert_matches(size_of::<BvhSphere>(), &members!(BvhSphere: sphere, material));
+        wgsl("illum::rtcore::bvh", "BvhObject")
+            .assert_matches(size_of::<BvhObject>(), &members!(BvhObject: a, b, c, d, tag));
         wgsl("illum::rtcore::material", "Material")
             .assert_matches(size_of::<MaterialRecord>(), &members!(MaterialRecord: kind, a, b));
         wgsl("illum::rtcore::camera", "Camera").assert_matches(

@@ -14,8 +14,8 @@
 //! - the object at a hit comes from literals (`object_at`), not from a storage buffer.
 //!
 //! A literal list's compile time grows with its length, so past a measured crossover the many
-//! are read from storage buffers under a BVH instead: spheres past
-//! [`sphere_bvh::LITERAL_SPHERES`] (sphere_bvh.rs), mesh triangles past
+//! are read from buffers under a BVH instead: small non-emitting analytic objects past
+//! [`analytic_bvh::LITERAL_OBJECTS`] (analytic_bvh.rs, which states which), mesh triangles past
 //! [`crate::mesh_traversal::LITERAL_TRIANGLES`] (mesh_traversal.rs); the other objects stay
 //! literals.
 //!
@@ -25,12 +25,12 @@ use std::collections::BTreeSet;
 
 use illum_gpu::shader::ShaderFile;
 
+use crate::analytic_bvh;
 use crate::bvh_traversal::{self, Tree};
 use crate::literal::{lit, switch_cases, vec3, vec4};
 use crate::mesh_traversal::mesh_code;
 use crate::object::{GpuObject, GpuShape, ObjectRecord, ShapeKind};
 pub use crate::scene_geometry::Geometry;
-use crate::sphere_bvh;
 
 /// A traversal generated for one scene. Two scenes with equal traversals share a pipeline.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
@@ -105,50 +105,13 @@ struct Bounds {
 
 impl Bounds {
     fn of(object: &GpuObject) -> Self {
-        let points: Vec<[f32; 3]> = match object.shape {
-            GpuShape::Aabb { min, max } => vec![min.to_array(), max.to_array()],
-            GpuShape::Box { local_min, local_max, cos: c, sin: s, offset } => {
-                // The eight corners of the rotated box.
-                let mut corners = Vec::new();
-                for i in 0..8 {
-                    let l = [
-                        if i & 1 == 0 { local_min.x } else { local_max.x },
-                        if i & 2 == 0 { local_min.y } else { local_max.y },
-                        if i & 4 == 0 { local_min.z } else { local_max.z },
-                    ];
-                    corners.push([
-                        c * l[0] + s * l[2] + offset.x,
-                        l[1] + offset.y,
-                        -s * l[0] + c * l[2] + offset.z,
-                    ]);
-                }
-                corners
-            }
-            GpuShape::Quad { corner, edge_u, edge_v } => {
-                let (p, u, v) = (corner.to_array(), edge_u.to_array(), edge_v.to_array());
-                vec![p, add(p, u), add(p, v), add(add(p, u), v)]
-            }
-            GpuShape::Sphere { center, radius: r } => {
-                vec![[center.x - r, center.y - r, center.z - r], [center.x + r, center.y + r, center.z + r]]
-            }
-        };
-        let mut bounds = Bounds { lo: [f32::MAX; 3], hi: [f32::MIN; 3] };
-        for p in points {
-            for (a, value) in p.into_iter().enumerate() {
-                bounds.lo[a] = bounds.lo[a].min(value);
-                bounds.hi[a] = bounds.hi[a].max(value);
-            }
-        }
-        bounds
+        let [lo, hi] = object.shape.bounds();
+        Bounds { lo: lo.to_array(), hi: hi.to_array() }
     }
 
     fn contains(&self, other: &Bounds) -> bool {
         (0..3).all(|a| self.lo[a] <= other.lo[a] && other.hi[a] <= self.hi[a])
     }
-}
-
-fn add(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
 
 /// Whether the object at `index` can lie on a shadow ray between a lit surface point and a light.
@@ -276,18 +239,20 @@ pub fn generate(scene: &Geometry) -> Traversal {
     // Triangles are numbered after the analytic objects.
     let base = scene.objects.len();
     let mesh = scene.meshes.as_ref().map(|form| mesh_code(form, base));
-    // Objects 0 to under_bvh - 1 are spheres under a hierarchy (sphere_bvh.rs), the rest literals.
-    let under_bvh = scene.spheres.as_ref().map_or(0, |bvh| bvh.records.len());
+    // Objects 0 to under_bvh - 1 are under a hierarchy (analytic_bvh.rs), the rest literals.
+    let under_bvh = scene.analytic.as_ref().map_or(0, |bvh| bvh.objects.len());
     // The walks closest_hit runs after the literal non-emitters (whose nearest hit, often the
     // floor's, bounds them) and before the emitters.
     let mut walks = String::new();
     let mut bvh_imports: Vec<&'static str> = Vec::new();
     let mut definitions = String::new();
-    if under_bvh > 0 {
-        let tree = Tree::Spheres;
+    if let Some(bvh) = &scene.analytic {
+        let kinds = bvh.kinds();
+        let names = kinds.iter().map(|k| k.name()).collect::<Vec<_>>().join(", ");
+        let tree = Tree::Analytic { kinds };
         let prefix = tree.prefix();
         walks.push_str(&format!(
-            "    // Objects 0 to {} (spheres) under one BVH (sphere_bvh.rs).\n    best = {prefix}_closest(o, d, inv_d, own, best);\n",
+            "    // Objects 0 to {} ({names}) under one BVH (analytic_bvh.rs).\n    best = {prefix}_closest(o, d, inv_d, own, best);\n",
             under_bvh - 1
         ));
         occluded.push_str(&format!(
@@ -296,11 +261,8 @@ pub fn generate(scene: &Geometry) -> Traversal {
         ));
         occluders.extend(0..under_bvh);
         bvh_imports.extend(tree.imports());
-        bvh_imports.push("BvhSphere");
-        if let Some(bvh) = &scene.spheres {
-            definitions.push_str(&sphere_bvh::declarations(bvh));
-        }
-        definitions.push_str(&bvh_traversal::functions(tree));
+        definitions.push_str(&analytic_bvh::declarations(bvh));
+        definitions.push_str(&bvh_traversal::functions(&tree));
     }
     if let Some(mesh) = &mesh {
         walks.push_str(&mesh.closest);
@@ -341,7 +303,7 @@ pub fn generate(scene: &Geometry) -> Traversal {
     // object_at: the ranges read from buffers, each (condition, record), then the literals.
     let mut ranges: Vec<(String, String)> = Vec::new();
     if under_bvh > 0 {
-        ranges.push((format!("index < {under_bvh}u"), "sphere_object(index)".to_owned()));
+        ranges.push((format!("index < {under_bvh}u"), "analytic_object(index)".to_owned()));
     }
     let mut objects: Vec<String> = scene.object_records()[under_bvh..].iter().map(object_literal).collect();
     if let Some(mesh) = mesh {

@@ -1,12 +1,13 @@
-//! The traversal generated for scenes with meshes or many spheres composes and validates (naga),
-//! in each form and arrangement: triangles as literals or under a BVH, spheres as literals or
-//! under a BVH, each alone, together, or after other analytic objects and before an emitter;
+//! The traversal generated for scenes with meshes or many small objects composes and validates
+//! (naga), in each form and arrangement: triangles as literals or under a BVH, spheres (alone or
+//! with quads and boxes) as literals or under a BVH, each alone, together, or after other
+//! analytic objects and before an emitter;
 //! and, run on the GPU, it finds a closed mesh for every ray aimed at a shared edge or vertex.
 
 use illum_gpu::shader::{self, ShaderFile};
 use illum_rtcore::Geometry;
+use illum_rtcore::analytic_bvh::LITERAL_OBJECTS;
 use illum_rtcore::mesh_traversal::LITERAL_TRIANGLES;
-use illum_rtcore::sphere_bvh::LITERAL_SPHERES;
 use illum_rtcore::traversal::generate;
 use illum_scene::testing::obj::scene_with_files;
 
@@ -36,37 +37,46 @@ fn main() {
 }
 ";
 
-/// Scene text of `n` unit spheres in a row.
-fn spheres(n: usize) -> String {
+/// Scene text of `n` small objects in a row: object i a sphere, a quad, a rotated box or an
+/// axis-aligned box by `i % kinds`.
+fn small_objects(n: usize, kinds: usize) -> String {
     (0..n)
         .map(|i| {
-            format!(
-                "[[objects]]\nmaterial = \"grey\"\nsphere = {{ center = [{}.0, 0.0, 9.0], radius = 0.4 }}\n",
-                i
-            )
+            let shape = match i % kinds {
+                0 => format!("sphere = {{ center = [{i}.0, 0.0, 9.0], radius = 0.4 }}"),
+                1 => format!("quad = {{ corner = [{i}.0, 0.0, 9.0], edge_u = [0.5, 0.0, 0.0], edge_v = [0.0, 0.5, 0.2] }}"),
+                2 => format!("box = {{ min = [{i}.0, 0.0, 9.0], max = [{i}.5, 0.5, 9.5], rotate_y = 30.0 }}"),
+                _ => format!("box = {{ min = [{i}.0, 0.0, 9.0], max = [{i}.5, 0.5, 9.5] }}"),
+            };
+            format!("[[objects]]\nmaterial = \"grey\"\n{shape}\n")
         })
         .collect()
 }
 
-/// `triangles` mesh triangles (none: no mesh), `spheres` spheres, then `objects`.
+/// `triangles` mesh triangles (none: no mesh), `sphere_count` small objects of `kinds` kinds
+/// ([`small_objects`]), then `objects`.
 fn compose(objects: &str, triangles: usize, sphere_count: usize) {
+    compose_kinds(objects, triangles, sphere_count, 1);
+}
+
+fn compose_kinds(objects: &str, triangles: usize, sphere_count: usize, kinds: usize) {
     let mesh =
         if triangles > 0 { "[[objects]]\nmaterial = \"grey\"\nmesh = { file = \"m.obj\" }\n" } else { "" };
     let scene = format!(
         "[camera]\neye = [0.0, 0.0, -5.0]\ntarget = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]\nvfov = 45.0\nwidth = 8\nheight = 8\n\
          [environment]\nradiance = [1.0, 1.0, 1.0]\n[materials.grey]\nalbedo = [0.5, 0.5, 0.5]\n[materials.lamp]\nemission = [1.0, 1.0, 1.0]\n\
          {mesh}{}{objects}",
-        spheres(sphere_count)
+        small_objects(sphere_count, kinds)
     );
     let obj = strip(triangles.max(1));
     let scene = scene_with_files(&scene, "t.toml", &[("m.obj", &obj)]).unwrap_or_else(|e| panic!("{e}"));
     let geometry = Geometry::new(&scene);
     assert_eq!(geometry.mesh_bvh().is_some(), triangles > LITERAL_TRIANGLES);
-    assert_eq!(geometry.spheres.is_some(), sphere_count > LITERAL_SPHERES);
+    assert_eq!(geometry.analytic.is_some(), sphere_count > LITERAL_OBJECTS);
     let mut modules = illum_rtcore::shaders::core_modules();
     modules.push(generate(&geometry).module("t"));
     let entry = ShaderFile::generated("entry".to_owned(), ENTRY.to_owned());
-    let what = format!("{triangles} triangles, {sphere_count} spheres, {objects:?}");
+    let what = format!("{triangles} triangles, {sphere_count} objects of {kinds} kinds, {objects:?}");
     let module = shader::compose(&modules, &entry, &[]).unwrap_or_else(|e| panic!("{what}: {e}"));
     shader::validate(&module, "entry").unwrap_or_else(|e| panic!("{what}: {e}"));
 }
@@ -85,10 +95,24 @@ fn mesh_traversals_compose_and_validate() {
 fn sphere_traversals_compose_and_validate() {
     let lamp = "[[objects]]\nmaterial = \"lamp\"\nquad = { corner = [0.0, 3.0, 0.0], edge_u = [1.0, 0.0, 0.0], edge_v = [0.0, 0.0, 1.0] }\n";
     let floor = "[[objects]]\nmaterial = \"grey\"\nquad = { corner = [-9.0, -1.0, 0.0], edge_u = [18.0, 0.0, 0.0], edge_v = [0.0, 0.0, 18.0] }\n";
-    for sphere_count in [LITERAL_SPHERES, LITERAL_SPHERES + 1, 200] {
+    for sphere_count in [LITERAL_OBJECTS, LITERAL_OBJECTS + 1, 200] {
         for objects in ["", lamp, &format!("{floor}{lamp}")] {
             for triangles in [0, 1, LITERAL_TRIANGLES + 1] {
                 compose(objects, triangles, sphere_count);
+            }
+        }
+    }
+}
+
+/// The hierarchy's leaf test dispatches on the kinds it holds: two (a switch with a default),
+/// all four (boxes of both kinds share hit_box's case).
+#[test]
+fn mixed_object_traversals_compose_and_validate() {
+    let lamp = "[[objects]]\nmaterial = \"lamp\"\nquad = { corner = [0.0, 3.0, 0.0], edge_u = [1.0, 0.0, 0.0], edge_v = [0.0, 0.0, 1.0] }\n";
+    for count in [LITERAL_OBJECTS, LITERAL_OBJECTS + 1, 200] {
+        for kinds in [2, 3, 4] {
+            for triangles in [0, LITERAL_TRIANGLES + 1] {
+                compose_kinds(lamp, triangles, count, kinds);
             }
         }
     }

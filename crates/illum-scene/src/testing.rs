@@ -119,6 +119,45 @@ pub fn with_small_spheres(mut scene: crate::Scene, count: usize) -> crate::Scene
     scene
 }
 
+/// [`with_small_spheres`] with every other added sphere replaced by an object of another kind in
+/// its place, cycling through a sphere, a quad (a 0.6 square on its lower edge, tilted back, 0.05
+/// above the plane), a box rotated by 30 degrees about +Y and an axis-aligned box (0.5 wide,
+/// from y = 0.05): a scene of many objects of every analytic kind, for the renderers' agreement
+/// tests.
+pub fn with_small_objects(scene: crate::Scene, count: usize) -> crate::Scene {
+    use crate::{BoxShape, Quad, Shape};
+    let first = scene.objects.len();
+    let mut scene = with_small_spheres(scene, count);
+    for (k, object) in scene.objects[first..].iter_mut().enumerate() {
+        let Shape::Sphere(s) = object.shape else { unreachable!("with_small_spheres adds spheres") };
+        let base = glam::Vec3::new(s.center.x, 0.05, s.center.z);
+        let (name, shape) = match k % 4 {
+            0 => continue,
+            1 => (
+                "quad",
+                Shape::Quad(Quad {
+                    corner: base - glam::Vec3::new(0.0, 0.0, 0.3),
+                    edge_u: glam::Vec3::new(0.0, 0.0, 0.6),
+                    edge_v: glam::Vec3::new(-0.2, 0.55, 0.0),
+                }),
+            ),
+            k => (
+                "box",
+                Shape::Box(BoxShape {
+                    min: glam::Vec3::new(-0.25, 0.0, -0.25),
+                    max: glam::Vec3::new(0.25, 0.5, 0.25),
+                    rotate_y_deg: if k == 2 { 30.0 } else { 0.0 },
+                    pivot: glam::Vec3::ZERO,
+                    translate: base,
+                }),
+            ),
+        };
+        object.name = format!("small {name} {k}");
+        object.shape = shape;
+    }
+    scene
+}
+
 /// What an error test edits and how it loads the result: a valid scene text, the file label
 /// its errors name, and the loader (`Scene::from_toml_str`, or a renderer's view of a scene).
 /// The error tests of every crate share it, so that each checks a rule the same way.

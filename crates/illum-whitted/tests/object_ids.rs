@@ -38,16 +38,17 @@ fn object_ids_match_ray_casting_and_shadows_are_the_balls_projections_along_the_
     check(&illum_scene::testing::shipped_scene("whitted.toml", 160, 90), 2, 50);
 }
 
-/// With spheres past the literal limit under a BVH (illum-rtcore's sphere_bvh.rs), which puts
-/// them first in the GPU's order, each pixel still names the scene's object.
+/// With spheres past the literal limit under a BVH (illum-rtcore's analytic_bvh.rs), which puts
+/// them first in the GPU's order, each pixel still names the scene's object (the order's map
+/// back to the scene does not depend on the kinds under the hierarchy).
 #[test]
 fn object_ids_name_the_scene_objects_of_spheres_under_the_bvh() {
-    let count = illum_rtcore::sphere_bvh::LITERAL_SPHERES + 24;
+    let count = illum_rtcore::analytic_bvh::LITERAL_OBJECTS + 24;
     let scene = illum_scene::testing::with_small_spheres(
         illum_scene::testing::shipped_scene("whitted.toml", 160, 90),
         count,
     );
-    assert!(illum_rtcore::Geometry::new(&scene).spheres.is_some());
+    assert!(illum_rtcore::Geometry::new(&scene).analytic.is_some());
     // Forty small outlines put more pixels within the margin of an edge: under 5%.
     check(&scene, count / 2, 20);
 }

@@ -54,36 +54,38 @@ fn the_cornell_box_matches_the_f64_copy() {
     }
 }
 
-/// Spheres past the traversal's literal limit go under a BVH (illum-rtcore's sphere_bvh.rs);
-/// the f64 copy tests every object by brute force.
+/// Small objects past the traversal's literal limit, spheres, quads and boxes of both kinds, go
+/// under one BVH (illum-rtcore's analytic_bvh.rs) while the floor stays a literal; the f64 copy
+/// tests every object by brute force.
 #[test]
-fn many_spheres_under_the_bvh_match_the_f64_copy() {
-    let count = illum_rtcore::sphere_bvh::LITERAL_SPHERES + 24;
+fn many_objects_under_the_bvh_match_the_f64_copy() {
+    let count = illum_rtcore::analytic_bvh::LITERAL_OBJECTS + 24;
     for depth in [1, 8] {
-        let mut scene = illum_scene::testing::with_small_spheres(
+        let mut scene = illum_scene::testing::with_small_objects(
             illum_scene::testing::shipped_scene("whitted.toml", 96, 54),
             count,
         );
-        assert!(illum_rtcore::Geometry::new(&scene).spheres.is_some());
+        let bvh = illum_rtcore::Geometry::new(&scene).analytic.expect("a BVH");
+        assert_eq!((bvh.objects.len(), bvh.kinds().len()), (count + 2, 4));
         scene.whitted.depth = depth;
-        check(&format!("whitted + {count} spheres (BVH)"), &scene);
+        check(&format!("whitted + {count} objects (BVH)"), &scene);
     }
 }
 
-/// Past the most spheres the hierarchy holds the tracer refuses the scene by count and limit
-/// (illum-rtcore's sphere_bvh::check_count), before compiling anything: as literals the
+/// Past the most objects the hierarchy holds the tracer refuses the scene by count and limit
+/// (illum-rtcore's analytic_bvh::check_count), before compiling anything: as literals the
 /// traversal would take minutes to compile.
 #[test]
-fn more_spheres_than_the_bvh_holds_are_refused_by_count() {
-    use illum_rtcore::sphere_bvh::MAX_BVH_SPHERES;
-    let scene = illum_scene::testing::with_small_spheres(
+fn more_objects_than_the_bvh_holds_are_refused_by_count() {
+    use illum_rtcore::analytic_bvh::MAX_BVH_OBJECTS;
+    let scene = illum_scene::testing::with_small_objects(
         illum_scene::testing::shipped_scene("whitted.toml", 8, 8),
-        MAX_BVH_SPHERES + 1,
+        MAX_BVH_OBJECTS + 1,
     );
     let err = WhittedTracer::new(gpu(), &scene).err().expect("refused").to_string();
-    // The Whitted scene's own two spheres make MAX_BVH_SPHERES + 3.
-    let count = format!("{} non-emitting spheres", MAX_BVH_SPHERES + 3);
-    assert!(err.contains(&count) && err.contains(&format!("at most {MAX_BVH_SPHERES}")), "{err}");
+    // The Whitted scene's own two spheres make MAX_BVH_OBJECTS + 3; its floor is not counted.
+    let count = format!("{} non-emitting spheres, quads and boxes", MAX_BVH_OBJECTS + 3);
+    assert!(err.contains(&count) && err.contains(&format!("at most {MAX_BVH_OBJECTS}")), "{err}");
 }
 
 #[test]

@@ -253,27 +253,29 @@ fn a_sun_disc_agrees_with_the_oracle() {
     compare_scene("whitted, sun of radius 5 degrees, bounces 1", &s);
 }
 
-/// Past the most spheres the hierarchy holds the tracer refuses the scene by count and limit
-/// (illum-rtcore's sphere_bvh::check_count), before compiling the traversal.
+/// Past the most objects the hierarchy holds the tracer refuses the scene by count and limit
+/// (illum-rtcore's analytic_bvh::check_count), before compiling the traversal.
 #[test]
-fn more_spheres_than_the_bvh_holds_are_refused_by_count() {
-    use illum_rtcore::sphere_bvh::MAX_BVH_SPHERES;
-    let s = illum_scene::testing::with_small_spheres(scene("whitted", 1), MAX_BVH_SPHERES + 1);
+fn more_objects_than_the_bvh_holds_are_refused_by_count() {
+    use illum_rtcore::analytic_bvh::MAX_BVH_OBJECTS;
+    let s = illum_scene::testing::with_small_objects(scene("whitted", 1), MAX_BVH_OBJECTS + 1);
     let err = illum_pathtrace::PathTracer::new(common::gpu(), &s).err().expect("refused").to_string();
-    // The Whitted scene's own two spheres make MAX_BVH_SPHERES + 3.
-    let count = format!("{} non-emitting spheres", MAX_BVH_SPHERES + 3);
-    assert!(err.contains(&count) && err.contains(&format!("at most {MAX_BVH_SPHERES}")), "{err}");
+    // The Whitted scene's own two spheres make MAX_BVH_OBJECTS + 3; its floor is not counted.
+    let count = format!("{} non-emitting spheres, quads and boxes", MAX_BVH_OBJECTS + 3);
+    assert!(err.contains(&count) && err.contains(&format!("at most {MAX_BVH_OBJECTS}")), "{err}");
 }
 
-/// Spheres past the traversal's literal limit go under a BVH (illum-rtcore's sphere_bvh.rs) in
-/// the camera paths and the caustic's passes alike; the oracle tests every object by brute force.
+/// Small objects past the traversal's literal limit, spheres, quads and boxes of both kinds, go
+/// under one BVH (illum-rtcore's analytic_bvh.rs) in the camera paths and the caustic's passes
+/// alike, the floor a literal; the oracle tests every object by brute force.
 #[test]
-fn many_spheres_under_the_bvh_agree_with_the_oracle() {
-    let count = illum_rtcore::sphere_bvh::LITERAL_SPHERES + 24;
-    let mut s = illum_scene::testing::with_small_spheres(scene("whitted", 2), count);
-    assert!(illum_rtcore::Geometry::new(&s).spheres.is_some());
+fn many_objects_under_the_bvh_agree_with_the_oracle() {
+    let count = illum_rtcore::analytic_bvh::LITERAL_OBJECTS + 24;
+    let mut s = illum_scene::testing::with_small_objects(scene("whitted", 2), count);
+    let bvh = illum_rtcore::Geometry::new(&s).analytic.expect("a BVH");
+    assert_eq!((bvh.objects.len(), bvh.kinds().len()), (count + 2, 4));
     // Fewer samples than the other comparisons (the oracle's brute force tests 43 objects per
     // ray): the power checks below still hold.
     s.pathtrace.spp = 1024;
-    compare_scene_with(&format!("whitted + {count} spheres (BVH), bounces 2"), &s, 256);
+    compare_scene_with(&format!("whitted + {count} objects (BVH), bounces 2"), &s, 256);
 }
