@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Writes the Whitted scene with N small spheres (or quads, or boxes) added on its floor: a scene
 with many specular objects, for measuring what each renderer's cost does as objects are added
-(docs/performance-caustics.md, "Many specular objects"; docs/performance.md, "Many spheres").
+(docs/performance-caustics.md, "Many specular objects"; docs/performance-geometry.md, "Many spheres").
 
     scripts/many-spheres.py 200 > out/spheres-200.toml
     scripts/many-spheres.py 50 -o out/spheres-50.toml

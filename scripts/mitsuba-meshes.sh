@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# illum's path tracer against Mitsuba 3 on triangle meshes (docs/performance.md, "Meshes"):
+# illum's path tracer against Mitsuba 3 on triangle meshes (docs/performance-geometry.md, "Meshes"):
 #
 #     scripts/mitsuba-meshes.sh PYTHON OUT_DIR
 #

@@ -196,8 +196,8 @@ def perf_tables(directory):
         ("bench-parts.txt", "caustic-parts", "performance-caustics.md", False),
         ("bench-glint.txt", "glint-bench", "performance-caustics.md", False),
         ("raster-bench.txt", "raster-bench", "performance-raster.md", True),
-        ("vs-mitsuba-meshes.txt", "mitsuba-meshes", "performance.md", False),
-        ("bench-largest-mesh.txt", "largest-mesh", "performance.md", True),
+        ("vs-mitsuba-meshes.txt", "mitsuba-meshes", "performance-geometry.md", False),
+        ("bench-largest-mesh.txt", "largest-mesh", "performance-geometry.md", True),
     ]
     for name, block, page, preformatted in blocks:
         text = read(directory, name).strip()

@@ -121,9 +121,9 @@ echo "== The headline figures (README, between the headline markers)"
 for n in 10 50 200; do python3 scripts/many-spheres.py $n -o "$out/spheres-$n.toml"; done
 "$bin/bench" --runs 3 --parts scenes/whitted.toml | tee "$out/bench-parts.txt"
 "$bin/bench" --runs 3 --glint scenes/whitted.toml "$out"/spheres-{10,50,200}.toml | tee "$out/bench-glint.txt"
-# docs/performance.md, "Many spheres": the time to the first image, cold and warm.
+# docs/performance-geometry.md, "Many spheres": the time to the first image, cold and warm.
 "$bin/bench" --runs 3 --first-image scenes/whitted.toml "$out"/spheres-{50,200}.toml | tee "$out/bench-first-image.txt"
-# docs/performance.md, "Meshes": the largest mesh the device holds.
+# docs/performance-geometry.md, "Meshes": the largest mesh the device holds.
 "$bin/bench" --largest-mesh | tee "$out/bench-largest-mesh.txt"
 if "$python" -c "import mitsuba" 2> /dev/null; then
     "$python" bench/vs_mitsuba.py --bounces 2 | tee "$out/vs-mitsuba.txt"

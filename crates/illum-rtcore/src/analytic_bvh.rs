@@ -20,7 +20,7 @@
 //! traversal with the scene's sizes: on lavapipe a storage-buffer read at a per-lane index is
 //! one bounds-checked scalar load per lane, and the same walk over storage buffers ran 2 to 4
 //! times slower at 200 spheres (no faster than the literal list), while uniform buffers made it
-//! 2 to 4 times faster than the list (docs/performance.md, "Many spheres, quads and boxes"). A
+//! 2 to 4 times faster than the list (docs/performance-geometry.md, "Many spheres, quads and boxes"). A
 //! uniform binding holds 64 KiB on every device WebGPU allows (wgpu's default limit), which
 //! bounds the objects under the hierarchy at [`MAX_BVH_OBJECTS`].
 
@@ -36,7 +36,7 @@ use crate::object::{GpuObject, ObjectRecord, ShapeKind};
 
 /// Up to this many objects that may go under the hierarchy ([`UnderHierarchy`]) are literals;
 /// past it, a BVH. The crossover measured on lavapipe, time to the first image and throughput
-/// both, is in docs/performance.md ("Many spheres, quads and boxes"): a literal list's compile
+/// both, is in docs/performance-geometry.md ("Many spheres, quads and boxes"): a literal list's compile
 /// time grows with its length, and a BVH walk costs a loop and per-lane buffer reads that a few
 /// literals do not.
 pub const LITERAL_OBJECTS: usize = 16;

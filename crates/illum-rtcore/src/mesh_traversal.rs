@@ -13,7 +13,7 @@ use crate::literal::{vec3, vec4};
 use crate::object::ShapeKind;
 
 /// Up to this many triangles a scene's meshes are literals; past it, a BVH: the crossover
-/// measured on lavapipe lies between 20 and 80 triangles (docs/performance.md, "Meshes", has
+/// measured on lavapipe lies between 20 and 80 triangles (docs/performance-geometry.md, "Meshes", has
 /// the figures), and a literal list's shader compile grows with its length.
 pub const LITERAL_TRIANGLES: usize = 32;
 
