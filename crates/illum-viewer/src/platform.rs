@@ -36,6 +36,7 @@ pub const BUILT_IN_SCENES: &[(&str, &str)] = &[
     ("scenes/cornell.toml", include_str!("../../../scenes/cornell.toml")),
     ("scenes/whitted.toml", include_str!("../../../scenes/whitted.toml")),
     ("scenes/cornell-classic.toml", include_str!("../../../scenes/cornell-classic.toml")),
+    ("scenes/cornell-sphere.toml", include_str!("../../../scenes/cornell-sphere.toml")),
 ];
 
 /// The built-in text of a scene path (`scenes/x.toml`, or `./scenes/x.toml`), if it is one.
