@@ -96,9 +96,11 @@ fn prepare(args: &RenderArgs) -> anyhow::Result<Option<Prepared>> {
         None => None,
     };
     let mut settings = args.settings.clone();
-    let (mut sequence, mut caustics) = (args.sequence, args.caustics);
+    let (mut sequence, mut caustics, mut caustic_method) =
+        (args.sequence, args.caustics, args.caustic_method);
     if let Some(checkpoint) = &checkpoint {
         crate::resume::fill_from_checkpoint(checkpoint, &mut settings, &mut sequence, &mut caustics);
+        caustic_method = caustic_method.or_else(|| crate::resume::caustic_method_of(checkpoint));
     }
     let mut scene = crate::load_scene(&args.scene, &settings)?;
     if let Some(sequence) = sequence {
@@ -106,6 +108,12 @@ fn prepare(args: &RenderArgs) -> anyhow::Result<Option<Prepared>> {
     }
     if let Some(caustics) = caustics {
         scene.pathtrace.caustics = caustics;
+    }
+    if let Some(method) = caustic_method {
+        scene.pathtrace.caustic_method = method;
+    }
+    if let Some(why) = illum_pathtrace::Estimators::manifold_falls_back(&scene) {
+        eprintln!("{}: {why}", args.scene.display());
     }
     if let Some(why) = illum_pathtrace::Estimators::mesh_stops_caustics(&scene) {
         if args.caustics == Some(true) {

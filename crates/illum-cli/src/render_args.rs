@@ -85,6 +85,13 @@ pub struct RenderArgs {
     /// or glass object (docs/caustics.md).
     #[arg(long, value_name = "on|off", value_parser = crate::on_off_arg)]
     pub caustics: Option<bool>,
+    /// Path-tracer scenes: how the caustic is found (default: the file's `[pathtrace]
+    /// caustic_method`): `light-tracer` (particles from the sun, every specular chain) or
+    /// `manifold` (solved through each specular sphere at every diffuse vertex; chains through
+    /// two objects are left out, docs/caustics-manifold.md). A scene the solve cannot take
+    /// falls back to the light tracer and says why.
+    #[arg(long, value_name = "light-tracer|manifold")]
+    pub caustic_method: Option<illum_scene::CausticMethod>,
     /// PNG exposure in stops, e.g. -1 or 2, at most 64 either way, or `auto`: the stops that
     /// bring the median luminance to mid-grey (0.18), for scenes of any brightness. EXR output
     /// is never scaled. Default 0.
@@ -146,6 +153,7 @@ impl RenderArgs {
             (self.region.is_some(), "--region"),
             (self.sequence.is_some(), "--sequence"),
             (self.caustics.is_some(), "--caustics"),
+            (self.caustic_method.is_some(), "--caustic-method"),
             (self.resume.is_some(), "--resume"),
             (self.sample_range.is_some(), "--sample-range"),
             (self.checkpoint_seconds.is_some(), "--checkpoint-seconds"),

@@ -30,6 +30,15 @@ pub(crate) fn fill_from_checkpoint(
     *caustics = caustics.or_else(|| crate::on_off_arg(get("caustics")?).ok());
 }
 
+/// The caustic method a checkpoint's estimators name: `manifold` when its token list holds the
+/// solve's token, else none (the scene file's or the flag's then decides, and the estimators'
+/// key comparison refuses a mismatch).
+pub(crate) fn caustic_method_of(checkpoint: &Checkpoint) -> Option<illum_scene::CausticMethod> {
+    let key = checkpoint.metadata.get(illum_pathtrace::metadata::ESTIMATORS)?;
+    let manifold = illum_pathtrace::Estimator::ManifoldNee.token();
+    key.split_whitespace().any(|t| t == manifold).then_some(illum_scene::CausticMethod::Manifold)
+}
+
 /// Checks that `checkpoint`, read from `path`, can be continued as the flags ask.
 pub(crate) fn check_resume(
     args: &RenderArgs,

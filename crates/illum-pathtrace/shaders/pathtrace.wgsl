@@ -40,6 +40,10 @@
 #ifdef SPECULAR
 #import illum::pathtrace::surfaces::scatter_dielectric
 #endif
+#ifdef MANIFOLD
+#import illum::pathtrace::manifold::Receiver
+#import illum::pathtrace::manifold_spheres::manifold_light
+#endif
 #ifdef CHECKER
 #import illum::rtcore::optics::checker_albedo
 #endif
@@ -297,7 +301,14 @@ fn diffuse_vertex(material: u32, index: u32, s: Surface, ns: vec3<f32>, depth: u
     // Every ray leaving this point (shadow and bounce) starts here, off the surface.
     let spawned = spawn_point(s.p, s.n, s.err);
     var throughput = (*next).throughput;
-    let light = throughput * albedo * INV_PI * direct(s, ns, spawned, index, sampler);
+    var incident = direct(s, ns, spawned, index, sampler);
+#ifdef MANIFOLD
+    // The sun's light through each specular sphere, solved (manifold.wgsl): a chain of k events
+    // counts when depth + k + 1 <= bounces (docs/caustics.md, "Path length").
+    let events = select(i32(params.bounces) - i32(depth) - 1, 3, params.bounces == UNBOUNDED);
+    incident += manifold_light(Receiver(s.p, spawned, s.n, ns, index), events, sample_1d(sampler));
+#endif
+    let light = throughput * albedo * INV_PI * incident;
     (*next).radiance += select(vec3<f32>(0.0), light, live);
     let u = sample_2d(sampler);
     // Lambertian f = albedo / pi. Cosine pdf cos/pi: f cos / pdf = albedo.

@@ -15,7 +15,8 @@
 //! A leaf: it depends on the scene model alone, so the tracer, the glint, the shaders'
 //! specialisation and the metadata all ask it, and it asks none of them.
 
-use illum_scene::{Feature, MaterialKind, Scene};
+use illum_scene::specular_spheres::solvable_spheres;
+use illum_scene::{CausticMethod, Feature, MaterialKind, Scene};
 
 /// The token list's own version: its first token.
 pub const KEY_VERSION: &str = "estimators.v1";
@@ -30,6 +31,10 @@ pub const GATHER_RADIUS_FRACTION: f32 = 0.02;
 /// than its own count of samples would, with a dishonest error estimate.
 const GATHER_TOKEN: &str = "photon-gather.r2";
 
+/// Manifold next-event estimation's rule: chains R, T T, T R T per sphere, the grid and the bound
+/// on the concentration of `manifold.wgsl`.
+const MANIFOLD_TOKEN: &str = "manifold-nee.v1";
+
 /// One estimator.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Estimator {
@@ -41,6 +46,10 @@ pub enum Estimator {
     PhotonGather,
     /// The sun's glint solved on the host and added to its pixel's mean: L S* E.
     GlintSolve,
+    /// Manifold next-event estimation through one sphere (`shaders/manifold.wgsl`): at every
+    /// diffuse vertex, the sun's light through each specular sphere's chains R, T T and T R T,
+    /// solved: L S+ D (S|D)* E with the chain on one sphere.
+    ManifoldNee,
 }
 
 impl Estimator {
@@ -51,6 +60,7 @@ impl Estimator {
             Estimator::LightTracer => "light-tracer",
             Estimator::PhotonGather => GATHER_TOKEN,
             Estimator::GlintSolve => "glint-solve",
+            Estimator::ManifoldNee => MANIFOLD_TOKEN,
         }
     }
 }
@@ -58,6 +68,7 @@ impl Estimator {
 /// The estimators of one scene's image.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub struct Estimators {
+    manifold: bool,
     light_tracer: bool,
     photon_gather: bool,
     glint: bool,
@@ -70,16 +81,35 @@ impl Estimators {
             matches!(scene.material_of(o).kind, MaterialKind::Mirror { .. } | MaterialKind::Dielectric { .. })
         });
         let diffuse = scene.features().any(&[Feature::Lambertian, Feature::Checker]);
-        let light_tracer = scene.pathtrace.caustics
+        let wanted = scene.pathtrace.caustics
             && scene.directional_light.is_some()
             && specular
             && Self::mesh_stops_caustics(scene).is_none();
         let delta_sun = scene.directional_light.is_some_and(|l| l.is_delta());
+        // Asked for and solvable, the solve replaces the light tracer and its gather
+        // (docs/caustics-manifold.md, "What it leaves out").
+        let manifold = wanted
+            && diffuse
+            && Self::manifold_falls_back(scene).is_none()
+            && scene.pathtrace.caustic_method == CausticMethod::Manifold;
+        let light_tracer = wanted && !manifold;
         Estimators {
+            manifold,
             light_tracer,
             photon_gather: light_tracer && delta_sun && diffuse,
-            glint: light_tracer && delta_sun,
+            glint: wanted && delta_sun,
         }
+    }
+
+    /// Why `caustic_method = "manifold"` falls back to the light tracer for `scene`: the
+    /// reason [`solvable_spheres`] gives. `None` when the solve runs, or was not asked for.
+    pub fn manifold_falls_back(scene: &Scene) -> Option<String> {
+        if scene.pathtrace.caustic_method != CausticMethod::Manifold || !scene.pathtrace.caustics {
+            return None;
+        }
+        solvable_spheres(scene)
+            .err()
+            .map(|why| format!("caustic method manifold falls back to the light tracer: {why}"))
     }
 
     /// Why the caustic's estimators are off although the scene asks for them: they follow light
@@ -92,6 +122,11 @@ impl Estimators {
             "caustics off: the caustic's estimators do not follow light through meshes; camera paths \
              alone miss the sun's caustic",
         )
+    }
+
+    /// Manifold next-event estimation (shader def MANIFOLD).
+    pub fn manifold(&self) -> bool {
+        self.manifold
     }
 
     /// The caustic's light tracer (and the shaders' CAUSTIC code).
@@ -112,7 +147,7 @@ impl Estimators {
     /// Whether any of the caustic's estimators runs: `on` or `off` in the metadata's
     /// `illum.caustics` ([`Self::caustics_label`]).
     pub fn caustics(&self) -> bool {
-        self.light_tracer
+        self.light_tracer || self.manifold
     }
 
     /// `on` or `off`, as EXR metadata and checkpoints store [`Self::caustics`].
@@ -124,6 +159,7 @@ impl Estimators {
     pub fn list(&self) -> Vec<Estimator> {
         let mut list = vec![Estimator::CameraPaths];
         let optional = [
+            (self.manifold, Estimator::ManifoldNee),
             (self.light_tracer, Estimator::LightTracer),
             (self.photon_gather, Estimator::PhotonGather),
             (self.glint, Estimator::GlintSolve),

@@ -24,6 +24,7 @@ mod estimators;
 pub mod glint;
 pub mod gpu_scene;
 mod limits;
+mod manifold;
 pub mod metadata;
 mod options;
 mod planner;

@@ -25,6 +25,8 @@ pub struct SceneCode {
     /// A mirror or a dielectric.
     pub specular: bool,
     pub checker: bool,
+    /// Manifold next-event estimation ([`Estimators::manifold`], `shaders/manifold.wgsl`).
+    pub manifold: bool,
     /// The caustic's light tracer ([`Estimators::light_tracer`]).
     pub caustic: bool,
     /// ... with the photon gather (E (S|D)* D S+ L but E D S+ L, `shaders/gather.wgsl`): the
@@ -51,6 +53,7 @@ impl SceneCode {
             sky: features.contains(Feature::Environment),
             specular: features.any(&[Feature::Mirror, Feature::Dielectric]),
             checker: features.contains(Feature::Checker),
+            manifold: Estimators::of(scene).manifold(),
             caustic: Estimators::of(scene).light_tracer(),
             caustic_gather: Estimators::of(scene).photon_gather(),
             uniform_sampling: scene.pathtrace.sampling == Sampling::Uniform,

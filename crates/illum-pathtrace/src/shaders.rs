@@ -62,6 +62,8 @@ pub fn shader_modules(scene: &Scene, gpu_scene: &GpuScene, traversal: Traversal)
         ]),
     }
     modules.push(SURFACES_MODULE);
+    modules.push(crate::manifold::MANIFOLD_MODULE);
+    modules.push(crate::manifold::manifold_spheres_module(scene, gpu_scene));
     modules.push(CAUSTIC_BUFFERS_MODULE);
     modules.push(CAUSTIC_WALK_MODULE);
     modules

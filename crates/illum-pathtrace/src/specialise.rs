@@ -37,6 +37,7 @@ impl Specialisation {
             ("SKY", code.sky),
             ("SPECULAR", code.specular),
             ("CHECKER", code.checker),
+            ("MANIFOLD", code.manifold),
             ("CAUSTIC", code.caustic),
             ("CAUSTIC_GATHER", code.caustic_gather),
             ("UNIFORM_SAMPLING", code.uniform_sampling),

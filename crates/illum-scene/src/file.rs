@@ -50,6 +50,7 @@
 //! sequence = "independent"         # or "low-discrepancy"
 //! caustics = false                 # true: light tracing from the directional light through
 //!                                  # mirrors and glass onto diffuse surfaces (the caustic)
+//! caustic_method = "light-tracer"  # or "manifold": solved through each specular sphere
 //! [raster]                         # the rasterizer
 //! look = "figure"                  # or "enhanced"
 //! pcf_radius = 0.05                # half-width of the soft shadow edge
@@ -145,6 +146,7 @@ pub(crate) struct RawPathTrace {
     pub sampling: String,
     pub sequence: String,
     pub caustics: bool,
+    pub caustic_method: String,
 }
 
 impl Default for RawPathTrace {
@@ -157,6 +159,7 @@ impl Default for RawPathTrace {
             sampling: "cosine".to_owned(),
             sequence: "independent".to_owned(),
             caustics: false,
+            caustic_method: "light-tracer".to_owned(),
         }
     }
 }

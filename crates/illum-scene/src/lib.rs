@@ -56,6 +56,7 @@ mod renderers;
 mod scene;
 mod settings;
 mod shapes;
+pub mod specular_spheres;
 mod spelling;
 #[cfg(any(test, feature = "testing"))]
 pub mod testing;
@@ -75,9 +76,9 @@ pub use mesh::{MeshPlacement, MeshRef, TriangleMesh};
 pub use mesh_load::ReadFile;
 pub use paths::resolve_scene_path;
 pub use renderers::{
-    Bounces, DenoiserKind, DielectricShading, Effects, Look, MAX_BOUNCES, MAX_WHITTED_AA, MAX_WHITTED_DEPTH,
-    MirrorShading, PathTraceSettings, RasterSettings, RendererKind, Sampling, Sequence, Shading,
-    WhittedSettings,
+    Bounces, CausticMethod, DenoiserKind, DielectricShading, Effects, Look, MAX_BOUNCES, MAX_WHITTED_AA,
+    MAX_WHITTED_DEPTH, MirrorShading, PathTraceSettings, RasterSettings, RendererKind, Sampling, Sequence,
+    Shading, WhittedSettings,
 };
 pub use scene::{Object, Overrides, Scene};
 pub use shapes::{BoxShape, Quad, Shape, Sphere};

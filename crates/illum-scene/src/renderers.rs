@@ -76,6 +76,19 @@ pub enum Sequence {
     LowDiscrepancy,
 }
 
+/// How the path tracer finds the sun's caustic (with `caustics = true`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum CausticMethod {
+    /// Particles traced from the sun, connected to the eye, and with a delta sun gathered as
+    /// photons (docs/caustics.md): every specular chain, through any number of objects.
+    #[default]
+    LightTracer,
+    /// Manifold next-event estimation: at every diffuse vertex the chains through one specular
+    /// sphere are solved (docs/caustics-manifold.md). Where the scene is not solvable sphere by
+    /// sphere (`specular_spheres::solvable_spheres`) the light tracer runs instead, and says so.
+    Manifold,
+}
+
 /// The denoisers `render --denoise` knows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum DenoiserKind {
@@ -119,6 +132,8 @@ pub struct PathTraceSettings {
     /// It covers the paths L S+ D E that next-event estimation cannot find (see
     /// docs/caustics.md); off by default.
     pub caustics: bool,
+    /// Which estimator finds the caustic when `caustics` is on.
+    pub caustic_method: CausticMethod,
 }
 
 /// The two looks of the rasterizer.

@@ -5,7 +5,7 @@ use std::fmt;
 use std::str::FromStr;
 
 use crate::error::ParseValueError;
-use crate::renderers::{Bounces, Look, MAX_BOUNCES, RendererKind, Sampling, Sequence};
+use crate::renderers::{Bounces, CausticMethod, Look, MAX_BOUNCES, RendererKind, Sampling, Sequence};
 
 /// The spelling of "no fixed depth" in files and on the command line.
 pub(crate) const UNBOUNDED: &str = "unbounded";
@@ -56,6 +56,8 @@ named_words! {
         { Cosine => "cosine", Uniform => "uniform" };
     Sequence, SEQUENCE_ALLOWED = "must be \"independent\" or \"low-discrepancy\"",
         { Independent => "independent", LowDiscrepancy => "low-discrepancy" };
+    CausticMethod, CAUSTIC_METHOD_ALLOWED = "must be \"light-tracer\" or \"manifold\"",
+        { LightTracer => "light-tracer", Manifold => "manifold" };
     Look, LOOK_ALLOWED = "must be \"figure\" or \"enhanced\"",
         { Figure => "figure", Enhanced => "enhanced" };
     RendererKind, RENDERER_ALLOWED = "must be \"raster\", \"pathtrace\" or \"whitted\"",

@@ -11,8 +11,8 @@ use crate::file::{
 };
 use crate::lights::{DirectionalLight, Environment};
 use crate::renderers::{
-    Bounces, DielectricShading, Look, MAX_BOUNCES, MAX_WHITTED_AA, MAX_WHITTED_DEPTH, MirrorShading,
-    PathTraceSettings, RasterSettings, Sampling, Sequence, Shading, WhittedSettings,
+    Bounces, CausticMethod, DielectricShading, Look, MAX_BOUNCES, MAX_WHITTED_AA, MAX_WHITTED_DEPTH,
+    MirrorShading, PathTraceSettings, RasterSettings, Sampling, Sequence, Shading, WhittedSettings,
 };
 use crate::settings::{LOOK_ALLOWED, UNBOUNDED, bounces_allowed};
 use crate::spelling::{fmt_num, fmt_vec};
@@ -101,7 +101,19 @@ impl Check<'_> {
         let sequence: Sequence = raw.sequence.parse().map_err(|e: crate::ParseValueError| {
             self.invalid("pathtrace.sequence", format!("{:?}", raw.sequence), e.allowed)
         })?;
-        Ok(PathTraceSettings { spp, bounces, seed, sampling, sequence, caustics: raw.caustics })
+        let caustic_method: CausticMethod =
+            raw.caustic_method.parse().map_err(|e: crate::ParseValueError| {
+                self.invalid("pathtrace.caustic_method", format!("{:?}", raw.caustic_method), e.allowed)
+            })?;
+        Ok(PathTraceSettings {
+            spp,
+            bounces,
+            seed,
+            sampling,
+            sequence,
+            caustics: raw.caustics,
+            caustic_method,
+        })
     }
 
     /// `bounces` is an integer in 0..=MAX_BOUNCES or exactly the string "unbounded".

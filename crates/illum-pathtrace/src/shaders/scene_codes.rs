@@ -62,10 +62,10 @@ const EVERY_KIND: &str = r#"
 
 /// Every scene the inputs of [`SceneCode::new`] can describe, up to what it reads: each
 /// subset of the four surface kinds, 0, 1 or 2 area lights, no sun, a delta sun or a sun
-/// disc, with and without the sky, the caustic setting on and off, both hemisphere samplings
+/// disc, with and without the sky, the caustic setting on and off with either method, both hemisphere samplings
 /// and fixed or unbounded bounces.
 fn scene_variants() -> Vec<Scene> {
-    use illum_scene::{Bounces, Sampling};
+    use illum_scene::{Bounces, CausticMethod, Sampling};
     let base = Scene::from_toml_str(EVERY_KIND, "every-kind.toml").unwrap_or_else(|e| panic!("{e}"));
     let (surfaces, lamps) = base.objects.split_at(4);
     let mut scenes = Vec::new();
@@ -73,8 +73,8 @@ fn scene_variants() -> Vec<Scene> {
         for lamp_count in 0..=lamps.len() {
             for sun in [None, Some(0.0), Some(0.25)] {
                 for sky in [false, true] {
-                    for (caustics, uniform, unbounded) in
-                        (0u32..8).map(|b| (b & 1 != 0, b & 2 != 0, b & 4 != 0))
+                    for (caustics, uniform, unbounded, manifold) in
+                        (0u32..16).map(|b| (b & 1 != 0, b & 2 != 0, b & 4 != 0, b & 8 != 0))
                     {
                         let mut scene = base.clone();
                         scene.objects = (0..surfaces.len())
@@ -88,6 +88,8 @@ fn scene_variants() -> Vec<Scene> {
                         });
                         scene.environment = base.environment.filter(|_| sky);
                         scene.pathtrace.caustics = caustics;
+                        scene.pathtrace.caustic_method =
+                            if manifold { CausticMethod::Manifold } else { CausticMethod::LightTracer };
                         scene.pathtrace.sampling = if uniform { Sampling::Uniform } else { Sampling::Cosine };
                         scene.pathtrace.bounces =
                             if unbounded { Bounces::Unbounded } else { Bounces::Fixed(4) };
@@ -127,6 +129,7 @@ fn every_combination_of_the_scene_code_validates() {
             sky,
             specular,
             checker,
+            manifold,
             caustic,
             caustic_gather,
             uniform_sampling,
@@ -142,13 +145,14 @@ fn every_combination_of_the_scene_code_validates() {
             sky,
             specular,
             checker,
+            manifold,
             caustic,
             caustic_gather,
             uniform_sampling,
             unbounded_bounces,
         ]
     };
-    for i in 0..11 {
+    for i in 0..12 {
         assert!(
             codes.iter().any(|c| flags(c)[i]) && codes.iter().any(|c| !flags(c)[i]),
             "flag {i} takes one value only in {} scene codes",

@@ -1,0 +1,147 @@
+//! Whether a scene's specular light can be solved sphere by sphere: the condition under which
+//! manifold next-event estimation through one sphere (illum-pathtrace's `manifold.wgsl` and the
+//! oracle's twin) owns every path whose specular chain stays on one sphere. The one home of that
+//! rule: the path tracer's choice of estimators and the oracle's both ask it.
+//!
+//! The solve follows a chain inside a sphere without looking for other objects there, so no
+//! other object may enter a specular sphere (touching is allowed). It needs a delta sun, and
+//! every mirror or dielectric must be a sphere. Its cost grows with the number of specular
+//! spheres at every diffuse vertex, so past [`MAX_SPHERES`] the light tracer is the cheaper
+//! estimator.
+
+use glam::Vec3;
+
+use crate::{MaterialKind, Quad, Scene, Shape};
+
+/// The most specular spheres the solve takes: each adds its chains' root search to every diffuse
+/// vertex of every path.
+pub const MAX_SPHERES: usize = 8;
+
+/// Why the scene's specular light cannot be solved sphere by sphere, or `Ok` with the indices of
+/// its specular spheres (in `scene.objects`).
+pub fn solvable_spheres(scene: &Scene) -> Result<Vec<usize>, String> {
+    match scene.directional_light {
+        Some(light) if light.is_delta() => {}
+        Some(_) => return Err("the sun has an angular radius: the solve needs a delta sun".to_owned()),
+        None => return Err("the scene has no directional light".to_owned()),
+    }
+    let mut spheres = Vec::new();
+    for (i, object) in scene.objects.iter().enumerate() {
+        let specular = matches!(
+            scene.material_of(object).kind,
+            MaterialKind::Mirror { .. } | MaterialKind::Dielectric { .. }
+        );
+        match (&object.shape, specular) {
+            (Shape::Sphere(_), true) => spheres.push(i),
+            (shape, true) => {
+                return Err(format!("object {:?} is a specular {}, not a sphere", object.name, shape.kind()));
+            }
+            _ => {}
+        }
+    }
+    if spheres.len() > MAX_SPHERES {
+        return Err(format!(
+            "{} specular spheres, more than the {MAX_SPHERES} the solve takes at every diffuse vertex",
+            spheres.len()
+        ));
+    }
+    for &k in &spheres {
+        let Shape::Sphere(sphere) = scene.objects[k].shape else { unreachable!("pushed as a sphere") };
+        for (j, other) in scene.objects.iter().enumerate() {
+            if j != k && enters(&other.shape, sphere.center, sphere.radius) {
+                return Err(format!(
+                    "object {:?} enters the specular sphere {:?}",
+                    other.name, scene.objects[k].name
+                ));
+            }
+        }
+    }
+    Ok(spheres)
+}
+
+/// Whether `shape` has points strictly inside the ball (centre, radius), up to a relative
+/// tolerance that lets shapes touch it. Meshes count as entering (the caustic's estimators are
+/// off with a mesh anyway).
+fn enters(shape: &Shape, centre: Vec3, radius: f32) -> bool {
+    let inside = |distance: f32| distance < radius * (1.0 - 1e-5);
+    match shape {
+        Shape::Sphere(s) => inside(s.center.distance(centre) - s.radius),
+        Shape::Quad(q) => inside(quad_distance(q, centre)),
+        Shape::Box(b) => {
+            let (rotation, offset) = b.local_to_world();
+            let local = rotation.transpose() * (centre - offset);
+            inside(local.clamp(b.min, b.max).distance(local))
+        }
+        Shape::Mesh(_) => true,
+    }
+}
+
+/// The distance from p to the parallelogram q.
+fn quad_distance(q: &Quad, p: Vec3) -> f32 {
+    let n = q.edge_u.cross(q.edge_v);
+    let h = p - q.corner;
+    // (s, t) of p's projection, from the dual basis of (edge_u, edge_v) in their plane.
+    let nn = n.length_squared();
+    let s = h.cross(q.edge_v).dot(n) / nn;
+    let t = q.edge_u.cross(h).dot(n) / nn;
+    if (0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&t) {
+        return (h.dot(n) / nn.sqrt()).abs();
+    }
+    let segment = |a: Vec3, d: Vec3| {
+        let along = ((p - a).dot(d) / d.length_squared()).clamp(0.0, 1.0);
+        (a + along * d).distance(p)
+    };
+    let (c, u, v) = (q.corner, q.edge_u, q.edge_v);
+    segment(c, u).min(segment(c, v)).min(segment(c + u, v)).min(segment(c + v, u))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn whitted() -> Scene {
+        Scene::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/whitted.toml")))
+            .expect("whitted.toml")
+    }
+
+    #[test]
+    fn the_whitted_scene_is_solvable_and_an_intruder_or_a_disc_is_named() {
+        let scene = whitted();
+        assert_eq!(solvable_spheres(&scene), Ok(vec![1, 2]));
+        // The metal sphere moved against the glass, then into it.
+        let Shape::Sphere(glass) = scene.objects[1].shape else { panic!("glass sphere") };
+        let moved = |dx: f32| {
+            let mut moved = scene.clone();
+            let Shape::Sphere(ref mut metal) = moved.objects[2].shape else { panic!("metal sphere") };
+            metal.center = glass.center + Vec3::new(dx, 0.0, 0.0);
+            moved
+        };
+        assert_eq!(solvable_spheres(&moved(2.0)), Ok(vec![1, 2]), "touching spheres are allowed");
+        let refused = solvable_spheres(&moved(1.9)).unwrap_err();
+        assert!(
+            refused.contains("\"metal sphere\" enters the specular sphere \"glass sphere\""),
+            "{refused}"
+        );
+        // The floor raised through the glass sphere.
+        let mut floor = scene.clone();
+        let Shape::Quad(ref mut q) = floor.objects[0].shape else { panic!("floor") };
+        q.corner.y = 2.0;
+        let refused = solvable_spheres(&floor).unwrap_err();
+        assert!(refused.contains("\"floor\" enters"), "{refused}");
+        let mut disc = scene.clone();
+        disc.directional_light.as_mut().expect("a sun").angular_radius_deg = 0.5;
+        assert!(solvable_spheres(&disc).unwrap_err().contains("delta sun"));
+    }
+
+    #[test]
+    fn the_distance_to_a_quad_is_exact_inside_and_beyond_its_edges() {
+        let q =
+            Quad { corner: Vec3::ZERO, edge_u: Vec3::new(2.0, 0.0, 0.0), edge_v: Vec3::new(1.0, 0.0, 1.0) };
+        assert!((quad_distance(&q, Vec3::new(1.5, 3.0, 0.5)) - 3.0).abs() < 1e-6);
+        // Beyond the edge from (2, 0, 0) to (3, 0, 1): the perpendicular from (4, 0, 0).
+        let expected = (2.0f32).sqrt();
+        assert!((quad_distance(&q, Vec3::new(4.0, 0.0, 0.0)) - expected).abs() < 1e-6);
+        // Beyond the corner (0, 0, 0).
+        assert!((quad_distance(&q, Vec3::new(-3.0, 4.0, 0.0)) - 5.0).abs() < 1e-6);
+    }
+}
