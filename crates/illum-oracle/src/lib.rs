@@ -52,6 +52,8 @@ pub mod glint;
 mod integrator;
 pub mod manifold;
 pub mod manifold_chain;
+#[cfg(test)]
+mod manifold_flux;
 mod manifold_support;
 pub mod optics;
 mod parallel;
