@@ -1,7 +1,8 @@
 //! What manifold next-event estimation (MNEE, `manifold.rs`) leaves out on the Whitted view:
 //! the oracle at 64 x 36 pixels, bounces 8, twice with the same seed,
 //!   (a) complete: camera paths + the caustic's light tracer + the photon gather,
-//!   (b) camera paths + MNEE (K = 1: chains R, TT, TRT; unbounded concentration),
+//!   (b) camera paths + MNEE (K internal reflections at most, default 1: chains R, TT, TRT;
+//!       unbounded concentration),
 //! and per region the mean of (b) - (a) with its standard error. MNEE leaves out chains with
 //! two or more internal reflections and chains through both balls (sun -> mirror -> glass ->
 //! floor, ...), so the difference should be small and negative, plus the gather's kernel bias.
@@ -14,7 +15,7 @@
 //! Regions: the whole image; the glass sphere's shadow (the pixel centre's camera ray hits the
 //! floor where the sun's ray is blocked by the glass sphere); the pixels that see a ball.
 //!
-//!     cargo run --release -p illum-oracle --example manifold_remainder [SPP]
+//!     cargo run --release -p illum-oracle --example manifold_remainder [SPP] [K]
 
 use glam::DVec3;
 use illum_oracle::{ManifoldSettings, Oracle, PinholeCamera};
@@ -61,8 +62,10 @@ fn accumulate(
 }
 
 fn main() {
-    let spp: u32 =
-        std::env::args().nth(1).map_or(1024, |s| s.parse().expect("SPP must be a positive integer"));
+    let mut args = std::env::args().skip(1);
+    let spp: u32 = args.next().map_or(1024, |s| s.parse().expect("SPP must be a positive integer"));
+    let internal: u32 =
+        args.next().map_or(1, |s| s.parse().expect("K must be a count of internal reflections"));
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/whitted.toml");
     let mut scene = Scene::load(std::path::Path::new(path)).expect("scenes/whitted.toml");
     scene.camera.width = 64;
@@ -72,7 +75,7 @@ fn main() {
     let (width, height) = (scene.camera.width, scene.camera.height);
     let complete = Oracle::new(&scene).expect("the oracle renders this scene");
     assert!(complete.caustics() && complete.gathers());
-    let mnee = complete.clone().with_manifold(Some(ManifoldSettings::default()));
+    let mnee = complete.clone().with_manifold(Some(ManifoldSettings::with_internal_reflections(internal)));
     let threads = illum_oracle::default_threads();
     let start = std::time::Instant::now();
     let mut sums = vec![[DVec3::ZERO; 3]; (width * height) as usize];
@@ -123,7 +126,7 @@ fn main() {
     };
     let n = f64::from(spp);
     println!(
-        "Whitted view 64 x 36, bounces 8, {spp} spp, seed {SEED}: (b) MNEE K = 1 minus (a) light tracer + gather"
+        "Whitted view 64 x 36, bounces 8, {spp} spp, seed {SEED}: (b) MNEE K = {internal} minus (a) light tracer + gather"
     );
     println!("| region | pixels | mean (a) r / g / b | (b) - (a) red | green | blue |");
     println!("|---|---|---|---|---|---|");

@@ -27,8 +27,8 @@
 //! Roots. g is tabulated (in unit-sphere coordinates, linear in x': z sin f - r cos f + sin theta1)
 //! on `intervals` equal intervals of theta1 over (-pi/2, pi/2). A sign change is refined by
 //! safeguarded Newton; an interval without one is searched for a hidden pair of roots (near a
-//! fold) when both ends are within h max|dg/dtheta1| of zero, h the interval's width (the only
-//! way g can reach zero inside): if g' changes sign there and g heads toward zero, the
+//! fold) when both ends are within 2 h max|dg/dtheta1| of zero, h the interval's width (g cannot
+//! reach zero inside otherwise; the factor 2 covers f' between nodes): if g' changes sign there and g heads toward zero, the
 //! extremum is found by bisection on g' and, if g crosses zero there, both roots are refined.
 //! What this misses needs four roots within one interval (~8e-4 rad for 4096).
 //!
@@ -89,7 +89,7 @@ pub struct ManifoldPath {
 /// g's pieces at the grid's nodes for one chain and index: sin f, cos f, sin theta1, f',
 /// cos theta1 (NaN where the chain does not exist).
 #[derive(Clone, Debug)]
-struct ChainTable {
+pub(crate) struct ChainTable {
     chain: Chain,
     n: f64,
     rows: Vec<[f64; 5]>,
@@ -98,7 +98,7 @@ struct ChainTable {
 }
 
 impl ChainTable {
-    fn new(chain: Chain, n: f64, intervals: usize) -> ChainTable {
+    pub(crate) fn new(chain: Chain, n: f64, intervals: usize) -> ChainTable {
         let rows: Vec<[f64; 5]> = (0..=intervals)
             .map(|i| {
                 let theta1 = node(i, intervals);
@@ -112,9 +112,10 @@ impl ChainTable {
     }
 
     /// Every theta1 with g = 0 for the unit-sphere point `x`, in increasing order.
-    fn roots(&self, x: DVec2, out: &mut Vec<f64>) {
+    pub(crate) fn roots(&self, x: DVec2, out: &mut Vec<f64>) {
         let intervals = self.rows.len() - 1;
-        let near = PI / intervals as f64 * (self.rate_bound * x.length() + 1.0);
+        // Twice the bound on |g(b) - g(a)|: f' between nodes may exceed its largest node value.
+        let near = 2.0 * PI / intervals as f64 * (self.rate_bound * x.length() + 1.0);
         let g = |r: &[f64; 5]| x.y * r[0] - x.x * r[1] + r[2];
         let dg = |r: &[f64; 5]| r[3] * (x.y * r[1] + x.x * r[0]) + r[4];
         let mut ga = g(&self.rows[0]);
