@@ -4,7 +4,7 @@
 //!   (b) camera paths + MNEE (K internal reflections at most, default 1: chains R, TT, TRT;
 //!       unbounded concentration),
 //! and per region the mean of (b) - (a) with its standard error. MNEE leaves out chains with
-//! two or more internal reflections and chains through both balls (sun -> mirror -> glass ->
+//! more than K internal reflections and chains through both balls (sun -> mirror -> glass ->
 //! floor, ...), so the difference should be small and negative, plus the gather's kernel bias.
 //!
 //! MNEE draws no random numbers and the light tracer's and the gather's are keyed apart, so
@@ -12,6 +12,8 @@
 //! sample by sample (MNEE's sum along the path minus caustic frame k at the pixel), and its
 //! standard error comes from those differences (the camera paths' own noise cancels).
 //!
+//! Printed per region: red and green (the floor's checker has no blue albedo, so nothing the
+//! balls send onto it is blue; blue's difference is exactly 0) and red as a percentage.
 //! Regions: the whole image; the glass sphere's shadow (the pixel centre's camera ray hits the
 //! floor where the sun's ray is blocked by the glass sphere); the pixels that see a ball.
 //!
@@ -128,7 +130,7 @@ fn main() {
     println!(
         "Whitted view 64 x 36, bounces 8, {spp} spp, seed {SEED}: (b) MNEE K = {internal} minus (a) light tracer + gather"
     );
-    println!("| region | pixels | mean (a) r / g / b | (b) - (a) red | green | blue |");
+    println!("| region | pixels | mean (a) r / g / b | (b) - (a) red | green | red, % of (a) |");
     println!("|---|---|---|---|---|---|");
     type Region<'a> = (&'a str, &'a dyn Fn(u32, u32) -> bool);
     let regions: [Region; 3] = [
@@ -156,8 +158,16 @@ fn main() {
         let (base, diff, se) =
             (base / count, diff / count, DVec3::new(var.x.sqrt(), var.y.sqrt(), var.z.sqrt()) / count);
         println!(
-            "| {label} | {count} | {:.3} / {:.3} / {:.3} | {:+.4} ± {:.4} | {:+.4} ± {:.4} | {:+.4} ± {:.4} |",
-            base.x, base.y, base.z, diff.x, se.x, diff.y, se.y, diff.z, se.z
+            "| {label} | {count} | {:.3} / {:.3} / {:.3} | {:+.5} ± {:.5} | {:+.5} ± {:.5} | {:+.2} ± {:.2} |",
+            base.x,
+            base.y,
+            base.z,
+            diff.x,
+            se.x,
+            diff.y,
+            se.y,
+            100.0 * diff.x / base.x,
+            100.0 * se.x / base.x
         );
     }
     eprintln!("{:.0} s", start.elapsed().as_secs_f64());

@@ -28,9 +28,10 @@
 //! on `intervals` equal intervals of theta1 over (-pi/2, pi/2). A sign change is refined by
 //! safeguarded Newton; an interval without one is searched for a hidden pair of roots (near a
 //! fold) when both ends are within 2 h max|dg/dtheta1| of zero, h the interval's width (g cannot
-//! reach zero inside otherwise; the factor 2 covers f' between nodes): if g' changes sign there and g heads toward zero, the
-//! extremum is found by bisection on g' and, if g crosses zero there, both roots are refined.
-//! What this misses needs four roots within one interval (~8e-4 rad for 4096).
+//! reach zero inside otherwise; the factor 2 covers f' between nodes): if g' changes sign there
+//! and g heads toward zero, the extremum is found by bisection on g' and, if g crosses zero
+//! there, both roots are refined. What this misses needs three or more roots within one
+//! interval (~8e-4 rad for 4096), which happens only next to a cusp of the caustic.
 //!
 //! Path length: a chain of k events at a diffuse vertex of depth d (continuation rays before
 //! it) counts under `Bounces::Fixed(n)` when d + k + 1 <= n, as the light tracer's L S^k D E.
