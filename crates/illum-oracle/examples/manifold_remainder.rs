@@ -17,7 +17,11 @@
 //! Regions: the whole image; the glass sphere's shadow (the pixel centre's camera ray hits the
 //! floor where the sun's ray is blocked by the glass sphere); the pixels that see a ball.
 //!
-//!     cargo run --release -p illum-oracle --example manifold_remainder [SPP] [K]
+//! With the third argument `glass-only` the metal sphere is removed, which leaves out every
+//! chain through both balls: what remains of the difference is the truncation and the gather's
+//! kernel bias.
+//!
+//!     cargo run --release -p illum-oracle --example manifold_remainder [SPP] [K] [glass-only]
 
 use glam::DVec3;
 use illum_oracle::{ManifoldSettings, Oracle, PinholeCamera};
@@ -73,6 +77,10 @@ fn main() {
     scene.camera.width = 64;
     scene.camera.height = 36;
     scene.pathtrace.caustics = true;
+    let glass_only = args.next().is_some_and(|a| a == "glass-only");
+    if glass_only {
+        scene.objects.retain(|o| o.name != "metal sphere");
+    }
     illum_oracle::manifold_supported(&scene).expect("MNEE is defined for the Whitted scene");
     let (width, height) = (scene.camera.width, scene.camera.height);
     let complete = Oracle::new(&scene).expect("the oracle renders this scene");
@@ -110,7 +118,7 @@ fn main() {
             _ => None,
         })
     };
-    let balls = [ball("glass sphere").expect("glass sphere"), ball("metal sphere").expect("metal sphere")];
+    let balls: Vec<(DVec3, f64)> = ["glass sphere", "metal sphere"].into_iter().filter_map(ball).collect();
     let to_sun = -scene.directional_light.expect("a sun").direction.as_dvec3().normalize();
     let first_ball =
         |d: DVec3| balls.iter().filter_map(|&b| hit_ball(camera.eye, d, b)).fold(f64::INFINITY, f64::min);
@@ -128,7 +136,8 @@ fn main() {
     };
     let n = f64::from(spp);
     println!(
-        "Whitted view 64 x 36, bounces 8, {spp} spp, seed {SEED}: (b) MNEE K = {internal} minus (a) light tracer + gather"
+        "Whitted view 64 x 36, bounces 8, {spp} spp, seed {SEED}: (b) MNEE K = {internal} minus (a) light tracer + gather{}",
+        if glass_only { ", metal sphere removed" } else { "" }
     );
     println!("| region | pixels | mean (a) r / g / b | (b) - (a) red | green | red, % of (a) |");
     println!("|---|---|---|---|---|---|");
