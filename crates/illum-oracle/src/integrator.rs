@@ -46,7 +46,7 @@ const EMITTER_TIE: f64 = 1e-9;
 pub(crate) const SPAWN_OFFSET: f64 = 1e-9;
 /// Shadow rays end this fraction short of the light point, so the light's own plane (and a
 /// surface coplanar with it) does not shadow it.
-const SHADOW_SHORTEN: f64 = 1e-8;
+pub(crate) const SHADOW_SHORTEN: f64 = 1e-8;
 /// Continuation rays taken without Russian roulette in unbounded mode.
 pub(crate) const ROULETTE_AFTER: u32 = 3;
 pub(crate) const ROULETTE_MAX_SURVIVAL: f64 = 0.95;
@@ -123,6 +123,8 @@ pub struct Oracle {
     pub(crate) caustic: Option<ParticleSource>,
     /// Whether the caustic's frames add the photon gather (`gather.rs`; with a delta sun only).
     pub(crate) gather: bool,
+    /// Manifold next-event estimation through one sphere (`manifold.rs`), when on.
+    pub(crate) manifold: Option<crate::manifold::Manifold>,
 }
 
 impl Oracle {
@@ -136,15 +138,16 @@ impl Oracle {
             sampling: scene.pathtrace.sampling,
             caustic: None,
             gather: true,
+            manifold: None,
         };
         Ok(oracle.with_caustics(scene.pathtrace.caustics))
     }
 
     /// Turns the caustic's light tracer on or off (on has an effect only with a directional
-    /// light and a mirror or dielectric).
+    /// light and a mirror or dielectric, and none while manifold next-event estimation is on).
     pub fn with_caustics(mut self, on: bool) -> Oracle {
         self.caustic = None;
-        if on {
+        if on && self.manifold.is_none() {
             self.caustic = ParticleSource::new(&self.scene);
         }
         self
@@ -177,7 +180,7 @@ impl Oracle {
     }
 
     /// True when a non-emitting surface crosses o + t d for some t in (0, t_max).
-    fn blocked(&self, o: DVec3, d: DVec3, t_max: f64) -> bool {
+    pub(crate) fn blocked(&self, o: DVec3, d: DVec3, t_max: f64) -> bool {
         self.scene.surfaces.iter().any(|p| p.surface.intersect(o, d, t_max).is_some())
     }
 
@@ -328,11 +331,12 @@ impl Oracle {
                 MaterialKind::Lambertian { .. } | MaterialKind::Checker(_) => {
                     let albedo = hit.diffuse_albedo(x);
                     let x_off = x + n * lift;
-                    sum += throughput
-                        * albedo
-                        * FRAC_1_PI
-                        * (self.light_sample(x_off, n, shading, rng)
-                            + self.sun_sample(x_off, n, shading, rng));
+                    let mut incident =
+                        self.light_sample(x_off, n, shading, rng) + self.sun_sample(x_off, n, shading, rng);
+                    if self.manifold.is_some() {
+                        incident += self.manifold_irradiance(x_off, n, shading, taken);
+                    }
+                    sum += throughput * albedo * FRAC_1_PI * incident;
                     if !self.may_continue(taken)
                         || !self.roulette(taken, throughput * albedo, &mut throughput, rng)
                     {

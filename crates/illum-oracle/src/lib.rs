@@ -21,7 +21,9 @@
 //!   only); a constant environment seen by every escaping ray (no next-event estimation, so no
 //!   double counting). Light that a delta light sends through glass onto a diffuse surface
 //!   (the caustic, paths L S+ D E) is found by a second estimator with `caustics = true`:
-//!   light tracing from the sun, paired sample by sample with the camera paths (`caustic.rs`);
+//!   light tracing from the sun, paired sample by sample with the camera paths (`caustic.rs`),
+//!   or instead, with `Oracle::with_manifold`, by manifold next-event estimation through one
+//!   sphere, exact and without random numbers (`manifold.rs`; docs/caustics-manifold.md);
 //! - next-event estimation at every diffuse hit with a point uniform on the union of the lights
 //!   by area; `Bounces::Fixed(n)` continuation rays (specular ones count) or unbounded with
 //!   Russian roulette; cosine or uniform hemisphere sampling (`Sampling`).
@@ -50,6 +52,13 @@ pub mod gather;
 pub mod geometry;
 pub mod glint;
 mod integrator;
+pub mod manifold;
+pub mod manifold_chain;
+#[cfg(test)]
+mod manifold_flux;
+#[cfg(test)]
+mod manifold_roots;
+mod manifold_support;
 pub mod optics;
 mod parallel;
 mod particle_source;
@@ -62,6 +71,9 @@ pub mod whitted_agreement;
 
 pub use camera::PinholeCamera;
 pub use integrator::Oracle;
+pub use manifold::{ManifoldPath, ManifoldSettings};
+pub use manifold_chain::Chain;
+pub use manifold_support::manifold_supported;
 pub use render::{OracleImage, PixelEstimate};
 pub use rng::Rng;
 pub use whitted::WhittedOracle;
