@@ -81,7 +81,7 @@ fn main() {
     if glass_only {
         scene.objects.retain(|o| o.name != "metal sphere");
     }
-    illum_oracle::manifold_supported(&scene).expect("MNEE is defined for the Whitted scene");
+    illum_scene::specular_spheres::solvable_spheres(&scene).expect("MNEE is defined for the Whitted scene");
     let (width, height) = (scene.camera.width, scene.camera.height);
     let complete = Oracle::new(&scene).expect("the oracle renders this scene");
     assert!(complete.caustics() && complete.gathers());

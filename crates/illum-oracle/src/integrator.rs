@@ -32,6 +32,7 @@ use illum_scene::{Bounces, MaterialKind, Sampling, Scene};
 
 use crate::camera::PinholeCamera;
 use crate::geometry::Surface;
+use crate::manifold::ManifoldSettings;
 use crate::optics::{dielectric_normal, mirror_normal, reflect, scatter_dielectric};
 use crate::particle_source::ParticleSource;
 use crate::rng::Rng;
@@ -140,7 +141,19 @@ impl Oracle {
             gather: true,
             manifold: None,
         };
-        Ok(oracle.with_caustics(scene.pathtrace.caustics))
+        let oracle = oracle.with_caustics(scene.pathtrace.caustics);
+        // `caustic_method = "manifold"`, where the scene can take it (illum-scene's rule, which
+        // the GPU path tracer's estimators follow too): the solve with the path tracer's bound.
+        let manifold = scene.pathtrace.caustics
+            && scene.pathtrace.caustic_method == illum_scene::CausticMethod::Manifold
+            && illum_scene::specular_spheres::solvable_spheres(scene).is_ok();
+        Ok(oracle.with_manifold(manifold.then(|| ManifoldSettings {
+            max_concentration: Some(f64::from(illum_scene::specular_spheres::MAX_CONCENTRATION)),
+            // The search for hidden pairs finds the roots a coarser grid's sign changes miss,
+            // so the count of intervals sets the time, not which roots are found.
+            intervals: 512,
+            ..ManifoldSettings::default()
+        })))
     }
 
     /// Turns the caustic's light tracer on or off (on has an effect only with a directional

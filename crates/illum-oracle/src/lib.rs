@@ -58,7 +58,6 @@ pub mod manifold_chain;
 mod manifold_flux;
 #[cfg(test)]
 mod manifold_roots;
-mod manifold_support;
 pub mod optics;
 mod parallel;
 mod particle_source;
@@ -73,7 +72,6 @@ pub use camera::PinholeCamera;
 pub use integrator::Oracle;
 pub use manifold::{ManifoldPath, ManifoldSettings};
 pub use manifold_chain::Chain;
-pub use manifold_support::manifold_supported;
 pub use render::{OracleImage, PixelEstimate};
 pub use rng::Rng;
 pub use whitted::WhittedOracle;

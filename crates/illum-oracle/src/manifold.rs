@@ -22,7 +22,7 @@
 //!
 //! Visibility. The sun's segment from the first hit p1 toward the light and the segment from x
 //! to the exit point must be unblocked; the chain's inside is not tested, which is why the
-//! estimator is defined only for spheres no other object enters (`manifold_supported`).
+//! estimator is defined only for spheres no other object enters (illum-scene's `specular_spheres::solvable_spheres`, the rule the path tracer also asks).
 //!
 //! Roots. g is tabulated (in unit-sphere coordinates, linear in x': z sin f - r cos f + sin theta1)
 //! on `intervals` equal intervals of theta1 over (-pi/2, pi/2). A sign change is refined by
@@ -247,7 +247,7 @@ impl Oracle {
     /// and photon gather are off (while MNEE is on, `with_caustics` has no effect): MNEE owns
     /// L S+ D (S|D)* E for chains inside one sphere; chains through two or more objects are not
     /// counted. Off does not turn the light tracer back on. The caller checks the scene with
-    /// [`crate::manifold_supported`]: the estimator is wrong where an object enters a sphere.
+    /// [`illum_scene::specular_spheres::solvable_spheres`]: the estimator is wrong where an object enters a sphere.
     pub fn with_manifold(mut self, settings: Option<ManifoldSettings>) -> Oracle {
         self.manifold = None;
         if let Some(settings) = settings {

@@ -21,7 +21,7 @@ fn ball_scene(material: &str) -> Scene {
 }
 
 fn mnee(scene: &Scene, bounces: Bounces, settings: ManifoldSettings) -> Oracle {
-    illum_oracle::manifold_supported(scene).unwrap();
+    illum_scene::specular_spheres::solvable_spheres(scene).unwrap();
     Oracle::new(scene).unwrap().with_bounces(bounces).with_manifold(Some(settings))
 }
 

@@ -25,7 +25,8 @@
 // chain's Fresnel factors or the mirror's tint: the concentration C = b / (|dg/db| r) is the
 // generalised geometry term of Hanika, Droske and Fascione's manifold next-event estimation, in
 // closed form for a sphere. C diverges at a fold of the chain (dg/db = 0) and on the axis
-// (r = 0); it is bounded by MAX_CONCENTRATION, whose bias docs/caustics-manifold.md measures.
+// (r = 0); it is bounded by `max_concentration`, illum-scene's specular_spheres::MAX_CONCENTRATION
+// (the oracle's bound too), whose bias docs/caustics-manifold.md measures.
 //
 // The roots. Every chain of a sphere leaves from the same entry points, and both sides of the
 // axis share them, so one pass over a grid of GRID intervals in a evaluates g for every chain
@@ -51,8 +52,6 @@ const GRID: u32 = 24u;
 const NEWTON_STEPS: u32 = 1u;
 // See "Visibility" above.
 const VISIBLE_LIGHT: f32 = 0.25;
-// The bound on the concentration C (see above).
-const MAX_CONCENTRATION: f32 = 64.0;
 // The segment from x to the chain's exit ends this fraction short of the sphere, which it
 // reaches there: rounding of the exit point is a few units of 2^-24 of the scene's size.
 const EXIT_SHORTEN: f32 = 1.0e-4;
@@ -157,7 +156,10 @@ struct Sphere {
     centre: vec3<f32>,
     radius: f32,
     index: u32,
+    // A mirror's reflectance (unused for glass).
     tint: vec3<f32>,
+    // The bound on the concentration (see above).
+    max_concentration: f32,
 }
 
 // One root of `chain` for b = sin a in [lo, hi] (g changes sign there: g_lo, g_hi) aimed at
@@ -187,7 +189,7 @@ fn root_light(chain: Chain, lo_in: f32, hi_in: f32, g_lo: f32, g_hi: f32, aim: v
     let facing = cos_x > 0.0 && -dot(rx.ng, u3) > 0.0;
     // |dg/db| = |dg/da| / cos a.
     let ca = sqrt(max(1.0 - b * b, 0.0));
-    let concentration = min(b * ca / (abs(miss_slope(e, aim)) * r), MAX_CONCENTRATION);
+    let concentration = min(b * ca / (abs(miss_slope(e, aim)) * r), sphere.max_concentration);
     let light = chain_weight(chain, b, sphere.tint) * params.sun_irradiance.xyz * (concentration * cos_x);
     let bright = max(max(light.x, light.y), light.z);
     let sun = max(max(params.sun_irradiance.x, params.sun_irradiance.y), params.sun_irradiance.z);
@@ -275,7 +277,7 @@ fn sphere_light(sphere: Sphere, n: f32, rx: Receiver, events: i32, u: f32) -> ve
     let z = dot(v, ws);
     let radial = v - z * ws;
     let r = length(radial);
-    // On the axis any radial direction serves: C is then bounded by MAX_CONCENTRATION.
+    // On the axis any radial direction serves: C is then at its bound.
     let across = normalize(cross(ws, select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 0.0, 1.0), abs(ws.x) > 0.5)));
     let e = select(across, radial / r, r > 0.0);
     let near = vec2<f32>(r, z);

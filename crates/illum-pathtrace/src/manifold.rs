@@ -7,6 +7,7 @@ use illum_gpu::shader::ShaderFile;
 use illum_rtcore::literal::{lit, vec3};
 use illum_rtcore::{GpuShape, MaterialCode};
 use illum_scene::Scene;
+use illum_scene::specular_spheres::MAX_CONCENTRATION;
 
 use crate::gpu_scene::GpuScene;
 
@@ -20,7 +21,9 @@ pub fn manifold_spheres_module(scene: &Scene, gpu_scene: &GpuScene) -> ShaderFil
     for (index, object) in gpu_scene.geometry.objects.iter().enumerate() {
         let GpuShape::Sphere { center, radius } = object.shape else { continue };
         let material = &gpu_scene.materials[object.material as usize];
-        let sphere = |tint: String| format!("Sphere({}, {}, {index}u, {tint})", vec3(center), lit(radius));
+        let sphere = |tint: String| {
+            format!("Sphere({}, {}, {index}u, {tint}, {})", vec3(center), lit(radius), lit(MAX_CONCENTRATION))
+        };
         let a = material.a;
         if material.kind == MaterialCode::Mirror.code() {
             let tint = format!("vec3<f32>({}, {}, {})", lit(a[0]), lit(a[1]), lit(a[2]));

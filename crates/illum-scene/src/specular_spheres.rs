@@ -13,6 +13,10 @@ use glam::Vec3;
 
 use crate::{MaterialKind, Quad, Scene, Shape};
 
+/// The bound on the solve's concentration C = b / (|dg/db| r), which diverges at a chain's fold
+/// and on a sphere's axis (docs/caustics-manifold.md, "The bound"): the GPU's and the oracle's.
+pub const MAX_CONCENTRATION: f32 = 64.0;
+
 /// The most specular spheres the solve takes: each adds its chains' root search to every diffuse
 /// vertex of every path.
 pub const MAX_SPHERES: usize = 8;
@@ -131,6 +135,53 @@ mod tests {
         let mut disc = scene.clone();
         disc.directional_light.as_mut().expect("a sun").angular_radius_deg = 0.5;
         assert!(solvable_spheres(&disc).unwrap_err().contains("delta sun"));
+    }
+
+    /// Whitted with `extra` TOML appended (objects and materials).
+    fn whitted_with(extra: &str) -> Scene {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/whitted.toml");
+        let text = std::fs::read_to_string(path).expect("whitted.toml") + extra;
+        Scene::from_toml_str(&text, "whitted+extra.toml").unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// Each kind of intruder is named with the sphere it enters; a box touching from outside
+    /// enters nothing; a mirror box is not a sphere; more than MAX_SPHERES are refused by count.
+    #[test]
+    fn intruders_of_every_kind_and_other_specular_shapes_are_named() {
+        let boxed = "[materials.white]\nalbedo = [0.5, 0.5, 0.5]\n[[objects]]\nname = \"crate\"\nmaterial = \"white\"\n";
+        let cases = [
+            format!("{boxed}box = {{ min = [4.9, 2.0, -4.5], max = [6.0, 3.0, -4.0] }}\n"),
+            format!(
+                "{boxed}box = {{ min = [4.9, 2.0, -4.5], max = [6.0, 3.0, -4.0], rotate_y = 30.0, pivot = [5.45, 2.5, -4.25] }}\n"
+            ),
+            format!("{boxed}sphere = {{ center = [4.2, 4.0, -4.2], radius = 0.5 }}\n"),
+            format!(
+                "{boxed}quad = {{ corner = [3.0, 3.3, -5.0], edge_u = [0.0, 0.0, 2.0], edge_v = [2.0, 0.0, 0.0] }}\n"
+            ),
+        ];
+        for extra in &cases {
+            let refused = solvable_spheres(&whitted_with(extra)).unwrap_err();
+            assert!(refused.contains("\"crate\" enters the specular sphere \"glass sphere\""), "{refused}");
+        }
+        let touching = format!("{boxed}box = {{ min = [5.201, 2.0, -4.5], max = [6.0, 3.0, -4.0] }}\n");
+        assert_eq!(solvable_spheres(&whitted_with(&touching)), Ok(vec![1, 2]));
+        let mirror_box = "[[objects]]\nname = \"mirror box\"\nmaterial = \"metal\"\n\
+            box = { min = [-3.0, 0.0, 2.0], max = [-2.0, 1.0, 3.0] }\n";
+        let refused = solvable_spheres(&whitted_with(mirror_box)).unwrap_err();
+        assert!(refused.contains("\"mirror box\" is a specular box, not a sphere"), "{refused}");
+        let many: String = (0..MAX_SPHERES)
+            .map(|i| {
+                format!(
+                    "[[objects]]\nname = \"ball {i}\"\nmaterial = \"metal\"\nsphere = {{ center = [{}, 0.5, 5.0], radius = 0.4 }}\n",
+                    -20.0 + i as f32
+                )
+            })
+            .collect();
+        let refused = solvable_spheres(&whitted_with(&many)).unwrap_err();
+        assert!(
+            refused.contains(&format!("{} specular spheres, more than the {MAX_SPHERES}", MAX_SPHERES + 2)),
+            "{refused}"
+        );
     }
 
     #[test]

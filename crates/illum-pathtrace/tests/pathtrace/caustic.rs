@@ -122,7 +122,7 @@ fn an_index_1_ball_vanishes_and_the_error_estimate_of_both_estimators_is_honest(
 
 /// The Whitted scene at the oracle tests' size, with the camera on the floor under the glass
 /// ball: the caustic (about (2.2, 0, -3.8), the glass ball's shadow) and the mirror ball's.
-fn caustic_view(bounces: u32) -> Scene {
+pub(crate) fn caustic_view(bounces: u32) -> Scene {
     let mut s = shipped("whitted", bounces);
     assert!(s.pathtrace.caustics, "scenes/whitted.toml turns the caustic on");
     s.camera.eye = glam::Vec3::new(2.2, 6.0, -7.5);
@@ -141,7 +141,7 @@ fn the_caustic_agrees_with_the_oracle_at_bounces_3_and_8() {
 /// The mirror ball from the side of the glass ball's caustic: its lower half reflects the
 /// caustic, paths E S+ D S+ L that only the photon gather finds with the delta sun
 /// (docs/caustics-gather.md).
-fn mirror_view() -> Scene {
+pub(crate) fn mirror_view() -> Scene {
     let mut s = shipped("whitted", 8);
     s.camera.eye = glam::Vec3::new(2.6, 2.4, -7.0);
     s.camera.target = glam::Vec3::new(2.0, 1.9, -2.5);
@@ -184,7 +184,7 @@ fn the_caustic_seen_in_the_mirror_agrees_with_the_oracle() {
 /// off the ball) that only the gather at a diffuse vertex after the camera ray's own hit owns
 /// with the delta sun. The ball's focus lies 1.5 radii beyond its centre, 0.7 units before the
 /// wall, so the wall's caustic is a bright spot a little wider than the ball's focus.
-fn wall_view() -> Scene {
+pub(crate) fn wall_view() -> Scene {
     let text = "[camera]\neye = [1.6, 3.5, 3.0]\ntarget = [0.3, 0.3, 0.0]\nup = [0.0, 1.0, 0.0]\nvfov = 35.0\n\
                 width = 24\nheight = 24\n[pathtrace]\nbounces = 8\ncaustics = true\nseed = 17\nspp = 4096\n\
                 [directional_light]\ndirection = [-1.0, -0.18, 0.0]\nirradiance = [3.0, 3.0, 3.0]\n\

@@ -39,6 +39,7 @@ mod error_estimate;
 mod extremes;
 mod furnace;
 mod glint;
+mod manifold;
 mod meshes;
 mod oracle_agreement;
 mod overflow;
