@@ -3,12 +3,14 @@
 //! caustic's estimators off and on, the runs alternated, and each row is a median over the runs
 //! of the part's seconds per spp, beside the same figure of the camera paths alone (estimators
 //! off) on the same clock: GPU rows against the camera paths' GPU time, host and wall rows
-//! against their wall time.
+//! against their wall time. Where the scene allows it, a third configuration renders with
+//! manifold next-event estimation instead of the light tracer (`caustic_method = "manifold"`).
 
 use illum::gpu::GpuContext;
 use illum::image::median;
+use illum::pathtrace::Estimators;
 use illum::pathtrace::{CausticParts, PathTracer};
-use illum::scene::Scene;
+use illum::scene::{CausticMethod, Scene};
 
 /// What one render measured, its times in seconds.
 struct Run {
@@ -36,6 +38,14 @@ fn render(gpu: &GpuContext, scene: &Scene, spp: u32) -> anyhow::Result<Run> {
     })
 }
 
+/// `scene` with its caustic on, found by `method`.
+fn caustic_scene(scene: &Scene, method: CausticMethod) -> Scene {
+    let mut on = scene.clone();
+    on.pathtrace.caustics = true;
+    on.pathtrace.caustic_method = method;
+    on
+}
+
 /// The median over `runs` of `f`.
 fn med(runs: &[Run], f: impl Fn(&Run) -> f64) -> f64 {
     median(&mut runs.iter().map(f).collect::<Vec<_>>())
@@ -44,16 +54,22 @@ fn med(runs: &[Run], f: impl Fn(&Run) -> f64) -> f64 {
 /// Prints the parts' table of `scene` at each (width, height, spp), `runs` times each.
 pub fn bench_parts(gpu: &GpuContext, scene: &Scene, runs: u32, load: &str) -> anyhow::Result<()> {
     println!("the parts of a path-traced render of {} with its caustic estimators on{load}\n", scene.name);
+    let solves = Estimators::of(&caustic_scene(scene, CausticMethod::Manifold)).manifold();
+    let configurations =
+        if solves { "caustics off, light tracer and manifold" } else { "caustics off and on" };
     for (width, height, spp) in [(320, 180, 64), (1280, 720, 16)] {
         let mut off_scene = scene.clone();
         (off_scene.camera.width, off_scene.camera.height) = (width, height);
         off_scene.pathtrace.caustics = false;
-        let mut on_scene = off_scene.clone();
-        on_scene.pathtrace.caustics = true;
-        let (mut off, mut on) = (Vec::new(), Vec::new());
+        let on_scene = caustic_scene(&off_scene, CausticMethod::LightTracer);
+        let solved_scene = caustic_scene(&off_scene, CausticMethod::Manifold);
+        let (mut off, mut on, mut solved) = (Vec::new(), Vec::new(), Vec::new());
         for _ in 0..runs {
             off.push(render(gpu, &off_scene, spp)?);
             on.push(render(gpu, &on_scene, spp)?);
+            if solves {
+                solved.push(render(gpu, &solved_scene, spp)?);
+            }
         }
         let n = f64::from(spp);
         let (camera_wall, camera_gpu) = (med(&off, |r| r.wall) / n, med(&off, |r| r.camera_gpu) / n);
@@ -74,7 +90,7 @@ pub fn bench_parts(gpu: &GpuContext, scene: &Scene, runs: u32, load: &str) -> an
             let ms = if seconds.is_finite() { format!("{:.3}", seconds * 1e3) } else { "-".into() };
             println!("| {part} | {clock} | {ms} | {ratio} |");
         };
-        println!("{width} x {height}, {spp} spp, median of {runs} runs (caustics off and on alternated):\n");
+        println!("{width} x {height}, {spp} spp, median of {runs} runs ({configurations} alternated):\n");
         println!("| part | clock | ms per spp | x the camera paths alone |");
         println!("|---|---|---|---|");
         row("camera paths alone (caustics off)", "GPU", camera_gpu, camera_gpu);
@@ -90,6 +106,17 @@ pub fn bench_parts(gpu: &GpuContext, scene: &Scene, runs: u32, load: &str) -> an
         row("fold of the light tracer's frames", "host", fold, camera_wall);
         row("the light tracer's readback and waits", "wall", rest, camera_wall);
         row("whole render, caustics on", "wall", med(&on, |r| r.wall) / n, camera_wall);
+        if solves {
+            // Manifold next-event estimation replaces the light tracer and the gather: its time is
+            // the camera paths' own (docs/caustics-manifold.md).
+            row(
+                "camera paths with manifold next-event estimation",
+                "GPU",
+                med(&solved, |r| r.camera_gpu) / n,
+                camera_gpu,
+            );
+            row("whole render, caustic method manifold", "wall", med(&solved, |r| r.wall) / n, camera_wall);
+        }
         let setup = med(&on, |r| r.setup) - med(&off, |r| r.setup);
         println!(
             "\nset-up before the first sample with the estimators on (the glint's solve, the light tracer's \
