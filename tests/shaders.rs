@@ -3,7 +3,8 @@
 //! - illum-rtcore (`shaders.rs`): spawning, geometry, material record, optics, camera;
 //! - illum-pathtrace (`shaders.rs`): the sampling modules, the scene module, the generic
 //!   material lookup, traversal and light choice (the specialised ones generated), the surfaces
-//!   module, the integrator, the caustic's light tracer and photon gather with their shared buffers, the
+//!   module, the integrator, manifold next-event estimation, the caustic's light tracer and
+//!   photon gather with their shared buffers, the
 //!   guide buffers and the display-sum
 //!   pass, for every scene file;
 //! - illum-denoise (`atrous.rs`): the à-trous filter;
@@ -41,6 +42,7 @@ fn every_wgsl_file_is_validated_by_its_crate() {
             &CAUSTIC_SHADER,
             &pathtrace::CAUSTIC_BUFFERS_MODULE,
             &pathtrace::CAUSTIC_WALK_MODULE,
+            &pathtrace::MANIFOLD_MODULE,
             &pathtrace::GATHER_SHADER,
             &pathtrace::GUIDES_SHADER,
             &pathtrace::DISPLAY_SUM_SHADER,

@@ -41,6 +41,7 @@
 // All roots at one vertex use the same uniform number, one dimension drawn per diffuse vertex.
 
 #import illum::rtcore::optics::fresnel
+#import illum::rtcore::spawn::{spawn_error, max_abs}
 #import illum::rtcore::traversal::occluded
 #import illum::pathtrace::scene::params
 
@@ -52,8 +53,8 @@ const GRID: u32 = 24u;
 const NEWTON_STEPS: u32 = 1u;
 // See "Visibility" above.
 const VISIBLE_LIGHT: f32 = 0.25;
-// The segment from x to the chain's exit ends this fraction short of the sphere, which it
-// reaches there: rounding of the exit point is a few units of 2^-24 of the scene's size.
+// The segment from x to the chain's exit ends at least this fraction short of the sphere, which
+// it reaches there (see root_light for the exit point's own error).
 const EXIT_SHORTEN: f32 = 1.0e-4;
 const HALF_PI: f32 = 1.57079632679489661923;
 
@@ -200,7 +201,10 @@ fn root_light(chain: Chain, lo_in: f32, hi_in: f32, g_lo: f32, g_hi: f32, aim: v
     let q3 = sphere.centre + sphere.radius * (e.q.x * e3 + e.q.y * ws);
     let segment = q3 - rx.origin;
     let length_to_exit = length(segment);
-    if (occluded(rx.origin, segment / length_to_exit, length_to_exit * (1.0 - EXIT_SHORTEN), rx.own)) {
+    // Short of the sphere by the larger of the segment's rounding and the exit point's own error
+    // bound, which grows with its distance from the origin (a scene at 1e4 rounds it by ~1e-3).
+    let short = max(length_to_exit * EXIT_SHORTEN, spawn_error(max_abs(q3)));
+    if (occluded(rx.origin, segment / length_to_exit, length_to_exit - short, rx.own)) {
         return vec3<f32>(0.0);
     }
     let p1 = sphere.centre + sphere.radius * (b * e3 - ca * ws);

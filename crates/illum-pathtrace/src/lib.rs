@@ -44,6 +44,7 @@ pub use error::PathTraceError;
 pub use estimators::{Estimator, Estimators};
 pub use gpu_scene::implements;
 pub use illum_scene::Sequence;
+pub use manifold::MANIFOLD_MODULE;
 pub use options::{TracerOptions, Traversal};
 pub use progressive::{
     Progress, Progressive, RenderClock, Rule, Status, StopReason, StopRules, parse_target_error,

@@ -5,7 +5,9 @@
 //!
 //! The solve follows a chain inside a sphere without looking for other objects there, so no
 //! other object may enter a specular sphere (touching is allowed). It needs a delta sun, and
-//! every mirror or dielectric must be a sphere. Its cost grows with the number of specular
+//! every mirror or dielectric must be a sphere, a dielectric of index at least 1 (inside a
+//! sphere every internal angle equals the refraction angle, below the critical angle, so no
+//! chain meets total internal reflection; below 1 the entry itself can). Its cost grows with the number of specular
 //! spheres at every diffuse vertex, so past [`MAX_SPHERES`] the light tracer is the cheaper
 //! estimator.
 
@@ -35,6 +37,15 @@ pub fn solvable_spheres(scene: &Scene) -> Result<Vec<usize>, String> {
             scene.material_of(object).kind,
             MaterialKind::Mirror { .. } | MaterialKind::Dielectric { .. }
         );
+        if let MaterialKind::Dielectric { ior } = scene.material_of(object).kind
+            && ior < 1.0
+        {
+            return Err(format!(
+                "object {:?} has index {ior}, below 1: the solve takes dielectrics denser than their \
+                 surroundings (below 1 light meets total internal reflection on entering)",
+                object.name
+            ));
+        }
         match (&object.shape, specular) {
             (Shape::Sphere(_), true) => spheres.push(i),
             (shape, true) => {
@@ -132,6 +143,13 @@ mod tests {
         q.corner.y = 2.0;
         let refused = solvable_spheres(&floor).unwrap_err();
         assert!(refused.contains("\"floor\" enters"), "{refused}");
+        let mut thin = scene.clone();
+        thin.materials.iter_mut().for_each(|m| {
+            if let MaterialKind::Dielectric { ior } = &mut m.kind {
+                *ior = 0.7;
+            }
+        });
+        assert!(solvable_spheres(&thin).unwrap_err().contains("\"glass sphere\" has index 0.7, below 1"));
         let mut disc = scene.clone();
         disc.directional_light.as_mut().expect("a sun").angular_radius_deg = 0.5;
         assert!(solvable_spheres(&disc).unwrap_err().contains("delta sun"));

@@ -16,7 +16,7 @@
 use illum_image::{RgbImage32, load_exr, rel_mse};
 use illum_pathtrace::allocation::plan_adaptive;
 use illum_pathtrace::{PathTracer, Sequence, StopReason, StopRules, TracerOptions, render_progressive};
-use illum_scene::{Bounces, Overrides, Sampling, Scene};
+use illum_scene::{Bounces, CausticMethod, Overrides, Sampling, Scene};
 
 use crate::common;
 
@@ -253,16 +253,27 @@ fn the_low_discrepancy_estimate_is_honest_over_four_seeds() {
     assert!(failures.is_empty(), "estimated / true relative RMS error outside 0.9 to 1.1: {failures:?}");
 }
 
-/// The Whitted scene with every caustic estimator, small enough for a test: its truth, rendered
-/// from sample index 0 with another seed, and that truth's own relMSE (its variance over its
-/// squared mean, the epsilon of `rel_mse`), which a measured error includes and is subtracted.
-pub(crate) fn whitted_truth(width: u32, height: u32, spp: u32) -> (RgbImage32, f64, [(f64, f64); 3]) {
-    let scene = common::scene("whitted", Overrides { seed: Some(9001), ..common::small(width, height, spp) });
+/// The Whitted scene at `width` x `height`, `spp`, its caustic found by `method`.
+fn whitted(method: CausticMethod, overrides: Overrides) -> Scene {
+    let mut scene = common::scene("whitted", overrides);
+    scene.pathtrace.caustic_method = method;
+    scene
+}
+
+/// The Whitted scene with every caustic estimator of `method`, small enough for a test: its
+/// truth, rendered from sample index 0 with another seed, and that truth's own relMSE (its
+/// variance over its squared mean, the epsilon of `rel_mse`), which a measured error includes
+/// and is subtracted.
+fn whitted_truth(
+    method: CausticMethod,
+    width: u32,
+    height: u32,
+    spp: u32,
+) -> (RgbImage32, f64, [(f64, f64); 3]) {
+    let scene = whitted(method, Overrides { seed: Some(9001), ..common::small(width, height, spp) });
     let mut tracer = PathTracer::new(common::gpu(), &scene).expect("builds");
-    assert!(
-        tracer.caustics() && tracer.caustic_params().is_some_and(|p| p.gather_radius > 0.0),
-        "the gather runs"
-    );
+    let gathers = tracer.caustics() && tracer.caustic_params().is_some_and(|p| p.gather_radius > 0.0);
+    assert_eq!(gathers, method == CausticMethod::LightTracer, "the gather runs with the light tracer only");
     tracer.add_samples_in_one_pass(spp).expect("renders");
     let acc = tracer.accumulator();
     let (mean, variance) = (acc.mean_image(), acc.variance_image());
@@ -294,11 +305,22 @@ pub(crate) fn whitted_truth(width: u32, height: u32, spp: u32) -> (RgbImage32, f
 /// probability 6e-4).
 #[test]
 fn a_whitted_part_is_honest_about_its_error_wherever_its_range_starts() {
+    parts_are_honest(CausticMethod::LightTracer);
+}
+
+/// The same with manifold next-event estimation, which has no radius rule: its solve is the same
+/// at every sample index, so its parts' estimates are the camera paths' own.
+#[test]
+fn a_whitted_part_with_the_solved_caustic_is_honest_wherever_its_range_starts() {
+    parts_are_honest(CausticMethod::Manifold);
+}
+
+fn parts_are_honest(method: CausticMethod) {
     let (width, height) = (96, 54);
-    let (truth, truth_noise, truth_means) = whitted_truth(width, height, 1024);
+    let (truth, truth_noise, truth_means) = whitted_truth(method, width, height, 1024);
     let mut failures = Vec::new();
     for start in [0u32, 1 << 20, 1 << 31] {
-        let scene = common::scene("whitted", common::small(width, height, 16));
+        let scene = whitted(method, common::small(width, height, 16));
         let mut tracer = PathTracer::new(common::gpu(), &scene).expect("builds");
         tracer.set_sample_offset(start);
         tracer.add_samples_in_one_pass(16).expect("renders");
