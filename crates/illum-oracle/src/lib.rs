@@ -56,6 +56,7 @@ pub mod manifold;
 pub mod manifold_chain;
 #[cfg(test)]
 mod manifold_flux;
+mod manifold_oracle;
 #[cfg(test)]
 mod manifold_roots;
 pub mod optics;

@@ -42,9 +42,9 @@ use glam::{DVec2, DVec3};
 use illum_scene::{Bounces, MaterialKind};
 
 use crate::geometry::Surface;
-use crate::integrator::{Oracle, SHADOW_SHORTEN, SPAWN_OFFSET};
 use crate::manifold_chain::Chain;
 use crate::sampling::local_to_world;
+use crate::scene::{Primitive, Sun};
 
 /// What MNEE adds: which chains, the bound on the concentration and the root grid.
 #[derive(Clone, Debug, PartialEq)]
@@ -211,11 +211,18 @@ pub(crate) struct Manifold {
     spheres: Vec<SpecularSphere>,
 }
 
+/// The oracle's shadow-ray offsets (integrator.rs): how far a ray starts off its surface, relative
+/// to the point's magnitude, and the fraction a segment to a surface ends short of it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Offsets {
+    pub spawn: f64,
+    pub shorten: f64,
+}
+
 impl Manifold {
-    fn new(oracle: &Oracle, settings: ManifoldSettings) -> Manifold {
-        let spheres = oracle
-            .scene
-            .surfaces
+    /// MNEE over the specular spheres among `surfaces`.
+    pub(crate) fn new(surfaces: &[Primitive], settings: ManifoldSettings) -> Manifold {
+        let spheres = surfaces
             .iter()
             .filter_map(|p| {
                 let Surface::Ball(ball) = p.surface else { return None };
@@ -241,45 +248,28 @@ impl Manifold {
     }
 }
 
-impl Oracle {
-    /// Turns MNEE on (`Some`) or off. On, every diffuse vertex of a camera path adds
-    /// throughput x albedo / pi x [`Self::manifold_irradiance`], and the caustic's light tracer
-    /// and photon gather are off (while MNEE is on, `with_caustics` has no effect): MNEE owns
-    /// L S+ D (S|D)* E for chains inside one sphere; chains through two or more objects are not
-    /// counted. Off does not turn the light tracer back on. The caller checks the scene with
-    /// [`illum_scene::specular_spheres::solvable_spheres`]: the estimator is wrong where an object enters a sphere.
-    pub fn with_manifold(mut self, settings: Option<ManifoldSettings>) -> Oracle {
-        self.manifold = None;
-        if let Some(settings) = settings {
-            self.caustic = None;
-            self.manifold = Some(Manifold::new(&self, settings));
-        }
-        self
-    }
-
-    /// Whether MNEE is on.
-    pub fn manifold(&self) -> bool {
-        self.manifold.is_some()
-    }
-
-    /// The irradiance-like sum E w C max(n_s.(-u3), 0) over every path MNEE finds at x (already
-    /// offset off its surface), facing normal `normal`, shading normal `shading`, for a
-    /// diffuse vertex of depth `depth` (module documentation). Zero when MNEE is off or the
-    /// sun is not delta.
-    pub fn manifold_irradiance(&self, x: DVec3, normal: DVec3, shading: DVec3, depth: u32) -> DVec3 {
-        self.manifold_paths(x, normal, shading, depth).iter().map(|p| p.irradiance).sum()
-    }
-
-    /// Every path of [`Self::manifold_irradiance`] with a nonzero contribution.
-    pub fn manifold_paths(&self, x: DVec3, normal: DVec3, shading: DVec3, depth: u32) -> Vec<ManifoldPath> {
+impl Manifold {
+    /// Every path MNEE finds at x with a nonzero contribution (see the oracle's
+    /// `manifold_paths`), under `sun` and `bounces`; `blocked(o, d, t_max)` is the oracle's
+    /// shadow test and `offsets` its offsets.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn paths(
+        &self,
+        sun: Sun,
+        bounces: Bounces,
+        offsets: Offsets,
+        blocked: &dyn Fn(DVec3, DVec3, f64) -> bool,
+        (x, normal, shading): (DVec3, DVec3, DVec3),
+        depth: u32,
+    ) -> Vec<ManifoldPath> {
         let mut paths = Vec::new();
-        let (Some(manifold), Some(sun)) = (&self.manifold, self.scene.sun) else { return paths };
         if !sun.is_delta() {
             return paths;
         }
+        let manifold = self;
         let w_s = -sun.to_light;
         let mut roots = Vec::new();
-        for (index, sphere) in manifold.spheres.iter().enumerate() {
+        for (index, sphere) in self.spheres.iter().enumerate() {
             let v = x - sphere.centre;
             let z = v.dot(w_s);
             let rho = v - z * w_s;
@@ -288,7 +278,7 @@ impl Oracle {
             let e = if r_x > 0.0 { rho / r_x } else { local_to_world(w_s, DVec3::X) };
             let unit = DVec2::new(r_x, z) / sphere.radius;
             for table in &sphere.tables {
-                if let Bounces::Fixed(n) = self.bounces
+                if let Bounces::Fixed(n) = bounces
                     && depth + table.chain.events() + 1 > n
                 {
                     continue;
@@ -296,8 +286,9 @@ impl Oracle {
                 roots.clear();
                 table.roots(unit, &mut roots);
                 for &theta1 in &roots {
+                    let at = (x, normal, shading);
                     if let Some(path) =
-                        self.manifold_path(sphere, table, x, normal, shading, (e, unit, theta1))
+                        manifold.path(sun, offsets, blocked, sphere, table, at, (e, unit, theta1))
                     {
                         paths.push(ManifoldPath { sphere: index, ..path });
                     }
@@ -310,17 +301,18 @@ impl Oracle {
     /// The contribution of the root theta1 of `table` at x (plane frame e, unit-sphere point
     /// `unit`), or `None` when it is behind the exit, from behind the surface, blocked or
     /// carries nothing.
-    fn manifold_path(
+    #[allow(clippy::too_many_arguments)]
+    fn path(
         &self,
+        sun: Sun,
+        offsets: Offsets,
+        blocked: &dyn Fn(DVec3, DVec3, f64) -> bool,
         sphere: &SpecularSphere,
         table: &ChainTable,
-        x: DVec3,
-        normal: DVec3,
-        shading: DVec3,
+        (x, normal, shading): (DVec3, DVec3, DVec3),
         (e, unit, theta1): (DVec3, DVec2, f64),
     ) -> Option<ManifoldPath> {
-        let sun = self.scene.sun?;
-        let manifold = self.manifold.as_ref()?;
+        let manifold = self;
         let w_s = -sun.to_light;
         let exit = table.chain.exit(table.n, theta1)?;
         if exit.u.dot(unit - exit.q) <= 0.0 {
@@ -346,14 +338,14 @@ impl Oracle {
         // The sun's segment from the first hit, lifted off the sphere along its normal.
         let n1 = theta1.sin() * e - theta1.cos() * w_s;
         let p1 = sphere.centre + sphere.radius * n1;
-        let lift = SPAWN_OFFSET * p1.abs().max_element().max(1.0);
-        if self.blocked(p1 + lift * n1, sun.to_light, f64::INFINITY) {
+        let lift = offsets.spawn * p1.abs().max_element().max(1.0);
+        if blocked(p1 + lift * n1, sun.to_light, f64::INFINITY) {
             return None;
         }
         // The segment from x to the exit point, ending short of the sphere.
         let q = sphere.centre + sphere.radius * (exit.q.x * e + exit.q.y * w_s);
         let dist = (q - x).length();
-        if self.blocked(x, (q - x) / dist, dist * (1.0 - SHADOW_SHORTEN)) {
+        if blocked(x, (q - x) / dist, dist * (1.0 - offsets.shorten)) {
             return None;
         }
         Some(ManifoldPath {
