@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Writes the generated blocks of the README and the docs from what scripts/readme-figures.sh measured.
 
-    readme-block.py ladder-summary LADDER.csv   README and docs/theory-whitted.md: selected rows of the ladder
+    readme-block.py ladder-summary LADDER.csv   README and docs/theory-whitted.md: selected rows of the ladder;
+                                                docs/performance.md: the caustic estimators' efficiency
     readme-block.py headline DIR                README: the headline figures, from the outputs in DIR
     readme-block.py perf-tables DIR             docs/performance*.md: the bench tables, from DIR
 
@@ -58,6 +59,7 @@ LADDER_ROWS = [
     ("pathtrace", "1 spp, bounces 8, caustic estimator"),
     ("pathtrace", "64 spp, bounces 8, caustic estimator"),
     ("pathtrace", "1024 spp, bounces 8, caustic estimator"),
+    ("pathtrace", "64 spp, bounces 8, manifold NEE"),
     ("pathtrace + à-trous", "16 spp, bounces 8, caustic estimator, à-trous"),
 ]
 LADDER_REGIONS = [
@@ -99,6 +101,37 @@ def ladder_summary(path):
     # The README and the Whitted scene's theory page show the same rows.
     for page in (README, os.path.join(ROOT, "docs", "theory-whitted.md")):
         replace_block("ladder-summary", "\n".join(out), page)
+    caustic_efficiency(rows, truth)
+
+
+# The caustic's estimators side by side at one spp: the efficiency the ladder measured.
+EFFICIENCY_ROWS = [
+    ("without the caustic's estimators", "64 spp, bounces 8"),
+    ("light tracer and photon gather", "64 spp, bounces 8, caustic estimator"),
+    ("manifold NEE", "64 spp, bounces 8, manifold NEE"),
+]
+
+
+def caustic_efficiency(rows, truth):
+    """docs/performance.md: efficiency 1 / (relMSE x seconds) of the path tracer at 64 spp with each
+    of the caustic's estimators, against the ladder's truth (made with the light tracer)."""
+    found = [(name, rows[("pathtrace", settings)]["all"]) for name, settings in EFFICIENCY_ROWS
+             if ("pathtrace", settings) in rows]
+    if len(found) < len(EFFICIENCY_ROWS):
+        return
+    base = float(found[1][1]["efficiency"])
+    out = ["| caustic | wall ms | relMSE | efficiency, 1 / (relMSE x s) | against the light tracer |",
+           "|---|---|---|---|---|"]
+    for name, whole in found:
+        e = float(whole["efficiency"])
+        out.append(f"| {name} | {float(whole['wall_ms']):.0f} | {float(whole['rel_mse']):.3e} | {e:.0f} | "
+                   f"{e / base:.2f}x |")
+    out.append("")
+    out.append(f"*Measured {host()} by the ladder (`cargo run --release --example ladder`, Whitted scene, "
+               f"320 x 180, bounces 8, the median of 3 renders of 64 spp from nothing).{truth} Without the "
+               "caustic's estimators the image is biased (the glass's shadow at half its light): its "
+               "efficiency is not comparable.*")
+    replace_block("caustic-efficiency", "\n".join(out), os.path.join(ROOT, "docs", "performance.md"))
 
 
 def read(directory, name):

@@ -13,7 +13,9 @@
 //! - the Whitted ray tracer at each depth of `--depths` (the first alone in a scene without a
 //!   mirror or glass, where depth changes nothing);
 //! - the path tracer at each spp of `--spp-list` (the scene's bounces), without and (where the
-//!   scene has a caustic: a sun and a mirror or glass) with the caustic estimator, and at each
+//!   scene has a caustic: a sun and a mirror or glass) with the caustic estimator (the light
+//!   tracer) and, where the scene is solvable sphere by sphere, with manifold next-event
+//!   estimation in its place (docs/caustics-manifold.md), and at each
 //!   bounce count of `--bounce-list` with `--bounce-spp` samples (on the Cornell box this is
 //!   the classic "Whitted against path tracing, bounce by bounce");
 //! - the path tracer at each spp of `--denoise-spp-list` followed by the à-trous denoiser, and
@@ -40,7 +42,7 @@
 //! object-ID image (`illum_lab::regions`).
 //!
 //! Outputs in DIR: ladder.csv (one line per row and region: renderer, settings, times, pixels,
-//! relMSE, luminance ratio, FLIP), ladder.md (the tables), error-vs-time.png and
+//! relMSE, luminance ratio, FLIP, efficiency), ladder.md (the tables), error-vs-time.png and
 //! flip-vs-time.png (log-log, one series per renderer), contact-sheet.png (each image beside
 //! its FLIP error map, labelled), regions.png; with `--tessellate`, tessellation-sheet.png (each
 //! tessellation row around the sphere, enlarged, beside FLIP's map of its difference from the
@@ -56,7 +58,8 @@ use std::path::PathBuf;
 use anyhow::{Context, bail};
 use clap::Parser;
 
-use illum::scene::{Bounces, MAX_WHITTED_DEPTH, MaterialKind, Scene};
+use illum::pathtrace::Estimators;
+use illum::scene::{Bounces, CausticMethod, MAX_WHITTED_DEPTH, MaterialKind, Scene};
 use illum::whitted::WhittedTracer;
 use illum_auto::settings::{has_caustic, truth_scene};
 use illum_denoise::{Denoiser, DenoiserKind};
@@ -212,15 +215,27 @@ fn run(args: Args) -> anyhow::Result<()> {
         print_rung(rungs.last().expect("pushed"));
     }
     // Without and with the caustic estimator, where the scene has a caustic (a sun and a mirror
-    // or glass to focus it); the truth has it.
-    let caustic_options: &[bool] = if has_caustic(&scene) { &[false, true] } else { &[false] };
-    for &caustics in caustic_options {
-        let mut variant = scene.clone();
-        variant.pathtrace.caustics = caustics;
-        let series = if caustics { Series::PathTraceCaustics } else { Series::PathTraceSpp };
+    // or glass to focus it; the truth has it), and with the manifold solve in the light
+    // tracer's place where the scene is solvable sphere by sphere.
+    let mut variants = vec![(scene.clone(), Series::PathTraceSpp)];
+    variants[0].0.pathtrace.caustics = false;
+    if has_caustic(&scene) {
+        let mut light_tracer = scene.clone();
+        light_tracer.pathtrace.caustics = true;
+        light_tracer.pathtrace.caustic_method = CausticMethod::LightTracer;
+        let mut manifold = light_tracer.clone();
+        manifold.pathtrace.caustic_method = CausticMethod::Manifold;
+        let solvable = Estimators::of(&manifold).manifold();
+        variants.push((light_tracer, Series::PathTraceCaustics));
+        if solvable {
+            variants.push((manifold, Series::PathTraceManifold));
+        }
+    }
+    for (variant, series) in &variants {
+        let series = *series;
         for &spp in &args.spp_list {
             let setting = (spp, scene.pathtrace.bounces);
-            rungs.push(pathtrace_rung(&gpu, &variant, setting, series, args.frames.min(3))?);
+            rungs.push(pathtrace_rung(&gpu, variant, setting, series, args.frames.min(3))?);
             print_rung(rungs.last().expect("pushed"));
         }
     }

@@ -31,6 +31,12 @@ fn number(x: f64) -> String {
     if x.is_nan() { "n/a".to_owned() } else { format!("{x:.3e}") }
 }
 
+/// Efficiency, 1 / (relMSE x seconds): for an unbiased renderer (relMSE falling as 1/time) the
+/// same at any spp, so settings compare by it; a biased one's falls as its time grows.
+fn efficiency(rel_mse: f64, wall_ms: f64) -> f64 {
+    1.0 / (rel_mse * wall_ms * 1e-3)
+}
+
 fn ratio(x: f64) -> String {
     if x.is_nan() { "n/a".to_owned() } else { format!("{x:.3}") }
 }
@@ -61,6 +67,7 @@ pub(crate) fn write_outputs(
                 format!("{:e}", e.rel_mse),
                 format!("{}", e.luminance_ratio),
                 format!("{}", e.flip),
+                format!("{:e}", efficiency(e.rel_mse, r.wall_ms)),
             ]);
         }
     }
@@ -74,6 +81,7 @@ pub(crate) fn write_outputs(
         "rel_mse",
         "luminance_ratio",
         "flip",
+        "efficiency",
     ];
     write_text(&out.join("ladder.csv"), &csv_text(&csv_header, &lines)?)?;
 
@@ -95,6 +103,7 @@ pub(crate) fn write_outputs(
          truth, overall and per region. Made by `{}`.\n\n\
          Scene `{}` at {}x{}, {} on {}. Truth: path traced, {} spp, bounces {}, its own estimated relMSE {}. \
          Times are medians over frames; errors are against the truth (relMSE with epsilon 0.01; \
+         efficiency = 1 / (relMSE x wall seconds), the same at any spp for an unbiased renderer; \
          luminance ratio = mean luminance / the truth's; FLIP = mean LDR-FLIP, sRGB, exposure 0).\n\n",
         s.name,
         command.join(" "),
@@ -117,13 +126,14 @@ pub(crate) fn write_outputs(
                 format!("{:.2}", r.wall_ms),
                 r.gpu_ms.map_or("-".to_owned(), |g| format!("{g:.2}")),
                 number(e.rel_mse),
+                number(efficiency(e.rel_mse, r.wall_ms)),
                 ratio(e.luminance_ratio),
                 ratio(e.flip),
             ]
         })
         .collect();
     md.push_str(&markdown_table(
-        &["renderer", "settings", "wall ms", "GPU ms", "relMSE", "luminance ratio", "FLIP"],
+        &["renderer", "settings", "wall ms", "GPU ms", "relMSE", "efficiency", "luminance ratio", "FLIP"],
         &overall,
     ));
     md.push_str(tessellation);
@@ -161,6 +171,7 @@ pub(crate) fn write_outputs(
             ("Whitted ray tracer", Series::Whitted, Style::Markers),
             ("path tracer, more spp", Series::PathTraceSpp, Style::Joined),
             ("path tracer + caustic estimator, more spp", Series::PathTraceCaustics, Style::Joined),
+            ("path tracer + manifold NEE, more spp", Series::PathTraceManifold, Style::Joined),
             ("path tracer, more bounces", Series::PathTraceBounces, Style::Joined),
             ("path tracer + à-trous, more spp", Series::PathTraceAtrous, Style::Joined),
             ("path tracer + OIDN, more spp", Series::PathTraceOidn, Style::Joined),

@@ -4,7 +4,7 @@ use std::time::Instant;
 
 use illum::gpu::GpuContext;
 use illum::image::{RgbImage32, median};
-use illum::pathtrace::PathTracer;
+use illum::pathtrace::{Estimators, PathTracer};
 use illum::raster::{Options, RasterRenderer, RasterScene};
 use illum::scene::{Bounces, Effects, Look, Scene};
 use illum::whitted::WhittedTracer;
@@ -20,6 +20,9 @@ pub(crate) enum Series {
     PathTraceSpp,
     /// The same with the caustic estimator (light tracing, `[pathtrace] caustics`).
     PathTraceCaustics,
+    /// The same with manifold next-event estimation in the light tracer's place
+    /// (`caustic_method = "manifold"`).
+    PathTraceManifold,
     /// The path tracer at a fixed spp, more bounces each rung.
     PathTraceBounces,
     /// The path tracer at the scene's bounces followed by the à-trous denoiser, more spp each rung.
@@ -79,15 +82,25 @@ pub(crate) fn denoised_rung(
     Ok(Rung {
         renderer,
         series,
-        settings: format!(
-            "{spp} spp, bounces {}{}, {name}",
-            scene.pathtrace.bounces,
-            if scene.pathtrace.caustics { ", caustic estimator" } else { "" }
-        ),
+        settings: format!("{spp} spp, bounces {}{}, {name}", scene.pathtrace.bounces, caustic_label(&scene)),
         wall_ms: median(&mut ms),
         gpu_ms: None,
         image: image.expect("at least one run"),
     })
+}
+
+/// What a row's settings say of the caustic's estimators (`Estimators::of`, the rule every
+/// renderer follows): nothing without them, "caustic estimator" for the light tracer and its
+/// gather, "manifold NEE" for the solve.
+fn caustic_label(scene: &Scene) -> &'static str {
+    let estimators = Estimators::of(scene);
+    if estimators.manifold() {
+        ", manifold NEE"
+    } else if estimators.light_tracer() {
+        ", caustic estimator"
+    } else {
+        ""
+    }
 }
 
 pub(crate) fn print_rung(r: &Rung) {
@@ -181,10 +194,7 @@ impl PathTraceRow {
         scene.pathtrace.spp = spp;
         let mut tracer = PathTracer::new(gpu, &scene)?;
         tracer.render_to_spp(1)?; // warm-up: the pipeline and buffers
-        let settings = format!(
-            "{spp} spp, bounces {bounces}{}",
-            if scene.pathtrace.caustics { ", caustic estimator" } else { "" }
-        );
+        let settings = format!("{spp} spp, bounces {bounces}{}", caustic_label(&scene));
         Ok(PathTraceRow { tracer, spp, settings, ms: Vec::new() })
     }
 
