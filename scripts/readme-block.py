@@ -178,7 +178,8 @@ def headline(directory):
                      f"while the window repaints at {statistics.median(fps):.1f} fps.")
     # Mitsuba 3 (bench/vs_mitsuba.py), when installed.
     mitsuba = read(directory, "vs-mitsuba.txt")
-    thr = number_after(mitsuba, r"throughput illum / Mitsuba \(fastest sampler\): ([0-9.]+)x")
+    # bench/vs_mitsuba.py names illum's first row: "throughput illum (independent) / Mitsuba ...".
+    thr = number_after(mitsuba, r"throughput illum(?: \([a-z -]+\))? / Mitsuba \(fastest sampler\): ([0-9.]+)x")
     eff = number_after(mitsuba, r"efficiency illum / Mitsuba \(best of each\): ([0-9.]+)x")
     mitsuba8 = read(directory, "vs-mitsuba-b8.txt")
     eff8 = number_after(mitsuba8, r"efficiency illum / Mitsuba \(best of each\): ([0-9.]+)x")
@@ -232,6 +233,15 @@ def perf_tables(directory):
         ("vs-mitsuba-meshes.txt", "mitsuba-meshes", "performance-geometry.md", False),
         ("bench-largest-mesh.txt", "largest-mesh", "performance-geometry.md", True),
     ]
+    # bench/vs_mitsuba.py's tables, from the first table's heading line on (before it: Mitsuba's
+    # own log lines); a run without Mitsuba has none and leaves the last measured blocks.
+    for name, block in [("vs-mitsuba.txt", "mitsuba-b2"), ("vs-mitsuba-b8.txt", "mitsuba-b8")]:
+        text = read(directory, name)
+        table = re.search(r"^\d+ x \d+, \d+ spp, bounces .*", text, re.M | re.S)
+        if table:
+            heading, rest = table.group(0).strip().split("\n", 1)
+            text = f"{heading}\n\n{rest}\n\n{measured}"
+            replace_block(block, text, os.path.join(docs, "performance.md"))
     for name, block, page, preformatted in blocks:
         text = read(directory, name).strip()
         if text:

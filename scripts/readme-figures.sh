@@ -2,7 +2,8 @@
 # Regenerates every picture the README shows and re-measures every number it quotes, from the
 # code as it is now, and writes the numbers into the generated blocks of the README (`headline`,
 # `ladder-summary`) and of docs/performance*.md (`bench-quick`, `viewer-bench`,
-# `viewer-bench-whitted`, `glint-bench`, `raster-bench`, `largest-mesh`),
+# `viewer-bench-whitted`, `caustic-parts`, `caustic-efficiency`, `glint-bench`, `raster-bench`,
+# `largest-mesh`, `mitsuba-meshes`, and with Mitsuba 3 `mitsuba-b2` and `mitsuba-b8`),
 # each with the date and the CPU:
 #
 #     scripts/readme-figures.sh              pictures, the ladder, then the headline figures
