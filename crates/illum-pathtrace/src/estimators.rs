@@ -250,8 +250,7 @@ mod tests {
     use super::*;
 
     fn whitted() -> Scene {
-        Scene::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/whitted.toml")))
-            .expect("whitted.toml")
+        illum_scene::testing::shipped_scene("whitted.toml", 64, 36)
     }
 
     #[test]
