@@ -67,7 +67,7 @@ pub(crate) fn summary(
         scene.pathtrace.bounces,
         scene.pathtrace.sampling,
         tracer.options().sequence,
-        illum_pathtrace::Estimators::of(scene).caustics_label(),
+        illum_pathtrace::Estimators::of(scene).caustics_description(),
         seconds,
         samples_per_second * 1e-6,
         accumulator.dropped_samples(),

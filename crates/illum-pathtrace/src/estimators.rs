@@ -155,6 +155,19 @@ impl Estimators {
         if self.caustics() { "on" } else { "off" }
     }
 
+    /// What a render's summary line says of the caustic: `off`, `on (light tracer)` or
+    /// `on (manifold NEE)`, so that a user who asked for the solve sees whether it ran or fell
+    /// back.
+    pub fn caustics_description(&self) -> &'static str {
+        if self.manifold {
+            "on (manifold NEE)"
+        } else if self.light_tracer {
+            "on (light tracer)"
+        } else {
+            "off"
+        }
+    }
+
     /// The estimators that run, camera paths first.
     pub fn list(&self) -> Vec<Estimator> {
         let mut list = vec![Estimator::CameraPaths];
@@ -259,19 +272,21 @@ mod tests {
         let all = Estimators::of(&scene);
         assert_eq!(all.key(), "estimators.v1 camera-paths light-tracer photon-gather.r2 glint-solve");
         assert_eq!(all.caustics_label(), "on");
+        assert_eq!(all.caustics_description(), "on (light tracer)");
+        let mut solved = scene.clone();
+        solved.pathtrace.caustic_method = CausticMethod::Manifold;
+        assert_eq!(Estimators::of(&solved).caustics_label(), "on");
+        assert_eq!(Estimators::of(&solved).caustics_description(), "on (manifold NEE)");
         let mut off = scene.clone();
         off.pathtrace.caustics = false;
         assert_eq!(Estimators::of(&off).key(), "estimators.v1 camera-paths");
         assert_eq!(Estimators::of(&off).caustics_label(), "off");
+        assert_eq!(Estimators::of(&off).caustics_description(), "off");
         // A sun disc: the camera paths find the gather's and the glint's paths themselves.
         let mut disc = scene.clone();
         disc.directional_light.as_mut().expect("a sun").angular_radius_deg = 1.0;
         assert_eq!(Estimators::of(&disc).list(), [Estimator::CameraPaths, Estimator::LightTracer]);
-        let cornell = Scene::load(std::path::Path::new(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../scenes/cornell.toml"
-        )))
-        .expect("cornell.toml");
+        let cornell = illum_scene::testing::shipped_scene("cornell.toml", 64, 64);
         assert_eq!(Estimators::of(&cornell).list(), [Estimator::CameraPaths]);
     }
 
