@@ -119,7 +119,7 @@ def caustic_efficiency(rows, truth):
              if ("pathtrace", settings) in rows]
     if len(found) < len(EFFICIENCY_ROWS):
         return
-    base = float(found[1][1]["efficiency"])
+    base = float(dict(found)["light tracer and photon gather"]["efficiency"])
     out = ["| caustic | wall ms | relMSE | efficiency, 1 / (relMSE x s) | against the light tracer |",
            "|---|---|---|---|---|"]
     for name, whole in found:
