@@ -15,15 +15,16 @@ the throughput, the relMSE against a converged reference and the efficiency
     cargo build --release --example render
     venv/bin/python bench/vs_mitsuba.py [--size 256] [--spp 1024] [--bounces 2]
         [--samplers independent,multijitter,orthogonal,ldsampler] [--reference-spp 32768]
-        [--reference-renderer mitsuba|illum] [--illum independent,low-discrepancy,adaptive]
+        [--reference-renderer mitsuba|illum] [--illum independent,low-discrepancy,adaptive,no-replicates]
         [--scene scenes/cornell.toml]
 
 (`scripts/readme-figures.sh --mitsuba-venv` makes that venv itself, in out/mitsuba-venv, and
 runs this script at bounces 2 and 8.) Where libLLVM-19 is installed, the script points Dr.Jit
 at it (DRJIT_LIBLLVM_PATH) unless that is already set.
 
-illum renders with independent numbers, the low-discrepancy sequence, and that sequence with
-adaptive sampling (`--adaptive`, the same mean spp).
+illum renders with independent numbers, the low-discrepancy sequence, that sequence with
+adaptive sampling (`--adaptive`, the same mean spp), and that sequence without replicates
+(`--replicates off`: one randomisation, no error estimate, as Mitsuba's samplers give none).
 
 Run it on an idle machine: a parallel build doubles every time. The reference is rendered by
 Mitsuba (`--reference-renderer mitsuba`, the default: its multijitter sampler at --reference-spp,
@@ -265,8 +266,9 @@ def main():
     parser.add_argument("--spp", type=int, default=1024)
     parser.add_argument("--bounces", type=int, default=2)
     parser.add_argument("--samplers", default="independent,multijitter,orthogonal,ldsampler")
-    parser.add_argument("--illum", default="independent,low-discrepancy,adaptive",
-                        help="illum's rows: independent, low-discrepancy, adaptive (the first is timed for throughput)")
+    parser.add_argument("--illum", default="independent,low-discrepancy,adaptive,no-replicates",
+                        help="illum's rows: independent, low-discrepancy, adaptive, no-replicates (the first is "
+                             "timed for throughput)")
     parser.add_argument("--reference-spp", type=int, default=32768)
     parser.add_argument("--reference-renderer", choices=["mitsuba", "illum"], default="mitsuba")
     parser.add_argument("--mitsuba-child", nargs=2, help=argparse.SUPPRESS)
@@ -285,13 +287,16 @@ def main():
 
     rows = []
     # Adaptive sampling (render --adaptive): the same mean spp, spread over the image by a pilot.
-    variants = {"independent": ("independent", ()), "low-discrepancy": ("low-discrepancy", ()),
-                "adaptive": ("low-discrepancy", ("--adaptive",))}
+    # Without replicates (render --replicates off): one randomisation of the sequence, no error
+    # estimate, as Mitsuba's samplers have none.
+    variants = {"independent": ("independent", (), "independent"),
+                "low-discrepancy": ("low-discrepancy", (), "low-discrepancy"),
+                "adaptive": ("low-discrepancy", ("--adaptive",), "low-discrepancy, adaptive"),
+                "no-replicates": ("low-discrepancy", ("--replicates", "off"), "low-discrepancy, no replicates")}
     for name in args.illum.split(","):
         if name not in variants:
             sys.exit(f"--illum {args.illum}: {name!r} is not one of {', '.join(variants)}")
-    for sequence, extra in (variants[name] for name in args.illum.split(",")):
-        label = sequence + "".join(", " + e.lstrip("-") for e in extra)
+    for sequence, extra, label in (variants[name] for name in args.illum.split(",")):
         path = os.path.join(OUT, f"illum-{label.replace(', ', '-')}-{tag}.exr")
         seconds = run_illum(args, path, args.spp, sequence, extra=extra)
         image = load_exr(path)

@@ -168,6 +168,11 @@ def headline(directory):
         lines.append(f"- **Low-discrepancy sequence against independent numbers** (`bench --quick`, Cornell box "
                      f"256 x 256, 256 spp, bounces 2, runs alternated): **{1 / sequence:.2f}x** the time per sample, "
                      "its error estimate from 4 replicates included.")
+    single = number_after(bench, r"low-discrepancy \(one randomisation\) / independent samples/s \(wall\), \d+ pairs: "
+                                 r"median ([0-9.]+)")
+    if single:
+        lines.append(f"- **The same sequence without replicates** (`--replicates off`, same runs): **{1 / single:.2f}x** "
+                     "the time per sample, with no error estimate.")
     # The viewer against render (bench --viewer).
     viewer = read(directory, "bench-viewer.txt")
     ratio = number_after(viewer, r"viewer / render, median of \d+ runs: ([0-9.]+)")

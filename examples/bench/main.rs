@@ -235,9 +235,10 @@ fn run(args: Args) -> anyhow::Result<()> {
     bench_raster(&gpu, args.runs)
 }
 
-/// Samples/s of the low-discrepancy sequence against independent numbers, the runs alternated
-/// (see the module documentation). Prints each sequence's median rates and the median, lowest
-/// and highest of the per-pair ratios.
+/// Samples/s of the low-discrepancy sequence, with its replicates and without
+/// (`TracerOptions::replicates`), against independent numbers, the runs alternated (see the
+/// module documentation). Prints each one's median rates and, for each low-discrepancy row, the
+/// median, lowest and highest of its per-run ratios to independent numbers.
 fn bench_sequences(gpu: &illum::gpu::GpuContext, args: &Args) -> anyhow::Result<()> {
     const SIZE: u32 = 256;
     const SPP: u32 = 256;
@@ -251,42 +252,56 @@ fn bench_sequences(gpu: &illum::gpu::GpuContext, args: &Args) -> anyhow::Result<
     };
     let scene: Scene = illum_cli::load_scene(&args.scene, &settings)?;
     let mut tracers = Vec::new();
-    for sequence in [Sequence::Independent, Sequence::LowDiscrepancy] {
-        let mut tracer =
-            PathTracer::with_options(gpu, &scene, TracerOptions { sequence, ..Default::default() })?;
+    for (sequence, replicates) in
+        [(Sequence::Independent, true), (Sequence::LowDiscrepancy, true), (Sequence::LowDiscrepancy, false)]
+    {
+        let options = TracerOptions { sequence, replicates, ..Default::default() };
+        let mut tracer = PathTracer::with_options(gpu, &scene, options)?;
         // Warm-up, as for the rows above.
         tracer.render_to_spp(16)?;
-        tracers.push((sequence, tracer, Vec::new(), Vec::new()));
+        tracers.push((options, tracer, Vec::new(), Vec::new(), Vec::new()));
     }
     let samples = f64::from(SIZE).powi(2) * f64::from(SPP);
-    let mut ratios = Vec::new();
     for _ in 0..args.runs {
-        let mut rates = [0.0; 2];
-        for (i, (_, tracer, wall, gpu_rate)) in tracers.iter_mut().enumerate() {
+        let mut independent_rate = 0.0;
+        for (options, tracer, wall, gpu_rate, ratios) in tracers.iter_mut() {
             tracer.reset();
             tracer.render_to_spp(SPP)?;
-            rates[i] = samples / tracer.wall_seconds();
-            wall.push(rates[i]);
+            let rate = samples / tracer.wall_seconds();
+            wall.push(rate);
             gpu_rate.push(samples / tracer.gpu_seconds());
+            if options.sequence == Sequence::Independent {
+                independent_rate = rate;
+            } else {
+                ratios.push(rate / independent_rate);
+            }
         }
-        ratios.push(rates[1] / rates[0]);
     }
     println!();
     println!(
         "| sequence ({SIZE}x{SIZE}, {SPP} spp, bounces {BOUNCES}, runs alternated) | Msamples/s (wall) | Msamples/s (GPU) |"
     );
     println!("|---|---|---|");
-    for (sequence, _, wall, gpu_rate) in &mut tracers {
-        println!("| {sequence} | {:.2} | {:.2} |", median(wall) * 1e-6, median(gpu_rate) * 1e-6);
+    for (options, _, wall, gpu_rate, _) in &mut tracers {
+        println!(
+            "| {} | {:.2} | {:.2} |",
+            options.sequence_label(),
+            median(wall) * 1e-6,
+            median(gpu_rate) * 1e-6
+        );
     }
-    let (lowest, highest) = ratios.iter().fold((f64::INFINITY, 0f64), |(lo, hi), &r| (lo.min(r), hi.max(r)));
-    let ratio = median(&mut ratios);
-    println!(
-        "\nlow-discrepancy / independent samples/s (wall), {} pairs: median {ratio:.3} ({lowest:.3} to \
-         {highest:.3}); time per sample {:.3}x",
-        ratios.len(),
-        1.0 / ratio
-    );
+    for (options, _, _, _, ratios) in tracers.iter_mut().filter(|t| !t.4.is_empty()) {
+        let (lowest, highest) =
+            ratios.iter().fold((f64::INFINITY, 0f64), |(lo, hi), &r| (lo.min(r), hi.max(r)));
+        let ratio = median(ratios);
+        println!(
+            "\n{} / independent samples/s (wall), {} pairs: median {ratio:.3} ({lowest:.3} to {highest:.3}); \
+             time per sample {:.3}x",
+            options.sequence_label(),
+            ratios.len(),
+            1.0 / ratio
+        );
+    }
     Ok(())
 }
 

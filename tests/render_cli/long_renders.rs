@@ -84,6 +84,67 @@ fn a_low_discrepancy_render_keeps_its_replicates_through_resume_and_merge() {
     );
 }
 
+/// One randomisation of the low-discrepancy sequence (`--replicates off`): the summary names it
+/// and says its error is not estimated; resumed from 41 spp without the flag (the file gives
+/// it) its statistics are a straight render's bit for bit, and merged from two ranges within
+/// 1e-12, with no replicates and no estimate in the merged file. Continuing it with replicates,
+/// and every rule that reads the estimate, is refused by name.
+#[test]
+fn one_randomisation_resumes_and_merges_like_one_render_and_claims_no_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).to_str().unwrap().to_owned();
+    let with = |extra: &[&str]| {
+        let mut args = vec!["--sequence", "low-discrepancy", "--replicates", "off"];
+        args.extend(extra);
+        render_ok(&args)
+    };
+    let out = with(&["--spp", "96", "-o", &p("straight.exr")]);
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains("low-discrepancy (one randomisation) samples"), "{stdout}");
+    assert!(
+        stdout.contains("estimated relative error none (low-discrepancy without replicates)"),
+        "{stdout}"
+    );
+    with(&["--spp", "41", "-o", &p("resumed.exr")]);
+    render_ok(&["--resume", &p("resumed.exr"), "--spp", "96"]);
+    assert!(
+        statistics_bits(Path::new(&p("resumed.exr"))) == statistics_bits(Path::new(&p("straight.exr"))),
+        "41 spp resumed to 96 differs from a straight 96 spp render"
+    );
+    with(&["--sample-range", "0..48", "-o", &p("a.exr")]);
+    with(&["--sample-range", "48..96", "-o", &p("b.exr")]);
+    let out = merge(&[&p("a.exr"), &p("b.exr"), "-o", &p("merged.exr")]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let difference = max_relative_difference(Path::new(&p("merged.exr")), Path::new(&p("straight.exr")));
+    assert!(difference <= 1e-12, "merged differs from one render by {difference:e} relative");
+    let merged = checkpoint(Path::new(&p("merged.exr"))).accumulator;
+    assert!(merged.replicates().is_none() && !merged.estimates_error());
+    assert!(merged.estimated_rel_mse().is_infinite());
+
+    let out = run(&["--resume", &p("straight.exr"), "--spp", "128", "--replicates", "on"]);
+    assert_refused(&out, "--resume with --replicates on", &["sequence", "(one randomisation)"]);
+    for (flags, expected) in [
+        (&["--sequence", "low-discrepancy", "--replicates", "off"][..], "the default stop rule"),
+        (&["--replicates", "off", "--spp", "8"][..], "the independent sequence has no replicates"),
+        (
+            &["--sequence", "low-discrepancy", "--replicates", "off", "--spp", "8", "--target-error", "0.1"]
+                [..],
+            "--target-error needs one",
+        ),
+        (
+            &["--sequence", "low-discrepancy", "--replicates", "off", "--spp", "8", "--adaptive"][..],
+            "--adaptive needs one",
+        ),
+    ] {
+        let mut args = SMALL.to_vec();
+        args.extend(flags);
+        let never = p("never.png");
+        args.extend(["-o", &never]);
+        assert_refused(&run(&args), &format!("{flags:?}"), &[expected]);
+    }
+    assert!(!Path::new(&p("never.png")).exists());
+}
+
 /// A render whose spp is not a multiple of the chunk (16) ends inside a chunk. Resumed, it goes
 /// on from its last chunk boundary and equals a straight render bit for bit; split into ranges
 /// (each starting on a chunk), merged and resumed, it equals one render within 1e-12.

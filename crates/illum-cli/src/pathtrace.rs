@@ -61,6 +61,7 @@ fn error_scope(args: &RenderArgs, gpu: &illum_gpu::GpuContext, scene: &Scene) ->
 /// A path-traced render checked and ready, before any GPU work.
 struct Prepared {
     scene: Scene,
+    options: TracerOptions,
     rules: StopRules,
     /// The `--resume` file's checkpoint, checked against the scene and the flags.
     resumed: Option<Checkpoint>,
@@ -96,10 +97,15 @@ fn prepare(args: &RenderArgs) -> anyhow::Result<Option<Prepared>> {
         None => None,
     };
     let mut settings = args.settings.clone();
-    let (mut sequence, mut caustics, mut caustic_method) =
-        (args.sequence, args.caustics, args.caustic_method);
+    let (mut sequence, mut replicates, mut caustics, mut caustic_method) =
+        (args.sequence, args.replicates, args.caustics, args.caustic_method);
     if let Some(checkpoint) = &checkpoint {
-        crate::resume::fill_from_checkpoint(checkpoint, &mut settings, &mut sequence, &mut caustics);
+        crate::resume::fill_from_checkpoint(
+            checkpoint,
+            &mut settings,
+            (&mut sequence, &mut replicates),
+            &mut caustics,
+        );
         caustic_method = caustic_method.or_else(|| crate::resume::caustic_method_of(checkpoint));
     }
     let mut scene = crate::load_scene(&args.scene, &settings)?;
@@ -128,10 +134,16 @@ fn prepare(args: &RenderArgs) -> anyhow::Result<Option<Prepared>> {
         );
     }
     check_combinations(args)?;
+    let options = TracerOptions {
+        sequence: scene.pathtrace.sequence,
+        replicates: replicates.unwrap_or(true),
+        ..Default::default()
+    };
     let rules = stop_rules(args, &scene);
+    check_replicates(args, options, &rules)?;
     let resumed = match (&args.resume, checkpoint) {
         (Some(path), Some(checkpoint)) => {
-            Some(crate::resume::check_resume(args, path, checkpoint, &scene, &rules)?)
+            Some(crate::resume::check_resume(args, path, checkpoint, &scene, options, &rules)?)
         }
         _ => None,
     };
@@ -180,7 +192,7 @@ fn prepare(args: &RenderArgs) -> anyhow::Result<Option<Prepared>> {
     if args.checkpoint_seconds.is_some() && !any_exr {
         bail!("--checkpoint-seconds writes the EXR outputs, and no -o file is a .exr");
     }
-    Ok(Some(Prepared { scene, rules, resumed, outputs }))
+    Ok(Some(Prepared { scene, options, rules, resumed, outputs }))
 }
 
 /// Refuses flags that cannot go together (checked before the stop rules are announced: a
@@ -229,6 +241,41 @@ fn check_combinations(args: &RenderArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Refuses `--replicates off` where it cannot go: with independent numbers (which have no
+/// replicates), and with any rule or output that reads the error estimate it leaves out.
+fn check_replicates(args: &RenderArgs, options: TracerOptions, rules: &StopRules) -> anyhow::Result<()> {
+    if args.replicates != Some(false) {
+        return Ok(());
+    }
+    if options.sequence != illum_pathtrace::Sequence::LowDiscrepancy {
+        bail!(
+            "--replicates off: the {} sequence has no replicates (they randomise the low-discrepancy one); \
+             give --sequence low-discrepancy, or leave --replicates out",
+            options.sequence
+        );
+    }
+    let conflicting = crate::given_flags(&[
+        (args.target_error.is_some(), "--target-error"),
+        (args.error_percentile.is_some(), "--error-percentile"),
+        (args.region.is_some(), "--region"),
+        (args.adaptive, "--adaptive"),
+        (args.denoise.is_some(), "--denoise"),
+    ]);
+    if !conflicting.is_empty() {
+        bail!(
+            "--replicates off renders without an error estimate, and {} needs one; leave --replicates out",
+            conflicting.join(" and ")
+        );
+    }
+    if rules.target_error.is_some() {
+        bail!(
+            "--replicates off renders without an error estimate, and the default stop rule stops at an \
+             estimated error: give --spp N (or --sample-range A..B, or --time-budget S)"
+        );
+    }
+    Ok(())
+}
+
 /// The stop rules the flags give; with no stop-rule flag at all, the default rules (said so).
 fn stop_rules(args: &RenderArgs, scene: &Scene) -> StopRules {
     let no_stop_flag = args.settings.spp.is_none()
@@ -260,12 +307,11 @@ pub fn render_pathtrace(
     interrupt: &Interrupt,
     long: LongRender,
 ) -> anyhow::Result<Option<f64>> {
-    let Some(Prepared { scene, rules, resumed, outputs }) = prepare(args)? else {
+    let Some(Prepared { scene, options, rules, resumed, outputs }) = prepare(args)? else {
         return Ok(None);
     };
     long.exit_if_requested("before the render started");
     let gpu = crate::gpu()?;
-    let options = TracerOptions { sequence: scene.pathtrace.sequence, ..Default::default() };
     if let Some(denoiser) = args.denoise {
         interrupt.set_note(&crate::interrupt::note(
             "nothing (a denoised render writes its image once, at the end)",

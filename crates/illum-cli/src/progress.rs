@@ -189,10 +189,7 @@ pub fn describe(progressive: &Progressive, tracer: &PathTracer) -> String {
     let mut text = format!("{spp}  {:.2} Msamples/s", status.samples_per_second() * 1e-6);
     text += &format!(
         "  error {}",
-        illum_pathtrace::progressive::error_text(
-            status.relative_error,
-            tracer.accumulator().spp_for_error_estimate()
-        )
+        illum_pathtrace::progressive::render_error_text(tracer.accumulator(), status.relative_error)
     );
     if let (Some(_), Some(target)) = (status.relative_error, progressive.rules.target_error) {
         text += &format!(" (target {}%)", target * 100.0);

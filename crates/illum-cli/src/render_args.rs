@@ -80,6 +80,13 @@ pub struct RenderArgs {
     /// replicates: see docs/accuracy.md).
     #[arg(long)]
     pub sequence: Option<Sequence>,
+    /// With --sequence low-discrepancy: `on` (default) deals the samples to 4 independently
+    /// randomised replicates, whose spread is the error estimate; `off` renders one
+    /// randomisation, with less error and less time per sample and no error estimate, so it
+    /// needs a fixed sample count (--spp, --sample-range or --time-budget) and no rule that
+    /// reads the estimate (docs/accuracy-estimate.md, "Without replicates").
+    #[arg(long, value_name = "on|off", value_parser = crate::on_off_arg)]
+    pub replicates: Option<bool>,
     /// Path-tracer scenes: the caustic's light tracer `on` or `off` (default: the file's
     /// `[pathtrace] caustics`). It runs only on a scene with a directional light and a mirror
     /// or glass object (docs/caustics.md).
@@ -152,6 +159,7 @@ impl RenderArgs {
             (self.error_percentile.is_some(), "--error-percentile"),
             (self.region.is_some(), "--region"),
             (self.sequence.is_some(), "--sequence"),
+            (self.replicates.is_some(), "--replicates"),
             (self.caustics.is_some(), "--caustics"),
             (self.caustic_method.is_some(), "--caustic-method"),
             (self.resume.is_some(), "--resume"),

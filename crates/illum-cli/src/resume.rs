@@ -17,7 +17,7 @@ use crate::render_args::RenderArgs;
 pub(crate) fn fill_from_checkpoint(
     checkpoint: &Checkpoint,
     settings: &mut SceneArgs,
-    sequence: &mut Option<Sequence>,
+    (sequence, replicates): (&mut Option<Sequence>, &mut Option<bool>),
     caustics: &mut Option<bool>,
 ) {
     let get = |key: &str| checkpoint.metadata.get(key);
@@ -26,7 +26,9 @@ pub(crate) fn fill_from_checkpoint(
     settings.bounces = settings.bounces.or_else(|| get("bounces")?.parse().ok());
     settings.seed = settings.seed.or_else(|| get("seed")?.parse().ok());
     settings.sampling = settings.sampling.or_else(|| get("sampling")?.parse().ok());
-    *sequence = sequence.or_else(|| get("sequence")?.parse().ok());
+    let stored = get("sequence").and_then(TracerOptions::parse_sequence_label);
+    *sequence = sequence.or(stored.map(|(sequence, _)| sequence));
+    *replicates = replicates.or(stored.map(|(_, replicates)| replicates));
     *caustics = caustics.or_else(|| crate::on_off_arg(get("caustics")?).ok());
 }
 
@@ -45,9 +47,9 @@ pub(crate) fn check_resume(
     path: &Path,
     checkpoint: Checkpoint,
     scene: &Scene,
+    options: TracerOptions,
     rules: &StopRules,
 ) -> anyhow::Result<Checkpoint> {
-    let options = TracerOptions { sequence: scene.pathtrace.sequence, ..Default::default() };
     checkpoint.header().check_matches(path, scene, options).map_err(anyhow::Error::msg)?;
     if let Some(range) = &args.sample_range
         && range.start != checkpoint.sample_start

@@ -47,9 +47,9 @@ pub(crate) fn summary(
             None => format!("{} spp", tracer.spp_done()),
         },
     };
-    let error = illum_pathtrace::progressive::error_text(
+    let error = illum_pathtrace::progressive::render_error_text(
+        accumulator,
         Some(accumulator.estimated_relative_error()).filter(|e| e.is_finite()),
-        accumulator.spp_for_error_estimate(),
     );
     format!(
         "{}: {}x{}, {} ({}), bounces {}, {} sampling, {} samples, caustics {}, {:.2} s, {:.2} Msamples/s (wall clock), \
@@ -66,7 +66,7 @@ pub(crate) fn summary(
         },
         scene.pathtrace.bounces,
         scene.pathtrace.sampling,
-        tracer.options().sequence,
+        tracer.options().sequence_label(),
         illum_pathtrace::Estimators::of(scene).caustics_description(),
         seconds,
         samples_per_second * 1e-6,

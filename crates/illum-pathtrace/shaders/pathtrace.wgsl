@@ -397,7 +397,7 @@ fn accumulate(l: vec3<f32>, sums: ptr<function, Sums>) {
     }
 }
 
-#ifdef LOW_DISCREPANCY
+#ifdef REPLICATED
 // a plus b where `take`, else a: adds a finished run's sums to one replicate's without a branch.
 fn add_if(a: Sums, b: Sums, take: bool) -> Sums {
     let c = Sums(a.sum + b.sum, a.sum_sq + b.sum_sq, a.finite + b.finite, a.dropped + b.dropped);
@@ -446,7 +446,7 @@ fn is_finite3(v: vec3<f32>) -> bool {
 // Slot layers per chunk: one, or one per replicate with the low-discrepancy sequence (whose
 // error comes from the spread of its replicates, src/replicates.rs). Mirrored by
 // src/batch.rs's `Layers` (checked there by a test).
-#ifdef LOW_DISCREPANCY
+#ifdef REPLICATED
 const SLOT_LAYERS: u32 = REPLICATES;
 #else
 const SLOT_LAYERS: u32 = 1u;
@@ -479,7 +479,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     // The sums of the samples since the last slot boundary: the whole chunk's, or with
     // replicates the current run's (end_run moves them to their replicate's).
     var sums = no_sums();
-#ifdef LOW_DISCREPANCY
+#ifdef REPLICATED
     var replicates = ReplicateSums(no_sums(), no_sums(), no_sums(), no_sums());
 #endif
     let inv_size = vec2<f32>(1.0 / f32(params.width), 1.0 / f32(params.height));
@@ -509,12 +509,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             }
         }
         accumulate(a.radiance, &sums);
-#ifdef LOW_DISCREPANCY
+#ifdef REPLICATED
         end_run(start + i, i + 1u == count, &sums, &replicates);
 #endif
         if (second) {
             accumulate(b.radiance, &sums);
-#ifdef LOW_DISCREPANCY
+#ifdef REPLICATED
             end_run(start + i + 1u, i + 2u == count, &sums, &replicates);
 #endif
         }
@@ -531,12 +531,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             }
         }
         accumulate(a.radiance, &sums);
-#ifdef LOW_DISCREPANCY
+#ifdef REPLICATED
         end_run(start + i, i + 1u == count, &sums, &replicates);
 #endif
     }
 #endif
-#ifdef LOW_DISCREPANCY
+#ifdef REPLICATED
     write_slot(gid, 0u, replicates.r0);
     write_slot(gid, 1u, replicates.r1);
     write_slot(gid, 2u, replicates.r2);

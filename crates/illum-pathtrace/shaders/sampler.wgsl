@@ -58,8 +58,13 @@ struct Sampler {
 // (src/replicates.rs); each replicate's first indices are still a prefix of its padded sequence.
 // The replicate is a function of the sample index alone, so a chunk of any length and start
 // keeps its replicates apart: pathtrace.wgsl's main sums each replicate's samples into a slot
-// of its own. Mirrored by src/replicates.rs (checked there by a test).
+// of its own. Mirrored by src/replicates.rs (checked there by a test). Without REPLICATED
+// (TracerOptions::replicates off) there is one: sample index i is index i of one sequence.
+#ifdef REPLICATED
 const REPLICATES: u32 = 4u;
+#else
+const REPLICATES: u32 = 1u;
+#endif
 const REPLICATE_RUN: u32 = 4u;
 
 // The replicate that sample index i of a pixel belongs to.

@@ -41,6 +41,10 @@ pub struct Accumulator {
     /// means and to nothing else. A point mass solved exactly has no variance: the statistics,
     /// the error estimate and the checkpoints' layers hold the samples alone.
     glint: Vec<(usize, [f64; 3])>,
+    /// False for samples whose error the statistics cannot estimate (the low-discrepancy
+    /// sequence without replicates: its per-sample spread overstates it, by 2 to 5 times):
+    /// the estimate is then infinite, and the front ends say "not estimated".
+    estimates_error: bool,
 }
 
 impl Accumulator {
@@ -111,6 +115,7 @@ impl Accumulator {
             sum_scale: 1.0,
             replicates: None,
             glint: Vec::new(),
+            estimates_error: true,
         })
     }
 
@@ -119,6 +124,17 @@ impl Accumulator {
     pub fn enable_replicates(&mut self) {
         debug_assert_eq!(self.total, 0, "replicates enabled on a started accumulator");
         self.replicates = Some(Replicates::new(self.count.len()));
+    }
+
+    /// Says whether the statistics estimate their error (see `estimates_error`, and
+    /// [`crate::TracerOptions::estimates_error`], which the tracer sets it from).
+    pub fn set_estimates_error(&mut self, estimates_error: bool) {
+        self.estimates_error = estimates_error;
+    }
+
+    /// Whether [`Self::estimated_rel_mse`] estimates anything (else it is infinite).
+    pub fn estimates_error(&self) -> bool {
+        self.estimates_error
     }
 
     /// Sets the per-replicate sums (a checkpoint's); `None`: independent samples.
@@ -184,6 +200,7 @@ impl Accumulator {
         }
         self.total += other.total;
         self.dropped += other.dropped;
+        self.estimates_error &= other.estimates_error;
         // Replicates add only when both sides kept them (a merge refuses mixed sequences first).
         match (&mut self.replicates, &other.replicates) {
             (Some(a), Some(b)) => a.merge(b),

@@ -61,7 +61,7 @@ pub fn exr_metadata(
         ("bounces", scene.pathtrace.bounces.to_string()),
         ("seed", scene.pathtrace.seed.to_string()),
         ("sampling", scene.pathtrace.sampling.to_string()),
-        ("sequence", tracer.options().sequence.to_string()),
+        ("sequence", tracer.options().sequence_label()),
         ("caustics", Estimators::of(scene).caustics_label().to_owned()),
         (ESTIMATORS, Estimators::of(scene).key()),
         ("glint", glint_field(accumulator.glint())),

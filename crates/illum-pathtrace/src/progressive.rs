@@ -152,7 +152,7 @@ impl Progressive {
     fn refresh_error(&mut self, tracer: &PathTracer) {
         let spp = tracer.spp_done();
         let accumulator = tracer.accumulator();
-        let known = spp >= accumulator.spp_for_error_estimate();
+        let known = accumulator.estimates_error() && spp >= accumulator.spp_for_error_estimate();
         if spp != self.error_at_spp || (self.relative_error.is_none() && known) {
             self.error_at_spp = spp;
             self.relative_error = known.then(|| match &self.error_scope {
@@ -170,6 +170,16 @@ pub fn error_text(error: Option<f64>, needs_spp: u32) -> String {
     match error {
         Some(e) => format!("{:.2}%", e * 100.0),
         None => format!("unknown until {needs_spp} spp"),
+    }
+}
+
+/// [`error_text`] for the render `accumulator` holds: its spp needed, or, for samples without an
+/// estimate (`TracerOptions::replicates` off), what was left out and why.
+pub fn render_error_text(accumulator: &crate::Accumulator, error: Option<f64>) -> String {
+    if accumulator.estimates_error() {
+        error_text(error, accumulator.spp_for_error_estimate())
+    } else {
+        "none (low-discrepancy without replicates)".to_owned()
     }
 }
 

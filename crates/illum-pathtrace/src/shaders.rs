@@ -228,13 +228,18 @@ mod tests {
         for scene in path_tracer_scenes() {
             let gpu_scene = GpuScene::new(&scene).unwrap_or_else(|e| panic!("{e}"));
             for traversal in [Traversal::Generic, Traversal::Specialised] {
-                for sequence in [Sequence::Independent, Sequence::LowDiscrepancy] {
+                // The low-discrepancy sequence with and without replicates (TracerOptions::replicates).
+                for (sequence, replicates) in [
+                    (Sequence::Independent, true),
+                    (Sequence::LowDiscrepancy, true),
+                    (Sequence::LowDiscrepancy, false),
+                ] {
                     // Alone, with adaptive sampling, and with samples in pairs (native; the
                     // browser traces them one at a time) with and without it.
                     for (paired_paths, adaptive) in
                         [(false, false), (false, true), (true, false), (true, true)]
                     {
-                        let options = TracerOptions { traversal, sequence, paired_paths };
+                        let options = TracerOptions { traversal, sequence, paired_paths, replicates };
                         let specialisation = Specialisation { scene: gpu_scene.code, options, adaptive };
                         compose_and_validate(
                             &shader_modules(&scene, &gpu_scene, traversal),
@@ -243,14 +248,14 @@ mod tests {
                         );
                     }
                     // The guide buffers (tracer/guides.rs), with the scene's code.
-                    let options = TracerOptions { traversal, sequence, paired_paths: false };
+                    let options = TracerOptions { traversal, sequence, paired_paths: false, replicates };
                     compose_and_validate(
                         &shader_modules(&scene, &gpu_scene, traversal),
                         &GUIDES_SHADER,
                         &Specialisation { scene: gpu_scene.code, options, adaptive: false }.shader_defs(),
                     );
                     if gpu_scene.code.caustic {
-                        let options = TracerOptions { traversal, sequence, paired_paths: false };
+                        let options = TracerOptions { traversal, sequence, paired_paths: false, replicates };
                         let specialisation =
                             Specialisation { scene: gpu_scene.code, options, adaptive: false };
                         compose_and_validate(
@@ -260,7 +265,7 @@ mod tests {
                         );
                     }
                     if gpu_scene.code.caustic_gather {
-                        let options = TracerOptions { traversal, sequence, paired_paths: false };
+                        let options = TracerOptions { traversal, sequence, paired_paths: false, replicates };
                         let specialisation =
                             Specialisation { scene: gpu_scene.code, options, adaptive: false };
                         compose_and_validate(

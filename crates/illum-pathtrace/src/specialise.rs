@@ -43,6 +43,7 @@ impl Specialisation {
             ("UNIFORM_SAMPLING", code.uniform_sampling),
             ("UNBOUNDED_BOUNCES", code.unbounded_bounces),
             ("LOW_DISCREPANCY", low_discrepancy),
+            ("REPLICATED", options.replicated()),
             // The low-discrepancy sequence also draws light points from the bilinear fit of the
             // geometric term (sampling.wgsl, sample_light_bilinear): it lowers that sequence's
             // error by more than it adds time; independent numbers' error is mostly in the

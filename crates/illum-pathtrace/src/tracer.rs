@@ -15,7 +15,7 @@
 //! settings callers choose.
 
 use illum_gpu::{GpuContext, wgpu};
-use illum_scene::{Scene, Sequence};
+use illum_scene::Scene;
 
 use crate::batch::{self, CHUNK_SAMPLES, Layers, SLOT_BYTES};
 use crate::display_sum::DisplaySum;
@@ -115,15 +115,11 @@ impl PathTracer {
         // and one row of one chunk must fit (below).
         limits::check_texture_size(scene, &limits)?;
         let max_slots = batch::device_max_slots(&limits);
-        let layers =
-            Layers { chunk: CHUNK_SAMPLES, replicated: options.sequence == Sequence::LowDiscrepancy };
+        let layers = Layers { chunk: CHUNK_SAMPLES, replicated: options.replicated() };
         batch::check_row_fits(scene, layers.per_chunk(), max_slots)?;
-        // A low-discrepancy render also keeps its replicates, and writes them into its EXR.
-        let replicate_bytes = if options.sequence == Sequence::LowDiscrepancy {
-            2 * crate::replicates::Replicates::BYTES_PER_PIXEL
-        } else {
-            0
-        };
+        // A replicated render also keeps its replicates, and writes them into its EXR.
+        let replicate_bytes =
+            if layers.replicated { 2 * crate::replicates::Replicates::BYTES_PER_PIXEL } else { 0 };
         crate::accumulator::check_host_memory(
             scene.camera.width,
             scene.camera.height,
@@ -152,6 +148,7 @@ impl PathTracer {
             // Its error comes from replicates, each summed in slots of its own (batch::Layers).
             accumulator.enable_replicates();
         }
+        accumulator.set_estimates_error(options.estimates_error());
         Ok(PathTracer { pipeline, bands, accumulation: Accumulation::new(accumulator) })
     }
 

@@ -71,6 +71,9 @@ impl Accumulator {
     /// the per-pixel variance alone: mean over pixels and channels of Var(mean) / (mean^2 + eps).
     /// This is the expectation of `rel_mse(mean, truth)` when the estimator is unbiased.
     pub fn estimated_rel_mse(&self) -> f64 {
+        if !self.estimates_error {
+            return f64::INFINITY;
+        }
         let mut total = 0.0;
         let mut terms = 0usize;
         for p in 0..self.count.len() {

@@ -124,6 +124,14 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint, CheckpointError> {
         layer.map(|layer| statistics_from_layer(&layer, width, height, dropped).map_err(corrupt)).transpose()
     });
     let mut accumulator = layers.next().transpose()?.flatten().ok_or_else(|| no_statistics(path))?;
+    // Samples of the low-discrepancy sequence without replicates have no error estimate.
+    let estimates_error = metadata
+        .get("sequence")
+        .and_then(crate::TracerOptions::parse_sequence_label)
+        .is_none_or(|(sequence, replicates)| {
+            crate::TracerOptions { sequence, replicates, ..Default::default() }.estimates_error()
+        });
+    accumulator.set_estimates_error(estimates_error);
     let glint = crate::metadata::parse_glint_field(metadata.get("glint").unwrap_or("none"))
         .and_then(|glint| accumulator.set_glint(&glint).map(|()| glint))
         .map_err(|reason| CheckpointError::InvalidField {
@@ -150,6 +158,7 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint, CheckpointError> {
             check_counts(&prefix, spp, None).map_err(|e| corrupt(format!("layer {ALIGNED_LAYER}: {e}")))?;
             let mut prefix = prefix;
             prefix.set_glint(&glint).map_err(corrupt)?;
+            prefix.set_estimates_error(estimates_error);
             Some((prefix, spp))
         }
         None => None,

@@ -88,7 +88,7 @@ pub fn image_settings(scene: &Scene, options: TracerOptions) -> Vec<(&'static st
         ("bounces", scene.pathtrace.bounces.to_string()),
         ("seed", scene.pathtrace.seed.to_string()),
         ("sampling", scene.pathtrace.sampling.to_string()),
-        ("sequence", options.sequence.to_string()),
+        ("sequence", options.sequence_label()),
         ("caustics", Estimators::of(scene).caustics_label().to_owned()),
     ]
 }

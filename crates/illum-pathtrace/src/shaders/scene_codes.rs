@@ -200,7 +200,12 @@ fn smooth_meshes_compose_and_validate() {
             let gpu_scene = GpuScene::new(&scene).unwrap_or_else(|e| panic!("{e}"));
             assert!(gpu_scene.code.smooth_shading && gpu_scene.code.specular);
             assert_eq!(gpu_scene.geometry.mesh_bvh().is_some(), k > 0);
-            let options = TracerOptions { traversal: Traversal::Specialised, sequence, paired_paths: true };
+            let options = TracerOptions {
+                traversal: Traversal::Specialised,
+                sequence,
+                paired_paths: true,
+                replicates: true,
+            };
             let defs = Specialisation { scene: gpu_scene.code, options, adaptive: false }.shader_defs();
             assert!(defs.iter().any(|(name, _)| *name == "SMOOTH_SHADING"));
             let modules = shader_modules(&scene, &gpu_scene, Traversal::Specialised);

@@ -58,6 +58,7 @@ impl PathTracer {
         }
         let radiance_exponent = self.pipeline.radiance_exponent;
         accumulator.set_radiance_exponent(radiance_exponent);
+        accumulator.set_estimates_error(self.pipeline.options.estimates_error());
         // The glint belongs to this tracer's scene (solved when it was built), not to the file.
         let glint = self.accumulation.accumulator.glint().to_vec();
         let set_glint = |a: &mut Accumulator| a.set_glint(&glint).expect("same resolution, checked above");

@@ -36,10 +36,9 @@ const READING: &str = "reading back a path-tracing batch";
 
 impl PathTracer {
     /// The slot layout of the next pass: [`crate::batch::Layers`] of this tracer's chunk, one
-    /// layer per replicate with the low-discrepancy sequence.
+    /// layer per replicate when the render keeps them ([`crate::TracerOptions::replicated`]).
     pub(super) fn layers(&self) -> Layers {
-        let replicated = self.pipeline.options.sequence == illum_scene::Sequence::LowDiscrepancy;
-        Layers { chunk: self.bands.chunk_samples, replicated }
+        Layers { chunk: self.bands.chunk_samples, replicated: self.pipeline.options.replicated() }
     }
 
     /// Shrinks a pass plan to what the device can take: at most `max_chunks` chunks per dispatch

@@ -50,55 +50,72 @@ fn cosine_and_uniform_sampling_converge_to_the_same_image_and_cosine_is_less_noi
     assert!(median < 0.95, "cosine sampling is not less noisy: median variance ratio {median:.3}");
 }
 
-/// Renders `scene` (at its own spp) with independent and with low-discrepancy numbers and
-/// checks, against a reference of `reference_spp` with another seed, that the low-discrepancy
-/// image agrees with it per pixel (Z-test; each estimate's variance from its own samples) and
-/// is closer to it than the independent one.
+/// A render of `scene` with the low-discrepancy sequence, with and without replicates
+/// (`TracerOptions::replicates`), against a reference of `reference_spp` with independent
+/// numbers and another seed: each image agrees with it per pixel (Z-test; each estimate's
+/// variance from its own samples) and is closer to it than the independent one; one
+/// randomisation has less relMSE than four replicates of a quarter of the samples each (the price of
+/// the replicates, docs/accuracy-estimate.md), and has no error estimate.
 fn check_low_discrepancy(name: &str, scene: &illum_scene::Scene, reference_spp: u32) {
-    let render = |sequence| {
-        let mut t =
-            PathTracer::with_options(common::gpu(), scene, TracerOptions { sequence, ..Default::default() })
-                .expect("builds");
+    let render = |sequence, replicates| {
+        let options = TracerOptions { sequence, replicates, ..Default::default() };
+        let mut t = PathTracer::with_options(common::gpu(), scene, options).expect("builds");
         t.render_to_spp(scene.pathtrace.spp).expect("renders");
         t
     };
-    let independent = render(Sequence::Independent);
-    let low_discrepancy = render(Sequence::LowDiscrepancy);
+    let independent = render(Sequence::Independent, true);
+    let low_discrepancy = render(Sequence::LowDiscrepancy, true);
+    let one_randomisation = render(Sequence::LowDiscrepancy, false);
+    assert!(
+        !one_randomisation.accumulator().estimates_error()
+            && one_randomisation.accumulator().estimated_rel_mse().is_infinite(),
+        "{name}: one randomisation has no error estimate"
+    );
     let mut reference_scene = scene.clone();
     reference_scene.pathtrace.seed = 99;
     reference_scene.pathtrace.spp = reference_spp;
     let reference_tracer = common::render(&reference_scene);
     let reference = reference_tracer.accumulator().mean_image();
-    // The Z-test's false-alarm rate needs a variance with many degrees of freedom. The
-    // low-discrepancy render's own (4 replicates: 3 degrees of freedom, a t distribution whose
-    // tails fail about 8% of pixels at the 1% level) has not; s^2 / n, which overstates this
-    // sequence's variance, has, and keeps the test conservative.
-    let ld = low_discrepancy.accumulator();
-    let mut sample_variance = illum_image::RgbImage32::new(ld.width, ld.height);
-    for (p, v) in sample_variance.pixels.iter_mut().enumerate() {
-        *v = ld.pixel_sample_variance_over_n(p).map(|x| x as f32);
+    for (label, tracer) in [("low-discrepancy", &low_discrepancy), ("one randomisation", &one_randomisation)]
+    {
+        // The Z-test's false-alarm rate needs a variance with many degrees of freedom. The
+        // low-discrepancy render's own (4 replicates: 3 degrees of freedom, a t distribution
+        // whose tails fail about 8% of pixels at the 1% level) has not; s^2 / n, which
+        // overstates this sequence's variance, has, and keeps the test conservative.
+        let ld = tracer.accumulator();
+        let mut sample_variance = illum_image::RgbImage32::new(ld.width, ld.height);
+        for (p, v) in sample_variance.pixels.iter_mut().enumerate() {
+            *v = ld.pixel_sample_variance_over_n(p).map(|x| x as f32);
+        }
+        let pass = z_test_pass_fraction(
+            &ld.mean_image(),
+            &sample_variance,
+            &reference,
+            &reference_tracer.accumulator().variance_image(),
+            0.01,
+        )
+        .expect("same size");
+        assert!(
+            pass > 0.97,
+            "{name}: the {label} image disagrees with the reference on {:.3} of pixels",
+            1.0 - pass
+        );
     }
-    let pass = z_test_pass_fraction(
-        &low_discrepancy.accumulator().mean_image(),
-        &sample_variance,
-        &reference,
-        &reference_tracer.accumulator().variance_image(),
-        0.01,
-    )
-    .expect("same size");
-    assert!(
-        pass > 0.97,
-        "{name}: low-discrepancy image disagrees with the reference on {:.3} of pixels",
-        1.0 - pass
-    );
     let error =
         |t: &PathTracer| illum_image::rmse(&t.accumulator().mean_image(), &reference).expect("same size");
-    let (e_ind, e_ld) = (error(&independent), error(&low_discrepancy));
+    let (e_ind, e_ld, e_one) = (error(&independent), error(&low_discrepancy), error(&one_randomisation));
     println!(
-        "{name}: RMSE at {} spp: independent {e_ind:.5}, low-discrepancy {e_ld:.5}",
+        "{name}: RMSE at {} spp: independent {e_ind:.5}, low-discrepancy {e_ld:.5}, one randomisation {e_one:.5}",
         scene.pathtrace.spp
     );
+    // relMSE, the measure of the replicates' price (RMSE is ruled by the light's edge pixels).
+    let rel =
+        |t: &PathTracer| illum_image::rel_mse(&t.accumulator().mean_image(), &reference).expect("same size");
+    let (r_ld, r_one) = (rel(&low_discrepancy), rel(&one_randomisation));
+    println!("{name}: relMSE: low-discrepancy {r_ld:.4e}, one randomisation {r_one:.4e}");
     assert!(e_ld < e_ind, "{name}: low-discrepancy RMSE {e_ld} is not below independent {e_ind}");
+    assert!(e_one < e_ind, "{name}: one randomisation's RMSE {e_one} is not below independent {e_ind}");
+    assert!(r_one < r_ld, "{name}: one randomisation's relMSE {r_one} is not below the replicates' {r_ld}");
 }
 
 #[test]
