@@ -188,11 +188,20 @@ def headline(directory):
     eff = number_after(mitsuba, r"efficiency illum / Mitsuba \(best of each\): ([0-9.]+)x")
     mitsuba8 = read(directory, "vs-mitsuba-b8.txt")
     eff8 = number_after(mitsuba8, r"efficiency illum / Mitsuba \(best of each\): ([0-9.]+)x")
+    kept = r"efficiency illum with its error estimate / Mitsuba \(best of each\): ([0-9.]+)x"
+    kept2, kept8 = number_after(mitsuba, kept), number_after(mitsuba8, kept)
     if thr is not None and eff is not None:
         at8 = f"; at bounces 8, **{eff8:.2f}x** its efficiency" if eff8 is not None else ""
+        best_row = re.search(r"efficiency illum / Mitsuba \(best of each\): [0-9.]+x \((.+)\)", mitsuba)
+        best = f": {best_row.group(1)}" if best_row else ""
+        with_estimate = ""
+        if kept2 is not None and kept8 is not None:
+            with_estimate = (f" Keeping illum's error estimate (the low-discrepancy sequence's 4 replicates): "
+                             f"{kept2:.2f}x at bounces 2, {kept8:.2f}x at 8.")
         lines.append(f"- **Against Mitsuba 3** (`bench/vs_mitsuba.py`, the same Cornell box, 256 x 256, 1024 spp, "
                      f"bounces 2, whole processes, against a reference Mitsuba rendered): **{thr:.2f}x** its "
-                     f"throughput and **{eff:.2f}x** its efficiency (1 / (relMSE x time)){at8}.")
+                     f"throughput and **{eff:.2f}x** its efficiency (1 / (relMSE x time), best of each{best}){at8}."
+                     f"{with_estimate}")
     else:
         lines.append("- Against Mitsuba 3: not re-measured in this run (Mitsuba 3 not installed; "
                      "`bench/vs_mitsuba.py` says how); docs/performance.md has the last measured ratios.")
