@@ -124,27 +124,29 @@ impl Replicates {
     pub fn variance_of_mean(&self, pixel: usize) -> [f64; 3] {
         let slots = pixel * REPLICATES..(pixel + 1) * REPLICATES;
         let (sums, counts) = (&self.sum[slots.clone()], &self.count[slots]);
-        let total: u64 = counts.iter().sum();
-        let filled = counts.iter().filter(|&&n| n > 0).count();
+        // One pass for the totals, one for the spread (every error estimate runs this for every
+        // pixel, once per pass).
+        let (mut total, mut filled, mut sum) = (0u64, 0usize, [0.0f64; 3]);
+        for (s, &n) in sums.iter().zip(counts) {
+            total += n;
+            filled += usize::from(n > 0);
+            for c in 0..3 {
+                sum[c] += s[c];
+            }
+        }
         if filled < 2 {
             return [f64::INFINITY; 3];
         }
         let total = total as f64;
-        let mut out = [0.0; 3];
-        for (c, value) in out.iter_mut().enumerate() {
-            let mean = sums.iter().map(|s| s[c]).sum::<f64>() / total;
-            let spread: f64 = sums
-                .iter()
-                .zip(counts)
-                .filter(|(_, n)| **n > 0)
-                .map(|(s, &n)| {
-                    let share = n as f64 / total;
-                    share * share * (s[c] / n as f64 - mean).powi(2)
-                })
-                .sum();
-            *value = spread * filled as f64 / (filled as f64 - 1.0);
+        let mean = sum.map(|s| s / total);
+        let mut spread = [0.0f64; 3];
+        for (s, &n) in sums.iter().zip(counts).filter(|(_, n)| **n > 0) {
+            let share = n as f64 / total;
+            for c in 0..3 {
+                spread[c] += share * share * (s[c] / n as f64 - mean[c]).powi(2);
+            }
         }
-        out
+        spread.map(|v| v * filled as f64 / (filled as f64 - 1.0))
     }
 }
 

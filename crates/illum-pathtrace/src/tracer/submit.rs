@@ -34,6 +34,10 @@ const WORKGROUP: u32 = 8;
 
 const READING: &str = "reading back a path-tracing batch";
 
+/// Pixels folded together across all of a band's slot layers: their statistics (56 bytes a
+/// pixel) and replicates (128) fill about 370 KB, within a core's L2 cache.
+const FOLD_TILE_PIXELS: usize = 2048;
+
 impl PathTracer {
     /// The slot layout of the next pass: [`crate::batch::Layers`] of this tracer's chunk, one
     /// layer per replicate when the render keeps them ([`crate::TracerOptions::replicated`]).
@@ -406,16 +410,25 @@ impl PathTracer {
         };
         let accumulator = &mut self.accumulation.accumulator;
         let first_pixel = row_offset as usize * width as usize;
-        for l in 0..slot_layers {
-            let range = l as usize * band_pixels..(l as usize + 1) * band_pixels;
-            accumulator.fold_slots(
-                first_pixel,
-                layers.replicate(l),
-                &sums[range.clone()],
-                &sums_sq[range.clone()],
-            );
-            if let Some(caustic) = &self.pipeline.caustic {
-                caustic.fold(accumulator, l, first_pixel, &sums[range]);
+        // Tile by tile, every layer of a tile before the next tile: the tile's statistics (and
+        // replicates) stay in the cache while its layers are added, where layer by layer over the
+        // whole band they would be fetched from memory once per layer (a 256 x 256 band of 64
+        // chunks x 4 replicate layers: 14 MB, 256 times). Each pixel still adds its layers in
+        // order, so the sums are the same bit for bit.
+        for tile in (0..band_pixels).step_by(FOLD_TILE_PIXELS) {
+            let tile = tile..(tile + FOLD_TILE_PIXELS).min(band_pixels);
+            for l in 0..slot_layers {
+                let layer_start = l as usize * band_pixels;
+                let range = layer_start + tile.start..layer_start + tile.end;
+                accumulator.fold_slots(
+                    first_pixel + tile.start,
+                    layers.replicate(l),
+                    &sums[range.clone()],
+                    &sums_sq[range.clone()],
+                );
+                if let Some(caustic) = &self.pipeline.caustic {
+                    caustic.fold(accumulator, l, first_pixel + tile.start, &sums[range]);
+                }
             }
         }
         // The display pass added the camera's samples only: show the accumulator's image.
