@@ -102,7 +102,10 @@ fn caustics_on_off_is_recorded_and_a_checkpoint_of_the_other_setting_is_refused(
     );
     let out = run(&args);
     assert!(out.status.success(), "{}", text(&out.stderr));
-    assert_ne!(field(&metadata(&exr), "glint"), "none");
+    // The glint is the image's exact part, in a layer of its own (illum.exact); the metadata
+    // holds its digest, which parts to be merged must share.
+    assert_eq!(field(&metadata(&exr), "glint_hash").len(), 16);
+    assert!(!rendered.accumulator.glint().is_empty(), "no glint read back from its layer");
     let sentence = "light tracer and photon gather at every diffuse vertex but the camera's own hit (r_1 = 0.02 x the \
                     largest specular radius, r_k = r_1 (k + 1)^(-1/6)); glint solved";
     let first_rule = today.replace("photon-gather.r2", "photon-gather.r1");
@@ -121,7 +124,8 @@ fn caustics_on_off_is_recorded_and_a_checkpoint_of_the_other_setting_is_refused(
         let mut older = rendered.clone();
         older.metadata.fields.retain(|(k, _)| k != "estimators" && k != "caustic_estimators");
         if case == "before-glint" {
-            older.metadata.fields.retain(|(k, _)| k != "glint");
+            older.metadata.fields.retain(|(k, _)| k != "glint_hash");
+            older.accumulator.set_glint(&[]).unwrap();
         }
         if let Some(value) = estimators {
             older.metadata.fields.push(("estimators".to_owned(), value.to_owned()));
@@ -141,6 +145,23 @@ fn caustics_on_off_is_recorded_and_a_checkpoint_of_the_other_setting_is_refused(
         assert_refused(&out, &format!("merging a file {case}"), &["estimators"]);
         assert!(!merged.exists());
     }
+
+    // A file that keeps its glint as metadata text (illum.glint, the form before its layer) is
+    // refused on resume and merge with that reason.
+    let mut older = rendered.clone();
+    older.metadata.fields.push(("glint".to_owned(), "3:0.5,0.5,0.5".to_owned()));
+    let old = dir.path().join("glint-text.exr");
+    illum::pathtrace::checkpoint::save_loaded(&old, &older).unwrap();
+    let out = run(&words(
+        "scenes/whitted.toml --renderer pathtrace --width 16 --height 16 --resume",
+        &[old.to_str().unwrap(), "--spp", "32"],
+    ));
+    let reason = ["illum.glint", "metadata text", "own layer", "render it again"];
+    assert_refused(&out, "resuming a file with the glint as text", &reason);
+    let merged = dir.path().join("never.exr");
+    let out = merge(&[old.to_str().unwrap(), part.to_str().unwrap(), "-o", merged.to_str().unwrap()]);
+    assert_refused(&out, "merging a file with the glint as text", &reason);
+    assert!(!merged.exists());
 
     // A bad value and the raster renderer are refused by name.
     let out = run(&["scenes/whitted.toml", "--renderer", "pathtrace", "--caustics", "maybe"]);

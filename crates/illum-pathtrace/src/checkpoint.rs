@@ -5,7 +5,8 @@
 //! image (the first layer, what any EXR viewer shows) it has a layer named
 //! [`STATISTICS_LAYER`] with, per pixel, the exact f64 sum and sum of squares of the finite
 //! samples (each f64 stored as two 32-bit words, since EXR has no 64-bit samples) and the u64
-//! count (two words as well). Its metadata ([`crate::metadata::exr_metadata`]) names the scene,
+//! count (two words as well); where the image has an exact part (the sun's glint), a layer
+//! [`GLINT_LAYER`] holds it the same way. Its metadata ([`crate::metadata::exr_metadata`]) names the scene,
 //! every setting that changes the image, a hash of the scene's content
 //! ([`crate::metadata::scene_hash`]), the first sample index (`sample_start`, for `--sample-range`), the
 //! completed spp and a pass stopped inside (`partial_pass_spp`, `partial_pass_rows`).
@@ -61,6 +62,11 @@ pub const ERROR_LAYER: &str = "illum.error";
 /// Name of the layer with the statistics at the last chunk boundary, in files whose samples end
 /// inside a chunk (its spp: metadata `aligned_spp`).
 pub const ALIGNED_LAYER: &str = "illum.statistics.aligned";
+
+/// Name of the layer with the exact part of the image, the sun's glint (`glint.rs`,
+/// [`Accumulator::glint`]): per pixel its f64 radiance, each as two 32-bit words; written only
+/// when the image has one. The mean image adds it to the samples' means.
+pub const GLINT_LAYER: &str = "illum.exact";
 
 /// A render read back from a checkpoint file.
 #[derive(Clone, Debug)]

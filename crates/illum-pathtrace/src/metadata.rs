@@ -44,6 +44,8 @@ pub fn scene_hash(scene: &Scene) -> String {
 ///   pixel, e.g. `8x8 blocks, 16 to 4096 spp, mean 1023.5, pilot 16 spp`; `spp` then counts the
 ///   sample indices reached, which each block has taken up to its own count;
 /// - `adapter`: the GPU adapter's name; `source`: the program that wrote the file;
+/// - `glint_hash`: [`glint_hash`], the digest of the image's exact part, which the layer
+///   [`crate::checkpoint::GLINT_LAYER`] holds;
 /// - `scene_hash`: [`scene_hash`]; `sample_start`: the first sample
 ///   index (see [`PathTracer::set_sample_offset`]); `partial_pass_spp` and `partial_pass_rows`:
 ///   a pass the render stopped inside (its spp and the rows it had done; 0 and 0 for none).
@@ -64,7 +66,7 @@ pub fn exr_metadata(
         ("sequence", tracer.options().sequence_label()),
         ("caustics", Estimators::of(scene).caustics_label().to_owned()),
         (ESTIMATORS, Estimators::of(scene).key()),
-        ("glint", glint_field(accumulator.glint())),
+        ("glint_hash", glint_hash(accumulator.glint())),
         ("estimated_relative_error", accumulator.estimated_relative_error().to_string()),
         ("dropped_samples", accumulator.dropped_samples().to_string()),
         ("stopped_by", stopped_by.map_or("none", StopReason::name).to_owned()),
@@ -89,52 +91,42 @@ pub fn exr_metadata(
     }
 }
 
-/// The glint an image's means hold (`illum.glint`): `none`, or `pixel:r,g,b` entries joined by
-/// `;`, each value in Rust's shortest form that reads back to the same f64, so a checkpoint
-/// loaded again adds exactly what the render added.
-pub fn glint_field(glint: &[(usize, [f64; 3])]) -> String {
+/// A digest of the glint an image's means hold (`illum.glint_hash`), whose values are in the
+/// file's [`crate::checkpoint::GLINT_LAYER`]: `none`, or 16 hex digits of the 64-bit FNV-1a of
+/// each entry's pixel index and radiances (little-endian bits). Parts to be merged must agree on
+/// it, from their headers alone.
+pub fn glint_hash(glint: &[(usize, [f64; 3])]) -> String {
     if glint.is_empty() {
         return "none".to_owned();
     }
-    let entries: Vec<String> = glint.iter().map(|(p, v)| format!("{p}:{},{},{}", v[0], v[1], v[2])).collect();
-    entries.join(";")
-}
-
-/// Reads [`glint_field`] back; the error names the entry that is not `pixel:r,g,b` of finite
-/// numbers.
-pub fn parse_glint_field(field: &str) -> Result<Vec<(usize, [f64; 3])>, String> {
-    if field == "none" {
-        return Ok(Vec::new());
+    let mut bytes = Vec::with_capacity(glint.len() * 32);
+    for (p, v) in glint {
+        bytes.extend((*p as u64).to_le_bytes());
+        for c in v {
+            bytes.extend(c.to_bits().to_le_bytes());
+        }
     }
-    field
-        .split(';')
-        .map(|entry| {
-            let bad = || format!("{entry:?} is not pixel:r,g,b (a pixel index and three finite radiances)");
-            let (pixel, rgb) = entry.split_once(':').ok_or_else(bad)?;
-            let pixel: usize = pixel.parse().map_err(|_| bad())?;
-            let values: Vec<f64> =
-                rgb.split(',').map(str::parse).collect::<Result<_, _>>().map_err(|_| bad())?;
-            match values[..] {
-                [r, g, b] if [r, g, b].iter().all(|v| v.is_finite()) => Ok((pixel, [r, g, b])),
-                _ => Err(bad()),
-            }
-        })
-        .collect()
+    format!("{:016x}", illum_scene::fnv1a_64(&bytes))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    /// The digest tells glints apart by any bit of any entry, and says `none` for no glint.
     #[test]
-    fn the_glint_field_reads_back_exactly_and_names_a_bad_entry() {
+    fn the_glint_hash_changes_with_every_entry() {
         let glint = vec![(3, [0.1, 1.0 / 3.0, 2e-300]), (40, [6.02e23, 0.0, 1.0])];
-        assert_eq!(parse_glint_field(&glint_field(&glint)).unwrap(), glint);
-        assert_eq!(glint_field(&[]), "none");
-        assert!(parse_glint_field("none").unwrap().is_empty());
-        for bad in ["3:1,2", "x:1,2,3", "3:1,2,inf", "3;1,2,3", ""] {
-            let err = parse_glint_field(bad).unwrap_err();
-            assert!(err.contains("pixel:r,g,b"), "{bad}: {err}");
+        let hash = glint_hash(&glint);
+        assert_eq!(hash.len(), 16);
+        assert_eq!(glint_hash(&glint.clone()), hash, "stable");
+        assert_eq!(glint_hash(&[]), "none");
+        let mut moved = glint.clone();
+        moved[1].0 = 41;
+        let mut nudged = glint.clone();
+        nudged[0].1[2] = f64::from_bits(nudged[0].1[2].to_bits() + 1);
+        for other in [moved, nudged, glint[..1].to_vec()] {
+            assert_ne!(glint_hash(&other), hash, "{other:?}");
         }
     }
 }

@@ -41,6 +41,15 @@ pub enum CheckpointError {
     /// (`estimators.rs`): it cannot be resumed or merged, whatever its settings.
     #[error("{}: illum.estimators: {reason}", path.display())]
     OlderEstimators { path: PathBuf, reason: String },
+    /// A file that keeps the sun's glint as text in its metadata (`illum.glint`), written before
+    /// the glint had a layer of its own ([`super::GLINT_LAYER`]).
+    #[error(
+        "{}: illum.glint: the sun's glint is stored as metadata text, the form before it moved to its own layer \
+         ({}); this build reads only the layer, so the file cannot be resumed or merged: render it again",
+        path.display(),
+        super::GLINT_LAYER
+    )]
+    OlderGlint { path: PathBuf },
     /// Resuming with settings other than the file's: each difference, with both values.
     #[error(
         "{}: rendered with other settings, so its samples cannot be combined with these: {}",

@@ -56,6 +56,63 @@ pub(super) fn layer_named(name: &str, accumulator: &Accumulator) -> U32Layer {
     U32Layer { name: name.to_owned(), channels }
 }
 
+/// The [`super::GLINT_LAYER`] of `accumulator`: its glint per pixel (zero elsewhere), or `None`
+/// when it has none.
+pub(super) fn glint_layer(accumulator: &Accumulator) -> Option<U32Layer> {
+    let glint = accumulator.glint();
+    if glint.is_empty() {
+        return None;
+    }
+    let pixels = accumulator.width as usize * accumulator.height as usize;
+    let mut values = vec![[0.0f64; 3]; pixels];
+    for &(p, v) in glint {
+        values[p] = v;
+    }
+    let mut channels = Vec::new();
+    for (c, name) in CHANNELS.iter().enumerate() {
+        let (hi, lo): (Vec<u32>, Vec<u32>) = values.iter().map(|v| split(v[c].to_bits())).unzip();
+        channels.push((format!("{name}.hi"), hi));
+        channels.push((format!("{name}.lo"), lo));
+    }
+    Some(U32Layer { name: super::GLINT_LAYER.to_owned(), channels })
+}
+
+/// Reads [`glint_layer`] back: (pixel, radiance) for every pixel with a glint, in pixel order.
+pub(super) fn glint_from_layer(layer: &U32Layer, pixels: usize) -> Result<Vec<(usize, [f64; 3])>, String> {
+    let values = f64_channels(layer, "", pixels)?;
+    if values.iter().flatten().any(|v| !v.is_finite()) {
+        return Err(format!("layer {} holds a NaN or infinite radiance: the file is corrupt", layer.name));
+    }
+    Ok(values.into_iter().enumerate().filter(|(_, v)| v.iter().any(|&c| c != 0.0)).collect())
+}
+
+/// The channel `name` of `layer`, which must hold `pixels` values.
+fn channel<'a>(layer: &'a U32Layer, name: &str, pixels: usize) -> Result<&'a Vec<u32>, String> {
+    let values = layer
+        .channels
+        .iter()
+        .find(|(n, _)| n == name)
+        .map(|(_, v)| v)
+        .ok_or_else(|| format!("layer {} has no channel {name}", layer.name))?;
+    if values.len() != pixels {
+        return Err(format!("channel {name} has {} values for {pixels} pixels", values.len()));
+    }
+    Ok(values)
+}
+
+/// The f64 rgb of channels `{prefix}R.hi`, `{prefix}R.lo`, ... of `layer`, per pixel.
+fn f64_channels(layer: &U32Layer, prefix: &str, pixels: usize) -> Result<Vec<[f64; 3]>, String> {
+    let mut out = vec![[0.0; 3]; pixels];
+    for (c, name) in CHANNELS.iter().enumerate() {
+        let hi = channel(layer, &format!("{prefix}{name}.hi"), pixels)?;
+        let lo = channel(layer, &format!("{prefix}{name}.lo"), pixels)?;
+        for (p, v) in out.iter_mut().enumerate() {
+            v[c] = f64::from_bits(join(hi[p], lo[p]));
+        }
+    }
+    Ok(out)
+}
+
 /// Rebuilds an accumulator from a statistics layer of a `width x height` image.
 pub(super) fn statistics_from_layer(
     layer: &U32Layer,
@@ -64,29 +121,8 @@ pub(super) fn statistics_from_layer(
     dropped: u64,
 ) -> Result<Accumulator, String> {
     let pixels = width as usize * height as usize;
-    let channel = |name: String| -> Result<&Vec<u32>, String> {
-        let values = layer
-            .channels
-            .iter()
-            .find(|(n, _)| *n == name)
-            .map(|(_, v)| v)
-            .ok_or_else(|| format!("layer {} has no channel {name}", layer.name))?;
-        if values.len() != pixels {
-            return Err(format!("channel {name} has {} values for {pixels} pixels", values.len()));
-        }
-        Ok(values)
-    };
-    let pair = |prefix: &str| -> Result<Vec<[f64; 3]>, String> {
-        let mut out = vec![[0.0; 3]; pixels];
-        for (c, name) in CHANNELS.iter().enumerate() {
-            let hi = channel(format!("{prefix}.{name}.hi"))?;
-            let lo = channel(format!("{prefix}.{name}.lo"))?;
-            for (p, v) in out.iter_mut().enumerate() {
-                v[c] = f64::from_bits(join(hi[p], lo[p]));
-            }
-        }
-        Ok(out)
-    };
+    let channel = |name: String| channel(layer, &name, pixels);
+    let pair = |prefix: &str| f64_channels(layer, &format!("{prefix}."), pixels);
     let sum = pair("sum")?;
     let sum_sq = pair("sum_sq")?;
     let (hi, lo) = (channel("count.hi".into())?, channel("count.lo".into())?);
@@ -163,6 +199,27 @@ pub(super) fn check_counts(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The glint's layer gives back every entry bit for bit, and none for an image without one.
+    #[test]
+    fn the_glint_layer_reads_back_exactly() {
+        let mut accumulator = Accumulator::new(8, 6);
+        assert!(glint_layer(&accumulator).is_none());
+        let glint = vec![(3, [0.1, 1.0 / 3.0, 2e-300]), (40, [6.02e23, 0.0, 1.0]), (47, [5e-324, 0.0, 0.0])];
+        accumulator.set_glint(&glint).unwrap();
+        let layer = glint_layer(&accumulator).expect("a glint");
+        assert_eq!(layer.name, super::super::GLINT_LAYER);
+        let back = glint_from_layer(&layer, 48).unwrap();
+        assert_eq!(back.len(), glint.len());
+        for ((p, v), (q, w)) in back.iter().zip(&glint) {
+            assert_eq!((p, v.map(f64::to_bits)), (q, w.map(f64::to_bits)));
+        }
+        let mut corrupt = layer.clone();
+        corrupt.channels[0].1[3] = 0x7ff0_0000; // R.hi of pixel 3: infinity
+        corrupt.channels[1].1[3] = 0;
+        assert!(glint_from_layer(&corrupt, 48).unwrap_err().contains("NaN or infinite"));
+        assert!(glint_from_layer(&layer, 49).unwrap_err().contains("49 pixels"));
+    }
 
     #[test]
     fn f64_and_u64_survive_the_two_word_split() {

@@ -6,8 +6,8 @@ use std::path::Path;
 use illum_image::{ExrMetadata, load_u32_layers};
 
 use super::error::with_causes;
-use super::layers::{check_counts, statistics_from_layer};
-use super::{ALIGNED_LAYER, Checkpoint, CheckpointError, CheckpointHeader, STATISTICS_LAYER};
+use super::layers::{check_counts, glint_from_layer, statistics_from_layer};
+use super::{ALIGNED_LAYER, Checkpoint, CheckpointError, CheckpointHeader, GLINT_LAYER, STATISTICS_LAYER};
 
 /// A whole number in illum metadata field `field` of the file at `path`.
 fn whole_number<T: std::str::FromStr>(
@@ -117,13 +117,20 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint, CheckpointError> {
         Some(_) => whole_number(path, &metadata, "dropped_samples")?,
         None => 0,
     };
-    // One read of the file for both layers (the mean image is recomputed from the statistics).
-    let layers =
-        load_u32_layers(path, &[STATISTICS_LAYER, ALIGNED_LAYER]).map_err(|e| unreadable(path, &e))?;
-    let mut layers = layers.into_iter().map(|layer| {
+    // The sun's glint as metadata text: the form before it had its own layer.
+    if metadata.get("glint").is_some_and(|glint| glint != "none") {
+        return Err(CheckpointError::OlderGlint { path: path.to_path_buf() });
+    }
+    // One read of the file for its layers (the mean image is recomputed from the statistics).
+    let [statistics, aligned, glint] = <[Option<illum_image::U32Layer>; 3]>::try_from(
+        load_u32_layers(path, &[STATISTICS_LAYER, ALIGNED_LAYER, GLINT_LAYER])
+            .map_err(|e| unreadable(path, &e))?,
+    )
+    .expect("one entry per layer asked for");
+    let statistics_of = |layer: Option<illum_image::U32Layer>| {
         layer.map(|layer| statistics_from_layer(&layer, width, height, dropped).map_err(corrupt)).transpose()
-    });
-    let mut accumulator = layers.next().transpose()?.flatten().ok_or_else(|| no_statistics(path))?;
+    };
+    let mut accumulator = statistics_of(statistics)?.ok_or_else(|| no_statistics(path))?;
     // Samples of the low-discrepancy sequence without replicates have no error estimate.
     let estimates_error = metadata
         .get("sequence")
@@ -132,16 +139,14 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint, CheckpointError> {
             crate::TracerOptions { sequence, replicates, ..Default::default() }.estimates_error()
         });
     accumulator.set_estimates_error(estimates_error);
-    let glint = crate::metadata::parse_glint_field(metadata.get("glint").unwrap_or("none"))
-        .and_then(|glint| accumulator.set_glint(&glint).map(|()| glint))
-        .map_err(|reason| CheckpointError::InvalidField {
-            path: path.to_path_buf(),
-            field: "glint",
-            value: metadata.get("glint").unwrap_or_default().chars().take(80).collect(),
-            allowed: format!("none, or pixel:r,g,b entries joined by ';' inside the image ({reason})"),
-        })?;
+    let glint = match glint {
+        Some(layer) => glint_from_layer(&layer, width as usize * height as usize)
+            .map_err(|e| corrupt(format!("layer {GLINT_LAYER}: {e}")))?,
+        None => Vec::new(),
+    };
+    accumulator.set_glint(&glint).map_err(corrupt)?;
     check_counts(&accumulator, spp_done, partial_pass).map_err(corrupt)?;
-    let aligned_prefix = match layers.next().transpose()?.flatten() {
+    let aligned_prefix = match statistics_of(aligned)? {
         Some(prefix) => {
             let spp: u32 = whole_number(path, &metadata, "aligned_spp")?;
             let chunk = crate::CHUNK_SAMPLES;

@@ -1,13 +1,13 @@
 //! Writing checkpoints: the mean image, the statistics layers (with, where the samples end
-//! inside a chunk, those at the last chunk boundary), the error layer and the metadata, to a
-//! file atomically or to bytes.
+//! inside a chunk, those at the last chunk boundary), the glint's layer, the error layer and the
+//! metadata, to a file atomically or to bytes.
 
 use std::path::Path;
 
 use illum_image::{ExrMetadata, F32Layer, U32Layer, save_exr_with_float_layers};
 
 use super::error::with_causes;
-use super::layers::{layer_named, statistics_layer};
+use super::layers::{glint_layer, layer_named, statistics_layer};
 use super::{ALIGNED_LAYER, Checkpoint, CheckpointError, ERROR_LAYER};
 use crate::{Accumulator, PathTracer};
 
@@ -32,6 +32,8 @@ fn checkpoint_layers(
         metadata.fields.push(("aligned_spp".to_owned(), spp.to_string()));
         layers.push(layer_named(ALIGNED_LAYER, prefix));
     }
+    // The prefix holds the same glint: the image's, stored once.
+    layers.extend(glint_layer(accumulator));
     (metadata, layers)
 }
 

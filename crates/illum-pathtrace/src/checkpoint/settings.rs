@@ -53,19 +53,19 @@ impl CheckpointHeader {
             "scene" => Some(self.metadata.scene.clone()),
             // A file without the key was rendered without the caustic's light tracer.
             "caustics" => Some(self.metadata.get(key).unwrap_or("off").to_owned()),
-            // A file without the key has no glint in its means.
-            "glint" => Some(self.metadata.get(key).unwrap_or("none").to_owned()),
+            // A file without the key has no glint in its means (one with the older text form is
+            // refused when loaded, `CheckpointError::OlderGlint`).
+            "glint_hash" => Some(self.metadata.get(key).unwrap_or("none").to_owned()),
             _ => self.metadata.get(key).map(str::to_owned),
         }
     }
 }
 
-/// Longest value a refusal shows whole: every setting's but a glint's (the caustic estimators'
-/// description is about 160 characters).
+/// Longest value a refusal shows whole: every setting's (the longest, the caustic estimators'
+/// token list, is under 100 characters); only an edited file's can be longer.
 const SHOWN_CHARS: usize = 200;
 
-/// A setting's value as a refusal shows it: whole when short, else its start and its length
-/// (an `illum.glint` value holds thousands of characters, and only its difference matters).
+/// A setting's value as a refusal shows it: whole when short, else its start and its length.
 pub(super) fn shown(value: Option<&str>) -> String {
     match value {
         None => "(missing)".to_owned(),
