@@ -123,6 +123,13 @@ fn one_randomisation_resumes_and_merges_like_one_render_and_claims_no_error() {
 
     let out = run(&["--resume", &p("straight.exr"), "--spp", "128", "--replicates", "on"]);
     assert_refused(&out, "--resume with --replicates on", &["sequence", "(one randomisation)"]);
+    // The file's setting holds without the flag: a rule that reads the estimate is refused.
+    let out = run(&["--resume", &p("straight.exr"), "--spp", "128", "--target-error", "0.01"]);
+    assert_refused(
+        &out,
+        "--resume of one randomisation with --target-error",
+        &["--replicates off", "--target-error needs one"],
+    );
     for (flags, expected) in [
         (&["--sequence", "low-discrepancy", "--replicates", "off"][..], "the default stop rule"),
         (&["--replicates", "off", "--spp", "8"][..], "the independent sequence has no replicates"),

@@ -242,18 +242,26 @@ fn check_combinations(args: &RenderArgs) -> anyhow::Result<()> {
 }
 
 /// Refuses `--replicates off` where it cannot go: with independent numbers (which have no
-/// replicates), and with any rule or output that reads the error estimate it leaves out.
+/// replicates), and, for any render without replicates (the flag's, or a resumed file's), with
+/// every rule or output that reads the error estimate it leaves out.
 fn check_replicates(args: &RenderArgs, options: TracerOptions, rules: &StopRules) -> anyhow::Result<()> {
-    if args.replicates != Some(false) {
-        return Ok(());
-    }
-    if options.sequence != illum_pathtrace::Sequence::LowDiscrepancy {
+    if args.replicates == Some(false) && options.sequence != illum_pathtrace::Sequence::LowDiscrepancy {
         bail!(
             "--replicates off: the {} sequence has no replicates (they randomise the low-discrepancy one); \
              give --sequence low-discrepancy, or leave --replicates out",
             options.sequence
         );
     }
+    if options.estimates_error() {
+        return Ok(());
+    }
+    let (source, hint) = match (&args.resume, args.replicates) {
+        (Some(path), None) => (
+            format!("{} was rendered with --replicates off, so it", path.display()),
+            "continue it with a fixed --spp, or render it again with replicates",
+        ),
+        _ => ("--replicates off".to_owned(), "leave --replicates out"),
+    };
     let conflicting = crate::given_flags(&[
         (args.target_error.is_some(), "--target-error"),
         (args.error_percentile.is_some(), "--error-percentile"),
@@ -263,13 +271,13 @@ fn check_replicates(args: &RenderArgs, options: TracerOptions, rules: &StopRules
     ]);
     if !conflicting.is_empty() {
         bail!(
-            "--replicates off renders without an error estimate, and {} needs one; leave --replicates out",
+            "{source} renders without an error estimate, and {} needs one; {hint}",
             conflicting.join(" and ")
         );
     }
     if rules.target_error.is_some() {
         bail!(
-            "--replicates off renders without an error estimate, and the default stop rule stops at an \
+            "{source} renders without an error estimate, and the default stop rule stops at an \
              estimated error: give --spp N (or --sample-range A..B, or --time-budget S)"
         );
     }
