@@ -51,9 +51,8 @@ fn path_traced_parts(scene: &Scene, spp: u32, bounces: Bounces, seed: u32) -> (R
     scene.pathtrace.seed = seed;
     let mut tracer = PathTracer::new(gpu(), &scene).unwrap();
     tracer.render_to_spp(spp).unwrap();
-    let mut samples = tracer.accumulator().clone();
-    samples.set_glint(&[]).unwrap();
-    (tracer.accumulator().mean_image(), samples.mean_image())
+    let parts = tracer.accumulator().parts();
+    (parts.mean(), parts.sampled_mean())
 }
 
 fn whitted(depth: u32) -> RgbImage32 {

@@ -105,7 +105,7 @@ fn caustics_on_off_is_recorded_and_a_checkpoint_of_the_other_setting_is_refused(
     // The glint is the image's exact part, in a layer of its own (illum.exact); the metadata
     // holds its digest, which parts to be merged must share.
     assert_eq!(field(&metadata(&exr), "glint_hash").len(), 16);
-    assert!(!rendered.accumulator.glint().is_empty(), "no glint read back from its layer");
+    assert!(!rendered.accumulator.exact().is_empty(), "no glint read back from its layer");
     let sentence = "light tracer and photon gather at every diffuse vertex but the camera's own hit (r_1 = 0.02 x the \
                     largest specular radius, r_k = r_1 (k + 1)^(-1/6)); glint solved";
     let first_rule = today.replace("photon-gather.r2", "photon-gather.r1");
@@ -125,7 +125,7 @@ fn caustics_on_off_is_recorded_and_a_checkpoint_of_the_other_setting_is_refused(
         older.metadata.fields.retain(|(k, _)| k != "estimators" && k != "caustic_estimators");
         if case == "before-glint" {
             older.metadata.fields.retain(|(k, _)| k != "glint_hash");
-            older.accumulator.set_glint(&[]).unwrap();
+            older.accumulator.set_exact(Default::default());
         }
         if let Some(value) = estimators {
             older.metadata.fields.push(("estimators".to_owned(), value.to_owned()));

@@ -46,11 +46,7 @@ impl DenoiseInput {
     /// back.
     pub fn finish(&self, denoised: &mut RgbImage32) {
         bound(self, denoised);
-        for &(p, g) in &self.exact {
-            for (value, glint) in denoised.pixels[p].iter_mut().zip(g) {
-                *value += glint;
-            }
-        }
+        self.exact.add_to(denoised);
     }
 }
 
@@ -66,7 +62,7 @@ mod tests {
             variance,
             albedo: vec![[0.5; 3]; n],
             normal: vec![[0.0, 0.0, 1.0]; n],
-            exact: Vec::new(),
+            exact: Default::default(),
         }
     }
 

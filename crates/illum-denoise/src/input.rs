@@ -1,6 +1,7 @@
 //! What a denoiser reads, gathered from a render.
 
 use illum_image::RgbImage32;
+use illum_pathtrace::accumulator::ExactPart;
 use illum_pathtrace::{Accumulator, Guides};
 
 /// A variance standing for "unknown" (a pixel with fewer than 2 samples): large enough that
@@ -16,30 +17,19 @@ pub struct DenoiseInput {
     pub variance: Vec<[f32; 3]>,
     pub albedo: Vec<[f32; 3]>,
     pub normal: Vec<[f32; 3]>,
-    /// Radiance the renderer solved exactly rather than sampled (the sun's glint: illum-pathtrace's
-    /// `Accumulator::glint`), as (pixel, radiance): left out of `image`, so that no denoiser
-    /// spreads it (a glint pixel can be 10^3 times its neighbours) or bounds it by a noise it
-    /// does not have, and added back by [`Self::finish`].
-    pub exact: Vec<(usize, [f32; 3])>,
+    /// Radiance the renderer solved exactly rather than sampled (the sun's glint: the exact part
+    /// of illum-pathtrace's `ImageParts`), where the image shows it: left out of `image`, so that
+    /// no denoiser spreads it (a glint pixel can be 10^3 times its neighbours) or bounds it by a
+    /// noise it does not have, and added back by [`Self::finish`].
+    pub exact: ExactPart,
 }
 
 impl DenoiseInput {
-    /// The accumulator's mean image and variances, with `guides` of the same size; its glint
-    /// goes to [`Self::exact`].
+    /// The accumulator's image as its parts: the sampled mean and its variances, with `guides`
+    /// of the same size, and the exact part it shows in [`Self::exact`].
     pub fn from_render(accumulator: &Accumulator, guides: &Guides) -> Self {
-        let mut image = accumulator.mean_image();
-        // The glint is in a pixel's mean once the pixel has samples (Accumulator::pixel_mean).
-        let exact: Vec<(usize, [f32; 3])> = accumulator
-            .glint()
-            .iter()
-            .filter(|&&(p, _)| accumulator.pixel_count(p) > 0)
-            .map(|&(p, g)| (p, g.map(|v| v as f32)))
-            .collect();
-        for &(p, g) in &exact {
-            for (value, glint) in image.pixels[p].iter_mut().zip(g) {
-                *value -= glint;
-            }
-        }
+        let parts = accumulator.parts();
+        let image = parts.sampled_mean();
         assert_eq!(
             (image.width, image.height),
             (guides.width, guides.height),
@@ -48,6 +38,7 @@ impl DenoiseInput {
         let variance = (0..image.pixels.len())
             .map(|p| channel_variance(accumulator.pixel_variance_of_mean(p)))
             .collect();
+        let exact = parts.shown_exact();
         DenoiseInput { image, variance, albedo: guides.albedo.clone(), normal: guides.normal.clone(), exact }
     }
 
@@ -76,7 +67,8 @@ mod tests {
     #[test]
     fn the_glint_is_left_out_of_the_filter_and_added_back() {
         let mut accumulator = Accumulator::new(3, 1);
-        accumulator.set_glint(&[(1, [500.0, 600.0, 700.0])]).expect("a pixel of the image");
+        accumulator
+            .set_exact(ExactPart::new(&[(1, [500.0, 600.0, 700.0])], 3).expect("a pixel of the image"));
         // Two samples per pixel, values 1 and 3 in every channel: mean 2, variance of the mean 1.
         accumulator.fold(0, &[[4.0, 4.0, 4.0, 2.0]; 3], &[[10.0, 10.0, 10.0, 0.0]; 3]);
         let guides = Guides {
@@ -88,7 +80,7 @@ mod tests {
         };
         let input = DenoiseInput::from_render(&accumulator, &guides);
         assert_eq!(input.image.pixels, vec![[2.0; 3]; 3], "the glint is not in the filter's image");
-        assert_eq!(input.exact, vec![(1, [500.0, 600.0, 700.0])]);
+        assert_eq!(input.exact.entries(), &[(1, [500.0, 600.0, 700.0])]);
         let mut denoised = input.image.clone();
         input.finish(&mut denoised);
         assert_eq!(denoised.pixels, vec![[2.0; 3], [502.0, 602.0, 702.0], [2.0; 3]]);

@@ -79,7 +79,7 @@ mod tests {
             variance,
             albedo,
             normal: vec![[0.0, 0.0, 1.0]; n],
-            exact: Vec::new(),
+            exact: Default::default(),
         }
     }
 

@@ -11,12 +11,14 @@
 
 mod estimates;
 mod host_memory;
+mod parts;
 mod radiance_scale;
 
 pub use host_memory::{
     ALIGNED_COPY_BYTES_PER_PIXEL, RENDER_HOST_BYTES_PER_PIXEL, STATISTICS_BYTES_PER_PIXEL,
     available_host_memory, check_host_memory,
 };
+pub use parts::{ExactPart, ImageParts};
 pub use radiance_scale::{UNSCALED_RADIANCE_LIMIT, radiance_exponent};
 
 use crate::replicates::Replicates;
@@ -37,10 +39,10 @@ pub struct Accumulator {
     /// Per-replicate sums of a low-discrepancy render (see `replicates.rs`): when present, the
     /// variance of each pixel's mean comes from their spread instead of s^2 / n.
     replicates: Option<Replicates>,
-    /// The sun's glint (`glint.rs`): (pixel, radiance) sorted by pixel, added to those pixels'
-    /// means and to nothing else. A point mass solved exactly has no variance: the statistics,
-    /// the error estimate and the checkpoints' layers hold the samples alone.
-    glint: Vec<(usize, [f64; 3])>,
+    /// The image's exact part (the sun's glint, `glint.rs`), joined to the sampled means by
+    /// [`ImageParts`] alone. Solved exactly, it has no variance: the statistics, the error
+    /// estimate and the checkpoints' statistics layers hold the samples alone.
+    exact: ExactPart,
     /// False for samples whose error the statistics cannot estimate (the low-discrepancy
     /// sequence without replicates: its per-sample spread overstates it, by 2 to 5 times):
     /// the estimate is then infinite, and the front ends say "not estimated".
@@ -114,7 +116,7 @@ impl Accumulator {
             dropped,
             sum_scale: 1.0,
             replicates: None,
-            glint: Vec::new(),
+            exact: ExactPart::default(),
             estimates_error: true,
         })
     }
@@ -299,28 +301,24 @@ impl Accumulator {
         self.count[pixel]
     }
 
-    /// Sets the glint added to the pixels' means: (pixel, radiance), at most once per pixel
-    /// Refused for a pixel outside the image.
-    pub fn set_glint(&mut self, glint: &[(usize, [f64; 3])]) -> Result<(), String> {
-        if let Some(&(p, _)) = glint.iter().find(|g| g.0 >= self.count.len()) {
-            return Err(format!("glint pixel {p} is outside the {} x {} image", self.width, self.height));
-        }
-        let mut sorted = glint.to_vec();
-        sorted.sort_by_key(|g| g.0);
-        // Two entries for one pixel add.
-        self.glint = Vec::with_capacity(sorted.len());
-        for (p, v) in sorted {
-            match self.glint.last_mut() {
-                Some((q, w)) if *q == p => (0..3).for_each(|c| w[c] += v[c]),
-                _ => self.glint.push((p, v)),
-            }
-        }
-        Ok(())
+    /// Sets the image's exact part (see [`ImageParts`]); it stays across [`Self::reset`].
+    pub fn set_exact(&mut self, exact: ExactPart) {
+        debug_assert!(
+            exact.entries().last().is_none_or(|e| e.0 < self.count.len()),
+            "built for another size"
+        );
+        self.exact = exact;
     }
 
-    /// The glint added to the means: (pixel, radiance), sorted by pixel.
-    pub fn glint(&self) -> &[(usize, [f64; 3])] {
-        &self.glint
+    /// The image's exact part, all of it (see [`ImageParts::shown_exact`] for the part an image
+    /// shows).
+    pub fn exact(&self) -> &ExactPart {
+        &self.exact
+    }
+
+    /// The image as its sampled and exact parts: the view every consumer takes.
+    pub fn parts(&self) -> ImageParts<'_> {
+        ImageParts::of(self)
     }
 
     /// Starts over (same size and radiance scale). Zeroes the statistics in place: fresh

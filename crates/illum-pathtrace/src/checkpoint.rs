@@ -64,7 +64,7 @@ pub const ERROR_LAYER: &str = "illum.error";
 pub const ALIGNED_LAYER: &str = "illum.statistics.aligned";
 
 /// Name of the layer with the exact part of the image, the sun's glint (`glint.rs`,
-/// [`Accumulator::glint`]): per pixel its f64 radiance, each as two 32-bit words; written only
+/// [`Accumulator::exact`]): per pixel its f64 radiance, each as two 32-bit words; written only
 /// when the image has one. The mean image adds it to the samples' means.
 pub const GLINT_LAYER: &str = "illum.exact";
 

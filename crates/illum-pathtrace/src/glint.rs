@@ -15,8 +15,9 @@
 //! with E the sun's irradiance, T the chain's throughput (mirror reflectances, Fresnel F for a
 //! glass reflection and 1 - F for a refraction, no eta^2: the chain starts and ends outside the
 //! glass, as the path tracer's camera paths) and g the gnomonic coordinates of d about w (at the
-//! root their area element is the solid angle's). The pixel containing s* gains I, once, in the
-//! accumulator's mean ([`crate::Accumulator::set_glint`]): no noise, the error estimate unchanged.
+//! root their area element is the solid angle's). The pixel containing s* gains I, once, as the
+//! image's exact part ([`crate::Accumulator::set_exact`], joined to the means by
+//! [`crate::ImageParts`]): no noise, the error estimate unchanged.
 //!
 //! The solve: the camera rays through dense seeds (over each specular sphere's disc on the film,
 //! finer toward its rim, and a grid over the film when a flat face is specular) are followed

@@ -36,7 +36,7 @@ mod shaders;
 pub mod specialise;
 mod tracer;
 
-pub use accumulator::Accumulator;
+pub use accumulator::{Accumulator, ExactPart, ImageParts};
 pub use allocation::SampleAllocation;
 pub use batch::{CHUNK_SAMPLES, SLOT_BYTES};
 pub use display_sum::{DISPLAY_PIXEL_BYTES, DISPLAY_SUM_SHADER};

@@ -44,7 +44,7 @@ pub fn scene_hash(scene: &Scene) -> String {
 ///   pixel, e.g. `8x8 blocks, 16 to 4096 spp, mean 1023.5, pilot 16 spp`; `spp` then counts the
 ///   sample indices reached, which each block has taken up to its own count;
 /// - `adapter`: the GPU adapter's name; `source`: the program that wrote the file;
-/// - `glint_hash`: [`glint_hash`], the digest of the image's exact part, which the layer
+/// - `glint_hash`: [`crate::accumulator::ExactPart::digest`], the digest of the image's exact part, which the layer
 ///   [`crate::checkpoint::GLINT_LAYER`] holds;
 /// - `scene_hash`: [`scene_hash`]; `sample_start`: the first sample
 ///   index (see [`PathTracer::set_sample_offset`]); `partial_pass_spp` and `partial_pass_rows`:
@@ -66,7 +66,7 @@ pub fn exr_metadata(
         ("sequence", tracer.options().sequence_label()),
         ("caustics", Estimators::of(scene).caustics_label().to_owned()),
         (ESTIMATORS, Estimators::of(scene).key()),
-        ("glint_hash", glint_hash(accumulator.glint())),
+        ("glint_hash", accumulator.exact().digest()),
         ("estimated_relative_error", accumulator.estimated_relative_error().to_string()),
         ("dropped_samples", accumulator.dropped_samples().to_string()),
         ("stopped_by", stopped_by.map_or("none", StopReason::name).to_owned()),
@@ -88,45 +88,5 @@ pub fn exr_metadata(
         scene: scene.name.clone(),
         render_seconds,
         fields: fields.into_iter().map(|(k, v)| (k.to_owned(), v)).collect(),
-    }
-}
-
-/// A digest of the glint an image's means hold (`illum.glint_hash`), whose values are in the
-/// file's [`crate::checkpoint::GLINT_LAYER`]: `none`, or 16 hex digits of the 64-bit FNV-1a of
-/// each entry's pixel index and radiances (little-endian bits). Parts to be merged must agree on
-/// it, from their headers alone.
-pub fn glint_hash(glint: &[(usize, [f64; 3])]) -> String {
-    if glint.is_empty() {
-        return "none".to_owned();
-    }
-    let mut bytes = Vec::with_capacity(glint.len() * 32);
-    for (p, v) in glint {
-        bytes.extend((*p as u64).to_le_bytes());
-        for c in v {
-            bytes.extend(c.to_bits().to_le_bytes());
-        }
-    }
-    format!("{:016x}", illum_scene::fnv1a_64(&bytes))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The digest tells glints apart by any bit of any entry, and says `none` for no glint.
-    #[test]
-    fn the_glint_hash_changes_with_every_entry() {
-        let glint = vec![(3, [0.1, 1.0 / 3.0, 2e-300]), (40, [6.02e23, 0.0, 1.0])];
-        let hash = glint_hash(&glint);
-        assert_eq!(hash.len(), 16);
-        assert_eq!(glint_hash(&glint.clone()), hash, "stable");
-        assert_eq!(glint_hash(&[]), "none");
-        let mut moved = glint.clone();
-        moved[1].0 = 41;
-        let mut nudged = glint.clone();
-        nudged[0].1[2] = f64::from_bits(nudged[0].1[2].to_bits() + 1);
-        for other in [moved, nudged, glint[..1].to_vec()] {
-            assert_ne!(glint_hash(&other), hash, "{other:?}");
-        }
     }
 }

@@ -17,6 +17,7 @@
 use illum_gpu::{GpuContext, wgpu};
 use illum_scene::Scene;
 
+use crate::accumulator::ExactPart;
 use crate::batch::{self, CHUNK_SAMPLES, Layers, SLOT_BYTES};
 use crate::display_sum::DisplaySum;
 use crate::gpu_scene::GpuScene;
@@ -65,11 +66,14 @@ pub struct PathTracer {
     accumulation: Accumulation,
 }
 
-/// Solves `scene`'s glint (`glint.rs`) into the accumulator's means: none without a delta sun
-/// and the caustic's estimators.
+/// Solves `scene`'s glint (`glint.rs`) as the accumulator's exact part: none without a delta
+/// sun and the caustic's estimators.
 fn set_glint(accumulator: &mut Accumulator, scene: &Scene) {
     let values = crate::glint::pixel_values(&crate::glint::solve(scene));
-    accumulator.set_glint(&values).expect("the solve keeps only pixels inside the image");
+    let pixels = accumulator.width as usize * accumulator.height as usize;
+    accumulator.set_exact(
+        ExactPart::new(&values, pixels).expect("the solve keeps only finite values inside the image"),
+    );
 }
 
 impl PathTracer {

@@ -15,9 +15,10 @@ struct Params {
 // Per pixel: rgb = running sum of finite samples, w = their count.
 @group(0) @binding(0) var<storage, read> display_sum: array<vec4<f32>>;
 @group(0) @binding(1) var<uniform> params: Params;
-// Per pixel: rgb = the sun's glint the path tracer solves on the host and adds to the pixel's
-// mean once it has a sample (crates/illum-pathtrace/src/glint.rs), in the display sum's units.
-@group(0) @binding(2) var<storage, read> glint: array<vec4<f32>>;
+// Per pixel: rgb = the image's exact part (the sun's glint, solved on the host), which joins the
+// pixel's mean once it has a sample (crates/illum-pathtrace/src/accumulator/parts.rs), in the
+// display sum's units.
+@group(0) @binding(2) var<storage, read> exact: array<vec4<f32>>;
 
 // One triangle covering the whole target: vertices (-1,-1), (3,-1), (-1,3).
 @vertex
@@ -33,8 +34,9 @@ fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
     let pixel = vec2<u32>(position.xy);
     let index = pixel.y * params.width + pixel.x;
     let sum = display_sum[index];
-    // The mean of the finite samples and the glint; a pixel without any (w = 0, rgb = 0) shows black.
-    let mean = sum.rgb / max(sum.w, 1.0) + select(vec3<f32>(0.0), glint[index].rgb, sum.w > 0.0);
+    // The mean of the finite samples and the exact part; a pixel without any (w = 0, rgb = 0)
+    // shows black.
+    let mean = sum.rgb / max(sum.w, 1.0) + select(vec3<f32>(0.0), exact[index].rgb, sum.w > 0.0);
     let encoded = pow(clamp(mean * params.scale, vec3<f32>(0.0), vec3<f32>(1.0)), vec3<f32>(1.0 / 2.2));
     return vec4<f32>(encoded, 1.0);
 }

@@ -8,14 +8,15 @@
 //! the display exposure and the PNG output's gamma 2.2, and writes an 8-bit texture registered
 //! with egui_wgpu. The image never goes through the CPU on its way to the screen; nothing is
 //! uploaded or read back. The pass re-runs when new samples arrived or the exposure changed.
-//! Saving still uses the f64 mean (`Accumulator::mean_image`). The sun's glint, which the tracer
-//! solves on the host and adds to the f64 means only, comes as a second per-pixel buffer, written
-//! when the glint changes (a camera move), and is added to every pixel with a sample.
+//! Saving still uses the f64 mean (`Accumulator::mean_image`). The image's exact part (the sun's
+//! glint, `illum_pathtrace::ImageParts`), which the tracer solves on the host and which the display
+//! sum's samples do not hold, comes as a second per-pixel buffer, written when it changes (a
+//! camera move), and the shader adds it to every pixel with a sample, as `ImageParts` does.
 
 use bytemuck::{Pod, Zeroable};
 use egui_wgpu::wgpu;
 use illum_gpu::GpuContext;
-use illum_pathtrace::DISPLAY_PIXEL_BYTES;
+use illum_pathtrace::{DISPLAY_PIXEL_BYTES, ExactPart};
 
 const SHADER: &str = include_str!("../shaders/display.wgsl");
 /// The texture egui shows: 8-bit, already gamma-encoded (egui's convention for native textures).
@@ -52,13 +53,10 @@ pub struct Display {
     source: Option<(wgpu::Buffer, wgpu::BindGroup)>,
     /// The egui texture id of the target, once registered.
     texture_id: Option<egui::TextureId>,
-    /// The glint per pixel (`vec4<f32>` each, rgb in the display sum's units), and the glint
-    /// and scale it was written from.
-    glint: Option<(wgpu::Buffer, Glint, f32)>,
+    /// The exact part per pixel (`vec4<f32>` each, rgb in the display sum's units), and the
+    /// exact part and scale it was written from.
+    exact: Option<(wgpu::Buffer, ExactPart, f32)>,
 }
-
-/// The tracer's glint: (pixel, radiance), as `Accumulator::glint` gives it.
-type Glint = Vec<(usize, [f64; 3])>;
 
 impl Display {
     pub fn new(gpu: &GpuContext) -> Self {
@@ -129,13 +127,13 @@ impl Display {
             "viewer display params",
             std::mem::size_of::<Params>() as u64,
         );
-        Display { pipeline, layout, params, target: None, source: None, texture_id: None, glint: None }
+        Display { pipeline, layout, params, target: None, source: None, texture_id: None, exact: None }
     }
 
     /// Draws the `width` x `height` image held by `display_sum` (the path tracer's display-sum
     /// buffer, on the same device) with `exposure` stops into the shown texture, (re)creating
-    /// and (re)registering that texture with egui when its size changed. `glint`: the tracer's
-    /// glint (`Accumulator::glint`, radiance), multiplied by `glint_scale` into the display
+    /// and (re)registering that texture with egui when its size changed. `exact`: the image's
+    /// exact part (`Accumulator::exact`, radiance), multiplied by `exact_scale` into the display
     /// sum's units. Returns its egui id.
     #[allow(clippy::too_many_arguments)]
     pub fn show(
@@ -145,8 +143,8 @@ impl Display {
         display_sum: &wgpu::Buffer,
         [width, height]: [u32; 2],
         exposure: f32,
-        glint: &[(usize, [f64; 3])],
-        glint_scale: f32,
+        exact: &ExactPart,
+        exact_scale: f32,
     ) -> Option<egui::TextureId> {
         let needed = u64::from(width) * u64::from(height) * DISPLAY_PIXEL_BYTES;
         if width == 0 || height == 0 || display_sum.size() < needed {
@@ -161,20 +159,16 @@ impl Display {
             self.target = Some(Self::create_target(gpu, width, height));
         }
         let pixels = u64::from(width) * u64::from(height);
-        let glint_changed = self.glint.as_ref().is_none_or(|(buffer, shown, scale)| {
-            buffer.size() != pixels * 16 || shown != glint || *scale != glint_scale
+        let exact_changed = self.exact.as_ref().is_none_or(|(buffer, shown, scale)| {
+            buffer.size() != pixels * 16 || shown != exact || *scale != exact_scale
         });
-        if glint_changed {
-            let mut values = vec![[0f32; 4]; pixels as usize];
-            for &(p, v) in glint.iter().filter(|g| (g.0 as u64) < pixels) {
-                values[p] =
-                    [v[0] as f32 * glint_scale, v[1] as f32 * glint_scale, v[2] as f32 * glint_scale, 0.0];
-            }
-            let reuse = self.glint.take().filter(|(buffer, _, _)| buffer.size() == pixels * 16);
+        if exact_changed {
+            let values = exact.dense(pixels as usize, exact_scale);
+            let reuse = self.exact.take().filter(|(buffer, _, _)| buffer.size() == pixels * 16);
             let buffer = reuse.map_or_else(
                 || {
                     gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                        label: Some("viewer display glint"),
+                        label: Some("viewer display exact part"),
                         size: pixels * 16,
                         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
                         mapped_at_creation: false,
@@ -183,19 +177,19 @@ impl Display {
                 |(buffer, _, _)| buffer,
             );
             gpu.queue.write_buffer(&buffer, 0, bytemuck::cast_slice(&values));
-            self.glint = Some((buffer, glint.to_vec(), glint_scale));
-            // The bind group names the glint's buffer, which may be a new one.
+            self.exact = Some((buffer, exact.clone(), exact_scale));
+            // The bind group names the exact part's buffer, which may be a new one.
             self.source = None;
         }
         if self.source.as_ref().is_none_or(|(bound, _)| bound != display_sum) {
-            let glint_buffer = &self.glint.as_ref().expect("written above").0;
+            let exact_buffer = &self.exact.as_ref().expect("written above").0;
             let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("viewer display"),
                 layout: &self.layout,
                 entries: &[
                     wgpu::BindGroupEntry { binding: 0, resource: display_sum.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 1, resource: self.params.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 2, resource: glint_buffer.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 2, resource: exact_buffer.as_entire_binding() },
                 ],
             });
             self.source = Some((display_sum.clone(), bind_group));

@@ -42,7 +42,7 @@ fn synthetic(width: u32, height: u32, seed: u64) -> DenoiseInput {
             });
         }
     }
-    DenoiseInput { image, variance, albedo, normal, exact: Vec::new() }
+    DenoiseInput { image, variance, albedo, normal, exact: Default::default() }
 }
 
 /// Tolerance: f32 against f64 through five iterations of sums of 25 weighted terms and exps,

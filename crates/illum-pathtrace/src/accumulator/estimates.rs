@@ -1,5 +1,5 @@
-//! What the statistics estimate: each pixel's mean (with the glint solved into it), the variance
-//! of that mean, and the image's relative error.
+//! What the statistics estimate: each pixel's mean (with the image's exact part, `parts.rs`), the
+//! variance of that mean, and the image's relative error.
 
 use illum_image::RgbImage32;
 // The epsilon of `illum_image::metrics::rel_mse` itself, so that the estimated and the measured
@@ -9,15 +9,9 @@ use illum_image::metrics::REL_MSE_EPSILON;
 use super::Accumulator;
 
 impl Accumulator {
-    /// The pixel's estimate: the mean of its samples, plus the glint solved into it once it has
-    /// a sample (0 before).
+    /// The pixel's estimate ([`super::ImageParts::pixel_mean`]).
     pub fn pixel_mean(&self, pixel: usize) -> [f64; 3] {
-        let n = self.count[pixel];
-        let mean = self.sum[pixel].map(|s| s / n.max(1) as f64);
-        match self.glint.binary_search_by_key(&pixel, |g| g.0) {
-            Ok(i) if n > 0 => [0, 1, 2].map(|c| mean[c] + self.glint[i].1[c]),
-            _ => mean,
-        }
+        self.parts().pixel_mean(pixel)
     }
 
     /// Variance of the pixel's mean, per channel: from the spread of the replicate means when
@@ -48,23 +42,14 @@ impl Accumulator {
         out
     }
 
+    /// The whole image ([`super::ImageParts::mean`]).
     pub fn mean_image(&self) -> RgbImage32 {
-        let mut image = RgbImage32::new(self.width, self.height);
-        for (p, px) in image.pixels.iter_mut().enumerate() {
-            // A mean beyond f32's range (a light near f32::MAX seen through noise) is stored as
-            // f32::MAX rather than infinity: EXR and PNG hold f32 at most.
-            *px = self.pixel_mean(p).map(|v| v.min(f32::MAX as f64) as f32);
-        }
-        image
+        self.parts().mean()
     }
 
     /// Per-pixel variance of the mean, as an image (for Z-tests and the viewer's error view).
     pub fn variance_image(&self) -> RgbImage32 {
-        let mut image = RgbImage32::new(self.width, self.height);
-        for (p, px) in image.pixels.iter_mut().enumerate() {
-            *px = self.pixel_variance_of_mean(p).map(|v| v as f32);
-        }
-        image
+        self.parts().variance()
     }
 
     /// The relMSE of the current mean image against the (unknown) converged image, estimated from
@@ -105,25 +90,6 @@ impl Accumulator {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn the_glint_adds_to_the_mean_of_sampled_pixels_and_to_nothing_else() {
-        let mut acc = Accumulator::new(3, 1);
-        acc.set_glint(&[(1, [5.0, 6.0, 7.0]), (1, [1.0, 1.0, 1.0])]).unwrap();
-        assert_eq!(acc.glint(), &[(1, [6.0, 7.0, 8.0])], "entries of one pixel add");
-        assert_eq!(acc.pixel_mean(1), [0.0; 3], "no sample yet: no glint");
-        let sums = [[2.0, 2.0, 2.0, 2.0]; 3];
-        let squares = [[2.0, 2.0, 2.0, 0.0]; 3];
-        acc.fold(0, &sums, &squares);
-        assert_eq!(acc.pixel_mean(0), [1.0; 3]);
-        assert_eq!(acc.pixel_mean(1), [7.0, 8.0, 9.0]);
-        assert_eq!(acc.pixel_variance_of_mean(1), acc.pixel_variance_of_mean(0), "no variance of its own");
-        assert_eq!(acc.pixel_sum(1), [2.0; 3], "the statistics hold the samples alone");
-        acc.reset();
-        acc.fold(0, &sums, &squares);
-        assert_eq!(acc.pixel_mean(1), [7.0, 8.0, 9.0], "kept across a reset");
-        assert!(acc.set_glint(&[(3, [1.0; 3])]).unwrap_err().contains("outside the 3 x 1 image"));
-    }
 
     #[test]
     fn single_sample_has_unknown_variance() {

@@ -9,6 +9,7 @@ use illum_image::U32Layer;
 
 use super::STATISTICS_LAYER;
 use crate::Accumulator;
+use crate::accumulator::ExactPart;
 use crate::replicates::{REPLICATES, Replicates};
 
 const CHANNELS: [&str; 3] = ["R", "G", "B"];
@@ -56,16 +57,16 @@ pub(super) fn layer_named(name: &str, accumulator: &Accumulator) -> U32Layer {
     U32Layer { name: name.to_owned(), channels }
 }
 
-/// The [`super::GLINT_LAYER`] of `accumulator`: its glint per pixel (zero elsewhere), or `None`
-/// when it has none.
-pub(super) fn glint_layer(accumulator: &Accumulator) -> Option<U32Layer> {
-    let glint = accumulator.glint();
-    if glint.is_empty() {
+/// The [`super::GLINT_LAYER`] of `accumulator`: its exact part per pixel (zero elsewhere), or
+/// `None` when it has none.
+pub(super) fn exact_layer(accumulator: &Accumulator) -> Option<U32Layer> {
+    let exact = accumulator.exact().entries();
+    if exact.is_empty() {
         return None;
     }
     let pixels = accumulator.width as usize * accumulator.height as usize;
     let mut values = vec![[0.0f64; 3]; pixels];
-    for &(p, v) in glint {
+    for &(p, v) in exact {
         values[p] = v;
     }
     let mut channels = Vec::new();
@@ -77,13 +78,15 @@ pub(super) fn glint_layer(accumulator: &Accumulator) -> Option<U32Layer> {
     Some(U32Layer { name: super::GLINT_LAYER.to_owned(), channels })
 }
 
-/// Reads [`glint_layer`] back: (pixel, radiance) for every pixel with a glint, in pixel order.
-pub(super) fn glint_from_layer(layer: &U32Layer, pixels: usize) -> Result<Vec<(usize, [f64; 3])>, String> {
+/// Reads [`exact_layer`] back: the exact part of an image of `pixels` pixels.
+pub(super) fn exact_from_layer(layer: &U32Layer, pixels: usize) -> Result<ExactPart, String> {
     let values = f64_channels(layer, "", pixels)?;
     if values.iter().flatten().any(|v| !v.is_finite()) {
         return Err(format!("layer {} holds a NaN or infinite radiance: the file is corrupt", layer.name));
     }
-    Ok(values.into_iter().enumerate().filter(|(_, v)| v.iter().any(|&c| c != 0.0)).collect())
+    let entries: Vec<_> =
+        values.into_iter().enumerate().filter(|(_, v)| v.iter().any(|&c| c != 0.0)).collect();
+    ExactPart::new(&entries, pixels)
 }
 
 /// The channel `name` of `layer`, which must hold `pixels` values.
@@ -200,25 +203,26 @@ pub(super) fn check_counts(
 mod tests {
     use super::*;
 
-    /// The glint's layer gives back every entry bit for bit, and none for an image without one.
+    /// The exact part's layer gives back every entry bit for bit, and none for an image without
+    /// one.
     #[test]
-    fn the_glint_layer_reads_back_exactly() {
+    fn the_exact_layer_reads_back_exactly() {
         let mut accumulator = Accumulator::new(8, 6);
-        assert!(glint_layer(&accumulator).is_none());
+        assert!(exact_layer(&accumulator).is_none());
         let glint = vec![(3, [0.1, 1.0 / 3.0, 2e-300]), (40, [6.02e23, 0.0, 1.0]), (47, [5e-324, 0.0, 0.0])];
-        accumulator.set_glint(&glint).unwrap();
-        let layer = glint_layer(&accumulator).expect("a glint");
+        accumulator.set_exact(ExactPart::new(&glint, 48).unwrap());
+        let layer = exact_layer(&accumulator).expect("a glint");
         assert_eq!(layer.name, super::super::GLINT_LAYER);
-        let back = glint_from_layer(&layer, 48).unwrap();
-        assert_eq!(back.len(), glint.len());
-        for ((p, v), (q, w)) in back.iter().zip(&glint) {
+        let back = exact_from_layer(&layer, 48).unwrap();
+        assert_eq!(back.entries().len(), glint.len());
+        for ((p, v), (q, w)) in back.entries().iter().zip(&glint) {
             assert_eq!((p, v.map(f64::to_bits)), (q, w.map(f64::to_bits)));
         }
         let mut corrupt = layer.clone();
         corrupt.channels[0].1[3] = 0x7ff0_0000; // R.hi of pixel 3: infinity
         corrupt.channels[1].1[3] = 0;
-        assert!(glint_from_layer(&corrupt, 48).unwrap_err().contains("NaN or infinite"));
-        assert!(glint_from_layer(&layer, 49).unwrap_err().contains("49 pixels"));
+        assert!(exact_from_layer(&corrupt, 48).unwrap_err().contains("NaN or infinite"));
+        assert!(exact_from_layer(&layer, 49).unwrap_err().contains("49 pixels"));
     }
 
     #[test]

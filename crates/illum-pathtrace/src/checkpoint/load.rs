@@ -6,8 +6,9 @@ use std::path::Path;
 use illum_image::{ExrMetadata, load_u32_layers};
 
 use super::error::with_causes;
-use super::layers::{check_counts, glint_from_layer, statistics_from_layer};
+use super::layers::{check_counts, exact_from_layer, statistics_from_layer};
 use super::{ALIGNED_LAYER, Checkpoint, CheckpointError, CheckpointHeader, GLINT_LAYER, STATISTICS_LAYER};
+use crate::accumulator::ExactPart;
 
 /// A whole number in illum metadata field `field` of the file at `path`.
 fn whole_number<T: std::str::FromStr>(
@@ -139,12 +140,12 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint, CheckpointError> {
             crate::TracerOptions { sequence, replicates, ..Default::default() }.estimates_error()
         });
     accumulator.set_estimates_error(estimates_error);
-    let glint = match glint {
-        Some(layer) => glint_from_layer(&layer, width as usize * height as usize)
+    let exact = match glint {
+        Some(layer) => exact_from_layer(&layer, width as usize * height as usize)
             .map_err(|e| corrupt(format!("layer {GLINT_LAYER}: {e}")))?,
-        None => Vec::new(),
+        None => ExactPart::default(),
     };
-    accumulator.set_glint(&glint).map_err(corrupt)?;
+    accumulator.set_exact(exact.clone());
     check_counts(&accumulator, spp_done, partial_pass).map_err(corrupt)?;
     let aligned_prefix = match statistics_of(aligned)? {
         Some(prefix) => {
@@ -162,7 +163,7 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint, CheckpointError> {
             }
             check_counts(&prefix, spp, None).map_err(|e| corrupt(format!("layer {ALIGNED_LAYER}: {e}")))?;
             let mut prefix = prefix;
-            prefix.set_glint(&glint).map_err(corrupt)?;
+            prefix.set_exact(exact);
             prefix.set_estimates_error(estimates_error);
             Some((prefix, spp))
         }

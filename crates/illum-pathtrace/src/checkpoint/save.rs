@@ -7,7 +7,7 @@ use std::path::Path;
 use illum_image::{ExrMetadata, F32Layer, U32Layer, save_exr_with_float_layers};
 
 use super::error::with_causes;
-use super::layers::{glint_layer, layer_named, statistics_layer};
+use super::layers::{exact_layer, layer_named, statistics_layer};
 use super::{ALIGNED_LAYER, Checkpoint, CheckpointError, ERROR_LAYER};
 use crate::{Accumulator, PathTracer};
 
@@ -33,7 +33,7 @@ fn checkpoint_layers(
         layers.push(layer_named(ALIGNED_LAYER, prefix));
     }
     // The prefix holds the same glint: the image's, stored once.
-    layers.extend(glint_layer(accumulator));
+    layers.extend(exact_layer(accumulator));
     (metadata, layers)
 }
 

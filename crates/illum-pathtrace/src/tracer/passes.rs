@@ -60,15 +60,14 @@ impl PathTracer {
         accumulator.set_radiance_exponent(radiance_exponent);
         accumulator.set_estimates_error(self.pipeline.options.estimates_error());
         // The glint belongs to this tracer's scene (solved when it was built), not to the file.
-        let glint = self.accumulation.accumulator.glint().to_vec();
-        let set_glint = |a: &mut Accumulator| a.set_glint(&glint).expect("same resolution, checked above");
-        set_glint(&mut accumulator);
+        let exact = self.accumulation.accumulator.exact().clone();
+        accumulator.set_exact(exact.clone());
         self.reset();
         self.accumulation.accumulator = accumulator;
         self.accumulation.spp_done = spp_done;
         self.accumulation.aligned_prefix = aligned_prefix.map(|(mut prefix, spp)| {
             prefix.set_radiance_exponent(radiance_exponent);
-            set_glint(&mut prefix);
+            prefix.set_exact(exact);
             (prefix, spp)
         });
         if let Some((spp, next_row)) = partial_pass.filter(|&(_, rows)| rows > 0 && rows < camera.height) {

@@ -74,17 +74,17 @@ impl PathTraceMode {
             let camera = tracer.scene().camera;
             if let Some(display_sum) = tracer.display_sum_buffer() {
                 let mut renderer = render_state.renderer.write();
-                // The glint is radiance; the display sum holds radiance / display_scale.
-                let glint_scale = 1.0 / tracer.display_scale();
-                let glint = tracer.accumulator().glint();
+                // The exact part is radiance; the display sum holds radiance / display_scale.
+                let exact_scale = 1.0 / tracer.display_scale();
+                let exact = tracer.accumulator().exact();
                 display.show(
                     gpu,
                     &mut renderer,
                     display_sum,
                     [camera.width, camera.height],
                     stops,
-                    glint,
-                    glint_scale,
+                    exact,
+                    exact_scale,
                 );
             }
             self.shown_exposure = self.settings.exposure;
