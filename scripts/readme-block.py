@@ -109,6 +109,8 @@ EFFICIENCY_ROWS = [
     ("without the caustic's estimators", "64 spp, bounces 8"),
     ("light tracer and photon gather", "64 spp, bounces 8, caustic estimator"),
     ("manifold NEE", "64 spp, bounces 8, manifold NEE"),
+    ("manifold NEE, low-discrepancy (one randomisation)",
+     "64 spp, bounces 8, manifold NEE, low-discrepancy (one randomisation)"),
 ]
 
 
@@ -130,7 +132,8 @@ def caustic_efficiency(rows, truth):
     out.append(f"*Measured {host()} by the ladder (`cargo run --release --example ladder`, Whitted scene, "
                f"320 x 180, bounces 8, the median of 3 renders of 64 spp from nothing).{truth} Without the "
                "caustic's estimators the image is biased (the glass's shadow at half its light): its "
-               "efficiency is not comparable.*")
+               "efficiency is not comparable. The last row is `render --caustic-method manifold --sequence "
+               "low-discrepancy --replicates off`: it reads no error estimate.*")
     replace_block("caustic-efficiency", "\n".join(out), os.path.join(ROOT, "docs", "performance.md"))
 
 

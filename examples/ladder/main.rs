@@ -15,7 +15,8 @@
 //! - the path tracer at each spp of `--spp-list` (the scene's bounces), without and (where the
 //!   scene has a caustic: a sun and a mirror or glass) with the caustic estimator (the light
 //!   tracer) and, where the scene is solvable sphere by sphere, with manifold next-event
-//!   estimation in its place (docs/caustics-manifold.md), and at each
+//!   estimation in its place (docs/caustics-manifold.md), the latter once more with the
+//!   low-discrepancy sequence, one randomisation (no error estimate), and at each
 //!   bounce count of `--bounce-list` with `--bounce-spp` samples (on the Cornell box this is
 //!   the classic "Whitted against path tracing, bounce by bounce");
 //! - the path tracer at each spp of `--denoise-spp-list` followed by the à-trous denoiser, and
@@ -228,7 +229,8 @@ fn run(args: Args) -> anyhow::Result<()> {
         let solvable = Estimators::of(&manifold).manifold();
         variants.push((light_tracer, Series::PathTraceCaustics));
         if solvable {
-            variants.push((manifold, Series::PathTraceManifold));
+            variants.push((manifold.clone(), Series::PathTraceManifold));
+            variants.push((manifold, Series::PathTraceManifoldLowDiscrepancy));
         }
     }
     for (variant, series) in &variants {

@@ -172,6 +172,11 @@ pub(crate) fn write_outputs(
             ("path tracer, more spp", Series::PathTraceSpp, Style::Joined),
             ("path tracer + caustic estimator, more spp", Series::PathTraceCaustics, Style::Joined),
             ("path tracer + manifold NEE, more spp", Series::PathTraceManifold, Style::Joined),
+            (
+                "path tracer + manifold NEE, low-discrepancy (one randomisation), more spp",
+                Series::PathTraceManifoldLowDiscrepancy,
+                Style::Joined,
+            ),
             ("path tracer, more bounces", Series::PathTraceBounces, Style::Joined),
             ("path tracer + à-trous, more spp", Series::PathTraceAtrous, Style::Joined),
             ("path tracer + OIDN, more spp", Series::PathTraceOidn, Style::Joined),

@@ -4,7 +4,7 @@ use std::time::Instant;
 
 use illum::gpu::GpuContext;
 use illum::image::{RgbImage32, median};
-use illum::pathtrace::{Estimators, PathTracer};
+use illum::pathtrace::{Estimators, PathTracer, Sequence, TracerOptions};
 use illum::raster::{Options, RasterRenderer, RasterScene};
 use illum::scene::{Bounces, Effects, Look, Scene};
 use illum::whitted::WhittedTracer;
@@ -23,6 +23,9 @@ pub(crate) enum Series {
     /// The same with manifold next-event estimation in the light tracer's place
     /// (`caustic_method = "manifold"`).
     PathTraceManifold,
+    /// The same with the low-discrepancy sequence, one randomisation (`render --sequence
+    /// low-discrepancy --replicates off`: no error estimate, less error per sample).
+    PathTraceManifoldLowDiscrepancy,
     /// The path tracer at a fixed spp, more bounces each rung.
     PathTraceBounces,
     /// The path tracer at the scene's bounces followed by the à-trous denoiser, more spp each rung.
@@ -188,13 +191,18 @@ impl PathTraceRow {
         gpu: &GpuContext,
         scene: &Scene,
         (spp, bounces): (u32, Bounces),
+        options: TracerOptions,
     ) -> anyhow::Result<Self> {
         let mut scene = scene.clone();
         scene.pathtrace.bounces = bounces;
         scene.pathtrace.spp = spp;
-        let mut tracer = PathTracer::new(gpu, &scene)?;
+        let mut tracer = PathTracer::with_options(gpu, &scene, options)?;
         tracer.render_to_spp(1)?; // warm-up: the pipeline and buffers
-        let settings = format!("{spp} spp, bounces {bounces}{}", caustic_label(&scene));
+        let sequence = match options.sequence {
+            Sequence::LowDiscrepancy => format!(", {}", options.sequence_label()),
+            _ => String::new(),
+        };
+        let settings = format!("{spp} spp, bounces {bounces}{}{sequence}", caustic_label(&scene));
         Ok(PathTraceRow { tracer, spp, settings, ms: Vec::new() })
     }
 
@@ -227,7 +235,13 @@ pub(crate) fn pathtrace_rung(
     series: Series,
     runs: u32,
 ) -> anyhow::Result<Rung> {
-    let mut row = PathTraceRow::new(gpu, scene, setting)?;
+    let options = match series {
+        Series::PathTraceManifoldLowDiscrepancy => {
+            TracerOptions { sequence: Sequence::LowDiscrepancy, replicates: false, ..TracerOptions::default() }
+        }
+        _ => TracerOptions::default(),
+    };
+    let mut row = PathTraceRow::new(gpu, scene, setting, options)?;
     for _ in 0..runs.max(1) {
         row.run()?;
     }
