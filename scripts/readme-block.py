@@ -245,6 +245,7 @@ def perf_tables(directory):
         ("bench-viewer.txt", "viewer-bench", "performance.md", False),
         ("bench-viewer-whitted.txt", "viewer-bench-whitted", "performance.md", False),
         ("bench-parts.txt", "caustic-parts", "performance-caustics.md", False),
+        ("against.txt", "against-build", "performance.md", False),
         ("bench-glint.txt", "glint-bench", "performance-caustics.md", False),
         ("raster-bench.txt", "raster-bench", "performance-raster.md", True),
         ("vs-mitsuba-meshes.txt", "mitsuba-meshes", "performance-geometry.md", False),

@@ -3,7 +3,8 @@
 # code as it is now, and writes the numbers into the generated blocks of the README (`headline`,
 # `ladder-summary`) and of docs/performance*.md (`bench-quick`, `viewer-bench`,
 # `viewer-bench-whitted`, `caustic-parts`, `caustic-efficiency`, `glint-bench`, `raster-bench`,
-# `largest-mesh`, `mitsuba-meshes`, and with Mitsuba 3 `mitsuba-b2` and `mitsuba-b8`),
+# `largest-mesh`, `mitsuba-meshes`, with Mitsuba 3 `mitsuba-b2` and `mitsuba-b8`, and with
+# --against `against-build`),
 # each with the date and the CPU:
 #
 #     scripts/readme-figures.sh              pictures, the ladder, then the headline figures
@@ -12,6 +13,10 @@
 #                                            Mitsuba 3 from pip, installs Debian's libllvm19 for its
 #                                            LLVM backend where missing, and compares with Mitsuba
 #                                            at bounces 2 and 8 (bench/vs_mitsuba.py)
+#     ... --against=REV                      (with either) builds commit REV's render in a worktree
+#                                            (out/against-REV) and compares the efficiency of this
+#                                            build's caustic estimators with it on the Whitted scene
+#                                            against the ladder's truth (bench --against)
 #
 # Timings are only meaningful on an idle machine (a parallel build doubles them), and absolute
 # ones only on the host named; the headline leads with ratios measured side by side. Needs the
@@ -21,13 +26,19 @@ cd "$(dirname "$0")/.."
 
 headline_only=false
 mitsuba_venv=false
+against=""
 for arg in "$@"; do
     case "$arg" in
         --headline) headline_only=true ;;
         --mitsuba-venv) mitsuba_venv=true ;;
-        *) echo "unknown option $arg (allowed: --headline, --mitsuba-venv)" >&2; exit 2 ;;
+        --against=?*) against="${arg#--against=}" ;;
+        *) echo "unknown option $arg (allowed: --headline, --mitsuba-venv, --against=REV)" >&2; exit 2 ;;
     esac
 done
+if [ -n "$against" ] && ! git rev-parse --verify --quiet "$against^{commit}" > /dev/null; then
+    echo "--against=$against: not a commit of this repository" >&2
+    exit 2
+fi
 
 # The Python that imports Mitsuba 3: the venv's when asked for, else the system's.
 python=python3
@@ -133,6 +144,21 @@ if "$python" -c "import mitsuba" 2> /dev/null; then
 else
     echo "Mitsuba 3 is not installed here: the comparison is not re-measured (see bench/vs_mitsuba.py)" \
         | tee "$out/vs-mitsuba.txt"
+fi
+if [ -n "$against" ]; then
+    # The ladder's truth (light tracer, 16384 spp, bounces unbounded), made by the ladder above
+    # or by an earlier run of this script.
+    truth=$(ls "$out"/ladder/reference-whitted-*.exr 2> /dev/null | head -n 1)
+    if [ -z "$truth" ]; then
+        echo "--against: no ladder truth in $out/ladder (run this script once without --headline)" >&2
+        exit 1
+    fi
+    tree="out/against-$against"
+    [ -d "$tree" ] || git worktree add --detach "$tree" "$against"
+    (cd "$tree" && CARGO_TARGET_DIR="$PWD/target" cargo build --release --example render)
+    { echo "The other build: commit $(git rev-parse --short "$against")'s \`render\`."
+      "$bin/bench" --runs 5 --against "$tree/target/release/examples/render" --truth "$truth" scenes/whitted.toml
+    } | tee "$out/against.txt"
 fi
 python3 scripts/readme-block.py headline "$out"
 python3 scripts/readme-block.py perf-tables "$out"

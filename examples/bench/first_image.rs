@@ -23,7 +23,7 @@ const HEIGHT: u32 = 180;
 const SPP: u32 = 16;
 
 /// The `render` example beside this binary.
-fn render_binary() -> anyhow::Result<PathBuf> {
+pub(crate) fn render_binary() -> anyhow::Result<PathBuf> {
     let exe = std::env::current_exe()?;
     exe.parent()
         .map(|dir| dir.join(format!("render{}", std::env::consts::EXE_SUFFIX)))

@@ -2,7 +2,8 @@
 //!
 //! ```text
 //! cargo run --release --example bench -- [--runs N] [--quick | --large [--compare-readback] | --viewer | --sequences
-//!     | --glint SCENE... | --parts SCENE | --first-image SCENE... | --largest-mesh [SCENE]]
+//!     | --glint SCENE... | --parts SCENE | --first-image SCENE... | --largest-mesh [SCENE]
+//!     | --against OLD_RENDER --truth TRUTH.exr SCENE]
 //! ```
 //! For `scenes/cornell.toml` at each size and bounce count it renders a fixed number of samples
 //! per pixel `runs` times and prints the median of:
@@ -41,6 +42,9 @@
 //! storage binding refuses it, and prints the largest accepted size's triangles, bytes on the
 //! device per triangle, hierarchy build time and one frame's throughput (`largest_mesh.rs`).
 //!
+//! `--against` compares the efficiency of this build's caustic estimators and sequences with
+//! another build's `render`, side by side against one truth (`against.rs`).
+//!
 //! Timings are never asserted in tests; the figures go to docs/performance.md.
 
 use std::path::PathBuf;
@@ -55,6 +59,7 @@ use illum::scene::{Bounces, Scene};
 use illum_cli::SceneArgs;
 use illum_lab::report::load_average;
 
+mod against;
 mod first_image;
 mod largest_mesh;
 mod parts;
@@ -103,6 +108,14 @@ struct Args {
     /// device's storage-binding limit refuses it.
     #[arg(long, conflicts_with_all = ["quick", "large", "viewer", "sequences", "parts", "glint", "first_image"])]
     largest_mesh: bool,
+    /// Only this build's caustic estimators and sequences against another build's `render`
+    /// binary (its scene's caustic estimator), side by side: time, relMSE against --truth,
+    /// efficiency (the scene should have a caustic: scenes/whitted.toml).
+    #[arg(long, requires = "truth", conflicts_with_all = ["quick", "large", "viewer", "sequences", "parts", "glint", "first_image", "largest_mesh"])]
+    against: Option<PathBuf>,
+    /// With --against: the truth every row is compared with (320 x 180, of the same scene).
+    #[arg(long, requires = "against")]
+    truth: Option<PathBuf>,
 }
 
 struct Config {
@@ -126,6 +139,9 @@ fn rays_per_sample(bounces: u32) -> u64 {
 }
 
 fn run(args: Args) -> anyhow::Result<()> {
+    if let (Some(other), Some(truth)) = (&args.against, &args.truth) {
+        return against::bench_against(other, truth, &illum_cli::resolve_scene_path(&args.scene), args.runs);
+    }
     if !args.glint.is_empty() {
         return bench_glint(&args.glint, args.runs);
     }

@@ -236,9 +236,11 @@ pub(crate) fn pathtrace_rung(
     runs: u32,
 ) -> anyhow::Result<Rung> {
     let options = match series {
-        Series::PathTraceManifoldLowDiscrepancy => {
-            TracerOptions { sequence: Sequence::LowDiscrepancy, replicates: false, ..TracerOptions::default() }
-        }
+        Series::PathTraceManifoldLowDiscrepancy => TracerOptions {
+            sequence: Sequence::LowDiscrepancy,
+            replicates: false,
+            ..TracerOptions::default()
+        },
         _ => TracerOptions::default(),
     };
     let mut row = PathTraceRow::new(gpu, scene, setting, options)?;

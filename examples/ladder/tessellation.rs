@@ -123,7 +123,10 @@ pub(crate) fn tessellation_rungs(
     let load = load_average().map_or(String::new(), |l| format!(", load average {l} before them"));
     let mut rows = Vec::new();
     for &geometry in geometries {
-        rows.push((geometry, PathTraceRow::new(gpu, &tessellated(scene, geometry)?, setting, Default::default())?));
+        rows.push((
+            geometry,
+            PathTraceRow::new(gpu, &tessellated(scene, geometry)?, setting, Default::default())?,
+        ));
     }
     for _ in 0..runs.max(1) {
         for (_, row) in &mut rows {
