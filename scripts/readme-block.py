@@ -178,14 +178,40 @@ def headline(directory):
     if single:
         lines.append(f"- **The same sequence without replicates** (`--replicates off`, same runs): **{1 / single:.2f}x** "
                      "the time per sample, with no error estimate.")
-    # The viewer against render (bench --viewer).
-    viewer = read(directory, "bench-viewer.txt")
-    ratio = number_after(viewer, r"viewer / render, median of \d+ runs: ([0-9.]+)")
-    fps = [float(c.split("|")[4]) for c in viewer.splitlines() if re.match(r"\| \d+ \|", c)]
-    if ratio is not None:
-        lines.append(f"- **Viewer, path tracer with the view still** (`bench --viewer`, 960 x 600 window under Xvfb): "
-                     f"**{ratio:.2f}x** `render`'s throughput at the same resolution, measured side by side, "
-                     f"while the window repaints at {statistics.median(fps):.1f} fps.")
+    # The viewer against render (bench --viewer), on the Cornell box and on the Whitted scene.
+    for name, scene in (("bench-viewer.txt", ""), ("bench-viewer-whitted.txt", ", the Whitted scene")):
+        viewer = read(directory, name)
+        ratio = number_after(viewer, r"viewer / render, median of \d+ runs: ([0-9.]+)")
+        fps = [float(c.split("|")[4]) for c in viewer.splitlines() if re.match(r"\| \d+ \|", c)]
+        if ratio is not None:
+            lines.append(f"- **Viewer, path tracer with the view still{scene}** (`bench --viewer`, 960 x 600 window "
+                         f"under Xvfb): **{ratio:.2f}x** `render`'s throughput at the same resolution, measured side "
+                         f"by side, while the window repaints at {statistics.median(fps):.1f} fps.")
+    # The Whitted scene's caustic: its estimators' cost per spp (bench --parts) and, where
+    # measured (--against), their efficiency against an older build's light tracer.
+    parts = read(directory, "bench-parts.txt")
+    cost = {}
+    for size in ("320 x 180", "1280 x 720"):
+        section = parts.split(size, 1)[1] if size in parts else ""
+        for label, key in (("whole render, caustics on", "light"), ("whole render, caustic method manifold", "manifold")):
+            value = number_after(section, rf"\| {label} \| wall \| [0-9.]+ \| ([0-9.]+) \|")
+            if value is not None:
+                cost[(size, key)] = value
+    if len(cost) == 4:
+        lines.append(f"- **Whitted scene, the caustic solved** (manifold next-event estimation, `bench --parts`): "
+                     f"**{cost[('320 x 180', 'manifold')]:.1f}x** the camera paths' cost per spp at 320 x 180 and "
+                     f"**{cost[('1280 x 720', 'manifold')]:.1f}x** at 1280 x 720, against "
+                     f"{cost[('320 x 180', 'light')]:.1f}x and {cost[('1280 x 720', 'light')]:.1f}x with the light "
+                     "tracer and its photon gather.")
+    against = read(directory, "against.txt")
+    commit = re.search(r"commit ([0-9a-f]+)", against)
+    one = number_after(against, r"one randomisation: no error estimate\) \| [^|]+ \| [^|]+ \| [^|]+ \| ([0-9.]+)x")
+    independent = number_after(against, r"this build, manifold NEE \| [^|]+ \| [^|]+ \| [^|]+ \| ([0-9.]+)x")
+    if commit and one is not None and independent is not None:
+        lines.append(f"- **Whitted scene, efficiency against the light tracer of commit {commit.group(1)}** "
+                     "(`bench --against`, 320 x 180, 64 spp, 1 / (relMSE x time), side by side): "
+                     f"**{one:.2f}x** with the solve and one randomisation of the low-discrepancy sequence (no "
+                     f"error estimate), {independent:.2f}x with the solve and independent numbers.")
     # Mitsuba 3 (bench/vs_mitsuba.py), when installed.
     mitsuba = read(directory, "vs-mitsuba.txt")
     # bench/vs_mitsuba.py names illum's first row: "throughput illum (independent) / Mitsuba ...".
