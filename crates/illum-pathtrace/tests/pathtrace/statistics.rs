@@ -129,14 +129,19 @@ fn the_low_discrepancy_sequence_is_less_noisy_on_the_whitted_scene_too() {
     // more dimensions than the Cornell box. One Kronecker sequence of 16 dimensions (R_16) is
     // worse here than independent numbers and fails this test: a sequence must hold beyond the
     // Cornell box's dimensions (docs/accuracy.md, "Independent against low-discrepancy numbers").
-    let overrides = illum_scene::Overrides {
+    check_low_discrepancy("whitted", &small_whitted(21), 4096);
+}
+
+/// The Whitted scene at 64 x 36 and 256 spp, with `seed`.
+fn small_whitted(seed: u32) -> illum_scene::Scene {
+    let overrides = Overrides {
         width: Some(64),
         height: Some(36),
         spp: Some(256),
-        seed: Some(21),
+        seed: Some(seed),
         ..Default::default()
     };
-    check_low_discrepancy("whitted", &common::scene("whitted", overrides), 4096);
+    common::scene("whitted", overrides)
 }
 
 /// The same with the caustic solved (manifold next-event estimation, which draws one number per
@@ -144,14 +149,7 @@ fn the_low_discrepancy_sequence_is_less_noisy_on_the_whitted_scene_too() {
 /// headline quotes with one randomisation of the sequence.
 #[test]
 fn the_low_discrepancy_sequence_is_less_noisy_with_the_caustic_solved() {
-    let overrides = illum_scene::Overrides {
-        width: Some(64),
-        height: Some(36),
-        spp: Some(256),
-        seed: Some(23),
-        ..Default::default()
-    };
-    let mut scene = common::scene("whitted", overrides);
+    let mut scene = small_whitted(23);
     scene.pathtrace.caustic_method = CausticMethod::Manifold;
     assert!(
         illum_pathtrace::Estimators::of(&scene).manifold(),
