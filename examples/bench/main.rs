@@ -35,7 +35,8 @@
 //! Mesa's shader cache cold and warm, beside the path tracer's throughput (`first_image.rs`).
 //!
 //! `--glint` times the host's solve of the sun's glint (`illum::pathtrace::glint::solve`, part of
-//! a render's set-up before its first sample) for each scene given, on all the host's threads:
+//! a render's set-up before its first sample) for each scene given, on all the host's threads,
+//! and the whole set-up (the path tracer's construction with the scene's estimators on):
 //! `scripts/many-spheres.py` writes scenes with many specular spheres for it.
 //!
 //! `--largest-mesh` grows a grid mesh on the scene's floor until the device's limit on one
@@ -94,7 +95,7 @@ struct Args {
     /// With --viewer: frames the window draws before it closes, 10 to 100000.
     #[arg(long, default_value_t = 150, requires = "viewer", value_parser = clap::value_parser!(u32).range(10..=100_000))]
     frames: u32,
-    /// Only the glint's solve on the host, for each of these scenes (see `scripts/many-spheres.py`).
+    /// Only the glint's solve on the host and the set-up before the first sample, for each of these scenes (see `scripts/many-spheres.py`).
     #[arg(long, num_args = 1.., conflicts_with_all = ["quick", "large", "viewer"])]
     glint: Vec<PathBuf>,
     /// Only the time to the first image of each of these scenes, cold and warm (see
@@ -352,13 +353,18 @@ fn bench_raster(gpu: &illum::gpu::GpuContext, runs: u32) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The glint's host solve per scene: its median time over `runs`, on every host thread.
+/// The glint's host solve per scene, and the set-up before the first sample it is part of: their
+/// median times over `runs`, on every host thread.
 fn bench_glint(scenes: &[PathBuf], runs: u32) -> anyhow::Result<()> {
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     let load = load_average().map_or(String::new(), |l| format!(", load average {l} at the start"));
     println!("glint solve on the host, {threads} threads, median of {runs} runs{load}\n");
-    println!("| scene | objects | specular objects | glints | solve s |");
-    println!("|---|---|---|---|---|");
+    println!(
+        "set-up: the path tracer's construction with the scene's estimators on (the glint's solve, the light \
+         tracer's buffers, the pipelines from Mesa's warm shader cache), each run on a new device\n"
+    );
+    println!("| scene | objects | specular objects | glints | solve s | set-up before the first sample s |");
+    println!("|---|---|---|---|---|---|");
     for path in scenes {
         let scene = Scene::load(path)?;
         let specular = scene
@@ -378,11 +384,25 @@ fn bench_glint(scenes: &[PathBuf], runs: u32) -> anyhow::Result<()> {
             glints = illum::pathtrace::glint::solve(&scene).len();
             seconds.push(start.elapsed().as_secs_f64());
         }
+        // A new device each time, so that no pipeline comes from the last run's context; the
+        // first, untimed, fills Mesa's shader cache as any earlier render of the scene would.
+        let mut setup = Vec::new();
+        for run in 0..=runs {
+            let gpu = illum_cli::gpu()?;
+            let start = std::time::Instant::now();
+            let tracer = PathTracer::new(&gpu, &scene)?;
+            let elapsed = start.elapsed().as_secs_f64();
+            drop(tracer);
+            if run > 0 {
+                setup.push(elapsed);
+            }
+        }
         println!(
-            "| {} | {} | {specular} | {glints} | {:.3} |",
+            "| {} | {} | {specular} | {glints} | {:.3} | {:.3} |",
             path.display(),
             scene.objects.len(),
-            median(&mut seconds)
+            median(&mut seconds),
+            median(&mut setup)
         );
     }
     Ok(())

@@ -60,8 +60,11 @@ impl Candidates {
     }
 }
 
-/// `work(offset, share)` over shares of `items`, one per thread, the results in the order of the
-/// shares. With one thread it runs on the caller's.
+/// `work(offset, share)` over consecutive shares of `items`, the results in the order of the
+/// shares, whatever the threads: each of `threads` threads takes the next share left until none
+/// is, so that a share that costs more than others (the chains of one crowded region, the seeds
+/// of a sphere seen through many others) does not leave the other threads idle. With one thread
+/// it runs on the caller's.
 fn in_shares<T: Sync, R: Send>(
     items: &[T],
     threads: usize,
@@ -71,17 +74,32 @@ fn in_shares<T: Sync, R: Send>(
     if threads <= 1 {
         return vec![work(0, items)];
     }
-    let per_share = items.len().div_ceil(threads);
-    let work = &work;
-    std::thread::scope(|scope| {
-        let handles: Vec<_> = items
-            .chunks(per_share)
-            .enumerate()
-            .map(|(k, share)| scope.spawn(move || work(k * per_share, share)))
+    let per_share = items.len().div_ceil(threads * SHARES_PER_THREAD);
+    let shares: Vec<&[T]> = items.chunks(per_share).collect();
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let (work, shares, next) = (&work, &shares, &next);
+    let mut done: Vec<(usize, R)> = std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..threads)
+            .map(|_| {
+                scope.spawn(move || {
+                    let mut results = Vec::new();
+                    loop {
+                        let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        let Some(share) = shares.get(k) else { break };
+                        results.push((k, work(k * per_share, share)));
+                    }
+                    results
+                })
+            })
             .collect();
-        handles.into_iter().map(|h| h.join().expect("a glint solver thread")).collect()
-    })
+        handles.into_iter().flat_map(|h| h.join().expect("a glint solver thread")).collect()
+    });
+    done.sort_by_key(|(k, _)| *k);
+    done.into_iter().map(|(_, r)| r).collect()
 }
+
+/// Shares per thread in [`in_shares`]: enough that the last ones even out the threads' load.
+const SHARES_PER_THREAD: usize = 32;
 
 impl Solver {
     pub(super) fn new(scene: &Scene) -> Self {
@@ -238,9 +256,15 @@ impl Solver {
 
     /// The camera ray through s followed along `chain`: the direction its last ray leaves in,
     /// that direction's derivatives per film coordinate, and the chain's throughput; None where
-    /// the ray does not follow the chain (an event is impossible, another object is nearer, or
-    /// the last ray does not escape) or leaves behind the sun's hemisphere.
-    fn follow(&self, s: [f64; 2], chain: &[Step]) -> Option<(DVec3, [DVec3; 2], [f64; 3])> {
+    /// the ray does not follow the chain's own geometry (it misses one of its objects, or an
+    /// event is impossible) or leaves behind the sun's hemisphere, and, with `Blockers::Checked`,
+    /// where another object is nearer on a segment or the last ray does not escape.
+    fn follow(
+        &self,
+        s: [f64; 2],
+        chain: &[Step],
+        blockers: Blockers,
+    ) -> Option<(DVec3, [DVec3; 2], [f64; 3])> {
         let mut o = self.film.eye;
         let mut d_o = [DVec3::ZERO; 2];
         let (mut d, mut dd) = self.film.direction_and_derivatives(s);
@@ -272,6 +296,9 @@ impl Solver {
         if d.dot(self.w) <= SUN_HEMISPHERE {
             return None;
         }
+        if blockers == Blockers::Ignored {
+            return Some((d, dd, throughput));
+        }
         let blocked =
             segments.iter().any(|&(o, d, own, t, object)| self.bodies.blocked(o, d, own, t, Some(object)));
         (!blocked && !self.bodies.blocked(o, d, own, f64::INFINITY, None)).then_some((d, dd, throughput))
@@ -279,8 +306,8 @@ impl Solver {
 
     /// The gnomonic coordinates g of the leaving direction about w, their Jacobian dg/ds and the
     /// chain's throughput at s (None where [`Self::follow`] has none).
-    fn residual(&self, s: [f64; 2], chain: &[Step]) -> Option<Residual> {
-        let (d, dd, throughput) = self.follow(s, chain)?;
+    fn residual(&self, s: [f64; 2], chain: &[Step], blockers: Blockers) -> Option<Residual> {
+        let (d, dd, throughput) = self.follow(s, chain, blockers)?;
         let z = d.dot(self.w);
         let g = [d.dot(self.t1) / z, d.dot(self.t2) / z];
         // g_r = d . t_r / z, z = d . w: dg_r = (dd . t_r - g_r dd . w) / z.
@@ -295,10 +322,16 @@ impl Solver {
 
     /// Newton's method on the film coordinate for `chain` from `seed`, with the step halved
     /// until it stays on the chain and lowers the residual. The root's glint, if it converges
-    /// onto the film.
+    /// onto the film and nothing blocks the chain there.
+    ///
+    /// The walk follows the chain's own geometry only; other objects are looked for once, at
+    /// the root. A blocker changes whether a root shines, not where it is: checked at every
+    /// trial point, it would cost a walk of the hierarchy per segment (most of the solve's
+    /// time, at the trial points of chains with no root) and would stop a start whose way to an
+    /// unblocked root crosses a shadow.
     fn newton(&self, seed: [f64; 2], chain: &[Step]) -> Option<GlintPoint> {
         let mut s = seed;
-        let mut at = self.residual(s, chain)?;
+        let mut at = self.residual(s, chain, Blockers::Ignored)?;
         for _ in 0..NEWTON_ITERATIONS {
             if norm2(at.g) < 1e-15 {
                 break;
@@ -313,7 +346,7 @@ impl Solver {
             let mut moved = None;
             for _ in 0..LINE_SEARCH_HALVINGS {
                 let next = [s[0] + scale * delta[0], s[1] + scale * delta[1]];
-                if let Some(r) = self.residual(next, chain)
+                if let Some(r) = self.residual(next, chain, Blockers::Ignored)
                     && norm2(r.g) < norm2(g)
                 {
                     moved = Some((next, r));
@@ -333,7 +366,9 @@ impl Solver {
                 break;
             }
         }
-        (norm2(at.g) < ROOT_RESIDUAL).then(|| self.point(s, &at, chain)).flatten()
+        let unblocked_root =
+            norm2(at.g) < ROOT_RESIDUAL && self.follow(s, chain, Blockers::Checked).is_some();
+        unblocked_root.then(|| self.point(s, &at, chain)).flatten()
     }
 
     fn point(&self, s: [f64; 2], at: &Residual, chain: &[Step]) -> Option<GlintPoint> {
@@ -354,6 +389,13 @@ impl Solver {
             chain: chain.to_vec(),
         })
     }
+}
+
+/// Whether [`Solver::follow`] looks for objects other than the chain's own on its segments.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Blockers {
+    Ignored,
+    Checked,
 }
 
 /// A chain's state at a film point: the gnomonic coordinates g of its leaving direction about

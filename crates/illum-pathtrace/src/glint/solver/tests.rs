@@ -47,7 +47,10 @@ mod jacobian {
                 let (mut plus, mut minus) = (s, s);
                 plus[c] += h;
                 minus[c] -= h;
-                let (gp, gm) = (solver.residual(plus, chain)?.g, solver.residual(minus, chain)?.g);
+                let (gp, gm) = (
+                    solver.residual(plus, chain, Blockers::Checked)?.g,
+                    solver.residual(minus, chain, Blockers::Checked)?.g,
+                );
                 for r in 0..2 {
                     j[r][c] = (gp[r] - gm[r]) / (2.0 * h);
                 }
@@ -67,7 +70,7 @@ mod jacobian {
             // At the root and off it, where Newton's method steers.
             for offset in [[0.0, 0.0], [0.37, -0.21], [-1.3, 0.8]] {
                 let s = [p.film[0] + offset[0], p.film[1] + offset[1]];
-                let Some(at) = solver.residual(s, &p.chain) else { continue };
+                let Some(at) = solver.residual(s, &p.chain, Blockers::Checked) else { continue };
                 // Differences err by truncation (large steps near a caustic) or by the residual's
                 // rounding (small steps along long chains): the forward Jacobian must match them
                 // at one of the steps, to 1e-4 of its largest entry.
