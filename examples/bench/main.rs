@@ -360,8 +360,9 @@ fn bench_glint(scenes: &[PathBuf], runs: u32) -> anyhow::Result<()> {
     let load = load_average().map_or(String::new(), |l| format!(", load average {l} at the start"));
     println!("glint solve on the host, {threads} threads, median of {runs} runs{load}\n");
     println!(
-        "set-up: the path tracer's construction with the scene's estimators on (the glint's solve, the light \
-         tracer's buffers, the pipelines from Mesa's warm shader cache), each run on a new device\n"
+        "set-up: the path tracer's construction with the scene's estimators on (the glint's solve started on a \
+         thread of its own, which the first samples do not wait for; the light tracer's buffers; the pipelines \
+         from Mesa's warm shader cache), each run on a new device\n"
     );
     println!("| scene | objects | specular objects | glints | solve s | set-up before the first sample s |");
     println!("|---|---|---|---|---|---|");

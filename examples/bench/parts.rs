@@ -119,8 +119,8 @@ pub fn bench_parts(gpu: &GpuContext, scene: &Scene, runs: u32, load: &str) -> an
         }
         let setup = med(&on, |r| r.setup) - med(&off, |r| r.setup);
         println!(
-            "\nset-up before the first sample with the estimators on (the glint's solve, the light tracer's \
-             buffers and pipelines): {setup:.2} s more than without\n"
+            "\nset-up before the first sample with the estimators on (the glint's solve started beside the first \
+             samples, the light tracer's buffers and pipelines): {setup:.2} s more than without\n"
         );
     }
     Ok(())

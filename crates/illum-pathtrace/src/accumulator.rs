@@ -10,10 +10,13 @@
 //! `accumulator/host_memory.rs`.
 
 mod estimates;
+mod exact_slot;
 mod host_memory;
 mod parts;
 mod radiance_scale;
 
+pub use exact_slot::AtomicFlag;
+use exact_slot::ExactSlot;
 pub use host_memory::{
     ALIGNED_COPY_BYTES_PER_PIXEL, RENDER_HOST_BYTES_PER_PIXEL, STATISTICS_BYTES_PER_PIXEL,
     available_host_memory, check_host_memory,
@@ -41,8 +44,9 @@ pub struct Accumulator {
     replicates: Option<Replicates>,
     /// The image's exact part (the sun's glint, `glint.rs`), joined to the sampled means by
     /// [`ImageParts`] alone. Solved exactly, it has no variance: the statistics, the error
-    /// estimate and the checkpoints' statistics layers hold the samples alone.
-    exact: ExactPart,
+    /// estimate and the checkpoints' statistics layers hold the samples alone. It may still be
+    /// being solved (see `exact_slot.rs`): [`Self::exact`] waits for it.
+    exact: ExactSlot,
     /// False for samples whose error the statistics cannot estimate (the low-discrepancy
     /// sequence without replicates: its per-sample spread overstates it, by 2 to 5 times):
     /// the estimate is then infinite, and the front ends say "not estimated".
@@ -116,7 +120,7 @@ impl Accumulator {
             dropped,
             sum_scale: 1.0,
             replicates: None,
-            exact: ExactPart::default(),
+            exact: ExactSlot::Ready(ExactPart::default()),
             estimates_error: true,
         })
     }
@@ -307,13 +311,22 @@ impl Accumulator {
             exact.entries().last().is_none_or(|e| e.0 < self.count.len()),
             "built for another size"
         );
-        self.exact = exact;
+        self.exact = ExactSlot::Ready(exact);
+    }
+
+    /// Sets the image's exact part to what `solve` returns, solved on a thread of its own
+    /// (inline where there are none), so that sampling starts without waiting for it: the first
+    /// reader of [`Self::exact`] (or of an image) waits instead. `solve` may stop early once its
+    /// flag is set: the part was replaced or dropped unread. It must return a part of this
+    /// accumulator's size.
+    pub fn set_exact_solving(&mut self, solve: impl FnOnce(&AtomicFlag) -> ExactPart + Send + 'static) {
+        self.exact = ExactSlot::solving(solve);
     }
 
     /// The image's exact part, all of it (see [`ImageParts::shown_exact`] for the part an image
-    /// shows).
+    /// shows), once solved: the first call after [`Self::set_exact_solving`] waits for the solve.
     pub fn exact(&self) -> &ExactPart {
-        &self.exact
+        self.exact.get()
     }
 
     /// The image as its sampled and exact parts: the view every consumer takes.

@@ -90,10 +90,16 @@ pub fn glint_active(scene: &Scene) -> bool {
 
 /// The glints of `scene` (empty when [`glint_active`] is false), sorted by pixel.
 pub fn solve(scene: &Scene) -> Vec<GlintPoint> {
+    solve_unless(scene, &|| false)
+}
+
+/// As [`solve`], but skips what is left once `stop` returns true (checked between shares of
+/// the work): the result is then incomplete, for a caller that will not read it.
+pub fn solve_unless(scene: &Scene, stop: &(dyn Fn() -> bool + Sync)) -> Vec<GlintPoint> {
     if !glint_active(scene) {
         return Vec::new();
     }
-    Solver::new(scene).solve()
+    Solver::new(scene).solve(stop)
 }
 
 /// The glints summed per pixel: (pixel, radiance), sorted by pixel.

@@ -66,14 +66,22 @@ pub struct PathTracer {
     accumulation: Accumulation,
 }
 
-/// Solves `scene`'s glint (`glint.rs`) as the accumulator's exact part: none without a delta
-/// sun and the caustic's estimators.
+/// Solves `scene`'s glint (`glint.rs`) as the accumulator's exact part, on a thread of its own
+/// while the first samples are traced (the host's solve would otherwise be most of the set-up
+/// before the first sample in a scene of many specular objects): none without a delta sun and
+/// the caustic's estimators.
 fn set_glint(accumulator: &mut Accumulator, scene: &Scene) {
-    let values = crate::glint::pixel_values(&crate::glint::solve(scene));
+    if !crate::glint::glint_active(scene) {
+        accumulator.set_exact(ExactPart::default());
+        return;
+    }
     let pixels = accumulator.width as usize * accumulator.height as usize;
-    accumulator.set_exact(
-        ExactPart::new(&values, pixels).expect("the solve keeps only finite values inside the image"),
-    );
+    let scene = scene.clone();
+    accumulator.set_exact_solving(move |unread| {
+        let points = crate::glint::solve_unless(&scene, &|| unread.is_set());
+        let values = crate::glint::pixel_values(&points);
+        ExactPart::new(&values, pixels).expect("the solve keeps only finite values inside the image")
+    });
 }
 
 impl PathTracer {

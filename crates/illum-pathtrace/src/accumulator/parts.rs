@@ -113,7 +113,7 @@ impl<'a> ImageParts<'a> {
     /// The pixel's estimate: its sampled mean, plus its exact part once it has a sample.
     pub fn pixel_mean(&self, pixel: usize) -> [f64; 3] {
         let mean = self.pixel_sampled_mean(pixel);
-        match self.accumulator.exact.at(pixel) {
+        match self.accumulator.exact().at(pixel) {
             Some(exact) if self.accumulator.pixel_count(pixel) > 0 => [0, 1, 2].map(|c| mean[c] + exact[c]),
             _ => mean,
         }
@@ -145,7 +145,8 @@ impl<'a> ImageParts<'a> {
     /// The exact part where the image shows it (pixels with a sample): what goes back onto an
     /// image made from [`Self::sampled_mean`], such as a filter's output.
     pub fn shown_exact(&self) -> ExactPart {
-        let entries = self.accumulator.exact.entries.iter().filter(|e| self.accumulator.pixel_count(e.0) > 0);
+        let entries =
+            self.accumulator.exact().entries.iter().filter(|e| self.accumulator.pixel_count(e.0) > 0);
         ExactPart { entries: entries.copied().collect() }
     }
 

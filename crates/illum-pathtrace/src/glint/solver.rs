@@ -122,12 +122,17 @@ impl Solver {
         }
     }
 
-    pub(super) fn solve(&self) -> Vec<GlintPoint> {
+    /// The glints, sorted by pixel; once `stop` returns true (checked between shares of the
+    /// work) the rest is skipped and the result is incomplete, for a caller that will not read it.
+    pub(super) fn solve(&self, stop: &(dyn Fn() -> bool + Sync)) -> Vec<GlintPoint> {
         let seeds = self.seeds();
         // Each share of the seeds is explored apart; their candidates merge into one map. A
         // chain's starts are its best by (leaving direction, seed index), whatever the shares.
         let shares = in_shares(&seeds, self.threads, |offset, share| {
             let mut found = Candidates::default();
+            if stop() {
+                return found;
+            }
             let mut chain = Vec::new();
             for (i, &seed) in share.iter().enumerate() {
                 let d = self.film.direction(seed);
@@ -151,6 +156,9 @@ impl Solver {
         chains.sort_by(|a, b| a.0.cmp(&b.0));
         // Newton from each chain's starts, the chains shared out the same way.
         let mut points: Vec<GlintPoint> = in_shares(&chains, self.threads, |_, share| {
+            if stop() {
+                return Vec::new();
+            }
             share.iter().flat_map(|(c, s)| self.roots(c, s)).collect::<Vec<_>>()
         })
         .into_iter()

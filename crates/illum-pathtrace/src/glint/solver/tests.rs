@@ -27,11 +27,11 @@ mod threads {
         // count says.
         let mut solver = Solver::new(&whitted_row());
         solver.threads = 1;
-        let one = solver.solve();
+        let one = solver.solve(&|| false);
         assert!(one.len() > 40, "{} glints", one.len());
         for threads in [2, 3, 7] {
             solver.threads = threads;
-            assert_eq!(solver.solve(), one, "{threads} threads against 1");
+            assert_eq!(solver.solve(&|| false), one, "{threads} threads against 1");
         }
     }
 }
@@ -64,7 +64,7 @@ mod jacobian {
     #[test]
     fn the_forward_jacobian_matches_differences_along_every_kind_of_chain() {
         let solver = Solver::new(&super::threads::whitted_row());
-        let points = solver.solve();
+        let points = solver.solve(&|| false);
         let (mut checked, mut refractions, mut long) = (0, 0, 0);
         for p in &points {
             // At the root and off it, where Newton's method steers.
