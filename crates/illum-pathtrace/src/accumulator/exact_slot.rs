@@ -23,21 +23,31 @@ pub(super) enum ExactSlot {
 impl ExactSlot {
     /// `solve` on a thread of its own; it should return early once its flag is set (the slot was
     /// dropped or replaced unread: a viewer's camera moved again), with any part, which is then
-    /// never read. Where there are no threads (a web page), `solve` runs here and now.
+    /// never read. Where there are no threads (a web page), or the host will not start one,
+    /// `solve` runs here and now.
     pub(super) fn solving(solve: impl FnOnce(&AtomicFlag) -> ExactPart + Send + 'static) -> Self {
         #[cfg(not(target_arch = "wasm32"))]
         {
             let cancel = Arc::new(AtomicBool::new(false));
-            let flag = AtomicFlag(Arc::clone(&cancel));
-            let thread = std::thread::Builder::new()
-                .name("illum exact part".into())
-                .spawn(move || solve(&flag))
-                .expect("the host can start a thread");
-            ExactSlot::Solving(Arc::new(Solving {
-                part: OnceLock::new(),
-                thread: Mutex::new(Some(thread)),
-                cancel,
-            }))
+            // Shared with the thread, so that the solve is still here if the thread never starts.
+            let job = Arc::new(Mutex::new(Some(solve)));
+            let (thread_job, flag) = (Arc::clone(&job), AtomicFlag(Arc::clone(&cancel)));
+            let started = std::thread::Builder::new().name("illum exact part".into()).spawn(move || {
+                let solve = thread_job.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).take();
+                solve.map(|solve| solve(&flag)).unwrap_or_default()
+            });
+            match started {
+                Ok(thread) => ExactSlot::Solving(Arc::new(Solving {
+                    part: OnceLock::new(),
+                    thread: Mutex::new(Some(thread)),
+                    cancel,
+                })),
+                Err(_) => {
+                    let solve = job.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).take();
+                    let flag = AtomicFlag(cancel);
+                    ExactSlot::Ready(solve.map(|solve| solve(&flag)).unwrap_or_default())
+                }
+            }
         }
         #[cfg(target_arch = "wasm32")]
         {
