@@ -15,8 +15,8 @@ mod host_memory;
 mod parts;
 mod radiance_scale;
 
-pub use exact_slot::AtomicFlag;
 use exact_slot::ExactSlot;
+pub use exact_slot::StopFlag;
 pub use host_memory::{
     ALIGNED_COPY_BYTES_PER_PIXEL, RENDER_HOST_BYTES_PER_PIXEL, STATISTICS_BYTES_PER_PIXEL,
     available_host_memory, check_host_memory,
@@ -319,7 +319,7 @@ impl Accumulator {
     /// reader of [`Self::exact`] (or of an image) waits instead. `solve` may stop early once its
     /// flag is set: the part was replaced or dropped unread. It must return a part of this
     /// accumulator's size.
-    pub fn set_exact_solving(&mut self, solve: impl FnOnce(&AtomicFlag) -> ExactPart + Send + 'static) {
+    pub fn set_exact_solving(&mut self, solve: impl FnOnce(&StopFlag) -> ExactPart + Send + 'static) {
         self.exact = ExactSlot::solving(solve);
     }
 

@@ -25,13 +25,13 @@ impl ExactSlot {
     /// dropped or replaced unread: a viewer's camera moved again), with any part, which is then
     /// never read. Where there are no threads (a web page), or the host will not start one,
     /// `solve` runs here and now.
-    pub(super) fn solving(solve: impl FnOnce(&AtomicFlag) -> ExactPart + Send + 'static) -> Self {
+    pub(super) fn solving(solve: impl FnOnce(&StopFlag) -> ExactPart + Send + 'static) -> Self {
         #[cfg(not(target_arch = "wasm32"))]
         {
             let cancel = Arc::new(AtomicBool::new(false));
             // Shared with the thread, so that the solve is still here if the thread never starts.
             let job = Arc::new(Mutex::new(Some(solve)));
-            let (thread_job, flag) = (Arc::clone(&job), AtomicFlag(Arc::clone(&cancel)));
+            let (thread_job, flag) = (Arc::clone(&job), StopFlag(Arc::clone(&cancel)));
             let started = std::thread::Builder::new().name("illum exact part".into()).spawn(move || {
                 let solve = thread_job.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).take();
                 solve.map(|solve| solve(&flag)).unwrap_or_default()
@@ -44,14 +44,14 @@ impl ExactSlot {
                 })),
                 Err(_) => {
                     let solve = job.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).take();
-                    let flag = AtomicFlag(cancel);
+                    let flag = StopFlag(cancel);
                     ExactSlot::Ready(solve.map(|solve| solve(&flag)).unwrap_or_default())
                 }
             }
         }
         #[cfg(target_arch = "wasm32")]
         {
-            ExactSlot::Ready(solve(&AtomicFlag(Arc::new(AtomicBool::new(false)))))
+            ExactSlot::Ready(solve(&StopFlag(Arc::new(AtomicBool::new(false)))))
         }
     }
 
@@ -66,9 +66,9 @@ impl ExactSlot {
 }
 
 /// Set when nobody will read a solve's result: the solve may stop.
-pub struct AtomicFlag(Arc<AtomicBool>);
+pub struct StopFlag(Arc<AtomicBool>);
 
-impl AtomicFlag {
+impl StopFlag {
     /// Whether the solve's result will never be read.
     pub fn is_set(&self) -> bool {
         self.0.load(Ordering::Relaxed)

@@ -278,13 +278,14 @@ impl Solver {
         let (mut d, mut dd) = self.film.direction_and_derivatives(s);
         let mut own = None;
         let mut throughput = [1.0; 3];
-        // The segments (origin, direction, object left, length, object hit), checked for blockers
-        // once the chain's own geometry holds: Newton's trial points mostly leave a chain by
-        // missing its objects, which costs no walk of the hierarchy.
-        let mut segments = Vec::with_capacity(chain.len());
+        // The segments (origin, direction, object left, length, object hit), kept when blockers
+        // are checked, and checked once the chain's own geometry holds.
+        let mut segments = Vec::with_capacity(if blockers == Blockers::Checked { chain.len() } else { 0 });
         for &(object, event) in chain {
             let hit = self.bodies.hit(object, o, d, own)?;
-            segments.push((o, d, own, hit.t, object));
+            if blockers == Blockers::Checked {
+                segments.push((o, d, own, hit.t, object));
+            }
             // The hit point p = o + t d stays on the surface as s moves: n . dp = 0 gives dt, and
             // the normal turns by the curvature times dp.
             let dp = [0, 1].map(|c| {
