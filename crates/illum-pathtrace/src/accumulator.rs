@@ -329,6 +329,13 @@ impl Accumulator {
         self.exact.get()
     }
 
+    /// Whether [`Self::exact`] would return without waiting for a solve: a front end that must
+    /// not stall (a viewer's frame) shows the samples alone until then, and the error estimate,
+    /// relative to the whole image, is unknown until then ([`crate::Progressive`]).
+    pub fn exact_solved(&self) -> bool {
+        self.exact.is_ready()
+    }
+
     /// The image as its sampled and exact parts: the view every consumer takes.
     pub fn parts(&self) -> ImageParts<'_> {
         ImageParts::of(self)

@@ -124,14 +124,14 @@ impl Progressive {
             return Ok(self.stopped);
         }
         self.start_samples.get_or_insert(tracer.accumulator().total_samples());
-        self.refresh_error(tracer);
+        self.refresh_error(tracer, false);
         self.stopped = self.rules.check(&self.status(tracer));
         if self.stopped.is_none() {
             let report = tracer.render_step(self.rules.spp)?;
             if report.pass_completed {
                 // Tools and tests watch for this line (RUST_LOG=illum_pathtrace=debug).
                 log::debug!("pass complete: {} spp", tracer.spp_done());
-                self.refresh_error(tracer);
+                self.refresh_error(tracer, false);
                 self.stopped = self.rules.check(&self.status(tracer));
             }
         }
@@ -143,16 +143,23 @@ impl Progressive {
             // last complete pass's.
             if tracer.partial_pass().is_some() {
                 self.error_at_spp = u32::MAX;
-                self.refresh_error(tracer);
             }
+            // The image is about to be read: its exact part is waited for now, if still solving.
+            self.refresh_error(tracer, true);
         }
         Ok(self.stopped)
     }
 
-    fn refresh_error(&mut self, tracer: &PathTracer) {
+    /// The error estimate of the image as it stands, recomputed when a pass has completed. While
+    /// the image's exact part is still being solved (a glint, beside the first samples) and
+    /// `wait_for_exact` is false, it stays unknown rather than stall the render: the estimate is
+    /// relative to the whole image, exact part included, and a stop rule on it can wait a step.
+    fn refresh_error(&mut self, tracer: &PathTracer, wait_for_exact: bool) {
         let spp = tracer.spp_done();
         let accumulator = tracer.accumulator();
-        let known = accumulator.estimates_error() && spp >= accumulator.spp_for_error_estimate();
+        let known = accumulator.estimates_error()
+            && spp >= accumulator.spp_for_error_estimate()
+            && (wait_for_exact || accumulator.exact_solved());
         if spp != self.error_at_spp || (self.relative_error.is_none() && known) {
             self.error_at_spp = spp;
             self.relative_error = known.then(|| match &self.error_scope {
@@ -173,13 +180,21 @@ pub fn error_text(error: Option<f64>, needs_spp: u32) -> String {
     }
 }
 
-/// [`error_text`] for the render `accumulator` holds: its spp needed, or, for samples without an
-/// estimate (`TracerOptions::replicates` off), what was left out and why.
+/// [`error_text`] for the render `accumulator` holds: its spp needed, what it waits for (the
+/// exact part's solve, see [`Progressive::step`]), or, for samples without an estimate
+/// (`TracerOptions::replicates` off), what was left out and why.
 pub fn render_error_text(accumulator: &crate::Accumulator, error: Option<f64>) -> String {
-    if accumulator.estimates_error() {
-        error_text(error, accumulator.spp_for_error_estimate())
-    } else {
+    if !accumulator.estimates_error() {
         "none (low-discrepancy without replicates)".to_owned()
+    } else {
+        let needs_spp = accumulator.spp_for_error_estimate();
+        let pixels = u64::from(accumulator.width) * u64::from(accumulator.height);
+        let has_spp = accumulator.total_samples() >= u64::from(needs_spp) * pixels;
+        if error.is_none() && has_spp && !accumulator.exact_solved() {
+            "unknown until the glint is solved".to_owned()
+        } else {
+            error_text(error, needs_spp)
+        }
     }
 }
 
@@ -224,5 +239,40 @@ mod tests {
     fn an_error_is_a_percentage_or_unknown_until_the_spp_it_needs() {
         assert_eq!(super::error_text(Some(0.012_345), 2), "1.23%");
         assert_eq!(super::error_text(None, 8), "unknown until 8 spp");
+    }
+
+    /// While the image's exact part is still being solved, the error estimate (relative to the
+    /// whole image) is unknown, so an error target that any estimate meets does not stop the
+    /// render, and no step waits for the solve (the solve here waits for the test, or 20 s, so a
+    /// step that waited would return only then, with an estimate); once the solve has ended,
+    /// the next step stops.
+    #[test]
+    #[cfg(not(target_arch = "wasm32"))]
+    fn the_error_is_unknown_while_the_exact_part_is_solved_and_no_step_waits_for_it() {
+        use super::*;
+        let scene = illum_scene::testing::shipped_scene("cornell.toml", 8, 8);
+        let mut tracer = PathTracer::new(illum_gpu::testing::gpu(), &scene).expect("a tracer");
+        let (go, told) = std::sync::mpsc::channel::<()>();
+        tracer.accumulator_mut().set_exact_solving(move |_| {
+            let _ = told.recv_timeout(std::time::Duration::from_secs(20));
+            crate::ExactPart::new(&[(0, [0.5; 3])], 64).expect("one pixel")
+        });
+        let rules = StopRules { spp: None, target_error: Some(1e9), time_budget: None };
+        let mut progressive = Progressive::new(rules);
+        let needed = tracer.accumulator().spp_for_error_estimate();
+        while tracer.spp_done() < 4 * needed {
+            assert_eq!(progressive.step(&mut tracer).expect("a step"), None, "no estimate yet");
+        }
+        assert_eq!(progressive.status(&tracer).relative_error, None);
+        let said = render_error_text(tracer.accumulator(), None);
+        assert_eq!(said, "unknown until the glint is solved");
+        go.send(()).expect("the solve listens");
+        let waited = std::time::Instant::now();
+        while !tracer.accumulator().exact_solved() {
+            assert!(waited.elapsed().as_secs() < 60, "the solve never ended");
+            std::thread::sleep(std::time::Duration::from_millis(1));
+        }
+        assert_eq!(progressive.step(&mut tracer).expect("a step"), Some(StopReason::ErrorReached));
+        assert!(progressive.status(&tracer).relative_error.is_some_and(f64::is_finite));
     }
 }

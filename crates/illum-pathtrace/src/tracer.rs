@@ -189,6 +189,12 @@ impl PathTracer {
         &self.accumulation.accumulator
     }
 
+    /// For tests that set the image's exact part themselves (a solve they hold back).
+    #[cfg(test)]
+    pub(crate) fn accumulator_mut(&mut self) -> &mut Accumulator {
+        &mut self.accumulation.accumulator
+    }
+
     /// The traversal and sample sequence this tracer was built with.
     pub fn options(&self) -> TracerOptions {
         self.pipeline.options

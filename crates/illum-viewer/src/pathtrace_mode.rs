@@ -116,6 +116,9 @@ pub struct PathTraceMode {
     stats: Stats,
     /// Total samples at the last statistics update, to tell when new samples arrived.
     shown_samples: u64,
+    /// Whether the image shown holds its exact part (the glint, solved beside the first
+    /// samples: until it is, the samples are shown alone, so that no frame waits for it).
+    shown_exact: bool,
     shown_exposure: f32,
     /// The error view's texture, the heat map in it and the total samples it shows, while the
     /// view is on.
@@ -146,6 +149,7 @@ impl PathTraceMode {
             work: WorkLog { smallest_submission: u64::MAX, ..WorkLog::default() },
             stats: Stats::default(),
             shown_samples: 0,
+            shown_exact: false,
             shown_exposure: 0.0,
             error_texture: None,
             denoise: DenoiseView::default(),
@@ -182,10 +186,13 @@ impl PathTraceMode {
         self.work
     }
 
-    /// Samples per pixel before the error can be estimated (2, or 8 with the low-discrepancy
-    /// sequence).
-    pub(crate) fn error_needs_spp(&self) -> u32 {
-        self.tracer.as_ref().map_or(2, |t| t.accumulator().spp_for_error_estimate())
+    /// The estimated error as the panel and the summary write it (as the command line does).
+    pub(crate) fn error_text(&self) -> String {
+        let error = self.stats.relative_error;
+        match &self.tracer {
+            Some(tracer) => illum_pathtrace::progressive::render_error_text(tracer.accumulator(), error),
+            None => illum_pathtrace::progressive::error_text(error, 2),
+        }
     }
 
     /// Total samples folded into the current accumulation.

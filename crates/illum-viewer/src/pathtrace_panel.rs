@@ -142,10 +142,7 @@ impl PathTraceMode {
             // Both over wall-clock time spent rendering, drawing the window included.
             row("Samples/s (wall)", format!("{:.3} M", st.samples_per_second / 1e6));
             row("Elapsed (wall)", format!("{:.1} s", st.elapsed_seconds));
-            row(
-                "Rel. error",
-                illum_pathtrace::progressive::error_text(st.relative_error, self.error_needs_spp()),
-            );
+            row("Rel. error", self.error_text());
             row("Dropped NaN/Inf", st.dropped_samples.to_string());
             let state = match (self.paused(), self.stop_reason()) {
                 (true, _) => "paused".to_owned(),

@@ -55,6 +55,15 @@ impl ExactSlot {
         }
     }
 
+    /// Whether [`Self::get`] would return at once: the part is known, or its solve has ended.
+    pub(super) fn is_ready(&self) -> bool {
+        match self {
+            ExactSlot::Ready(_) => true,
+            #[cfg(not(target_arch = "wasm32"))]
+            ExactSlot::Solving(solving) => solving.has_ended(),
+        }
+    }
+
     /// The part, waiting for its solve if it is still running.
     pub(super) fn get(&self) -> &ExactPart {
         match self {
@@ -85,6 +94,16 @@ pub(super) struct Solving {
 
 #[cfg(not(target_arch = "wasm32"))]
 impl Solving {
+    fn has_ended(&self) -> bool {
+        self.part.get().is_some()
+            || self
+                .thread
+                .lock()
+                .unwrap_or_else(|poisoned| poisoned.into_inner())
+                .as_ref()
+                .is_none_or(|thread| thread.is_finished())
+    }
+
     fn wait(&self) -> &ExactPart {
         self.part.get_or_init(|| {
             let thread = self.thread.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).take();
@@ -130,8 +149,27 @@ mod tests {
         });
         let copy = slot.clone();
         assert_eq!(slot.get(), &part(2.5));
+        assert!(slot.is_ready() && copy.is_ready(), "read once, known to every clone");
         assert_eq!(copy.get(), &part(2.5));
         assert_eq!(ExactSlot::Ready(part(1.0)).get(), &part(1.0));
+    }
+
+    #[test]
+    #[cfg(not(target_arch = "wasm32"))]
+    fn a_slot_is_ready_once_its_solve_has_ended_and_not_before() {
+        let (go, told) = std::sync::mpsc::channel::<()>();
+        let slot = ExactSlot::solving(move |_| {
+            told.recv().expect("the test says go");
+            part(1.5)
+        });
+        assert!(!slot.is_ready(), "its solve waits for the test");
+        go.send(()).expect("the solve listens");
+        let waited = std::time::Instant::now();
+        while !slot.is_ready() {
+            assert!(waited.elapsed().as_secs() < 60, "the solve never ended");
+            std::thread::sleep(std::time::Duration::from_millis(1));
+        }
+        assert_eq!(slot.get(), &part(1.5));
     }
 
     #[test]

@@ -40,7 +40,7 @@ impl PathTraceMode {
     /// One line of the mode's statistics, as a `--screenshot` run prints them on exit.
     pub fn summary(&self) -> String {
         let st = &self.stats;
-        let error = illum_pathtrace::progressive::error_text(st.relative_error, self.error_needs_spp());
+        let error = self.error_text();
         // The share of the wall time in the path tracer's steps: what the window's drawing
         // leaves it (samples/s over that share is the rate while it runs).
         let stepping =

@@ -3,7 +3,7 @@
 //! error view or the denoised image).
 
 use illum_gpu::GpuContext;
-use illum_pathtrace::PathTracer;
+use illum_pathtrace::{ExactPart, PathTracer};
 use illum_scene::Scene;
 
 use super::{PathTraceMode, WHOLE_PASS_SAMPLES, WorkLog};
@@ -64,19 +64,22 @@ impl PathTraceMode {
             }
         }
         let total = tracer.accumulator().total_samples();
+        let solved = tracer.accumulator().exact_solved();
         let display = self.display.get_or_insert_with(|| Display::new(gpu));
         // The display sum holds radiance scaled by 2^-k for very bright lights (k = 0 below
         // 2^16): k more stops give the radiance back.
         let stops = self.settings.exposure + tracer.display_scale().log2();
-        if total != self.shown_samples {
+        if total != self.shown_samples || solved != self.shown_exact {
             self.shown_samples = total;
+            self.shown_exact = solved;
             self.stats = Self::measure(tracer, &self.progressive);
             let camera = tracer.scene().camera;
             if let Some(display_sum) = tracer.display_sum_buffer() {
                 let mut renderer = render_state.renderer.write();
                 // The exact part is radiance; the display sum holds radiance / display_scale.
                 let exact_scale = 1.0 / tracer.display_scale();
-                let exact = tracer.accumulator().exact();
+                let unsolved = ExactPart::default();
+                let exact = if solved { tracer.accumulator().exact() } else { &unsolved };
                 display.show(
                     gpu,
                     &mut renderer,
@@ -91,6 +94,11 @@ impl PathTraceMode {
         } else if self.shown_exposure != self.settings.exposure {
             display.redraw(gpu, stops);
             self.shown_exposure = self.settings.exposure;
+        }
+        // The error view and the denoiser read the whole image, exact part included: they
+        // wait for its solve to end rather than hold a frame for it.
+        if !solved {
+            return;
         }
         self.refresh_error_view(ctx);
         if self.settings.denoise
