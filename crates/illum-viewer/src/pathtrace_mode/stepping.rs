@@ -63,9 +63,6 @@ impl PathTraceMode {
                 work.passes += u64::from(report.pass_completed);
             }
         }
-        // Every frame, so that the elapsed time beside the steps' seconds is this frame's, even
-        // in frames that fold no samples (a long pass of the light tracer).
-        self.stats = Self::measure(tracer, &self.progressive);
         let total = tracer.accumulator().total_samples();
         let solved = tracer.accumulator().exact_solved();
         let display = self.display.get_or_insert_with(|| Display::new(gpu));
@@ -75,6 +72,7 @@ impl PathTraceMode {
         if total != self.shown_samples || solved != self.shown_exact {
             self.shown_samples = total;
             self.shown_exact = solved;
+            self.stats = Self::measure(tracer, &self.progressive);
             let camera = tracer.scene().camera;
             if let Some(display_sum) = tracer.display_sum_buffer() {
                 let mut renderer = render_state.renderer.write();
