@@ -42,9 +42,14 @@ impl PathTraceMode {
         let st = &self.stats;
         let error = self.error_text();
         // The share of the wall time in the path tracer's steps: what the window's drawing
-        // leaves it (samples/s over that share is the rate while it runs).
-        let stepping =
-            if st.elapsed_seconds > 0.0 { self.work.step_seconds / st.elapsed_seconds } else { 0.0 };
+        // leaves it (samples/s over that share is the rate while it runs). Over the elapsed time
+        // now, as the steps' seconds are counted to now; the statistics' samples/s is measured
+        // at the last fold, where the samples counted and the time agree.
+        let elapsed = self
+            .tracer
+            .as_ref()
+            .map_or(st.elapsed_seconds, |tracer| self.progressive.status(tracer).elapsed.as_secs_f64());
+        let stepping = if elapsed > 0.0 { self.work.step_seconds / elapsed } else { 0.0 };
         let line = format!(
             "pathtrace: {} x {}, spp done {}, samples/s (wall) {:.3} M, elapsed {:.2} s, estimated error {error}, stepping {:.0}% of the wall time",
             st.width,
