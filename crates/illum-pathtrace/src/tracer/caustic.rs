@@ -15,12 +15,13 @@
 //! unchanged. Frames depend only on (seed, particle, frame index), and integer atomics add in
 //! any order to the same result, so the image does not depend on how a render is batched.
 //!
-//! Scheduling: one submission per step, sized like a band to the step's time target
+//! Scheduling: submissions sized like a band to the step's time target
 //! (`caustic/schedule.rs`): whole frames when a frame fits it, else a frame in pieces (ranges of
 //! its particles, then of its gathering pixels), the frame read back and folded with its last.
-//! Natively the tools wait for each submission ([`CausticTracer::prepare_pass`]); a web page
-//! cannot wait, so there each submission's completion or mapping is asked again on later frames
-//! ([`CausticTracer::poll_pass`]). Frames are folded in order whatever the cut, so the pass's
+//! Natively the tools wait for each submission ([`CausticTracer::prepare_pass`]), and a step
+//! goes on with the next frame's pieces, sized to what is left of its target, while much of it
+//! is (whole frames seldom fill it); a web page cannot wait, so there one submission's
+//! completion or mapping is asked again on later frames ([`CausticTracer::poll_pass`]). Frames are folded in order whatever the cut, so the pass's
 //! statistics are the same bit for bit.
 //!
 //! Fixed point: see [`fixed_point`].
