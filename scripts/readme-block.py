@@ -23,8 +23,18 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 README = os.path.join(ROOT, "README.md")
 
 
-def host():
-    """'2026-12-03, Intel(R) Xeon(R) Processor, 2 CPUs, llvmpipe': when and where."""
+def measured_on(paths):
+    """The day (UTC) the outputs at `paths` were written, or the first and last day: a block
+    regenerated from older outputs keeps their date. Today when none exists."""
+    days = sorted({datetime.datetime.fromtimestamp(os.path.getmtime(p), datetime.timezone.utc).date()
+                   for p in paths if os.path.exists(p)})
+    if not days:
+        return datetime.date.today().isoformat()
+    return days[0].isoformat() if len(days) == 1 else f"{days[0].isoformat()} to {days[-1].isoformat()}"
+
+
+def host(paths=()):
+    """'2026-12-03, Intel(R) Xeon(R) Processor, 2 CPUs': when (see measured_on) and where."""
     cpu = "unknown CPU"
     try:
         for line in subprocess.run(["lscpu"], capture_output=True, text=True, check=True).stdout.splitlines():
@@ -33,7 +43,7 @@ def host():
                 break
     except (OSError, subprocess.CalledProcessError):
         pass
-    return f"{datetime.date.today().isoformat()}, {cpu}, {os.cpu_count()} CPUs"
+    return f"{measured_on(paths)}, {cpu}, {os.cpu_count()} CPUs"
 
 
 def replace_block(name, text, page=README):
@@ -95,13 +105,13 @@ def ladder_summary(path):
                       read(os.path.dirname(path), "ladder.md"))
     truth = f" Truth: {truth.group(1)}." if truth else ""
     out.append("")
-    out.append(f"*Measured {host()} (lavapipe unless a GPU is present).{truth} wall ms: the median time per frame; "
+    out.append(f"*Measured {host([path])} (lavapipe unless a GPU is present).{truth} wall ms: the median time per frame; "
                "for the rasterizer a whole frame with its shadow and cube maps made again, for the path tracer "
                "the time to render that many spp from nothing.*")
     # The README and the Whitted scene's theory page show the same rows.
     for page in (README, os.path.join(ROOT, "docs", "theory-whitted.md")):
         replace_block("ladder-summary", "\n".join(out), page)
-    caustic_efficiency(rows, truth)
+    caustic_efficiency(rows, truth, path)
 
 
 # The caustic's estimators side by side at one spp: the efficiency the ladder measured.
@@ -114,7 +124,7 @@ EFFICIENCY_ROWS = [
 ]
 
 
-def caustic_efficiency(rows, truth):
+def caustic_efficiency(rows, truth, path):
     """docs/performance.md: efficiency 1 / (relMSE x seconds) of the path tracer at 64 spp with each
     of the caustic's estimators, against the ladder's truth (made with the light tracer)."""
     found = [(name, rows[("pathtrace", settings)]["all"]) for name, settings in EFFICIENCY_ROWS
@@ -129,7 +139,7 @@ def caustic_efficiency(rows, truth):
         out.append(f"| {name} | {float(whole['wall_ms']):.0f} | {float(whole['rel_mse']):.3e} | {e:.0f} | "
                    f"{e / base:.2f}x |")
     out.append("")
-    out.append(f"*Measured {host()} by the ladder (`cargo run --release --example ladder`, Whitted scene, "
+    out.append(f"*Measured {host([path])} by the ladder (`cargo run --release --example ladder`, Whitted scene, "
                f"320 x 180, bounces 8, the median of 3 renders of 64 spp from nothing).{truth} Without the "
                "caustic's estimators the image is biased (the glass's shadow at half its light): its "
                "efficiency is not comparable.*")
@@ -149,8 +159,15 @@ def number_after(text, pattern):
     return float(m.group(1)) if m else None
 
 
+# The outputs the headline reads (each line from one or two of them).
+HEADLINE_SOURCES = ["bench-quick.txt", "bench-viewer.txt", "bench-viewer-whitted.txt", "bench-parts.txt",
+                    "against.txt", "vs-mitsuba.txt", "vs-mitsuba-b8.txt", "render-default.txt",
+                    "render-1pct.txt", "raster-bench.txt"]
+
+
 def headline(directory):
-    lines = [f"Measured {host()}:", ""]
+    sources = [os.path.join(directory, n) for n in HEADLINE_SOURCES]
+    lines = [f"Measured {host(sources)}:", ""]
     # Throughput of the pipeline generated per scene against the generic one (bench --quick).
     bench = read(directory, "bench-quick.txt")
     rates = {}
@@ -266,7 +283,9 @@ def headline(directory):
 
 def perf_tables(directory):
     """The bench outputs as they were printed, each with the host it was measured on."""
-    measured = f"*Measured {host()}, by `scripts/readme-figures.sh`.*"
+    def measured(name):
+        return f"*Measured {host([os.path.join(directory, name)])}, by `scripts/readme-figures.sh`.*"
+
     docs = os.path.join(ROOT, "docs")
     blocks = [
         ("bench-quick.txt", "bench-quick", "performance.md", False),
@@ -286,13 +305,13 @@ def perf_tables(directory):
         table = re.search(r"^\d+ x \d+, \d+ spp, bounces .*", text, re.M | re.S)
         if table:
             heading, rest = table.group(0).strip().split("\n", 1)
-            text = f"{heading}\n\n{rest}\n\n{measured}"
+            text = f"{heading}\n\n{rest}\n\n{measured(name)}"
             replace_block(block, text, os.path.join(docs, "performance.md"))
     for name, block, page, preformatted in blocks:
         text = read(directory, name).strip()
         if text:
             text = f"```text\n{text}\n```" if preformatted else text
-            replace_block(block, f"{text}\n\n{measured}", os.path.join(docs, page))
+            replace_block(block, f"{text}\n\n{measured(name)}", os.path.join(docs, page))
 
 
 if __name__ == "__main__":
