@@ -35,6 +35,8 @@ pub struct Progressive {
     /// `spp_done` when `relative_error` was computed.
     error_at_spp: u32,
     stopped: Option<StopReason>,
+    /// Whether the stopped render's last error was taken ([`Self::finish`]).
+    finished: bool,
     /// The tracer's samples when this render first stepped (a resumed render starts with some).
     start_samples: Option<u64>,
     /// What the error rule measures: the whole image (the default), a percentile of the pixels
@@ -51,6 +53,7 @@ impl Progressive {
             relative_error: None,
             error_at_spp: 0,
             stopped: None,
+            finished: false,
             start_samples: None,
             error_scope: ErrorScope::Image,
         }
@@ -121,6 +124,8 @@ impl Progressive {
     /// stopped, once it has (and from then on without doing anything).
     pub fn step(&mut self, tracer: &mut PathTracer) -> Result<Option<StopReason>, PathTraceError> {
         if self.stopped.is_some() {
+            // Cancelled between steps, or stepped again after the end.
+            self.finish(tracer);
             return Ok(self.stopped);
         }
         self.start_samples.get_or_insert(tracer.accumulator().total_samples());
@@ -136,18 +141,26 @@ impl Progressive {
             }
         }
         if self.stopped.is_some() {
-            // The render is over: its time stands.
-            self.clock.pause();
-            // Stopped inside a pass, the image holds more samples than its complete passes: its
-            // error is that of the image as written (what a summary and the file report), not the
-            // last complete pass's.
-            if tracer.partial_pass().is_some() {
-                self.error_at_spp = u32::MAX;
-            }
-            // The image is about to be read: its exact part is waited for now, if still solving.
-            self.refresh_error(tracer, true);
+            self.finish(tracer);
         }
         Ok(self.stopped)
+    }
+
+    /// Once, when the render is over: its time stands, and its error is that of the image as
+    /// it will be read.
+    fn finish(&mut self, tracer: &PathTracer) {
+        if std::mem::replace(&mut self.finished, true) {
+            return;
+        }
+        self.clock.pause();
+        // Stopped inside a pass, the image holds more samples than its complete passes: its
+        // error is that of the image as written (what a summary and the file report), not the
+        // last complete pass's.
+        if tracer.partial_pass().is_some() {
+            self.error_at_spp = u32::MAX;
+        }
+        // The image is about to be read: its exact part is waited for now, if still solving.
+        self.refresh_error(tracer, true);
     }
 
     /// The error estimate of the image as it stands, recomputed when a pass has completed. While
