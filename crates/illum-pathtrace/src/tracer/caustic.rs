@@ -21,8 +21,8 @@
 //! Natively the tools wait for each submission ([`CausticTracer::prepare_pass`]), and a step
 //! goes on with the next frame's pieces, sized to what is left of its target, while much of it
 //! is (whole frames seldom fill it); a web page cannot wait, so there one submission's
-//! completion or mapping is asked again on later frames ([`CausticTracer::poll_pass`]). Frames are folded in order whatever the cut, so the pass's
-//! statistics are the same bit for bit.
+//! completion or mapping is asked again on later frames ([`CausticTracer::poll_pass`]). Frames
+//! are folded in order whatever the cut, so the pass's statistics are the same bit for bit.
 //!
 //! Fixed point: see [`fixed_point`].
 //!
