@@ -152,6 +152,23 @@ fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
         }
 #endif
         let v = -ray.d;
+        // The lights at the hit, for every material but an emitter: one call, so that its shadow
+        // rays (the traversal, inlined) are compiled once, not once per kind of material.
+        var shininess = 1.0;
+#ifdef MIRRORS
+        if (m.kind == MATERIAL_MIRROR) {
+            shininess = params.mirror_specular.w;
+        }
+#endif
+#ifdef DIELECTRICS
+        if (m.kind == MATERIAL_DIELECTRIC) {
+            shininess = params.shading.y;
+        }
+#endif
+        var lit = Lit(vec3<f32>(0.0), vec3<f32>(0.0));
+        if (m.kind != MATERIAL_EMITTER) {
+            lit = light_at(s.p, n, ns, s.err, hit.index, v, shininess);
+        }
         // Only the kinds of material the scene has are compiled (shader defs EMITTERS, MIRRORS,
         // DIELECTRICS, CHECKER): Lambertian and checker surfaces take the default case.
         switch m.kind {
@@ -164,7 +181,6 @@ fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
             case MATERIAL_MIRROR: {
                 let c = m.a.rgb;
                 let w = params.shading.x;
-                let lit = light_at(s.p, n, ns, s.err, hit.index, v, params.mirror_specular.w);
                 colour += ray.weight
                     * ((1.0 - w) * c * (params.ambient.rgb + lit.diffuse) + params.mirror_specular.rgb * lit.highlight);
 #ifdef SMOOTH_SHADING
@@ -183,7 +199,6 @@ fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
                 // Entering through the front or leaving.
                 let ior = m.a.w;
                 let eta = select(ior, 1.0 / ior, front);
-                let lit = light_at(s.p, n, ns, s.err, hit.index, v, params.shading.y);
                 colour += ray.weight * lit.highlight;
 #ifdef SMOOTH_SHADING
                 let nd = dielectric_normal(ray.d, n, ns, eta);
@@ -220,7 +235,6 @@ fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
                     c = checker_albedo(obj, m, s.p);
                 }
 #endif
-                let lit = light_at(s.p, n, ns, s.err, hit.index, v, 1.0);
                 colour += ray.weight * c * (params.ambient.rgb + lit.diffuse);
             }
         }
