@@ -297,6 +297,7 @@ def perf_tables(directory):
         ("raster-bench.txt", "raster-bench", "performance-raster.md", True),
         ("vs-mitsuba-meshes.txt", "mitsuba-meshes", "performance-geometry.md", False),
         ("bench-largest-mesh.txt", "largest-mesh", "performance-geometry.md", True),
+        ("bench-first-image.txt", "first-image", "performance-geometry.md", False),
     ]
     # bench/vs_mitsuba.py's tables, from the first table's heading line on (before it: Mitsuba's
     # own log lines); a run without Mitsuba has none and leaves the last measured blocks.
