@@ -1,14 +1,16 @@
 // Whitted's 1980 ray tracer, one invocation per pixel (see crates/illum-whitted/src/lib.rs for
 // the model; crates/illum-oracle/src/whitted.rs is its independent f64 copy).
 //
-// The ray tree is walked depth-first with an explicit stack (WGSL has no recursion): a hit on a
-// mirror or a dielectric pushes its reflected and refracted rays with their weights. Each entry
-// pushes at most two children one level deeper and the walk always takes the top entry, so the
-// stack holds at most one pending sibling per level plus the entry in hand: depth + 2 entries.
-// The pipeline is built for the scene's depth (shader def WHITTED_STACK = depth + 2, at most 66
-// for the deepest recursion the scene format accepts): WGSL zero-fills a function's arrays on
-// every call, so a stack sized for the deepest recursion would cost every shallow render that
-// much more (docs/performance.md, "Levers").
+// The ray tree is walked depth-first with an explicit stack (WGSL has no recursion): the walk
+// goes on with a hit's one child (a mirror's reflection, a total internal reflection) or, of a
+// dielectric's two, with the refracted ray, pushing the reflected one; with none it takes the
+// last ray pushed. A ray pushed at remaining depth k has depth k - 1 and everything pushed in its
+// sibling's subtree is shallower, so the stack's depths fall strictly from bottom to top: at most
+// depth entries. The pipeline is built for the scene's depth (shader def WHITTED_STACK = depth,
+// at least 1, at most 64 for the deepest recursion the scene format accepts): WGSL zero-fills a
+// function's arrays on every call, so a stack sized for the deepest recursion would cost every
+// shallow render that much more, and lavapipe's compile time grows with the stack's size and
+// with the places that write it, so there is one.
 //
 // The traversal (closest_hit, occluded, surface_at, object_at) and the materials (material_at)
 // are illum-rtcore's, generated for the scene with its numbers as constants, as the path
@@ -129,114 +131,122 @@ fn light_at(p: vec3<f32>, n: vec3<f32>, ns: vec3<f32>, err: f32, own: u32, v: ve
 
 fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
     var stack: array<Ray, MAX_STACK>;
-    var top = 1u;
-    stack[0] = Ray(eye, dir, vec3<f32>(1.0), params.counts.y, NO_HIT);
+    var top = 0u;
+    var ray = Ray(eye, dir, vec3<f32>(1.0), params.counts.y, NO_HIT);
     var colour = vec3<f32>(0.0);
-    while (top > 0u) {
-        top -= 1u;
-        let ray = stack[top];
+    loop {
+        // The ray the walk takes next: a child of this hit (the transmitted one of two), or else
+        // the last one pushed.
+        var next = ray;
+        var spawned = false;
         let hit = closest_hit(ray.o, ray.d, ray.own);
         if (hit.index == NO_HIT) {
             colour += ray.weight * params.background.rgb;
-            continue;
-        }
-        let obj = object_at(hit.index);
-        let m = material_at(obj.material);
-        let s = surface_at(obj, ray.o + hit.t * ray.d);
-        let front = dot(s.n, ray.d) < 0.0;
-        let n = select(-s.n, s.n, front);
-        var ns = n;
+        } else {
+            let obj = object_at(hit.index);
+            let m = material_at(obj.material);
+            let s = surface_at(obj, ray.o + hit.t * ray.d);
+            let front = dot(s.n, ray.d) < 0.0;
+            let n = select(-s.n, s.n, front);
+            var ns = n;
 #ifdef SMOOTH_SHADING
-        if (obj.kind == KIND_TRIANGLE) {
-            ns = triangle_shading_normal(obj, s.p, n);
-        }
+            if (obj.kind == KIND_TRIANGLE) {
+                ns = triangle_shading_normal(obj, s.p, n);
+            }
 #endif
-        let v = -ray.d;
-        // The lights at the hit, for every material but an emitter: one call, so that its shadow
-        // rays (the traversal, inlined) are compiled once, not once per kind of material.
-        var shininess = 1.0;
+            let v = -ray.d;
+            // The lights at the hit, for every material but an emitter: one call, so that its shadow
+            // rays (the traversal, inlined) are compiled once, not once per kind of material.
+            var shininess = 1.0;
 #ifdef MIRRORS
-        if (m.kind == MATERIAL_MIRROR) {
-            shininess = params.mirror_specular.w;
-        }
+            if (m.kind == MATERIAL_MIRROR) {
+                shininess = params.mirror_specular.w;
+            }
 #endif
 #ifdef DIELECTRICS
-        if (m.kind == MATERIAL_DIELECTRIC) {
-            shininess = params.shading.y;
-        }
+            if (m.kind == MATERIAL_DIELECTRIC) {
+                shininess = params.shading.y;
+            }
 #endif
-        var lit = Lit(vec3<f32>(0.0), vec3<f32>(0.0));
-        if (m.kind != MATERIAL_EMITTER) {
-            lit = light_at(s.p, n, ns, s.err, hit.index, v, shininess);
-        }
-        // Only the kinds of material the scene has are compiled (shader defs EMITTERS, MIRRORS,
-        // DIELECTRICS, CHECKER): Lambertian and checker surfaces take the default case.
-        switch m.kind {
+            var lit = Lit(vec3<f32>(0.0), vec3<f32>(0.0));
+            if (m.kind != MATERIAL_EMITTER) {
+                lit = light_at(s.p, n, ns, s.err, hit.index, v, shininess);
+            }
+            // Only the kinds of material the scene has are compiled (shader defs EMITTERS, MIRRORS,
+            // DIELECTRICS, CHECKER): Lambertian and checker surfaces take the default case.
+            switch m.kind {
 #ifdef EMITTERS
-            case MATERIAL_EMITTER: {
-                colour += select(vec3<f32>(0.0), ray.weight * m.b.rgb, front);
-            }
+                case MATERIAL_EMITTER: {
+                    colour += select(vec3<f32>(0.0), ray.weight * m.b.rgb, front);
+                }
 #endif
 #ifdef MIRRORS
-            case MATERIAL_MIRROR: {
-                let c = m.a.rgb;
-                let w = params.shading.x;
-                colour += ray.weight
-                    * ((1.0 - w) * c * (params.ambient.rgb + lit.diffuse) + params.mirror_specular.rgb * lit.highlight);
+                case MATERIAL_MIRROR: {
+                    let c = m.a.rgb;
+                    let w = params.shading.x;
+                    colour += ray.weight
+                        * ((1.0 - w) * c * (params.ambient.rgb + lit.diffuse) + params.mirror_specular.rgb * lit.highlight);
 #ifdef SMOOTH_SHADING
-                let nr = mirror_normal(ray.d, n, ns);
+                    let nr = mirror_normal(ray.d, n, ns);
 #else
-                let nr = n;
+                    let nr = n;
 #endif
-                if (ray.depth > 0u && top < MAX_STACK) {
-                    stack[top] = Ray(spawn_point(s.p, n, s.err), reflect(ray.d, nr), ray.weight * w * c, ray.depth - 1u, hit.index);
-                    top += 1u;
+                    if (ray.depth > 0u) {
+                        next = Ray(spawn_point(s.p, n, s.err), reflect(ray.d, nr), ray.weight * w * c, ray.depth - 1u, hit.index);
+                        spawned = true;
+                    }
                 }
-            }
 #endif
 #ifdef DIELECTRICS
-            case MATERIAL_DIELECTRIC: {
-                // Entering through the front or leaving.
-                let ior = m.a.w;
-                let eta = select(ior, 1.0 / ior, front);
-                colour += ray.weight * lit.highlight;
+                case MATERIAL_DIELECTRIC: {
+                    // Entering through the front or leaving.
+                    let ior = m.a.w;
+                    let eta = select(ior, 1.0 / ior, front);
+                    colour += ray.weight * lit.highlight;
 #ifdef SMOOTH_SHADING
-                let nd = dielectric_normal(ray.d, n, ns, eta);
+                    let nd = dielectric_normal(ray.d, n, ns, eta);
 #else
-                let nd = n;
+                    let nd = n;
 #endif
-                if (ray.depth > 0u) {
-                    let cos_i = dot(v, nd);
-                    let k = transmitted_cos2(cos_i, eta);
-                    let reflected = reflect(ray.d, nd);
-                    if (k < 0.0) {
-                        if (top < MAX_STACK) {
-                            stack[top] = Ray(spawn_point(s.p, n, s.err), reflected, ray.weight, ray.depth - 1u, hit.index);
-                            top += 1u;
-                        }
-                    } else {
-                        let cos_t = sqrt(k);
-                        let transmitted = refracted(ray.d, nd, eta, cos_i, cos_t);
-                        let f = fresnel(cos_i, cos_t, eta);
-                        if (top + 1u < MAX_STACK) {
-                            stack[top] = Ray(spawn_point(s.p, n, s.err), reflected, ray.weight * f, ray.depth - 1u, hit.index);
-                            stack[top + 1u] =
-                                Ray(spawn_point(s.p, -n, s.err), transmitted, ray.weight * (1.0 - f), ray.depth - 1u, hit.index);
-                            top += 2u;
+                    if (ray.depth > 0u) {
+                        let cos_i = dot(v, nd);
+                        let k = transmitted_cos2(cos_i, eta);
+                        let reflected = reflect(ray.d, nd);
+                        if (k < 0.0) {
+                            next = Ray(spawn_point(s.p, n, s.err), reflected, ray.weight, ray.depth - 1u, hit.index);
+                            spawned = true;
+                        } else {
+                            let cos_t = sqrt(k);
+                            let transmitted = refracted(ray.d, nd, eta, cos_i, cos_t);
+                            let f = fresnel(cos_i, cos_t, eta);
+                            if (top < MAX_STACK) {
+                                stack[top] = Ray(spawn_point(s.p, n, s.err), reflected, ray.weight * f, ray.depth - 1u, hit.index);
+                                top += 1u;
+                                next = Ray(spawn_point(s.p, -n, s.err), transmitted, ray.weight * (1.0 - f), ray.depth - 1u, hit.index);
+                                spawned = true;
+                            }
                         }
                     }
                 }
-            }
 #endif
-            default: {
-                var c = m.a.rgb;
+                default: {
+                    var c = m.a.rgb;
 #ifdef CHECKER
-                if (m.kind == MATERIAL_CHECKER) {
-                    c = checker_albedo(obj, m, s.p);
-                }
+                    if (m.kind == MATERIAL_CHECKER) {
+                        c = checker_albedo(obj, m, s.p);
+                    }
 #endif
-                colour += ray.weight * c * (params.ambient.rgb + lit.diffuse);
+                    colour += ray.weight * c * (params.ambient.rgb + lit.diffuse);
+                }
             }
+        }
+        if (spawned) {
+            ray = next;
+        } else if (top > 0u) {
+            top -= 1u;
+            ray = stack[top];
+        } else {
+            break;
         }
     }
     return colour;

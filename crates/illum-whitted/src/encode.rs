@@ -35,7 +35,7 @@ pub fn implements(feature: Feature) -> bool {
 /// together with the generated traversal and materials.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Specialisation {
-    /// Entries of the ray stack: depth + 2 (see the shader's header).
+    /// Entries of the ray stack: the depth, at least 1 (see the shader's header).
     pub stack: u32,
     pub checker: bool,
     pub mirrors: bool,
@@ -53,7 +53,7 @@ impl Specialisation {
     pub fn new(scene: &Scene) -> Self {
         let features = scene.features();
         Specialisation {
-            stack: scene.whitted.depth + 2,
+            stack: scene.whitted.depth.max(1),
             checker: features.contains(Feature::Checker),
             mirrors: features.contains(Feature::Mirror),
             dielectrics: features.contains(Feature::Dielectric),

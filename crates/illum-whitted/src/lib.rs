@@ -11,7 +11,8 @@
 //! deterministic. An area light (the Cornell box's) is treated as a point light at its centre
 //! with the quad's power pattern (radiance x area x cos theta); a sun of finite size is refused.
 //!
-//! The ray tree is walked with an explicit stack of depth + 2 entries (`shaders/whitted.wgsl`).
+//! The ray tree is walked with an explicit stack of as many entries as its depth
+//! (`shaders/whitted.wgsl`).
 //! The objects, materials, camera, optics and traversal are illum-rtcore's, shared with the
 //! path tracer: one copy.
 //! `illum_oracle::whitted` is the independent f64 copy of the algorithm the tests compare with.
