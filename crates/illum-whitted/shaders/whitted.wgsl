@@ -155,8 +155,8 @@ fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
             }
 #endif
             let v = -ray.d;
-            // The lights at the hit, for every material but an emitter: one call, so that its shadow
-            // rays (the traversal, inlined) are compiled once, not once per kind of material.
+            // The lights at the hit, for every material but an emitter: one call, so that its
+            // shadow rays (the traversal, inlined) are compiled once, not once per material.
             var shininess = 1.0;
 #ifdef MIRRORS
             if (m.kind == MATERIAL_MIRROR) {
@@ -172,8 +172,8 @@ fn trace(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
             if (m.kind != MATERIAL_EMITTER) {
                 lit = light_at(s.p, n, ns, s.err, hit.index, v, shininess);
             }
-            // Only the kinds of material the scene has are compiled (shader defs EMITTERS, MIRRORS,
-            // DIELECTRICS, CHECKER): Lambertian and checker surfaces take the default case.
+            // Only the kinds of material the scene has are compiled (shader defs EMITTERS,
+            // MIRRORS, DIELECTRICS, CHECKER): Lambertian and checker surfaces take the default.
             switch m.kind {
 #ifdef EMITTERS
                 case MATERIAL_EMITTER: {
